@@ -1,0 +1,109 @@
+"""The element contract shared by built-in and user elements (the analogue of Abaqus UEL).
+
+An *element family* is a batch of elements of one kind.  It holds, as arrays,
+
+* ``nodes``: (n_el, n_nodes_per_el) int array of node *indices* (0-based rows of
+  the model's node table; the Analysis converts user labels to indices);
+* its parameters (any arrays it likes);
+* ``n_state``: the number of state variables per element (0 if none).
+
+and implements one method, :meth:`ElementFamily.evaluate`, which computes for all
+its elements at once, from the current nodal configuration and the *committed*
+state (the state at the start of the increment):
+
+* ``f``: (n_el, 6 * n_nodes_per_el) internal force vectors, ordered per node as
+  [fx, fy, fz, mx, my, mz] (N, N m), global axes;
+* ``k``: (n_el, 6 * n_nodes_per_el, 6 * n_nodes_per_el) tangent stiffness, the
+  derivative of ``f`` with respect to nodal translations (m) and nodal *spatial
+  spin* increments (rad): a rotation increment dw updates a nodal rotation matrix
+  as R <- expm(skew(dw)) R;
+* ``state``: (n_el, n_state) trial state variables;
+* ``output``: a dict of per-element output arrays (section forces, status, ...)
+  with shape (n_el, ...), written to the results at converged increments.
+
+The analysis owns commit and rollback: the trial state returned at the converged
+iteration is copied into the committed state; on a cut-back it is simply
+discarded.  An element must therefore never mutate its committed state.
+
+Kernels that run per element per iteration are numba-compiled functions taking
+plain arrays; ``evaluate`` only gathers arrays and calls them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+# Node DOF layout used everywhere: 3 translations then 3 rotations.
+DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
+TRANSLATIONS = (0, 1, 2)
+ROTATIONS = (3, 4, 5)
+
+
+@dataclass
+class IncrementContext:
+    """What an element may need to know about the increment being solved.
+
+    time : step time at the end of the increment, s (pseudo-time for static steps).
+    dtime : increment of step time, s.
+    total_time : analysis time at the end of the increment, s.
+    x_committed : (n_nodes, 3) nodal positions at the start of the increment, m.
+    R_committed : (n_nodes, 3, 3) nodal rotation matrices at the start of the increment.
+    step_name : name of the current step.
+    """
+
+    time: float = 0.0
+    dtime: float = 0.0
+    total_time: float = 0.0
+    x_committed: np.ndarray | None = None
+    R_committed: np.ndarray | None = None
+    step_name: str = ""
+
+
+@dataclass
+class ElementResponse:
+    """What :meth:`ElementFamily.evaluate` returns (see module docstring)."""
+
+    f: np.ndarray
+    k: np.ndarray
+    state: np.ndarray
+    output: dict = field(default_factory=dict)
+    # Strain energy per element, J (used for stabilisation energy ratios and reports).
+    energy: np.ndarray | None = None
+
+
+class ElementFamily:
+    """Base class of element families.  Subclasses set ``name``, ``nodes``, ``n_state``,
+    ``active_dofs`` and implement :meth:`evaluate`.
+
+    ``active_dofs`` is a tuple of the node DOFs (0..5) the family gives stiffness to:
+    (0, 1, 2) for trusses and cables, (0, ..., 5) for beams.  The analysis only numbers
+    a node's rotational DOFs if some family activates them; entries of ``f``/``k`` on
+    inactive DOFs are ignored.
+    """
+
+    name: str = "element"
+    nodes: np.ndarray
+    n_state: int = 0
+    active_dofs: tuple = (0, 1, 2, 3, 4, 5)
+    # True when ``k`` is always symmetric (lets the analysis use a symmetric solver).
+    symmetric: bool = False
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.nodes.shape[0])
+
+    def initial_state(self) -> np.ndarray:
+        """Committed state before the first increment, (n_el, n_state)."""
+        return np.zeros((self.n_elements, self.n_state))
+
+    def evaluate(self, x, R, state, ctx: IncrementContext) -> ElementResponse:  # pragma: no cover
+        """Internal forces, tangent and trial state for every element of the family.
+
+        x : (n_nodes, 3) current nodal positions, m (all model nodes; gather with ``self.nodes``).
+        R : (n_nodes, 3, 3) current nodal rotation matrices (total rotation from the initial triad).
+        state : (n_el, n_state) committed state (do not modify).
+        ctx : :class:`IncrementContext`.
+        """
+        raise NotImplementedError

@@ -1,0 +1,25 @@
+"""Exceptions raised by femast.
+
+Every error names the offending item (node label, element, DOF, file line...)
+and says what to do about it.  Catch :class:`FemastError` to catch them all.
+"""
+
+
+class FemastError(Exception):
+    """Base class of every error femast raises on purpose."""
+
+
+class ModelError(FemastError, ValueError):
+    """The model definition is invalid (unknown node, zero-length element, ...)."""
+
+
+class SingularModelError(FemastError):
+    """The tangent stiffness is singular: the model has a mechanism or rigid-body mode."""
+
+
+class ConvergenceError(FemastError):
+    """The solver gave up on a step after cutting the increment back to its minimum."""
+
+
+class DataFileError(FemastError, ValueError):
+    """A measured-data file is malformed."""
