@@ -1,0 +1,427 @@
+"""The static analysis: numbering, assembly, steps, increments, Newton, commit/rollback.
+
+``Analysis(model, out).run()`` walks the model's steps.  For each increment a control
+strategy sets the load level, Newton iterates (with the exact tangent), and when the
+increment converges the element states are committed and a frame is written to the
+results folder at once.  A diverging increment is retried with a quarter of the
+increment (Abaqus' cutback); easy increments grow by 1.5.  If the increment falls
+below the minimum, the run stops with :class:`~femast.errors.ConvergenceError`
+saying where and why; every converged increment is already on disk.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import time as _time
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+from tqdm.auto import tqdm
+
+from .assembly import Assembler
+from .dofs import number_dofs
+from .elements.base import DOF_NAMES, IncrementContext
+from .elements.beam_corot import BeamFamily, element_frame
+from .elements.truss import TrussFamily
+from .errors import ConvergenceError, ModelError, SingularModelError
+from .results import Results, ResultsWriter
+from .rotations import expm_so3, rotation_vectors
+from .solvers.control import LoadControl
+from .solvers.convergence import Convergence
+from .solvers.linear import SparseLU, mechanism_dofs
+
+
+@njit(cache=True)
+def _apply_spins(R, W):
+    for i in range(R.shape[0]):
+        w = W[i]
+        if w[0] != 0.0 or w[1] != 0.0 or w[2] != 0.0:
+            R[i] = expm_so3(w) @ R[i]
+
+
+@dataclass
+class AnalysisSummary:
+    """What a run did: counts, wall time and where it stopped."""
+
+    completed: bool = True
+    increments: int = 0
+    iterations: int = 0
+    cutbacks: int = 0
+    wall_time: float = 0.0
+    assembly_time: float = 0.0
+    solve_time: float = 0.0
+    message: str = ""
+    steps: list = field(default_factory=list)
+
+    def __str__(self):
+        state = "completed" if self.completed else "STOPPED"
+        return (f"femast: analysis {state}: {self.increments} increments, {self.iterations} Newton iterations, "
+                f"{self.cutbacks} cutbacks, wall time {self.wall_time:.2f} s "
+                f"(assembly {self.assembly_time:.2f} s, linear solve {self.solve_time:.2f} s)"
+                + (f"\n  {self.message}" if self.message else ""))
+
+
+def build_families(model):
+    """Element families (with node *indices*) from a model's beams, trusses and user families."""
+    X = model.coordinates
+    fams = []
+    groups = {}
+    for b in model.beams:
+        groups.setdefault(("beam", b.family), []).append(b)
+    for t in model.trusses:
+        groups.setdefault(("truss", t.family), []).append(t)
+    for (kind, name), specs in groups.items():
+        nodes = np.array([[model.index(n) for n in s.nodes] for s in specs], dtype=np.int64)
+        labels = np.array([s.label for s in specs])
+        lengths = np.linalg.norm(X[nodes[:, 1]] - X[nodes[:, 0]], axis=1)
+        if kind == "beam":
+            E0 = np.empty((len(specs), 3, 3))
+            for i, s in enumerate(specs):
+                frame = element_frame(X[nodes[i, 0]], X[nodes[i, 1]], s.up)
+                if frame is None:
+                    raise ModelError(f"beam element {s.label}: up-vector parallel to the element")
+                E0[i] = frame
+            sec = [s.section for s in specs]
+            fams.append(BeamFamily(nodes, E0, lengths, [c.E * c.A for c in sec], [c.G * c.J for c in sec],
+                                   [c.E * c.Iy for c in sec], [c.E * c.Iz for c in sec], labels=labels, name=name))
+        else:
+            L0 = np.empty(len(specs))
+            for i, s in enumerate(specs):
+                if s.L0 is not None:
+                    L0[i] = s.L0
+                elif s.pretension is not None:
+                    L0[i] = lengths[i] / (1.0 + s.pretension / s.EA)
+                else:
+                    L0[i] = lengths[i]
+            fams.append(TrussFamily(nodes, L0, [s.EA for s in specs], [s.tension_only for s in specs],
+                                    labels=labels, name=name))
+    for fam in model.families:
+        f = copy.copy(fam)
+        f.nodes = np.ascontiguousarray(np.vectorize(model.index)(np.asarray(fam.nodes)), dtype=np.int64)
+        fams.append(f)
+    names = [f.name for f in fams]
+    for n in set(names):
+        if names.count(n) > 1:
+            raise ModelError(f"two element families are named '{n}'; give them different names")
+    return fams
+
+
+class Analysis:
+    """A static, geometrically nonlinear analysis of ``model`` writing to folder ``out``.
+
+    convergence : :class:`~femast.solvers.convergence.Convergence` (tolerances, max iterations).
+    progress : show a tqdm progress bar per step.
+    cutback : factor applied to a failed increment (Abaqus: 0.25).
+    growth : factor applied after two easy increments (Abaqus: 1.5).
+    """
+
+    def __init__(self, model, out="results", convergence: Convergence | None = None, progress: bool = True,
+                 cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 4):
+        self.model = model
+        self.out = out
+        self.convergence = convergence or Convergence()
+        self.progress = progress
+        self.cutback = cutback
+        self.growth = growth
+        self.easy_iterations = easy_iterations
+        if not model.steps:
+            raise ModelError(f"model '{model.name}' has no steps; add one with model.step()")
+        if not (model.beams or model.trusses or model.families):
+            raise ModelError(f"model '{model.name}' has no elements")
+        self.X0 = model.coordinates
+        n = len(self.X0)
+        self.families = build_families(model)
+        constrained = np.zeros((n, 6), dtype=bool)
+        self.fixed = np.zeros((n, 6), dtype=bool)
+        for label, dofs in model.fixed.items():
+            self.fixed[model.index(label), list(dofs)] = True
+        constrained |= self.fixed
+        for s in model.steps:
+            for c in s.prescribed:
+                i = model.index(c.node)
+                if self.fixed[i, c.dof]:
+                    raise ModelError(f"step '{s.name}': node {c.node} {DOF_NAMES[c.dof]} is both fixed and "
+                                     "prescribed; remove one of the two")
+                constrained[i, c.dof] = True
+        for s in model.steps:
+            for c in s.loads:
+                if constrained[model.index(c.node), c.dof] and c.magnitude != 0.0:
+                    raise ModelError(f"step '{s.name}': node {c.node} {DOF_NAMES[c.dof]} is both loaded and "
+                                     "fixed/prescribed; a DOF can have a load or a prescribed value, not both")
+        self.constrained = constrained
+        self.dofmap = number_dofs(n, self.families, constrained, model.node_labels)
+        if self.dofmap.n_free == 0:
+            raise ModelError(f"model '{model.name}' has no free DOFs")
+        self.assembler = Assembler(self.dofmap, self.families)
+        nf = self.dofmap.n_free
+        self.free_node, self.free_dof = self.dofmap.slots(np.arange(nf))
+        self.cons_node, self.cons_dof = self.dofmap.slots(np.arange(nf, self.dofmap.n_active))
+        self.is_rot = self.free_dof >= 3
+        self.length = float(np.ptp(self.X0, axis=0).max()) or 1.0
+        self.symmetric = all(getattr(f, "symmetric", False) for f in self.families)
+        self.solver = SparseLU(symmetric=self.symmetric)
+        # configuration and committed state
+        self.x = self.X0.copy()
+        self.R = np.tile(np.eye(3), (n, 1, 1))
+        self.spin = np.zeros((n, 3))
+        self.states = [f.initial_state() for f in self.families]
+        self.loads = np.zeros((n, 6))        # applied at the last converged increment
+        self.prescribed = np.zeros((n, 6))   # prescribed values at the last converged increment
+        self.total_time = 0.0
+        self.lam = 0.0
+        self.summary = AnalysisSummary()
+        self.strain_energy = 0.0
+
+    # ------------------------------------------------------------ helpers
+    def dof_value(self, idx, dof):
+        return self.x[idx, dof] - self.X0[idx, dof] if dof < 3 else self.spin[idx, dof - 3]
+
+    def _evaluate(self, ctx):
+        responses = [f.evaluate(self.x, self.R, s, ctx) for f, s in zip(self.families, self.states)]
+        for f, r in zip(self.families, responses):
+            if not (np.all(np.isfinite(r.f)) and np.all(np.isfinite(r.k))):
+                raise FloatingPointError(f"non-finite internal forces in element family '{f.name}'")
+        return responses
+
+    def _update(self, du_free, du_cons=None):
+        W = np.zeros_like(self.spin)
+        for node, dof, du in ((self.free_node, self.free_dof, du_free),
+                              (self.cons_node, self.cons_dof, du_cons)):
+            if du is None:
+                continue
+            t = dof < 3
+            np.add.at(self.x, (node[t], dof[t]), du[t])
+            np.add.at(W, (node[~t], dof[~t] - 3), du[~t])
+        self.spin += W
+        _apply_spins(self.R, W)
+
+    def _values(self, conds, start, frac_time, period, lam=None):
+        """Loads or prescribed values at step time ``frac_time * period`` (or load factor lam)."""
+        out = start.copy()
+        for c in conds:
+            i = self.model.index(c.node)
+            if lam is not None:
+                out[i, c.dof] = start[i, c.dof] + lam * (c.magnitude - start[i, c.dof])
+            elif c.amplitude is not None:
+                out[i, c.dof] = c.amplitude(frac_time * period) * c.magnitude
+            else:
+                out[i, c.dof] = start[i, c.dof] + frac_time * (c.magnitude - start[i, c.dof])
+        return out
+
+    def _name_dofs(self, eqs):
+        return ", ".join(self.dofmap.describe(int(e)) for e in eqs)
+
+    def _singular_message(self, K, where):
+        eqs = mechanism_dofs(K)
+        what = (f"the free DOFs of the mechanism include: {self._name_dofs(eqs)}" if eqs is not None
+                else "the model is too large to name the mechanism")
+        return (f"{where}: the tangent stiffness is singular: {what}. Fix or constrain these DOFs, or connect "
+                "the nodes to an element that stiffens them.")
+
+    # ------------------------------------------------------------ the run
+    def run(self) -> Results:
+        t0 = _time.perf_counter()
+        writer = ResultsWriter(self.out, self.model, self.families)
+        self._write(writer, step_name="initial", inc=0, time=0.0, iterations=0, responses=None)
+        try:
+            for k, step in enumerate(self.model.steps):
+                self._run_step(k, step, writer)
+        except ConvergenceError as exc:
+            self.summary.completed = False
+            self.summary.message = str(exc)
+            raise
+        finally:
+            self.summary.wall_time = _time.perf_counter() - t0
+            writer.close({**self.summary.__dict__, "strain_energy": self.strain_energy})
+            if self.progress:
+                tqdm.write(str(self.summary))
+        return Results(self.out)
+
+    def _run_step(self, k, step, writer):
+        period = step.period
+        dt = step.initial_increment or min(period, step.max_increment or period)
+        dt_min = step.min_increment or period * 1e-5
+        dt_max = step.max_increment or period
+        control = step.control or LoadControl()
+        control.setup(self, step)
+        if control.solves_for_load_factor and any(c.amplitude is not None for c in step.loads):
+            raise ModelError(f"step '{step.name}': amplitudes cannot be used with {type(control).__name__}; "
+                             "the load factor is an unknown")
+        hit = sorted({float(h) for h in step.hit_times} |
+                     {float(t) for c in step.loads + step.prescribed if c.amplitude is not None
+                      for t in c.amplitude.times if 0 < t < period})
+        load_start, pres_start = self.loads.copy(), self.prescribed.copy()
+        t, inc, easy = 0.0, 0, 0
+        self.lam = 0.0
+        step_iters = 0
+        bar = tqdm(total=period, desc=f"step {step.name}", unit="s", disable=not self.progress, leave=False,
+                   bar_format="{desc}: {percentage:3.0f}%|{bar}| t={n:.4g}/{total:.4g} [{elapsed}<{remaining}]")
+        while t < period * (1 - 1e-12):
+            if inc >= step.max_increments:
+                raise ConvergenceError(f"step '{step.name}': reached max_increments={step.max_increments} at step "
+                                       f"time {t:.6g} of {period:g} s; raise max_increments or max_increment")
+            dt = min(dt, dt_max, period - t)
+            for h in hit:
+                if t + 1e-12 * period < h < t + dt - 1e-12 * period:
+                    dt = h - t
+                    break
+            attempt = 0
+            while True:
+                attempt += 1
+                ok, iters, note, responses = self._increment(step, control, t, dt, load_start, pres_start)
+                step_iters += iters
+                self.summary.iterations += iters
+                if ok:
+                    break
+                writer.status(step.name, inc + 1, attempt, iters, t + dt, self.total_time + dt, dt, self.lam,
+                              f"cutback: {note}")
+                self.summary.cutbacks += 1
+                dt *= self.cutback
+                easy = 0
+                if dt < dt_min:
+                    bar.close()
+                    raise ConvergenceError(
+                        f"step '{step.name}': increment fell below the minimum {dt_min:.3g} s at step time "
+                        f"{t:.6g} s (total time {self.total_time:.6g} s): {note}. The {self.summary.increments} "
+                        f"converged increments are saved in '{self.out}'.")
+            inc += 1
+            t += dt
+            self.total_time += dt
+            self.summary.increments += 1
+            self._write(writer, step.name, inc, t, iters, responses, period=period)
+            writer.status(step.name, inc, attempt, iters, t, self.total_time, dt, self.lam)
+            bar.update(dt)
+            easy = easy + 1 if iters <= self.easy_iterations else 0
+            if easy >= 2:
+                dt *= self.growth
+        bar.close()
+        self.summary.steps.append({"name": step.name, "increments": inc, "iterations": step_iters})
+
+    def _increment(self, step, control, t, dt, load_start, pres_start):
+        """Try one increment; on success commit and return (True, iterations, '', responses);
+        on failure restore the committed configuration and return (False, iterations, why, None)."""
+        saved = (self.x.copy(), self.R.copy(), self.spin.copy(), self.lam)
+        frac = (t + dt) / step.period
+        period = step.period
+        ctx = IncrementContext(time=t + dt, dtime=dt, total_time=self.total_time + dt, x_committed=saved[0],
+                               R_committed=saved[1], step_name=step.name)
+        uses_lam = control.solves_for_load_factor
+        P_ref = None
+        if uses_lam:
+            lam = self.lam
+            P_end = self._values(step.loads, load_start, 1.0, period)
+            P_ref_full = P_end - load_start
+            P_ref = P_ref_full[self.free_node, self.free_dof]
+        else:
+            lam = frac
+        pres = self._values(step.prescribed, pres_start, frac, period)
+        dpres = pres[self.cons_node, self.cons_dof] - self.prescribed[self.cons_node, self.cons_dof]
+        dpres[self.fixed[self.cons_node, self.cons_dof]] = 0.0
+        nf = self.dofmap.n_free
+        Du = np.zeros(nf)
+        iters = 0
+        rnorm_hist = []
+        try:
+            for it in range(self.convergence.max_iterations + 1):
+                P = (self._values(step.loads, load_start, frac, period) if not uses_lam
+                     else load_start + lam * P_ref_full)
+                ta = _time.perf_counter()
+                responses = self._evaluate(ctx)
+                F = self.assembler.forces([r.f for r in responses])
+                r = P[self.free_node, self.free_dof] - F[:nf]
+                K, Kfc = self.assembler.tangent([r.k for r in responses], with_fc=(it == 0 and np.any(dpres)))
+                self.summary.assembly_time += _time.perf_counter() - ta
+                if not np.all(np.isfinite(r)):
+                    raise FloatingPointError("non-finite residual")
+                if it > 0:
+                    ok, ratio = self._converged(r, du, Du, F, P)
+                    rnorm_hist.append(ratio)
+                    if ok:
+                        self._commit(responses, P, F, lam)
+                        return True, iters, "", responses
+                    if it == self.convergence.max_iterations:
+                        return self._fail(saved, iters, f"no convergence in {iters} iterations "
+                                          f"(residual ratio {ratio:.3g}, worst at {self._worst(r)})")
+                    if len(rnorm_hist) >= 3 and rnorm_hist[-1] > rnorm_hist[-2] > rnorm_hist[-3] and it >= 4:
+                        return self._fail(saved, iters, f"residual diverging (ratio {ratio:.3g}, worst at "
+                                          f"{self._worst(r)})")
+                ts = _time.perf_counter()
+                try:
+                    self.solver.factorize(K)
+                except SingularModelError:
+                    if self.summary.increments == 0 and it == 0:
+                        raise SingularModelError(self._singular_message(K, f"step '{step.name}'")) from None
+                    return self._fail(saved, iters, "singular tangent (bifurcation or mechanism)")
+                rhs = r if Kfc is None else r - Kfc @ dpres
+                du = self.solver.solve(rhs)
+                if uses_lam:
+                    du_p = self.solver.solve(P_ref)
+                    cur = self.dof_value(self.free_node[control.eq], self.free_dof[control.eq])
+                    dlam = control.dlambda(du, du_p, cur, frac)
+                    du = du + dlam * du_p
+                    lam += dlam
+                self.summary.solve_time += _time.perf_counter() - ts
+                iters += 1
+                Du += du
+                self._update(du, dpres if it == 0 else None)
+        except (FloatingPointError, SingularModelError, ValueError) as exc:
+            if isinstance(exc, SingularModelError) and self.summary.increments == 0 and iters == 0:
+                raise
+            if isinstance(exc, ModelError):
+                raise
+            return self._fail(saved, iters, str(exc))
+        return self._fail(saved, iters, "no convergence")
+
+    def _worst(self, r):
+        return self.dofmap.describe(int(np.argmax(np.abs(r))))
+
+    def _converged(self, r, du, Du, F, P):
+        nf = self.dofmap.n_free
+        rot_all = np.zeros(self.dofmap.n_active, dtype=bool)
+        rot_all[:nf] = self.is_rot
+        rot_all[nf:] = self.cons_dof >= 3
+        Pf = P[self.free_node, self.free_dof]
+        fmax = max(float(np.abs(F[~rot_all]).max(initial=0.0)), float(np.abs(Pf[~self.is_rot]).max(initial=0.0)))
+        mmax = max(float(np.abs(F[rot_all]).max(initial=0.0)), float(np.abs(Pf[self.is_rot]).max(initial=0.0)))
+        L = self.length
+        ref_f = max(fmax, 1e-2 * mmax / L, 1e-300)
+        ref_m = max(mmax, 1e-2 * fmax * L, 1e-300)
+        return self.convergence.check(r, du, Du, self.is_rot, ref_f, ref_m, L)
+
+    def _fail(self, saved, iters, why):
+        self.x, self.R, self.spin, self.lam = saved[0], saved[1], saved[2], saved[3]
+        return False, iters, why, None
+
+    def _commit(self, responses, P, F, lam):
+        self.states = [r.state.copy() if r.state is not None else s for r, s in zip(responses, self.states)]
+        self.loads = P.copy()
+        self.prescribed[self.cons_node, self.cons_dof] = [self.dof_value(n, d) for n, d in
+                                                          zip(self.cons_node, self.cons_dof)]
+        self.lam = lam
+        self.strain_energy = float(sum(np.sum(r.energy) for r in responses if r.energy is not None))
+        self._F = F
+
+    def _write(self, writer, step_name, inc, time, iterations, responses, period=1.0):
+        n = len(self.X0)
+        RF = np.zeros((n, 6))
+        if responses is not None:
+            nf = self.dofmap.n_free
+            RF[self.cons_node, self.cons_dof] = self._F[nf:] - self.loads[self.cons_node, self.cons_dof]
+        data = {"step": step_name, "increment": inc, "time": time, "total_time": self.total_time,
+                "load_factor": self.lam, "iterations": iterations, "U": self.x - self.X0, "R": self.R,
+                "UR": rotation_vectors(self.R), "URA": self.spin, "RF": RF, "P": self.loads,
+                "strain_energy": self.strain_energy}
+        if responses is None:
+            responses = self._evaluate(IncrementContext(x_committed=self.x, R_committed=self.R))
+        for f, r in zip(self.families, responses):
+            for key, val in r.output.items():
+                data[f"el/{f.name}/{key}"] = val
+        writer.frame(**data)
+
+
+def solve(model, out="results", **options) -> Results:
+    """Run all steps of ``model``; write results to folder ``out``; return :class:`Results`.
+    Options are those of :class:`Analysis`."""
+    return Analysis(model, out, **options).run()

@@ -1,0 +1,72 @@
+"""Two-node truss / cable element (the analogue of Abaqus T3D2), geometrically exact.
+
+Axial force N = EA (l - L0) / L0 with L0 the unstretched length (engineering strain
+on the reference length, large rotations exact).  A tension-only element (a cable)
+carries N = max(N, 0).  Given a pretension N0 instead of L0, the unstretched length
+is chosen so that the element carries N0 in the initial geometry: L0 = l_init / (1 + N0/EA).
+
+Tangent: K = EA/L0 e e^T + N/l (I - e e^T) on each node pair (symmetric).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .base import ElementFamily, ElementResponse
+
+
+@njit(cache=True, parallel=True)
+def truss_family_kernel(nodes, x, L0, EA, tension_only, f, K, N_out, energy):
+    for el in prange(nodes.shape[0]):
+        a = nodes[el, 0]
+        b = nodes[el, 1]
+        d = x[b] - x[a]
+        l = math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)
+        e = d / l
+        k_ax = EA[el] / L0[el]
+        N = k_ax * (l - L0[el])
+        if tension_only[el] and N <= 0.0:
+            N = 0.0
+            k_ax = 0.0
+        N_out[el] = N
+        energy[el] = 0.5 * N * (l - L0[el])
+        g = N / l
+        for i in range(3):
+            f[el, i] = -N * e[i]
+            f[el, 6 + i] = N * e[i]
+            for j in range(3):
+                kij = k_ax * e[i] * e[j] + g * ((1.0 if i == j else 0.0) - e[i] * e[j])
+                K[el, i, j] = kij
+                K[el, 6 + i, 6 + j] = kij
+                K[el, i, 6 + j] = -kij
+                K[el, 6 + i, j] = -kij
+
+
+class TrussFamily(ElementFamily):
+    """A batch of trusses / cables: ``L0`` unstretched lengths (m), ``EA`` (N),
+    ``tension_only`` (bool per element)."""
+
+    name = "truss"
+    active_dofs = (0, 1, 2)
+    n_state = 0
+    symmetric = True
+
+    def __init__(self, nodes, L0, EA, tension_only, labels=None, name="truss"):
+        self.name = name
+        self.nodes = np.ascontiguousarray(nodes, dtype=np.int64)
+        self.L0 = np.ascontiguousarray(L0, dtype=float)
+        self.EA = np.ascontiguousarray(EA, dtype=float)
+        self.tension_only = np.ascontiguousarray(tension_only, dtype=np.bool_)
+        self.labels = np.arange(1, len(self.nodes) + 1) if labels is None else np.asarray(labels)
+
+    def evaluate(self, x, R, state, ctx=None):
+        n = self.n_elements
+        f = np.zeros((n, 12))
+        K = np.zeros((n, 12, 12))
+        N = np.zeros(n)
+        energy = np.zeros(n)
+        truss_family_kernel(self.nodes, np.ascontiguousarray(x), self.L0, self.EA, self.tension_only, f, K, N, energy)
+        return ElementResponse(f=f, k=K, state=state, output={"N": N}, energy=energy)

@@ -1,0 +1,307 @@
+"""Model definition for scripts: nodes, elements, boundary conditions, loads, steps.
+
+Example::
+
+    import femast as fm
+    m = fm.Model("cantilever")
+    root, tip = m.node(0, 0, 0), m.node(1.0, 0, 0)
+    m.beam(root, tip, fm.circular_tube(0.02, 0.016, E=70e9), up=(0, 0, 1), n=16)
+    m.fix(root)
+    step = m.step("bend")
+    step.load(tip, mz=1.0)          # N m at the end of the step
+    results = fm.solve(m, "results/cantilever")
+
+All numbers are SI: coordinates and lengths in m, forces in N, moments in N m,
+stiffnesses in N, N m^2, pressures in Pa, rotations in rad.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .amplitudes import Amplitude
+from .elements.base import DOF_NAMES
+from .errors import ModelError
+from .sections import Section
+
+LOAD_NAMES = ("fx", "fy", "fz", "mx", "my", "mz")
+_DOF_INDEX = {n: i for i, n in enumerate(DOF_NAMES)}
+_LOAD_INDEX = {n: i for i, n in enumerate(LOAD_NAMES)}
+
+
+def dof_index(name: str) -> int:
+    """Index 0..5 of a DOF name (ux, uy, uz, rx, ry, rz) or a load name (fx .. mz)."""
+    key = str(name).lower()
+    if key in _DOF_INDEX:
+        return _DOF_INDEX[key]
+    if key in _LOAD_INDEX:
+        return _LOAD_INDEX[key]
+    raise ModelError(f"unknown DOF '{name}'; use one of {', '.join(DOF_NAMES)} (or loads {', '.join(LOAD_NAMES)})")
+
+
+def _finite(value, what):
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what} = {value!r} is not a number") from None
+    if not math.isfinite(v):
+        raise ModelError(f"{what} = {value!r} is not finite; give a finite number")
+    return v
+
+
+@dataclass
+class BeamSpec:
+    label: int
+    nodes: tuple
+    section: Section
+    up: np.ndarray
+    family: str
+
+
+@dataclass
+class TrussSpec:
+    label: int
+    nodes: tuple
+    EA: float
+    L0: float | None
+    pretension: float | None
+    tension_only: bool
+    family: str
+
+
+@dataclass
+class Condition:
+    """A load or prescribed value on one DOF: ``magnitude`` at the end of the step (or the
+    factor-1 value of its amplitude)."""
+
+    node: int
+    dof: int
+    magnitude: float
+    amplitude: Amplitude | None = None
+
+
+@dataclass
+class Step:
+    """A static step (as an Abaqus *STEP, *STATIC).
+
+    period : step time, s (pseudo-time for static steps).
+    initial_increment, min_increment, max_increment : increments of step time, s.
+    max_increments : most increments allowed in the step.
+    control : None (load / prescribed-displacement control) or a control strategy such as
+        :class:`femast.solvers.control.DisplacementControl`.
+    stabilize : None, or a :class:`femast.solvers.stabilize.Stabilize` (issue 3).
+    hit_times : step times (s) at which an increment must end (amplitude table points
+        are added automatically).
+    """
+
+    name: str
+    period: float = 1.0
+    initial_increment: float | None = None
+    min_increment: float | None = None
+    max_increment: float | None = None
+    max_increments: int = 1000
+    control: object = None
+    stabilize: object = None
+    hit_times: tuple = ()
+    loads: list = field(default_factory=list)
+    prescribed: list = field(default_factory=list)
+    _model: "Model" = field(default=None, repr=False)
+
+    def load(self, node, amplitude: Amplitude | None = None, **components):
+        """Nodal force/moment at the end of the step: ``step.load(n, fx=10.0, mz=-2.0)`` (N, N m,
+        global axes, fixed directions).  A load not redefined in a later step stays applied."""
+        self._model._check_node(node, f"load in step '{self.name}'")
+        if not components:
+            raise ModelError(f"step '{self.name}': load on node {node} has no components; give e.g. fx=1.0")
+        for name, value in components.items():
+            if name.lower() not in _LOAD_INDEX:
+                raise ModelError(f"step '{self.name}': unknown load component '{name}' on node {node}; "
+                                 f"use {', '.join(LOAD_NAMES)}")
+            v = _finite(value, f"step '{self.name}': load {name} on node {node}")
+            self.loads.append(Condition(node, _LOAD_INDEX[name.lower()], v, amplitude))
+        return self
+
+    def prescribe(self, node, amplitude: Amplitude | None = None, **components):
+        """Prescribed displacement/rotation at the end of the step: ``step.prescribe(n, ux=0.01,
+        rz=0.05)`` (m, rad).  A prescribed rotation component is the accumulated spin about that
+        global axis (exact when the other two rotation components are held)."""
+        self._model._check_node(node, f"prescribed motion in step '{self.name}'")
+        if not components:
+            raise ModelError(f"step '{self.name}': prescribe on node {node} has no components; give e.g. ux=0.0")
+        for name, value in components.items():
+            if name.lower() not in _DOF_INDEX:
+                raise ModelError(f"step '{self.name}': unknown DOF '{name}' on node {node}; use {', '.join(DOF_NAMES)}")
+            v = _finite(value, f"step '{self.name}': prescribed {name} on node {node}")
+            self.prescribed.append(Condition(node, _DOF_INDEX[name.lower()], v, amplitude))
+        return self
+
+
+class Model:
+    """A structural model: nodes (6 DOF each), element families, fixed DOFs and steps."""
+
+    def __init__(self, name: str = "model"):
+        self.name = name
+        self._node_labels: list[int] = []
+        self._node_xyz: list[tuple] = []
+        self._node_index: dict[int, int] = {}
+        self.beams: list[BeamSpec] = []
+        self.trusses: list[TrussSpec] = []
+        self.families: list = []  # user / custom ElementFamily objects (built with node labels)
+        self.fixed: dict[int, set] = {}
+        self.steps: list[Step] = []
+        self._next_element = 1
+
+    # ---------------------------------------------------------------- nodes
+    def node(self, x: float, y: float, z: float, label: int | None = None) -> int:
+        """Add a node at (x, y, z) (m); returns its label (auto-numbered from 1 if not given)."""
+        xyz = tuple(_finite(v, f"node {label if label is not None else len(self._node_labels) + 1} coordinate {c}")
+                    for v, c in zip((x, y, z), "xyz"))
+        if label is None:
+            label = (max(self._node_labels) + 1) if self._node_labels else 1
+        label = int(label)
+        if label in self._node_index:
+            raise ModelError(f"node {label} is defined twice; labels must be unique")
+        self._node_index[label] = len(self._node_labels)
+        self._node_labels.append(label)
+        self._node_xyz.append(xyz)
+        return label
+
+    def nodes(self, coords) -> list[int]:
+        """Add several nodes from an (n, 3) array of coordinates (m); returns their labels."""
+        return [self.node(*c) for c in np.asarray(coords, dtype=float).reshape(-1, 3)]
+
+    @property
+    def node_labels(self) -> np.ndarray:
+        return np.array(self._node_labels, dtype=np.int64)
+
+    @property
+    def coordinates(self) -> np.ndarray:
+        """(n_nodes, 3) initial coordinates, m, in the order of :attr:`node_labels`."""
+        return np.array(self._node_xyz, dtype=float).reshape(-1, 3)
+
+    def index(self, label) -> int:
+        """Row of node ``label`` in the node table."""
+        self._check_node(label, "lookup")
+        return self._node_index[int(label)]
+
+    def xyz(self, label) -> np.ndarray:
+        """Initial coordinates (m) of node ``label``."""
+        return np.array(self._node_xyz[self.index(label)])
+
+    def _check_node(self, label, where):
+        try:
+            ok = int(label) in self._node_index and float(label) == int(label)
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            known = self._node_labels
+            hint = f"known labels {known[0]}..{known[-1]}" if known else "the model has no nodes yet"
+            raise ModelError(f"{where}: unknown node {label!r} ({hint}); create it with model.node(x, y, z)")
+
+    # ------------------------------------------------------------- elements
+    def beam(self, n1, n2, section: Section, up=(0.0, 0.0, 1.0), n: int = 1, family: str = "beam") -> list[int]:
+        """Beam(s) from node ``n1`` to ``n2``, split into ``n`` equal elements (new nodes are
+        created in between).  ``up`` (global vector) sets the local y axis: it is made
+        orthogonal to the element; Iz resists bending in the plane of the axis and ``up``.
+        Returns the element labels."""
+        self._check_node(n1, "beam")
+        self._check_node(n2, "beam")
+        if not isinstance(section, Section):
+            raise ModelError(f"beam {n1}-{n2}: section must be a femast Section (got {type(section).__name__})")
+        n = int(n)
+        if n < 1:
+            raise ModelError(f"beam {n1}-{n2}: n = {n} elements; need n >= 1")
+        a, b = self.xyz(n1), self.xyz(n2)
+        L = float(np.linalg.norm(b - a))
+        if L <= 1e-12 * max(1.0, float(np.abs(a).max())):
+            raise ModelError(f"beam {n1}-{n2}: nodes {n1} and {n2} coincide (length {L:g} m); "
+                             "a beam needs two distinct nodes")
+        up = np.array([_finite(u, f"beam {n1}-{n2}: up-vector") for u in up])
+        e = (b - a) / L
+        if np.linalg.norm(up - (up @ e) * e) < 1e-6 * max(np.linalg.norm(up), 1e-300):
+            raise ModelError(f"beam {n1}-{n2}: up-vector {tuple(up)} is parallel to the element axis "
+                             f"{tuple(np.round(e, 6))}; choose an up-vector not along the beam")
+        chain = [n1] + [self.node(*(a + (b - a) * k / n)) for k in range(1, n)] + [n2]
+        labels = []
+        for p, q in zip(chain[:-1], chain[1:]):
+            labels.append(self._next_element)
+            self.beams.append(BeamSpec(self._next_element, (p, q), section, up, family))
+            self._next_element += 1
+        return labels
+
+    def truss(self, n1, n2, EA: float, L0: float | None = None, pretension: float | None = None,
+              tension_only: bool = False, family: str | None = None) -> int:
+        """Truss (or, with ``tension_only=True``, cable) from ``n1`` to ``n2``; EA in N.
+        Give the unstretched length ``L0`` (m) or the ``pretension`` (N) it carries in the
+        initial geometry; neither means stress-free.  Returns the element label."""
+        self._check_node(n1, "truss")
+        self._check_node(n2, "truss")
+        EA = _finite(EA, f"truss {n1}-{n2}: EA")
+        if EA <= 0:
+            raise ModelError(f"truss {n1}-{n2}: EA = {EA} N must be positive")
+        L = float(np.linalg.norm(self.xyz(n2) - self.xyz(n1)))
+        if L <= 1e-12:
+            raise ModelError(f"truss {n1}-{n2}: nodes {n1} and {n2} coincide; a truss needs two distinct nodes")
+        if L0 is not None and pretension is not None:
+            raise ModelError(f"truss {n1}-{n2}: give L0 or pretension, not both")
+        if L0 is not None:
+            L0 = _finite(L0, f"truss {n1}-{n2}: L0")
+            if L0 <= 0:
+                raise ModelError(f"truss {n1}-{n2}: unstretched length L0 = {L0} m must be positive")
+        if pretension is not None:
+            pretension = _finite(pretension, f"truss {n1}-{n2}: pretension")
+            if pretension <= -EA:
+                raise ModelError(f"truss {n1}-{n2}: pretension {pretension} N <= -EA is impossible")
+        label = self._next_element
+        self._next_element += 1
+        fam = family or ("cable" if tension_only else "truss")
+        self.trusses.append(TrussSpec(label, (n1, n2), EA, L0, pretension, bool(tension_only), fam))
+        return label
+
+    def add_family(self, family):
+        """Add a user or built-in element family (see :mod:`femast.elements.base`) whose
+        ``nodes`` array holds node *labels*; returns it."""
+        for lab in np.unique(np.asarray(family.nodes)):
+            self._check_node(int(lab), f"element family '{family.name}'")
+        self.families.append(family)
+        return family
+
+    # ------------------------------------------------------- boundary conditions
+    def fix(self, node, *dofs):
+        """Fix DOFs of ``node`` at zero for the whole analysis: ``fix(n)`` fixes all six,
+        ``fix(n, "ux", "rz")`` some (names ux, uy, uz, rx, ry, rz; "translations", "rotations")."""
+        self._check_node(node, "fix")
+        if not dofs or dofs == ("all",):
+            idx = range(6)
+        else:
+            idx = []
+            for d in dofs:
+                if d == "translations":
+                    idx += [0, 1, 2]
+                elif d == "rotations":
+                    idx += [3, 4, 5]
+                else:
+                    if str(d).lower() not in _DOF_INDEX:
+                        raise ModelError(f"fix node {node}: unknown DOF '{d}'; use {', '.join(DOF_NAMES)}")
+                    idx.append(_DOF_INDEX[str(d).lower()])
+        self.fixed.setdefault(int(node), set()).update(idx)
+
+    # ----------------------------------------------------------------- steps
+    def step(self, name: str | None = None, **options) -> Step:
+        """Append a static step; options are :class:`Step` fields (period, increments, control...)."""
+        name = name or f"Step-{len(self.steps) + 1}"
+        if any(s.name == name for s in self.steps):
+            raise ModelError(f"step '{name}' is defined twice; step names must be unique")
+        s = Step(name=name, **options)
+        s._model = self
+        if not (s.period > 0 and math.isfinite(s.period)):
+            raise ModelError(f"step '{name}': period = {s.period} s must be positive")
+        self.steps.append(s)
+        return s
+
+    def __repr__(self):
+        return (f"Model({self.name!r}: {len(self._node_labels)} nodes, {len(self.beams)} beams, "
+                f"{len(self.trusses)} trusses, {len(self.families)} other families, {len(self.steps)} steps)")

@@ -1,0 +1,159 @@
+"""Results on disk, written increment by increment, readable without femast.
+
+Layout of a results folder::
+
+    mesh.npz              node labels, reference coordinates, element connectivity per family
+    frames/000001.npz     one file per converged increment (written atomically)
+    status.sta            one line per increment, like Abaqus' .sta file
+    summary.json          written at the end (or when the run gives up)
+
+Each frame holds: ``step`` (name), ``increment``, ``time`` (step time, s),
+``total_time`` (s), ``load_factor``, ``iterations``, ``U`` (n, 3) displacements (m),
+``R`` (n, 3, 3) nodal rotation matrices, ``UR`` (n, 3) rotation vectors (rad, |UR| <= pi),
+``URA`` (n, 3) accumulated spins (rad; the total rotation for rotations about a fixed
+axis, beyond 2 pi), ``RF`` (n, 6) reactions (N, N m), ``P`` (n, 6) applied loads, and
+element outputs as ``el/<family>/<name>``.  Read them with numpy.load, or with
+:class:`Results`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .elements.base import DOF_NAMES
+from .errors import FemastError
+
+_COMPONENTS = {
+    "ux": ("U", 0), "uy": ("U", 1), "uz": ("U", 2),
+    "urx": ("URA", 0), "ury": ("URA", 1), "urz": ("URA", 2),
+    "rx": ("URA", 0), "ry": ("URA", 1), "rz": ("URA", 2),
+    "rfx": ("RF", 0), "rfy": ("RF", 1), "rfz": ("RF", 2), "rmx": ("RF", 3), "rmy": ("RF", 4), "rmz": ("RF", 5),
+    "fx": ("P", 0), "fy": ("P", 1), "fz": ("P", 2), "mx": ("P", 3), "my": ("P", 4), "mz": ("P", 5),
+}
+
+
+def _atomic_savez(path: Path, **arrays):
+    tmp = path.with_name(path.stem + ".tmp.npz")
+    np.savez(tmp, **arrays)
+    os.replace(tmp, path)
+
+
+class ResultsWriter:
+    """Writes a results folder as the analysis runs (see module docstring)."""
+
+    def __init__(self, folder, model, families):
+        self.folder = Path(folder)
+        (self.folder / "frames").mkdir(parents=True, exist_ok=True)
+        for old in (self.folder / "frames").glob("*.npz"):
+            old.unlink()
+        mesh = {"node_labels": model.node_labels, "X": model.coordinates,
+                "families": np.array([f.name for f in families])}
+        for f in families:
+            mesh[f"conn/{f.name}"] = model.node_labels[np.asarray(f.nodes)]
+            mesh[f"labels/{f.name}"] = np.asarray(getattr(f, "labels", np.arange(1, f.n_elements + 1)))
+        _atomic_savez(self.folder / "mesh.npz", **mesh)
+        self.count = 0
+        self.sta = open(self.folder / "status.sta", "w")
+        self.sta.write(f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} {'TOTAL TIME':>11} "
+                       f"{'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n")
+
+    def status(self, step, inc, attempt, iterations, time, total_time, dtime, lam, note=""):
+        self.sta.write(f"{step:>12.12} {inc:5d} {attempt:3d} {iterations:4d} {time:11.4e} {total_time:11.4e} "
+                       f"{dtime:11.4e} {lam:12.5e}  {note}\n")
+        self.sta.flush()
+
+    def frame(self, **data):
+        self.count += 1
+        _atomic_savez(self.folder / "frames" / f"{self.count:06d}.npz", **data)
+
+    def close(self, summary: dict):
+        self.sta.close()
+        with open(self.folder / "summary.json", "w") as fh:
+            json.dump(summary, fh, indent=2, default=float)
+
+
+class Results:
+    """Read a results folder: ``Results("results/run")``.
+
+    ``len(results)`` frames (converged increments, frame 0 is the initial state);
+    ``results.frame(i)`` a dict of arrays; ``results.node_history(label, "uz")`` a time
+    history (components ux uy uz, rx ry rz (accumulated spins), rfx..rmz reactions,
+    fx..mz applied loads); ``results.element_history(family, label, name, column)``.
+    """
+
+    def __init__(self, folder):
+        self.folder = Path(folder)
+        mesh_file = self.folder / "mesh.npz"
+        if not mesh_file.exists():
+            raise FemastError(f"{self.folder}: not a femast results folder (no mesh.npz); run an analysis first")
+        with np.load(mesh_file) as m:
+            self.mesh = {k: m[k] for k in m.files}
+        self.node_labels = self.mesh["node_labels"]
+        self.X = self.mesh["X"]
+        self.families = [str(f) for f in self.mesh["families"]]
+        self.files = sorted((self.folder / "frames").glob("[0-9]*.npz"))
+        self._cache = {}
+        sfile = self.folder / "summary.json"
+        self.summary = json.loads(sfile.read_text()) if sfile.exists() else None
+
+    def __len__(self):
+        return len(self.files)
+
+    def frame(self, i: int) -> dict:
+        i = range(len(self.files))[i]
+        if i not in self._cache:
+            with np.load(self.files[i]) as f:
+                self._cache[i] = {k: f[k] for k in f.files}
+        return self._cache[i]
+
+    def _node_row(self, label):
+        rows = np.flatnonzero(self.node_labels == int(label))
+        if rows.size == 0:
+            raise FemastError(f"node {label} is not in these results (labels {self.node_labels.min()}.."
+                              f"{self.node_labels.max()})")
+        return int(rows[0])
+
+    def scalar_history(self, name: str) -> np.ndarray:
+        """History of a frame scalar: time, total_time, load_factor, increment, iterations."""
+        return np.array([float(self.frame(i)[name]) for i in range(len(self))])
+
+    @property
+    def time(self):
+        return self.scalar_history("total_time")
+
+    @property
+    def steps(self):
+        return [str(self.frame(i)["step"]) for i in range(len(self))]
+
+    def node_history(self, label, component: str) -> np.ndarray:
+        """History of one nodal quantity (see class docstring) over all frames."""
+        key = component.lower()
+        if key not in _COMPONENTS:
+            raise FemastError(f"unknown nodal component '{component}'; use one of {', '.join(_COMPONENTS)}")
+        arr, col = _COMPONENTS[key]
+        row = self._node_row(label)
+        return np.array([self.frame(i)[arr][row, col] for i in range(len(self))])
+
+    def element_history(self, family: str, label: int, name: str) -> np.ndarray:
+        """History of element output ``name`` (e.g. 'section_forces', 'N') of element ``label``."""
+        if family not in self.families:
+            raise FemastError(f"no element family '{family}' in these results; families: {', '.join(self.families)}")
+        rows = np.flatnonzero(self.mesh[f"labels/{family}"] == int(label))
+        if rows.size == 0:
+            raise FemastError(f"element {label} is not in family '{family}'")
+        key = f"el/{family}/{name}"
+        if key not in self.frame(0):
+            names = [k.split("/")[-1] for k in self.frame(0) if k.startswith(f"el/{family}/")]
+            raise FemastError(f"family '{family}' has no output '{name}'; it has {', '.join(names)}")
+        return np.array([self.frame(i)[key][rows[0]] for i in range(len(self))])
+
+    def positions(self, i: int) -> np.ndarray:
+        """Current nodal positions (m) at frame i."""
+        return self.X + self.frame(i)["U"]
+
+
+DOF_COMPONENTS = DOF_NAMES
