@@ -173,6 +173,7 @@ class Analysis:
         self.lam = 0.0
         self.summary = AnalysisSummary()
         self.strain_energy = 0.0
+        self._zero_force = None
 
     # ------------------------------------------------------------ helpers
     def dof_value(self, idx, dof):
@@ -219,6 +220,44 @@ class Analysis:
                 else "the model is too large to name the mechanism")
         return (f"{where}: the tangent stiffness is singular: {what}. Fix or constrain these DOFs, or connect "
                 "the nodes to an element that stiffens them.")
+
+    def tangent(self):
+        """Tangent stiffness K_ff (scipy CSR, free DOFs) at the current configuration and
+        committed state; use :meth:`free_equation` to find a node's rows."""
+        responses = self._evaluate(IncrementContext(x_committed=self.x, R_committed=self.R))
+        K, _ = self.assembler.tangent([r.k for r in responses])
+        return K.copy()
+
+    def free_equation(self, label, dof) -> int:
+        """Equation number of a free DOF (dof index 0..5 or name); ModelError if not free."""
+        from .model import dof_index
+
+        d = dof if isinstance(dof, (int, np.integer)) else dof_index(dof)
+        eq = int(self.dofmap.eq[self.model.index(label), d])
+        if not 0 <= eq < self.dofmap.n_free:
+            raise ModelError(f"node {label} {DOF_NAMES[d]} is not a free DOF (fixed, prescribed or unused)")
+        return eq
+
+    def condensed_stiffness(self, labels, dofs=range(6)):
+        """Stiffness (N/m, N, N m/rad) seen at ``dofs`` of nodes ``labels``: the current tangent
+        with every other free DOF condensed out (Schur complement).  Rows/columns ordered
+        node by node, DOF by DOF."""
+        import scipy.sparse.linalg as spla
+
+        K = self.tangent().tocsc()
+        keep = np.array([self.free_equation(l, d) for l in np.atleast_1d(labels) for d in dofs])
+        rest = np.setdiff1d(np.arange(K.shape[0]), keep)
+        Kaa = K[keep][:, keep].toarray()
+        if rest.size == 0:
+            return Kaa
+        Kab = K[keep][:, rest]
+        Kbb = K[rest][:, rest]
+        try:
+            lu = spla.splu(Kbb.tocsc())
+        except RuntimeError:
+            raise SingularModelError("condensed_stiffness: the model is singular once the retained DOFs are "
+                                     "held; it has a mechanism besides them") from None
+        return Kaa - Kab @ lu.solve(K[rest][:, keep].toarray())
 
     # ------------------------------------------------------------ the run
     def run(self) -> Results:
@@ -333,6 +372,12 @@ class Analysis:
                 r = P[self.free_node, self.free_dof] - F[:nf]
                 K, Kfc = self.assembler.tangent([r.k for r in responses], with_fc=(it == 0 and np.any(dpres)))
                 self.summary.assembly_time += _time.perf_counter() - ta
+                if self._zero_force is None:
+                    dk = np.abs(K.diagonal())
+                    kt = float(dk[~self.is_rot].max(initial=0.0))
+                    kr = float(dk[self.is_rot].max(initial=0.0))
+                    # 'zero flux' floors: forces of a 1e-6 L (1e-6 rad) motion of the stiffest DOF
+                    self._zero_force = 1e-6 * max(kt * self.length, kr / self.length)
                 if not np.all(np.isfinite(r)):
                     raise FloatingPointError("non-finite residual")
                 if it > 0:
@@ -386,8 +431,8 @@ class Analysis:
         fmax = max(float(np.abs(F[~rot_all]).max(initial=0.0)), float(np.abs(Pf[~self.is_rot]).max(initial=0.0)))
         mmax = max(float(np.abs(F[rot_all]).max(initial=0.0)), float(np.abs(Pf[self.is_rot]).max(initial=0.0)))
         L = self.length
-        ref_f = max(fmax, 1e-2 * mmax / L, 1e-300)
-        ref_m = max(mmax, 1e-2 * fmax * L, 1e-300)
+        ref_f = max(fmax, 1e-2 * mmax / L, self._zero_force)
+        ref_m = max(mmax, 1e-2 * fmax * L, self._zero_force * L)
         return self.convergence.check(r, du, Du, self.is_rot, ref_f, ref_m, L)
 
     def _fail(self, saved, iters, why):
