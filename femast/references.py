@@ -519,6 +519,30 @@ class PlanarPath:
     rotation: np.ndarray
     info: dict = field(default_factory=dict)
 
+    def distance(self, load, disp, load_scale: float, disp_scale: float, component: str = "v"):
+        """Distance of points (disp, load), e.g. from an FE analysis, to this
+        path, in the plane (disp/disp_scale, load/load_scale).
+
+        The path may be multi-valued (snap-back), so points are compared with
+        the nearest segment of the reference polyline, not interpolated at
+        equal displacement.  ``component`` is 'v' or 'u'.  Returns an array of
+        distances; e.g. ``max(distance) < 0.01`` with load_scale the limit
+        load and disp_scale the displacement range is a 1 % path check.
+        Accuracy is limited by the spacing of the path points (chord error).
+        """
+        d = getattr(self, component) / disp_scale
+        p = self.load / load_scale
+        A = np.stack((d[:-1], p[:-1]), axis=1)
+        B = np.stack((d[1:], p[1:]), axis=1)
+        AB = B - A
+        L2 = np.maximum(np.einsum("ij,ij->i", AB, AB), 1e-300)
+        pts = np.stack((np.atleast_1d(np.asarray(disp, float)) / disp_scale, np.atleast_1d(np.asarray(load, float)) / load_scale), axis=1)
+        out = np.empty(len(pts))
+        for n, X in enumerate(pts):
+            t = np.clip(np.einsum("ij,ij->i", X - A, AB) / L2, 0.0, 1.0)
+            out[n] = np.sqrt(np.min(np.sum((A + t[:, None] * AB - X) ** 2, axis=1)))
+        return out
+
 
 class _PlanarChain:
     """A chain of straight extensible Euler-Bernoulli bars, integrated along its
@@ -668,6 +692,17 @@ def _continuation(chain, P_scale, L_scale, ds, n_max, stop, q_scale):
     return pts
 
 
+def _past_maximum(drop=0.98):
+    """Stop criterion: the load has passed its first maximum and fallen by 2 %."""
+    state = {"max": -np.inf}
+
+    def stop(q, lam):
+        state["max"] = max(state["max"], lam)
+        return state["max"] > 0 and lam < drop * state["max"]
+
+    return stop
+
+
 def _path_from_points(chain, pts, q_scale, P_scale, load_dir):
     lam, u, v, rot = [], [], [], []
     for z in pts:
@@ -684,7 +719,10 @@ def _limit_load(chain, path, P_scale, L_scale, q_scale, load_dir):
     """Refine the first load maximum of ``path`` by maximising the load over the
     displacement v of the monitored point (displacement control: v is
     monotonic near a load limit point)."""
-    i = int(np.argmax(path.load[: max(3, np.argmax(np.diff(path.load) < 0) + 2)]))
+    dec = np.nonzero(np.diff(path.load) < 0)[0]
+    if len(dec) == 0:
+        raise RuntimeError("no load limit point on the computed path; extend it")
+    i = int(dec[0])
     i = max(1, min(i, len(path.load) - 2))
     v_lo, v_hi = path.v[i - 1], path.v[i + 1]
     state = {"z": np.concatenate((path.info["q"][i] / q_scale, [path.load[i] / P_scale]))}
@@ -743,10 +781,10 @@ def lee_frame_path(
     A: float = 6.0,
     I: float = 2.0,
     load_offset: float = 24.0,
-    v_max: float = 100.0,
-    ds: float = 0.05,
-    h: float = 1.0,
-    n_max: int = 400,
+    v_max: float = 90.0,
+    ds: float = 0.2,
+    h: float = 2.0,
+    n_max: int = 1000,
 ) -> PlanarPath:
     """Equilibrium path of Lee's frame, from the elastica (independent reference).
 
@@ -776,17 +814,20 @@ def lee_frame_path(
     return path
 
 
-def lee_frame_limit_load(h: float = 1.0, **kw):
+def lee_frame_limit_load(h: float = 2.0, **kw):
     """First (maximum) limit load of Lee's frame and the downward displacement
     v of the load point there, from :func:`lee_frame_path` refined by Brent
     maximisation under displacement control.  Returns (P_max, v_at_P_max).
     Compare with :data:`LEE_FRAME_PUBLISHED` (Simo and Vu-Quoc 1986: 18532)."""
     p = dict(LEE_FRAME)
     p.update({k: v for k, v in kw.items() if k in p})
-    path = lee_frame_path(h=h, v_max=40.0, **{k: v for k, v in kw.items() if k not in ("v_max",)})
     chain = _lee_chain(p["L"], p["E"], p["A"], p["I"], p["load_offset"], h)
     P_scale = p["E"] * p["I"] / p["L"] ** 2
-    return _limit_load(chain, path, P_scale, p["L"], np.array([P_scale, P_scale, 1.0]), np.array([0.0, -1.0]))
+    q_scale = np.array([P_scale, P_scale, 1.0])
+    pts = _continuation(chain, P_scale, p["L"], kw.get("ds", 0.2), 1000, _past_maximum(), q_scale)
+    path = _path_from_points(chain, pts, q_scale, P_scale, np.array([0.0, -1.0]))
+    path.info = {"q": [z[:3] * q_scale for z in pts]}
+    return _limit_load(chain, path, P_scale, p["L"], q_scale, np.array([0.0, -1.0]))
 
 
 #: Williams' toggle (F.W. Williams 1964, "An approach to the non-linear
@@ -810,16 +851,22 @@ def _toggle_chain(half_span, rise, E, b, d, h):
     return _PlanarChain(nodes, E * I, E * A, "clamp", "clamp", load_node=1, load_dir=(0.0, -1.0), h=h)
 
 
+def _toggle_scales(half_span, rise, E, b, d):
+    EI = E * b * d**3 / 12.0
+    P_scale = EI * rise / half_span**3  # load scale of the shallow toggle
+    return P_scale, np.array([P_scale * half_span / rise, P_scale, P_scale * half_span])
+
+
 def williams_toggle_path(
     half_span: float = 12.943,
     rise: float = 0.386,
     E: float = 10.3e6,
     b: float = 0.753,
     d: float = 0.243,
-    v_max: float = 1.0,
-    ds: float = 0.05,
-    h: float = 0.05,
-    n_max: int = 400,
+    v_max: float = 0.6,
+    ds: float = 0.2,
+    h: float = 0.5,
+    n_max: int = 1000,
 ) -> PlanarPath:
     """Equilibrium path of Williams' toggle from the elastica (independent reference).
 
@@ -832,23 +879,24 @@ def williams_toggle_path(
     apex; v downward).  Stops when v > ``v_max``.
     """
     chain = _toggle_chain(half_span, rise, E, b, d, h)
-    EI = E * b * d**3 / 12.0
-    P_scale = EI * rise / half_span**3  # ~ load scale of the shallow toggle
-    q_scale = np.array([P_scale * half_span / rise, P_scale, P_scale * half_span])
+    P_scale, q_scale = _toggle_scales(half_span, rise, E, b, d)
     pts = _continuation(chain, P_scale, rise, ds, n_max, lambda q, lam: chain.monitor(q, lam)[0][1] < -v_max, q_scale)
     path = _path_from_points(chain, pts, q_scale, P_scale, np.array([0.0, -1.0]))
     path.info = {"q": [z[:3] * q_scale for z in pts], "model": "Williams toggle", "h": h, "P_scale": P_scale, "q_scale": q_scale}
     return path
 
 
-def williams_toggle_limit_load(h: float = 0.05, **kw):
+def williams_toggle_limit_load(h: float = 0.5, **kw):
     """First limit load of Williams' toggle and the apex deflection there:
     (P_max, v_at_P_max), refined as in :func:`lee_frame_limit_load`."""
     p = dict(WILLIAMS_TOGGLE)
     p.update({k: v for k, v in kw.items() if k in p})
-    path = williams_toggle_path(h=h, v_max=p["rise"] * 1.5, **{k: v for k, v in kw.items() if k != "v_max"})
     chain = _toggle_chain(p["half_span"], p["rise"], p["E"], p["b"], p["d"], h)
-    return _limit_load(chain, path, path.info["P_scale"], p["rise"], path.info["q_scale"], np.array([0.0, -1.0]))
+    P_scale, q_scale = _toggle_scales(p["half_span"], p["rise"], p["E"], p["b"], p["d"])
+    pts = _continuation(chain, P_scale, p["rise"], kw.get("ds", 0.2), 1000, _past_maximum(), q_scale)
+    path = _path_from_points(chain, pts, q_scale, P_scale, np.array([0.0, -1.0]))
+    path.info = {"q": [z[:3] * q_scale for z in pts]}
+    return _limit_load(chain, path, P_scale, p["rise"], q_scale, np.array([0.0, -1.0]))
 
 
 # =============================================================================
