@@ -210,10 +210,13 @@ def _feasible_polygon(W, w_g, tau_min, tau_max):
     V = lam[inside]
     if V.shape[0] == 0:
         return tau_p, N, V
-    V = np.unique(np.round(V / tol) * tol, axis=0)
     c = V.mean(axis=0)
-    order = np.argsort(np.arctan2(V[:, 1] - c[1], V[:, 0] - c[0]))
-    return tau_p, N, V[order]
+    V = V[np.argsort(np.arctan2(V[:, 1] - c[1], V[:, 0] - c[0]))]
+    # Several limit lines can meet at one vertex: drop repeats (values are kept, not rounded).
+    keep = np.linalg.norm(V - np.roll(V, 1, axis=0), axis=1) > tol
+    if not keep.any():
+        keep[0] = True
+    return tau_p, N, V[keep]
 
 
 def _polygon_centroid(V):

@@ -19,7 +19,9 @@ stiffness ``tau/dl``.  The passive stiffness of Eq. 24 needs ``d tau / d l``, th
 
     EA_t = d tau / d eps = g^2 / (k0 - k2 tau^2)
 
-which is 18 % above the secant value at 1200 N.  :func:`shroud_stiffness` returns
+which is 18 % above the secant value at 1200 N.  Since the strain is referred to the
+unstretched length ``l_free = l / (1 + eps)``, ``d tau / d l = EA_t / l_free``; dividing
+by the current length l as Eq. 25 does is a further O(eps) ~ 0.1 % difference.  :func:`shroud_stiffness` returns
 the tangent value by default (consistent linearisation, what a finite-element model
 gives); ``kind="secant"`` gives Eq. 25 as printed.
 """
@@ -93,12 +95,15 @@ def axial_rigidity_tangent(law: DyneemaLaw, tau):
 def shroud_stiffness(law: DyneemaLaw, tau, length, kind: str = "tangent"):
     """Spring coefficient k of a shroud of current length ``length`` (m) at tension ``tau`` (N), N/m (Eq. 25).
 
-    ``kind="tangent"`` (default): ``EA_t(tau) / l``, the derivative d tau / d l needed by Eq. 24.
+    ``kind="tangent"`` (default): ``d tau / d l = EA_t(tau) / l_free = EA_t(tau) (1 + eps) / l``, the
+    derivative needed by Eq. 24, with the strain eps measured from the unstretched length as in
+    the tensile test (Eq. 27).
     ``kind="secant"``: Eq. 25 as printed, ``(k0 + k1 tau + k2 tau^2) / l``.
     """
     length = check_positive("shroud length", length, "m")
     if kind == "tangent":
-        return axial_rigidity_tangent(law, tau) / length
+        # strain is measured from the unstretched length l_free = l / (1 + eps) (as dl / l0 in Eq. 27)
+        return axial_rigidity_tangent(law, tau) * (1.0 + strain_from_tension(law, tau)) / length
     if kind == "secant":
         return axial_rigidity_secant(law, tau) / length
     raise ModelError(f"unknown stiffness kind {kind!r}; use 'tangent' or 'secant'")
