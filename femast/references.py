@@ -120,6 +120,9 @@ def elastica_tip_load(k: float) -> ElasticaTip:
     K, E complete and F, E incomplete elliptic integrals of parameter m = p^2
     (scipy convention).  theta_L is found by Brent's method to machine
     precision.  Negative k gives the mirror image (v and theta change sign).
+    For |k| < 0.5 the same first integral is evaluated by Gauss quadrature
+    instead (the closed form loses relative precision as k -> 0); the two
+    branches agree to ~1e-15 at k = 0.5.  Valid for |k| <= 1e5.
 
     Returns
     -------
@@ -135,24 +138,65 @@ def elastica_tip_load(k: float) -> ElasticaTip:
     sgn = 1.0 if k > 0 else -1.0
     k = abs(k)
     rk = math.sqrt(k)
+    if k > 1e5:
+        raise ValueError(f"elastica_tip_load: |k|={k:g} > 1e5 is beyond double precision (theta_L = pi/2 - O(exp(-sqrt k)))")
 
-    def parts(th):
-        # m = p^2 = (1 + sin th)/2 ; 1 - m = (1 - sin th)/2 = sin^2(pi/4 - th/2)
-        m = 0.5 * (1.0 + math.sin(th))
-        m1 = math.sin(0.25 * math.pi - 0.5 * th) ** 2
+    if k < 0.5:
+        u, v, th = _elastica_small_load(k)
+        return ElasticaTip(u, sgn * v, sgn * th)
+
+    # Unknown: beta = pi/2 - theta_L, solved in log(beta) so that loads up to k ~ 1e5
+    # (beta ~ exp(-sqrt(k))) stay resolvable.  m = p^2 = (1 + cos beta)/2 and
+    # 1 - m = sin^2(beta/2) are then both computed without cancellation.
+    def parts(beta):
+        m = 0.5 * (1.0 + math.cos(beta))
+        m1 = math.sin(0.5 * beta) ** 2
         phi0 = math.asin(min(1.0, 1.0 / math.sqrt(2.0 * m)))
         return m, m1, phi0
 
-    def f(th):
-        m, m1, phi0 = parts(th)
+    def f(t):
+        m, m1, phi0 = parts(math.exp(t))
         return float(ellipkm1(m1)) - float(ellipkinc(phi0, m)) - rk
 
-    hi = 0.5 * math.pi - 1e-15
-    th = brentq(f, 0.0, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=500)
-    m, _, phi0 = parts(th)
+    t = brentq(f, math.log(1e-150), math.log(0.5 * math.pi), xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=500)
+    beta = math.exp(t)
+    th = 0.5 * math.pi - beta
+    m, _, phi0 = parts(beta)
     v = 1.0 - 2.0 / rk * (float(ellipe(m)) - float(ellipeinc(phi0, m)))
-    x = math.sqrt(2.0 * math.sin(th) / k)
+    x = math.sqrt(2.0 * math.cos(beta) / k)
     return ElasticaTip(1.0 - x, sgn * v, sgn * th)
+
+
+_GL64 = np.polynomial.legendre.leggauss(64)
+
+
+def _elastica_small_load(k):
+    """End-loaded elastica for k < 0.5 without the cancellation of the
+    elliptic-integral formula (v = 1 - (2/sqrt k)(...) loses ~eps/sqrt(k)).
+
+    With S = sin(theta_L) and the substitution sin(theta) = S - w^2 (w in
+    [0, sqrt S]) the first integral gives smooth integrands (c = cos theta)::
+
+        sqrt(2k) = 2 int dw / c,   v/L = 2/sqrt(2k) int sin(theta)/c dw,
+        u/L = 2/sqrt(2k) int sin^2(theta) / ((1 + c) c) dw
+
+    evaluated by 64-point Gauss-Legendre quadrature (exact to roundoff for
+    these analytic integrands when theta_L < 0.3).
+    """
+    x, wts = _GL64
+
+    def integrals(S):
+        r = math.sqrt(S)
+        w = 0.5 * r * (x + 1.0)
+        s = S - w * w
+        c = np.sqrt(1.0 - s * s)
+        f = 0.5 * r * wts
+        return 2.0 * np.sum(f / c), 2.0 * np.sum(f * s / c), 2.0 * np.sum(f * s * s / ((1.0 + c) * c))
+
+    target = math.sqrt(2.0 * k)
+    S = brentq(lambda S: integrals(S)[0] - target, 0.0, 0.5, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
+    _, iv, iu = integrals(S)
+    return float(iu / target), float(iv / target), math.asin(S)
 
 
 # =============================================================================
@@ -170,21 +214,19 @@ def pure_bending_tip(M: float, L: float, EI: float):
         x = L sin(phi)/phi,   y = L (1 - cos(phi))/phi,   rotation = phi
 
     exact for an inextensible Euler-Bernoulli beam at any phi (phi = 2 pi closes
-    a full circle with the tip back at the root, 4 pi winds it twice).  Source:
+    a full circle with the tip back at the root, 4 pi winds it twice); 1 - cos is
+    evaluated as 2 sin^2(phi/2), so small moments lose no precision.  Source:
     elementary beam theory; e.g. Simo and Vu-Quoc (1986), "A three-dimensional
     finite-strain rod model. Part II", CMAME 58:79-116, Example 7.1 (end moment
-    winding the rod twice).  The small-phi limit uses series expansions.
+    winding the rod twice).
 
     Returns (x_tip, y_tip, rotation) in length, length, rad.
     """
     phi = M * L / EI
-    if abs(phi) < 1e-4:
-        p2 = phi * phi
-        sinc = 1.0 - p2 / 6.0 + p2 * p2 / 120.0
-        cosc = phi / 2.0 - phi * p2 / 24.0 + phi * p2 * p2 / 720.0
-    else:
-        sinc = math.sin(phi) / phi
-        cosc = (1.0 - math.cos(phi)) / phi
+    if phi == 0.0:
+        return L, 0.0, 0.0
+    sinc = math.sin(phi) / phi
+    cosc = 2.0 * math.sin(0.5 * phi) ** 2 / phi  # (1 - cos phi)/phi without cancellation
     return L * sinc, L * cosc, phi
 
 
@@ -194,9 +236,9 @@ def pure_bending_shape(M: float, L: float, EI: float, s):
     s = np.asarray(s, dtype=float)
     kappa = M / EI
     theta = kappa * s
-    if abs(kappa * L) < 1e-8:
-        return s.copy(), 0.5 * kappa * s**2, theta
-    return np.sin(theta) / kappa, (1.0 - np.cos(theta)) / kappa, theta
+    if kappa == 0.0:
+        return s.copy(), np.zeros_like(s), theta
+    return np.sin(theta) / kappa, 2.0 * np.sin(0.5 * theta) ** 2 / kappa, theta
 
 
 # =============================================================================
