@@ -292,12 +292,16 @@ BEND45_PUBLISHED = {
 }
 
 #: The source most often used as "the" reference is Simo and Vu-Quoc (1986);
-#: at 450 only Crisfield (1990) is available.  The published values scatter
-#: by up to about 1.2 % (Z at 300: 39.5 to 40.53) because they are coarse FE
-#: solutions (8 elements, shear-deformable in Bathe-Bolourchi and Simo-Vu-Quoc);
-#: the converged Kirchhoff-rod solution :func:`bend45_tip_position` lies close
-#: to Crisfield/Longva.  For a 1 % check, compare with
-#: :func:`bend45_tip_position` and report the published rows alongside.
+#: at 450 only Crisfield (1990) and Longva (2015) are available.  The
+#: published values scatter by up to ~1.7 % of |position| (Z at 300: 39.5 to
+#: 40.53) because they are coarse FE results and differ in the torsion
+#: constant: the converged Kirchhoff rod :func:`bend45_tip_position` with the
+#: St Venant J = 0.1406 agrees with Crisfield and Longva to 0.2 % of
+#: |position|, and with J = 1/6 (polar moment of the unit square) with Simo
+#: and Vu-Quoc to 0.25 %, which suggests that Simo and Vu-Quoc (and Bathe and
+#: Bolourchi) used J = 1/6 (not stated in the sources found).  For a 1 % check
+#: of an Euler-Bernoulli FE model with J = 0.1406, compare with
+#: :func:`bend45_tip_position` (same J) or Crisfield 1990.
 BEND45_COMMON_REFERENCE = "Simo-Vu-Quoc 1986"
 
 
