@@ -776,7 +776,6 @@ def _limit_load(chain, path, P_scale, L_scale, q_scale, load_dir):
     def solve_v(vt):
         z = state["z"].copy()
         for _ in range(40):
-            q, lm = z[:3] * q_scale, z[3] * P_scale
 
             def H(zz):
                 qq, ll = zz[:3] * q_scale, zz[3] * P_scale
