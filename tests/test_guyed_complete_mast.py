@@ -114,6 +114,18 @@ def test_passive_block_form_equals_wrench_product():
     assert np.linalg.matrix_rank(Kp, tol=1e-9 * np.abs(Kp).max()) == 3  # three springs
 
 
+def test_active_stiffness_asymmetry_is_the_net_shroud_moment():
+    # Identity: a b^T - b a^T = [b x a]x, so K_a - K_a^T = [m]x in the rotation block, where
+    # m = W_s[3:] tau is the shrouds' net moment about C_i3, and zero elsewhere.
+    shrouds = ShroudSet(UPPER, LOWER, TAU0)
+    K = active_stiffness(TOP, shrouds)
+    m = (shroud_wrench_matrix(TOP, shrouds) @ TAU0)[3:]
+    expected = np.zeros((6, 6))
+    expected[3:, 3:] = [[0, -m[2], m[1]], [m[2], 0, -m[0]], [-m[1], m[0], 0]]
+    np.testing.assert_allclose(K - K.T, expected, atol=1e-9 * np.abs(K).max())  # round-off
+    assert np.abs(m).max() > 10.0  # N m: the check is not vacuous
+
+
 def test_single_taut_string_active_stiffness():
     # A string tied at the reference point (e = 0): lateral stiffness tau / l, nothing else.
     shrouds = ShroudSet([TOP], [TOP + [0.0, 0.0, -4.0]], [1000.0], law=None, stiffness=[1.0])

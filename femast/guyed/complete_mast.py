@@ -22,9 +22,9 @@ Correction to Eq. 26.  The printed lower-right block contains ``[l_r d_r]x``: ti
 Deriving ``-d(W_s tau_s)/dc`` gives ``[l_r d_r]x [e_r]x`` instead (the moment arm e_r
 rotating with the top): the seed's factor ``[e_r]x`` is missing.  The other blocks
 of Eq. 26 agree with the derivation.  ``form="seed"`` in :func:`active_stiffness`
-keeps the printed matrix for comparison.  K_a is not symmetric in general: the
-rotation increments are spins of the top, and the asymmetric part is the
-``[d]x[e]x`` load-stiffness term of a follower-free moment arm.
+keeps the printed matrix for comparison.  K_a is not symmetric in general: with
+spin increments of the top, the ``[d]x[e]x`` term (a force turning with its moment arm)
+is only symmetric when the net shroud moment about C_i3 vanishes.
 """
 
 from __future__ import annotations
@@ -62,7 +62,11 @@ class ShroudSet:
         lo = check_vectors("shroud lower points D_ir", self.lower).reshape(-1, 3)
         if up.shape != lo.shape:
             raise ModelError(f"shroud upper {up.shape} and lower {lo.shape} points must pair up, shape (q, 3), in m")
-        tau = np.broadcast_to(np.asarray(self.tension, dtype=float), (up.shape[0],)).copy()
+        try:
+            tau = np.broadcast_to(np.asarray(self.tension, dtype=float), (up.shape[0],)).copy()
+        except ValueError:
+            raise ModelError(f"give one tension (N) per shroud ({up.shape[0]}) or a single value; "
+                             f"got {self.tension!r}") from None
         if np.any(~np.isfinite(tau)) or np.any(tau < 0):
             raise ModelError(f"shroud tensions {tau} must be finite and >= 0 N (a shroud cannot push)")
         labels = tuple(self.labels) or tuple(f"{r + 1}" for r in range(up.shape[0]))
