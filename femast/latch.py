@@ -142,6 +142,8 @@ def _as_param_array(params) -> np.ndarray:
         return params.as_array()
     if isinstance(params, dict):
         return LatchParameters(**params).as_array()
+    if isinstance(params, (list, tuple)) and params and all(isinstance(q, LatchParameters) for q in params):
+        return np.stack([q.as_array() for q in params])
     p = np.asarray(params, dtype=float)
     if p.shape[-1] != 6:
         raise ModelError(f"latch parameters must be [r, x_backstop, k, mu, h, R] (6 values), got shape {p.shape}")

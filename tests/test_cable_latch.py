@@ -331,3 +331,15 @@ def test_coincident_nodes():
     X[1] = X[0]
     with pytest.raises(ModelError, match="zero length"):
         fam.evaluate(X, None, fam.initial_state(), IncrementContext(x_committed=X3))
+
+
+def test_initial_state_layout():
+    X = np.array([[0, 0, 0], [0.2, 0.05, 0], [0.35, 0.2, 0.05], [0.5, 0.1, 0.1], [0.7, 0.0, 0.0]], float)
+    fam = CableLatchFamily([[0, 1, 2, 3, 4], [0, 1, 2, 3, 4]], EA=EA, L0=0.9, latch_node=[2, 0], bead=0.45,
+                           latch=[P, P], x0=[1e-3, 0.0])
+    st = fam.initial_state()
+    np.testing.assert_allclose(st[0], [1e-3, 0, 0.2245, 0.2245, 0.2255, 0.2255], rtol=1e-12)  # hand split
+    np.testing.assert_allclose(st[1, 2:], 0.225, rtol=1e-12)  # no latch: L0 / n
+    np.testing.assert_allclose(st[:, 2:].sum(axis=1), 0.9, rtol=1e-14)  # Eq. 4
+    r = evaluate(fam, X, st)
+    assert np.isnan(r.output["bead_position"][1]) and r.output["latch_zone"][1] == -1

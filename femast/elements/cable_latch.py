@@ -193,16 +193,14 @@ class CableLatchFamily(ElementFamily):
         """[x0, status 0 (stick), L0_i] with L0 shared equally among the sections of each side
         of the latch (a placeholder: the first evaluation replaces it from the geometry)."""
         n = self.n_sections
+        j = self.latch_node[:, None]
+        s = np.where(self.latch_node > 0, self.bead - self.x0, 0.0)[:, None]
+        cols = np.arange(n)[None, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            L0i = np.where(cols < j, s / j, (self.L0[:, None] - s) / (n - j))
         st = np.zeros((self.n_elements, self.n_state))
         st[:, 0] = self.x0
-        for el in range(self.n_elements):
-            j = self.latch_node[el]
-            if j > 0:
-                s = self.bead[el] - self.x0[el]
-                st[el, 2 : 2 + j] = s / j
-                st[el, 2 + j :] = (self.L0[el] - s) / (n - j)
-            else:
-                st[el, 2:] = self.L0[el] / n
+        st[:, 2:] = L0i
         return st
 
     def _check_configuration(self, X):
@@ -214,7 +212,7 @@ class CableLatchFamily(ElementFamily):
         LB = Lsec.sum(axis=1) - LA
         # least strain over all bead positions the backstop allows (latch forces neglected)
         s_free = self.L0 * LA / (LA + LB)
-        s = np.minimum(s_free, self.bead + self.latch[:, 1])
+        s = np.clip(np.minimum(s_free, self.bead + self.latch[:, 1]), 1e-12 * self.L0, (1 - 1e-12) * self.L0)
         with np.errstate(divide="ignore", invalid="ignore"):
             eps_latch = np.maximum(LA / s - 1.0, LB / (self.L0 - s) - 1.0)
         eps = np.where(j > 0, eps_latch, (LA + LB) / self.L0 - 1.0)
