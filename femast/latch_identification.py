@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import OptimizeResult, least_squares
 
+from .elements.cable_latch import CableLatchFamily
 from .errors import ModelError
 from .latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force
 
@@ -98,8 +99,6 @@ def simulate_pull_test(params=None, direction=UNLATCHING, *, EA=2.0e5, L_cable=0
     with the Eq. 15 constants of the rig (so that ``bead_position`` inverts it up to the
     length change of the loaded cable, T (x - x_start) / EA).
     """
-    from .elements.cable_latch import CableLatchFamily  # avoid an import cycle at module load
-
     p = params if isinstance(params, LatchParameters) else LatchParameters.seed_fit() if params is None \
         else LatchParameters(*np.asarray(params, float))
     p.validate("simulate_pull_test")
