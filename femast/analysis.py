@@ -49,6 +49,7 @@ class AnalysisSummary:
     increments: int = 0
     iterations: int = 0
     cutbacks: int = 0
+    line_searches: int = 0
     wall_time: float = 0.0
     assembly_time: float = 0.0
     solve_time: float = 0.0
@@ -115,10 +116,16 @@ class Analysis:
     progress : show a tqdm progress bar per step.
     cutback : factor applied to a failed increment (Abaqus: 0.25).
     growth : factor applied after two easy increments (Abaqus: 1.5).
+    line_search : secant line search when a Newton step overshoots (load control).
+    extrapolate : start each increment from the previous increment's solution scaled to the new
+        increment (Abaqus' default linear extrapolation); off after a step change.
+    easy_iterations : an increment converged in at most this many iterations is easy (Abaqus'
+        I_G = 4 with looser tolerances; 5 with femast's tighter defaults).
     """
 
     def __init__(self, model, out="results", convergence: Convergence | None = None, progress: bool = True,
-                 cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 4):
+                 cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 5, line_search: bool = True,
+                 extrapolate: bool = False):
         self.model = model
         self.out = out
         self.convergence = convergence or Convergence()
@@ -126,6 +133,9 @@ class Analysis:
         self.cutback = cutback
         self.growth = growth
         self.easy_iterations = easy_iterations
+        self.line_search = line_search
+        self.extrapolate = extrapolate
+        self._last_Du = None
         if not model.steps:
             raise ModelError(f"model '{model.name}' has no steps; add one with model.step()")
         if not (model.beams or model.trusses or model.families):
@@ -292,6 +302,7 @@ class Analysis:
                      {float(t) for c in step.loads + step.prescribed if c.amplitude is not None
                       for t in c.amplitude.times if 0 < t < period})
         load_start, pres_start = self.loads.copy(), self.prescribed.copy()
+        self._last_Du = None
         t, inc, easy = 0.0, 0, 0
         self.lam = 0.0
         step_iters = 0
@@ -362,15 +373,34 @@ class Analysis:
         Du = np.zeros(nf)
         iters = 0
         rnorm_hist = []
+
+        def loads_now(lam_):
+            return (self._values(step.loads, load_start, frac, period) if not uses_lam
+                    else load_start + lam_ * P_ref_full)
+
+        def evaluate(P):
+            ta = _time.perf_counter()
+            resp = self._evaluate(ctx)
+            F_ = self.assembler.forces([q.f for q in resp])
+            r_ = P[self.free_node, self.free_dof] - F_[:nf]
+            self.summary.assembly_time += _time.perf_counter() - ta
+            if not np.all(np.isfinite(r_)):
+                raise FloatingPointError("non-finite residual")
+            return resp, F_, r_
+
+        if self.extrapolate and self._last_Du is not None and not np.any(dpres):
+            # Abaqus' linear extrapolation: start from the previous increment's solution, scaled
+            scale = dt / self._last_dt
+            Du += scale * self._last_Du
+            self._update(scale * self._last_Du)
+            lam += scale * self._last_Dlam if uses_lam else 0.0
+        lam_start = self.lam
         try:
+            P = loads_now(lam)
+            responses, F, r = evaluate(P)
             for it in range(self.convergence.max_iterations + 1):
-                P = (self._values(step.loads, load_start, frac, period) if not uses_lam
-                     else load_start + lam * P_ref_full)
                 ta = _time.perf_counter()
-                responses = self._evaluate(ctx)
-                F = self.assembler.forces([r.f for r in responses])
-                r = P[self.free_node, self.free_dof] - F[:nf]
-                K, Kfc = self.assembler.tangent([r.k for r in responses], with_fc=(it == 0 and np.any(dpres)))
+                K, Kfc = self.assembler.tangent([q.k for q in responses], with_fc=(it == 0 and np.any(dpres)))
                 self.summary.assembly_time += _time.perf_counter() - ta
                 if self._zero_force is None:
                     dk = np.abs(K.diagonal())
@@ -378,18 +408,17 @@ class Analysis:
                     kr = float(dk[self.is_rot].max(initial=0.0))
                     # 'zero flux' floors: forces of a 1e-6 L (1e-6 rad) motion of the stiffest DOF
                     self._zero_force = 1e-6 * max(kt * self.length, kr / self.length)
-                if not np.all(np.isfinite(r)):
-                    raise FloatingPointError("non-finite residual")
                 if it > 0:
-                    ok, ratio = self._converged(r, du, Du, F, P)
+                    ok, ratio = self._converged(r, du, Du, responses, P)
                     rnorm_hist.append(ratio)
                     if ok:
+                        self._last_Du, self._last_dt, self._last_Dlam = Du.copy(), dt, lam - lam_start
                         self._commit(responses, P, F, lam)
                         return True, iters, "", responses
                     if it == self.convergence.max_iterations:
                         return self._fail(saved, iters, f"no convergence in {iters} iterations "
                                           f"(residual ratio {ratio:.3g}, worst at {self._worst(r)})")
-                    if len(rnorm_hist) >= 3 and rnorm_hist[-1] > rnorm_hist[-2] > rnorm_hist[-3] and it >= 4:
+                    if it >= 8 and rnorm_hist[-1] > rnorm_hist[-2] > rnorm_hist[-3] > rnorm_hist[-4]:
                         return self._fail(saved, iters, f"residual diverging (ratio {ratio:.3g}, worst at "
                                           f"{self._worst(r)})")
                 ts = _time.perf_counter()
@@ -409,8 +438,14 @@ class Analysis:
                     lam += dlam
                 self.summary.solve_time += _time.perf_counter() - ts
                 iters += 1
-                Du += du
+                before = (self.x.copy(), self.R.copy(), self.spin.copy())
                 self._update(du, dpres if it == 0 else None)
+                P = loads_now(lam)
+                responses, F, r_new = evaluate(P)
+                if self.line_search and not uses_lam and not (it == 0 and np.any(dpres)):
+                    du, responses, F, r_new = self._line_search(du, r, r_new, responses, F, before, evaluate, P)
+                r = r_new
+                Du += du
         except (FloatingPointError, SingularModelError, ValueError) as exc:
             if isinstance(exc, SingularModelError) and self.summary.increments == 0 and iters == 0:
                 raise
@@ -419,17 +454,49 @@ class Analysis:
             return self._fail(saved, iters, str(exc))
         return self._fail(saved, iters, "no convergence")
 
+    def _line_search(self, du, r0, r1, responses, F, before, evaluate, P, eta=0.8, max_steps=5):
+        """Secant line search on g(s) = du . r(u + s du) (Crisfield 1991, sec. 9.3): only when the
+        full step leaves |g(1)| > eta |g(0)|.  Returns the accepted step and its evaluation."""
+        g0 = float(du @ r0)
+        g1 = float(du @ r1)
+        if g0 == 0.0 or abs(g1) <= eta * abs(g0):
+            return du, responses, F, r1
+        s_prev, g_prev, s, g = 0.0, g0, 1.0, g1
+        best = (abs(g1), 1.0, responses, F, r1)
+        for _ in range(max_steps):
+            s_new = s - g * (s - s_prev) / (g - g_prev) if g != g_prev else 0.5 * s
+            s_new = min(max(s_new, 0.05), 1.0)
+            self.x, self.R, self.spin = before[0].copy(), before[1].copy(), before[2].copy()
+            self._update(s_new * du)
+            resp, F_, r_ = evaluate(P)
+            g_new = float(du @ r_)
+            if abs(g_new) < best[0]:
+                best = (abs(g_new), s_new, resp, F_, r_)
+            if abs(g_new) <= eta * abs(g0):
+                break
+            s_prev, g_prev, s, g = s, g, s_new, g_new
+        _, s_best, resp, F_, r_ = best
+        if s_best != s_new:
+            self.x, self.R, self.spin = before[0].copy(), before[1].copy(), before[2].copy()
+            self._update(s_best * du)
+        self.summary.line_searches += 1
+        return s_best * du, resp, F_, r_
+
     def _worst(self, r):
         return self.dofmap.describe(int(np.argmax(np.abs(r))))
 
-    def _converged(self, r, du, Du, F, P):
-        nf = self.dofmap.n_free
-        rot_all = np.zeros(self.dofmap.n_active, dtype=bool)
-        rot_all[:nf] = self.is_rot
-        rot_all[nf:] = self.cons_dof >= 3
+    def _converged(self, r, du, Du, responses, P):
+        """Force/moment residual against the largest element nodal force/moment or applied load
+        (Abaqus' 'flux' magnitude), displacement correction against the increment."""
+        fmax = mmax = 0.0
+        for resp in responses:
+            fe = resp.f.reshape(resp.f.shape[0], -1, 6)
+            if fe.size:
+                fmax = max(fmax, float(np.abs(fe[:, :, :3]).max()))
+                mmax = max(mmax, float(np.abs(fe[:, :, 3:]).max()))
         Pf = P[self.free_node, self.free_dof]
-        fmax = max(float(np.abs(F[~rot_all]).max(initial=0.0)), float(np.abs(Pf[~self.is_rot]).max(initial=0.0)))
-        mmax = max(float(np.abs(F[rot_all]).max(initial=0.0)), float(np.abs(Pf[self.is_rot]).max(initial=0.0)))
+        fmax = max(fmax, float(np.abs(Pf[~self.is_rot]).max(initial=0.0)))
+        mmax = max(mmax, float(np.abs(Pf[self.is_rot]).max(initial=0.0)))
         L = self.length
         ref_f = max(fmax, 1e-2 * mmax / L, self._zero_force)
         ref_m = max(mmax, 1e-2 * fmax * L, self._zero_force * L)

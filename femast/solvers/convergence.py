@@ -3,8 +3,8 @@
 An increment has converged when, for translations and rotations separately,
 
 * the largest residual force (moment) is at most ``force_tol`` times the reference
-  force (moment): the largest of the external loads, internal forces and reactions of
-  that field, with a floor for fields that carry nothing (moments: force x model size);
+  force (moment): the largest nodal force (moment) that any element carries or any load
+  applies, with a floor for fields that carry nothing (moments: force x model size);
 * the largest Newton correction of displacement (rotation) is at most ``disp_tol``
   times the largest displacement (rotation) increment of the increment so far.
 
@@ -25,7 +25,7 @@ class Convergence:
 
     force_tol: float = 1e-6
     disp_tol: float = 1e-6
-    max_iterations: int = 20
+    max_iterations: int = 25
 
     def check(self, r, du, Du, is_rot, ref_force, ref_moment, length):
         """Return (converged, residual_ratio) given the free residual ``r``, the last
