@@ -1,0 +1,163 @@
+"""Numba kernels of the friction ball joint (see :mod:`femast.elements.ball_joint`).
+
+One element, local DOF order [xa(3), wa(3), xb(3), wb(3)] (translations, spatial spins).
+
+State row (``N_STATE`` = 15)::
+
+    0:3   m      committed friction moment in the body frame of node b, N m
+    3     slip   1.0 if the joint slipped in the committed increment, else 0.0
+    4     gamma  accumulated slip (relative rotation by sliding), rad
+    5     D      dissipated energy, J
+    6:15  Q      committed relative rotation Q = R_a^T R_b, row-major
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from ..rotations import logm_so3, skew, ts_inv
+
+N_STATE = 15
+I_M = 0
+I_SLIP = 3
+I_GAMMA = 4
+I_DISS = 5
+I_Q = 6
+
+# error codes of the kernel
+OK = 0
+ERR_NOT_FINITE = 1
+ERR_BIG_INCREMENT = 2
+
+# a relative-rotation increment this close to pi cannot be told from its complement
+MAX_INCREMENT = 3.0  # rad
+
+
+@njit(cache=True)
+def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out):
+    """Forces ``f`` (12), tangent ``K`` (12x12), trial state ``new`` (15) and output ``out``
+    (11: M (3, global), F (3, global), |F|, limit, slip, gamma, D) of one joint.
+    Returns (strain energy in J, error code)."""
+    # tie: node b sits at the point x_a + R_a d0 of node a (d0: initial offset, below the tolerance)
+    c = Ra @ d0
+    d = xb - xa - c
+    F = k_pen * d
+    Fn = math.sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2])
+    Y = mu * B * Fn
+    if not (math.isfinite(Fn) and math.isfinite(Ra.sum()) and math.isfinite(Rb.sum())):
+        return 0.0, ERR_NOT_FINITE
+    Q = Ra.T @ Rb
+    Qc = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            Qc[i, j] = st[I_Q + 3 * i + j]
+    # finite relative-rotation increment, right (body-b) form: Q = Qc exp(th)
+    th = logm_so3(Qc.T @ Q)
+    tn = math.sqrt(th[0] ** 2 + th[1] ** 2 + th[2] ** 2)
+    err = OK
+    if tn > MAX_INCREMENT:
+        err = ERR_BIG_INCREMENT
+    # elastic predictor
+    mtr = np.empty(3)
+    for i in range(3):
+        mtr[i] = st[I_M + i] + k_s * th[i]
+    nm = math.sqrt(mtr[0] ** 2 + mtr[1] ** 2 + mtr[2] ** 2)
+    C = np.zeros((3, 3))
+    G = np.zeros((3, 3))  # dm/dd (slip only): n (mu B dFn/dd)^T
+    m = np.empty(3)
+    # relative tolerance: a point on the slip surface (|m_tr| = Y to round-off) sticks
+    if nm <= Y * (1.0 + 1e-12):
+        slip = 0.0
+        dgam = 0.0
+        for i in range(3):
+            m[i] = mtr[i]
+            C[i, i] = k_s
+    else:
+        # return mapping (radial return = backward Euler on the circular slip surface)
+        slip = 1.0
+        n = mtr / nm
+        dgam = (nm - Y) / k_s
+        r = Y * k_s / nm
+        for i in range(3):
+            m[i] = Y * n[i]
+            for j in range(3):
+                C[i, j] = r * ((1.0 if i == j else 0.0) - n[i] * n[j])
+        if Fn > 0.0:
+            g = (mu * B * k_pen / Fn) * F  # d|F|/dd * mu B
+            for i in range(3):
+                for j in range(3):
+                    G[i, j] = n[i] * g[j]
+    M = Rb @ m
+    # dm/dw_b = C Ts^-T(th) Rb^T = -dm/dw_a ; spatial A = Rb C Ts^-T Rb^T
+    A = Rb @ (C @ (ts_inv(th).T @ Rb.T))
+    Gs = Rb @ G
+    SM = skew(M)
+    Sc = skew(c)
+    Gc = Gs @ Sc          # d(M)/d(w_a) through |F| (eccentric tie)
+    kSc = k_pen * Sc      # dF/dw_a
+    SF = skew(F)
+    # tie moment on node a: F x c; its derivative w.r.t. w_a
+    Kcc = -(Sc @ kSc) - SF @ Sc
+    for i in range(12):
+        f[i] = 0.0
+        for j in range(12):
+            K[i, j] = 0.0
+    for i in range(3):
+        f[i] = -F[i]
+        f[6 + i] = F[i]
+        f[3 + i] = -M[i] + (F[(i + 1) % 3] * c[(i + 2) % 3] - F[(i + 2) % 3] * c[(i + 1) % 3])
+        f[9 + i] = M[i]
+        K[i, i] = k_pen
+        K[6 + i, 6 + i] = k_pen
+        K[i, 6 + i] = -k_pen
+        K[6 + i, i] = -k_pen
+        for j in range(3):
+            a = A[i, j]
+            b = A[i, j] - SM[i, j]
+            g = Gs[i, j]
+            # tie forces: F depends on w_a through the offset
+            K[6 + i, 3 + j] = kSc[i, j]
+            K[i, 3 + j] = -kSc[i, j]
+            # row of node b's moment
+            K[9 + i, 9 + j] = b
+            K[9 + i, 3 + j] = -a + Gc[i, j]
+            K[9 + i, 6 + j] = g
+            K[9 + i, j] = -g
+            # node a's moment is the opposite, plus the tie moment F x c
+            K[3 + i, 9 + j] = -b
+            K[3 + i, 3 + j] = a - Gc[i, j] + Kcc[i, j]
+            K[3 + i, 6 + j] = -g - kSc[i, j]
+            K[3 + i, j] = g + kSc[i, j]
+    for i in range(3):
+        new[I_M + i] = m[i]
+    new[I_SLIP] = slip
+    new[I_GAMMA] = st[I_GAMMA] + dgam
+    new[I_DISS] = st[I_DISS] + Y * dgam
+    for i in range(3):
+        for j in range(3):
+            new[I_Q + 3 * i + j] = Q[i, j]
+    for i in range(3):
+        out[i] = M[i]
+        out[3 + i] = F[i]
+    out[6] = Fn
+    out[7] = Y
+    out[8] = slip
+    out[9] = new[I_GAMMA]
+    out[10] = new[I_DISS]
+    mm = m[0] ** 2 + m[1] ** 2 + m[2] ** 2
+    return 0.5 * Fn * Fn / k_pen + 0.5 * mm / k_s, err
+
+
+@njit(cache=True, parallel=True)
+def ball_joint_family_kernel(nodes, x, R, d0, k_pen, k_s, mu, B, state, f, K, new, out, energy, err):
+    """All joints of a family at once (see :func:`ball_joint_element`)."""
+    for e in prange(nodes.shape[0]):
+        a = nodes[e, 0]
+        b = nodes[e, 1]
+        en, code = ball_joint_element(x[a], x[b], R[a], R[b], d0[e], k_pen[e], k_s[e], mu[e], B[e],
+                                      state[e], f[e], K[e], new[e], out[e])
+        energy[e] = en
+        err[e] = code
