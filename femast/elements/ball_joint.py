@@ -135,7 +135,7 @@ class BallJointFamily(ElementFamily):
                 ("B", self.B, self.B > 0, "is the ball end radius: it must be finite and > 0 m (seed: 0.004)")):
             bad = np.flatnonzero(~(np.isfinite(arr) & ok))
             if bad.size:
-                raise ModelError(f"{self._who(bad[0])}: {what} = {arr[bad[0]]!r} {rule}")
+                raise ModelError(f"{self._who(bad[0])}: {what} = {float(arr[bad[0]])!r} {rule}")
         self.d0 = np.zeros((n, 3))
         self.tol = None
         if X is not None:
@@ -299,7 +299,7 @@ def add_ball_joints(model, pairs, mu=SEED_MU, B=SEED_B, *, k_pen=None, k_stick=N
     if pairs.ndim != 2 or pairs.shape[1] != 2 or pairs.shape[0] == 0:
         raise ModelError(f"ball joints '{name}': pairs must be a list of (longeron end, corner) node labels, "
                          f"got shape {pairs.shape}")
-    for a, b in pairs:
+    for a, b in pairs.tolist():
         model._check_node(a, f"ball joint {a}-{b}")
         model._check_node(b, f"ball joint {a}-{b}")
     pairs = pairs.astype(np.int64)
