@@ -116,15 +116,17 @@ class Analysis:
     progress : show a tqdm progress bar per step.
     cutback : factor applied to a failed increment (Abaqus: 0.25).
     growth : factor applied after two easy increments (Abaqus: 1.5).
-    line_search : secant line search when a Newton step overshoots (load control).
+    line_search : secant line search when a Newton step overshoots (load control): True, False, or
+        "auto" (default): only when retrying an increment that failed, where plain Newton
+        already went astray (a line search slows the easy increments down).
     extrapolate : start each increment from the previous increment's solution scaled to the new
         increment (Abaqus' default linear extrapolation); off after a step change.
     easy_iterations : an increment converged in at most this many iterations is easy (Abaqus'
-        I_G = 4 with looser tolerances; 5 with femast's tighter defaults).
+        I_G = 4 with looser tolerances; 6 with femast's tighter defaults).
     """
 
     def __init__(self, model, out="results", convergence: Convergence | None = None, progress: bool = True,
-                 cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 5, line_search: bool = True,
+                 cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
                  extrapolate: bool = False):
         self.model = model
         self.out = out
@@ -320,7 +322,9 @@ class Analysis:
             attempt = 0
             while True:
                 attempt += 1
-                ok, iters, note, responses = self._increment(step, control, t, dt, load_start, pres_start)
+                ok, iters, note, responses = self._increment(step, control, t, dt, load_start, pres_start,
+                                                             line_search=self.line_search is True or
+                                                             (self.line_search == "auto" and attempt > 1))
                 step_iters += iters
                 self.summary.iterations += iters
                 if ok:
@@ -349,7 +353,7 @@ class Analysis:
         bar.close()
         self.summary.steps.append({"name": step.name, "increments": inc, "iterations": step_iters})
 
-    def _increment(self, step, control, t, dt, load_start, pres_start):
+    def _increment(self, step, control, t, dt, load_start, pres_start, line_search=False):
         """Try one increment; on success commit and return (True, iterations, '', responses);
         on failure restore the committed configuration and return (False, iterations, why, None)."""
         saved = (self.x.copy(), self.R.copy(), self.spin.copy(), self.lam)
@@ -442,7 +446,7 @@ class Analysis:
                 self._update(du, dpres if it == 0 else None)
                 P = loads_now(lam)
                 responses, F, r_new = evaluate(P)
-                if self.line_search and not uses_lam and not (it == 0 and np.any(dpres)):
+                if line_search and not uses_lam and not (it == 0 and np.any(dpres)):
                     du, responses, F, r_new = self._line_search(du, r, r_new, responses, F, before, evaluate, P)
                 r = r_new
                 Du += du

@@ -35,6 +35,17 @@ def skew(v):
     return S
 
 
+@njit(cache=True, inline="always")
+def _sq(S):
+    """S @ S for a 3x3 matrix, as loops (numba's @ calls BLAS: slow for 3x3)."""
+    out = np.zeros((3, 3))
+    for i in range(3):
+        for j in range(3):
+            for k in range(3):
+                out[i, j] += S[i, k] * S[k, j]
+    return out
+
+
 @njit(cache=True)
 def expm_so3(v):
     """Rotation matrix exp(skew(v)) of the rotation vector ``v`` (rad), Rodrigues' formula."""
@@ -48,7 +59,7 @@ def expm_so3(v):
         a = math.sin(t) / t
         b = (1.0 - math.cos(t)) / t2
     S = skew(v)
-    return np.eye(3) + a * S + b * (S @ S)
+    return np.eye(3) + a * S + b * _sq(S)
 
 
 @njit(cache=True)
@@ -116,7 +127,7 @@ def ts_inv(theta):
     t = math.sqrt(theta[0] ** 2 + theta[1] ** 2 + theta[2] ** 2)
     eta, _ = _eta(t)
     S = skew(theta)
-    return np.eye(3) - 0.5 * S + eta * (S @ S)
+    return np.eye(3) - 0.5 * S + eta * _sq(S)
 
 
 @njit(cache=True)

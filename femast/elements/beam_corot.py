@@ -34,6 +34,51 @@ from .base import ElementFamily, ElementResponse
 SECTION_FORCE_NAMES = ("N", "Vy", "Vz", "T", "My", "Mz")
 
 
+# Small dense products as plain loops: numba's `@` calls BLAS, whose per-call overhead
+# dominates for 3x3 and 3x12 operands.
+@njit(cache=True, inline="always")
+def _mm(A, B):
+    n, k = A.shape
+    m = B.shape[1]
+    C = np.zeros((n, m))
+    for i in range(n):
+        for p in range(k):
+            a = A[i, p]
+            if a != 0.0:
+                for j in range(m):
+                    C[i, j] += a * B[p, j]
+    return C
+
+
+@njit(cache=True, inline="always")
+def _mv(A, v):
+    n, k = A.shape
+    out = np.zeros(n)
+    for i in range(n):
+        for p in range(k):
+            out[i] += A[i, p] * v[p]
+    return out
+
+
+@njit(cache=True, inline="always")
+def _vm(v, A):
+    k, m = A.shape
+    out = np.zeros(m)
+    for p in range(k):
+        if v[p] != 0.0:
+            for j in range(m):
+                out[j] += v[p] * A[p, j]
+    return out
+
+
+@njit(cache=True, inline="always")
+def _dot(a, b):
+    s = 0.0
+    for i in range(a.shape[0]):
+        s += a[i] * b[i]
+    return s
+
+
 @njit(cache=True)
 def _cross(a, b):
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
@@ -43,8 +88,8 @@ def _cross(a, b):
 def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
     """Internal force ``f`` (12), tangent ``K`` (12x12) and section forces ``sf`` (2x6)
     of one corotational beam.  Returns the strain energy (J)."""
-    T1 = R1 @ E0
-    T2 = R2 @ E0
+    T1 = _mm(R1, E0)
+    T2 = _mm(R2, E0)
     q1 = T1[:, 1].copy()
     q2 = T2[:, 1].copy()
     d = x2 - x1
@@ -58,10 +103,10 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
     Rr[:, 0] = e1
     Rr[:, 1] = e2
     Rr[:, 2] = e3
-    th1 = logm_so3(Rr.T @ T1)
-    th2 = logm_so3(Rr.T @ T2)
-    q1c = q @ e1
-    q2c = q @ e2
+    th1 = logm_so3(_mm(Rr.T, T1))
+    th2 = logm_so3(_mm(Rr.T, T2))
+    q1c = _dot(q, e1)
+    q2c = _dot(q, e2)
 
     # local response (7 dofs: ubar, theta1, theta2)
     ubar = (l * l - l0 * l0) / (l + l0)
@@ -73,8 +118,8 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
     m2 = np.array([kt * (th2[0] - th1[0]), ky * (th1[1] + 2 * th2[1]), kz * (th1[2] + 2 * th2[2])])
     Ti1 = ts_inv(th1)
     Ti2 = ts_inv(th2)
-    mt1 = Ti1.T @ m1
-    mt2 = Ti2.T @ m2
+    mt1 = _mv(Ti1.T, m1)
+    mt2 = _mv(Ti2.T, m2)
     M = mt1 + mt2
     alpha = M[1] + M[0] * q1c / q2c
     c = M[0] / (2.0 * q2c)
@@ -82,8 +127,8 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
     fx2 = N * e1 - FD
     qe1 = _cross(q1, e3)
     qe2 = _cross(q2, e3)
-    fw1 = Rr @ mt1 - c * qe1
-    fw2 = Rr @ mt2 - c * qe2
+    fw1 = _mv(Rr, mt1) - c * qe1
+    fw2 = _mv(Rr, mt2) - c * qe2
     for i in range(3):
         f[i] = -fx2[i]
         f[3 + i] = fw1[i]
@@ -96,34 +141,34 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
     for i in range(3):
         Dl[i, i] = -1.0
         Dl[i, 6 + i] = 1.0
-    J_l = e1 @ Dl
+    J_l = _vm(e1, Dl)
     G = np.zeros((3, 12))
-    G[2, :] = (e2 @ Dl) / l
-    G[1, :] = -(e3 @ Dl) / l
+    G[2, :] = _vm(e2, Dl) / l
+    G[1, :] = -_vm(e3, Dl) / l
     G[0, :] = q1c * G[1, :]
     for i in range(3):
         G[0, 3 + i] += 0.5 * qe1[i]
         G[0, 9 + i] += 0.5 * qe2[i]
     G[0, :] /= q2c
-    Wr = Rr @ G
-    J_e1 = -skew(e1) @ Wr
-    J_e2 = -skew(e2) @ Wr
-    J_e3 = -skew(e3) @ Wr
+    Wr = _mm(Rr, G)
+    J_e1 = -_mm(skew(e1), Wr)
+    J_e2 = -_mm(skew(e2), Wr)
+    J_e3 = -_mm(skew(e3), Wr)
     J_q1 = np.zeros((3, 12))
     J_q2 = np.zeros((3, 12))
     J_q1[:, 3:6] = -skew(q1)
     J_q2[:, 9:12] = -skew(q2)
     J_q = 0.5 * (J_q1 + J_q2)
-    J_q1c = e1 @ J_q + q @ J_e1
-    J_q2c = e2 @ J_q + q @ J_e2
+    J_q1c = _vm(e1, J_q) + _vm(q, J_e1)
+    J_q2c = _vm(e2, J_q) + _vm(q, J_e2)
     # local rotations
     A1 = -G.copy()
     A2 = -G.copy()
     RrT = Rr.T.copy()
     A1[:, 3:6] += RrT
     A2[:, 9:12] += RrT
-    J_th1 = Ti1 @ A1
-    J_th2 = Ti2 @ A2
+    J_th1 = _mm(Ti1, A1)
+    J_th2 = _mm(Ti2, A2)
     J_N = (EA / l0) * J_l
     J_m1 = np.empty((3, 12))
     J_m2 = np.empty((3, 12))
@@ -133,8 +178,8 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
     J_m2[1] = ky * (J_th1[1] + 2 * J_th2[1])
     J_m1[2] = kz * (2 * J_th1[2] + J_th2[2])
     J_m2[2] = kz * (J_th1[2] + 2 * J_th2[2])
-    J_mt1 = Ti1.T @ J_m1 + ts_inv_T_times_derivative(th1, m1) @ J_th1
-    J_mt2 = Ti2.T @ J_m2 + ts_inv_T_times_derivative(th2, m2) @ J_th2
+    J_mt1 = _mm(Ti1.T, J_m1) + _mm(ts_inv_T_times_derivative(th1, m1), J_th1)
+    J_mt2 = _mm(Ti2.T, J_m2) + _mm(ts_inv_T_times_derivative(th2, m2), J_th2)
     J_M = J_mt1 + J_mt2
     J_alpha = J_M[1] + (q1c / q2c) * J_M[0] + (M[0] / q2c) * J_q1c - (M[0] * q1c / (q2c * q2c)) * J_q2c
     J_FD = np.empty((3, 12))
@@ -145,13 +190,13 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
         J_fx2[i] = e1[i] * J_N + N * J_e1[i] - J_FD[i]
     J_c = J_M[0] / (2.0 * q2c) - (M[0] / (2.0 * q2c * q2c)) * J_q2c
     S_e3 = skew(e3)
-    J_fw1 = Rr @ J_mt1 + mt1[0] * J_e1 + mt1[1] * J_e2 + mt1[2] * J_e3
-    J_fw2 = Rr @ J_mt2 + mt2[0] * J_e1 + mt2[1] * J_e2 + mt2[2] * J_e3
+    J_fw1 = _mm(Rr, J_mt1) + mt1[0] * J_e1 + mt1[1] * J_e2 + mt1[2] * J_e3
+    J_fw2 = _mm(Rr, J_mt2) + mt2[0] * J_e1 + mt2[1] * J_e2 + mt2[2] * J_e3
     for i in range(3):
         J_fw1[i] -= qe1[i] * J_c
         J_fw2[i] -= qe2[i] * J_c
-    J_fw1 -= c * (-S_e3 @ J_q1 + skew(q1) @ J_e3)
-    J_fw2 -= c * (-S_e3 @ J_q2 + skew(q2) @ J_e3)
+    J_fw1 -= c * (_mm(skew(q1), J_e3) - _mm(S_e3, J_q1))
+    J_fw2 -= c * (_mm(skew(q2), J_e3) - _mm(S_e3, J_q2))
     for j in range(12):
         for i in range(3):
             K[i, j] = -J_fx2[i, j]
@@ -175,7 +220,7 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
     sf[1, 3] = m2[0]
     sf[1, 4] = m2[1]
     sf[1, 5] = m2[2]
-    return 0.5 * (N * ubar + m1 @ th1 + m2 @ th2)
+    return 0.5 * (N * ubar + _dot(m1, th1) + _dot(m2, th2))
 
 
 @njit(cache=True, parallel=True)

@@ -1,0 +1,360 @@
+"""Tension-only Dyneema shroud cable: two nodes, the tension-dependent rope law of seed 000 (Eq. 25).
+
+One element is a straight rope between two end points.  Each end point may sit on a
+*rigid offset* from its node (a lever rigidly attached to the node, as the seed's
+shroud attachment points C_ir are rigidly attached to the mast top C_i3):
+
+    p_a = x_a + R_a o_a                      (o_a: offset in the initial configuration, m)
+
+with R_a the node's total rotation.  Without offsets the element is a plain cable with
+translational DOFs only.
+
+Axial law (seed 000, Eqs. 25, 27, as corrected in :mod:`femast.guyed.shroud`).  The strain is
+measured from the unstretched length L0, ``eps = l / L0 - 1``, and the tension is the root of
+``tau = g(tau) eps`` with ``g = k0 + k1 tau + k2 tau^2`` (k0 in N, k1 dimensionless, k2 in 1/N):
+
+    tau(eps) = 2 k0 eps / ((1 - k1 eps) + sqrt((1 - k1 eps)^2 - 4 k0 k2 eps^2))   (eps >= 0)
+    tau = 0                                                                       (eps < 0, slack)
+
+and the material tangent ``d tau / d l = EA_t(tau) / L0`` with ``EA_t = g^2 / (k0 - k2 tau^2)``
+(:func:`femast.guyed.shroud.axial_rigidity_tangent`).  At exactly ``eps = 0`` the rope counts as
+taut (tangent ``k0 / L0``, the one-sided derivative from the taut side): a shroud installed
+exactly taut with zero pretension then has the seed's passive stiffness at tau = 0.
+
+Forces and consistent tangent (q = [x_a, w_a, x_b, w_b], w spatial spins; e the unit vector from
+p_a to p_b; r = R o the current arms; ``G = [I, -[r]x]`` maps a node increment to its end
+point's increment; ``D = [-G_a, G_b]`` (3 x 12) maps q to ``d(p_b - p_a)``):
+
+    f = tau D^T e                                   (f_a = -tau [e ; r_a x e], f_b = +tau [e ; r_b x e])
+    K = (d tau / d l) D^T e e^T D                   material ("passive") part
+      + tau / l D^T (I - e e^T) D                   geometric part of the rope turning
+      + tau ([e]x [r_b]x on (w_b, w_b)  -  [e]x [r_a]x on (w_a, w_a))   arms turning with the nodes
+
+The first term is the FE counterpart of the seed's passive stiffness K_p (Eq. 24), the last two
+of the active stiffness K_a (Eq. 26): for a shroud from the mast top (node a, arm e_r) to a
+ground anchor (node b, fixed) the (a, a) block of K is exactly ``K_p + K_a`` of
+:mod:`femast.guyed.complete_mast`.  ``tangent_parts`` selects the parts assembled
+("full", "material", "geometric" or "none"); anything but "full" is for decomposing the
+tangent of a converged state, not for solving.  K is symmetric without offsets; with offsets
+the arm term is not (``[e]x[r]x`` is symmetric only for r parallel to e).
+
+Construction: :class:`ShroudCableFamily` takes the unstretched lengths; :func:`add_shrouds`
+adds shrouds to a :class:`~femast.model.Model` given either the unstretched length or the
+tension that each carries in the model's initial geometry.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from ..errors import ModelError
+from .base import ElementFamily, ElementResponse
+
+PARTS = {"none": 0, "material": 1, "geometric": 2, "full": 3}
+
+ERR_ZERO_LENGTH = 1
+ERR_BEYOND_LAW = 2
+ERR_NOT_FINITE = 3
+
+# 5-point Gauss-Legendre rule on [0, 1] for the strain energy L0 * int_0^eps tau(e) de
+_GX = np.array([0.04691007703066800, 0.23076534494715845, 0.5, 0.76923465505284155, 0.95308992296933200])
+_GW = np.array([0.11846344252809454, 0.23931433524968324, 0.28444444444444444, 0.23931433524968324,
+                0.11846344252809454])
+
+
+@njit(cache=True)
+def dyneema_tension(eps, k0, k1, k2):
+    """Tension (N) of the rope law at strain eps (Eq. 27 inverted; 0 for eps < 0).
+    Returns (tau, ok): ok False when eps is beyond the range where the law has a finite root."""
+    if eps <= 0.0:
+        return 0.0, True
+    a = 1.0 - k1 * eps
+    disc = a * a - 4.0 * k0 * k2 * eps * eps
+    if disc < 0.0:
+        return 0.0, False
+    den = a + math.sqrt(disc)
+    if den <= 0.0:
+        return 0.0, False
+    return 2.0 * k0 * eps / den, True
+
+
+@njit(cache=True)
+def dyneema_tangent_rigidity(tau, k0, k1, k2):
+    """EA_t = d tau / d eps = g^2 / (k0 - k2 tau^2), N (derivative of tau = g(tau) eps)."""
+    g = k0 + k1 * tau + k2 * tau * tau
+    return g * g / (k0 - k2 * tau * tau)
+
+
+@njit(cache=True, parallel=True)
+def shroud_family_kernel(nodes, x, R, offsets, L0, law, parts, gx, gw, f, K, tau_out, eps_out, len_out,
+                         energy, err):
+    """All shroud elements: forces f (n, 12), tangent K (n, 12, 12), tension, strain, length,
+    strain energy and an error code per element (see module docstring)."""
+    for el in prange(nodes.shape[0]):
+        a = nodes[el, 0]
+        b = nodes[el, 1]
+        ra = R[a] @ offsets[el, 0]
+        rb = R[b] @ offsets[el, 1]
+        d = (x[b] + rb) - (x[a] + ra)
+        l = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        if not math.isfinite(l):
+            err[el] = ERR_NOT_FINITE
+            continue
+        if l <= 1e-12 * L0[el]:
+            err[el] = ERR_ZERO_LENGTH
+            continue
+        e = d / l
+        k0 = law[el, 0]
+        k1 = law[el, 1]
+        k2 = law[el, 2]
+        eps = l / L0[el] - 1.0
+        if eps < 0.0:
+            tau = 0.0
+            kt = 0.0
+        else:
+            tau, ok = dyneema_tension(eps, k0, k1, k2)
+            if not ok:
+                err[el] = ERR_BEYOND_LAW
+                continue
+            kt = dyneema_tangent_rigidity(tau, k0, k1, k2) / L0[el]
+            if not (kt > 0.0):
+                err[el] = ERR_BEYOND_LAW
+                continue
+        tau_out[el] = tau
+        eps_out[el] = eps
+        len_out[el] = l
+        # strain energy L0 int_0^eps tau de (Gauss-Legendre, exact to ~1e-12 for this smooth law)
+        en = 0.0
+        if eps > 0.0:
+            for g in range(gx.shape[0]):
+                t, ok = dyneema_tension(gx[g] * eps, k0, k1, k2)
+                en += gw[g] * t
+            en *= eps * L0[el]
+        energy[el] = en
+        # D = [-G_a, G_b], G = [I, -[r]x]; B = D^T e
+        Dm = np.zeros((3, 12))
+        for i in range(3):
+            Dm[i, i] = -1.0
+            Dm[i, 6 + i] = 1.0
+        # -G_a rotation block = +[r_a]x ; G_b rotation block = -[r_b]x
+        Dm[0, 4] = -ra[2]
+        Dm[0, 5] = ra[1]
+        Dm[1, 3] = ra[2]
+        Dm[1, 5] = -ra[0]
+        Dm[2, 3] = -ra[1]
+        Dm[2, 4] = ra[0]
+        Dm[0, 10] = rb[2]
+        Dm[0, 11] = -rb[1]
+        Dm[1, 9] = -rb[2]
+        Dm[1, 11] = rb[0]
+        Dm[2, 9] = rb[1]
+        Dm[2, 10] = -rb[0]
+        B = Dm.T @ e
+        for i in range(12):
+            f[el, i] = tau * B[i]
+        Kel = np.zeros((12, 12))
+        if parts & 1:
+            for i in range(12):
+                for j in range(12):
+                    Kel[i, j] += kt * B[i] * B[j]
+        if parts & 2:
+            P = np.eye(3)
+            for i in range(3):
+                for j in range(3):
+                    P[i, j] -= e[i] * e[j]
+            Kel += (tau / l) * (Dm.T @ P @ Dm)
+            # arms turning with the nodes: tau [e]x[r]x = tau (r e^T - (e . r) I), sign -/+ for a/b
+            era = e[0] * ra[0] + e[1] * ra[1] + e[2] * ra[2]
+            erb = e[0] * rb[0] + e[1] * rb[1] + e[2] * rb[2]
+            for i in range(3):
+                for j in range(3):
+                    ia = ra[i] * e[j] - (era if i == j else 0.0)
+                    ib = rb[i] * e[j] - (erb if i == j else 0.0)
+                    Kel[3 + i, 3 + j] -= tau * ia
+                    Kel[9 + i, 9 + j] += tau * ib
+        for i in range(12):
+            for j in range(12):
+                K[el, i, j] = Kel[i, j]
+
+
+def _law_array(law, n_el, name):
+    """(n_el, 3) array [k0, k1, k2] from a DyneemaLaw, a sequence of them, or an array."""
+    from ..guyed.shroud import DyneemaLaw  # local import: guyed imports the FE core, not vice versa
+
+    if law is None:
+        law = DyneemaLaw()
+    if isinstance(law, DyneemaLaw):
+        arr = np.array([[law.k0, law.k1, law.k2]])
+    elif isinstance(law, (list, tuple)) and law and all(isinstance(v, DyneemaLaw) for v in law):
+        arr = np.array([[v.k0, v.k1, v.k2] for v in law])
+    else:
+        arr = np.asarray(law, dtype=float)
+        if arr.ndim == 1:
+            arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise ModelError(f"{name}: the rope law must be a DyneemaLaw or [k0 (N), k1 (-), k2 (1/N)] per element; "
+                         f"got shape {arr.shape}")
+    try:
+        arr = np.ascontiguousarray(np.broadcast_to(arr, (n_el, 3)), dtype=float).copy()
+    except ValueError:
+        raise ModelError(f"{name}: give one rope law or one per element ({n_el}); got {arr.shape[0]}") from None
+    bad = np.flatnonzero(~np.all(np.isfinite(arr), axis=1) | ~(arr[:, 0] > 0.0))
+    if bad.size:
+        raise ModelError(f"{name} element {bad[0]}: rope law [k0, k1, k2] = {arr[bad[0]].tolist()} needs a finite, "
+                         "positive k0 (axial rigidity at zero tension, N) and finite k1 (-), k2 (1/N); "
+                         "give the physical stiffness (the seed's is k0 = 935353.664 N)")
+    return arr
+
+
+def _per_element(value, n_el, name, what):
+    try:
+        return np.ascontiguousarray(np.broadcast_to(np.asarray(value, dtype=float), (n_el,)), dtype=float).copy()
+    except (ValueError, TypeError):
+        raise ModelError(f"{name}: {what} must be a scalar or one value per element ({n_el}); got {value!r}") from None
+
+
+class ShroudCableFamily(ElementFamily):
+    """A batch of tension-only Dyneema ropes (seed 000, Eq. 25), optionally on rigid end offsets.
+
+    Parameters
+    ----------
+    nodes : (n_el, 2) int, end nodes (labels when added with ``Model.add_family``).
+    L0 : unstretched lengths, m (> 0), scalar or per element.
+    law : :class:`~femast.guyed.shroud.DyneemaLaw` (default: the seed's coefficients), a list of
+        them, or an (n_el, 3) array ``[k0 (N), k1 (-), k2 (1/N)]``; k0 must be > 0.
+    offsets : optional (n_el, 2, 3) rigid offsets of the end points from nodes a and b in the
+        initial configuration, m (global axes).  With any nonzero offset the family also acts on
+        the rotations of its nodes: every node of the family then needs rotational support
+        (a beam, a fix) -- keep offset-free ropes on translational-only nodes in another family.
+    name : label used in messages and results.
+
+    Output per element: ``tension`` (N), ``strain`` (from L0), ``length`` (m, between the end
+    points), ``slack`` (1.0 when the rope carries nothing).
+    """
+
+    n_state = 0
+
+    def __init__(self, nodes, L0, law=None, offsets=None, labels=None, name: str = "shroud"):
+        self.name = name
+        nodes = np.asarray(nodes)
+        if nodes.ndim == 1:
+            nodes = nodes[None, :]
+        if nodes.ndim != 2 or nodes.shape[1] != 2 or not np.issubdtype(nodes.dtype, np.integer):
+            raise ModelError(f"{name}: nodes must be an (n_el, 2) integer array; got shape {nodes.shape}")
+        self.nodes = np.ascontiguousarray(nodes, dtype=np.int64)
+        n_el = self.nodes.shape[0]
+        self.L0 = _per_element(L0, n_el, name, "L0 (m)")
+        bad = np.flatnonzero(~(np.isfinite(self.L0) & (self.L0 > 0.0)))
+        if bad.size:
+            raise ModelError(f"{name} element {bad[0]}: unstretched length L0 = {self.L0[bad[0]]!r} m must be "
+                             "finite and > 0")
+        self.law = _law_array(law, n_el, name)
+        if offsets is None:
+            off = np.zeros((n_el, 2, 3))
+        else:
+            try:
+                off = np.broadcast_to(np.asarray(offsets, dtype=float), (n_el, 2, 3)).copy()
+            except ValueError:
+                raise ModelError(f"{name}: offsets must have shape (n_el, 2, 3) in m; got "
+                                 f"{np.shape(offsets)}") from None
+            if not np.all(np.isfinite(off)):
+                raise ModelError(f"{name}: offsets must be finite, in m")
+        self.offsets = np.ascontiguousarray(off)
+        has_off = bool(np.any(off != 0.0))
+        self.active_dofs = (0, 1, 2, 3, 4, 5) if has_off else (0, 1, 2)
+        self.symmetric = not has_off
+        self.labels = np.arange(1, n_el + 1) if labels is None else np.asarray(labels)
+        self.tangent_parts = "full"
+
+    def end_points(self, x, R) -> np.ndarray:
+        """(n_el, 2, 3) current end points p = x + R o, m (x, R for all model nodes)."""
+        x = np.asarray(x, dtype=float)
+        R = np.asarray(R, dtype=float)
+        return x[self.nodes] + np.einsum("enij,enj->eni", R[self.nodes], self.offsets)
+
+    def evaluate(self, x, R, state, ctx=None) -> ElementResponse:
+        if self.tangent_parts not in PARTS:
+            raise ModelError(f"{self.name}: tangent_parts = {self.tangent_parts!r}; use one of {', '.join(PARTS)}")
+        n = self.n_elements
+        x = np.ascontiguousarray(x, dtype=float)
+        R = np.ascontiguousarray(R, dtype=float) if R is not None else np.tile(np.eye(3), (x.shape[0], 1, 1))
+        f = np.zeros((n, 12))
+        K = np.zeros((n, 12, 12))
+        tau = np.zeros(n)
+        eps = np.zeros(n)
+        length = np.zeros(n)
+        energy = np.zeros(n)
+        err = np.zeros(n, dtype=np.int64)
+        shroud_family_kernel(self.nodes, x, R, self.offsets, self.L0, self.law, PARTS[self.tangent_parts],
+                             _GX, _GW, f, K, tau, eps, length, energy, err)
+        bad = np.flatnonzero(err)
+        if bad.size:
+            el = int(bad[0])
+            code = int(err[el])
+            p = self.end_points(x, R)[el]
+            if code == ERR_ZERO_LENGTH:
+                msg = (f"its two end points coincide at {np.round(p[0], 6).tolist()} m (nodes "
+                       f"{self.nodes[el, 0]} and {self.nodes[el, 1]} plus offsets); a rope needs two distinct "
+                       "attachment points")
+            elif code == ERR_BEYOND_LAW:
+                l = float(np.linalg.norm(p[1] - p[0]))
+                msg = (f"strain {l / self.L0[el] - 1.0:.4g} is beyond the range of the rope law "
+                       f"{self.law[el].tolist()} (no finite increasing tension there); check L0 = {self.L0[el]:.6g} m "
+                       "and the node coordinates (units m)")
+            else:
+                msg = "nodal coordinates are not finite"
+            raise ModelError(f"{self.name} element {self.labels[el]}: {msg}")
+        output = {"tension": tau, "strain": eps, "length": length, "slack": (eps < 0.0).astype(float)}
+        return ElementResponse(f=f, k=K, state=state, output=output, energy=energy)
+
+
+def unstretched_length(law, tension, length):
+    """Unstretched length L0 (m) at which a rope of the law carries ``tension`` (N) at ``length`` (m):
+    ``L0 = length / (1 + eps(tension))`` with eps from :func:`femast.guyed.shroud.strain_from_tension`."""
+    from ..guyed.shroud import DyneemaLaw, strain_from_tension
+
+    return np.asarray(length, float) / (1.0 + strain_from_tension(law or DyneemaLaw(), tension))
+
+
+def add_shrouds(model, pairs, law=None, tension=None, L0=None, offsets=None, name: str = "shroud") -> ShroudCableFamily:
+    """Add Dyneema shrouds between node-label pairs ``pairs`` ((n, 2)) to ``model``; returns the family.
+
+    Give either ``L0`` (unstretched lengths, m) or ``tension`` (N, >= 0: the tension each rope carries
+    in the model's *initial* geometry, including the offsets); neither means taut at zero tension.
+    ``offsets`` (n, 2, 3) as in :class:`ShroudCableFamily`.  Raises ModelError for coincident
+    attachment points, non-positive lengths or stiffness, and tensions outside the law's range.
+    """
+    from ..guyed.shroud import DyneemaLaw
+
+    pairs = np.atleast_2d(np.asarray(pairs, dtype=np.int64))
+    if pairs.ndim != 2 or pairs.shape[1] != 2:
+        raise ModelError(f"{name}: pairs must be (n, 2) node labels; got shape {pairs.shape}")
+    n = pairs.shape[0]
+    laws = _law_array(law, n, name)
+    off = np.zeros((n, 2, 3)) if offsets is None else np.broadcast_to(np.asarray(offsets, float), (n, 2, 3))
+    p = np.array([[model.xyz(a), model.xyz(b)] for a, b in pairs]) + off
+    length = np.linalg.norm(p[:, 1] - p[:, 0], axis=1)
+    scale = max(1.0, float(np.abs(p).max()))
+    for k in np.flatnonzero(length <= 1e-9 * scale):
+        raise ModelError(f"{name} {k + 1} (nodes {pairs[k, 0]}-{pairs[k, 1]}): its attachment points coincide at "
+                         f"{np.round(p[k, 0], 6).tolist()} m; move one of them so the rope has a length")
+    if L0 is not None and tension is not None:
+        raise ModelError(f"{name}: give the unstretched length L0 or the tension, not both")
+    if tension is not None:
+        tau = _per_element(tension, n, name, "tension (N)")
+        L0v = np.empty(n)
+        for k in range(n):
+            lk = DyneemaLaw(*laws[k])
+            if not (np.isfinite(tau[k]) and 0.0 <= tau[k] < lk.tau_max_valid):
+                raise ModelError(f"{name} {k + 1}: tension {tau[k]!r} N must be >= 0 and below "
+                                 f"{lk.tau_max_valid:.4g} N, where the rope law is increasing")
+            L0v[k] = float(unstretched_length(lk, tau[k], length[k]))
+    elif L0 is not None:
+        L0v = _per_element(L0, n, name, "L0 (m)")
+    else:
+        L0v = length.copy()
+    fam = ShroudCableFamily(pairs, L0v, laws, offsets=None if offsets is None else off, name=name)
+    return model.add_family(fam)
