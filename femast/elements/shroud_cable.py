@@ -349,7 +349,7 @@ def add_shrouds(model, pairs, law=None, tension=None, L0=None, offsets=None, nam
         for k in range(n):
             lk = DyneemaLaw(*laws[k])
             if not (np.isfinite(tau[k]) and 0.0 <= tau[k] < lk.tau_max_valid):
-                raise ModelError(f"{name} {k + 1}: tension {tau[k]!r} N must be >= 0 and below "
+                raise ModelError(f"{name} {k + 1}: tension {float(tau[k])!r} N must be >= 0 and below "
                                  f"{lk.tau_max_valid:.4g} N, where the rope law is increasing")
             L0v[k] = float(unstretched_length(lk, tau[k], length[k]))
     elif L0 is not None:

@@ -207,6 +207,32 @@ class MastFE:
         raise ModelError(f"shroud pretension did not settle to {tol:g} in {max_iter} iterations "
                          f"(tensions {st.tension} N, target {target} N)")
 
+    def run_wrenches(self, wrenches) -> dict:
+        """Nonlinear response to a sequence of top wrenches (k, 6) (N, N m about the top, dead loads),
+        applied one step each after the pretension step (keep :meth:`equilibrate`'s unstretched lengths:
+        call it first).  Returns a dict with, at the end of the pretension step (``"u0"``) and of each
+        load step (``"u"``, (k, 6)): the top displacement [ux, uy, uz] (m) and accumulated spins (rad)
+        from the initial geometry, and the shroud tensions ``"tension0"``, ``"tension"`` (k, q) in N."""
+        from ..results import Results
+
+        wrenches = np.asarray(wrenches, dtype=float).reshape(-1, 6)
+        self.solve(wrenches)
+        res = Results(self._tmp.name)
+        steps = res.steps
+        last = {s: i for i, s in enumerate(steps)}
+        row = int(np.flatnonzero(res.node_labels == self.top)[0])
+
+        def pick(i):
+            fr = res.frame(i)
+            u = np.concatenate([fr["U"][row], fr["URA"][row]])
+            tau = fr.get(f"el/{SHROUD_FAMILY}/tension", np.zeros(0))
+            return u, np.asarray(tau, dtype=float)
+
+        u0, t0 = pick(last["pretension"])
+        picked = [pick(last[f"load{k + 1:04d}"]) for k in range(len(wrenches))]
+        return {"u0": u0, "tension0": t0, "u": np.array([p[0] for p in picked]).reshape(-1, 6),
+                "tension": np.array([p[1] for p in picked]).reshape(len(wrenches), -1)}
+
     # ----------------------------------------------------------------- state
     def _family(self, name):
         for f in self.analysis.families:
