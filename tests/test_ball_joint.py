@@ -65,8 +65,8 @@ def test_loop_plateau_and_energy_per_cycle(tmp_path, P, max_increment):
     m, a, b = single_joint_model(P, A, ks, max_increment)
     h = histories(fm.solve(m, tmp_path, progress=False), b)
     Y = MU * B * P
-    # the tie carries the applied force (equilibrium of node b, converged to 1e-6 relative)
-    assert np.allclose(h["F"][1:], P, rtol=1e-9)  # penalty tie force = load, to Newton round-off
+    # the tie carries the applied force (equilibrium of node b)
+    assert np.allclose(h["F"][1:], P, rtol=1e-9)  # the tie is linear: Newton solves it to round-off
     # plateau exactly at mu B |F| and never above it
     assert np.max(np.abs(h["M"])) <= Y * (1 + 1e-12)  # return mapping lands on |m| = Y to round-off
     slip = h["slip"] > 0
@@ -79,19 +79,21 @@ def test_loop_plateau_and_energy_per_cycle(tmp_path, P, max_increment):
         i = at(h, t_turn)
         j = i + 1
         if not h["slip"][j]:
+            # elastic predictor is exactly linear in the relative rotation: round-off only
             assert h["M"][j] - h["M"][i] == pytest.approx(ks * (h["rz"][j] - h["rz"][i]), rel=1e-9)
         assert h["M"][i] == pytest.approx(-sign * Y, rel=1e-12)  # at +A the joint slipped forwards
     # dissipated energy over the closed cycle +A -> -A -> +A (total times 2 -> 6)
     D = h["D"][at(h, 6.0)] - h["D"][at(h, 2.0)]
     exact = friction_loop_energy(MU, B, P, A, ks)
-    assert exact == pytest.approx(4 * Y * (A - Y / ks))
+    assert exact == pytest.approx(4 * Y * (A - Y / ks), rel=1e-14)  # same formula, round-off
     # 1D radial return is exact for any increment size: only round-off differs
     assert D == pytest.approx(exact, rel=1e-9)
-    # ... and equals the area of the loop (trapezoid rule is exact on piecewise-linear segments
-    # whose corners are increment ends; the stick-slip corner inside an increment is not, so
-    # compare with the increment size's share of the area)
+    # ... and is close to the area of the plotted loop: the trapezoid rule over increment ends
+    # cuts the stick-slip corner that falls inside an increment (a triangle of at most
+    # 2Y x one increment's rotation), a few % with 0.1 s increments, ~15% with 0.7 s
     i0, i1 = at(h, 2.0), at(h, 6.0)
-    area = np.trapezoid(h["M"][i0:i1 + 1], h["rz"][i0:i1 + 1])
+    Mc, rc = h["M"][i0:i1 + 1], h["rz"][i0:i1 + 1]
+    area = float(np.sum(0.5 * (Mc[1:] + Mc[:-1]) * np.diff(rc)))
     assert area == pytest.approx(exact, rel=0.2 if max_increment > 0.5 else 0.05)  # corner cut by coarse increments
 
 
@@ -155,11 +157,12 @@ def test_tangent_matches_finite_differences(slip, offset, seed):
     assert r.output["slip"][0] == float(slip)
     if slip:
         # trial point well inside the slip regime: |m_tr| - Y >> the FD step's moment k_s h
-        mtr = np.linalg.norm(st[0, :3] + 50.0 * np.linalg.norm(_rel_increment(R, st)))
-        assert mtr > 2 * Y and Mn == pytest.approx(Y, rel=1e-12)
+        mtr = np.linalg.norm(st[0, :3] + fam.k_stick[0] * _rel_increment(R, st))
+        assert mtr > 2 * Y  # |m_tr| - Y ~ Y >> k_stick h = 5e-5 N m: FD never crosses the surface
+        assert Mn == pytest.approx(Y, rel=1e-12)  # radial return lands on the circle to round-off
         assert not np.allclose(r.k[0], r.k[0].T)  # non-symmetric while slipping (d|F| term)
     else:
-        assert Mn < 0.5 * Y  # far from the switching surface
+        assert Mn < 0.5 * Y  # far from the switching surface: FD stays in stick
     Kn = _fd_tangent(fam, x, R, st)
     for rows in (np.r_[0:3, 6:9], np.r_[3:6, 9:12]):
         for cols in (np.r_[0:3, 6:9], np.r_[3:6, 9:12]):
@@ -285,21 +288,21 @@ def test_two_beams_joint_transmits_mu_B_F(tmp_path):
     F = res.element_history("ball_joint", 1, "F")
     slip = res.element_history("ball_joint", 1, "slip") > 0
     Mn = np.linalg.norm(M, axis=1)
-    assert np.allclose(F, np.linalg.norm(Fv, axis=1), rtol=1e-14)  # output |F| is the norm of the tie force
-    assert F[1:].min() >= 200.0 * (1 - 1e-6)  # at least the axial load (plus the shear of bending)
+    assert np.allclose(F, np.linalg.norm(Fv, axis=1), rtol=1e-14)  # |F| output is the norm: round-off
+    # at least the axial load (plus the shear of bending); 1e-6 = Newton's force tolerance
+    assert F[1:].min() >= 200.0 * (1 - 1e-6)
     # slips both ways, and the slip plateau is mu B |F| with |F| the transmitted force
     assert (M[slip, 2] > 0).sum() > 3 and (M[slip, 2] < 0).sum() > 3
     assert np.allclose(Mn[slip], MU * B * F[slip], rtol=1e-12)  # return mapping, round-off
     assert np.all(Mn <= MU * B * F * (1 + 1e-12) + 1e-300)  # Coulomb: |M| <= mu B |F| always
     # independent check through beam 1: reactions at the clamp balance the joint's action on node 2,
     # (force F, moment M), so the transmitted moment follows from the reactions and the geometry
-    i1, i2 = res._node_row(n1), res._node_row(n2)
+    RF = np.column_stack([res.node_history(n1, c) for c in ("rfx", "rfy", "rfz", "rmx", "rmy", "rmz")])
+    arm = np.column_stack([res.node_history(n2, c) - res.node_history(n1, c) for c in ("ux", "uy", "uz")])
+    arm += m.xyz(n2) - m.xyz(n1)
     for i in range(1, len(res)):
-        fr = res.frame(i)
-        RF = fr["RF"][i1]
-        arm = res.positions(i)[i2] - res.positions(i)[i1]
-        assert np.allclose(RF[:3], -Fv[i], atol=1e-6 * 200.0)  # Newton force tolerance 1e-6 x load
-        M_from_beam = -(RF[3:] + np.cross(arm, Fv[i]))
+        assert np.allclose(RF[i, :3], -Fv[i], atol=1e-6 * 200.0)  # Newton force tolerance 1e-6 x load
+        M_from_beam = -(RF[i, 3:] + np.cross(arm[i], Fv[i]))
         # Newton's moment tolerance: 1e-6 of the largest nodal moment (~ 3EI A / L ~ 20 N m)
         assert np.allclose(M_from_beam, M[i], atol=1e-4)
 
@@ -356,8 +359,8 @@ def test_default_stiffnesses_follow_the_connected_members():
     sec = fm.circular_tube(0.02, 0.016, E=70e9)
     le = 0.5 / 4  # element length
     kp, ks = default_stiffnesses(m, [(n2, n3)])
-    assert kp[0] == pytest.approx(PENALTY_FACTOR * sec.E * sec.A / le)
-    assert ks[0] == pytest.approx(STICK_FACTOR * 4 * sec.E * sec.Iz / le)
+    assert kp[0] == pytest.approx(PENALTY_FACTOR * sec.E * sec.A / le)  # same formula: round-off
+    assert ks[0] == pytest.approx(STICK_FACTOR * 4 * sec.E * sec.Iz / le)  # same formula: round-off
     assert fam.k_pen[0] == kp[0] and fam.k_stick[0] == ks[0]
 
 
