@@ -21,6 +21,7 @@ from numba import njit
 from tqdm.auto import tqdm
 
 from .assembly import Assembler
+from .constraints import Constraints
 from .dofs import number_dofs
 from .elements.base import DOF_NAMES, IncrementContext
 from .elements.beam_corot import BeamFamily, element_frame
@@ -163,13 +164,24 @@ class Analysis:
                     raise ModelError(f"step '{s.name}': node {c.node} {DOF_NAMES[c.dof]} is both loaded and "
                                      "fixed/prescribed; a DOF can have a load or a prescribed value, not both")
         self.constrained = constrained
-        self.dofmap = number_dofs(n, self.families, constrained, model.node_labels)
+        self.constraints = Constraints(model, n)
+        clash = self.constraints.dependent & constrained
+        if clash.any():
+            i, d = np.argwhere(clash)[0]
+            raise ModelError(f"node {model.node_labels[i]} {DOF_NAMES[d]} is dependent in a rigid body or tie and "
+                             "also fixed or prescribed; fix or drive the reference (master) node instead")
+        extra = np.zeros((n, 6), dtype=bool)
+        extra[self.constraints.references] = True
+        self.dofmap = number_dofs(n, self.families, constrained, model.node_labels, extra_active=extra,
+                                  dependent=self.constraints.dependent)
         if self.dofmap.n_free == 0:
             raise ModelError(f"model '{model.name}' has no free DOFs")
-        self.assembler = Assembler(self.dofmap, self.families)
-        nf = self.dofmap.n_free
+        self.assembler = Assembler(self.dofmap, self.families, full=self.constraints.active)
+        self.constraints.setup(self.dofmap, self.X0)
+        nf, ni = self.dofmap.n_free, self.dofmap.n_independent
         self.free_node, self.free_dof = self.dofmap.slots(np.arange(nf))
-        self.cons_node, self.cons_dof = self.dofmap.slots(np.arange(nf, self.dofmap.n_active))
+        self.cons_node, self.cons_dof = self.dofmap.slots(np.arange(nf, ni))
+        self.act_node, self.act_dof = self.dofmap.slots(np.arange(self.dofmap.n_active))
         self.is_rot = self.free_dof >= 3
         self.length = float(np.ptp(self.X0, axis=0).max()) or 1.0
         self.symmetric = all(getattr(f, "symmetric", False) for f in self.families)
@@ -198,6 +210,33 @@ class Analysis:
                 raise FloatingPointError(f"non-finite internal forces in element family '{f.name}'")
         return responses
 
+    def _residual(self, responses, P):
+        """Residual P - F on the independent DOFs (free first, then constrained)."""
+        F = self.assembler.forces([q.f for q in responses])
+        Pa = P[self.act_node, self.act_dof]
+        self._net = F - Pa
+        if not self.constraints.active:
+            return -self._net
+        self._T = self.constraints.transformation(self.x)
+        return -(self._T.T @ self._net)
+
+    def _reduce_load(self, P):
+        """A nodal load array (n, 6) as a vector on the free DOFs (through the constraints)."""
+        Pa = P[self.act_node, self.act_dof]
+        if self.constraints.active:
+            Pa = self._T.T @ Pa
+        return Pa[: self.dofmap.n_free]
+
+    def _tangent(self, responses, with_fc):
+        """(K_ff, K_fc) at the configuration of the last :meth:`_residual` call."""
+        k_list = [q.k for q in responses]
+        if not self.constraints.active:
+            return self.assembler.tangent(k_list, with_fc=with_fc)
+        nf = self.dofmap.n_free
+        T = self._T
+        K = (T.T @ self.assembler.full_tangent(k_list) @ T + self.constraints.geometric(self.x, self._net)).tocsr()
+        return K[:nf, :nf], (K[:nf, nf:] if with_fc else None)
+
     def _update(self, du_free, du_cons=None):
         W = np.zeros_like(self.spin)
         for node, dof, du in ((self.free_node, self.free_dof, du_free),
@@ -209,6 +248,8 @@ class Analysis:
             np.add.at(W, (node[~t], dof[~t] - 3), du[~t])
         self.spin += W
         _apply_spins(self.R, W)
+        if self.constraints.active:
+            self.constraints.update_slaves(self.x, self.R, self.spin)
 
     def _values(self, conds, start, frac_time, period, lam=None):
         """Loads or prescribed values at step time ``frac_time * period`` (or load factor lam)."""
@@ -237,7 +278,8 @@ class Analysis:
         """Tangent stiffness K_ff (scipy CSR, free DOFs) at the current configuration and
         committed state; use :meth:`free_equation` to find a node's rows."""
         responses = self._evaluate(IncrementContext(x_committed=self.x, R_committed=self.R))
-        K, _ = self.assembler.tangent([r.k for r in responses])
+        self._residual(responses, self.loads)
+        K, _ = self._tangent(responses, with_fc=False)
         return K.copy()
 
     def free_equation(self, label, dof) -> int:
@@ -367,7 +409,6 @@ class Analysis:
             lam = self.lam
             P_end = self._values(step.loads, load_start, 1.0, period)
             P_ref_full = P_end - load_start
-            P_ref = P_ref_full[self.free_node, self.free_dof]
         else:
             lam = frac
         pres = self._values(step.prescribed, pres_start, frac, period)
@@ -385,12 +426,11 @@ class Analysis:
         def evaluate(P):
             ta = _time.perf_counter()
             resp = self._evaluate(ctx)
-            F_ = self.assembler.forces([q.f for q in resp])
-            r_ = P[self.free_node, self.free_dof] - F_[:nf]
+            res_ = self._residual(resp, P)
             self.summary.assembly_time += _time.perf_counter() - ta
-            if not np.all(np.isfinite(r_)):
+            if not np.all(np.isfinite(res_)):
                 raise FloatingPointError("non-finite residual")
-            return resp, F_, r_
+            return resp, res_, res_[:nf]
 
         if self.extrapolate and self._last_Du is not None and not np.any(dpres):
             # Abaqus' linear extrapolation: start from the previous increment's solution, scaled
@@ -404,7 +444,7 @@ class Analysis:
             responses, F, r = evaluate(P)
             for it in range(self.convergence.max_iterations + 1):
                 ta = _time.perf_counter()
-                K, Kfc = self.assembler.tangent([q.k for q in responses], with_fc=(it == 0 and np.any(dpres)))
+                K, Kfc = self._tangent(responses, with_fc=(it == 0 and np.any(dpres)))
                 self.summary.assembly_time += _time.perf_counter() - ta
                 if self._zero_force is None:
                     dk = np.abs(K.diagonal())
@@ -435,7 +475,7 @@ class Analysis:
                 rhs = r if Kfc is None else r - Kfc @ dpres
                 du = self.solver.solve(rhs)
                 if uses_lam:
-                    du_p = self.solver.solve(P_ref)
+                    du_p = self.solver.solve(self._reduce_load(P_ref_full))
                     cur = self.dof_value(self.free_node[control.eq], self.free_dof[control.eq])
                     dlam = control.dlambda(du, du_p, cur, frac)
                     du = du + dlam * du_p
@@ -459,6 +499,7 @@ class Analysis:
         return self._fail(saved, iters, "no convergence")
 
     def _line_search(self, du, r0, r1, responses, F, before, evaluate, P, eta=0.8, max_steps=5):
+        # F here is the reduced residual of the trial point (kept for the commit)
         """Secant line search on g(s) = du . r(u + s du) (Crisfield 1991, sec. 9.3): only when the
         full step leaves |g(1)| > eta |g(0)|.  Returns the accepted step and its evaluation."""
         g0 = float(du @ r0)
@@ -498,9 +539,8 @@ class Analysis:
             if fe.size:
                 fmax = max(fmax, float(np.abs(fe[:, :, :3]).max()))
                 mmax = max(mmax, float(np.abs(fe[:, :, 3:]).max()))
-        Pf = P[self.free_node, self.free_dof]
-        fmax = max(fmax, float(np.abs(Pf[~self.is_rot]).max(initial=0.0)))
-        mmax = max(mmax, float(np.abs(Pf[self.is_rot]).max(initial=0.0)))
+        fmax = max(fmax, float(np.abs(P[:, :3]).max(initial=0.0)))
+        mmax = max(mmax, float(np.abs(P[:, 3:]).max(initial=0.0)))
         L = self.length
         ref_f = max(fmax, 1e-2 * mmax / L, self._zero_force)
         ref_m = max(mmax, 1e-2 * fmax * L, self._zero_force * L)
@@ -510,21 +550,20 @@ class Analysis:
         self.x, self.R, self.spin, self.lam = saved[0], saved[1], saved[2], saved[3]
         return False, iters, why, None
 
-    def _commit(self, responses, P, F, lam):
+    def _commit(self, responses, P, res, lam):
         self.states = [r.state.copy() if r.state is not None else s for r, s in zip(responses, self.states)]
         self.loads = P.copy()
         self.prescribed[self.cons_node, self.cons_dof] = [self.dof_value(n, d) for n, d in
                                                           zip(self.cons_node, self.cons_dof)]
         self.lam = lam
         self.strain_energy = float(sum(np.sum(r.energy) for r in responses if r.energy is not None))
-        self._F = F
+        self._reactions = -res[self.dofmap.n_free:]
 
     def _write(self, writer, step_name, inc, time, iterations, responses, period=1.0):
         n = len(self.X0)
         RF = np.zeros((n, 6))
         if responses is not None:
-            nf = self.dofmap.n_free
-            RF[self.cons_node, self.cons_dof] = self._F[nf:] - self.loads[self.cons_node, self.cons_dof]
+            RF[self.cons_node, self.cons_dof] = self._reactions
         data = {"step": step_name, "increment": inc, "time": time, "total_time": self.total_time,
                 "load_factor": self.lam, "iterations": iterations, "U": self.x - self.X0, "R": self.R,
                 "UR": rotation_vectors(self.R), "URA": self.spin, "RF": RF, "P": self.loads,

@@ -68,12 +68,23 @@ def _block_pattern(eq_list, row_lo, row_hi, col_lo, col_hi):
 class Assembler:
     """Assembles internal forces (all active DOFs) and the K_ff, K_fc tangent blocks."""
 
-    def __init__(self, dofmap, families):
+    def __init__(self, dofmap, families, full: bool = False):
         self.dofmap = dofmap
+        self.full = full
         self.eqs = [np.ascontiguousarray(dofmap.element_equations(f.nodes)) for f in families]
         nf, na = dofmap.n_free, dofmap.n_active
-        self.K_ff, self.pos_ff = _block_pattern(self.eqs, 0, nf, 0, nf)
-        self.K_fc, self.pos_fc = _block_pattern(self.eqs, 0, nf, nf, na)
+        if full:  # all active DOFs (the analysis reduces it with the constraint transformation)
+            self.K_aa, self.pos_aa = _block_pattern(self.eqs, 0, na, 0, na)
+        else:
+            self.K_ff, self.pos_ff = _block_pattern(self.eqs, 0, nf, 0, nf)
+            self.K_fc, self.pos_fc = _block_pattern(self.eqs, 0, nf, nf, na)
+
+    def full_tangent(self, k_list):
+        """K over all active DOFs (only with ``full=True``)."""
+        self.K_aa.data[:] = 0.0
+        for k, pos in zip(k_list, self.pos_aa):
+            _scatter_matrix(k, pos, self.K_aa.data)
+        return self.K_aa
 
     def forces(self, f_list) -> np.ndarray:
         out = np.zeros(self.dofmap.n_active)

@@ -139,6 +139,30 @@ class Step:
         return self
 
 
+def _step_rotate(self, node, axis, angle: float, amplitude: Amplitude | None = None):
+    """Prescribe a rotation of ``node`` by ``angle`` (rad) about the fixed global ``axis`` (any
+    direction) at the end of the step: the three rotation components are driven together, which
+    is exact for a rotation about a fixed axis."""
+    a = np.asarray(axis, dtype=float)
+    if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) == 0:
+        raise ModelError(f"step '{self.name}': rotation axis {axis!r} must be a non-zero 3-vector")
+    a = a / np.linalg.norm(a)
+    return self.prescribe(node, amplitude=amplitude, rx=angle * a[0], ry=angle * a[1], rz=angle * a[2])
+
+
+def _step_follow(self, node, times, **tables):
+    """Drive DOFs of ``node`` along measured time tables: ``step.follow(n, t, rz=theta, ux=x)``
+    with ``times`` (step time, s) and one array of values (m, rad) per DOF; increments end at
+    every table time."""
+    for name, values in tables.items():
+        self.prescribe(node, amplitude=Amplitude(times, values, name=f"{name} of node {node}"), **{name: 1.0})
+    return self
+
+
+Step.rotate = _step_rotate
+Step.follow = _step_follow
+
+
 class Model:
     """A structural model: nodes (6 DOF each), element families, fixed DOFs and steps."""
 
@@ -151,6 +175,8 @@ class Model:
         self.trusses: list[TrussSpec] = []
         self.families: list = []  # user / custom ElementFamily objects (built with node labels)
         self.fixed: dict[int, set] = {}
+        self.rigid_bodies: list = []
+        self.ties: list = []
         self.steps: list[Step] = []
         self._next_element = 1
 
@@ -288,6 +314,48 @@ class Model:
                         raise ModelError(f"fix node {node}: unknown DOF '{d}'; use {', '.join(DOF_NAMES)}")
                     idx.append(_DOF_INDEX[str(d).lower()])
         self.fixed.setdefault(int(node), set()).update(idx)
+
+    # ------------------------------------------------------------ constraints
+    def rigid_body(self, reference, nodes, name: str | None = None):
+        """Tie ``nodes`` rigidly to the ``reference`` node (exact for large rotations, as Abaqus
+        *RIGID BODY with a REF NODE).  Load, fix or drive the reference node; the tied nodes
+        follow.  The reference node may be a node without elements (e.g. a control node)."""
+        from .constraints import RigidBodySpec
+
+        name = name or f"rigid-{len(self.rigid_bodies) + 1}"
+        self._check_node(reference, f"rigid body '{name}'")
+        nodes = [n for n in np.atleast_1d(nodes).tolist()]
+        for n in nodes:
+            self._check_node(n, f"rigid body '{name}'")
+        others = [n for n in nodes if int(n) != int(reference)]
+        if len(others) < 1:
+            raise ModelError(f"rigid body '{name}': needs the reference node and at least one other node "
+                             f"(got {len(others) + 1} node in all); a rigid body with fewer than two nodes ties nothing")
+        if len(set(int(n) for n in others)) != len(others):
+            raise ModelError(f"rigid body '{name}': a node is listed twice")
+        spec = RigidBodySpec(name, int(reference), tuple(int(n) for n in others))
+        self.rigid_bodies.append(spec)
+        return spec
+
+    def tie(self, master, slave, *dofs):
+        """Make ``dofs`` of node ``slave`` equal to those of ``master`` (default: the three
+        translations, a pin between coincident nodes; "all" ties rotations too: exact for any
+        rotation when all three rotations are tied)."""
+        from .constraints import TieSpec
+
+        self._check_node(master, "tie")
+        self._check_node(slave, "tie")
+        if int(master) == int(slave):
+            raise ModelError(f"tie: node {master} tied to itself")
+        if not dofs:
+            idx = (0, 1, 2)
+        elif dofs == ("all",):
+            idx = tuple(range(6))
+        else:
+            idx = tuple(dof_index(d) for d in dofs)
+        spec = TieSpec(int(master), int(slave), idx)
+        self.ties.append(spec)
+        return spec
 
     # ----------------------------------------------------------------- steps
     def step(self, name: str | None = None, **options) -> Step:

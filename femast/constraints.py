@@ -1,0 +1,173 @@
+"""Multi-point constraints: rigid bodies and equal-DOF ties, exact for large rotations.
+
+A *rigid body* ties a set of nodes to a reference node (Abaqus *RIGID BODY, REF NODE):
+
+    x_s = x_r + R_r (X_s - X_r),     R_s = R_r
+
+for every tied node s, whatever the size of the reference rotation R_r.  A *tie* makes chosen DOFs
+of a node equal to those of a master node (Abaqus *EQUATION / *TIE with coincident nodes):
+translations u_s = u_m, and, if all three rotations are tied, R_s = R_m (tying one or two rotation
+components is exact only for rotations about a fixed axis).
+
+The analysis eliminates the dependent DOFs by the transformation method: with T the (exact,
+configuration-dependent) map from independent to all variations,
+
+    dx_s = dx_r - [d]x dw_r,   dw_s = dw_r,   d = x_s - x_r,
+
+forces are reduced as T^T f and the tangent as T^T K T + G, where G = sum_s [f_s]x [d_s]x on the
+reference rotation block is the derivative of the lever arm (f_s = net force on node s).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .errors import ModelError
+
+
+@dataclass
+class RigidBodySpec:
+    name: str
+    reference: int
+    nodes: tuple
+
+
+@dataclass
+class TieSpec:
+    master: int
+    slave: int
+    dofs: tuple
+
+
+def _skew(v):
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+class Constraints:
+    """Dependent DOFs of a model and the transformation to the independent ones."""
+
+    def __init__(self, model, n_nodes):
+        self.n = n_nodes
+        self.dependent = np.zeros((n_nodes, 6), dtype=bool)
+        self.rigid_slave = []      # (slave index, reference index)
+        self.tie = []              # (slave index, master index, dof)
+        owner = {}
+        for rb in model.rigid_bodies:
+            r = model.index(rb.reference)
+            for lab in rb.nodes:
+                s = model.index(lab)
+                if s == r:
+                    continue
+                if s in owner:
+                    raise ModelError(f"node {lab} is in two constraints ({owner[s]} and rigid body '{rb.name}'); "
+                                     "a node can belong to one rigid body or tie only")
+                owner[s] = f"rigid body '{rb.name}'"
+                self.rigid_slave.append((s, r))
+                self.dependent[s, :] = True
+        for t in model.ties:
+            s, m = model.index(t.slave), model.index(t.master)
+            if s in owner:
+                raise ModelError(f"node {t.slave} is in two constraints ({owner[s]} and a tie to node {t.master}); "
+                                 "a node can belong to one rigid body or tie only")
+            owner[s] = f"tie to node {t.master}"
+            for d in t.dofs:
+                self.tie.append((s, m, d))
+                self.dependent[s, d] = True
+        masters = {r for _, r in self.rigid_slave} | {m for _, m, _ in self.tie}
+        for node in masters:
+            if node in owner:
+                lab = model.node_labels[node]
+                raise ModelError(f"node {lab} is the reference/master of one constraint and dependent in another "
+                                 f"({owner[node]}); chains of constraints are not supported: tie it to the same "
+                                 "reference node instead")
+        self.rigid_slave = np.array(self.rigid_slave, dtype=np.int64).reshape(-1, 2)
+        self.tie = np.array(self.tie, dtype=np.int64).reshape(-1, 3)
+        self.references = np.unique(self.rigid_slave[:, 1]) if len(self.rigid_slave) else np.zeros(0, np.int64)
+        self.X_rel = None
+
+    @property
+    def active(self) -> bool:
+        return bool(self.dependent.any())
+
+    def setup(self, dofmap, X0):
+        self.eq = dofmap.eq
+        self.n_ind = dofmap.n_free + dofmap.n_constrained
+        self.n_active = dofmap.n_active
+        s, r = self.rigid_slave[:, 0], self.rigid_slave[:, 1]
+        self.X_rel = X0[s] - X0[r]
+        self.X0 = X0
+
+    def update_slaves(self, x, R, spin):
+        """Put every dependent node where its constraint says (exact for any rotation)."""
+        if len(self.rigid_slave):
+            s, r = self.rigid_slave[:, 0], self.rigid_slave[:, 1]
+            x[s] = x[r] + np.einsum("nij,nj->ni", R[r], self.X_rel)
+            R[s] = R[r]
+            spin[s] = spin[r]
+        if len(self.tie):
+            for s, m, d in self.tie:
+                if d < 3:
+                    x[s, d] = self.X0[s, d] + (x[m, d] - self.X0[m, d])
+                else:
+                    spin[s, d - 3] = spin[m, d - 3]
+            full = {}
+            for s, m, d in self.tie:
+                if d >= 3:
+                    full.setdefault((s, m), set()).add(d)
+            for (s, m), ds in full.items():
+                if len(ds) == 3:
+                    R[s] = R[m]
+
+    def transformation(self, x):
+        """T (n_active x n_ind): variations of all active DOFs from the independent ones."""
+        rows, cols, vals = [], [], []
+        eq = self.eq
+        ind = np.flatnonzero((eq.ravel() >= 0) & (eq.ravel() < self.n_ind))
+        e = eq.ravel()[ind]
+        rows.append(e), cols.append(e), vals.append(np.ones(e.size))
+        for s, r in self.rigid_slave:
+            d = x[s] - x[r]
+            Sd = _skew(d)
+            for i in range(6):
+                es = eq[s, i]
+                if es < 0:
+                    continue
+                if i < 3:
+                    rows.append([es]), cols.append([eq[r, i]]), vals.append([1.0])
+                    for j in range(3):
+                        if Sd[i, j] != 0.0:
+                            er = eq[r, 3 + j]
+                            if er < 0:
+                                raise ModelError("rigid body reference node has no rotational DOFs")
+                            rows.append([es]), cols.append([er]), vals.append([-Sd[i, j]])
+                else:
+                    rows.append([es]), cols.append([eq[r, i]]), vals.append([1.0])
+        for s, m, d in self.tie:
+            es, em = eq[s, d], eq[m, d]
+            if es >= 0:
+                if em < 0:
+                    raise ModelError(f"tie: the master node has no active DOF {d} to tie to")
+                rows.append([es]), cols.append([em]), vals.append([1.0])
+        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                             shape=(self.n_active, self.n_ind))
+
+    def geometric(self, x, f_net):
+        """G (n_ind x n_ind): derivative of the lever arms, sum_s [f_s]x [d_s]x on reference rotations."""
+        n = self.n_ind
+        if not len(self.rigid_slave):
+            return sp.csr_matrix((n, n))
+        blocks = {}
+        for s, r in self.rigid_slave:
+            fs = np.array([f_net[self.eq[s, i]] if self.eq[s, i] >= 0 else 0.0 for i in range(3)])
+            d = x[s] - x[r]
+            blocks[r] = blocks.get(r, 0.0) + _skew(fs) @ _skew(d)
+        rows, cols, vals = [], [], []
+        for r, B in blocks.items():
+            er = self.eq[r, 3:6]
+            for i in range(3):
+                for j in range(3):
+                    rows.append(er[i]), cols.append(er[j]), vals.append(B[i, j])
+        return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
