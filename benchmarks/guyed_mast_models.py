@@ -16,12 +16,19 @@ Parameters (all from the seed unless stated):
 * complete: the bare beam (E_no_shroud) plus three shrouds at the case's pretension, Dyneema
   law of Eq. 25 with the tangent stiffness, shroud geometry assumed in
   :mod:`femast.guyed.rocaspect`; linearised at the pretension (constant K_m).
+* FE: the same mast in the FE core (:class:`femast.guyed.fe_mast.MastFE`: 16 corotational beam
+  elements, E_no_shroud, three Eq. 25 shroud cables pretensioned to the case's tension at
+  equilibrium).  Nonlinear: after the pretension step the full mast-1 cable wrench at the initial
+  pose, w(POSE_0), is applied (dead loads at the top), then w(pose) for every pose; the displacement
+  is measured from the state at POSE_0.  So, unlike the linear models, it sees the beam's geometric
+  stiffness, the shroud tensions changing (and going slack) under the cable loads, and the law's
+  progressive stiffness.
 
 Adding a model: write ``predict(case, dw) -> (k, 6)`` and put it in ``MODELS`` (or pass
-``models=`` to :func:`compute`); the plot and table pick it up.  The FE mast will go there.
+``models=`` to :func:`compute`); the plot and table pick it up.
 
 Run:  python benchmarks/guyed_mast_models.py  [--docs]   (PNG in benchmarks/out/; --docs also
-copies it to docs/figures/guyed_mast_models.png)
+copies it to docs/figures/guyed_fe_mast_models.png; about 4 s, most of it the FE model)
 """
 
 from __future__ import annotations
@@ -39,12 +46,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from femast.guyed import (cable_vectors, cantilever_compliance, cantilever_stiffness, compliance_3r, displacement_complete,  # noqa: E402
-                          fit_beam_E, mast_section, mast_stiffness, trajectory_loads)
+                          fit_beam_E, mast_section, mast_stiffness, mast_top_wrenches, tension_distribution,
+                          trajectory_loads)
+from femast.guyed.fe_mast import MastFE  # noqa: E402
 from femast.guyed.rocaspect import (E_1200N, E_NO_SHROUD, L_BEAM, POSE_0, TABLE_III, fig5a_trajectory,  # noqa: E402
                                     mast_bases, mast_tops, rocaspect_geometry, rocaspect_shrouds)
 
 OUT = Path(__file__).resolve().parent / "out"
-DOCS_FIG = Path(__file__).resolve().parents[1] / "docs" / "figures" / "guyed_mast_models.png"
+DOCS_FIG = Path(__file__).resolve().parents[1] / "docs" / "figures" / "guyed_fe_mast_models.png"
 MAST = 0  # mast 1
 
 
@@ -56,6 +65,7 @@ class Case:
     pretension: float | None  # N per shroud; None = shrouds detached
     k_theta: tuple  # 3R joint stiffnesses, N m/rad
     E_beam: float | None  # beam-model E, Pa (None: identified from the 3R prediction)
+    fe_tension: np.ndarray | None = None  # filled by predict_fe: shroud tensions along the path, N
 
 
 CASES = [
@@ -86,7 +96,18 @@ def predict_complete(case: Case, dw):
     return displacement_complete(mast_stiffness(K_beam, mast_tops()[MAST], shrouds), dw)
 
 
-MODELS = {"3R": predict_3r, "beam": predict_beam, "complete": predict_complete}
+def predict_fe(case: Case, dw):
+    """Nonlinear FE mast (module note): pretension, then w(POSE_0), then w(POSE_0) + dw per pose."""
+    geom = rocaspect_geometry()
+    w0 = mast_top_wrenches(geom, POSE_0, tension_distribution(geom, POSE_0).tau)[MAST]
+    fe = MastFE(case.pretension, mast=MAST, E=E_NO_SHROUD, n_beam=16)
+    fe.equilibrate()
+    out = fe.run_wrenches(np.vstack([w0, w0 + np.asarray(dw)]))
+    case.fe_tension = out["tension"]  # shroud tensions along the trajectory (first row: at POSE_0), N
+    return out["u"][1:] - out["u"][0]
+
+
+MODELS = {"3R": predict_3r, "beam": predict_beam, "complete": predict_complete, "FE": predict_fe}
 
 
 def compute(models=None, n_per_segment: int = 25):
@@ -102,18 +123,18 @@ def compute(models=None, n_per_segment: int = 25):
     return {"trajectory": traj, "tau": tau, "dw": dw, "pred": pred, "cases": cases}
 
 
-def table(res) -> str:
-    """Max and RMS horizontal top displacement per model, and RMS / max differences to the first model (mm)."""
-    names0 = next(iter(next(iter(res["pred"].values()))))
+def table(res, ref: str | None = None) -> str:
+    """Max and RMS horizontal top displacement per model, and RMS / max differences to model ``ref``
+    (default: the first model), in mm."""
+    names0 = ref or next(iter(next(iter(res["pred"].values()))))
     lines = [f"{'case':<11} {'model':<9} {'max |dc|':>9} {'rms |dc|':>9} {'rms diff':>9} {'max diff':>9}"
              f"   (mm, x-y plane; diff to {names0})"]
     for case, preds in res["pred"].items():
-        names = list(preds)
-        ref = preds[names[0]][:, :2]
-        for m in names:
+        ref_d = preds[names0][:, :2]
+        for m in preds:
             d = preds[m][:, :2]
             mag = np.linalg.norm(d, axis=1) * 1e3
-            diff = np.linalg.norm(d - ref, axis=1) * 1e3
+            diff = np.linalg.norm(d - ref_d, axis=1) * 1e3
             lines.append(f"{case:<11} {m:<9} {mag.max():9.2f} {np.sqrt((mag**2).mean()):9.2f} "
                          f"{np.sqrt((diff**2).mean()):9.2f} {diff.max():9.2f}")
     return "\n".join(lines)
@@ -154,7 +175,7 @@ def plot(res, path: Path):
         a.set(xlabel="dx of mast-1 top (mm)", ylabel="dy (mm)", title=f"({'bcd'[k]}) " + (case if case == "no shrouds" else f"shroud pretension {case}"), aspect="equal")
         a.grid(alpha=0.3)
         a.legend()
-    fig.suptitle("Seed 000: mast-1 top displacement from the initial pose, analytic models (cf. Fig. 6)")
+    fig.suptitle("Seed 000: mast-1 top displacement from the initial pose, analytic and FE models (cf. Fig. 6)")
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
@@ -172,6 +193,14 @@ def main(argv=None):
     print("beam E per case (Pa): " + ", ".join(f"{c.name}: {c.E_beam:.3g}" for c in res["cases"])
           + "  (400 N: identified from the 3R curve; the seed gives none)")
     print(table(res))
+    if any(c.fe_tension is not None and c.fe_tension.size for c in res["cases"]):
+        print(table(res, ref="FE"))
+        for c in res["cases"]:
+            if c.fe_tension is not None and c.fe_tension.size:
+                t = c.fe_tension
+                print(f"FE shroud tensions, {c.name}: at POSE_0 {np.round(t[0]).tolist()} N; along the path "
+                      + ", ".join(f"#{r + 1} {t[:, r].min():.0f}..{t[:, r].max():.0f}" for r in range(t.shape[1]))
+                      + " N")
     print(f"figure: {png}  ({time.perf_counter() - t0:.1f} s)")
     if "--docs" in argv:
         DOCS_FIG.parent.mkdir(parents=True, exist_ok=True)
