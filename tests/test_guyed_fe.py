@@ -273,3 +273,19 @@ def test_wall_attachment_variant_runs_and_is_slightly_softer():
     assert np.allclose(top.top_point, mast_tops()[0])
     assert relative_difference(active_stiffness(top.state().top, top.analytic_shrouds()),
                                top.stiffness_parts()["K_a_FE"]) < 1e-6
+
+
+def test_docs_fe_example_runs_and_matches_its_printed_output():
+    import contextlib
+    import io
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "guyed_masts.md").read_text()
+    section = text.split("## The FE mast")[1].split("\n## ")[0]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    expected = re.search(r"Output:\n\n```\n(.*?)```", section, re.S).group(1).strip().splitlines()
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, "guyed_masts.md (FE example)", "exec"), {})
+    assert out.getvalue().strip().splitlines() == expected  # printed to 0.01 mm / 0.1 N: stable
