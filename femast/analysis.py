@@ -13,10 +13,12 @@ from __future__ import annotations
 
 import copy
 import math
+import warnings
 import time as _time
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 from numba import njit
 from tqdm.auto import tqdm
 
@@ -32,6 +34,10 @@ from .rotations import expm_so3, rotation_vectors
 from .solvers.control import LoadControl
 from .solvers.convergence import Convergence
 from .solvers.linear import SparseLU, mechanism_dofs
+
+
+class StabilizationWarning(UserWarning):
+    """The stabilisation energy of a step exceeds its warning ratio of the strain energy."""
 
 
 @njit(cache=True)
@@ -347,6 +353,9 @@ class Analysis:
                       for t in c.amplitude.times if 0 < t < period})
         load_start, pres_start = self.loads.copy(), self.prescribed.copy()
         self._last_Du = None
+        self._stab_C = None
+        self._stab_dt0 = dt
+        self._stab_energy = 0.0
         t, inc, easy = 0.0, 0, 0
         self.lam = 0.0
         step_iters = 0
@@ -387,13 +396,33 @@ class Analysis:
             self.total_time += dt
             self.summary.increments += 1
             self._write(writer, step.name, inc, t, iters, responses, period=period)
-            writer.status(step.name, inc, attempt, iters, t, self.total_time, dt, self.lam)
+            note = ""
+            if step.stabilize is not None:
+                note = f"stabilisation/strain energy {self.stabilization_ratio:.3g}"
+            writer.status(step.name, inc, attempt, iters, t, self.total_time, dt, self.lam, note)
             bar.update(dt)
             easy = easy + 1 if iters <= self.easy_iterations else 0
             if easy >= 2:
                 dt *= self.growth
         bar.close()
-        self.summary.steps.append({"name": step.name, "increments": inc, "iterations": step_iters})
+        info = {"name": step.name, "increments": inc, "iterations": step_iters}
+        if step.stabilize is not None:
+            info["stabilization_energy"] = self._stab_energy
+            info["stabilization_ratio"] = self.stabilization_ratio
+            if self.stabilization_ratio > step.stabilize.warn_ratio:
+                msg = (f"step '{step.name}': stabilisation energy is {100 * self.stabilization_ratio:.1f}% of the strain "
+                       f"energy (above {100 * step.stabilize.warn_ratio:.0f}%): the stabilised solution may be "
+                       "far from equilibrium; lower the damping factor or the energy fraction")
+                warnings.warn(msg, StabilizationWarning, stacklevel=3)
+                if self.progress:
+                    tqdm.write("femast: warning: " + msg)
+        self.summary.steps.append(info)
+
+    @property
+    def stabilization_ratio(self) -> float:
+        """Stabilisation energy dissipated in the current step / strain energy (dimensionless)."""
+        return self._stab_energy / self.strain_energy if self.strain_energy > 0 else (
+            0.0 if self._stab_energy == 0 else float("inf"))
 
     def _increment(self, step, control, t, dt, load_start, pres_start, line_search=False):
         """Try one increment; on success commit and return (True, iterations, '', responses);
@@ -423,14 +452,19 @@ class Analysis:
             return (self._values(step.loads, load_start, frac, period) if not uses_lam
                     else load_start + lam_ * P_ref_full)
 
-        def evaluate(P):
+        stab = step.stabilize
+
+        def evaluate(P, Dtrial=None):
             ta = _time.perf_counter()
             resp = self._evaluate(ctx)
             res_ = self._residual(resp, P)
             self.summary.assembly_time += _time.perf_counter() - ta
             if not np.all(np.isfinite(res_)):
                 raise FloatingPointError("non-finite residual")
-            return resp, res_, res_[:nf]
+            r_ = res_[:nf]
+            if stab is not None and self._stab_C is not None:
+                r_ = r_ - self._stab_C / dt * (Du if Dtrial is None else Dtrial)
+            return resp, res_, r_
 
         if self.extrapolate and self._last_Du is not None and not np.any(dpres):
             # Abaqus' linear extrapolation: start from the previous increment's solution, scaled
@@ -445,6 +479,11 @@ class Analysis:
             for it in range(self.convergence.max_iterations + 1):
                 ta = _time.perf_counter()
                 K, Kfc = self._tangent(responses, with_fc=(it == 0 and np.any(dpres)))
+                if stab is not None:
+                    if self._stab_C is None:  # damping from the tangent at the start of the step
+                        self._stab_C = stab.damping(K.diagonal(), self.is_rot, self._stab_dt0)
+                        self._stab_C0 = self._stab_C.copy()
+                    K = (K + sp.diags(self._stab_C / dt)).tocsr()
                 self.summary.assembly_time += _time.perf_counter() - ta
                 if self._zero_force is None:
                     dk = np.abs(K.diagonal())
@@ -456,6 +495,12 @@ class Analysis:
                     ok, ratio = self._converged(r, du, Du, responses, P)
                     rnorm_hist.append(ratio)
                     if ok:
+                        if stab is not None:
+                            self._stab_energy += float(Du @ (self._stab_C / dt * Du))
+                            self.strain_energy_now = sum(float(np.sum(q.energy)) for q in responses
+                                                         if q.energy is not None)
+                            ratio = self._stab_energy / max(self.strain_energy_now, 1e-300)
+                            self._stab_C = stab.adapt(self._stab_C, self._stab_C0, ratio)
                         self._last_Du, self._last_dt, self._last_Dlam = Du.copy(), dt, lam - lam_start
                         self._commit(responses, P, F, lam)
                         return True, iters, "", responses
@@ -485,11 +530,14 @@ class Analysis:
                 before = (self.x.copy(), self.R.copy(), self.spin.copy())
                 self._update(du, dpres if it == 0 else None)
                 P = loads_now(lam)
+                Du_before = Du.copy()
+                Du += du
                 responses, F, r_new = evaluate(P)
                 if line_search and not uses_lam and not (it == 0 and np.any(dpres)):
-                    du, responses, F, r_new = self._line_search(du, r, r_new, responses, F, before, evaluate, P)
+                    du, responses, F, r_new = self._line_search(du, r, r_new, responses, F, before, evaluate, P,
+                                                                Du_before)
+                    Du = Du_before + du
                 r = r_new
-                Du += du
         except (FloatingPointError, SingularModelError, ValueError) as exc:
             if isinstance(exc, SingularModelError) and self.summary.increments == 0 and iters == 0:
                 raise
@@ -498,7 +546,7 @@ class Analysis:
             return self._fail(saved, iters, str(exc))
         return self._fail(saved, iters, "no convergence")
 
-    def _line_search(self, du, r0, r1, responses, F, before, evaluate, P, eta=0.8, max_steps=5):
+    def _line_search(self, du, r0, r1, responses, F, before, evaluate, P, Du_before, eta=0.8, max_steps=5):
         # F here is the reduced residual of the trial point (kept for the commit)
         """Secant line search on g(s) = du . r(u + s du) (Crisfield 1991, sec. 9.3): only when the
         full step leaves |g(1)| > eta |g(0)|.  Returns the accepted step and its evaluation."""
@@ -513,7 +561,7 @@ class Analysis:
             s_new = min(max(s_new, 0.05), 1.0)
             self.x, self.R, self.spin = before[0].copy(), before[1].copy(), before[2].copy()
             self._update(s_new * du)
-            resp, F_, r_ = evaluate(P)
+            resp, F_, r_ = evaluate(P, Du_before + s_new * du)
             g_new = float(du @ r_)
             if abs(g_new) < best[0]:
                 best = (abs(g_new), s_new, resp, F_, r_)
