@@ -1,0 +1,132 @@
+"""Joint effects: clearance (backlash), friction hysteresis, ball-joint friction.
+
+Hooks used (see the experiments' ``hooks``):
+
+* mast-top -- ``joint_moment`` (the moments ``m`` (n, 3), N m, about the base axes that drive
+  the elastic joints of the 3R model, seed 000 Eqs. 4-6) and ``joint_rotation`` (the joint
+  rotations ``theta`` (n, 3), rad).  Only the two bending joints (columns 0 and 1) are affected:
+  the torsion joint is rigid and invisible in top translations.
+* latch-pull -- ``bead_position`` (bead position ``x`` (n,), m, seed 001 Eq. 15) and
+  ``branch_force`` (the latching and unlatching branches ``[dT_in, dT_out]`` (n, 2), N, of
+  seed 001 Eq. 14 at the bead positions).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..experiments.core import Parameter
+from .base import Effect, Implementation, register_effect
+from .operators import play
+
+PENDING = ("bay-torsion", "tip-cycle")
+
+
+# ----------------------------------------------------------------------------- clearance
+def _clearance_mast_top(theta, p, ctx):
+    m = ctx["prep"]["m"][:, :2]
+    ms = ctx["prep"]["m_smooth"][:2]
+    theta = theta.copy()
+    theta[:, :2] += p["c"] * np.tanh(m / ms)
+    return theta
+
+
+def _clearance_latch_pull(x, p, ctx):
+    return x - p["c"] * np.tanh(ctx["prep"]["dT"] / 1.0)
+
+
+JOINT_CLEARANCE = register_effect(Effect(
+    name="joint_clearance",
+    title="joint clearance (backlash)",
+    physics=(
+        "A joint with a gap: as the load through it changes sign, the joint crosses its play of 2c before the "
+        "elastic parts take up load again, so the displacement jumps by 2c at the load's zero crossing and is "
+        "offset by +-c with the sign of the load (seed 000 Sec. IV-C suspects the clearance at the mast's beam "
+        "assembly point).  Elastic (no hysteresis): the side of the gap follows the sign of the load, not the "
+        "direction of loading."),
+    signature="a step in the displacement where the load changes sign; the error is largest near zero load",
+    acts_where=("near-zero load",),
+    seed="seed 000 Sec. IV-C",
+    implementations={
+        "mast-top": Implementation(
+            hook="joint_rotation", order=30,
+            parameters=(Parameter("c", "rad", 1e-4, 0.0, 0.02, "half play of each bending joint", scale=1e-4,
+                                  starts=(1e-5, 1e-3)),),
+            apply=_clearance_mast_top,
+            doc="theta_k += c tanh(m_k / m_s), k = 1, 2 (bending joints); m_s = 1 % of the largest |m_k| in the "
+                "data (the contact stiffness that closes the gap)."),
+        "latch-pull": Implementation(
+            hook="bead_position", order=30,
+            parameters=(Parameter("c", "m", 5e-5, 0.0, 2e-3, "half play of the latch body on its mount",
+                                  scale=1e-4, starts=(1e-5, 3e-4)),),
+            apply=_clearance_latch_pull,
+            doc="x_bead = x - c tanh(dT / 1 N): the latch shifts by c towards the pulling cable."),
+        **{e: Implementation(hook="(pending)", parameters=(
+            Parameter("c", "rad", 1e-4, 0.0, 0.02, "half play of the longeron-corner joints"),)) for e in PENDING},
+    },
+))
+
+
+# ----------------------------------------------------------------------------- friction hysteresis
+def _friction_mast_top(m, p, ctx):
+    m = m.copy()
+    m[:, :2] = play(m[:, :2], p["M_f"])
+    return m
+
+
+def _friction_latch_pull(D, p, ctx):
+    D = D.copy()
+    D[:, 0] -= p["F_f"]
+    D[:, 1] += p["F_f"]
+    return D
+
+
+FRICTION_HYSTERESIS = register_effect(Effect(
+    name="friction_hysteresis",
+    title="friction hysteresis in a joint",
+    physics=(
+        "Coulomb friction in a joint: the joint slips only when the load exceeds the friction threshold in the "
+        "direction of motion, so after every reversal it sticks until the load has changed by twice the "
+        "friction (play operator).  The offset depends on the direction of loading, not on the sign of the "
+        "load (seed 001 Sec. II.B.1, the ball joints' |M| <= mu B |F| with a constant normal force)."),
+    signature="the error changes sign with the direction of loading (loading and unloading offset in opposite "
+              "directions) and the response sticks just after each reversal",
+    acts_where=("loading", "unloading", "reversal"),
+    seed="seed 001 Sec. II.B.1",
+    implementations={
+        "mast-top": Implementation(
+            hook="joint_moment", order=40,
+            parameters=(Parameter("M_f", "N m", 10.0, 0.0, 1e5, "friction moment of each bending joint",
+                                  scale=10.0, starts=(1.0, 100.0)),),
+            apply=_friction_mast_top,
+            doc="m_k -> play(m_k; M_f), k = 1, 2: the elastic joint sees the moment less the friction, which "
+                "holds until the moment has changed by 2 M_f after a reversal."),
+        "latch-pull": Implementation(
+            hook="branch_force", order=40,
+            parameters=(Parameter("F_f", "N", 1.0, 0.0, 200.0, "friction force on the moving bead or cable",
+                                  scale=1.0, starts=(0.2, 5.0)),),
+            apply=_friction_latch_pull,
+            doc="dT_in -= F_f, dT_out += F_f: a constant friction opposing the motion of the bead, everywhere on "
+                "the path (also out of roller contact)."),
+        **{e: Implementation(hook="(pending)", parameters=(
+            Parameter("M_f", "N m", 0.01, 0.0, 10.0, "friction moment of the joints"),)) for e in PENDING},
+    },
+))
+
+
+# ----------------------------------------------------------------------------- ball-joint friction
+BALL_JOINT_FRICTION = register_effect(Effect(
+    name="ball_joint_friction",
+    title="ball-joint friction",
+    physics=(
+        "Coulomb friction in the longeron ball joints of an ADAM bay (seed 001 Sec. II.B.1): a moving joint "
+        "transmitting a force F resists with a moment |M| = mu B |F| opposing the motion, a joint at rest holds "
+        "|M| <= mu B |F| (mu = 0.5, B = 4 mm in the seed).  Unlike a constant friction it grows with the force "
+        "through the joint, so the hysteresis widens with the cable pretension and the load."),
+    signature="hysteresis whose width grows with the load through the joints; the bay sticks after reversals",
+    acts_where=("reversal", "loading", "unloading"),
+    seed="seed 001 Sec. II.B.1",
+    implementations={e: Implementation(hook="(pending)", parameters=(
+        Parameter("mu", "-", 0.5, 0.0, 1.5, "friction coefficient of the ball joints"),
+        Parameter("B", "m", 4e-3, 1e-4, 0.05, "ball end radius"),)) for e in PENDING},
+))

@@ -1,0 +1,165 @@
+"""``compare``: run (or fit) a model variant along the measured path and localise where it fails.
+
+:func:`compare` returns a scipy-like result and, given an output folder, writes
+``compare.json`` (the report), ``compare.png`` (measured against model, the load path, the
+residual with the worst segments shaded) and appends the run to ``history.jsonl`` (plotted
+in ``history.png``).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import OptimizeResult
+
+from .core import Experiment, Measured
+from .figures import compare_figure, display_scale
+from .fitting import fit as _fit
+from .fitting import params_table, run_model
+from .history import append_history, plot_history
+from .residuals import TURN_FRACTION, noise_floor, segment_path, segment_report, signatures, turning_points
+
+
+def load_path(exp: Experiment, data: Measured) -> np.ndarray:
+    """The signed load that drives the segmentation (``exp.load_measure``, else the first input column)."""
+    if exp.load_measure is not None:
+        return np.asarray(exp.load_measure(data, exp.options), dtype=float)
+    inputs = [c.name for c in exp.columns if c.required and c.name not in exp.channels]
+    return data[inputs[0]] if inputs else np.arange(data.n, dtype=float)
+
+
+def analyse(exp: Experiment, data: Measured, run: OptimizeResult) -> dict:
+    """Segments, per-kind and worst-segment errors and residual signatures of a model run."""
+    s = load_path(exp, data)
+    ns = noise_floor(s)
+    extra = exp.extra_segments(data, run.params, exp.options) if exp.extra_segments else ()
+    segments, masks = segment_path(s, ns, extra)
+    weights = {c: exp.weight(c) for c in exp.channels}
+    by_kind, worst = segment_report(segments, masks, run.residuals, run.noise, weights, data.lines)
+    rng = float(np.ptp(s))
+    _, direction = turning_points(s, max(TURN_FRACTION * rng, 5 * ns)) if rng > 0 else (None, np.ones(data.n))
+    sig = signatures(s, direction, data.tau, run.residuals, run.noise)
+    return {"load": s, "segments": segments, "masks": masks, "by_kind": by_kind, "worst": worst,
+            "signatures": sig, "direction": direction}
+
+
+def compare(exp: Experiment, data: Measured, effects=(), *, fit: bool = False, params=None, out=None,
+            history: bool = True, noise=None) -> OptimizeResult:
+    """Run the model variant (baseline + ``effects``) along the measured path of ``data``.
+
+    fit : fit the baseline and effect parameters (:func:`~femast.experiments.fitting.fit`);
+        otherwise use ``params`` (baseline ``{name: value}`` and ``"effect.param"`` entries) or the
+        defaults.
+    out : output folder for ``compare.json``, ``compare.png``, ``history.jsonl``, ``history.png``
+        (nothing is written if None).  history : append the run to the history file.
+
+    Returns an ``OptimizeResult`` with ``experiment``, ``n_samples``, ``effects``, ``fitted``,
+    ``run`` (the model run/fit result), ``params`` (table with stderr and units), ``rms``
+    (error unit), ``channel_rms``, ``noise`` (per channel), ``noise_rms``, ``ratio`` (rms / noise),
+    ``by_kind`` and ``worst`` (segments, worst first), ``signatures``, ``report`` (JSON dict),
+    ``files``, ``version`` (in the history, or None), ``success``, ``message``.
+    """
+    exp.require_model("compare")
+    if isinstance(effects, str):
+        effects = [e for e in effects.split(",") if e.strip()]
+    effects = list(effects)
+    if fit:
+        run = _fit(exp, data, effects, noise=noise)
+    else:
+        params = dict(params or {})
+        base = {k: v for k, v in params.items() if "." not in k}
+        eff = {e: {} for e in effects}
+        for k, v in params.items():
+            if "." in k:
+                e, p = k.split(".", 1)
+                eff.setdefault(e, {})[p] = v
+        run = run_model(exp, data, base, eff, noise=noise)
+    a = analyse(exp, data, run)
+    report = {
+        "experiment": exp.name,
+        "data": str(data.path),
+        "n_samples": int(data.n),
+        "effects": list(run.effects),
+        "fit": bool(fit),
+        "params": params_table(run),
+        "error_unit": exp.error_unit,
+        "rms": run.rms,
+        "noise_rms": run.noise_rms,
+        "ratio": run.ratio,
+        "bic": run.bic,
+        "channels": {c: {"rms": run.channel_rms[c], "noise": run.noise[c], "unit": exp.unit_of(c)}
+                     for c in exp.channels},
+        "segments_by_kind": a["by_kind"],
+        "worst_segments": a["worst"][:5],
+        "signatures": a["signatures"][:3],
+        "message": run.message,
+        "success": bool(run.success),
+    }
+    files, version = {}, None
+    if out is not None:
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        if history:
+            version = append_history(out, {k: report[k] for k in (
+                "experiment", "data", "n_samples", "effects", "fit", "params", "error_unit", "rms", "noise_rms",
+                "ratio", "bic")} | {"channel_rms": {c: run.channel_rms[c] for c in exp.channels}})
+            report["version"] = version
+    result = OptimizeResult(
+        experiment=exp.name, data=str(data.path), n_samples=data.n, effects=tuple(run.effects), fitted=bool(fit),
+        run=run, params=run.params, effect_params=run.effect_params, params_table=report["params"],
+        predicted=run.predicted, residuals=run.residuals, rms=run.rms, channel_rms=run.channel_rms,
+        noise=run.noise, noise_rms=run.noise_rms, ratio=run.ratio, bic=run.bic, load=a["load"],
+        segments=a["segments"], masks=a["masks"], by_kind=a["by_kind"], worst=a["worst"],
+        signatures=a["signatures"], report=report, files=files, version=version, success=bool(run.success),
+        message=run.message, x=run.x, stderr=run.stderr, names=run.names)
+    if out is not None:
+        files["json"] = str(out / "compare.json")
+        files["png"] = str(compare_figure(exp, data, result, out / "compare.png"))
+        if history:
+            files["history"] = str(out / "history.jsonl")
+            files["history_png"] = str(plot_history(out))
+        report["files"] = files
+        Path(files["json"]).write_text(json.dumps(report, indent=2))
+    return result
+
+
+def _fmt(v, unit):
+    f, ul = display_scale(unit)
+    return f"{f * v:.4g} {ul}"
+
+
+def format_compare(exp: Experiment, result: OptimizeResult) -> str:
+    """Plain-text summary of a compare result (what ``femast compare`` prints)."""
+    r = result.report
+    lines = [f"femast compare: {exp.name} on {result.data} ({result.n_samples} samples)",
+             f"  model: {'+'.join(result.effects) or 'baseline'}"
+             + (" (parameters fitted)" if result.fitted else " (given parameters, not fitted)")]
+    if result.fitted and not result.success:
+        lines.append(f"  warning: the fit did not converge: {result.message}")
+    for name, p in r["params"].items():
+        se = f" +- {p['stderr']:.3g}" if p["stderr"] is not None and result.fitted else ""
+        lines.append(f"    {name:>22s} = {p['value']:.6g}{se} {p['unit']}")
+    lines.append(f"  overall RMS error {_fmt(result.rms, exp.error_unit)}; noise floor {_fmt(result.noise_rms, exp.error_unit)}"
+                 f" -> {result.ratio:.2f}x noise")
+    for c in exp.channels:
+        u = exp.unit_of(c)
+        lines.append(f"    {c:>8s}: RMS {_fmt(result.channel_rms[c], u)}, noise {_fmt(result.noise[c], u)} "
+                     f"({np.sqrt(np.mean((result.residuals[c] / result.noise[c]) ** 2)):.2f}x)")
+    lines.append("  error by kind of segment (x noise):")
+    for k in result.by_kind:
+        lines.append(f"    {k['kind']:>30s}: {k['ratio']:6.2f}x  ({k['n']} samples)")
+    lines.append("  worst segments:")
+    for k, s in enumerate(result.worst[:5]):
+        lines.append(f"    #{k + 1} {s['kind']:>28s}: rows {s['start_row']}-{s['end_row']} (file lines "
+                     f"{s.get('first_line', '?')}-{s.get('last_line', '?')}), {s['ratio']:.2f}x noise, RMS "
+                     f"{_fmt(s['rms'], exp.error_unit)}")
+    if result.ratio > 1.2 and result.signatures and result.signatures[0]["fraction"] > 0.2:
+        sg = result.signatures[0]
+        lines.append(f"  reading: {100 * sg['fraction']:.0f} % of the excess error is {sg['reading']}")
+    elif result.ratio <= 1.2:
+        lines.append("  reading: the model is at the noise floor")
+    if result.files:
+        lines.append("  wrote " + ", ".join(result.files.values()))
+    return "\n".join(lines)

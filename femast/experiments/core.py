@@ -1,0 +1,311 @@
+"""The Experiment contract: columns, parameters, a model with hooks for effects, measured data.
+
+An :class:`Experiment` pairs a measured data format (its :class:`Column` s) with a model
+function and the model's fittable :class:`Parameter` s.  The model is called as::
+
+    predicted = experiment.model(params, data, effects, options)
+
+* ``params``  -- dict of baseline parameter values (SI units, names of ``experiment.parameters``);
+* ``data``    -- the :class:`Measured` data (columns in the units of their names, e.g. ``x_mm``);
+* ``effects`` -- an :class:`EffectStack`; the model passes its intermediate quantities through
+  ``effects.apply(hook, value, **ctx)`` at the points named in ``experiment.hooks``, which is how
+  a physical effect (``femast.effects``) changes the model without the model knowing it;
+* ``options`` -- dict of geometry and other non-fitted settings (``experiment.options``).
+
+It returns a dict ``{channel: (n,) array}`` with one predicted value per row for every name in
+``experiment.channels``, in the units of the channel's column name.  Everything else (fits,
+noise floor, segmentation, ranking of effects, figures, history) is generic.
+
+Built-in experiments live in :mod:`femast.experiments.mast_top`,
+:mod:`femast.experiments.latch_pull` and :mod:`femast.experiments.pending`; a user adds one
+from a Python script that defines a module-level ``experiment`` (see ``docs/experiments.md``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Callable
+
+import numpy as np
+
+from ..errors import ModelError
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A fittable parameter of a model or of an effect.
+
+    name : identifier (used in JSON reports and as ``params[name]``).
+    unit : its SI unit as text ("N m/rad", "m", "-").
+    default : value used without ``--fit`` and as the start of a fit.
+    lower, upper : bounds of the fit (same unit).
+    doc : one line of physics.
+    scale : typical magnitude, used to scale the fit (default ``|default|`` or 1).
+    starts : extra start values tried by the fit (multi-start for non-convex effects).
+    """
+
+    name: str
+    unit: str
+    default: float
+    lower: float = -math.inf
+    upper: float = math.inf
+    doc: str = ""
+    scale: float | None = None
+    starts: tuple = ()
+
+    def __post_init__(self):
+        if not (self.lower <= self.default <= self.upper):
+            raise ModelError(f"parameter {self.name}: default {self.default!r} {self.unit} lies outside its "
+                             f"bounds [{self.lower!r}, {self.upper!r}]")
+
+    @property
+    def typical(self) -> float:
+        """Magnitude used to scale the fit, in the parameter's unit."""
+        if self.scale:
+            return float(self.scale)
+        return abs(float(self.default)) or 1.0
+
+
+@dataclass(frozen=True)
+class Column:
+    """A column of a data file: ``name`` carries the unit as a suffix (``fx_N``, ``x_mm``).
+
+    unit : the unit of the values in the file.  doc : what is measured, frame and sign.
+    required : False for optional columns (missing means "not measured").
+    """
+
+    name: str
+    unit: str
+    doc: str = ""
+    required: bool = True
+
+
+#: Optional time column accepted by every experiment (s); without it time is the row index.
+TIME_COLUMN = Column("t_s", "s", "time of the sample (optional; rows must be in time order)", required=False)
+
+
+@dataclass
+class Measured:
+    """Measured data of one experiment: ``columns[name]`` (n,) float arrays, rows in time order.
+
+    path : the file it came from (or ``"<arrays>"``).  lines : file line number of each row
+    (1-based), used to point at rows in reports and errors.  ``cache`` holds quantities an
+    experiment prepares once per data set (see :attr:`Experiment.prepare`).
+    """
+
+    experiment: str
+    columns: dict
+    path: str = "<arrays>"
+    lines: np.ndarray | None = None
+    cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def __post_init__(self):
+        self.columns = {k: np.asarray(v, dtype=float) for k, v in self.columns.items()}
+        if self.lines is None:
+            self.lines = np.arange(2, self.n + 2)  # header on line 1
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.columns[name]
+
+    def __contains__(self, name: str) -> bool:
+        return name in self.columns
+
+    @property
+    def n(self) -> int:
+        """Number of rows (samples)."""
+        return len(next(iter(self.columns.values()))) if self.columns else 0
+
+    @property
+    def tau(self) -> np.ndarray:
+        """Normalised time in [0, 1] (from ``t_s`` if present, else the row index), dimensionless."""
+        t = self.columns.get("t_s")
+        if t is None:
+            t = np.arange(self.n, dtype=float)
+        span = t[-1] - t[0]
+        return (t - t[0]) / span if span > 0 else np.zeros(self.n)
+
+    def subset(self, rows) -> "Measured":
+        """A copy restricted to ``rows`` (index array or mask), with an empty cache."""
+        rows = np.asarray(rows)
+        return Measured(self.experiment, {k: v[rows] for k, v in self.columns.items()}, self.path,
+                        self.lines[rows])
+
+    def __getstate__(self):  # the cache is rebuilt where it is needed (worker processes)
+        d = dict(self.__dict__)
+        d["cache"] = {}
+        return d
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """A measured data format, a model and its parameters (see the module docstring).
+
+    name : registry name (``mast-top``).  title : one line.  doc : data format and model.
+    columns : every accepted column (required and optional; ``t_s`` is always accepted).
+    channels : the columns the model predicts and that are compared (subset of ``columns``).
+    parameters : fittable baseline parameters.
+    model : ``model(params, data, effects, options) -> {channel: array}``; None while the
+        experiment is *pending a model* (its data format is defined, compare/diagnose refuse it).
+    options : non-fitted settings (geometry...) with their defaults; a user changes them with
+        :func:`femast.experiments.get_experiment` ``(name, **options)``.
+    hooks : ``{hook name: description}`` of the points where the model calls
+        ``effects.apply``; an effect implementation names one of them.
+    prepare : optional ``prepare(data, options) -> dict`` of per-data-set quantities, cached in
+        ``data.cache`` (e.g. joint moments, directions of motion).
+    initial_guess : optional ``initial_guess(data, options) -> {param: value}`` start of a fit.
+    load_measure : optional ``load_measure(data, options) -> (n,) signed load`` that drives the
+        segmentation (loading, unloading, reversals, near-zero load, peaks); default: the first
+        required non-channel column.
+    load_label : name and unit of the load measure, for reports.
+    extra_segments : optional ``extra_segments(data, params, options) -> [(kind, mask)]`` of
+        experiment-specific path segments (e.g. the latch zones of seed 001 Fig. 6).
+    plot_measured : optional ``plot_measured(ax, data, predicted, params, options)`` drawing the
+        measured-against-model panel of the compare figure (default: channels against row).
+    channel_weights : factors converting each channel to ``error_unit`` for the overall RMS
+        (default 1: all channels already in ``error_unit``).
+    error_unit : unit of the overall RMS error.
+    min_rows : fewest data rows accepted.
+    effects_from : name of the experiment whose effect implementations apply (default: own name;
+        a variant of ``mast-top`` sets ``effects_from="mast-top"`` to inherit its effects).
+    source : where it came from (a built-in name or a script path), set by the registry.
+    """
+
+    name: str
+    title: str
+    columns: tuple
+    channels: tuple
+    parameters: tuple = ()
+    model: Callable | None = None
+    options: dict = field(default_factory=dict)
+    hooks: dict = field(default_factory=dict)
+    doc: str = ""
+    prepare: Callable | None = None
+    initial_guess: Callable | None = None
+    load_measure: Callable | None = None
+    load_label: str = "load"
+    extra_segments: Callable | None = None
+    plot_measured: Callable | None = None
+    channel_weights: dict = field(default_factory=dict)
+    error_unit: str = ""
+    min_rows: int = 10
+    effects_from: str | None = None
+    source: str = ""
+
+    def __post_init__(self):
+        names = [c.name for c in self.columns]
+        if len(set(names)) != len(names):
+            raise ModelError(f"experiment {self.name}: duplicate column names in {names}")
+        missing = [c for c in self.channels if c not in names]
+        if missing:
+            raise ModelError(f"experiment {self.name}: channels {missing} are not among its columns {names}")
+        pn = [p.name for p in self.parameters]
+        if len(set(pn)) != len(pn):
+            raise ModelError(f"experiment {self.name}: duplicate parameter names in {pn}")
+
+    # ------------------------------------------------------------------ helpers
+    @property
+    def pending(self) -> bool:
+        """True while the experiment has a data format but no model yet."""
+        return self.model is None
+
+    @property
+    def effect_key(self) -> str:
+        """The experiment name under which effect implementations are looked up."""
+        return self.effects_from or self.name
+
+    def column(self, name: str) -> Column:
+        """The :class:`Column` called ``name``."""
+        for c in self.all_columns:
+            if c.name == name:
+                return c
+        raise KeyError(name)
+
+    @property
+    def all_columns(self) -> tuple:
+        """Declared columns plus the optional time column ``t_s``."""
+        if any(c.name == TIME_COLUMN.name for c in self.columns):
+            return tuple(self.columns)
+        return tuple(self.columns) + (TIME_COLUMN,)
+
+    def unit_of(self, channel: str) -> str:
+        """Unit of a channel (column)."""
+        return self.column(channel).unit
+
+    def weight(self, channel: str) -> float:
+        """Factor converting ``channel`` to :attr:`error_unit` (1 by default)."""
+        return float(self.channel_weights.get(channel, 1.0))
+
+    def defaults(self) -> dict:
+        """Default baseline parameters ``{name: value}``."""
+        return {p.name: float(p.default) for p in self.parameters}
+
+    def with_options(self, **options) -> "Experiment":
+        """A copy with some options changed; unknown option names raise ModelError."""
+        unknown = sorted(set(options) - set(self.options))
+        if unknown:
+            raise ModelError(f"experiment {self.name}: unknown option(s) {', '.join(unknown)}; accepted: "
+                             f"{', '.join(sorted(self.options)) or '(none)'}")
+        return replace(self, options={**self.options, **options})
+
+    def prepared(self, data: Measured) -> dict:
+        """Per-data-set quantities from :attr:`prepare`, computed once and cached on ``data``."""
+        return prepared(data, self.prepare, self.options) if self.prepare else {}
+
+    def require_model(self, what: str = "this") -> None:
+        """Raise ModelError if the experiment is pending a model."""
+        if self.pending:
+            raise ModelError(
+                f"experiment '{self.name}' is registered with its data format but is pending a model, so "
+                f"{what} cannot run yet. {self.doc.splitlines()[0] if self.doc else ''} "
+                "A model can be plugged in from a script (docs/experiments.md, 'Adding an experiment'): "
+                f"define `experiment = Experiment(name='{self.name}', ..., model=...)` and pass the script path "
+                "instead of the name."
+            )
+
+
+def prepared(data: Measured, prepare: Callable, options: dict) -> dict:
+    """``prepare(data, options)``, computed once per (function, options) and cached on ``data``.
+
+    Models call it to get their per-data-set arrays (the options may differ between variants of
+    one experiment, so they are part of the key)."""
+    key = ("prepare", getattr(prepare, "__module__", ""), getattr(prepare, "__qualname__", repr(prepare)),
+           repr(sorted(options.items(), key=lambda kv: kv[0])))
+    if key not in data.cache:
+        data.cache[key] = prepare(data, options)
+    return data.cache[key]
+
+
+class EffectStack:
+    """The effects switched on in one model run, each with its parameter values.
+
+    ``items`` is a list of ``(effect_name, implementation, params)``; ``apply(hook, value, **ctx)``
+    passes ``value`` through every implementation attached to ``hook``, in their ``order``.
+    An implementation's function is called as ``fn(value, params, ctx)`` and returns the new value;
+    ``ctx`` holds the keyword arguments of the hook call.
+    """
+
+    def __init__(self, items=()):
+        self.items = sorted(list(items), key=lambda it: it[1].order)
+
+    def __bool__(self):
+        return bool(self.items)
+
+    @property
+    def names(self) -> tuple:
+        """Names of the active effects."""
+        return tuple(name for name, _, _ in self.items)
+
+    def apply(self, hook: str, value, **ctx):
+        """Apply the active effects attached to ``hook`` to ``value`` (see the class docstring)."""
+        for _, impl, params in self.items:
+            if impl.hook == hook:
+                value = impl.apply(value, params, ctx)
+        return value
+
+    def on(self, hook: str) -> bool:
+        """True if an active effect is attached to ``hook``."""
+        return any(impl.hook == hook for _, impl, _ in self.items)
+
+
+NO_EFFECTS = EffectStack()

@@ -1,0 +1,163 @@
+"""Reading and writing measured-data files (CSV with a header row, rows in time order).
+
+Format
+------
+* Plain CSV (comma-separated, read with the standard :mod:`csv` module).  Lines starting
+  with ``#`` and empty lines are comments and are skipped anywhere in the file.
+* The first other line is the header: the column names of the experiment, unit suffix
+  included (``fx_N``, ``x_mm``), in any order.  Every required column must be present, an
+  optional column may be, and no other column is accepted.  ``t_s`` (time, s) is accepted
+  by every experiment.
+* Each further line is one sample, rows in time order, one finite decimal number per column.
+
+Every error is a :class:`~femast.errors.DataFileError` naming the file, the line and the
+column, and listing the accepted values.
+"""
+
+from __future__ import annotations
+
+import csv
+import difflib
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataFileError
+from .core import Experiment, Measured
+
+
+def _accepted(exp: Experiment) -> str:
+    parts = [c.name + ("" if c.required else " (optional)") for c in exp.all_columns]
+    return ", ".join(parts)
+
+
+def _suggest(name: str, choices) -> str:
+    close = difflib.get_close_matches(name, list(choices), n=1, cutoff=0.5)
+    if not close:  # 'fx' -> 'fx_N': compare without the unit suffix
+        stems = {c.rsplit("_", 1)[0].lower(): c for c in choices}
+        hit = stems.get(name.rsplit("_", 1)[0].lower())
+        close = [hit] if hit else []
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+def check_header(exp: Experiment, header, path: str = "<arrays>", line: int = 1) -> list:
+    """Check the column names of a data file against the experiment; return them stripped."""
+    names = [h.strip() for h in header]
+    known = [c.name for c in exp.all_columns]
+    where = f"{path} line {line}"
+    for i, h in enumerate(names):
+        if not h:
+            raise DataFileError(f"{where}: column {i + 1} of the header has no name; {exp.name} accepts: "
+                                f"{_accepted(exp)}")
+    seen = set()
+    for h in names:
+        if h in seen:
+            raise DataFileError(f"{where}: column '{h}' appears twice in the header; {exp.name} accepts: "
+                                f"{_accepted(exp)}")
+        seen.add(h)
+    unknown = [h for h in names if h not in known]
+    if unknown:
+        h = unknown[0]
+        raise DataFileError(f"{where}: column '{h}' is not a {exp.name} column{_suggest(h, known)}; "
+                            f"accepted columns: {_accepted(exp)}")
+    missing = [c.name for c in exp.all_columns if c.required and c.name not in names]
+    if missing:
+        raise DataFileError(f"{where}: missing column(s) {', '.join(missing)}; {exp.name} needs "
+                            f"{', '.join(c.name for c in exp.all_columns if c.required)}"
+                            f" and accepts {_accepted(exp)}")
+    return names
+
+
+def read_data(exp: Experiment, path) -> Measured:
+    """Read and check a measured-data file of experiment ``exp`` (see the module docstring).
+
+    Returns a :class:`~femast.experiments.core.Measured` whose ``lines`` give the file line of
+    every row.  Raises :class:`~femast.errors.DataFileError` on any malformed content.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise DataFileError(f"{path}: no such data file")
+    header, header_line, rows, lines = None, 0, [], []
+    with open(path, newline="", encoding="utf-8-sig") as fh:
+        reader = csv.reader(fh)
+        try:
+            for cells in reader:
+                line = reader.line_num
+                if not cells or not "".join(cells).strip() or cells[0].lstrip().startswith("#"):
+                    continue
+                if header is None:
+                    header, header_line = check_header(exp, cells, str(path), line), line
+                    continue
+                rows.append(cells)
+                lines.append(line)
+        except csv.Error as exc:
+            raise DataFileError(f"{path} line {reader.line_num}: not valid CSV ({exc})") from None
+        except UnicodeDecodeError as exc:
+            raise DataFileError(f"{path}: not a text (UTF-8) CSV file ({exc.reason})") from None
+    if header is None:
+        raise DataFileError(f"{path}: no header row; the first non-comment line must name the columns: "
+                            f"{_accepted(exp)}")
+    ncol = len(header)
+    values = np.empty((len(rows), ncol))
+    for r, (cells, line) in enumerate(zip(rows, lines)):
+        if len(cells) != ncol:
+            raise DataFileError(f"{path} line {line}: {len(cells)} cells but the header (line {header_line}) has "
+                                f"{ncol} columns ({', '.join(header)})")
+        for c, text in enumerate(cells):
+            col = exp.column(header[c])
+            s = text.strip()
+            try:
+                v = float(s)
+            except ValueError:
+                what = "an empty cell" if not s else f"'{s}' is not a number"
+                raise DataFileError(f"{path} line {line}, column '{header[c]}': {what}; every cell must be a "
+                                    f"decimal number in {col.unit}") from None
+            if not math.isfinite(v):
+                raise DataFileError(f"{path} line {line}, column '{header[c]}': {s} is not a finite number; "
+                                    f"every cell must be a finite decimal number in {col.unit} "
+                                    "(remove the row or fill in the value)")
+            values[r, c] = v
+    if len(rows) < exp.min_rows:
+        raise DataFileError(f"{path}: {len(rows)} data row(s); {exp.name} needs at least {exp.min_rows} "
+                            "(one per sample, in time order)")
+    cols = {h: values[:, i] for i, h in enumerate(header)}
+    if "t_s" in cols and np.any(np.diff(cols["t_s"]) < 0):
+        bad = int(np.flatnonzero(np.diff(cols["t_s"]) < 0)[0]) + 1
+        raise DataFileError(f"{path} line {lines[bad]}, column 't_s': time goes backwards "
+                            f"({cols['t_s'][bad - 1]:g} s then {cols['t_s'][bad]:g} s); rows must be in time order")
+    return Measured(exp.name, cols, str(path), np.asarray(lines))
+
+
+def from_arrays(exp: Experiment, **columns) -> Measured:
+    """Build :class:`Measured` data from arrays (same checks as :func:`read_data`)."""
+    check_header(exp, list(columns), "<arrays>", 0)
+    arrs = {k: np.asarray(v, dtype=float).ravel() for k, v in columns.items()}
+    sizes = {k: a.size for k, a in arrs.items()}
+    if len(set(sizes.values())) != 1:
+        raise DataFileError(f"<arrays>: columns have different lengths {sizes}")
+    for k, a in arrs.items():
+        if not np.all(np.isfinite(a)):
+            i = int(np.flatnonzero(~np.isfinite(a))[0])
+            raise DataFileError(f"<arrays> row {i}, column '{k}': {a[i]} is not a finite number")
+    n = next(iter(sizes.values()))
+    if n < exp.min_rows:
+        raise DataFileError(f"<arrays>: {n} rows; {exp.name} needs at least {exp.min_rows}")
+    return Measured(exp.name, arrs)
+
+
+def write_data(path, data: Measured, exp: Experiment | None = None, comments=(), fmt: str = "%.9g") -> Path:
+    """Write ``data`` as a CSV file readable by :func:`read_data`; ``comments`` become ``#`` lines."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    names = list(data.columns)
+    if exp is not None:  # the experiment's column order
+        names = [c.name for c in exp.all_columns if c.name in data.columns]
+    with open(path, "w", newline="") as fh:
+        for c in comments:
+            fh.write(f"# {c}\n")
+        w = csv.writer(fh, lineterminator="\n")
+        w.writerow(names)
+        for row in np.column_stack([data.columns[k] for k in names]):
+            w.writerow([fmt % v for v in row])
+    return path

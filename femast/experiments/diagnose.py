@@ -1,0 +1,286 @@
+"""``diagnose``: which physical effect is the model most likely missing?
+
+The baseline (the experiment's model, plus any effects already switched on) is fitted and the
+noise floor of every channel is estimated from its residual.  Then the model is refitted once
+per candidate effect -- every applicable effect not yet in the model -- with the same noise
+weights.  The refits are independent and run in parallel: local processes by default
+(:class:`concurrent.futures.ProcessPoolExecutor`), a dask.distributed cluster when a scheduler
+address (or a ``distributed.Client``) is given.
+
+Ranking and verdict
+-------------------
+Candidates are ranked by ``delta_bic = BIC(candidate) - BIC(baseline)`` (see
+:func:`~femast.experiments.fitting.bic`), which rewards explained error and penalises each added
+parameter by ``ln n``.  A candidate is *significant* when ``delta_bic < -10`` ("very strong"
+evidence on the Kass-Raftery scale; for one added parameter and n = 1500 residuals this needs a
+chi-square drop of 17, i.e. p < 4e-5 under the null).  A model is *at the noise floor* when its
+RMS error is at most ``AT_NOISE = 1.2`` times the noise: the white-noise estimate scatters by a
+few % for a few hundred samples, and 1.2 leaves room for that; a structured error whose RMS is
+0.66 of the noise lifts the total to 1.2x, so structure smaller than that is not claimed.
+
+* no significant candidate and the baseline at the noise floor -> "nothing is missing"
+  (``missing_effect`` null, ``explained`` true);
+* the best candidate significant and at the noise floor -> it is the missing effect
+  (``explained`` true);
+* otherwise -> "none of the candidates explains this" (``missing_effect`` null, ``explained``
+  false; ``best_candidate`` names the one that helps most, if any is significant).
+"""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import OptimizeResult
+
+from ..effects.base import applicable_effects, get_effect, load_script, loaded_scripts, resolve
+from ..errors import ModelError
+from .compare import analyse
+from .core import Experiment, Measured
+from .figures import diagnose_figure, display_scale
+from .fitting import fit, params_table
+
+AT_NOISE = 1.2
+SIGNIFICANT_DBIC = -10.0
+_START_METHOD = None  # multiprocessing start method of the local pool (None: the platform's default)
+
+
+# --------------------------------------------------------------------------- refit tasks
+def _refit_task(payload: dict) -> OptimizeResult:
+    """One refit (runs in a worker process or on a dask worker)."""
+    from .registry import experiment_from_source
+
+    for script in payload["scripts"]:
+        load_script(script)
+    exp = experiment_from_source(payload["source"], payload["options"])
+    data = Measured(payload["data_experiment"], payload["columns"], payload["path"], payload["lines"])
+    res = fit(exp, data, payload["effects"], start=payload["start"], noise=payload["noise"])
+    res.pid = os.getpid()
+    return res
+
+
+def _rebuildable(exp: Experiment) -> bool:
+    """True if a worker can rebuild ``exp`` from its source name/script and options."""
+    if not exp.source:
+        return False
+    try:
+        from .registry import experiment_from_source
+
+        other = experiment_from_source(exp.source, exp.options)
+    except Exception:
+        return False
+    return other.name == exp.name and other.model is exp.model
+
+
+def _run_tasks(payloads, workers, scheduler):
+    """Run the refits; returns (results, how) with ``how`` describing the executor used."""
+    if scheduler is not None:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise ModelError("--scheduler needs dask.distributed: pip install 'dask[distributed]' "
+                             "(the femast extra 'dist')") from None
+        own = not isinstance(scheduler, Client)
+        client = Client(scheduler) if own else scheduler
+        try:
+            futures = client.map(_refit_task, payloads, pure=False)
+            results = client.gather(futures)
+        finally:
+            if own:
+                client.close()
+        return list(results), f"dask.distributed ({getattr(client, 'scheduler', None) and client.scheduler.address})"
+    n = (os.cpu_count() or 1) if workers is None else int(workers)
+    if n < 1:
+        raise ModelError(f"--workers must be >= 1, got {workers}")
+    n = min(n, len(payloads))
+    if n <= 1:
+        return [_refit_task(p) for p in payloads], "serial (1 process)"
+    ctx = multiprocessing.get_context(_START_METHOD) if _START_METHOD else None
+    with ProcessPoolExecutor(max_workers=n, mp_context=ctx) as pool:
+        results = list(pool.map(_refit_task, payloads))
+    return results, f"{n} local processes"
+
+
+# --------------------------------------------------------------------------- readings
+def _kind_ratio(mask, fun, nch):
+    z = fun.reshape(nch, -1)[:, mask]
+    return float(np.sqrt(np.mean(z**2))) if z.size else float("nan")
+
+
+def _reading(effect, entry, base_fit, cand_fit, masks, nch, worst_kind):
+    eff = get_effect(effect)
+    r0, rc = base_fit.ratio, cand_fit.ratio
+    text = f"{eff.signature[0].upper()}{eff.signature[1:]}. " if eff.signature else ""
+    text += (f"Refitted with {eff.title}, the error goes from {r0:.2f}x to {rc:.2f}x the noise "
+             f"(explains {100 * entry['explained_fraction']:.0f} % of the excess; delta BIC {entry['delta_bic']:+.1f}).")
+    gains = []
+    for kind, m in masks.items():
+        if m.sum() >= 3:
+            gains.append((_kind_ratio(m, base_fit.fun, nch) - _kind_ratio(m, cand_fit.fun, nch), kind))
+    if gains and entry["significant"]:
+        g, kind = max(gains)
+        if g > 0:
+            text += f" The largest gain is in the {kind} segments."
+    if worst_kind and worst_kind in eff.acts_where:
+        text += f" The baseline fails most in the {worst_kind} segments, where this effect acts."
+    if not entry["significant"]:
+        text += " Not significant: the data do not ask for it."
+    elif rc > AT_NOISE:
+        text += " Structure remains after it."
+    return text
+
+
+# --------------------------------------------------------------------------- diagnose
+def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(), workers=None, scheduler=None,
+             out=None) -> OptimizeResult:
+    """Refit the model with each candidate effect, rank them and conclude (see the module docstring).
+
+    candidates : effect names to try (default: every effect applicable to the experiment and not in
+        ``base_effects``).  base_effects : effects already in the model being diagnosed.
+    workers : local worker processes (default: the number of CPUs; 1 runs in this process).
+    scheduler : a dask.distributed scheduler address (``tcp://...``) or ``distributed.Client``.
+    out : folder for ``diagnose.json`` and ``diagnose.png`` (nothing written if None).
+
+    Returns an ``OptimizeResult`` with ``experiment``, ``n_samples``, ``noise`` (per channel),
+    ``noise_rms``, ``baseline`` (``{"rms", "ratio", "bic", "params", "effects"}``), ``baseline_fit``,
+    ``ranking`` (list of dicts, best first: ``effect``, ``rms``, ``ratio``, ``delta_bic``, ``params``,
+    ``significant``, ``explained_fraction``, ``reading``, ``success``), ``fits`` (``{effect: fit
+    result}``), ``best_fit``, ``verdict`` (``missing_effect``, ``explained``, ``best_candidate``,
+    ``alternatives``, ``conclusion``), ``report`` (the JSON document), ``executor``, ``files``,
+    ``success``, ``message``.
+    """
+    exp.require_model("diagnose")
+    if isinstance(base_effects, str):
+        base_effects = [e for e in base_effects.split(",") if e.strip()]
+    base_effects = [n for n, _ in resolve(exp, list(base_effects))]
+    if candidates is None:
+        candidates = [e.name for e in applicable_effects(exp) if e.name not in base_effects]
+    else:
+        candidates = [n for n, _ in resolve(exp, list(candidates))]
+        dup = set(candidates) & set(base_effects)
+        if dup:
+            raise ModelError(f"candidate effect(s) {', '.join(sorted(dup))} are already in the model")
+    baseline = fit(exp, data, base_effects)
+    sigma = baseline.noise
+    start = dict(zip(baseline.names, baseline.x))
+    payload0 = {"source": exp.source, "options": exp.options, "scripts": list(loaded_scripts()),
+                "data_experiment": data.experiment, "columns": data.columns, "path": data.path,
+                "lines": data.lines, "start": start, "noise": sigma}
+    payloads = [{**payload0, "effects": base_effects + [c]} for c in candidates]
+    if payloads and not _rebuildable(exp):
+        fits_list = [fit(exp, data, p["effects"], start=start, noise=sigma) for p in payloads]
+        how = "serial (experiment defined in memory: worker processes cannot rebuild it)"
+    elif payloads:
+        fits_list, how = _run_tasks(payloads, workers, scheduler)
+    else:
+        fits_list, how = [], "no candidates"
+    a = analyse(exp, data, baseline)
+    worst_kind = a["by_kind"][0]["kind"] if a["by_kind"] else None
+    nch = len(exp.channels)
+    r0 = baseline.ratio
+    ranking, fits = [], {}
+    for name, res in zip(candidates, fits_list):
+        fits[name] = res
+        d = float(res.bic - baseline.bic)
+        excess0 = r0**2 - 1.0
+        frac = float(np.clip((r0**2 - res.ratio**2) / excess0, 0.0, 1.0)) if excess0 > 0 else 0.0
+        table = params_table(res)
+        entry = {"effect": name, "rms": float(res.rms), "ratio": float(res.ratio), "delta_bic": d,
+                 "params": {k.split(".", 1)[1]: v for k, v in table.items() if k.startswith(name + ".")},
+                 "significant": bool(d < SIGNIFICANT_DBIC), "explained_fraction": frac,
+                 "baseline_params": {k: v for k, v in table.items() if "." not in k},
+                 "success": bool(res.success), "at_bound": list(res.at_bound)}
+        entry["reading"] = _reading(name, entry, baseline, res, a["masks"], nch, worst_kind)
+        ranking.append(entry)
+    ranking.sort(key=lambda e: e["delta_bic"])
+    best = ranking[0] if ranking and ranking[0]["significant"] else None
+    base_ok = r0 <= AT_NOISE
+    alternatives = [e["effect"] for e in ranking[1:] if best and e["significant"] and e["ratio"] <= AT_NOISE
+                    and e["delta_bic"] - best["delta_bic"] < 10.0]
+    f, ul = display_scale(exp.error_unit)
+    if best is None:
+        missing, explained = None, base_ok
+        if base_ok:
+            conclusion = (f"nothing is missing: the model is at the noise floor ({r0:.2f}x noise) and no candidate "
+                          "is significant")
+        else:
+            conclusion = (f"none of the candidates explains this: the model is {r0:.2f}x the noise and no candidate "
+                          "effect reduces the error significantly")
+    elif best["ratio"] <= AT_NOISE:
+        missing, explained = best["effect"], True
+        conclusion = (f"missing effect: {best['effect']} ({get_effect(best['effect']).title}); with it the error "
+                      f"falls from {r0:.2f}x to {best['ratio']:.2f}x the noise")
+        if alternatives:
+            conclusion += f"; also consistent with the data: {', '.join(alternatives)}"
+    else:
+        missing, explained = None, False
+        conclusion = (f"none of the candidates explains this: the best, {best['effect']}, brings the error from "
+                      f"{r0:.2f}x to {best['ratio']:.2f}x the noise but structure remains (an effect outside the "
+                      "library, or several at once: add the best one and diagnose again)")
+    verdict = {"missing_effect": missing, "explained": bool(explained),
+               "best_candidate": best["effect"] if best else None, "alternatives": alternatives,
+               "conclusion": conclusion}
+    base_table = params_table(baseline)
+    noise_rms = float(baseline.noise_rms)
+    report = {
+        "experiment": exp.name,
+        "n_samples": int(data.n),
+        "noise_rms": noise_rms,
+        "baseline": {"rms": float(baseline.rms), "params": base_table, "ratio": float(r0),
+                     "effects": list(base_effects), "bic": float(baseline.bic)},
+        "ranking": [{k: e[k] for k in ("effect", "rms", "delta_bic", "params", "significant", "ratio",
+                                       "explained_fraction", "reading")} for e in ranking],
+        "verdict": verdict,
+        "data": str(data.path),
+        "error_unit": exp.error_unit,
+        "noise": {c: float(sigma[c]) for c in exp.channels},
+        "baseline_worst_kinds": a["by_kind"][:3],
+        "baseline_signatures": a["signatures"][:3],
+        "executor": how,
+    }
+    result = OptimizeResult(
+        experiment=exp.name, n_samples=data.n, noise=sigma, noise_rms=noise_rms,
+        baseline={"rms": float(baseline.rms), "ratio": float(r0), "bic": float(baseline.bic),
+                  "params": base_table, "effects": list(base_effects)},
+        baseline_fit=baseline, ranking=ranking, fits=fits, best_fit=fits[ranking[0]["effect"]] if ranking else None,
+        verdict=verdict, report=report, executor=how, files={}, at_noise=AT_NOISE,
+        success=bool(baseline.success) and all(e["success"] for e in ranking), message=conclusion,
+        by_kind=a["by_kind"], signatures=a["signatures"])
+    if out is not None:
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        result.files["png"] = str(diagnose_figure(exp, data, result, out / "diagnose.png"))
+        result.files["json"] = str(out / "diagnose.json")
+        report["files"] = result.files
+        Path(result.files["json"]).write_text(json.dumps(report, indent=2))
+    return result
+
+
+def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
+    """Plain-text summary of a diagnosis (what ``femast diagnose`` prints)."""
+    f, ul = display_scale(exp.error_unit)
+    b = result.baseline
+    lines = [f"femast diagnose: {exp.name} on {result.report['data']} ({result.n_samples} samples; refits: "
+             f"{result.executor})",
+             f"  noise floor {f * result.noise_rms:.4g} {ul}; baseline"
+             f"{' + ' + '+'.join(b['effects']) if b['effects'] else ''} RMS {f * b['rms']:.4g} {ul} "
+             f"({b['ratio']:.2f}x noise)"]
+    if result.by_kind:
+        lines.append("  baseline fails most in: " + ", ".join(f"{k['kind']} ({k['ratio']:.1f}x)"
+                                                          for k in result.by_kind[:3]))
+    lines.append(f"  {'rank':>4s}  {'effect':<22s} {'RMS':>10s} {'x noise':>8s} {'dBIC':>9s}  sig  parameters")
+    for i, e in enumerate(result.ranking):
+        ps = ", ".join(f"{k} = {v['value']:.4g}" + (f" +- {v['stderr']:.2g}" if v["stderr"] is not None else "")
+                       + f" {v['unit']}" for k, v in e["params"].items())
+        lines.append(f"  {i + 1:>4d}  {e['effect']:<22s} {f * e['rms']:>10.4g} {e['ratio']:>8.2f} "
+                     f"{e['delta_bic']:>9.1f}  {'yes' if e['significant'] else ' no'}  {ps}")
+    if result.ranking:
+        lines.append(f"  reading of #1: {result.ranking[0]['reading']}")
+    lines.append(f"  verdict: {result.verdict['conclusion']}")
+    if result.files:
+        lines.append("  wrote " + ", ".join(result.files.values()))
+    return "\n".join(lines)

@@ -1,0 +1,135 @@
+"""Figures of ``compare`` and ``diagnose`` (matplotlib, Agg backend, PNG)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+_SCALES = {"m": (1e3, "mm"), "rad": (1e3, "mrad"), "mm": (1.0, "mm"), "N": (1.0, "N"), "N m": (1.0, "N m")}
+
+
+def display_scale(unit: str):
+    """(factor, label) to show values of ``unit`` in a readable unit (m -> mm, rad -> mrad)."""
+    return _SCALES.get(unit, (1.0, unit))
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def compare_figure(exp, data, result, png) -> Path:
+    """Measured against model, the load path with its segments, and the residual along the path with
+    the worst segments shaded."""
+    plt = _plt()
+    png = Path(png)
+    rows = np.arange(data.n)
+    fig = plt.figure(figsize=(12, 9.5))
+    gs = fig.add_gridspec(3, 2, height_ratios=[1.35, 0.6, 1.0], width_ratios=[1, 1.6])
+    ax0 = fig.add_subplot(gs[0, 0])
+    ax1 = fig.add_subplot(gs[0, 1])
+    ax2 = fig.add_subplot(gs[1, :])
+    ax3 = fig.add_subplot(gs[2, :], sharex=ax2)
+    pred = result.predicted
+    if exp.plot_measured:
+        exp.plot_measured(ax0, data, pred, result.params, exp.options)
+    else:
+        c = exp.channels[0]
+        f, ul = display_scale(exp.unit_of(c))
+        ax0.plot(f * data[c], f * pred[c], ".", ms=3)
+        lim = [f * min(data[c].min(), pred[c].min()), f * max(data[c].max(), pred[c].max())]
+        ax0.plot(lim, lim, "k--", lw=0.8)
+        ax0.set_xlabel(f"measured {c} ({ul})")
+        ax0.set_ylabel(f"model {c} ({ul})")
+    for i, c in enumerate(exp.channels):
+        f, ul = display_scale(exp.unit_of(c))
+        ax1.plot(rows, f * data[c], ".", ms=2, color=f"C{i}", alpha=0.6)
+        ax1.plot(rows, f * pred[c], "-", lw=1.0, color=f"C{i}", label=f"{c} ({ul})")
+    ax1.set_title("measured (dots) and model (lines) along the path")
+    ax1.set_xlabel("row")
+    ax1.legend(fontsize=8, ncol=min(3, len(exp.channels)))
+    s = result.load
+    ax2.plot(rows, s, "-", color="0.3", lw=1.0)
+    for kind, color in (("near-zero load", "C1"), ("reversal", "C4"), ("peak", "C2")):
+        m = result.masks.get(kind)
+        if m is not None and m.any():
+            ax2.plot(rows[m], s[m], ".", ms=3, color=color, label=kind)
+    ax2.set_ylabel(exp.load_label, fontsize=8)
+    ax2.legend(fontsize=7, ncol=3, loc="upper right")
+    ax2.grid(alpha=0.3)
+    for i, c in enumerate(exp.channels):
+        f, ul = display_scale(exp.unit_of(c))
+        ax3.plot(rows, f * result.residuals[c], "-", lw=0.8, color=f"C{i}", label=f"{c} ({ul})")
+        ax3.axhline(f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
+        ax3.axhline(-f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
+    ymax = ax3.get_ylim()[1]
+    for k, seg in enumerate(result.worst[:3]):
+        ax3.axvspan(seg["start_row"] - 0.5, seg["end_row"] + 0.5, color="C3", alpha=0.18 - 0.04 * k, lw=0)
+        ax3.text(0.5 * (seg["start_row"] + seg["end_row"]), ymax, f"#{k + 1} {seg['kind']}\n{seg['ratio']:.1f}x noise",
+                 ha="center", va="top", fontsize=7, color="C3")
+    ax3.set_xlabel("row (time order)")
+    ax3.set_ylabel("residual measured - model")
+    ax3.set_title(f"residual (dotted: noise floor); worst segments shaded; RMS {result.ratio:.2f}x noise")
+    ax3.legend(fontsize=8, ncol=min(3, len(exp.channels)), loc="lower right")
+    ax3.grid(alpha=0.3)
+    eff = "+".join(result.effects) or "baseline"
+    fig.suptitle(f"femast compare {exp.name} -- {Path(data.path).name} -- model: {eff}"
+                 + (" (fitted)" if result.fitted else " (given parameters)"), fontsize=11)
+    fig.tight_layout()
+    png.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(png, dpi=100)
+    plt.close(fig)
+    return png
+
+
+def diagnose_figure(exp, data, result, png) -> Path:
+    """Error of the baseline and of each candidate effect (bars, noise floor), and the residual of the
+    baseline and of the best candidate along the path."""
+    plt = _plt()
+    png = Path(png)
+    f, ul = display_scale(exp.error_unit)
+    entries = [("baseline", result.baseline["rms"], None, False)] + [
+        (r["effect"], r["rms"], r["delta_bic"], r["significant"]) for r in result.ranking]
+    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(13, max(4.0, 0.45 * len(entries) + 2)),
+                                   gridspec_kw={"width_ratios": [1, 1.3]})
+    y = np.arange(len(entries))[::-1]
+    colors = ["C0"] + [("C2" if sig else "0.65") for _, _, _, sig in entries[1:]]
+    ax0.barh(y, [f * e[1] for e in entries], color=colors)
+    ax0.set_yticks(y)
+    ax0.set_yticklabels([e[0] for e in entries], fontsize=9)
+    ax0.axvline(f * result.noise_rms, color="k", ls="--", lw=1, label="noise floor")
+    ax0.axvline(f * result.noise_rms * result.at_noise, color="k", ls=":", lw=1,
+                label=f"{result.at_noise:g} x noise")
+    for yy, e in zip(y, entries):
+        if e[2] is not None:
+            ax0.text(f * e[1], yy, f"  dBIC {e[2]:+.0f}", va="center", fontsize=8)
+    ax0.set_xlabel(f"RMS error after refit ({ul})")
+    v = result.verdict
+    verdict = (f"missing: {v['missing_effect']}" if v["missing_effect"] else
+               ("nothing is missing" if v["explained"] else "none of the candidates explains this"))
+    ax0.set_title(f"{exp.name}: refit with each candidate (green: significant)\nverdict: {verdict}", fontsize=10)
+    ax0.legend(fontsize=8, loc="lower right")
+    xmax = max(f * e[1] for e in entries)
+    ax0.set_xlim(0, 1.35 * xmax)
+    rows = np.arange(data.n)
+    zb = result.baseline_fit.fun.reshape(len(exp.channels), -1)
+    ax1.plot(rows, np.sqrt((zb**2).mean(0)), "-", lw=0.8, color="C0", label="baseline")
+    if result.best_fit is not None:
+        zc = result.best_fit.fun.reshape(len(exp.channels), -1)
+        ax1.plot(rows, np.sqrt((zc**2).mean(0)), "-", lw=0.8, color="C2", label=f"with {result.ranking[0]['effect']}")
+    ax1.axhline(1.0, color="k", ls="--", lw=0.8)
+    ax1.set_xlabel("row (time order)")
+    ax1.set_ylabel("|residual| / noise (RMS over channels)")
+    ax1.set_title("residual along the path")
+    ax1.legend(fontsize=8)
+    ax1.grid(alpha=0.3)
+    fig.tight_layout()
+    png.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(png, dpi=100)
+    plt.close(fig)
+    return png

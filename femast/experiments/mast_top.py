@@ -1,0 +1,157 @@
+"""Built-in experiment ``mast-top``: wrench on a mast top and its measured displacement (seed 000).
+
+Data format
+-----------
+=========  ====  ===========================================================================
+column     unit  meaning
+=========  ====  ===========================================================================
+fx_N       N     change of the force on the mast top (base frame), x
+fy_N       N     ... y
+fz_N       N     ... z
+mx_Nm      N m   change of the moment on the top, about the top point (base frame), x
+my_Nm      N m   ... y
+mz_Nm      N m   ... z
+dx_m       m     measured displacement of the top (e.g. laser tracker), x
+dy_m       m     ... y
+dz_m       m     ... z
+t_s        s     optional time
+=========  ====  ===========================================================================
+
+The wrench change ``dw`` is taken from a reference state (seed 000 Sec. IV-C: the initial
+pose of the platform), as is the displacement ``dc``.
+
+Baseline model
+--------------
+The 3R model of seed 000 (Eqs. 4-7, Eq. 6 with the corrected sign, :mod:`femast.guyed.mast_3r`):
+a rigid mast on three elastic base joints about the base axes,
+``dc = J K^-1 J^T dw``.  The moments driving the joints are ``m = J^T dw`` (N m about the base
+point O, along the base axes); the joint rotations ``theta = m / k``; the top translation
+``dc_T = J_T theta``.  Fitted: the bending joint stiffnesses ``k_theta1, k_theta2`` (N m/rad).
+The torsion joint (``k_theta3`` option, default rigid) does not move the top point.
+
+Options: ``r_oc_m`` vector from the base O to the top C (m), default ``(0, 0, 3.651)`` (a
+vertical mast from the origin, seed 000's L); ``k_theta3_Nm_per_rad`` (inf); the mast tube for
+the beam effect ``s_out_m`` = 0.1, ``s_in_m`` = 0.094, ``nu`` = 0.3.
+
+Hooks (where effects act)
+-------------------------
+* ``joint_moment`` -- value ``m`` (n, 3) N m, the moments the elastic joints see (friction and
+  hysteresis operators replace it);
+* ``joint_rotation`` -- value ``theta`` (n, 3) rad (clearance, progressive stiffness, pretension);
+* ``top_displacement`` -- value ``dc_T`` (n, 3) m (beam flexibility, user additions).
+
+Every hook call passes ``data``, ``options``, ``params`` (baseline) and ``prep`` (``dw`` (n, 6),
+``J`` (6, 3), ``m`` (n, 3) the unmodified joint moments, ``m_smooth`` (3,) 1 % of max |m| per
+joint, ``tau`` normalised time) and, from ``joint_rotation`` on, ``k`` (3,) and ``m_eff``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..guyed.mast_3r import jacobian_3r
+from .core import Column, Experiment, Measured, Parameter, prepared
+
+WRENCH = ("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm")
+DISPLACEMENT = ("dx_m", "dy_m", "dz_m")
+L_SEED = 3.651  # m, seed 000 Sec. IV-B-2
+
+
+def _prepare(data: Measured, options: dict) -> dict:
+    dw = np.column_stack([data[c] for c in WRENCH])
+    J = jacobian_3r(np.asarray(options["r_oc_m"], dtype=float), seed_sign=bool(options.get("seed_sign", False)))
+    m = dw @ J
+    m_smooth = np.maximum(0.01 * np.max(np.abs(m), axis=0), 1e-12)
+    return {"dw": dw, "J": J, "m": m, "m_smooth": m_smooth, "tau": data.tau}
+
+
+def model(params: dict, data: Measured, effects, options: dict) -> dict:
+    """3R mast-top model (seed 000 Eqs. 4-7) with effect hooks; returns ``{dx_m, dy_m, dz_m}`` in m."""
+    prep = prepared(data, _prepare, options)
+    k = np.array([params["k_theta1"], params["k_theta2"], float(options["k_theta3_Nm_per_rad"])])
+    ctx = dict(data=data, options=options, params=params, prep=prep)
+    m_eff = effects.apply("joint_moment", prep["m"], **ctx) if effects else prep["m"]
+    theta = m_eff / k
+    if effects:
+        theta = effects.apply("joint_rotation", theta, k=k, m_eff=m_eff, **ctx)
+    d = theta @ prep["J"][:3].T
+    if effects:
+        d = effects.apply("top_displacement", d, k=k, m_eff=m_eff, theta=theta, **ctx)
+    return {"dx_m": d[:, 0], "dy_m": d[:, 1], "dz_m": d[:, 2]}
+
+
+def initial_guess(data: Measured, options: dict) -> dict:
+    """Linear least-squares compliances of the two bending joints (Eqs. 28-29) as the fit start."""
+    prep = prepared(data, _prepare, options)
+    JT = prep["J"][:3, :2]
+    A = (prep["m"][:, None, :2] * JT[None, :, :]).reshape(-1, 2)  # d = sum_k J_T[:, k] m_k / k_k
+    b = np.column_stack([data[c] for c in DISPLACEMENT]).ravel()
+    comp = np.linalg.lstsq(A, b, rcond=None)[0]
+    k = np.where(comp > 0, 1.0 / np.where(comp > 0, comp, 1.0), 2.5e5)
+    return {"k_theta1": float(np.clip(k[0], 1e2, 1e10)), "k_theta2": float(np.clip(k[1], 1e2, 1e10))}
+
+
+def load_measure(data: Measured, options: dict) -> np.ndarray:
+    """Signed bending moment at the base (N m): the joint moments (m1, m2) projected on their
+    principal direction, the sign chosen so that the largest |value| is positive."""
+    prep = prepared(data, _prepare, options)
+    m = prep["m"][:, :2]
+    if not np.any(m):
+        return np.zeros(data.n)
+    _, _, Vt = np.linalg.svd(m - 0.0, full_matrices=False)
+    s = m @ Vt[0]
+    return s if s[np.argmax(np.abs(s))] > 0 else -s
+
+
+def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: dict) -> None:
+    """Top view of the top's path, measured against model (seed 000 Fig. 6 style), mm."""
+    ax.plot(1e3 * data["dx_m"], 1e3 * data["dy_m"], ".", ms=2.5, color="0.35", label="measured")
+    ax.plot(1e3 * predicted["dx_m"], 1e3 * predicted["dy_m"], "-", lw=1.2, color="C3", label="model")
+    ax.set_xlabel("dx (mm)")
+    ax.set_ylabel("dy (mm)")
+    ax.set_title("mast top, plan view")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(fontsize=8)
+
+
+_EXPERIMENT = Experiment(
+    name="mast-top",
+    title="mast-top wrench and displacement (seed 000, 3R model)",
+    columns=tuple(Column(c, u, d) for c, u, d in (
+        ("fx_N", "N", "change of the force on the mast top, base frame, x"),
+        ("fy_N", "N", "change of the force on the mast top, base frame, y"),
+        ("fz_N", "N", "change of the force on the mast top, base frame, z"),
+        ("mx_Nm", "N m", "change of the moment about the top point, base frame, x"),
+        ("my_Nm", "N m", "change of the moment about the top point, base frame, y"),
+        ("mz_Nm", "N m", "change of the moment about the top point, base frame, z"),
+        ("dx_m", "m", "measured displacement of the top, x"),
+        ("dy_m", "m", "measured displacement of the top, y"),
+        ("dz_m", "m", "measured displacement of the top, z"),
+    )),
+    channels=DISPLACEMENT,
+    parameters=(
+        Parameter("k_theta1", "N m/rad", 2.5e5, 1e2, 1e10, "stiffness of the base joint about x (Eq. 5)",
+                  scale=2.5e5),
+        Parameter("k_theta2", "N m/rad", 2.5e5, 1e2, 1e10, "stiffness of the base joint about y (Eq. 5)",
+                  scale=2.5e5),
+    ),
+    model=model,
+    options={"r_oc_m": (0.0, 0.0, L_SEED), "k_theta3_Nm_per_rad": np.inf, "s_out_m": 0.1, "s_in_m": 0.094,
+             "nu": 0.3, "seed_sign": False},
+    hooks={
+        "joint_moment": "m (n, 3) N m: moments about the base axes that drive the elastic joints",
+        "joint_rotation": "theta (n, 3) rad: rotations of the base joints",
+        "top_displacement": "dc_T (n, 3) m: translation of the top point",
+    },
+    doc=__doc__,
+    prepare=_prepare,
+    initial_guess=initial_guess,
+    load_measure=load_measure,
+    load_label="base bending moment (N m)",
+    plot_measured=plot_measured,
+    error_unit="m",
+    min_rows=10,
+    source="mast-top",
+)
+
+EXPERIMENT = _EXPERIMENT
