@@ -48,7 +48,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from ..errors import ModelError
 from .base import ElementFamily, ElementResponse
@@ -88,12 +88,13 @@ def dyneema_tangent_rigidity(tau, k0, k1, k2):
     return g * g / (k0 - k2 * tau * tau)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def shroud_family_kernel(nodes, x, R, offsets, L0, law, parts, gx, gw, f, K, tau_out, eps_out, len_out,
                          energy, err):
-    """All shroud elements: forces f (n, 12), tangent K (n, 12, 12), tension, strain, length,
-    strain energy and an error code per element (see module docstring)."""
-    for el in prange(nodes.shape[0]):
+    """All shroud elements in one call: forces f (n, 12), tangent K (n, 12, 12), tension, strain,
+    length, strain energy and an error code per element (see module docstring).  Serial on purpose:
+    a family holds a few ropes (3 per mast), and ``parallel=True`` doubles the compile time (~11 s)."""
+    for el in range(nodes.shape[0]):
         a = nodes[el, 0]
         b = nodes[el, 1]
         ra = R[a] @ offsets[el, 0]
