@@ -20,11 +20,12 @@ from .results import Results
 from .sections import Section, circular_solid, circular_tube, shear_modulus, square_solid, square_tube
 from .solvers.control import DisplacementControl, LoadControl
 from .solvers.stabilize import Stabilize
+from .solvers.arclength import ArcLength
 from .solvers.convergence import Convergence
 
 __all__ = [
     "Amplitude", "Analysis", "solve", "Model", "Results", "Section", "circular_solid", "circular_tube",
-    "square_solid", "square_tube", "shear_modulus", "DisplacementControl", "LoadControl", "Convergence", "Stabilize",
+    "square_solid", "square_tube", "shear_modulus", "DisplacementControl", "LoadControl", "Convergence", "Stabilize", "ArcLength",
     "FemastError", "ModelError", "SingularModelError", "ConvergenceError", "DataFileError",
 ]
 __version__ = "0.1.0"

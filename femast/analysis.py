@@ -237,11 +237,20 @@ class Analysis:
         """(K_ff, K_fc) at the configuration of the last :meth:`_residual` call."""
         k_list = [q.k for q in responses]
         if not self.constraints.active:
-            return self.assembler.tangent(k_list, with_fc=with_fc)
-        nf = self.dofmap.n_free
-        T = self._T
-        K = (T.T @ self.assembler.full_tangent(k_list) @ T + self.constraints.geometric(self.x, self._net)).tocsr()
-        return K[:nf, :nf], (K[:nf, nf:] if with_fc else None)
+            K, Kfc = self.assembler.tangent(k_list, with_fc=with_fc)
+        else:
+            nf = self.dofmap.n_free
+            T = self._T
+            Kind = (T.T @ self.assembler.full_tangent(k_list) @ T
+                    + self.constraints.geometric(self.x, self._net)).tocsr()
+            K, Kfc = Kind[:nf, :nf], (Kind[:nf, nf:] if with_fc else None)
+        if self._zero_force is None:
+            dk = np.abs(K.diagonal())
+            kt = float(dk[~self.is_rot].max(initial=0.0))
+            kr = float(dk[self.is_rot].max(initial=0.0))
+            # 'zero flux' floors: forces of a 1e-6 L (1e-6 rad) motion of the stiffest DOF
+            self._zero_force = 1e-6 * max(kt * self.length, kr / self.length)
+        return K, Kfc
 
     def _update(self, du_free, du_cons=None):
         W = np.zeros_like(self.spin)
@@ -339,6 +348,8 @@ class Analysis:
         return Results(self.out)
 
     def _run_step(self, k, step, writer):
+        if getattr(step.control, "arc_length", False):
+            return self._run_arc_step(step, writer)
         period = step.period
         dt = step.initial_increment or min(period, step.max_increment or period)
         dt_min = step.min_increment or period * 1e-5
@@ -485,12 +496,13 @@ class Analysis:
                         self._stab_C0 = self._stab_C.copy()
                     K = (K + sp.diags(self._stab_C / dt)).tocsr()
                 self.summary.assembly_time += _time.perf_counter() - ta
-                if self._zero_force is None:
-                    dk = np.abs(K.diagonal())
-                    kt = float(dk[~self.is_rot].max(initial=0.0))
-                    kr = float(dk[self.is_rot].max(initial=0.0))
-                    # 'zero flux' floors: forces of a 1e-6 L (1e-6 rad) motion of the stiffest DOF
-                    self._zero_force = 1e-6 * max(kt * self.length, kr / self.length)
+                if it == 0 and not uses_lam and not np.any(dpres) and not np.any(Du):
+                    # nothing to do: the start of the increment is already in equilibrium
+                    # (e.g. a step that repeats the previous loads)
+                    ok, _ = self._converged(r, None, Du, responses, P)
+                    if ok:
+                        self._commit(responses, P, F, lam)
+                        return True, 0, "", responses
                 if it > 0:
                     ok, ratio = self._converged(r, du, Du, responses, P)
                     rnorm_hist.append(ratio)
@@ -574,6 +586,121 @@ class Analysis:
             self._update(s_best * du)
         self.summary.line_searches += 1
         return s_best * du, resp, F_, r_
+
+    # ------------------------------------------------------------ arc length
+    def _run_arc_step(self, step, writer):
+        control = step.control
+        control.setup(self, step)
+        load_start = self.loads.copy()
+        P_ref_full = self._values(step.loads, load_start, 1.0, step.period) - load_start
+        self.lam = 0.0
+        dl0 = dl = None
+        prev = None
+        inc = step_iters = 0
+        bar = tqdm(total=1.0, desc=f"step {step.name} (arc length)", disable=not self.progress, leave=False,
+                   bar_format="{desc}: {percentage:3.0f}%|{bar}| [{elapsed}<{remaining}]")
+        while True:
+            attempt = 0
+            while True:
+                attempt += 1
+                ok, iters, note, responses, dl_used, Du, dlam = self._increment_arc(
+                    step, control, dl, prev, load_start, P_ref_full)
+                step_iters += iters
+                self.summary.iterations += iters
+                if dl0 is None:
+                    dl0 = dl_used
+                if ok:
+                    break
+                writer.status(step.name, inc + 1, attempt, iters, self.lam, self.total_time, dl_used, self.lam,
+                              f"cutback: {note}")
+                self.summary.cutbacks += 1
+                dl = dl_used * self.cutback
+                if dl < control.min_arc * dl0:
+                    bar.close()
+                    raise ConvergenceError(
+                        f"step '{step.name}': arc length fell below the minimum ({control.min_arc:g} of the first) "
+                        f"at load factor {self.lam:.6g}: {note}. The {self.summary.increments} converged "
+                        f"increments are saved in '{self.out}'.")
+            inc += 1
+            prev = (Du, dlam)
+            dt = dl_used / dl0 * control.initial_load_factor
+            self.total_time += dt
+            self.summary.increments += 1
+            self._write(writer, step.name, inc, self.lam, iters, responses)
+            writer.status(step.name, inc, attempt, iters, self.lam, self.total_time, dl_used, self.lam,
+                          f"arc length {dl_used:.4g}")
+            frac = control.progress(self, self.lam)
+            bar.n = min(max(frac, 0.0), 1.0)
+            bar.refresh()
+            dl = dl_used * min(max(math.sqrt(control.desired_iterations / max(iters, 1)), 0.5), 2.0)
+            dl = min(max(dl, control.min_arc * dl0), control.max_arc * dl0)
+            if frac >= 1.0 - 1e-12 or inc >= step.max_increments:
+                break
+        bar.close()
+        self.summary.steps.append({"name": step.name, "increments": inc, "iterations": step_iters,
+                                   "final_load_factor": self.lam})
+
+    def _increment_arc(self, step, control, dl, prev, load_start, P_ref_full):
+        """One arc-length increment; returns (ok, iterations, note, responses, dl, Du, dlambda)."""
+        saved = (self.x.copy(), self.R.copy(), self.spin.copy(), self.lam)
+        ctx = IncrementContext(time=self.lam, dtime=0.0, total_time=self.total_time, x_committed=saved[0],
+                               R_committed=saved[1], step_name=step.name)
+        nf = self.dofmap.n_free
+        lam = lam0 = self.lam
+        iters = 0
+        try:
+            P = load_start + lam * P_ref_full
+            responses = self._evaluate(ctx)
+            res = self._residual(responses, P)
+            K, _ = self._tangent(responses, with_fc=False)
+            self.solver.factorize(K)
+            du_p = self.solver.solve(self._reduce_load(P_ref_full))
+            norm_p = math.sqrt(control.norm2(du_p))
+            if dl is None:
+                dl = control.initial_load_factor * norm_p
+            sign = 1.0
+            if prev is not None:
+                sign = 1.0 if float(prev[0] @ (control.weights * du_p)) >= 0 else -1.0
+            dlam = sign * dl / norm_p
+            du = dlam * du_p
+            Du = du.copy()
+            lam += dlam
+            self._update(du)
+            iters = 1
+            rhist = []
+            for it in range(1, self.convergence.max_iterations + 1):
+                P = load_start + lam * P_ref_full
+                responses = self._evaluate(ctx)
+                res = self._residual(responses, P)
+                r = res[:nf]
+                if not np.all(np.isfinite(r)):
+                    raise FloatingPointError("non-finite residual")
+                ok, ratio = self._converged(r, du, Du, responses, P)
+                rhist.append(ratio)
+                if ok:
+                    self._commit(responses, P, res, lam)
+                    return True, iters, "", responses, dl, Du, lam - lam0
+                if it >= 8 and rhist[-1] > rhist[-2] > rhist[-3] > rhist[-4]:
+                    break
+                K, _ = self._tangent(responses, with_fc=False)
+                self.solver.factorize(K)
+                du_r = self.solver.solve(r)
+                du_p = self.solver.solve(self._reduce_load(P_ref_full))
+                d = control.correction(Du, du_r, du_p, dl)
+                if d is None:
+                    return self._fail_arc(saved, iters, "arc-length constraint has no real root", dl)
+                du = du_r + d * du_p
+                lam += d
+                Du += du
+                self._update(du)
+                iters += 1
+            return self._fail_arc(saved, iters, f"no convergence in {iters} iterations", dl)
+        except (FloatingPointError, SingularModelError) as exc:
+            return self._fail_arc(saved, iters, str(exc), dl)
+
+    def _fail_arc(self, saved, iters, why, dl):
+        self._fail(saved, iters, why)
+        return False, iters, why, None, dl, None, 0.0
 
     def _worst(self, r):
         return self.dofmap.describe(int(np.argmax(np.abs(r))))

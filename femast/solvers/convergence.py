@@ -43,6 +43,6 @@ class Convergence:
             if du is not None:
                 dmax = float(np.max(np.abs(du[mask])))
                 Dmax = float(np.max(np.abs(Du[mask])))
-                if dmax > self.disp_tol * max(Dmax, 1e-12 * dref):
+                if dmax > self.disp_tol * max(Dmax, 1e-9 * dref):  # floor: round-off-sized increments
                     ok = False
         return ok, worst
