@@ -203,6 +203,7 @@ class Analysis:
         self.lam = 0.0
         self.summary = AnalysisSummary()
         self.strain_energy = 0.0
+        self._stab_energy = 0.0
         self._zero_force = None
 
     # ------------------------------------------------------------ helpers
@@ -742,7 +743,7 @@ class Analysis:
         data = {"step": step_name, "increment": inc, "time": time, "total_time": self.total_time,
                 "load_factor": self.lam, "iterations": iterations, "U": self.x - self.X0, "R": self.R,
                 "UR": rotation_vectors(self.R), "URA": self.spin, "RF": RF, "P": self.loads,
-                "strain_energy": self.strain_energy}
+                "strain_energy": self.strain_energy, "stabilization_energy": self._stab_energy}
         if responses is None:
             responses = self._evaluate(IncrementContext(x_committed=self.x, R_committed=self.R))
         for f, r in zip(self.families, responses):

@@ -7,7 +7,8 @@ from pathlib import Path
 import pytest
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
-PAGES = ["getting_started.md", "model.md", "solver.md", "results.md"]
+PAGES = ["getting_started.md", "model.md", "solver.md", "results.md", "stabilize.md", "arc_length.md",
+         "constraints.md"]
 
 
 @pytest.mark.parametrize("page", PAGES)
@@ -23,6 +24,9 @@ def test_page_examples_run(page, tmp_path, capsys):
         os.chdir(cwd)
     out = capsys.readouterr().out
     # printed numbers quoted on the page must be what the example prints
-    for quoted in re.findall(r"prints `([^`]+)`|^    (tip deflection[^\n]+)$", (DOCS / page).read_text(), re.M):
-        text = quoted[0] or quoted[1]
-        assert text in out, f"{page}: the page says it prints {text!r}"
+    text = (DOCS / page).read_text()
+    quoted = re.findall(r"prints `([^`]+)`", text)
+    quoted += re.findall(r"^    (tip deflection[^\n]+)$", text, re.M)
+    quoted += re.findall(r"^`(top lean[^`]+)`", text, re.M)
+    for q in quoted:
+        assert q in out, f"{page}: the page says it prints {q!r}"
