@@ -87,12 +87,13 @@ def _run_tasks(payloads, workers, scheduler):
         own = not isinstance(scheduler, Client)
         client = Client(scheduler) if own else scheduler
         try:
+            address = client.scheduler.address if client.scheduler is not None else str(scheduler)
             futures = client.map(_refit_task, payloads, pure=False)
             results = client.gather(futures)
         finally:
             if own:
                 client.close()
-        return list(results), f"dask.distributed ({getattr(client, 'scheduler', None) and client.scheduler.address})"
+        return list(results), f"dask.distributed at {address}"
     n = (os.cpu_count() or 1) if workers is None else int(workers)
     if n < 1:
         raise ModelError(f"--workers must be >= 1, got {workers}")
@@ -126,7 +127,7 @@ def _reading(effect, entry, base_fit, cand_fit, masks, nch, worst_kind):
         if g > 0:
             text += f" The largest gain is in the {kind} segments."
     if worst_kind and worst_kind in eff.acts_where:
-        text += f" The baseline fails most in the {worst_kind} segments, where this effect acts."
+        text += f" The model fails most in the {worst_kind} segments, where this effect acts."
     if not entry["significant"]:
         text += " Not significant: the data do not ask for it."
     elif rc > AT_NOISE:
@@ -270,7 +271,7 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
              f"{' + ' + '+'.join(b['effects']) if b['effects'] else ''} RMS {f * b['rms']:.4g} {ul} "
              f"({b['ratio']:.2f}x noise)"]
     if result.by_kind:
-        lines.append("  baseline fails most in: " + ", ".join(f"{k['kind']} ({k['ratio']:.1f}x)"
+        lines.append("  the model fails most in: " + ", ".join(f"{k['kind']} ({k['ratio']:.1f}x)"
                                                           for k in result.by_kind[:3]))
     lines.append(f"  {'rank':>4s}  {'effect':<22s} {'RMS':>10s} {'x noise':>8s} {'dBIC':>9s}  sig  parameters")
     for i, e in enumerate(result.ranking):

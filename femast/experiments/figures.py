@@ -67,11 +67,12 @@ def compare_figure(exp, data, result, png) -> Path:
         ax3.plot(rows, f * result.residuals[c], "-", lw=0.8, color=f"C{i}", label=f"{c} ({ul})")
         ax3.axhline(f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
         ax3.axhline(-f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
-    ymax = ax3.get_ylim()[1]
     for k, seg in enumerate(result.worst[:3]):
         ax3.axvspan(seg["start_row"] - 0.5, seg["end_row"] + 0.5, color="C3", alpha=0.18 - 0.04 * k, lw=0)
-        ax3.text(0.5 * (seg["start_row"] + seg["end_row"]), ymax, f"#{k + 1} {seg['kind']}\n{seg['ratio']:.1f}x noise",
-                 ha="center", va="top", fontsize=7, color="C3")
+        ax3.text(0.5 * (seg["start_row"] + seg["end_row"]), 0.97 - 0.13 * k,
+                 f"#{k + 1} {seg['kind']} {seg['ratio']:.1f}x", transform=ax3.get_xaxis_transform(),
+                 ha="center", va="top", fontsize=7, color="C3",
+                 bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.7))
     ax3.set_xlabel("row (time order)")
     ax3.set_ylabel("residual measured - model")
     ax3.set_title(f"residual (dotted: noise floor); worst segments shaded; RMS {result.ratio:.2f}x noise")
@@ -113,7 +114,7 @@ def diagnose_figure(exp, data, result, png) -> Path:
     verdict = (f"missing: {v['missing_effect']}" if v["missing_effect"] else
                ("nothing is missing" if v["explained"] else "none of the candidates explains this"))
     ax0.set_title(f"{exp.name}: refit with each candidate (green: significant)\nverdict: {verdict}", fontsize=10)
-    ax0.legend(fontsize=8, loc="lower right")
+    ax0.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     xmax = max(f * e[1] for e in entries)
     ax0.set_xlim(0, 1.35 * xmax)
     rows = np.arange(data.n)

@@ -160,7 +160,7 @@ def run_model(exp: Experiment, data: Measured, params=None, effects=None, noise=
     predicted = predict(exp, data, {k: v for k, v in vals.items() if "." not in k}, effects)
     sigma = noise or estimate_noise(exp, channel_residuals(exp, data, predicted))
     n = len(x)
-    return _result(exp, data, specs, x, np.full(n, np.nan), np.full((n, n), np.nan), sigma, predicted, False,
+    return _result(exp, data, specs, x, np.full(n, np.nan), np.full((n, n), np.nan), sigma, predicted, False, True,
                    "model run with given parameters (not fitted)", 1, [i[0] for i in impls])
 
 

@@ -13,8 +13,9 @@ t_s     s     optional time
 
 Rows are in time order; a file may hold several latching and unlatching passes and holds
 against the backstop.  The direction of motion of the bead is taken from the x path: a
-reversal is confirmed when x moves back by more than ``max(5 noise, 2 % of its range)`` (or the
-``turn_threshold_m`` option).
+reversal is confirmed when x moves back by more than ``max(5 noise, 5 % of its range)`` (or the
+``turn_threshold_m`` option); the bead counts as possibly at rest until it has moved
+``max(3 noise, 1 % of the range)`` from the turning point.
 
 Baseline model
 --------------
@@ -50,8 +51,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..latch import LATCHING, UNLATCHING, LatchParameters, latch_force, latch_zone
-from ..latch_identification import initial_guess as _latch_initial_guess
+from ..latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force, latch_zone
 from .core import Column, Experiment, Measured, Parameter, prepared
 from .residuals import noise_floor, turning_points
 
@@ -63,12 +63,13 @@ def _prepare(data: Measured, options: dict) -> dict:
     sx = noise_floor(x)
     h = options.get("turn_threshold_m")
     if h is None:
-        h = max(5.0 * sx, 0.02 * float(np.ptp(x)), 1e-9)
+        h = max(5.0 * sx, 0.05 * float(np.ptp(x)), 1e-9)
     tps, sigma = turning_points(x, float(h))
+    h_rest = max(3.0 * sx, 0.01 * float(np.ptp(x)), 1e-9)
     rest = np.zeros(data.n, bool)
     for t in [0, *tps]:
         j = t
-        while j < data.n and abs(x[j] - x[t]) <= h:
+        while j < data.n and abs(x[j] - x[t]) <= h_rest:
             rest[j] = True
             j += 1
     return {"x": x, "dT": dT, "sigma": sigma, "rest": rest, "tau": data.tau, "noise_x": sx, "turn_m": float(h),
@@ -101,11 +102,23 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
 
 
 def initial_guess(data: Measured, options: dict) -> dict:
-    """Data-driven start of r, x_backstop, k, mu (:func:`femast.latch_identification.initial_guess`)."""
+    """Data-driven start of r, x_backstop, k, mu (as :func:`femast.latch_identification.initial_guess`).
+
+    x_backstop from the smallest bead position; r from the largest |x| with a force above 5 noise
+    (the contact half-width, Eq. 6 with delta = 0); k from the peak force by proportion to the law
+    at k = 1e5 N/m; mu = 0.05."""
     prep = prepared(data, _prepare, options)
-    g = _latch_initial_guess(prep["x"], prep["dT"], float(options["h_m"]), float(options["R_m"]),
-                             noise_T=max(noise_floor(prep["dT"]), 1e-3))
-    return dict(zip(("r", "x_backstop", "k", "mu"), (float(v) for v in g)))
+    x, dT = prep["x"], prep["dT"]
+    h, R = float(options["h_m"]), float(options["R_m"])
+    xb = max(-float(np.min(x)), 1e-5)
+    loaded = x[np.abs(dT) > 5.0 * max(noise_floor(dT), 1e-3)]
+    xc = float(np.max(np.abs(loaded))) if loaded.size else 2.0e-3
+    r = float(np.clip((xc**2 - R**2 + h**2) / (2 * (R - h)), 0.1 * R, 5 * R))
+    ref = LatchParameters(r=r, x_backstop=xb, k=1e5, mu=0.05, h=h, R=R)
+    xg = np.linspace(-xb, contact_half_width(ref), 501)
+    peak = float(np.abs(latch_force(xg, UNLATCHING, ref)).max())
+    k = 1e5 * float(np.max(np.abs(dT))) / peak if peak > 0 else 1e5
+    return {"r": r, "x_backstop": xb, "k": float(np.clip(k, 10.0, 1e9)), "mu": 0.05}
 
 
 def load_measure(data: Measured, options: dict) -> np.ndarray:
