@@ -35,7 +35,7 @@ def skew(v):
     return S
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _sq(S):
     """S @ S for a 3x3 matrix, as loops (numba's @ calls BLAS: slow for 3x3)."""
     out = np.zeros((3, 3))

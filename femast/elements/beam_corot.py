@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from ..rotations import logm_so3, skew, ts_inv, ts_inv_T_times_derivative
 from .base import ElementFamily, ElementResponse
@@ -36,7 +36,7 @@ SECTION_FORCE_NAMES = ("N", "Vy", "Vz", "T", "My", "Mz")
 
 # Small dense products as plain loops: numba's `@` calls BLAS, whose per-call overhead
 # dominates for 3x3 and 3x12 operands.
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _mm(A, B):
     n, k = A.shape
     m = B.shape[1]
@@ -50,7 +50,7 @@ def _mm(A, B):
     return C
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _mv(A, v):
     n, k = A.shape
     out = np.zeros(n)
@@ -60,7 +60,7 @@ def _mv(A, v):
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _vm(v, A):
     k, m = A.shape
     out = np.zeros(m)
@@ -71,7 +71,7 @@ def _vm(v, A):
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _dot(a, b):
     s = 0.0
     for i in range(a.shape[0]):
@@ -223,10 +223,10 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
     return 0.5 * (N * ubar + _dot(m1, th1) + _dot(m2, th2))
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def beam_family_kernel(nodes, x, R, E0, l0, EA, GJ, EIy, EIz, f, K, sf, energy):
     """All elements of a beam family at once (see :func:`beam_element`)."""
-    for e in prange(nodes.shape[0]):
+    for e in range(nodes.shape[0]):
         a = nodes[e, 0]
         b = nodes[e, 1]
         energy[e] = beam_element(x[a], x[b], R[a], R[b], E0[e], l0[e], EA[e], GJ[e], EIy[e], EIz[e],

@@ -13,14 +13,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from .base import ElementFamily, ElementResponse
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def truss_family_kernel(nodes, x, L0, EA, tension_only, f, K, N_out, energy):
-    for el in prange(nodes.shape[0]):
+    for el in range(nodes.shape[0]):
         a = nodes[el, 0]
         b = nodes[el, 1]
         d = x[b] - x[a]
