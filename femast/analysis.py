@@ -445,7 +445,6 @@ class Analysis:
         ctx = IncrementContext(time=t + dt, dtime=dt, total_time=self.total_time + dt, x_committed=saved[0],
                                R_committed=saved[1], step_name=step.name)
         uses_lam = control.solves_for_load_factor
-        P_ref = None
         if uses_lam:
             lam = self.lam
             P_end = self._values(step.loads, load_start, 1.0, period)
@@ -510,9 +509,8 @@ class Analysis:
                     if ok:
                         if stab is not None:
                             self._stab_energy += float(Du @ (self._stab_C / dt * Du))
-                            self.strain_energy_now = sum(float(np.sum(q.energy)) for q in responses
-                                                         if q.energy is not None)
-                            ratio = self._stab_energy / max(self.strain_energy_now, 1e-300)
+                            strain = sum(float(np.sum(q.energy)) for q in responses if q.energy is not None)
+                            ratio = self._stab_energy / max(strain, 1e-300)
                             self._stab_C = stab.adapt(self._stab_C, self._stab_C0, ratio)
                         self._last_Du, self._last_dt, self._last_Dlam = Du.copy(), dt, lam - lam_start
                         self._commit(responses, P, F, lam)
@@ -540,13 +538,14 @@ class Analysis:
                     lam += dlam
                 self.summary.solve_time += _time.perf_counter() - ts
                 iters += 1
-                before = (self.x.copy(), self.R.copy(), self.spin.copy())
+                search = line_search and not uses_lam and not (it == 0 and np.any(dpres))
+                before = (self.x.copy(), self.R.copy(), self.spin.copy()) if search else None
                 self._update(du, dpres if it == 0 else None)
                 P = loads_now(lam)
                 Du_before = Du.copy()
                 Du += du
                 responses, F, r_new = evaluate(P)
-                if line_search and not uses_lam and not (it == 0 and np.any(dpres)):
+                if search:
                     du, responses, F, r_new = self._line_search(du, r, r_new, responses, F, before, evaluate, P,
                                                                 Du_before)
                     Du = Du_before + du
