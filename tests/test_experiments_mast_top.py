@@ -108,6 +108,7 @@ def test_out_of_library_thermal_drift_is_not_explained():
     assert d.baseline["ratio"] > 2.0
 
 
+@pytest.mark.slow  # the same loop runs by default on the shipped data (test_experiments_docs, _cli)
 def test_two_hidden_effects_are_found_one_after_the_other():
     data, _ = mast_top_data(effects={"joint_clearance": {"c": 1.5e-4}, "friction_hysteresis": {"M_f": 12.0}},
                             path=mast_top_path(kind="cycles", seed=41), seed=41)

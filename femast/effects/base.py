@@ -105,6 +105,11 @@ def register_effect(effect: Effect, replace_existing: bool = False) -> Effect:
     return effect
 
 
+def unregister_effect(name: str) -> None:
+    """Remove an effect from the library (e.g. a user effect after a study); unknown names are ignored."""
+    _REGISTRY.pop(name, None)
+
+
 def add_implementation(effect_name: str, experiment: str, implementation: Implementation) -> Effect:
     """Make a registered effect apply to another experiment (e.g. a user's)."""
     eff = get_effect(effect_name)

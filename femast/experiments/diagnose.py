@@ -5,7 +5,10 @@ noise floor of every channel is estimated from its residual.  Then the model is 
 per candidate effect -- every applicable effect not yet in the model -- with the same noise
 weights.  The refits are independent and run in parallel: local processes by default
 (:class:`concurrent.futures.ProcessPoolExecutor`), a dask.distributed cluster when a scheduler
-address (or a ``distributed.Client``) is given.
+address (or a ``distributed.Client``) is given.  With the default number of workers a
+diagnosis whose refits are estimated to take under a second in all runs in the calling process:
+starting worker processes would cost more than it saves (the FE experiments are the ones that
+need the workers).
 
 Ranking and verdict
 -------------------
@@ -31,6 +34,7 @@ from __future__ import annotations
 import json
 import multiprocessing
 import os
+import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -47,6 +51,7 @@ from .fitting import fit, params_table
 AT_NOISE = 1.2
 SIGNIFICANT_DBIC = -10.0
 _START_METHOD = None  # multiprocessing start method of the local pool (None: the platform's default)
+SERIAL_BELOW_S = 1.0  # default workers: refit in this process when the refits should take less than this (s)
 
 
 # --------------------------------------------------------------------------- refit tasks
@@ -142,7 +147,9 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
 
     candidates : effect names to try (default: every effect applicable to the experiment and not in
         ``base_effects``).  base_effects : effects already in the model being diagnosed.
-    workers : local worker processes (default: the number of CPUs; 1 runs in this process).
+    workers : local worker processes (default: the number of CPUs, unless the refits are estimated
+        -- twice the baseline fit time each -- to take less than ``SERIAL_BELOW_S`` = 1 s in all, which
+        is less than starting the processes costs; 1 runs in this process).
     scheduler : a dask.distributed scheduler address (``tcp://...``) or ``distributed.Client``.
     out : folder for ``diagnose.json`` and ``diagnose.png`` (nothing written if None).
 
@@ -165,7 +172,9 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         dup = set(candidates) & set(base_effects)
         if dup:
             raise ModelError(f"candidate effect(s) {', '.join(sorted(dup))} are already in the model")
+    t0 = time.perf_counter()
     baseline = fit(exp, data, base_effects)
+    t_base = time.perf_counter() - t0
     sigma = baseline.noise
     start = dict(zip(baseline.names, baseline.x))
     payload0 = {"source": exp.source, "options": exp.options, "scripts": list(loaded_scripts()),
@@ -175,6 +184,9 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     if payloads and not _rebuildable(exp):
         fits_list = [fit(exp, data, p["effects"], start=start, noise=sigma) for p in payloads]
         how = "serial (experiment defined in memory: worker processes cannot rebuild it)"
+    elif payloads and workers is None and scheduler is None and 6.0 * t_base * len(payloads) < SERIAL_BELOW_S:
+        fits_list = [_refit_task(p) for p in payloads]
+        how = f"serial (refits estimated at {6.0 * t_base * len(payloads):.2f} s: cheaper than starting processes)"
     elif payloads:
         fits_list, how = _run_tasks(payloads, workers, scheduler)
     else:

@@ -1,0 +1,57 @@
+"""The experiments docs run: python examples execute, and the tutorial's commands print what the page quotes."""
+
+import os
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+
+from femast.cli import main
+from femast.effects import list_effects, unregister_effect
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+
+
+@pytest.mark.parametrize("page", ["experiments.md", "compare_and_diagnose.md"])
+def test_python_examples_run(page, capsys, monkeypatch):
+    text = (DOCS / page).read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
+    assert blocks
+    monkeypatch.chdir(ROOT)  # the examples read the shipped data by relative path
+    before = {e.name for e in list_effects()}
+    try:
+        for i, src in enumerate(blocks):
+            exec(compile(src, f"{page}[{i}]", "exec"), {"__name__": "__doc_example__"})
+    finally:  # an example's user effect must not become a candidate of later diagnoses
+        for e in list_effects():
+            if e.name not in before:
+                unregister_effect(e.name)
+    out = capsys.readouterr().out
+    for q in re.findall(r"prints `([^`]+)`", text):
+        assert q in out, f"{page}: the page says it prints {q!r}"
+
+
+def test_tutorial_commands_print_what_the_page_quotes(tmp_path, capsys, monkeypatch):
+    text = (DOCS / "compare_and_diagnose.md").read_text()
+    blocks = re.findall(r"```console\n(.*?)```", text, re.S)
+    assert len(blocks) >= 5
+    monkeypatch.chdir(tmp_path)  # outputs (tutorial/...) go to a temporary folder
+    (tmp_path / "benchmarks").symlink_to(ROOT / "benchmarks")
+    checked = 0
+    for block in blocks:
+        cmd, out = None, ""
+        for line in block.splitlines() + ["$ end"]:
+            if line.startswith("$ "):
+                cmd = shlex.split(line[2:])
+                if cmd[0] == "femast":
+                    assert main(cmd[1:]) == 0, line
+                    out = capsys.readouterr().out
+                elif cmd[0] == "head":
+                    out = "".join((tmp_path / cmd[-1]).read_text().splitlines(True)[:int(cmd[1][1:])])
+                continue
+            if line.strip() and line.strip() != "...":
+                assert line.rstrip() in out, f"the tutorial quotes a line the command does not print:\n{line}"
+                checked += 1
+    assert checked > 40
