@@ -1,6 +1,5 @@
 """The experiments docs run: python examples execute, and the tutorial's commands print what the page quotes."""
 
-import os
 import re
 import shlex
 from pathlib import Path

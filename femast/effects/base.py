@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Callable
 
 from ..errors import ModelError
-from ..experiments.core import Parameter
+from ..experiments.core import Parameter  # noqa: F401  (re-exported: effects declare Parameters)
 
 
 @dataclass(frozen=True)

@@ -67,7 +67,9 @@ def compare_figure(exp, data, result, png) -> Path:
         ax3.plot(rows, f * result.residuals[c], "-", lw=0.8, color=f"C{i}", label=f"{c} ({ul})")
         ax3.axhline(f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
         ax3.axhline(-f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
-    for k, seg in enumerate(result.worst[:3]):
+    from .diagnose import AT_NOISE
+
+    for k, seg in enumerate([w for w in result.worst[:3] if w["ratio"] > AT_NOISE]):
         ax3.axvspan(seg["start_row"] - 0.5, seg["end_row"] + 0.5, color="C3", alpha=0.18 - 0.04 * k, lw=0)
         ax3.text(0.5 * (seg["start_row"] + seg["end_row"]), 0.97 - 0.13 * k,
                  f"#{k + 1} {seg['kind']} {seg['ratio']:.1f}x", transform=ax3.get_xaxis_transform(),
@@ -75,7 +77,8 @@ def compare_figure(exp, data, result, png) -> Path:
                  bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.7))
     ax3.set_xlabel("row (time order)")
     ax3.set_ylabel("residual measured - model")
-    ax3.set_title(f"residual (dotted: noise floor); worst segments shaded; RMS {result.ratio:.2f}x noise")
+    ax3.set_title(f"residual (dotted: noise floor); worst segments above {AT_NOISE:g}x noise shaded; "
+                  f"RMS {result.ratio:.2f}x noise")
     ax3.legend(fontsize=8, ncol=min(3, len(exp.channels)), loc="lower right")
     ax3.grid(alpha=0.3)
     eff = "+".join(result.effects) or "baseline"
