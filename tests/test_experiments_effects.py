@@ -88,7 +88,7 @@ def test_register_a_user_effect_and_extend_an_existing_one():
         data, _ = mast_top_data(path=mast_top_path(n=50, seed=1), noise_m=0.0)
         base = predict(get_experiment("mast-top"), data)
         moved = predict(get_experiment("mast-top"), data, effects={"test_offset": {"a": 1e-3}})
-        np.testing.assert_allclose(moved["dx_m"] - base["dx_m"], 1e-3)
+        np.testing.assert_allclose(moved["dx_m"] - base["dx_m"], 1e-3)  # default rtol 1e-7: an exact shift
         # make an effect apply to another (a user's) experiment
         add_implementation("test_offset", "spring-x", Implementation(
             hook="h", apply=shift, parameters=eff.implementations["mast-top"].parameters))
@@ -107,6 +107,7 @@ def test_effects_do_not_change_the_model_at_their_neutral_values():
                "pretension_loss": {"lam": 0.0}, "beam_flexibility": {"E": 1e30}}
     for name, p in neutral.items():
         got = predict(exp, data, effects={name: p})
+        # exactly neutral up to round-off (E = 1e30 Pa leaves a 1e-20 relative compliance)
         np.testing.assert_allclose(got["dx_m"], base["dx_m"], rtol=1e-12, atol=1e-15, err_msg=name)
 
 
@@ -119,4 +120,5 @@ def test_beam_flexibility_is_the_seed000_cantilever_in_series():
     base = predict(exp, data)
     C = cantilever_compliance(3.651, mast_section(7e10, 0.3, 0.1, 0.094))
     dw = np.column_stack([data[c] for c in ("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm")])
+    # the same compliance matrix, scaled by 1/E instead of built at E: round-off only
     np.testing.assert_allclose(got["dx_m"] - base["dx_m"], (dw @ C.T)[:, 0], rtol=1e-10, atol=1e-16)
