@@ -292,6 +292,34 @@ def friction_band(x, params=None):
     return lo, hi
 
 
+def hysteresis_force(x, params=None, force: float = 0.0, length: float = 3e-4):
+    """Extra friction H(x) (N) of the *latch hysteresis* option, for bead positions x (m).
+
+    Seed 001 fits one curve near the latched state ("the model assumes no hysteresis in this
+    region", Sec. III.C) and so predicts no residual rotation at zero moment (Sec. VIII).  The
+    option adds a friction force that is largest with the bead seated on the backstop and
+    fades over ``length`` (m) as the bead moves out, vanishing at the roller axis::
+
+        H(x) = force w(x),   w = (exp(-(x + x_b)/length) - exp(-x_b/length)) / (1 - exp(-x_b/length))
+
+    for -x_b <= x < 0, and 0 for x >= 0.  The static band becomes [dT_in - H, dT_out + H] and a
+    sliding bead follows dT_sigma + sigma H.  Up to the factor that makes w vanish at the roller
+    axis (exp(-x_b/length) = 1.3e-3 for x_b = 2 mm, length = 0.3 mm) this is the
+    ``latch_hysteresis`` effect of :mod:`femast.effects.latch` (``F_h`` = force, ``ell`` = length).
+    """
+    p = _as_param_array(params)
+    x = np.asarray(x, dtype=float)
+    if force <= 0.0:
+        return np.zeros(np.broadcast_shapes(x.shape, p.shape[:-1]))
+    if not length > 0.0:
+        raise ModelError(f"hysteresis_force: length = {length!r} m must be > 0")
+    xb = p[..., 1]
+    u = np.clip(x + xb, 0.0, None)
+    e0 = np.exp(-xb / length)
+    w = (np.exp(-u / length) - e0) / (1.0 - e0)
+    return np.where(x < 0.0, force * w, 0.0)
+
+
 def latch_zone(x, params=None):
     """Zone of Fig. 6 for bead positions x (m): 0 (a) at backstop, 1 (b) contact behind the
     roller axis, 2 (c) contact in front of it, 3 (d) no contact.  See ``ZONE_LABELS``."""

@@ -64,6 +64,36 @@ S_EPS = 1e-9  # s is kept in [S_EPS L0, (1 - S_EPS) L0]
 
 
 @njit(cache=True)
+def hysteresis_scalar(x, xb, Fh, ell):
+    """Extra friction H(x) (N) of the latch hysteresis option and dH/dx (N/m).
+
+    H = Fh w(x) with w = (exp(-(x + xb)/ell) - exp(-xb/ell)) / (1 - exp(-xb/ell)) for
+    -xb <= x < 0 (1 with the bead on the backstop, 0 at the roller axis and beyond), so the
+    static band widens to [dT_in - H, dT_out + H] near the latched state.  Fh = 0: H = 0."""
+    if Fh <= 0.0 or x >= 0.0:
+        return 0.0, 0.0
+    u = x + xb
+    if u < 0.0:
+        u = 0.0
+    e0 = math.exp(-xb / ell)
+    den = 1.0 - e0
+    eu = math.exp(-u / ell)
+    return Fh * (eu - e0) / den, -Fh * eu / (ell * den)
+
+
+@njit(cache=True)
+def branch_scalar(x, sigma, p, Fh, ell):
+    """Force jump of a bead moving in direction sigma (N) and its x-derivative (N/m): Eq. 14
+    plus sigma H(x) of the hysteresis option (exactly Eq. 14 when Fh = 0)."""
+    D, dD = latch_dT_scalar(x, sigma, p[0], p[1], p[2], p[3], p[4], p[5])
+    if Fh > 0.0:
+        H, dH = hysteresis_scalar(x, p[1], Fh, ell)
+        D += sigma * H
+        dD += sigma * dH
+    return D, dD
+
+
+@njit(cache=True)
 def group_tensions(s, LA, LB, EA, L0):
     """Tensions of the two groups and their partial derivatives.
 
@@ -87,18 +117,18 @@ def group_tensions(s, LA, LB, EA, L0):
 
 
 @njit(cache=True)
-def _G(x, sigma, Lb, LA, LB, EA, L0, p):
+def _G(x, sigma, Lb, LA, LB, EA, L0, p, Fh, ell):
     """G = sigma (C - dT_sigma(x)) and dG/dx."""
     s = Lb - x
     tA, dtA_ds, _, tB, dtB_ds, _ = group_tensions(s, LA, LB, EA, L0)
-    D, dD = latch_dT_scalar(x, sigma, p[0], p[1], p[2], p[3], p[4], p[5])
+    D, dD = branch_scalar(x, sigma, p, Fh, ell)
     C = tB - tA
     dC_dx = -(dtB_ds - dtA_ds)
     return sigma * (C - D), sigma * (dC_dx - dD), abs(tA) + abs(tB) + abs(D)
 
 
 @njit(cache=True)
-def _refine(xa, Ga, xb, Gb, sigma, Lb, LA, LB, EA, L0, p):
+def _refine(xa, Ga, xb, Gb, sigma, Lb, LA, LB, EA, L0, p, Fh, ell):
     """First root of G in a bracket with G(xa) > 0 >= G(xb) (rtsafe-like)."""
     a = xa
     b = xb
@@ -110,7 +140,7 @@ def _refine(xa, Ga, xb, Gb, sigma, Lb, LA, LB, EA, L0, p):
         xcur = b
     else:
         xcur = a
-    Gc, dGc, scale = _G(xcur, sigma, Lb, LA, LB, EA, L0, p)
+    Gc, dGc, scale = _G(xcur, sigma, Lb, LA, LB, EA, L0, p, Fh, ell)
     dxold = abs(b - a)
     for _ in range(300):
         if Gc > 0.0:
@@ -133,12 +163,12 @@ def _refine(xa, Ga, xb, Gb, sigma, Lb, LA, LB, EA, L0, p):
             xn = 0.5 * (a + b)
         dxold = abs(xn - xcur)
         xcur = xn
-        Gc, dGc, scale = _G(xcur, sigma, Lb, LA, LB, EA, L0, p)
+        Gc, dGc, scale = _G(xcur, sigma, Lb, LA, LB, EA, L0, p, Fh, ell)
     return xcur
 
 
 @njit(cache=True)
-def first_root(sigma, x_start, x_end, Lb, LA, LB, EA, L0, p):
+def first_root(sigma, x_start, x_end, Lb, LA, LB, EA, L0, p, Fh, ell):
     """First x from x_start towards x_end (in direction sigma) with G(x) <= 0.
 
     Assumes G(x_start) > 0.  Returns (x, hit_end): hit_end is True when G > 0 all
@@ -150,7 +180,7 @@ def first_root(sigma, x_start, x_end, Lb, LA, LB, EA, L0, p):
     xct = math.sqrt(c2) if c2 > 0.0 else 0.0
     hstep = 2.0 * xct / N_GRID
     xa = x_start
-    Ga, _, _ = _G(xa, sigma, Lb, LA, LB, EA, L0, p)
+    Ga, _, _ = _G(xa, sigma, Lb, LA, LB, EA, L0, p, Fh, ell)
     if xct > 0.0:
         if sigma > 0:
             i = int(math.floor((xa + xct) / hstep)) + 1
@@ -161,9 +191,9 @@ def first_root(sigma, x_start, x_end, Lb, LA, LB, EA, L0, p):
                 if xg >= x_end:
                     break
                 if xg > xa:
-                    Gg, _, _ = _G(xg, sigma, Lb, LA, LB, EA, L0, p)
+                    Gg, _, _ = _G(xg, sigma, Lb, LA, LB, EA, L0, p, Fh, ell)
                     if Gg <= 0.0:
-                        return _refine(xa, Ga, xg, Gg, sigma, Lb, LA, LB, EA, L0, p), False
+                        return _refine(xa, Ga, xg, Gg, sigma, Lb, LA, LB, EA, L0, p, Fh, ell), False
                     xa = xg
                     Ga = Gg
                 i += 1
@@ -176,21 +206,21 @@ def first_root(sigma, x_start, x_end, Lb, LA, LB, EA, L0, p):
                 if xg <= x_end:
                     break
                 if xg < xa:
-                    Gg, _, _ = _G(xg, sigma, Lb, LA, LB, EA, L0, p)
+                    Gg, _, _ = _G(xg, sigma, Lb, LA, LB, EA, L0, p, Fh, ell)
                     if Gg <= 0.0:
-                        return _refine(xa, Ga, xg, Gg, sigma, Lb, LA, LB, EA, L0, p), False
+                        return _refine(xa, Ga, xg, Gg, sigma, Lb, LA, LB, EA, L0, p, Fh, ell), False
                     xa = xg
                     Ga = Gg
                 i -= 1
-    Ge, _, _ = _G(x_end, sigma, Lb, LA, LB, EA, L0, p)
+    Ge, _, _ = _G(x_end, sigma, Lb, LA, LB, EA, L0, p, Fh, ell)
     if Ge <= 0.0:
-        return _refine(xa, Ga, x_end, Ge, sigma, Lb, LA, LB, EA, L0, p), False
+        return _refine(xa, Ga, x_end, Ge, sigma, Lb, LA, LB, EA, L0, p, Fh, ell), False
     return x_end, True
 
 
 @njit(cache=True)
-def solve_latch(LA, LB, EA, L0, Lb, has_latch, p, x_c):
-    """Solve the reduced cable equation for one element.
+def solve_latch(LA, LB, EA, L0, Lb, has_latch, p, x_c, Fh=0.0, ell=1.0):
+    """Solve the reduced cable equation for one element (Fh, ell: hysteresis option, N and m).
 
     Returns x (m, bead position), s = Lb - x (m), status, tA, tB (N), ds/dLA, ds/dLB (-)."""
     if not has_latch:
@@ -202,8 +232,8 @@ def solve_latch(LA, LB, EA, L0, Lb, has_latch, p, x_c):
     tA, dtA_ds, dtA_dLA, tB, dtB_ds, dtB_dLB = group_tensions(s_c, LA, LB, EA, L0)
     C = tB - tA
     at_stop = x_c <= -xb * (1.0 - 1e-12)
-    D_in, _ = latch_dT_scalar(x_c, -1.0, r, xb, p[2], p[3], p[4], p[5])
-    D_out, _ = latch_dT_scalar(x_c, 1.0, r, xb, p[2], p[3], p[4], p[5])
+    D_in, _ = branch_scalar(x_c, -1.0, p, Fh, ell)
+    D_out, _ = branch_scalar(x_c, 1.0, p, Fh, ell)
     lo = -np.inf if at_stop else D_in
     hi = D_out
     free = (not at_stop) and latch_opening_scalar(x_c, r, p[4], p[5]) <= 0.0
@@ -222,20 +252,20 @@ def solve_latch(LA, LB, EA, L0, Lb, has_latch, p, x_c):
         x = x_c  # taut cable already balanced on a free bead
     elif sigma > 0:
         x_end = Lb - S_EPS * L0
-        x, _ = first_root(1.0, x_c, x_end, Lb, LA, LB, EA, L0, p)
+        x, _ = first_root(1.0, x_c, x_end, Lb, LA, LB, EA, L0, p, Fh, ell)
     else:
         x_end = Lb - (1.0 - S_EPS) * L0
         stop = -xb
         if stop > x_end:
             x_end = stop
-        x, hit = first_root(-1.0, x_c, x_end, Lb, LA, LB, EA, L0, p)
+        x, hit = first_root(-1.0, x_c, x_end, Lb, LA, LB, EA, L0, p, Fh, ell)
         if hit and x_end == stop:
             s = Lb - x
             tA, _, _, tB, _, _ = group_tensions(s, LA, LB, EA, L0)
             return x, s, BACKSTOP, tA, tB, 0.0, 0.0
     s = Lb - x
     tA, dtA_ds, dtA_dLA, tB, dtB_ds, dtB_dLB = group_tensions(s, LA, LB, EA, L0)
-    _, dD = latch_dT_scalar(x, float(sigma), r, xb, p[2], p[3], p[4], p[5])
+    _, dD = branch_scalar(x, float(sigma), p, Fh, ell)
     phi_s = dtB_ds - dtA_ds + dD
     scale = dtA_dLA + dtB_dLB + abs(dD) + dtB_ds - dtA_ds
     ds_dLA = 0.0
@@ -248,11 +278,12 @@ def solve_latch(LA, LB, EA, L0, Lb, has_latch, p, x_c):
 
 
 @njit(cache=True)
-def cable_latch_kernel(X, EA, L0, Lb, jl, P, state, f, K, state_new, T, dT, energy, err):
+def cable_latch_kernel(X, EA, L0, Lb, jl, P, Hy, state, f, K, state_new, T, dT, energy, err):
     """All elements: nodal forces f (n_el, 6(n+1)), tangent K, trial state, tensions.
 
     X (n_el, n+1, 3) m; EA (N), L0 (m), Lb (m) per element; jl latch node (local
-    index 1..n-1, 0 for none); P (n_el, 6) latch parameters; state (n_el, n+2)
+    index 1..n-1, 0 for none); P (n_el, 6) latch parameters; Hy (n_el, 2) hysteresis
+    option [Fh (N), ell (m)] (Fh = 0: off); state (n_el, n+2)
     committed [x_bead, status, L0_1..L0_n] (read only)."""
     n_el = X.shape[0]
     nn = X.shape[1]
@@ -306,7 +337,8 @@ def cable_latch_kernel(X, EA, L0, Lb, jl, P, state, f, K, state_new, T, dT, ener
                 state_new[el, c] = state[el, c]
             continue
         p = P[el]
-        x_new, s, status, tA, tB, ds_dLA, ds_dLB = solve_latch(LA, LB, EA[el], L0[el], Lb[el], has_latch, p, x_c)
+        x_new, s, status, tA, tB, ds_dLA, ds_dLB = solve_latch(LA, LB, EA[el], L0[el], Lb[el], has_latch, p, x_c,
+                                                                Hy[el, 0], Hy[el, 1])
         tA, dtA_ds, dtA_dLA, tB, dtB_ds, dtB_dLB = group_tensions(s, LA, LB, EA[el], L0[el])
         # total derivatives of the group tensions w.r.t. the group chord lengths
         MAA = dtA_dLA + dtA_ds * ds_dLA

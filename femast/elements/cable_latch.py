@@ -44,6 +44,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..latch import LatchParameters, _as_param_array, latch_force, latch_zone, validate_latch_array
+from ..latch import hysteresis_force as hysteresis_force_law
 from ._cable_kernels import (
     BACKSTOP,
     ERR_BEAD_OFF_CABLE,
@@ -86,6 +87,11 @@ class CableLatchFamily(ElementFamily):
     x0 : initial bead position, m (default ``-x_backstop``: latched, against the backstop).
     max_strain : largest cable strain accepted in a committed configuration; beyond it the
         total unstretched length is reported as too short (default 0.1).
+    hysteresis_force, hysteresis_length : the *latch hysteresis* option (N, m; scalar or per
+        element; default 0: off, the seed's law).  Near the latched state the static band
+        widens to ``[dT_in - H, dT_out + H]`` and a sliding bead follows the widened branches,
+        ``H = hysteresis_force * w(x)``, ``w = 1`` on the backstop fading to 0 at the roller axis
+        over ``hysteresis_length`` (see :func:`femast.latch.hysteresis_force`).
     name : label used in messages and results.
     """
 
@@ -93,7 +99,8 @@ class CableLatchFamily(ElementFamily):
     symmetric = False
 
     def __init__(self, nodes, EA, L0, *, latch_node=None, bead=None, latch=None, x0=None,
-                 max_strain: float = 0.1, name: str = "cable_latch"):
+                 max_strain: float = 0.1, hysteresis_force=0.0, hysteresis_length=3e-4,
+                 name: str = "cable_latch"):
         self.name = name
         nodes = np.asarray(nodes)
         if nodes.ndim == 1:
@@ -160,6 +167,22 @@ class CableLatchFamily(ElementFamily):
         if not max_strain > 0:
             raise ModelError(f"{name}: max_strain = {max_strain!r} must be > 0")
         self.max_strain = float(max_strain)
+        Fh = _per_element(hysteresis_force, n_el, "hysteresis_force (N)", name)
+        ell = _per_element(hysteresis_length, n_el, "hysteresis_length (m)", name)
+        bad = np.flatnonzero(~(np.isfinite(Fh) & (Fh >= 0.0)))
+        if bad.size:
+            raise ModelError(f"{name} element {bad[0]}: hysteresis_force = {Fh[bad[0]]!r} N must be finite and >= 0 "
+                             "(0 switches the latch hysteresis off)")
+        bad = np.flatnonzero(~(np.isfinite(ell) & (ell > 0.0)))
+        if bad.size:
+            raise ModelError(f"{name} element {bad[0]}: hysteresis_length = {ell[bad[0]]!r} m must be finite and > 0")
+        xct = np.sqrt(np.clip((self.latch[:, 0] + self.latch[:, 5]) ** 2 - (self.latch[:, 4] + self.latch[:, 0]) ** 2,
+                              0.0, None))
+        bad = np.flatnonzero(has & (Fh > 0.0) & (self.latch[:, 1] >= xct))
+        if bad.size:
+            raise ModelError(f"{name} element {bad[0]}: the latch hysteresis option needs the backstop inside the "
+                             f"roller contact zone (x_backstop < x_contact = {xct[bad[0]]:.6g} m)")
+        self.hysteresis = np.ascontiguousarray(np.column_stack([np.where(has, Fh, 0.0), ell]))
 
     # ------------------------------------------------------------------ construction helpers
     @classmethod
@@ -250,7 +273,11 @@ class CableLatchFamily(ElementFamily):
         dT = np.zeros(n_el)
         energy = np.zeros(n_el)
         err = np.zeros(n_el, dtype=np.int64)
-        cable_latch_kernel(X, self.EA, self.L0, self.bead, self.latch_node, self.latch,
+        hy = getattr(self, "hysteresis", None)
+        if hy is None:  # families pickled or built before the option existed
+            hy = np.zeros((n_el, 2))
+            hy[:, 1] = 1.0
+        cable_latch_kernel(X, self.EA, self.L0, self.bead, self.latch_node, self.latch, hy,
                            np.ascontiguousarray(state), f, k, new, T, dT, energy, err)
         bad = np.flatnonzero(err)
         if bad.size:
@@ -286,7 +313,7 @@ class CableLatchFamily(ElementFamily):
 
 
 def cable_equations(X, T, L0_sections, EA, L0, *, latch_node=None, bead=None, latch=None,
-                    status=STICK, x_committed=None):
+                    status=STICK, x_committed=None, hysteresis_force=0.0, hysteresis_length=3e-4):
     """Residuals of the 2n equations of one element (seed 001, Eqs. 2-5), for checking a solution.
 
     X : (n+1, 3) anchor positions, m.  T : (n,) tensions, N.  L0_sections : (n,) unstretched
@@ -295,7 +322,7 @@ def cable_equations(X, T, L0_sections, EA, L0, *, latch_node=None, bead=None, la
 
     Returns (2n,) residuals: rows 0..n-1 the constitutive laws (N, Eqs. 2-3), row n the
     length constraint (m, Eq. 4), rows n+1.. the jumps across nodes 1..n-1 (N; m for a
-    sticking latch).
+    sticking latch).  hysteresis_force, hysteresis_length: the hysteresis option (N, m).
     """
     X = np.asarray(X, float)
     T = np.asarray(T, float)
@@ -314,7 +341,9 @@ def cable_equations(X, T, L0_sections, EA, L0, *, latch_node=None, bead=None, la
         if status in (STICK, BACKSTOP):
             res[n + i] = x - x_committed
         else:
-            res[n + i] = T[i] - T[i - 1] - latch_force(x, 1 if status == SLIP_OUT else -1, latch)
+            sigma = 1 if status == SLIP_OUT else -1
+            res[n + i] = (T[i] - T[i - 1] - latch_force(x, sigma, latch)
+                          - sigma * hysteresis_force_law(x, latch, hysteresis_force, hysteresis_length))
     return res
 
 

@@ -1,0 +1,12 @@
+"""ADAM-type deployable mast bays and masts (seed 001): builders, load paths, post-processing
+and identification.  See ``docs/adam_bay.md`` and ``docs/adam_mast.md``.
+
+    from femast.adam import BayParameters, build_bay, build_mast
+"""
+
+from .build import AdamModel, build_bay, build_mast, corner_xy
+from .kinematics import eq1_height, eq1_twist
+from .parameters import SEED_BAY_HEIGHT, BayParameters
+
+__all__ = ["AdamModel", "BayParameters", "SEED_BAY_HEIGHT", "build_bay", "build_mast", "corner_xy",
+           "eq1_height", "eq1_twist"]

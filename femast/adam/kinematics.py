@@ -1,0 +1,31 @@
+"""Deployment kinematics of an ADAM bay (seed 001, Sec. II.A, Eq. 1).
+
+With rigid longerons of length l (ball centre to ball centre) between square frames of side b
+whose top frame turns by theta_t about the bay axis, a top corner moves on a circle of radius
+b / sqrt(2): its horizontal distance to the bottom corner is b sqrt(2 (1 - cos theta_t)) / sqrt(2)
+... squared, b^2 (1 - cos theta_t), so the height h between the frames obeys
+
+    h^2 = l^2 - b^2 (1 - cos theta_t) = b^2 cos theta_t - (b^2 - l^2)        (Eq. 1)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ModelError
+
+
+def eq1_height(theta, b: float, l: float):
+    """Bay height h (m) at twist theta (rad) from Eq. 1; NaN beyond the stowed angle (h^2 < 0)."""
+    if not (b > 0 and l > 0):
+        raise ModelError(f"eq1_height: b = {b!r} m and l = {l!r} m must be > 0")
+    h2 = b ** 2 * np.cos(np.asarray(theta, dtype=float)) - (b ** 2 - l ** 2)
+    return np.where(h2 >= 0.0, np.sqrt(np.clip(h2, 0.0, None)), np.nan)
+
+
+def eq1_twist(h, b: float, l: float):
+    """Twist theta_t (rad, >= 0) at which the bay has height h (m), Eq. 1 inverted."""
+    if not (b > 0 and l > 0):
+        raise ModelError(f"eq1_twist: b = {b!r} m and l = {l!r} m must be > 0")
+    c = (np.asarray(h, dtype=float) ** 2 + b ** 2 - l ** 2) / b ** 2
+    return np.arccos(np.clip(c, -1.0, 1.0))
