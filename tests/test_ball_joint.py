@@ -21,6 +21,7 @@ from femast.elements.ball_joint import (
 )
 from femast.errors import ModelError
 from femast.rotations import expm_so3
+from femast.testing import fd_tangent
 
 MU, B = 0.5, 0.004  # seed 001, Sec. II.B.1
 
@@ -127,25 +128,6 @@ def _random_case(rng, slip, offset):
     return fam, x, np.stack([Ra, Rb]), st
 
 
-def _fd_tangent(fam, x, R, st, h=1e-6):
-    """Central differences of f w.r.t. nodal translations and spatial spins (R <- expm(h e) R)."""
-    Kn = np.zeros((12, 12))
-    for n in range(2):
-        for d in range(6):
-            fs = []
-            for s in (h, -h):
-                xx, RR = x.copy(), R.copy()
-                if d < 3:
-                    xx[n, d] += s
-                else:
-                    w = np.zeros(3)
-                    w[d - 3] = s
-                    RR[n] = expm_so3(w) @ RR[n]
-                fs.append(fam.evaluate(xx, RR, st).f[0])
-            Kn[:, 6 * n + d] = (fs[0] - fs[1]) / (2 * h)
-    return Kn
-
-
 @pytest.mark.parametrize("slip", [False, True], ids=["stick", "slip"])
 @pytest.mark.parametrize("offset", [False, True], ids=["coincident", "offset"])
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -163,7 +145,7 @@ def test_tangent_matches_finite_differences(slip, offset, seed):
         assert not np.allclose(r.k[0], r.k[0].T)  # non-symmetric while slipping (d|F| term)
     else:
         assert Mn < 0.5 * Y  # far from the switching surface: FD stays in stick
-    Kn = _fd_tangent(fam, x, R, st)
+    Kn = fd_tangent(fam, x, R, st)[0]
     for rows in (np.r_[0:3, 6:9], np.r_[3:6, 9:12]):
         for cols in (np.r_[0:3, 6:9], np.r_[3:6, 9:12]):
             blk, ref = r.k[0][np.ix_(rows, cols)], Kn[np.ix_(rows, cols)]

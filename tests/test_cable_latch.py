@@ -13,6 +13,7 @@ from femast.elements.cable_latch import (
     cable_equations,
 )
 from femast.errors import ModelError
+from femast.testing import fd_tangent as _fd
 from femast.latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force
 
 P = LatchParameters.seed_fit()
@@ -28,16 +29,7 @@ def evaluate(fam, X, state):
 
 def fd_tangent(fam, X, state, h=1e-7):
     """Central differences of f w.r.t. nodal translations (state held fixed)."""
-    nn = X.shape[0]
-    K = np.zeros((6 * nn, 6 * nn))
-    for a in range(nn):
-        for c in range(3):
-            Xp = X.copy()
-            Xm = X.copy()
-            Xp[a, c] += h
-            Xm[a, c] -= h
-            K[:, 6 * a + c] = (evaluate(fam, Xp, state).f[0] - evaluate(fam, Xm, state).f[0]) / (2 * h)
-    return K
+    return _fd(fam, X, None, state, h=h, dofs=range(3))[0]
 
 
 def trans(K):

@@ -14,30 +14,9 @@ from femast.guyed.cantilever import mast_section
 from femast.guyed.rocaspect import E_NO_SHROUD, L_BEAM, mast_tops
 from femast.guyed.shroud import DyneemaLaw, axial_rigidity_tangent, strain_from_tension, tension_from_strain
 from femast.rotations import expm_so3
+from femast.testing import fd_tangent
 
 LAW = DyneemaLaw()
-
-
-def _fd_tangent(family, x, R, h=1e-6):
-    """Central differences of the element forces w.r.t. translations and spatial spins."""
-    n_el = family.n_elements
-    Kfd = np.zeros((n_el, 12, 12))
-    for j in range(12):
-        slot, dof = divmod(j, 6)
-        fs = []
-        for s in (1.0, -1.0):
-            xp, Rp = x.copy(), R.copy()
-            for e in range(n_el):
-                a = family.nodes[e, slot]
-                if dof < 3:
-                    xp[a, dof] += s * h
-                else:
-                    w = np.zeros(3)
-                    w[dof - 3] = s * h
-                    Rp[a] = expm_so3(w) @ R[a]
-            fs.append(family.evaluate(xp, Rp, None).f)
-        Kfd[:, :, j] = (fs[0] - fs[1]) / (2 * h)
-    return Kfd
 
 
 def _random_shrouds(rng, strains, offsets=True):
@@ -61,7 +40,7 @@ def test_shroud_tangent_matches_finite_differences():
     fam, x, R = _random_shrouds(rng, [1e-4, 1.3e-3, 4e-3, 1e-2, -2e-3])
     r = fam.evaluate(x, R, None)
     assert r.output["slack"].tolist() == [0, 0, 0, 0, 1]
-    Kfd = _fd_tangent(fam, x, R)
+    Kfd = fd_tangent(fam, x, R)
     for e in range(fam.n_elements):
         scale = max(np.abs(r.k[e]).max(), 1.0)
         # central FD, h = 1e-6 m/rad on lengths ~2 m: truncation ~h^2 |f'''| and round-off

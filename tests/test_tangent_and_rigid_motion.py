@@ -11,28 +11,7 @@ from femast.elements.base import IncrementContext
 from femast.elements.beam_corot import BeamFamily, element_frame
 from femast.elements.truss import TrussFamily
 from femast.rotations import expm_so3, logm_so3, ts_inv, ts_inv_T_times_derivative
-
-
-def _fd_tangent(family, x, R, h=1e-6):
-    """Central finite difference of element forces w.r.t. translations and spatial spins."""
-    n_el, m = family.evaluate(x, R, None).f.shape
-    Kfd = np.zeros((n_el, m, m))
-    for j in range(m):
-        node_slot, dof = divmod(j, 6)
-        fs = []
-        for s in (1.0, -1.0):
-            xp, Rp = x.copy(), R.copy()
-            for e in range(n_el):
-                a = family.nodes[e, node_slot]
-                if dof < 3:
-                    xp[a, dof] += s * h
-                else:
-                    w = np.zeros(3)
-                    w[dof - 3] = s * h
-                    Rp[a] = expm_so3(w) @ R[a]
-            fs.append(family.evaluate(xp, Rp, None).f)
-        Kfd[:, :, j] = (fs[0] - fs[1]) / (2 * h)
-    return Kfd
+from femast.testing import fd_tangent
 
 
 def _random_beams(rng, n=6):
@@ -80,7 +59,7 @@ def test_beam_tangent_matches_finite_differences_at_large_rotations():
     rng = np.random.default_rng(42)
     fam, x, R = _random_beams(rng)
     K = fam.evaluate(x, R, None).k
-    Kfd = _fd_tangent(fam, x, R)
+    Kfd = fd_tangent(fam, x, R)
     for e in range(fam.n_elements):
         assert np.abs(K[e] - Kfd[e]).max() <= 1e-6 * np.abs(K[e]).max()
 
@@ -94,7 +73,7 @@ def test_truss_tangent_matches_finite_differences():
     x = X + 0.1 * rng.normal(size=X.shape)
     R = np.tile(np.eye(3), (8, 1, 1))
     K = fam.evaluate(x, R, None).k
-    Kfd = _fd_tangent(fam, x, R)
+    Kfd = fd_tangent(fam, x, R)
     assert np.abs(K - Kfd).max() <= 1e-6 * np.abs(K).max()  # FD truncation ~1e-10 relative
 
 
