@@ -19,7 +19,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
 from tqdm.auto import tqdm
 
 from .assembly import Assembler
@@ -30,7 +29,8 @@ from .elements.beam_corot import BeamFamily, element_frame
 from .elements.truss import TrussFamily
 from .errors import ConvergenceError, ModelError, SingularModelError
 from .results import Results, ResultsWriter
-from .rotations import expm_so3, rotation_vectors
+from .rotations import apply_spins as _apply_spins  # R <- exp(W) R, plain loops (fast to compile)
+from .rotations import rotation_vectors
 from .solvers.control import LoadControl
 from .solvers.convergence import Convergence
 from .solvers.linear import SparseLU, mechanism_dofs
@@ -38,14 +38,6 @@ from .solvers.linear import SparseLU, mechanism_dofs
 
 class StabilizationWarning(UserWarning):
     """The stabilisation energy of a step exceeds its warning ratio of the strain energy."""
-
-
-@njit(cache=True)
-def _apply_spins(R, W):
-    for i in range(R.shape[0]):
-        w = W[i]
-        if w[0] != 0.0 or w[1] != 0.0 or w[2] != 0.0:
-            R[i] = expm_so3(w) @ R[i]
 
 
 @dataclass
