@@ -63,20 +63,17 @@ def expm_so3(v):
 
 
 @njit(cache=True)
-def logm_so3(R):
-    """Rotation vector (rad, |v| <= pi) of the rotation matrix ``R``.
-
-    Uses the quaternion of R (Spurrier's method), accurate near 0 and near pi.
-    """
+def logm_so3_into(R, out):
+    """Rotation vector (rad, |v| <= pi) of the rotation matrix ``R`` written into ``out`` (3,),
+    without allocating.  Uses the quaternion of R (Spurrier's method), accurate near 0 and pi."""
     tr = R[0, 0] + R[1, 1] + R[2, 2]
-    q = np.empty(4)
     m = max(tr, R[0, 0], R[1, 1], R[2, 2])
     if m == tr:
-        q[0] = 0.5 * math.sqrt(1.0 + tr)
-        s = 0.25 / q[0]
-        q[1] = (R[2, 1] - R[1, 2]) * s
-        q[2] = (R[0, 2] - R[2, 0]) * s
-        q[3] = (R[1, 0] - R[0, 1]) * s
+        q0 = 0.5 * math.sqrt(1.0 + tr)
+        s = 0.25 / q0
+        q1 = (R[2, 1] - R[1, 2]) * s
+        q2 = (R[0, 2] - R[2, 0]) * s
+        q3 = (R[1, 0] - R[0, 1]) * s
     else:
         i = 0
         if R[1, 1] > R[i, i]:
@@ -87,20 +84,38 @@ def logm_so3(R):
         k = (j + 1) % 3
         qi = 0.5 * math.sqrt(1.0 + R[i, i] - R[j, j] - R[k, k])
         s = 0.25 / qi
-        q[0] = (R[k, j] - R[j, k]) * s
-        q[1 + i] = qi
-        q[1 + j] = (R[j, i] + R[i, j]) * s
-        q[1 + k] = (R[k, i] + R[i, k]) * s
-    if q[0] < 0.0:
-        for c in range(4):
-            q[c] = -q[c]
-    nv = math.sqrt(q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-    out = np.zeros(3)
+        q0 = (R[k, j] - R[j, k]) * s
+        qj = (R[j, i] + R[i, j]) * s
+        qk = (R[k, i] + R[i, k]) * s
+        # scatter (qi, qj, qk) to the vector part (q1, q2, q3)
+        if i == 0:
+            q1, q2, q3 = qi, qj, qk
+        elif i == 1:
+            q1, q2, q3 = qk, qi, qj
+        else:
+            q1, q2, q3 = qj, qk, qi
+    if q0 < 0.0:
+        q0, q1, q2, q3 = -q0, -q1, -q2, -q3
+    nv = math.sqrt(q1 * q1 + q2 * q2 + q3 * q3)
     if nv < 1e-300:
-        return out
-    angle = 2.0 * math.atan2(nv, q[0])
-    for c in range(3):
-        out[c] = angle * q[1 + c] / nv
+        out[0] = 0.0
+        out[1] = 0.0
+        out[2] = 0.0
+        return
+    f = 2.0 * math.atan2(nv, q0) / nv
+    out[0] = f * q1
+    out[1] = f * q2
+    out[2] = f * q3
+
+
+@njit(cache=True)
+def logm_so3(R):
+    """Rotation vector (rad, |v| <= pi) of the rotation matrix ``R``.
+
+    Uses the quaternion of R (Spurrier's method), accurate near 0 and near pi.
+    """
+    out = np.empty(3)
+    logm_so3_into(R, out)
     return out
 
 
@@ -122,34 +137,104 @@ def _eta(t):
 
 
 @njit(cache=True)
+def ts_inv_into(theta, out):
+    """Ts^-1(theta) = I - S/2 + eta S^2 written into the 3x3 ``out`` (S^2 = theta theta^T - t^2 I)."""
+    t2 = theta[0] * theta[0] + theta[1] * theta[1] + theta[2] * theta[2]
+    eta, _ = _eta(math.sqrt(t2))
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = eta * theta[i] * theta[j]
+        out[i, i] += 1.0 - eta * t2
+    out[0, 1] += 0.5 * theta[2]
+    out[0, 2] -= 0.5 * theta[1]
+    out[1, 0] -= 0.5 * theta[2]
+    out[1, 2] += 0.5 * theta[0]
+    out[2, 0] += 0.5 * theta[1]
+    out[2, 1] -= 0.5 * theta[0]
+
+
+@njit(cache=True)
 def ts_inv(theta):
     """Ts^-1(theta): maps a spatial spin to the variation of the rotation vector."""
-    t = math.sqrt(theta[0] ** 2 + theta[1] ** 2 + theta[2] ** 2)
-    eta, _ = _eta(t)
-    S = skew(theta)
-    return np.eye(3) - 0.5 * S + eta * _sq(S)
+    out = np.empty((3, 3))
+    ts_inv_into(theta, out)
+    return out
+
+
+@njit(cache=True)
+def ts_inv_T_times_derivative_into(theta, m, out):
+    """d/dtheta [Ts^-T(theta) m] for fixed m written into the 3x3 ``out`` (Battini & Pacoste 2002, K_h)."""
+    tt = theta[0] * theta[0] + theta[1] * theta[1] + theta[2] * theta[2]
+    eta, deta_t = _eta(math.sqrt(tt))
+    tm = theta[0] * m[0] + theta[1] * m[1] + theta[2] * m[2]
+    for i in range(3):
+        vi = (theta[i] * tm - m[i] * tt) * deta_t  # theta x (theta x m), times eta'(t)/t
+        for j in range(3):
+            out[i, j] = eta * (theta[i] * m[j] - 2.0 * m[i] * theta[j]) + vi * theta[j]
+        out[i, i] += eta * tm
+    # -skew(m) / 2
+    out[0, 1] += 0.5 * m[2]
+    out[0, 2] -= 0.5 * m[1]
+    out[1, 0] -= 0.5 * m[2]
+    out[1, 2] += 0.5 * m[0]
+    out[2, 0] += 0.5 * m[1]
+    out[2, 1] -= 0.5 * m[0]
 
 
 @njit(cache=True)
 def ts_inv_T_times_derivative(theta, m):
     """d/dtheta [Ts^-T(theta) m] for fixed m, a 3x3 matrix (Battini & Pacoste 2002, K_h)."""
-    t = math.sqrt(theta[0] ** 2 + theta[1] ** 2 + theta[2] ** 2)
-    eta, deta_t = _eta(t)
-    tm = theta[0] * m[0] + theta[1] * m[1] + theta[2] * m[2]
-    tt = t * t
-    v = theta * tm - m * tt  # theta x (theta x m)
-    K = -0.5 * skew(m)
-    for i in range(3):
-        K[i, i] += eta * tm
-        for j in range(3):
-            K[i, j] += eta * (theta[i] * m[j] - 2.0 * m[i] * theta[j]) + v[i] * deta_t * theta[j]
-    return K
+    out = np.empty((3, 3))
+    ts_inv_T_times_derivative_into(theta, m, out)
+    return out
+
+
+@njit(cache=True)
+def _rotation_vectors(R, out):
+    for i in range(R.shape[0]):
+        logm_so3_into(R[i], out[i])
+
+
+@njit(cache=True)
+def apply_spins(R, W):
+    """R[i] <- exp(skew(W[i])) R[i] for every node i with a nonzero spin W[i] (in place)."""
+    E = np.empty((3, 3))
+    C = np.empty((3, 3))
+    for n in range(R.shape[0]):
+        w0 = W[n, 0]
+        w1 = W[n, 1]
+        w2 = W[n, 2]
+        if w0 == 0.0 and w1 == 0.0 and w2 == 0.0:
+            continue
+        t2 = w0 * w0 + w1 * w1 + w2 * w2
+        if t2 < 1e-8:
+            a = 1.0 - t2 / 6.0 + t2 * t2 / 120.0
+            b = 0.5 - t2 / 24.0 + t2 * t2 / 720.0
+        else:
+            t = math.sqrt(t2)
+            a = math.sin(t) / t
+            b = (1.0 - math.cos(t)) / t2
+        # exp = I + a S + b S^2,  S^2 = w w^T - t^2 I
+        E[0, 0] = 1.0 + b * (w0 * w0 - t2)
+        E[1, 1] = 1.0 + b * (w1 * w1 - t2)
+        E[2, 2] = 1.0 + b * (w2 * w2 - t2)
+        E[0, 1] = b * w0 * w1 - a * w2
+        E[1, 0] = b * w0 * w1 + a * w2
+        E[0, 2] = b * w0 * w2 + a * w1
+        E[2, 0] = b * w0 * w2 - a * w1
+        E[1, 2] = b * w1 * w2 - a * w0
+        E[2, 1] = b * w1 * w2 + a * w0
+        for i in range(3):
+            for j in range(3):
+                C[i, j] = E[i, 0] * R[n, 0, j] + E[i, 1] * R[n, 1, j] + E[i, 2] * R[n, 2, j]
+        for i in range(3):
+            for j in range(3):
+                R[n, i, j] = C[i, j]
 
 
 def rotation_vectors(R: np.ndarray) -> np.ndarray:
     """Rotation vectors (rad) of an array of rotation matrices (..., 3, 3)."""
-    flat = np.asarray(R, dtype=float).reshape(-1, 3, 3)
+    flat = np.ascontiguousarray(np.asarray(R, dtype=float).reshape(-1, 3, 3))
     out = np.empty((flat.shape[0], 3))
-    for i in range(flat.shape[0]):
-        out[i] = logm_so3(flat[i])
+    _rotation_vectors(flat, out)
     return out.reshape(np.shape(R)[:-2] + (3,))

@@ -27,86 +27,95 @@ import math
 import numpy as np
 from numba import njit
 
-from ..rotations import logm_so3, skew, ts_inv, ts_inv_T_times_derivative
+from ..rotations import logm_so3_into, ts_inv_into, ts_inv_T_times_derivative_into
 from .base import ElementFamily, ElementResponse
 
 # Columns of the per-element output "section_forces": end 1 then end 2, local axes.
 SECTION_FORCE_NAMES = ("N", "Vy", "Vz", "T", "My", "Mz")
 
 
-# Small dense products as plain loops: numba's `@` calls BLAS, whose per-call overhead
-# dominates for 3x3 and 3x12 operands.
-@njit(cache=True)
-def _mm(A, B):
-    n, k = A.shape
-    m = B.shape[1]
-    C = np.zeros((n, m))
-    for i in range(n):
-        for p in range(k):
-            a = A[i, p]
-            if a != 0.0:
-                for j in range(m):
-                    C[i, j] += a * B[p, j]
-    return C
+# ---------------------------------------------------------------------------------------------
+# The kernel.  Every quantity of the element depends on the nodal translations only through the
+# chord d = x2 - x1, so its Jacobians are taken with respect to the 9 independent variations
+# [dd, dw1, dw2] (columns 0:3, 3:6, 6:9) and expanded to the 12 element DOFs at the end
+# (d/dx1 = -d/dd, d/dx2 = d/dd).  Plain loops with fixed trip counts over preallocated scratch
+# (allocated once per family call): no allocation per element, few small functions to compile.
+
+# scratch 3x3 matrices (Ms)
+_T1, _T2, _RR, _TI1, _TI2, _KH1, _KH2, _A = 0, 1, 2, 3, 4, 5, 6, 7
+N_MAT = 8
+# scratch 3x9 Jacobians (Js)
+_G, _WR, _JE1, _JE2, _JE3, _JTH1, _JTH2, _JM1, _JM2, _JMT1, _JMT2, _JFX2, _JFW1, _JFW2 = range(14)
+N_JAC = 14
+# scratch 9-row Jacobians of scalars and 3-vectors (vs: rows of 9; first 3 entries for vectors)
+_JQ1C, _JQ2C, _JAL, _JC, _TH1, _TH2, _M1, _M2, _MT1, _MT2, _QE1, _QE2, _Q = range(13)
+N_VEC = 13
+
+
+def beam_scratch():
+    """Scratch arrays of :func:`beam_element` (one set per thread)."""
+    return np.empty((N_MAT, 3, 3)), np.empty((N_JAC, 3, 9)), np.empty((N_VEC, 9))
 
 
 @njit(cache=True)
-def _mv(A, v):
-    n, k = A.shape
-    out = np.zeros(n)
-    for i in range(n):
-        for p in range(k):
-            out[i] += A[i, p] * v[p]
-    return out
-
-
-@njit(cache=True)
-def _vm(v, A):
-    k, m = A.shape
-    out = np.zeros(m)
-    for p in range(k):
-        if v[p] != 0.0:
-            for j in range(m):
-                out[j] += v[p] * A[p, j]
-    return out
-
-
-@njit(cache=True)
-def _dot(a, b):
-    s = 0.0
-    for i in range(a.shape[0]):
-        s += a[i] * b[i]
-    return s
-
-
-@njit(cache=True)
-def _cross(a, b):
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-@njit(cache=True)
-def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
+def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf, Ms, Js, vs):
     """Internal force ``f`` (12), tangent ``K`` (12x12) and section forces ``sf`` (2x6)
-    of one corotational beam.  Returns the strain energy (J)."""
-    T1 = _mm(R1, E0)
-    T2 = _mm(R2, E0)
-    q1 = T1[:, 1].copy()
-    q2 = T2[:, 1].copy()
-    d = x2 - x1
-    l = math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)
-    e1 = d / l
-    q = 0.5 * (q1 + q2)
-    e3 = _cross(e1, q)
-    e3 /= math.sqrt(e3[0] ** 2 + e3[1] ** 2 + e3[2] ** 2)
-    e2 = _cross(e3, e1)
-    Rr = np.empty((3, 3))
-    Rr[:, 0] = e1
-    Rr[:, 1] = e2
-    Rr[:, 2] = e3
-    th1 = logm_so3(_mm(Rr.T, T1))
-    th2 = logm_so3(_mm(Rr.T, T2))
-    q1c = _dot(q, e1)
-    q2c = _dot(q, e2)
+    of one corotational beam; ``Ms, Js, vs`` are scratch arrays from :func:`beam_scratch`.
+    Returns the strain energy (J)."""
+    T1 = Ms[_T1]
+    T2 = Ms[_T2]
+    Rr = Ms[_RR]
+    Ti1 = Ms[_TI1]
+    Ti2 = Ms[_TI2]
+    A = Ms[_A]
+    th1 = vs[_TH1]
+    th2 = vs[_TH2]
+    m1 = vs[_M1]
+    m2 = vs[_M2]
+    mt1 = vs[_MT1]
+    mt2 = vs[_MT2]
+    qe1 = vs[_QE1]
+    qe2 = vs[_QE2]
+    q = vs[_Q]
+    # nodal triads T_a = R_a E0
+    for i in range(3):
+        for j in range(3):
+            s1 = 0.0
+            s2 = 0.0
+            for k in range(3):
+                s1 += R1[i, k] * E0[k, j]
+                s2 += R2[i, k] * E0[k, j]
+            T1[i, j] = s1
+            T2[i, j] = s2
+    # corotated frame Rr = [e1 e2 e3]
+    d0 = x2[0] - x1[0]
+    d1 = x2[1] - x1[1]
+    d2 = x2[2] - x1[2]
+    l = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    Rr[0, 0] = d0 / l
+    Rr[1, 0] = d1 / l
+    Rr[2, 0] = d2 / l
+    for i in range(3):
+        q[i] = 0.5 * (T1[i, 1] + T2[i, 1])
+    c0 = Rr[1, 0] * q[2] - Rr[2, 0] * q[1]
+    c1 = Rr[2, 0] * q[0] - Rr[0, 0] * q[2]
+    c2 = Rr[0, 0] * q[1] - Rr[1, 0] * q[0]
+    n3 = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+    Rr[0, 2] = c0 / n3
+    Rr[1, 2] = c1 / n3
+    Rr[2, 2] = c2 / n3
+    Rr[0, 1] = Rr[1, 2] * Rr[2, 0] - Rr[2, 2] * Rr[1, 0]
+    Rr[1, 1] = Rr[2, 2] * Rr[0, 0] - Rr[0, 2] * Rr[2, 0]
+    Rr[2, 1] = Rr[0, 2] * Rr[1, 0] - Rr[1, 2] * Rr[0, 0]
+    # local rotations theta_a = log(Rr^T T_a)
+    for a in range(2):
+        Ta = T1 if a == 0 else T2
+        for i in range(3):
+            for j in range(3):
+                A[i, j] = Rr[0, i] * Ta[0, j] + Rr[1, i] * Ta[1, j] + Rr[2, i] * Ta[2, j]
+        logm_so3_into(A, th1 if a == 0 else th2)
+    q1c = q[0] * Rr[0, 0] + q[1] * Rr[1, 0] + q[2] * Rr[2, 0]
+    q2c = q[0] * Rr[0, 1] + q[1] * Rr[1, 1] + q[2] * Rr[2, 1]
 
     # local response (7 dofs: ubar, theta1, theta2)
     ubar = (l * l - l0 * l0) / (l + l0)
@@ -114,95 +123,180 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
     kt = GJ / l0
     ky = 2.0 * EIy / l0
     kz = 2.0 * EIz / l0
-    m1 = np.array([kt * (th1[0] - th2[0]), ky * (2 * th1[1] + th2[1]), kz * (2 * th1[2] + th2[2])])
-    m2 = np.array([kt * (th2[0] - th1[0]), ky * (th1[1] + 2 * th2[1]), kz * (th1[2] + 2 * th2[2])])
-    Ti1 = ts_inv(th1)
-    Ti2 = ts_inv(th2)
-    mt1 = _mv(Ti1.T, m1)
-    mt2 = _mv(Ti2.T, m2)
-    M = mt1 + mt2
-    alpha = M[1] + M[0] * q1c / q2c
-    c = M[0] / (2.0 * q2c)
-    FD = (-alpha * e3 + M[2] * e2) / l
-    fx2 = N * e1 - FD
-    qe1 = _cross(q1, e3)
-    qe2 = _cross(q2, e3)
-    fw1 = _mv(Rr, mt1) - c * qe1
-    fw2 = _mv(Rr, mt2) - c * qe2
+    m1[0] = kt * (th1[0] - th2[0])
+    m1[1] = ky * (2.0 * th1[1] + th2[1])
+    m1[2] = kz * (2.0 * th1[2] + th2[2])
+    m2[0] = -m1[0]
+    m2[1] = ky * (th1[1] + 2.0 * th2[1])
+    m2[2] = kz * (th1[2] + 2.0 * th2[2])
+    ts_inv_into(th1, Ti1)
+    ts_inv_into(th2, Ti2)
     for i in range(3):
-        f[i] = -fx2[i]
-        f[3 + i] = fw1[i]
-        f[6 + i] = fx2[i]
-        f[9 + i] = fw2[i]
+        mt1[i] = Ti1[0, i] * m1[0] + Ti1[1, i] * m1[1] + Ti1[2, i] * m1[2]
+        mt2[i] = Ti2[0, i] * m2[0] + Ti2[1, i] * m2[1] + Ti2[2, i] * m2[2]
+    M0 = mt1[0] + mt2[0]
+    M1 = mt1[1] + mt2[1]
+    M2 = mt1[2] + mt2[2]
+    alpha = M1 + M0 * q1c / q2c
+    c = M0 / (2.0 * q2c)
+    # qe_a = q_a x e3 (q_a = T_a[:, 1])
+    for a in range(2):
+        Ta = T1 if a == 0 else T2
+        qe = qe1 if a == 0 else qe2
+        qe[0] = Ta[1, 1] * Rr[2, 2] - Ta[2, 1] * Rr[1, 2]
+        qe[1] = Ta[2, 1] * Rr[0, 2] - Ta[0, 1] * Rr[2, 2]
+        qe[2] = Ta[0, 1] * Rr[1, 2] - Ta[1, 1] * Rr[0, 2]
+    for i in range(3):
+        FDi = (-alpha * Rr[i, 2] + M2 * Rr[i, 1]) / l
+        fx2 = N * Rr[i, 0] - FDi
+        f[i] = -fx2
+        f[6 + i] = fx2
+        f[3 + i] = Rr[i, 0] * mt1[0] + Rr[i, 1] * mt1[1] + Rr[i, 2] * mt1[2] - c * qe1[i]
+        f[9 + i] = Rr[i, 0] * mt2[0] + Rr[i, 1] * mt2[1] + Rr[i, 2] * mt2[2] - c * qe2[i]
 
-    # ---- consistent tangent: chain rule with 3x12 Jacobians ----
-    # d(x2 - x1)
-    Dl = np.zeros((3, 12))
+    # ---- consistent tangent: chain rule with 3x9 Jacobians ----
+    G = Js[_G]
+    Wr = Js[_WR]
+    Je1 = Js[_JE1]
+    Je2 = Js[_JE2]
+    Je3 = Js[_JE3]
+    Jth1 = Js[_JTH1]
+    Jth2 = Js[_JTH2]
+    Jm1 = Js[_JM1]
+    Jm2 = Js[_JM2]
+    Jmt1 = Js[_JMT1]
+    Jmt2 = Js[_JMT2]
+    Jfx2 = Js[_JFX2]
+    Jfw1 = Js[_JFW1]
+    Jfw2 = Js[_JFW2]
+    Jq1c = vs[_JQ1C]
+    Jq2c = vs[_JQ2C]
+    Jal = vs[_JAL]
+    Jc = vs[_JC]
+    # spin of the corotated frame w_r = Rr G dd
+    for k in range(3):
+        G[1, k] = -Rr[k, 2] / l
+        G[2, k] = Rr[k, 1] / l
+        G[1, 3 + k] = 0.0
+        G[2, 3 + k] = 0.0
+        G[1, 6 + k] = 0.0
+        G[2, 6 + k] = 0.0
+        G[0, k] = q1c * G[1, k] / q2c
+        G[0, 3 + k] = 0.5 * qe1[k] / q2c
+        G[0, 6 + k] = 0.5 * qe2[k] / q2c
     for i in range(3):
-        Dl[i, i] = -1.0
-        Dl[i, 6 + i] = 1.0
-    J_l = _vm(e1, Dl)
-    G = np.zeros((3, 12))
-    G[2, :] = _vm(e2, Dl) / l
-    G[1, :] = -_vm(e3, Dl) / l
-    G[0, :] = q1c * G[1, :]
+        for j in range(9):
+            Wr[i, j] = Rr[i, 0] * G[0, j] + Rr[i, 1] * G[1, j] + Rr[i, 2] * G[2, j]
+    # J_ea = -skew(e_a) Wr: columns Wr[:, j] x e_a
+    for a in range(3):
+        Je = Js[_JE1 + a]
+        for j in range(9):
+            Je[0, j] = Wr[1, j] * Rr[2, a] - Wr[2, j] * Rr[1, a]
+            Je[1, j] = Wr[2, j] * Rr[0, a] - Wr[0, j] * Rr[2, a]
+            Je[2, j] = Wr[0, j] * Rr[1, a] - Wr[1, j] * Rr[0, a]
+    # J_q = (J_q1 + J_q2)/2, J_qa = -skew(q_a) in the columns of w_a;
+    # J_q1c = e1^T J_q + q^T J_e1, J_q2c = e2^T J_q + q^T J_e2
+    for j in range(9):
+        Jq1c[j] = q[0] * Je1[0, j] + q[1] * Je1[1, j] + q[2] * Je1[2, j]
+        Jq2c[j] = q[0] * Je2[0, j] + q[1] * Je2[1, j] + q[2] * Je2[2, j]
+    for a in range(2):
+        Ta = T1 if a == 0 else T2
+        o = 3 + 3 * a
+        # e^T (-skew(q_a)) / 2 = (q_a x e) / 2
+        for b in range(2):
+            Jv = Jq1c if b == 0 else Jq2c
+            Jv[o + 0] += 0.5 * (Ta[1, 1] * Rr[2, b] - Ta[2, 1] * Rr[1, b])
+            Jv[o + 1] += 0.5 * (Ta[2, 1] * Rr[0, b] - Ta[0, 1] * Rr[2, b])
+            Jv[o + 2] += 0.5 * (Ta[0, 1] * Rr[1, b] - Ta[1, 1] * Rr[0, b])
+    # local rotations: J_tha = Ti_a (-G + [Rr^T in the columns of w_a])
     for i in range(3):
-        G[0, 3 + i] += 0.5 * qe1[i]
-        G[0, 9 + i] += 0.5 * qe2[i]
-    G[0, :] /= q2c
-    Wr = _mm(Rr, G)
-    J_e1 = -_mm(skew(e1), Wr)
-    J_e2 = -_mm(skew(e2), Wr)
-    J_e3 = -_mm(skew(e3), Wr)
-    J_q1 = np.zeros((3, 12))
-    J_q2 = np.zeros((3, 12))
-    J_q1[:, 3:6] = -skew(q1)
-    J_q2[:, 9:12] = -skew(q2)
-    J_q = 0.5 * (J_q1 + J_q2)
-    J_q1c = _vm(e1, J_q) + _vm(q, J_e1)
-    J_q2c = _vm(e2, J_q) + _vm(q, J_e2)
-    # local rotations
-    A1 = -G.copy()
-    A2 = -G.copy()
-    RrT = Rr.T.copy()
-    A1[:, 3:6] += RrT
-    A2[:, 9:12] += RrT
-    J_th1 = _mm(Ti1, A1)
-    J_th2 = _mm(Ti2, A2)
-    J_N = (EA / l0) * J_l
-    J_m1 = np.empty((3, 12))
-    J_m2 = np.empty((3, 12))
-    J_m1[0] = kt * (J_th1[0] - J_th2[0])
-    J_m2[0] = -J_m1[0]
-    J_m1[1] = ky * (2 * J_th1[1] + J_th2[1])
-    J_m2[1] = ky * (J_th1[1] + 2 * J_th2[1])
-    J_m1[2] = kz * (2 * J_th1[2] + J_th2[2])
-    J_m2[2] = kz * (J_th1[2] + 2 * J_th2[2])
-    J_mt1 = _mm(Ti1.T, J_m1) + _mm(ts_inv_T_times_derivative(th1, m1), J_th1)
-    J_mt2 = _mm(Ti2.T, J_m2) + _mm(ts_inv_T_times_derivative(th2, m2), J_th2)
-    J_M = J_mt1 + J_mt2
-    J_alpha = J_M[1] + (q1c / q2c) * J_M[0] + (M[0] / q2c) * J_q1c - (M[0] * q1c / (q2c * q2c)) * J_q2c
-    J_FD = np.empty((3, 12))
+        for j in range(9):
+            g = Ti1[i, 0] * G[0, j] + Ti1[i, 1] * G[1, j] + Ti1[i, 2] * G[2, j]
+            h = Ti2[i, 0] * G[0, j] + Ti2[i, 1] * G[1, j] + Ti2[i, 2] * G[2, j]
+            Jth1[i, j] = -g
+            Jth2[i, j] = -h
+        for k in range(3):
+            Jth1[i, 3 + k] += Ti1[i, 0] * Rr[k, 0] + Ti1[i, 1] * Rr[k, 1] + Ti1[i, 2] * Rr[k, 2]
+            Jth2[i, 6 + k] += Ti2[i, 0] * Rr[k, 0] + Ti2[i, 1] * Rr[k, 1] + Ti2[i, 2] * Rr[k, 2]
+    for j in range(9):
+        Jm1[0, j] = kt * (Jth1[0, j] - Jth2[0, j])
+        Jm2[0, j] = -Jm1[0, j]
+        Jm1[1, j] = ky * (2.0 * Jth1[1, j] + Jth2[1, j])
+        Jm2[1, j] = ky * (Jth1[1, j] + 2.0 * Jth2[1, j])
+        Jm1[2, j] = kz * (2.0 * Jth1[2, j] + Jth2[2, j])
+        Jm2[2, j] = kz * (Jth1[2, j] + 2.0 * Jth2[2, j])
+    # J_mta = Ti_a^T J_ma + K_h(theta_a, m_a) J_tha
+    Kh1 = Ms[_KH1]
+    Kh2 = Ms[_KH2]
+    ts_inv_T_times_derivative_into(th1, m1, Kh1)
+    ts_inv_T_times_derivative_into(th2, m2, Kh2)
     for i in range(3):
-        J_FD[i] = (-e3[i] * J_alpha - alpha * J_e3[i] + e2[i] * J_M[2] + M[2] * J_e2[i] - FD[i] * J_l) / l
-    J_fx2 = np.empty((3, 12))
+        for j in range(9):
+            Jmt1[i, j] = (Ti1[0, i] * Jm1[0, j] + Ti1[1, i] * Jm1[1, j] + Ti1[2, i] * Jm1[2, j]
+                          + Kh1[i, 0] * Jth1[0, j] + Kh1[i, 1] * Jth1[1, j] + Kh1[i, 2] * Jth1[2, j])
+            Jmt2[i, j] = (Ti2[0, i] * Jm2[0, j] + Ti2[1, i] * Jm2[1, j] + Ti2[2, i] * Jm2[2, j]
+                          + Kh2[i, 0] * Jth2[0, j] + Kh2[i, 1] * Jth2[1, j] + Kh2[i, 2] * Jth2[2, j])
+    r12 = q1c / q2c
+    for j in range(9):
+        JM0 = Jmt1[0, j] + Jmt2[0, j]
+        Jal[j] = Jmt1[1, j] + Jmt2[1, j] + r12 * JM0 + (M0 / q2c) * Jq1c[j] - (M0 * r12 / q2c) * Jq2c[j]
+        Jc[j] = JM0 / (2.0 * q2c) - (M0 / (2.0 * q2c * q2c)) * Jq2c[j]
+    # forces at node 2: fx2 = N e1 - FD, FD = (-alpha e3 + M2 e2) / l
+    kN = EA / l0
     for i in range(3):
-        J_fx2[i] = e1[i] * J_N + N * J_e1[i] - J_FD[i]
-    J_c = J_M[0] / (2.0 * q2c) - (M[0] / (2.0 * q2c * q2c)) * J_q2c
-    S_e3 = skew(e3)
-    J_fw1 = _mm(Rr, J_mt1) + mt1[0] * J_e1 + mt1[1] * J_e2 + mt1[2] * J_e3
-    J_fw2 = _mm(Rr, J_mt2) + mt2[0] * J_e1 + mt2[1] * J_e2 + mt2[2] * J_e3
-    for i in range(3):
-        J_fw1[i] -= qe1[i] * J_c
-        J_fw2[i] -= qe2[i] * J_c
-    J_fw1 -= c * (_mm(skew(q1), J_e3) - _mm(S_e3, J_q1))
-    J_fw2 -= c * (_mm(skew(q2), J_e3) - _mm(S_e3, J_q2))
-    for j in range(12):
+        FDi = (-alpha * Rr[i, 2] + M2 * Rr[i, 1]) / l
+        for j in range(9):
+            JFD = (-Rr[i, 2] * Jal[j] - alpha * Je3[i, j] + Rr[i, 1] * (Jmt1[2, j] + Jmt2[2, j])
+                   + M2 * Je2[i, j]) / l
+            Jfx2[i, j] = N * Je1[i, j] - JFD
+        for k in range(3):  # J_l = [e1, 0, 0]
+            Jfx2[i, k] += (Rr[i, 0] * kN + FDi / l) * Rr[k, 0]
+    # moments: fw_a = Rr mt_a - c (q_a x e3)
+    e3q1 = T1[0, 1] * Rr[0, 2] + T1[1, 1] * Rr[1, 2] + T1[2, 1] * Rr[2, 2]
+    e3q2 = T2[0, 1] * Rr[0, 2] + T2[1, 1] * Rr[1, 2] + T2[2, 1] * Rr[2, 2]
+    for a in range(2):
+        Ta = T1 if a == 0 else T2
+        Jmt = Jmt1 if a == 0 else Jmt2
+        mt = mt1 if a == 0 else mt2
+        qe = qe1 if a == 0 else qe2
+        Jfw = Jfw1 if a == 0 else Jfw2
+        qa0 = Ta[0, 1]
+        qa1 = Ta[1, 1]
+        qa2 = Ta[2, 1]
+        for j in range(9):
+            # - c q_a x J_e3[:, j]
+            x0 = qa1 * Je3[2, j] - qa2 * Je3[1, j]
+            x1_ = qa2 * Je3[0, j] - qa0 * Je3[2, j]
+            x2_ = qa0 * Je3[1, j] - qa1 * Je3[0, j]
+            for i in range(3):
+                Jfw[i, j] = (Rr[i, 0] * Jmt[0, j] + Rr[i, 1] * Jmt[1, j] + Rr[i, 2] * Jmt[2, j]
+                             + mt[0] * Je1[i, j] + mt[1] * Je2[i, j] + mt[2] * Je3[i, j] - qe[i] * Jc[j])
+            Jfw[0, j] -= c * x0
+            Jfw[1, j] -= c * x1_
+            Jfw[2, j] -= c * x2_
+        # + c skew(e3) J_qa, J_qa = -skew(q_a) in the columns of w_a:
+        # -c skew(e3) skew(q_a) = -c (q_a e3^T - (e3 . q_a) I)
+        o = 3 + 3 * a
         for i in range(3):
-            K[i, j] = -J_fx2[i, j]
-            K[3 + i, j] = J_fw1[i, j]
-            K[6 + i, j] = J_fx2[i, j]
-            K[9 + i, j] = J_fw2[i, j]
+            qai = Ta[i, 1]
+            for k in range(3):
+                Jfw[i, o + k] -= c * qai * Rr[k, 2]
+            Jfw[i, o + i] += c * (e3q1 if a == 0 else e3q2)
+    # expand to the 12 DOFs: rows [-fx2, fw1, fx2, fw2], columns [-dd, dw1, dd, dw2]
+    for r in range(4):
+        for i in range(3):
+            if r == 0 or r == 2:
+                Jr = Jfx2
+                s = -1.0 if r == 0 else 1.0
+            else:
+                Jr = Jfw1 if r == 1 else Jfw2
+                s = 1.0
+            row = 3 * r + i
+            for k in range(3):
+                K[row, k] = -s * Jr[i, k]
+                K[row, 3 + k] = s * Jr[i, 3 + k]
+                K[row, 6 + k] = s * Jr[i, k]
+                K[row, 9 + k] = s * Jr[i, 6 + k]
 
     # section forces, local axes: N (tension +), shear from end-moment equilibrium,
     # torsion and bending moments as acting on the beam section at each end
@@ -220,32 +314,44 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf):
     sf[1, 3] = m2[0]
     sf[1, 4] = m2[1]
     sf[1, 5] = m2[2]
-    return 0.5 * (N * ubar + _dot(m1, th1) + _dot(m2, th2))
+    return 0.5 * (N * ubar + m1[0] * th1[0] + m1[1] * th1[1] + m1[2] * th1[2]
+                  + m2[0] * th2[0] + m2[1] * th2[1] + m2[2] * th2[2])
 
 
 @njit(cache=True)
 def beam_family_kernel(nodes, x, R, E0, l0, EA, GJ, EIy, EIz, f, K, sf, energy):
     """All elements of a beam family at once (see :func:`beam_element`)."""
+    Ms = np.empty((N_MAT, 3, 3))
+    Js = np.empty((N_JAC, 3, 9))
+    vs = np.empty((N_VEC, 9))
     for e in range(nodes.shape[0]):
         a = nodes[e, 0]
         b = nodes[e, 1]
         energy[e] = beam_element(x[a], x[b], R[a], R[b], E0[e], l0[e], EA[e], GJ[e], EIy[e], EIz[e],
-                                 f[e], K[e], sf[e])
+                                 f[e], K[e], sf[e], Ms, Js, vs)
 
 
 def element_frame(x1, x2, up):
     """Initial element frame E0 = [e1 e2 e3] (columns): e1 along the element, e2 the
     up-vector made orthogonal to e1, e3 = e1 x e2.  Returns None if ``up`` is parallel
     to the element."""
-    e1 = np.asarray(x2, float) - np.asarray(x1, float)
-    e1 = e1 / np.linalg.norm(e1)
-    up = np.asarray(up, float)
-    e2 = up - (up @ e1) * e1
-    n = np.linalg.norm(e2)
-    if n < 1e-8 * max(np.linalg.norm(up), 1e-300):
+    # plain floats: this runs once per element when a model is built (numpy's per-call
+    # overhead on 3-vectors was 0.2 ms per element)
+    a0, a1, a2 = (float(v) for v in x1)
+    b0, b1, b2 = (float(v) for v in x2)
+    u0, u1, u2 = (float(v) for v in up)
+    e0, e1_, e2_ = b0 - a0, b1 - a1, b2 - a2
+    n = math.sqrt(e0 * e0 + e1_ * e1_ + e2_ * e2_)
+    e0, e1_, e2_ = e0 / n, e1_ / n, e2_ / n
+    p = u0 * e0 + u1 * e1_ + u2 * e2_
+    y0, y1, y2 = u0 - p * e0, u1 - p * e1_, u2 - p * e2_
+    ny = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+    if ny < 1e-8 * max(math.sqrt(u0 * u0 + u1 * u1 + u2 * u2), 1e-300):
         return None
-    e2 /= n
-    return np.column_stack([e1, e2, np.cross(e1, e2)])
+    y0, y1, y2 = y0 / ny, y1 / ny, y2 / ny
+    return np.array([[e0, y0, e1_ * y2 - e2_ * y1],
+                     [e1_, y1, e2_ * y0 - e0 * y2],
+                     [e2_, y2, e0 * y1 - e1_ * y0]])
 
 
 class BeamFamily(ElementFamily):
@@ -274,10 +380,10 @@ class BeamFamily(ElementFamily):
 
     def evaluate(self, x, R, state, ctx=None):
         n = self.n_elements
-        f = np.zeros((n, 12))
-        K = np.zeros((n, 12, 12))
-        sf = np.zeros((n, 2, 6))
-        energy = np.zeros(n)
+        f = np.empty((n, 12))  # the kernel writes every entry
+        K = np.empty((n, 12, 12))
+        sf = np.empty((n, 2, 6))
+        energy = np.empty(n)
         beam_family_kernel(self.nodes, np.ascontiguousarray(x), np.ascontiguousarray(R), self.E0, self.l0,
                            self.EA, self.GJ, self.EIy, self.EIz, f, K, sf, energy)
         return ElementResponse(f=f, k=K, state=state, output={"section_forces": sf}, energy=energy)
