@@ -1,9 +1,24 @@
-"""Linear systems: sparse LU (SuperLU) of the tangent, with a symmetric mode.
+"""Linear systems: sparse LU (SuperLU) of the tangent, with the ordering computed once.
 
-When every element family reports a symmetric tangent, SuperLU runs in symmetric
-mode (minimum-degree ordering on A^T + A, diagonal pivoting preferred), the setting
-scipy recommends for symmetric matrices.  A singular tangent raises
-:class:`~femast.errors.SingularModelError` naming the DOFs of the mechanism.
+The tangent keeps its sparsity pattern from one Newton iteration to the next (the assembler
+fills the same CSR arrays in place), so the fill-reducing ordering -- the symbolic part that can
+be reused with SuperLU as scipy exposes it -- is computed once per pattern:
+
+* on the first factorisation of a pattern, two symmetric orderings are tried on the actual
+  values, reverse Cuthill-McKee (best for slender, chain-like structures such as masts and
+  cantilevers) and SuperLU's minimum degree on A^T + A; the one with less fill is kept;
+* every later factorisation of the same pattern gathers the values into the permuted CSC
+  matrix P K P^T (one precomputed index, no CSR -> CSC conversion) and factorises it with the
+  NATURAL column order in SuperLU's symmetric mode (diagonal pivots preferred, the structure of
+  femast tangents is symmetric even when the values are not).
+
+Pivoting: with a symmetric tangent (every family symmetric) the diagonal is always taken
+(``diag_pivot_thresh=0``, as before); otherwise a row interchange happens when the diagonal is
+below 1 % of the largest entry of its column (threshold partial pivoting, MUMPS' default).
+``ordering="colamd"`` restores scipy's default (COLAMD, partial pivoting, no reuse).
+
+A singular tangent raises :class:`~femast.errors.SingularModelError` naming the DOFs of the
+mechanism (through :func:`mechanism_dofs`).
 """
 
 from __future__ import annotations
@@ -12,28 +27,115 @@ import warnings
 
 import numpy as np
 import scipy.linalg
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ..errors import SingularModelError
 
+ORDERINGS = ("auto", "rcm", "mmd", "colamd")
+
 
 class SparseLU:
-    """Factorise once per iteration, solve for one or more right-hand sides."""
+    """Factorise once per iteration, solve for one or more right-hand sides.
 
-    def __init__(self, symmetric: bool = False):
+    symmetric : every element family has a symmetric tangent (diagonal pivoting only).
+    ordering : "auto" (the better of "rcm" and "mmd" on the first factorisation of a pattern),
+        "rcm", "mmd" (minimum degree on A^T + A), or "colamd" (scipy's default, no reuse).
+    pivot_threshold : relative size below which a diagonal pivot is replaced (unsymmetric case).
+    """
+
+    def __init__(self, symmetric: bool = False, ordering: str = "auto", pivot_threshold: float = 0.01):
+        if ordering not in ORDERINGS:
+            raise ValueError(f"ordering must be one of {ORDERINGS}, not {ordering!r}")
         self.symmetric = symmetric
+        self.ordering = ordering
+        self.pivot_threshold = 0.0 if symmetric else float(pivot_threshold)
         self._lu = None
+        self._perm = None       # symmetric permutation p: B = K[p][:, p]
+        self._B = None          # permuted CSC matrix, data refilled each factorisation
+        self._gather = None     # B.data = K.data[gather]
+        self._pattern = None    # (shape, indptr, indices) the ordering belongs to
+        self.analyses = 0       # orderings computed (1 for a fixed-pattern run)
+        self.chosen = None      # name of the ordering in use
 
+    # ------------------------------------------------------------------ symbolic part
+    def _same_pattern(self, K):
+        p = self._pattern
+        return (p is not None and p[0] == K.shape and np.array_equal(p[1], K.indptr)
+                and np.array_equal(p[2], K.indices))
+
+    def _permuted(self, K, perm):
+        """(B, gather): the CSC matrix K[perm][:, perm] and the index with B.data = K.data[gather]."""
+        marker = sp.csr_matrix((np.arange(1, K.nnz + 1, dtype=np.float64), K.indices, K.indptr), shape=K.shape)
+        Bm = marker[perm][:, perm].tocsc()
+        Bm.sort_indices()
+        gather = Bm.data.astype(np.int64) - 1
+        B = sp.csc_matrix((K.data[gather], Bm.indices, Bm.indptr), shape=K.shape)
+        return B, gather
+
+    def _factor_permuted(self, B):
+        return spla.splu(B, permc_spec="NATURAL", diag_pivot_thresh=self.pivot_threshold,
+                         options=dict(SymmetricMode=True))
+
+    def _analyse(self, K):
+        """Choose the ordering for the pattern of K; returns the LU of K in that ordering.
+
+        The first pattern tries every candidate ordering; a later new pattern (e.g. a constrained
+        model whose reduced tangent lost an exact zero) reuses the kind chosen the first time."""
+        self.analyses += 1
+        kinds = [self.chosen] if self.chosen else (["rcm", "mmd"] if self.ordering == "auto" else [self.ordering])
+        best = None
+        first = None
+        error = RuntimeError("Factor is exactly singular")
+        for kind in kinds:
+            if kind == "rcm":
+                perm = np.asarray(reverse_cuthill_mckee(K, symmetric_mode=True), dtype=np.int64)
+            else:
+                try:
+                    lu = spla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=self.pivot_threshold,
+                                   options=dict(SymmetricMode=True))
+                except RuntimeError as exc:
+                    error = exc
+                    continue
+                perm = np.argsort(lu.perm_c).astype(np.int64)
+            B, gather = self._permuted(K, perm)
+            first = first or (kind, perm, B, gather)
+            try:
+                lu = self._factor_permuted(B)
+            except RuntimeError as exc:
+                error = exc
+                continue
+            if best is None or lu.nnz < best[0]:
+                best = (lu.nnz, (kind, perm, B, gather), lu)
+        self._pattern = (K.shape, K.indptr.copy(), K.indices.copy())
+        if best is None:  # singular: keep an ordering so that the pattern is not analysed again
+            if first is None:
+                perm = np.arange(K.shape[0])
+                first = (kinds[0], perm) + self._permuted(K, perm)
+            self.chosen, self._perm, self._B, self._gather = first
+            raise error
+        self.chosen, self._perm, self._B, self._gather = best[1]
+        return best[2]
+
+    # ------------------------------------------------------------------ numeric part
     def factorize(self, K):
-        K = K.tocsc()
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("error", spla.MatrixRankWarning)
-                if self.symmetric:
-                    self._lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                                         options=dict(SymmetricMode=True))
+                if self.ordering == "colamd":
+                    self._perm = None
+                    self._lu = spla.splu(K.tocsc())
                 else:
-                    self._lu = spla.splu(K)
+                    K = K if K.format == "csr" else K.tocsr()
+                    if not K.has_canonical_format:
+                        K = K.copy()
+                        K.sum_duplicates()
+                    if self._same_pattern(K):
+                        np.take(K.data, self._gather, out=self._B.data)
+                        self._lu = self._factor_permuted(self._B)
+                    else:
+                        self._lu = self._analyse(K)
         except (RuntimeError, spla.MatrixRankWarning) as exc:
             self._lu = None
             raise SingularModelError(str(exc)) from None
@@ -43,7 +145,13 @@ class SparseLU:
             raise SingularModelError("zero pivot in the LU factorisation")
 
     def solve(self, rhs):
-        x = self._lu.solve(np.asarray(rhs, dtype=float))
+        rhs = np.asarray(rhs, dtype=float)
+        if self._perm is None:
+            x = self._lu.solve(rhs)
+        else:
+            y = self._lu.solve(rhs[self._perm])
+            x = np.empty_like(y)
+            x[self._perm] = y
         if not np.all(np.isfinite(x)):
             raise SingularModelError("non-finite solution of the linear system")
         return x
