@@ -177,26 +177,30 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf, Ms, Js, vs)
     for k in range(3):
         G[1, k] = -Rr[k, 2] / l
         G[2, k] = Rr[k, 1] / l
-        G[1, 3 + k] = 0.0
-        G[2, 3 + k] = 0.0
-        G[1, 6 + k] = 0.0
-        G[2, 6 + k] = 0.0
         G[0, k] = q1c * G[1, k] / q2c
         G[0, 3 + k] = 0.5 * qe1[k] / q2c
         G[0, 6 + k] = 0.5 * qe2[k] / q2c
+    # G[1:3] vanish in the spin columns, so there Wr[:, j] = e1 G[0, j]
     for i in range(3):
-        for j in range(9):
+        for j in range(3):
             Wr[i, j] = Rr[i, 0] * G[0, j] + Rr[i, 1] * G[1, j] + Rr[i, 2] * G[2, j]
-    # J_ea = -skew(e_a) Wr: columns Wr[:, j] x e_a
+        for j in range(3, 9):
+            Wr[i, j] = Rr[i, 0] * G[0, j]
+    # J_ea = -skew(e_a) Wr: columns Wr[:, j] x e_a; in the spin columns G[0, j] (e1 x e_a)
     for a in range(3):
         Je = Js[_JE1 + a]
-        for j in range(9):
+        for j in range(3):
             Je[0, j] = Wr[1, j] * Rr[2, a] - Wr[2, j] * Rr[1, a]
             Je[1, j] = Wr[2, j] * Rr[0, a] - Wr[0, j] * Rr[2, a]
             Je[2, j] = Wr[0, j] * Rr[1, a] - Wr[1, j] * Rr[0, a]
+    for j in range(3, 9):
+        for i in range(3):
+            Je1[i, j] = 0.0
+            Je2[i, j] = G[0, j] * Rr[i, 2]
+            Je3[i, j] = -G[0, j] * Rr[i, 1]
     # J_q = (J_q1 + J_q2)/2, J_qa = -skew(q_a) in the columns of w_a;
-    # J_q1c = e1^T J_q + q^T J_e1, J_q2c = e2^T J_q + q^T J_e2
-    for j in range(9):
+    # J_q1c = e1^T J_q + q^T J_e1, J_q2c = e2^T J_q + q^T J_e2 (q . e3 = 0 in the spin columns)
+    for j in range(3):
         Jq1c[j] = q[0] * Je1[0, j] + q[1] * Je1[1, j] + q[2] * Je1[2, j]
         Jq2c[j] = q[0] * Je2[0, j] + q[1] * Je2[1, j] + q[2] * Je2[2, j]
     for a in range(2):
@@ -205,16 +209,17 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf, Ms, Js, vs)
         # e^T (-skew(q_a)) / 2 = (q_a x e) / 2
         for b in range(2):
             Jv = Jq1c if b == 0 else Jq2c
-            Jv[o + 0] += 0.5 * (Ta[1, 1] * Rr[2, b] - Ta[2, 1] * Rr[1, b])
-            Jv[o + 1] += 0.5 * (Ta[2, 1] * Rr[0, b] - Ta[0, 1] * Rr[2, b])
-            Jv[o + 2] += 0.5 * (Ta[0, 1] * Rr[1, b] - Ta[1, 1] * Rr[0, b])
+            Jv[o + 0] = 0.5 * (Ta[1, 1] * Rr[2, b] - Ta[2, 1] * Rr[1, b])
+            Jv[o + 1] = 0.5 * (Ta[2, 1] * Rr[0, b] - Ta[0, 1] * Rr[2, b])
+            Jv[o + 2] = 0.5 * (Ta[0, 1] * Rr[1, b] - Ta[1, 1] * Rr[0, b])
     # local rotations: J_tha = Ti_a (-G + [Rr^T in the columns of w_a])
     for i in range(3):
-        for j in range(9):
-            g = Ti1[i, 0] * G[0, j] + Ti1[i, 1] * G[1, j] + Ti1[i, 2] * G[2, j]
-            h = Ti2[i, 0] * G[0, j] + Ti2[i, 1] * G[1, j] + Ti2[i, 2] * G[2, j]
-            Jth1[i, j] = -g
-            Jth2[i, j] = -h
+        for j in range(3):
+            Jth1[i, j] = -(Ti1[i, 0] * G[0, j] + Ti1[i, 1] * G[1, j] + Ti1[i, 2] * G[2, j])
+            Jth2[i, j] = -(Ti2[i, 0] * G[0, j] + Ti2[i, 1] * G[1, j] + Ti2[i, 2] * G[2, j])
+        for j in range(3, 9):
+            Jth1[i, j] = -Ti1[i, 0] * G[0, j]
+            Jth2[i, j] = -Ti2[i, 0] * G[0, j]
         for k in range(3):
             Jth1[i, 3 + k] += Ti1[i, 0] * Rr[k, 0] + Ti1[i, 1] * Rr[k, 1] + Ti1[i, 2] * Rr[k, 2]
             Jth2[i, 6 + k] += Ti2[i, 0] * Rr[k, 0] + Ti2[i, 1] * Rr[k, 1] + Ti2[i, 2] * Rr[k, 2]
@@ -283,20 +288,29 @@ def beam_element(x1, x2, R1, R2, E0, l0, EA, GJ, EIy, EIz, f, K, sf, Ms, Js, vs)
                 Jfw[i, o + k] -= c * qai * Rr[k, 2]
             Jfw[i, o + i] += c * (e3q1 if a == 0 else e3q2)
     # expand to the 12 DOFs: rows [-fx2, fw1, fx2, fw2], columns [-dd, dw1, dd, dw2]
-    for r in range(4):
-        for i in range(3):
-            if r == 0 or r == 2:
-                Jr = Jfx2
-                s = -1.0 if r == 0 else 1.0
-            else:
-                Jr = Jfw1 if r == 1 else Jfw2
-                s = 1.0
-            row = 3 * r + i
-            for k in range(3):
-                K[row, k] = -s * Jr[i, k]
-                K[row, 3 + k] = s * Jr[i, 3 + k]
-                K[row, 6 + k] = s * Jr[i, k]
-                K[row, 9 + k] = s * Jr[i, 6 + k]
+    for i in range(3):
+        for k in range(3):
+            a = Jfx2[i, k]
+            b = Jfx2[i, 3 + k]
+            g = Jfx2[i, 6 + k]
+            K[i, k] = a
+            K[i, 3 + k] = -b
+            K[i, 6 + k] = -a
+            K[i, 9 + k] = -g
+            K[6 + i, k] = -a
+            K[6 + i, 3 + k] = b
+            K[6 + i, 6 + k] = a
+            K[6 + i, 9 + k] = g
+            a = Jfw1[i, k]
+            K[3 + i, k] = -a
+            K[3 + i, 3 + k] = Jfw1[i, 3 + k]
+            K[3 + i, 6 + k] = a
+            K[3 + i, 9 + k] = Jfw1[i, 6 + k]
+            a = Jfw2[i, k]
+            K[9 + i, k] = -a
+            K[9 + i, 3 + k] = Jfw2[i, 3 + k]
+            K[9 + i, 6 + k] = a
+            K[9 + i, 9 + k] = Jfw2[i, 6 + k]
 
     # section forces, local axes: N (tension +), shear from end-moment equilibrium,
     # torsion and bending moments as acting on the beam section at each end
