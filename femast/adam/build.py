@@ -47,6 +47,7 @@ from ..elements.ball_joint import add_ball_joints
 from ..elements.cable_latch import CableLatchFamily
 from ..errors import ModelError
 from ..model import Model
+from .joint_spring import JointSprings
 from .parameters import BayParameters
 
 LATCH_FAMILY = "adam_latch"
@@ -54,6 +55,7 @@ ARM_FAMILY = "adam_arm"
 JOINT_FAMILY = "adam_joint"
 LONGERON_FAMILY = "adam_longeron"
 BATTEN_FAMILY = "adam_batten"
+SPRING_FAMILY = "adam_joint_spring"
 
 
 @dataclass
@@ -183,6 +185,8 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
             pairs += [(a, bot), (c, top)]
     add_ball_joints(m, pairs, mu=p.mu, B=p.B, penalty_factor=p.joint_penalty_factor,
                     stick_factor=p.joint_stick_factor, name=JOINT_FAMILY)
+    if p.joint_spring > 0:
+        m.add_family(JointSprings(pairs, p.joint_spring, name=SPRING_FAMILY))
     # cable/pulley/latch assemblies
     units = np.zeros((n_bays, 4), dtype=np.int64)
     latch_nodes = []

@@ -70,14 +70,14 @@ class BayParameters:
     l: float = SEED_BAY_HEIGHT
     corner: float = 0.015
     longeron_d: float = 0.025
-    longeron_t: float = 0.0035
+    longeron_t: float = 6.527e-3
     longeron_E: float = 120e9
     longeron_nu: float = 0.3
     batten_d: float = 0.020
     batten_t: float = 0.002
     batten_E: float = 120e9
     batten_nu: float = 0.3
-    cable_EA: float = 6.5e4
+    cable_EA: float = 3.4006e4
     pretension: float = 170.0
     latch: LatchParameters = field(default_factory=LatchParameters.seed_fit)
     hysteresis_force: float = 0.0
@@ -85,7 +85,8 @@ class BayParameters:
     mu: float = 0.5
     B: float = 0.004
     joint_penalty_factor: float = 1e3
-    joint_stick_factor: float = 3.0
+    joint_stick_factor: float = 0.3
+    joint_spring: float = 10.0
     n_longeron: int = 1
     n_batten: int = 1
 
@@ -93,7 +94,7 @@ class BayParameters:
         "b": "m", "l": "m", "corner": "m", "longeron_d": "m", "longeron_t": "m", "longeron_E": "Pa",
         "longeron_nu": "-", "batten_d": "m", "batten_t": "m", "batten_E": "Pa", "batten_nu": "-",
         "cable_EA": "N", "pretension": "N", "latch": "SI", "hysteresis_force": "N", "hysteresis_length": "m",
-        "mu": "-", "B": "m", "joint_penalty_factor": "-", "joint_stick_factor": "-", "n_longeron": "-",
+        "mu": "-", "B": "m", "joint_penalty_factor": "-", "joint_stick_factor": "-", "joint_spring": "N m/rad", "n_longeron": "-",
         "n_batten": "-",
     }
 
@@ -109,7 +110,7 @@ class BayParameters:
             v = getattr(self, name)
             if not _is_number(v) or not (v > 0 and math.isfinite(v)):
                 raise ModelError(f"BayParameters: {name} = {v!r} {self.UNITS[name]} must be a finite number > 0")
-        for name in ("corner", "pretension", "mu", "hysteresis_force"):
+        for name in ("corner", "pretension", "mu", "hysteresis_force", "joint_spring"):
             v = getattr(self, name)
             if not _is_number(v) or not (v >= 0 and math.isfinite(v)):
                 raise ModelError(f"BayParameters: {name} = {v!r} {self.UNITS[name]} must be a finite number >= 0")
