@@ -20,12 +20,18 @@ from .base import ElementFamily, ElementResponse
 
 @njit(cache=True)
 def truss_family_kernel(nodes, x, L0, EA, tension_only, f, K, N_out, energy):
+    """All trusses at once; writes the translational entries of ``f`` and ``K`` (the rotational
+    rows and columns stay as given: zero).  Scalars only, no allocation."""
     for el in range(nodes.shape[0]):
         a = nodes[el, 0]
         b = nodes[el, 1]
-        d = x[b] - x[a]
-        l = math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)
-        e = d / l
+        d0 = x[b, 0] - x[a, 0]
+        d1 = x[b, 1] - x[a, 1]
+        d2 = x[b, 2] - x[a, 2]
+        l = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        e0 = d0 / l
+        e1 = d1 / l
+        e2 = d2 / l
         k_ax = EA[el] / L0[el]
         N = k_ax * (l - L0[el])
         if tension_only[el] and N <= 0.0:
@@ -35,10 +41,12 @@ def truss_family_kernel(nodes, x, L0, EA, tension_only, f, K, N_out, energy):
         energy[el] = 0.5 * N * (l - L0[el])
         g = N / l
         for i in range(3):
-            f[el, i] = -N * e[i]
-            f[el, 6 + i] = N * e[i]
+            ei = e0 if i == 0 else (e1 if i == 1 else e2)
+            f[el, i] = -N * ei
+            f[el, 6 + i] = N * ei
             for j in range(3):
-                kij = k_ax * e[i] * e[j] + g * ((1.0 if i == j else 0.0) - e[i] * e[j])
+                ej = e0 if j == 0 else (e1 if j == 1 else e2)
+                kij = (k_ax - g) * ei * ej + (g if i == j else 0.0)
                 K[el, i, j] = kij
                 K[el, 6 + i, 6 + j] = kij
                 K[el, i, 6 + j] = -kij
