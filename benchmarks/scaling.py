@@ -1,0 +1,237 @@
+"""How femast's cost grows with model size, and how close a Newton iteration is to the linear
+solve (issue 8, item 2).
+
+    python benchmarks/scaling.py [--bays 40 100 200 400 700 1000] [--increments 10] [--repeat 3]
+
+For each size, in a fresh process (so that its peak memory is its own), the truss mast of
+``benchmarks/peers/mast.py`` (beam-column members, tip torsion + shear in K load increments) is
+solved --repeat times and the medians are printed:
+
+* time per increment and per Newton iteration in the run (everything: element kernels, assembly,
+  linear solves, convergence checks, writing each converged increment to disk);
+* the same converged tangent factorised and solved in isolation: bare SuperLU with the ordering
+  femast chose (the floor set by the linear solve), femast's SparseLU (adds the value gather and
+  the zero-pivot check), and scipy's default ``splu`` (COLAMD) for reference; one assembly
+  (element kernels + scatter) in isolation;
+* peak resident memory of the process and its growth over the 2-bay warm-up.
+
+Targets: time per iteration <= 1.5 x (factorisation + solve of the same tangent); time per
+increment growing at most linearly with the number of bays from 40 to 1000 bays.
+
+    python benchmarks/scaling.py --jit [--venv]
+
+measures the first-run JIT cost instead: a fresh process imports femast and solves a 2-bay mast of
+beams plus a truss, with an empty numba cache (``NUMBA_CACHE_DIR`` set to a new temporary folder:
+everything compiles) and then again with that cache warm.  With ``--venv`` it also installs femast
+non-editable (``pip install --no-deps .`` into a temporary venv that sees this interpreter's
+packages) and checks that numba's cache works there: the first run compiles and writes the cache
+next to the installed package, the second one loads it.  Target: first run under 15 s.
+Timings on a shared 2-core machine are noisy: medians of --repeat runs (and --reps isolated calls).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "peers"))
+
+
+def _rss_mb():
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def _median_time(fn, reps):
+    ts = []
+    for _ in range(reps):
+        t0 = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t0)
+    return statistics.median(ts)
+
+
+def child(n_bays, n_inc, repeat, reps):
+    """Measure one size; print one JSON line."""
+    import numpy as np
+    import scipy.sparse.linalg as spla
+
+    import femast_mast
+    from mast import build_mast
+
+    femast_mast.warm_up()
+    rss0 = _rss_mb()
+    mast = build_mast(n_bays)
+    runs = [femast_mast.solve(mast, n_inc) for _ in range(repeat)]
+    walls = [r["analyze"] for r in runs]
+    run = runs[walls.index(statistics.median_low(walls))]
+    an = run["analysis"]
+    s = an.summary
+    # the converged tangent, in isolation
+    responses = an._evaluate(None)
+    an.assembler.forces([q.f for q in responses])
+    K, _ = an.assembler.tangent([q.k for q in responses])
+    rhs = np.random.default_rng(0).normal(size=K.shape[0])
+
+    def assemble():
+        resp = an._evaluate(None)
+        an.assembler.forces([q.f for q in resp])
+        an.assembler.tangent([q.k for q in resp])
+
+    solver = an.solver
+    solver.factorize(K)
+    B = solver._B
+
+    def bare():
+        solver._factor_permuted(B).solve(rhs)
+
+    def femast_lu():
+        solver.factorize(K)
+        solver.solve(rhs)
+
+    Kc = K.tocsc()
+    out = dict(
+        bays=n_bays, dofs=int(an.dofmap.n_free), elements=int(len(mast.conn)), increments=s.increments,
+        iterations=s.iterations, wall=statistics.median(walls), walls=walls, build=run["build"],
+        assembly_in_run=s.assembly_time, solve_in_run=s.solve_time,
+        t_assembly=_median_time(assemble, reps), t_bare=_median_time(bare, reps),
+        t_femast_lu=_median_time(femast_lu, reps),
+        t_scipy_default=_median_time(lambda: spla.splu(Kc).solve(rhs), max(3, reps // 2)),
+        ordering=solver.chosen, lu_nnz=int(solver._lu.nnz), K_nnz=int(K.nnz),
+        rss_mb=_rss_mb(), rss_growth_mb=_rss_mb() - rss0)
+    print("RESULT " + json.dumps(out))
+
+
+def jit_probe():
+    """Child: import femast and solve a small model that uses the core kernels; print JSON."""
+    t0 = time.perf_counter()
+    import femast
+
+    t1 = time.perf_counter()
+    import femast_mast
+    from mast import build_mast
+
+    from femast.analysis import Analysis
+
+    m, labels = femast_mast.model(build_mast(2), 2)
+    m.truss(labels[0], labels[6], EA=1e5)
+    Analysis(m, tempfile.mkdtemp(), progress=False).run()
+    t2 = time.perf_counter()
+    print("RESULT " + json.dumps(dict(import_s=t1 - t0, first_solve_s=t2 - t1, total_s=t2 - t0,
+                                      femast=os.path.dirname(femast.__file__))))
+
+
+def _probe(python, env, cwd):
+    cmd = [python, os.path.abspath(__file__), "--jit-probe"]
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=cwd)
+    line = [ln for ln in p.stdout.splitlines() if ln.startswith("RESULT ")]
+    if p.returncode != 0 or not line:
+        raise SystemExit(f"JIT probe failed:\n{p.stdout}\n{p.stderr}")
+    return json.loads(line[0][7:])
+
+
+def jit_report(venv: bool):
+    import shutil
+
+    cwd = tempfile.mkdtemp(prefix="femast_jit_")  # not the source tree: import what is installed
+    cache = tempfile.mkdtemp(prefix="numba_cache_")
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+    cold = _probe(sys.executable, env, cwd)
+    warm = _probe(sys.executable, env, cwd)
+    print(f"femast at {cold['femast']}")
+    print(f"first run, cold numba cache (empty NUMBA_CACHE_DIR): import {cold['import_s']:.2f} s + first solve "
+          f"{cold['first_solve_s']:.2f} s = {cold['total_s']:.2f} s (target < 15 s: "
+          f"{'met' if cold['total_s'] < 15 else 'NOT MET'})")
+    print(f"same, warm cache                                   : import {warm['import_s']:.2f} s + first solve "
+          f"{warm['first_solve_s']:.2f} s = {warm['total_s']:.2f} s")
+    shutil.rmtree(cache, ignore_errors=True)
+    if not venv:
+        return
+    root = os.path.dirname(HERE)
+    vdir = tempfile.mkdtemp(prefix="femast_venv_")
+    subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", vdir], check=True)
+    py = os.path.join(vdir, "bin", "python")
+    p = subprocess.run([py, "-m", "pip", "install", "--no-deps", "-q", root],
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        raise SystemExit(f"pip install . failed:\n{p.stdout}\n{p.stderr}")
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["PYTHONPATH"] = ""
+    first = _probe(py, env, cwd)
+    second = _probe(py, env, cwd)
+    pkg = first["femast"]
+    n_index = sum(f.endswith(".nbi") for _, _, fs in os.walk(pkg) for f in fs)
+    print(f"non-editable install (pip install . in a temporary venv): femast at {pkg}")
+    print(f"  first run (compiles, writes the cache beside the package): {first['total_s']:.2f} s; "
+          f"second run (loads it): {second['total_s']:.2f} s; {n_index} numba index files in the package: "
+          f"caching {'works' if n_index and second['total_s'] < 0.5 * first['total_s'] else 'DOES NOT WORK'}")
+    shutil.rmtree(vdir, ignore_errors=True)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--bays", type=int, nargs="+", default=[40, 100, 200, 400, 700, 1000])
+    ap.add_argument("--increments", type=int, default=10)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--reps", type=int, default=15, help="repetitions of the isolated timings")
+    ap.add_argument("--jit", action="store_true", help="measure the first-run JIT cost instead")
+    ap.add_argument("--venv", action="store_true", help="with --jit: also test a non-editable install")
+    ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
+    ap.add_argument("--jit-probe", action="store_true", help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.jit_probe:
+        return jit_probe()
+    if args.jit:
+        return jit_report(args.venv)
+    if args.child:
+        return child(args.child, args.increments, args.repeat, args.reps)
+    rows = []
+    for nb in args.bays:
+        cmd = [sys.executable, os.path.abspath(__file__), "--child", str(nb), "--increments", str(args.increments),
+               "--repeat", str(args.repeat), "--reps", str(args.reps)]
+        p = subprocess.run(cmd, capture_output=True, text=True, cwd=tempfile.gettempdir())
+        line = [ln for ln in p.stdout.splitlines() if ln.startswith("RESULT ")]
+        if p.returncode != 0 or not line:
+            print(p.stdout, p.stderr)
+            raise SystemExit(f"{nb} bays: child process failed")
+        rows.append(json.loads(line[0][7:]))
+    print(f"femast scaling, truss mast of beam-columns, {args.increments} load increments; medians of "
+          f"{args.repeat} runs (isolated timings: {args.reps} calls); noisy shared 2-core machine")
+    print(f"{'bays':>5} {'DOFs':>6} {'iter':>4} {'wall s':>7} {'ms/inc':>7} {'x40':>5} {'N/40':>5} {'ms/iter':>7} "
+          f"{'asm ms':>6} {'LU ms':>6} {'fLU ms':>6} {'scipy':>6} {'it/LU':>5} {'order':>5} {'RSS MB':>7} "
+          f"{'+MB':>6}")
+    base = rows[0]
+    ok_lin = True
+    worst = 0.0
+    for r in rows:
+        t_inc = r["wall"] / r["increments"]
+        t_it = r["wall"] / r["iterations"]
+        growth = t_inc / (base["wall"] / base["increments"])
+        lin = r["bays"] / base["bays"]
+        ok_lin &= growth <= lin * 1.05
+        ratio = t_it / r["t_bare"]
+        worst = max(worst, ratio)
+        print(f"{r['bays']:5d} {r['dofs']:6d} {r['iterations']:4d} {r['wall']:7.3f} {1e3 * t_inc:7.1f} {growth:5.1f} "
+              f"{lin:5.1f} {1e3 * t_it:7.2f} {1e3 * r['t_assembly']:6.2f} {1e3 * r['t_bare']:6.2f} "
+              f"{1e3 * r['t_femast_lu']:6.2f} {1e3 * r['t_scipy_default']:6.2f} {ratio:5.2f} {r['ordering']:>5} "
+              f"{r['rss_mb']:7.0f} {r['rss_growth_mb']:6.0f}")
+    print("columns: ms/inc, ms/iter: wall time of the run (build excluded) per increment / Newton iteration; x40: "
+          "time per increment over the first size's; N/40: bays ratio (linear growth); asm: one assembly; LU: bare "
+          "SuperLU factorise + solve with femast's ordering; fLU: femast SparseLU (adds gather + zero-pivot check); "
+          "scipy: scipy's default splu; it/LU: ms/iter over LU; RSS: peak resident memory of the process; "
+          "+MB: growth over the 2-bay warm-up")
+    print(f"time per iteration / (factorisation + solve): worst {worst:.2f} (target <= 1.5): "
+          f"{'met' if worst <= 1.5 else 'NOT MET'}")
+    print(f"time per increment grows at most linearly from {base['bays']} to {rows[-1]['bays']} bays: "
+          f"{'yes' if ok_lin else 'NO'}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
