@@ -17,8 +17,12 @@ Pivoting: with a symmetric tangent (every family symmetric) the diagonal is alwa
 below 1 % of the largest entry of its column (threshold partial pivoting, MUMPS' default).
 ``ordering="colamd"`` restores scipy's default (COLAMD, partial pivoting, no reuse).
 
-A singular tangent raises :class:`~femast.errors.SingularModelError` naming the DOFs of the
-mechanism (through :func:`mechanism_dofs`).
+A singular tangent raises :class:`~femast.errors.SingularModelError` (the analysis names the DOFs
+of the mechanism through :func:`mechanism_dofs`): on the first factorisation of a pattern (so a
+model with a mechanism fails at its first iteration, as before) the diagonal of U is tested; on
+later ones that test -- which needs scipy to build L and U as sparse matrices, ~10 % of a
+factorisation -- runs only when a solution is amplified by more than 1e11 (``pivot_check="always"``
+tests every factorisation).
 """
 
 from __future__ import annotations
@@ -43,11 +47,20 @@ class SparseLU:
     ordering : "auto" (the better of "rcm" and "mmd" on the first factorisation of a pattern),
         "rcm", "mmd" (minimum degree on A^T + A), or "colamd" (scipy's default, no reuse).
     pivot_threshold : relative size below which a diagonal pivot is replaced (unsymmetric case).
+    pivot_check : "always": test every factorisation for a zero pivot (|u_kk| <= 1e-13 max |u_kk|);
+        "auto" (default): test the first factorisation of each pattern, and later ones only when a
+        solution is amplified enough (|x| max|u_kk| > 1e11 |b|) for such a pivot to be possible.
     """
 
-    def __init__(self, symmetric: bool = False, ordering: str = "auto", pivot_threshold: float = 0.01):
+    def __init__(self, symmetric: bool = False, ordering: str = "auto", pivot_threshold: float = 0.01,
+                 pivot_check: str = "auto"):
         if ordering not in ORDERINGS:
             raise ValueError(f"ordering must be one of {ORDERINGS}, not {ordering!r}")
+        if pivot_check not in ("auto", "always"):
+            raise ValueError(f"pivot_check must be 'auto' or 'always', not {pivot_check!r}")
+        self.pivot_check = pivot_check
+        self._dmax = None       # largest |pivot| at the last zero-pivot test
+        self._checked = False   # zero-pivot test done for the current factorisation
         self.symmetric = symmetric
         self.ordering = ordering
         self.pivot_threshold = 0.0 if symmetric else float(pivot_threshold)
@@ -126,23 +139,34 @@ class SparseLU:
                 if self.ordering == "colamd":
                     self._perm = None
                     self._lu = spla.splu(K.tocsc())
+                    new_pattern = True
                 else:
                     K = K if K.format == "csr" else K.tocsr()
                     if not K.has_canonical_format:
                         K = K.copy()
                         K.sum_duplicates()
-                    if self._same_pattern(K):
+                    new_pattern = not self._same_pattern(K)
+                    if new_pattern:
+                        self._lu = self._analyse(K)
+                    else:
                         np.take(K.data, self._gather, out=self._B.data)
                         self._lu = self._factor_permuted(self._B)
-                    else:
-                        self._lu = self._analyse(K)
         except (RuntimeError, spla.MatrixRankWarning) as exc:
             self._lu = None
             raise SingularModelError(str(exc)) from None
-        d = self._lu.U.diagonal()
-        if d.size and (not np.all(np.isfinite(d)) or np.min(np.abs(d)) <= 1e-13 * np.max(np.abs(d))):
+        self._checked = False
+        if new_pattern or self.pivot_check == "always" or self._dmax is None:
+            self._check_pivots()
+
+    def _check_pivots(self):
+        """Zero-pivot test on the diagonal of U (scipy builds L and U as CSC matrices for it:
+        ~10 % of a factorisation)."""
+        d = np.abs(self._lu.U.diagonal())
+        if d.size and (not np.all(np.isfinite(d)) or np.min(d) <= 1e-13 * np.max(d)):
             self._lu = None
             raise SingularModelError("zero pivot in the LU factorisation")
+        self._dmax = float(np.max(d, initial=0.0))
+        self._checked = True
 
     def solve(self, rhs):
         rhs = np.asarray(rhs, dtype=float)
@@ -154,6 +178,9 @@ class SparseLU:
             x[self._perm] = y
         if not np.all(np.isfinite(x)):
             raise SingularModelError("non-finite solution of the linear system")
+        if not self._checked and np.abs(x).max(initial=0.0) * self._dmax > 1e11 * np.abs(rhs).max(initial=0.0):
+            # an amplification this large means a pivot within ~1e-11 of the largest: test them
+            self._check_pivots()
         return x
 
 
