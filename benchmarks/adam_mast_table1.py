@@ -135,6 +135,15 @@ def main(argv=None):
     print(f"residual after {args.cycles} cycle(s): x = {vals[-1, 0]:.3g} um, theta_z = {vals[-1, 5]:.4g} arcsec "
           f"({vals[-1, 5] / 3600:.4f} deg); seed: 0.02 um, 0.38 arcsec; seed's scaling estimate with latch "
           "hysteresis: 2.0 deg")
+    dT = np.array([res.frame(i)[f"el/{am.latch_family}/latch_dT"] for i in range(len(res))])
+    bead = np.array([res.frame(i)[f"el/{am.latch_family}/bead_position"] for i in range(len(res))])
+    ieq = res.steps.index("equilibrium")
+    max_dT = float(np.abs(dT[ieq:]).max())
+    max_travel = float((bead[ieq:] + params.latch.x_backstop).max())
+    print(f"latches: largest |dT| over the run {max_dT:.2f} N (a seated bead leaves the backstop above 43.9 N"
+          + (f" + {params.hysteresis_force:g} N of hysteresis" if params.hysteresis_force > 0 else "")
+          + f"); largest bead travel from the backstop {max_travel * 1e6:.3g} um")
+    summary.update({"max_latch_dT_N": max_dT, "max_bead_travel_m": max_travel})
     print("\n" + EXPLAIN)
     print(f"\nrun: {an.summary.increments} increments, {an.summary.iterations} Newton iterations, "
           f"{an.summary.cutbacks} cutbacks, wall time {wall:.1f} s (assembly {an.summary.assembly_time:.1f} s, "
