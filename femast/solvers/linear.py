@@ -10,7 +10,11 @@ be reused with SuperLU as scipy exposes it -- is computed once per pattern:
 * every later factorisation of the same pattern gathers the values into the permuted CSC
   matrix P K P^T (one precomputed index, no CSR -> CSC conversion) and factorises it with the
   NATURAL column order in SuperLU's symmetric mode (diagonal pivots preferred, the structure of
-  femast tangents is symmetric even when the values are not).
+  femast tangents is symmetric even when the values are not);
+* a tangent whose pattern differs -- the reduced tangent of a constrained model, T^T K T, drops
+  exact zeros from one iteration to the next -- is laid out on this master pattern with zeros
+  where it has no entries; only a tangent with entries outside it makes the master pattern the
+  union of the two, analysed once more (with the ordering kind chosen the first time).
 
 Pivoting: with a symmetric tangent (every family symmetric) the diagonal is always taken
 (``diag_pivot_thresh=0``, as before); otherwise a row interchange happens when the diagonal is
@@ -68,15 +72,32 @@ class SparseLU:
         self._perm = None       # symmetric permutation p: B = K[p][:, p]
         self._B = None          # permuted CSC matrix, data refilled each factorisation
         self._gather = None     # B.data = K.data[gather]
-        self._pattern = None    # (shape, indptr, indices) the ordering belongs to
+        self._pattern = None    # (shape, indptr, indices) of the master pattern the ordering belongs to
+        self._master_keys = None  # row * n + col of its entries, ascending
+        self._sub = None        # the last pattern seen inside the master one, and its positions there
+        self._sub_pos = None
         self.analyses = 0       # orderings computed (1 for a fixed-pattern run)
         self.chosen = None      # name of the ordering in use
 
     # ------------------------------------------------------------------ symbolic part
-    def _same_pattern(self, K):
-        p = self._pattern
-        return (p is not None and p[0] == K.shape and np.array_equal(p[1], K.indptr)
-                and np.array_equal(p[2], K.indices))
+    @staticmethod
+    def _same(pattern, K):
+        return (pattern is not None and pattern[0] == K.shape and np.array_equal(pattern[1], K.indptr)
+                and np.array_equal(pattern[2], K.indices))
+
+    @staticmethod
+    def _keys(shape, indptr, indices):
+        rows = np.repeat(np.arange(shape[0], dtype=np.int64), np.diff(indptr))
+        return rows * shape[1] + indices
+
+    def _positions(self, K):
+        """Positions of K's entries in the master pattern, or None if one is outside it."""
+        keys = self._keys(K.shape, K.indptr, K.indices)
+        pos = np.searchsorted(self._master_keys, keys)
+        pos[pos >= self._master_keys.size] = 0
+        if not np.array_equal(self._master_keys[pos], keys):
+            return None
+        return pos
 
     def _permuted(self, K, perm):
         """(B, gather): the CSC matrix K[perm][:, perm] and the index with B.data = K.data[gather]."""
@@ -92,10 +113,9 @@ class SparseLU:
                          options=dict(SymmetricMode=True))
 
     def _analyse(self, K):
-        """Choose the ordering for the pattern of K; returns the LU of K in that ordering.
-
-        The first pattern tries every candidate ordering; a later new pattern (e.g. a constrained
-        model whose reduced tangent lost an exact zero) reuses the kind chosen the first time."""
+        """Choose the ordering for the pattern of K (the master pattern from now on); returns the
+        LU of K in that ordering.  The first pattern tries every candidate ordering; a later one
+        (the union of the master and a tangent with entries outside it) reuses the kind chosen."""
         self.analyses += 1
         kinds = [self.chosen] if self.chosen else (["rcm", "mmd"] if self.ordering == "auto" else [self.ordering])
         best = None
@@ -122,6 +142,8 @@ class SparseLU:
             if best is None or lu.nnz < best[0]:
                 best = (lu.nnz, (kind, perm, B, gather), lu)
         self._pattern = (K.shape, K.indptr.copy(), K.indices.copy())
+        self._master_keys = self._keys(K.shape, K.indptr, K.indices)
+        self._sub = None
         if best is None:  # singular: keep an ordering so that the pattern is not analysed again
             if first is None:
                 perm = np.arange(K.shape[0])
@@ -131,6 +153,32 @@ class SparseLU:
         self.chosen, self._perm, self._B, self._gather = best[1]
         return best[2]
 
+    def _master_data(self, K):
+        """K's values laid out on the master pattern, or None after a new analysis (which has
+        factorised already; the LU is in self._lu)."""
+        if self._same(self._pattern, K):
+            return K.data
+        if self._same(self._sub, K):
+            pos = self._sub_pos
+        else:
+            pos = self._positions(K)
+            if pos is None:  # entries outside the master pattern: analyse the union once
+                ones = sp.csr_matrix((np.ones(K.nnz), K.indices, K.indptr), shape=K.shape)
+                master = sp.csr_matrix((np.ones(self._master_keys.size), self._pattern[2], self._pattern[1]),
+                                       shape=K.shape)
+                union = (ones + master).tocsr()
+                union.sort_indices()
+                union.data[:] = 0.0
+                self._master_keys = self._keys(union.shape, union.indptr, union.indices)
+                union.data[self._positions(K)] = K.data
+                self._lu = self._analyse(union)
+                return None
+            self._sub = (K.shape, K.indptr.copy(), K.indices.copy())
+            self._sub_pos = pos
+        data = np.zeros(self._master_keys.size)
+        data[pos] = K.data
+        return data
+
     # ------------------------------------------------------------------ numeric part
     def factorize(self, K):
         try:
@@ -139,23 +187,26 @@ class SparseLU:
                 if self.ordering == "colamd":
                     self._perm = None
                     self._lu = spla.splu(K.tocsc())
-                    new_pattern = True
+                    analysed = True
                 else:
                     K = K if K.format == "csr" else K.tocsr()
                     if not K.has_canonical_format:
                         K = K.copy()
                         K.sum_duplicates()
-                    new_pattern = not self._same_pattern(K)
-                    if new_pattern:
+                    if self._pattern is None:
                         self._lu = self._analyse(K)
+                        analysed = True
                     else:
-                        np.take(K.data, self._gather, out=self._B.data)
-                        self._lu = self._factor_permuted(self._B)
+                        data = self._master_data(K)
+                        analysed = data is None
+                        if not analysed:
+                            np.take(data, self._gather, out=self._B.data)
+                            self._lu = self._factor_permuted(self._B)
         except (RuntimeError, spla.MatrixRankWarning) as exc:
             self._lu = None
             raise SingularModelError(str(exc)) from None
         self._checked = False
-        if new_pattern or self.pivot_check == "always" or self._dmax is None:
+        if analysed or self.pivot_check == "always" or self._dmax is None:
             self._check_pivots()
 
     def _check_pivots(self):
