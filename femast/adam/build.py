@@ -111,18 +111,21 @@ def _check_fold(fold, where):
     return int(fold)
 
 
-def build_bay(params: BayParameters | None = None, fold: int = 1, name: str = "ADAM bay", **changes) -> AdamModel:
+def build_bay(params: BayParameters | None = None, fold: int = 1, name: str = "ADAM bay", cables: bool = True,
+              **changes) -> AdamModel:
     """One ADAM bay (seed 001 Sec. II): bottom frame fixed, top frame rigid with the control node.
 
     params : :class:`BayParameters` (default: the documented choices); keyword ``changes``
         override single parameters, e.g. ``build_bay(b=0.3, cable_EA=5e4)``.
     fold : +1 (the bay folds under a positive twist about z) or -1.
+    cables : False leaves out the cable/pulley/latch assemblies (frames, longerons and joints only:
+        the deployment kinematics of Eq. 1).
     Returns an :class:`AdamModel`; add steps to ``.model``."""
-    return build_mast(1, params, fold=fold, alternate=False, name=name, **changes)
+    return build_mast(1, params, fold=fold, alternate=False, name=name, cables=cables, **changes)
 
 
 def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, alternate: bool = True,
-               name: str | None = None, **changes) -> AdamModel:
+               name: str | None = None, cables: bool = True, **changes) -> AdamModel:
     """A mast of ``n_bays`` identical ADAM bays (seed 001 Sec. VII: 40 bays, 6.84 m).
 
     params : :class:`BayParameters`; keyword ``changes`` override single parameters.
@@ -130,7 +133,8 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
     alternate : alternate the folding sense from bay to bay (seed Sec. VIII: "the bays are
         arranged to fold in alternate directions").
     The base frame is fixed (all DOFs of its nodes); the top frame is a rigid body whose reference
-    is the control node at its centre.  Returns an :class:`AdamModel`."""
+    is the control node at its centre.  ``cables=False`` leaves out the cable assemblies.
+    Returns an :class:`AdamModel`."""
     try:
         n_ok = int(n_bays) == n_bays and int(n_bays) >= 1 and not isinstance(n_bays, bool)
     except (TypeError, ValueError):
@@ -188,12 +192,12 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
     if p.joint_spring > 0:
         m.add_family(JointSprings(pairs, p.joint_spring, name=SPRING_FAMILY))
     # cable/pulley/latch assemblies
-    units = np.zeros((n_bays, 4), dtype=np.int64)
+    units = np.zeros((n_bays, 4 if cables else 0), dtype=np.int64)
     latch_nodes = []
     arm_labels = []
     stretch = 1.0 + p.pretension / p.cable_EA
     LA_list, LB_list = [], []
-    for j in range(n_bays):
+    for j in range(n_bays if cables else 0):
         for k in range(4):
             k1 = (k + 1) % 4
             B0, B1 = corners[j, k], corners[j, k1]
@@ -216,12 +220,13 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
                                           family=ARM_FAMILY))
     LA, LB = np.array(LA_list), np.array(LB_list)
     x0 = -p.latch.x_backstop
-    fam = CableLatchFamily(np.array(latch_nodes, dtype=np.int64), EA=p.cable_EA, L0=(LA + LB) / stretch,
+    fam = None if not cables else CableLatchFamily(np.array(latch_nodes, dtype=np.int64), EA=p.cable_EA, L0=(LA + LB) / stretch,
                            latch_node=1, bead=LA / stretch + x0, latch=p.latch, x0=x0,
                            hysteresis_force=p.hysteresis_force, hysteresis_length=p.hysteresis_length,
                            name=LATCH_FAMILY)
-    m.add_family(fam)
-    latch_labels = np.arange(1, 4 * n_bays + 1).reshape(n_bays, 4)
+    if fam is not None:
+        m.add_family(fam)
+    latch_labels = np.arange(1, 4 * n_bays + 1).reshape(n_bays, 4) if cables else np.zeros((n_bays, 0), int)
     # boundary conditions and rigid bodies
     base = [int(c) for c in corners[0]] + [int(e) for e in np.unique(batten_ends[0])]
     for nd in sorted(set(base)):
