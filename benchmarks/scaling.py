@@ -19,6 +19,11 @@ solved --repeat times and the medians are printed:
 Targets: time per iteration <= 1.5 x (factorisation + solve of the same tangent); time per
 increment growing at most linearly with the number of bays from 40 to 1000 bays.
 
+    python benchmarks/scaling.py --profile 400
+
+prints the cProfile of building and solving the 400-bay mast (numba cache warm), the profile shown
+before and after the optimisations in docs/performance.md.
+
     python benchmarks/scaling.py --jit [--venv]
 
 measures the first-run JIT cost instead: a fresh process imports femast and solves a 2-bay mast of
@@ -181,6 +186,29 @@ def jit_report(venv: bool):
     shutil.rmtree(vdir, ignore_errors=True)
 
 
+def profile(n_bays, n_inc, top=16):
+    import cProfile
+    import io
+    import pstats
+
+    import femast_mast
+    from mast import build_mast
+
+    femast_mast.warm_up()
+    mast = build_mast(n_bays)
+    pr = cProfile.Profile()
+    t0 = time.perf_counter()
+    pr.enable()
+    r = femast_mast.solve(mast, n_inc)
+    pr.disable()
+    wall = time.perf_counter() - t0
+    print(f"{n_bays}-bay mast, {n_inc} increments: wall {wall:.2f} s (build {r['build']:.2f} s), "
+          f"{r['iterations']} Newton iterations, {len(mast.conn)} beams")
+    out = io.StringIO()
+    pstats.Stats(pr, stream=out).sort_stats("tottime").print_stats(top)
+    print(out.getvalue())
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--bays", type=int, nargs="+", default=[40, 100, 200, 400, 700, 1000])
@@ -189,6 +217,7 @@ def main(argv=None):
     ap.add_argument("--reps", type=int, default=15, help="repetitions of the isolated timings")
     ap.add_argument("--jit", action="store_true", help="measure the first-run JIT cost instead")
     ap.add_argument("--venv", action="store_true", help="with --jit: also test a non-editable install")
+    ap.add_argument("--profile", type=int, metavar="BAYS", help="cProfile of one run of this size instead")
     ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--jit-probe", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -196,6 +225,8 @@ def main(argv=None):
         return jit_probe()
     if args.jit:
         return jit_report(args.venv)
+    if args.profile:
+        return profile(args.profile, args.increments)
     if args.child:
         return child(args.child, args.increments, args.repeat, args.reps)
     rows = []
