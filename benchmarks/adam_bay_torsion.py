@@ -94,7 +94,7 @@ def run_path(kind: str, out: Path, theta_max_deg: float, progress: bool, hystere
         "latched_at_end": int(np.sum(curve["zone"][-1] == 0)),
         "final_rotation_deg": float(np.degrees(curve["theta"][-1])), "final_moment_Nm": float(curve["M"][-1]),
         "pretension_N": float(np.mean(curve["tension"][0 if len(curve["tension"]) == 1 else
-                                                        list(curve["step"]).index("equilibrium")])),
+                                                        len(curve["step"]) - 1 - list(curve["step"])[::-1].index("pretension")])),
     }
     (folder / "summary.json").write_text(json.dumps(info, indent=2))
     return info
@@ -103,7 +103,7 @@ def run_path(kind: str, out: Path, theta_max_deg: float, progress: bool, hystere
 def print_summary(info: dict):
     rel = ", ".join("held" if np.isnan(v) else f"{v:.2f}" for v in info["release_deg"])
     print(f"\n== {info['path']} path ==")
-    print(f"  initial step: cables at {info['pretension_N']:.1f} N after equilibrium; stabilisation energy / strain "
+    print(f"  initial step: cables at {info['pretension_N']:.1f} N in equilibrium; stabilisation energy / strain "
           f"energy = {info['stabilization_ratio']:.2e}")
     print(f"  peak moment {info['peak_moment_Nm']:.1f} N m (seed sign) at {info['peak_at_deg']:.3f} deg")
     print(f"  latches reach zone {ZONE_LABELS[3]} at (deg), sides 0-3: {rel}")

@@ -118,8 +118,8 @@ def test_pretension_equilibrium(pretensioned):
     fr = res.frame(-1)
     st = an.summary.steps
     assert st[0]["name"] == "pretension" and "stabilization_ratio" in st[0]
-    assert st[0]["stabilization_ratio"] < 1e-4            # the stabilised state is an equilibrium
-    assert st[1]["iterations"] <= 2                         # so the unstabilised step has nothing left to do
+    assert st[0]["stabilization_ratio"] < 1e-4            # the viscous forces did (almost) no work
+    assert len(st) == 1
     # no external load: the reactions (base and held control DOFs) sum to zero (forces and moments)
     X = res.X + fr["U"]
     RF = fr["RF"]

@@ -4,8 +4,8 @@ The seed gives the elastic tip response of its 40-bay model under M + F (M = 6.8
 F = 14 N along x): x = 1740 um and theta_z = 3030 arcsec.  It does not give the cable EA nor the
 longeron section.  :func:`fit_tip_response` finds them by least squares (scipy's trust-region
 reflective ``least_squares``, as the project's other fits): each residual evaluation builds the
-mast, brings it to its pretensioned equilibrium (stabilised initial step, then an unstabilised
-one) and applies M + F in one step, exactly as the Table 1 benchmark does; the residuals are the
+mast, brings it to its pretensioned equilibrium (stabilised initial step) and applies M + F in
+one unstabilised step, exactly as the Table 1 benchmark does; the residuals are the
 relative differences of x and theta_z from their targets.  Parameters are fitted in log scale
 (both are positive and span decades).  With two parameters and two targets the fit is exact when
 it succeeds; ``sensitivity`` (d log response / d log parameter) tells how well each is determined.
@@ -48,7 +48,7 @@ def tip_response(params: BayParameters, n_bays: int = 40, M: float = TABLE1_M, F
         res = an.run()
         row = int(np.flatnonzero(res.node_labels == am.control)[0])
         steps = res.steps
-        i0 = len(steps) - 1 - steps[::-1].index("equilibrium")
+        i0 = len(steps) - 1 - steps[::-1].index("pretension")
         f0, f1 = res.frame(i0), res.frame(len(res) - 1)
         u = f1["U"][row] - f0["U"][row]
         th = f1["URA"][row] - f0["URA"][row]

@@ -190,7 +190,7 @@ TABLE1_ROWS = ("0", "M+F", "0", "-M-F", "0", "M+F", "0", "-M-F", "0", "M+F", "0"
 TABLE1_COLUMNS = ("x (um)", "y (um)", "z (um)", "thx (asec)", "thy (asec)", "thz (asec)")
 
 
-def tip_table(res: Results, am: AdamModel, reference_step: str = "equilibrium") -> tuple[list, np.ndarray]:
+def tip_table(res: Results, am: AdamModel, reference_step: str = "pretension") -> tuple[list, np.ndarray]:
     """Tip (control node) position and rotation at the end of each step after ``reference_step``,
     relative to the state at the end of ``reference_step`` (the pretensioned mast), in the units
     of Table 1: x, y, z in um and theta_x, theta_y, theta_z in arcsec.  Returns (row labels,
