@@ -12,7 +12,7 @@ from ..experiments.core import Parameter
 from .base import Effect, Implementation, register_effect
 from .operators import proportional_play
 
-PENDING = ("bay-torsion", "tip-cycle")
+FE = ("bay-torsion", "tip-cycle")
 
 
 # ----------------------------------------------------------------------------- progressive stiffness
@@ -43,8 +43,6 @@ PROGRESSIVE_STIFFNESS = register_effect(Effect(
                                   scale=1e-4, starts=(1e-5, 1e-3)),),
             apply=_progressive_mast_top,
             doc="theta_k = m_k / (k_k (1 + beta |m_k|)), k = 1, 2 (secant stiffness rising with the moment)."),
-        **{e: Implementation(hook="(pending)", parameters=(
-            Parameter("k1", "-", 144.32, -1e4, 1e4, "slope of EA(tau) (Eq. 25), N per N"),)) for e in PENDING},
     },
 ))
 
@@ -92,13 +90,15 @@ CABLE_HYSTERESIS = register_effect(Effect(
             doc="x_bead = x + sign(dT) c_cable (|dT| - play(|dT|; eta |dT|)): Eq. 15 removed the mean stretch "
                 "c_cable |dT| (c_cable = L_cable / EA, option cable_compliance_m_per_N), the cable's own "
                 "stretch lags it."),
-        **{e: Implementation(hook="(pending)", parameters=(
-            Parameter("eta", "-", 0.05, 0.0, 0.6, "loop half-width relative to the tension"),)) for e in PENDING},
     },
 ))
 
 
 # ----------------------------------------------------------------------------- pretension loss / error
+def _pretension_fe(bay, p, ctx):
+    return {**bay, "pretension": float(bay["pretension"]) + float(p["dT0"])}
+
+
 def _pretension_mast_top(theta, p, ctx):
     theta = theta.copy()
     tau = ctx["prep"]["tau"][:, None]
@@ -115,8 +115,9 @@ PRETENSION = register_effect(Effect(
         "pretension; seed 001 Eq. 16 measures the ADAM cable pretension by vibration).  A pretension that creeps "
         "or slips during a test makes the stiffness fall with time; a pretension different from the assumed one "
         "shifts it (identifiable only in models that take the pretension as an input: bay-torsion, tip-cycle)."),
-    signature="the compliance drifts along the test: the error grows with time in proportion to the load",
-    acts_where=("peak", "loading", "unloading"),
+    signature="the compliance drifts along the test: the error grows with time in proportion to the load (a "
+              "loss during the test); the unlatched bay's moment is offset (an error of the pretension)",
+    acts_where=("peak", "loading", "unloading", "zone (d) no contact"),
     seed="seed 000 Table III; seed 001 Eq. 16",
     implementations={
         "mast-top": Implementation(
@@ -124,8 +125,13 @@ PRETENSION = register_effect(Effect(
             parameters=(Parameter("lam", "-", 0.1, 0.0, 0.9, "relative stiffness loss over the test", scale=0.1),),
             apply=_pretension_mast_top,
             doc="k_k(t) = k_k (1 - lam tau), tau = normalised time in [0, 1] (t_s column or row index)."),
-        **{e: Implementation(hook="(pending)", parameters=(
-            Parameter("dT0", "N", 0.0, -200.0, 200.0, "error of the cable pretension"),)) for e in PENDING},
+        **{e: Implementation(
+            hook="bay_parameters", order=60,
+            parameters=(Parameter("dT0", "N", 0.0, -150.0, 150.0, "error of the cable pretension against the "
+                                  "nominal option pretension_N (< 0: a loss)", scale=20.0),),
+            apply=_pretension_fe,
+            doc="the FE cables are pretensioned to pretension_N + dT0 (a constant error or a loss before the "
+                "test, e.g. creep since the vibration measurement of seed 001 Eq. 16).") for e in FE},
     },
 ))
 

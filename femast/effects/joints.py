@@ -9,6 +9,8 @@ Hooks used (see the experiments' ``hooks``):
 * latch-pull -- ``bead_position`` (bead position ``x`` (n,), m, seed 001 Eq. 15) and
   ``branch_force`` (the latching and unlatching branches ``[dT_in, dT_out]`` (n, 2), N, of
   seed 001 Eq. 14 at the bead positions).
+* bay-torsion, tip-cycle (FE models) -- ``bay_parameters`` (the dict of inputs the FE bay or
+  mast is built with: ``mu``, ``B``, ``pretension``, ...).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from ..experiments.core import Parameter
 from .base import Effect, Implementation, register_effect
 from .operators import play
 
-PENDING = ("bay-torsion", "tip-cycle")
+FE = ("bay-torsion", "tip-cycle")
 
 
 # ----------------------------------------------------------------------------- clearance
@@ -61,8 +63,6 @@ JOINT_CLEARANCE = register_effect(Effect(
                                   scale=1e-4, starts=(1e-5, 3e-4)),),
             apply=_clearance_latch_pull,
             doc="x_bead = x - c tanh(dT / 1 N): the latch shifts by c towards the pulling cable."),
-        **{e: Implementation(hook="(pending)", parameters=(
-            Parameter("c", "rad", 1e-4, 0.0, 0.02, "half play of the longeron-corner joints"),)) for e in PENDING},
     },
 ))
 
@@ -108,13 +108,15 @@ FRICTION_HYSTERESIS = register_effect(Effect(
             apply=_friction_latch_pull,
             doc="dT_in -= F_f, dT_out += F_f: a constant friction opposing the motion of the bead, everywhere on "
                 "the path (also out of roller contact)."),
-        **{e: Implementation(hook="(pending)", parameters=(
-            Parameter("M_f", "N m", 0.01, 0.0, 10.0, "friction moment of the joints"),)) for e in PENDING},
     },
 ))
 
 
 # ----------------------------------------------------------------------------- ball-joint friction
+def _ball_joint_fe(bay, p, ctx):
+    return {**bay, "mu": float(p["mu"])}
+
+
 BALL_JOINT_FRICTION = register_effect(Effect(
     name="ball_joint_friction",
     title="ball-joint friction",
@@ -123,10 +125,17 @@ BALL_JOINT_FRICTION = register_effect(Effect(
         "transmitting a force F resists with a moment |M| = mu B |F| opposing the motion, a joint at rest holds "
         "|M| <= mu B |F| (mu = 0.5, B = 4 mm in the seed).  Unlike a constant friction it grows with the force "
         "through the joint, so the hysteresis widens with the cable pretension and the load."),
-    signature="hysteresis whose width grows with the load through the joints; the bay sticks after reversals",
-    acts_where=("reversal", "loading", "unloading"),
+    signature="hysteresis whose width grows with the load through the joints: the moment is offset against the "
+              "direction of twisting all along the path (bay torsion), the tip keeps a residual displacement at "
+              "zero load (mast)",
+    acts_where=("reversal", "loading", "unloading", "near-zero load"),
     seed="seed 001 Sec. II.B.1",
-    implementations={e: Implementation(hook="(pending)", parameters=(
-        Parameter("mu", "-", 0.5, 0.0, 1.5, "friction coefficient of the ball joints"),
-        Parameter("B", "m", 4e-3, 1e-4, 0.05, "ball end radius"),)) for e in PENDING},
+    implementations={e: Implementation(
+        hook="bay_parameters", order=40,
+        parameters=(Parameter("mu", "-", 0.2, 0.0, 1.5, "friction coefficient of the ball joints (B: option "
+                                                          "ball_B_m, 4 mm; only mu B counts)", scale=0.1),),
+        apply=_ball_joint_fe,
+        doc="the FE ball joints (femast.elements.ball_joint) get the friction coefficient mu (the baseline has "
+            "option ball_mu = 0); each joint holds |M| <= mu B |F| and slips against the motion beyond it.")
+        for e in FE},
 ))

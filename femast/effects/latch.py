@@ -16,6 +16,10 @@ from ..experiments.core import Parameter
 from .base import Effect, Implementation, register_effect
 
 
+def _latch_hysteresis_fe(bay, p, ctx):
+    return {**bay, "hysteresis_force": float(p["F_h"])}
+
+
 def _latch_hysteresis(D, p, ctx):
     x = ctx["x"]
     xb = ctx["params"]["x_backstop"]
@@ -32,7 +36,7 @@ LATCH_HYSTERESIS = register_effect(Effect(
     physics=__doc__.split("\n\n", 1)[1].strip(),
     signature="latching and unlatching curves differ near the backstop, where the baseline has a single curve; "
               "the error is concentrated in the latched zones (a)-(b) of seed 001 Fig. 6",
-    acts_where=("zone (a) at backstop", "zone (b) behind roller axis"),
+    acts_where=("zone (a) at backstop", "zone (b) behind roller axis", "near-zero load"),
     seed="seed 001 Sec. III.C, Sec. VIII",
     implementations={
         "latch-pull": Implementation(
@@ -45,8 +49,13 @@ LATCH_HYSTERESIS = register_effect(Effect(
             ),
             apply=_latch_hysteresis,
             doc="dT_in -= F_h w, dT_out += F_h w, w = exp(-max(x + x_backstop, 0) / ell)."),
-        **{e: Implementation(hook="(pending)", parameters=(
-            Parameter("F_h", "N", 5.0, 0.0, 200.0, "extra latch friction with the bead seated"),
-            Parameter("ell", "m", 3e-4, 2e-5, 5e-3, "fade-out length"),)) for e in ("bay-torsion", "tip-cycle")},
+        **{e: Implementation(
+            hook="bay_parameters", order=30,
+            parameters=(Parameter("F_h", "N", 5.0, 0.0, 200.0, "extra friction force of a latch with the bead "
+                                  "seated (fade-out length: option latch_hysteresis_length_m)", scale=5.0),),
+            apply=_latch_hysteresis_fe,
+            doc="the FE latches (cable/latch element, femast.latch hysteresis option) get hysteresis_force = F_h, "
+                "fading over the option latch_hysteresis_length_m (3e-4 m); it acts only on beads that have left "
+                "the backstop.") for e in ("bay-torsion", "tip-cycle")},
     },
 ))

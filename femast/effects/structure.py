@@ -1,5 +1,5 @@
 """Structural effects: beam bending flexibility in series with the base joint (seed 000 Eqs. 8-15)
-and off-axis motion of the bay top (seed 001 Sec. VI)."""
+and off-axis motion of the bay top (seed 001 Sec. VI, hook ``control_path`` of bay-torsion)."""
 
 from __future__ import annotations
 
@@ -49,10 +49,22 @@ BEAM_FLEXIBILITY = register_effect(Effect(
             apply=_beam_mast_top,
             doc="dc_T += C_beam(E)[:3] dw, the cantilever of length |r_oc| along r_oc with the section options "
                 "s_out_m, s_in_m, nu; E at its upper bound means a rigid mast."),
-        "tip-cycle": Implementation(hook="(pending)", parameters=(
-            Parameter("EI_scale", "-", 1.0, 0.1, 10.0, "scale of the longerons' bending stiffness"),)),
     },
 ))
+
+
+def _off_axis_bay(drive, p, ctx):
+    """Turn the top frame about a vertical axis at p["e"] from the bay axis, towards the centre of
+    side ``options["off_axis_side"]``: the control node moves by (I - R(theta)) c on top of the path."""
+    k = int(ctx["options"].get("off_axis_side", 0))
+    a = np.pi / 2 + k * np.pi / 2
+    cx, cy = p["e"] * np.cos(a), p["e"] * np.sin(a)
+    th = drive[:, 0]
+    c, s = np.cos(th), np.sin(th)
+    out = np.array(drive, dtype=float, copy=True)
+    out[:, 1] += cx - (c * cx - s * cy)
+    out[:, 2] += cy - (s * cx + c * cy)
+    return out
 
 
 OFF_AXIS = register_effect(Effect(
@@ -61,14 +73,21 @@ OFF_AXIS = register_effect(Effect(
     physics=(
         "The single-bay torsion rig of seed 001 (Sec. V-VI) does not keep the bay top on its axis: displacements "
         "of up to 1 cm in x and y were recorded, so the four latches do not unlatch together.  The idealised "
-        "model drives the top by its rotation only; this effect drives it along the measured ux, uy (the "
-        "seed's 'actual path', Fig. 17) or, when they are not measured, along a fitted eccentric axis."),
-    signature="the latches do not act together: the moment-rotation curve has steps (one latch at a time) where "
-              "the idealised model has one",
-    acts_where=("loading", "unloading"),
+        "model drives the top by its rotation only (the baseline of bay-torsion follows ux, uy when they are "
+        "measured); this effect turns the top frame about a vertical axis at a distance e from the bay axis, "
+        "so the top centre moves by (I - R(theta)) c, |c| = e, on top of the driven path.  By the four-fold "
+        "symmetry of the bay only e counts, not the side it points to.  Without ux, uy this is the unmeasured "
+        "drift of the rig; with them, a measurement point off the frame centre."),
+    signature="the latches do not release together: the moment differs where they leave the rollers (zone (c)) "
+              "and around release and relatching, where the idealised model has one sharp step",
+    acts_where=("zone (c) in front of roller axis", "loading", "unloading"),
     seed="seed 001 Sec. VI.B, Fig. 17",
-    implementations={e: Implementation(hook="(pending)", parameters=(
-        Parameter("ex", "m", 0.0, -0.02, 0.02, "eccentricity of the rotation axis along x"),
-        Parameter("ey", "m", 0.0, -0.02, 0.02, "eccentricity of the rotation axis along y"),))
-        for e in ("bay-torsion", "tip-cycle")},
+    implementations={"bay-torsion": Implementation(
+        hook="control_path", order=50,
+        parameters=(Parameter("e", "m", 0.01, 0.0, 0.05, "distance of the rig's rotation axis from the bay axis "
+                              "(towards the centre of side off_axis_side)", scale=0.01),),
+        apply=_off_axis_bay,
+        doc="[ux, uy] += (I - R(theta)) c, c = e (cos a, sin a), a = 90 + 90 k degrees for side k = option "
+            "off_axis_side (side 0: +y)."),
+    },
 ))

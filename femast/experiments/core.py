@@ -17,8 +17,8 @@ It returns a dict ``{channel: (n,) array}`` with one predicted value per row for
 noise floor, segmentation, ranking of effects, figures, history) is generic.
 
 Built-in experiments live in :mod:`femast.experiments.mast_top`,
-:mod:`femast.experiments.latch_pull` and :mod:`femast.experiments.pending`; a user adds one
-from a Python script that defines a module-level ``experiment`` (see ``docs/experiments.md``).
+:mod:`femast.experiments.latch_pull`, :mod:`femast.experiments.bay_torsion` and
+:mod:`femast.experiments.tip_cycle` (FE models); a user adds one from a Python script that defines a module-level ``experiment`` (see ``docs/experiments.md``).
 """
 
 from __future__ import annotations
@@ -168,6 +168,13 @@ class Experiment:
     min_rows : fewest data rows accepted.
     effects_from : name of the experiment whose effect implementations apply (default: own name;
         a variant of ``mast-top`` sets ``effects_from="mast-top"`` to inherit its effects).
+    fit_options : settings of :func:`scipy.optimize.least_squares` for this model, overriding the
+        defaults of :func:`~femast.experiments.fitting.fit` (``xtol = ftol = gtol = 1e-10``, 2-point
+        differences with scipy's default step, ``max_nfev = 100 (p + 1)``).  An expensive model
+        (the FE experiments: about a second per evaluation) sets looser tolerances, a finite
+        difference step (``diff_step``, relative to the scaled parameters) larger than the
+        convergence noise of its solver and a lower ``max_nfev_per_param`` (``max_nfev = that x
+        (p + 1)``).
     source : where it came from (a built-in name or a script path), set by the registry.
     """
 
@@ -190,6 +197,7 @@ class Experiment:
     error_unit: str = ""
     min_rows: int = 10
     effects_from: str | None = None
+    fit_options: dict = field(default_factory=dict)
     source: str = ""
 
     def __post_init__(self):

@@ -81,6 +81,24 @@ def _rebuildable(exp: Experiment) -> bool:
     return other.name == exp.name and other.model is exp.model
 
 
+def _mp_context():
+    """Start method of the local pool: ``_START_METHOD`` if set; else 'forkserver' once a numba
+    kernel has started GNU OpenMP threads in this process (the FE experiments' ball-joint kernel
+    is parallel; forking after that aborts the child: "fork() called from a process already using
+    GNU OpenMP"); else the platform's default (fork on Linux: the fastest start)."""
+    if _START_METHOD:
+        return multiprocessing.get_context(_START_METHOD)
+    try:
+        import numba
+
+        layer = numba.threading_layer()  # ValueError while no parallel kernel has run
+    except Exception:
+        layer = None
+    if layer == "omp" and "forkserver" in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("forkserver")
+    return None
+
+
 def _run_tasks(payloads, workers, scheduler):
     """Run the refits; returns (results, how) with ``how`` describing the executor used."""
     if scheduler is not None:
@@ -105,8 +123,7 @@ def _run_tasks(payloads, workers, scheduler):
     n = min(n, len(payloads))
     if n <= 1:
         return [_refit_task(p) for p in payloads], "serial (1 process)"
-    ctx = multiprocessing.get_context(_START_METHOD) if _START_METHOD else None
-    with ProcessPoolExecutor(max_workers=n, mp_context=ctx) as pool:
+    with ProcessPoolExecutor(max_workers=n, mp_context=_mp_context()) as pool:
         results = list(pool.map(_refit_task, payloads))
     return results, f"{n} local processes"
 

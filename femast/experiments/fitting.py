@@ -243,8 +243,11 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
             for i, st in extra:
                 x[i] = np.clip(st[min(k, len(st) - 1)], specs[i][1].lower, specs[i][1].upper)
             starts.append(x)
-    kw = dict(method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10, x_scale=1.0,
-              max_nfev=max_nfev or 100 * (len(specs) + 1))
+    fo = dict(exp.fit_options)
+    per_param = int(fo.pop("max_nfev_per_param", 100))
+    kw = dict(method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10, x_scale=1.0)
+    kw.update(fo)
+    kw["max_nfev"] = max_nfev or kw.get("max_nfev") or per_param * (len(specs) + 1)
 
     def solve(sigma, candidates):
         best = None

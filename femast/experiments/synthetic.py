@@ -178,3 +178,125 @@ def latch_pull_data(params=None, effects=None, *, passes=2, n_move: int = 120, n
         dT_meas = dT_meas + drift_N * np.sin(0.5 * np.pi * np.linspace(0, 1, n))
     x_mm = 1e3 * x_meas + rng.normal(0.0, noise_mm, n)
     return Measured(exp.name, {"x_mm": x_mm, "dT_N": dT_meas}), {"x_m": xb_true, "dT_N": dT}
+
+
+# --------------------------------------------------------------------------- bay-torsion (FE)
+def bay_torsion_path(n: int = 41, theta_max_deg: float = 3.2, kind: str = "cycle", cycles: float = 1.0,
+                     offaxis_mm: float = 0.0, seed: int = 0) -> dict:
+    """Twist paths of the single-bay torsion test, ``{theta_deg}`` (and ``ux_m, uy_m`` when
+    ``offaxis_mm`` > 0), n rows.
+
+    kind : ``"cycle"`` (0 -> theta_max -> 0, ``cycles`` times), ``"partial"`` (out to theta_max,
+        back to 45-60 % of it, out again to 80-100 %, back to 0: reversals away from zero),
+        ``"release"`` (0 -> theta_max -> 0 with rows twice as dense near 0 and through the
+        release of the latches, 1.9-2.8 degrees).
+    offaxis_mm : a measured drift of the top-frame centre (the seed's up to 1 cm), growing with
+        the twist: ``u = offaxis (sin(0.7 + seed), cos(0.7 + seed)) (theta / theta_max)^2``.
+    """
+    rng = np.random.default_rng(seed)
+    if kind == "cycle":
+        u = np.linspace(0.0, 2.0 * cycles, n)
+        th = theta_max_deg * (1.0 - np.abs((u % 2.0) - 1.0))
+    elif kind == "partial":
+        a, b = rng.uniform(0.45, 0.6), rng.uniform(0.8, 1.0)
+        knots = np.array([0.0, 1.0, a, b, 0.0]) * theta_max_deg
+        length = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(knots)))])
+        th = np.interp(np.linspace(0.0, length[-1], n), length, knots)
+    elif kind == "release":
+        w = lambda x: 1.0 + 1.0 * (np.abs(x - 0.0) < 0.5) + 1.0 * ((x > 1.9) & (x < 2.8))  # noqa: E731
+        grid = np.linspace(0.0, theta_max_deg, 2001)
+        s = np.concatenate([[0.0], np.cumsum(w(grid[1:]) * np.diff(grid))])
+        half = np.interp(np.linspace(0.0, s[-1], n // 2 + 1), s, grid)
+        th = np.concatenate([half, half[-2::-1]])[:n] if n % 2 else np.concatenate([half, half[-2:0:-1]])
+        th = th[:n]
+    else:
+        raise ModelError(f"unknown path kind {kind!r}; use cycle, partial or release")
+    out = {"theta_deg": th}
+    if offaxis_mm:
+        f = (th / max(theta_max_deg, 1e-12)) ** 2
+        out["ux_m"] = 1e-3 * offaxis_mm * np.sin(0.7 + seed) * f
+        out["uy_m"] = 1e-3 * offaxis_mm * np.cos(0.7 + seed) * f
+    return out
+
+
+def bay_torsion_data(params=None, effects=None, path=None, noise_Nm: float = 0.2, drift_Nm: float = 0.0,
+                     seed: int = 0, experiment=None) -> tuple:
+    """Synthetic single-bay torsion data: the FE bay (the experiment's own model) with hidden
+    ``effects`` along ``path`` (:func:`bay_torsion_path`), plus Gaussian noise ``noise_Nm`` on Mz.
+
+    params : baseline ``{latch_k, latch_mu}`` (default the seed's pull-test fit).
+    drift_Nm : amplitude of a slow drift of the load cell (N m) that no effect models.
+    Returns ``(data, truth)`` with ``truth`` the noise-free ``{Mz_Nm}``."""
+    from .registry import get_experiment
+
+    exp = experiment or get_experiment("bay-torsion")
+    path = dict(path or bay_torsion_path(seed=seed))
+    n = len(path["theta_deg"])
+    data = Measured(exp.name, {**path, "Mz_Nm": np.zeros(n)})
+    truth = predict(exp, data, params or {}, effects or {})
+    if drift_Nm:
+        truth = {"Mz_Nm": truth["Mz_Nm"] + drift_Nm * np.sin(0.5 * np.pi * data.tau)}
+    rng = np.random.default_rng(seed + 3000)
+    return Measured(exp.name, {**path, "Mz_Nm": truth["Mz_Nm"] + rng.normal(0.0, noise_Nm, n)}), truth
+
+
+# --------------------------------------------------------------------------- tip-cycle (FE)
+def tip_cycle_path(points_per_ramp: int = 3, cycles: int = 2, M_Nm: float = 6.8, F_N: float = 14.0,
+                   kind: str = "table1", seed: int = 0) -> dict:
+    """Tip load paths ``{fx_N, ..., mz_Nm}``: the sequence 0, +P, 0, -P, 0 ... with ``P`` = M about z and
+    F along x (seed 001 Table 1), ``cycles`` times, each ramp sampled at ``points_per_ramp`` rows.
+
+    kind : ``"table1"`` (every peak at full load), ``"varying"`` (peaks of 55-100 % of P, different
+        from cycle to cycle, and a partial unloading to 30-50 % in each cycle: reversals away from
+        zero), ``"shear"`` (F along a direction turning by 40 degrees per cycle, M at 30 %).
+    """
+    rng = np.random.default_rng(seed)
+    knots = [np.zeros(6)]
+    for c in range(cycles):
+        for sign in (1.0, -1.0):
+            if kind == "table1":
+                a, part = 1.0, None
+            elif kind == "varying":
+                a, part = rng.uniform(0.55, 1.0), rng.uniform(0.3, 0.5)
+            elif kind == "shear":
+                a, part = 1.0, None
+            else:
+                raise ModelError(f"unknown path kind {kind!r}; use table1, varying or shear")
+            ang = np.radians(40.0 * c) if kind == "shear" else 0.0
+            m = (0.3 if kind == "shear" else 1.0) * M_Nm
+            peak = sign * a * np.array([F_N * np.cos(ang), F_N * np.sin(ang), 0.0, 0.0, 0.0, m])
+            knots.append(peak)
+            if part is not None:
+                knots.append(part * peak)
+                knots.append(peak * rng.uniform(0.8, 1.0))
+            knots.append(np.zeros(6))
+    rows = [knots[0]]
+    for a, b in zip(knots[:-1], knots[1:]):
+        for k in range(1, points_per_ramp + 1):
+            rows.append(a + (b - a) * k / points_per_ramp)
+    w = np.array(rows)
+    return dict(zip(("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"), w.T))
+
+
+def tip_cycle_data(params=None, effects=None, path=None, noise_m: float = 2e-6, noise_rad: float = 5e-6,
+                   drift_m: float = 0.0, seed: int = 0, experiment=None) -> tuple:
+    """Synthetic tip-cycle data: the FE mast (the experiment's own model, its ``n_bays`` option) with
+    hidden ``effects`` along the load ``path`` (:func:`tip_cycle_path`), plus Gaussian noise
+    (``noise_m`` on displacements, ``noise_rad`` on rotations).
+
+    params : baseline ``{cable_EA, longeron_t}``.  drift_m : a slow drift of the tip along x and y
+    (m) that no effect models.  Returns ``(data, truth)`` with the noise-free channels."""
+    from .registry import get_experiment
+
+    exp = experiment or get_experiment("tip-cycle")
+    path = dict(path or tip_cycle_path(seed=seed))
+    n = len(path["fx_N"])
+    data = Measured(exp.name, {**path, **{c: np.zeros(n) for c in exp.channels}})
+    truth = predict(exp, data, params or {}, effects or {})
+    if drift_m:
+        tau = data.tau
+        truth = {**truth, "ux_m": truth["ux_m"] + drift_m * np.sin(0.5 * np.pi * tau),
+                 "uy_m": truth["uy_m"] + 0.6 * drift_m * (1.0 - np.cos(np.pi * tau))}
+    rng = np.random.default_rng(seed + 4000)
+    noisy = {c: truth[c] + rng.normal(0.0, noise_rad if c.endswith("_rad") else noise_m, n) for c in exp.channels}
+    return Measured(exp.name, {**path, **noisy}), truth

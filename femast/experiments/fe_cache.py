@@ -1,0 +1,149 @@
+"""Cache of the forward solves of the FE experiments (``bay-torsion``, ``tip-cycle``).
+
+A finite-element run along a measured path takes about a second for a single bay and several for
+a mast, and a fit asks for the same run more than once: the final prediction repeats the last
+accepted evaluation, the noise re-estimation of :func:`~femast.experiments.fitting.fit` restarts
+from the solution, ``compare`` then asks for the latch zones of the fitted model, and a second
+``compare`` or ``diagnose`` on the same data repeats the baseline fit.  :func:`cached` keys every
+run by a SHA-1 of everything that defines it (the model inputs and the drive path, bit for bit)
+and keeps
+
+* the last ``MEMORY_ENTRIES`` runs of this process in memory (always), and
+* every run as a small pickle in a folder, shared between processes and sessions, when the
+  experiment option ``cache_dir`` or the environment variable ``FEMAST_FE_CACHE`` names one
+  (worker processes of ``diagnose`` then reuse each other's runs, and a repeated command is
+  nearly free).
+
+A cached run is returned as a fresh copy, so callers may modify it.  ``STATS`` counts hits and
+misses (``stats()``; ``clear()`` empties the memory cache and resets the counts).
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import os
+import pickle
+from collections import OrderedDict
+from pathlib import Path
+
+import numpy as np
+
+MEMORY_ENTRIES = 256
+ENV = "FEMAST_FE_CACHE"
+_MEM: OrderedDict = OrderedDict()
+STATS = {"hits": 0, "disk_hits": 0, "misses": 0}
+
+
+def _feed(h, obj) -> None:
+    if isinstance(obj, np.ndarray):
+        a = np.ascontiguousarray(obj)
+        h.update(f"nd{a.dtype.str}{a.shape}".encode())
+        h.update(a.tobytes())
+    elif isinstance(obj, dict):
+        h.update(b"{")
+        for k in sorted(obj, key=str):
+            h.update(repr(k).encode())
+            _feed(h, obj[k])
+        h.update(b"}")
+    elif isinstance(obj, (list, tuple)):
+        h.update(b"(")
+        for v in obj:
+            _feed(h, v)
+        h.update(b")")
+    elif isinstance(obj, float):
+        h.update(float(obj).hex().encode())  # bit for bit
+    else:
+        h.update(repr(obj).encode())
+
+
+def key_of(*parts) -> str:
+    """SHA-1 hex digest of nested tuples/dicts of numbers, strings and arrays (floats bit for bit)."""
+    h = hashlib.sha1()
+    for p in parts:
+        _feed(h, p)
+    return h.hexdigest()
+
+
+def cache_dir(options: dict | None = None) -> Path | None:
+    """The disk cache folder: option ``cache_dir``, else ``$FEMAST_FE_CACHE``, else None (memory only)."""
+    d = (options or {}).get("cache_dir") or os.environ.get(ENV)
+    return Path(d) if d else None
+
+
+def cached(kind: str, key_parts, compute, options: dict | None = None):
+    """``compute()`` once per distinct ``key_parts`` (see the module docstring); returns a copy."""
+    key = f"{kind}-{key_of(kind, key_parts)}"
+    if key in _MEM:
+        _MEM.move_to_end(key)
+        STATS["hits"] += 1
+        return copy.deepcopy(_MEM[key])
+    folder = cache_dir(options)
+    path = folder / f"{key}.pkl" if folder else None
+    if path is not None and path.is_file():
+        try:
+            with open(path, "rb") as fh:
+                value = pickle.load(fh)
+            STATS["disk_hits"] += 1
+            _remember(key, value)
+            return copy.deepcopy(value)
+        except Exception:  # a truncated file from a killed process: recompute it
+            pass
+    STATS["misses"] += 1
+    value = compute()
+    _remember(key, value)
+    if path is not None:
+        folder.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        with open(tmp, "wb") as fh:
+            pickle.dump(value, fh, protocol=pickle.HIGHEST_PROTOCOL)
+        os.replace(tmp, path)  # atomic: concurrent workers never read half a file
+    return copy.deepcopy(value)
+
+
+def _remember(key, value) -> None:
+    _MEM[key] = value
+    _MEM.move_to_end(key)
+    while len(_MEM) > MEMORY_ENTRIES:
+        _MEM.popitem(last=False)
+
+
+def stats() -> dict:
+    """Counts of memory hits, disk hits and misses (computed runs) in this process."""
+    return dict(STATS)
+
+
+def clear() -> None:
+    """Empty the memory cache and reset the counts (the disk folder is left alone)."""
+    _MEM.clear()
+    for k in STATS:
+        STATS[k] = 0
+
+
+class kernel_threads:
+    """Context manager running numba's parallel kernels (the ball joints) on ``n`` threads, then
+    restoring the previous count.  The FE experiments run on one: the bay's and a short mast's
+    kernels have a few dozen joints, too few to share, and on a busy machine (or with the refits of
+    ``diagnose`` already using every core) thread synchronisation made a single-bay run 3x slower."""
+
+    def __init__(self, n: int | None = 1):
+        self.n = n
+        self.old = None
+
+    def __enter__(self):
+        if self.n:
+            try:
+                import numba
+
+                self.old = numba.get_num_threads()
+                numba.set_num_threads(max(1, min(int(self.n), numba.config.NUMBA_NUM_THREADS)))
+            except Exception:  # numba without threading support: nothing to do
+                self.old = None
+        return self
+
+    def __exit__(self, *exc):
+        if self.old is not None:
+            import numba
+
+            numba.set_num_threads(self.old)
+        return False
