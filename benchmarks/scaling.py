@@ -247,8 +247,8 @@ def main(argv=None):
     print(f"femast scaling, truss mast of beam-columns, {args.increments} load increments; medians of "
           f"{args.repeat} runs (isolated timings: {args.reps} calls); noisy shared 2-core machine")
     print(f"{'bays':>5} {'DOFs':>6} {'iter':>4} {'wall s':>7} {'ms/inc':>7} {'x40':>5} {'N/40':>5} {'ms/iter':>7} "
-          f"{'asm ms':>6} {'LU ms':>6} {'fLU ms':>6} {'scipy':>6} {'it/LU':>5} {'it/sp':>5} {'order':>5} "
-          f"{'RSS MB':>7} {'+MB':>6}")
+          f"{'asm ms':>6} {'LU ms':>6} {'fLU ms':>6} {'scipy':>6} {'it/LU':>5} {'it/sp':>5} {'runLU':>6} {'it/rLU':>6} "
+          f"{'order':>5} {'RSS MB':>7} {'+MB':>6}")
     base = rows[0]
     ok_lin = True
     worst = 0.0
@@ -266,13 +266,15 @@ def main(argv=None):
         print(f"{r['bays']:5d} {r['dofs']:6d} {r['iterations']:4d} {r['wall']:7.3f} {1e3 * t_inc:7.1f} {growth:5.1f} "
               f"{lin:5.1f} {1e3 * t_it:7.2f} {1e3 * r['t_assembly']:6.2f} {1e3 * r['t_bare']:6.2f} "
               f"{1e3 * r['t_femast_lu']:6.2f} {1e3 * r['t_scipy_default']:6.2f} {ratio:5.2f} {ratio_scipy:5.2f} "
+              f"{1e3 * r['solve_in_run'] / r['iterations']:6.2f} {r['wall'] / r['solve_in_run']:6.2f} "
               f"{r['ordering']:>5} "
               f"{r['rss_mb']:7.0f} {r['rss_growth_mb']:6.0f}")
     print("columns: ms/inc, ms/iter: wall time of the run (build excluded) per increment / Newton iteration; x40: "
           "time per increment over the first size's; N/40: bays ratio (linear growth); asm: one assembly; LU: bare "
           "SuperLU factorise + solve with femast's ordering; fLU: femast SparseLU (adds gather + zero-pivot check); "
-          "scipy: scipy's default splu; it/LU, it/sp: ms/iter over LU, over scipy; RSS: peak resident memory of "
-          "the process; "
+          "scipy: scipy's default splu; it/LU, it/sp: ms/iter over LU, over scipy; runLU: femast's factorise + "
+          "solve per iteration inside the run (caches shared with the rest), it/rLU: ms/iter over it; RSS: peak "
+          "resident memory of the process; "
           "+MB: growth over the 2-bay warm-up")
     print(f"time per iteration / (factorisation + solve), worst over the sizes: {worst:.2f} against bare SuperLU "
           f"with femast's ordering ({'met' if worst <= 1.5 else 'NOT MET'}), {worst_scipy:.2f} against scipy's default "
