@@ -33,7 +33,7 @@ from scipy.optimize import brentq
 
 import femast as fm
 from femast.adam import build_bay, build_mast
-from femast.adam.post import ARCSEC, bay_curve, tip_table
+from femast.adam.post import bay_curve, tip_table
 from femast.adam.steps import CONVERGENCE, add_idealised_torsion, add_initial_steps, add_table1_steps
 
 ROOT = Path(__file__).resolve().parents[1]

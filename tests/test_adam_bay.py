@@ -35,11 +35,12 @@ def test_eq1_closed_form_and_inverse():
 def test_stowing_with_stiff_members_follows_eq1(tmp_path):
     """Top frame turned to 50 degrees (stowed angle 57.9) under a 100 N compression: the bay height
     follows h^2 = b^2 cos(theta) - (b^2 - l^2) to 1e-6 l."""
-    am = build_bay(cables=False, longeron_E=120e12, batten_E=120e12)   # members 1000 x stiffer
+    # members 1000 x stiffer; frictionless joints (kinematics only: friction makes it 10 x slower)
+    am = build_bay(cables=False, longeron_E=120e12, batten_E=120e12, mu=0.0)
     p = am.params
     m = am.model
     m.step("press").load(am.control, fz=-100.0).prescribe(am.control, ux=0.0, uy=0.0, rz=0.0)
-    m.step("stow", initial_increment=0.05, max_increment=0.05).prescribe(am.control, rz=math.radians(50.0))
+    m.step("stow", initial_increment=0.1, max_increment=0.1).prescribe(am.control, rz=math.radians(50.0))
     res = fm.solve(m, tmp_path, progress=False)
     th = res.node_history(am.control, "rz")
     h = p.l + res.node_history(am.control, "uz")

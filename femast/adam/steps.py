@@ -10,7 +10,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..amplitudes import Amplitude
 from ..errors import ModelError
 from ..solvers.convergence import Convergence
 from ..solvers.stabilize import Stabilize
