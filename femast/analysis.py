@@ -196,6 +196,8 @@ class Analysis:
         self.summary = AnalysisSummary()
         self.strain_energy = 0.0
         self._stab_energy = 0.0
+        self._stab_force = (0.0, 0.0)
+        self._at_equilibrium = True
         self._zero_force = None
 
     # ------------------------------------------------------------ helpers
@@ -239,9 +241,10 @@ class Analysis:
             K, Kfc = Kind[:nf, :nf], (Kind[:nf, nf:] if with_fc else None)
         if self._zero_force is None:
             dk = np.abs(K.diagonal())
-            kt = float(dk[~self.is_rot].max(initial=0.0))
-            kr = float(dk[self.is_rot].max(initial=0.0))
-            # 'zero flux' floors: forces of a 1e-6 L (1e-6 rad) motion of the stiffest DOF
+            kt, kr = (float(np.median(v[v > 0])) if np.any(v > 0) else 0.0
+                      for v in (dk[~self.is_rot], dk[self.is_rot]))
+            # 'zero flux' floors: forces of a 1e-6 L (1e-6 rad) motion of a typical DOF (the median
+            # stiffness, so that penalty ties do not inflate it)
             self._zero_force = 1e-6 * max(kt * self.length, kr / self.length)
         return K, Kfc
 
@@ -402,7 +405,8 @@ class Analysis:
             self._write(writer, step.name, inc, t, iters, responses, period=period)
             note = ""
             if step.stabilize is not None:
-                note = f"stabilisation/strain energy {self.stabilization_ratio:.3g}"
+                note = (f"stabilisation/strain energy {self.stabilization_ratio:.3g}, largest viscous force "
+                        f"{self._stab_force[0]:.3g} N, moment {self._stab_force[1]:.3g} N m")
             writer.status(step.name, inc, attempt, iters, t, self.total_time, dt, self.lam, note)
             bar.update(dt)
             easy = easy + 1 if iters <= self.easy_iterations else 0
@@ -413,6 +417,8 @@ class Analysis:
         if step.stabilize is not None:
             info["stabilization_energy"] = self._stab_energy
             info["stabilization_ratio"] = self.stabilization_ratio
+            # viscous forces left in the last increment: how far from equilibrium the end state is
+            info["stabilization_force"], info["stabilization_moment"] = self._stab_force
             if self.stabilization_ratio > step.stabilize.warn_ratio:
                 msg = (f"step '{step.name}': stabilisation energy is {100 * self.stabilization_ratio:.1f}% of the strain "
                        f"energy (above {100 * step.stabilize.warn_ratio:.0f}%): the stabilised solution may be "
@@ -488,24 +494,26 @@ class Analysis:
                         self._stab_C0 = self._stab_C.copy()
                     K = (K + sp.diags(self._stab_C / dt)).tocsr()
                 self.summary.assembly_time += _time.perf_counter() - ta
-                if it == 0 and not uses_lam and not np.any(dpres) and not np.any(Du):
-                    # nothing to do: the start of the increment is already in equilibrium
-                    # (e.g. a step that repeats the previous loads)
-                    ok, _ = self._converged(r, None, Du, responses, P)
-                    if ok:
-                        self._commit(responses, P, F, lam)
-                        return True, 0, "", responses
+                if (it == 0 and not uses_lam and not np.any(dpres) and not np.any(Du) and stab is None
+                        and self._at_equilibrium and np.array_equal(P, self.loads)):
+                    # nothing changes (e.g. a step that repeats the previous loads): the committed
+                    # state is the converged solution
+                    self._commit(responses, P, F, lam)
+                    return True, 0, "", responses
                 if it > 0:
                     ok, ratio = self._converged(r, du, Du, responses, P)
                     rnorm_hist.append(ratio)
                     if ok:
                         if stab is not None:
                             self._stab_energy += float(Du @ (self._stab_C / dt * Du))
+                            fv = np.abs(self._stab_C / dt * Du)
+                            self._stab_force = (float(fv[~self.is_rot].max(initial=0.0)),
+                                                float(fv[self.is_rot].max(initial=0.0)))
                             strain = sum(float(np.sum(q.energy)) for q in responses if q.energy is not None)
                             ratio = self._stab_energy / max(strain, 1e-300)
                             self._stab_C = stab.adapt(self._stab_C, self._stab_C0, ratio)
                         self._last_Du, self._last_dt, self._last_Dlam = Du.copy(), dt, lam - lam_start
-                        self._commit(responses, P, F, lam)
+                        self._commit(responses, P, F, lam, equilibrium=stab is None)
                         return True, iters, "", responses
                     if it == self.convergence.max_iterations:
                         return self._fail(saved, iters, f"no convergence in {iters} iterations "
@@ -717,7 +725,8 @@ class Analysis:
         self.x, self.R, self.spin, self.lam = saved[0], saved[1], saved[2], saved[3]
         return False, iters, why, None
 
-    def _commit(self, responses, P, res, lam):
+    def _commit(self, responses, P, res, lam, equilibrium=True):
+        self._at_equilibrium = equilibrium   # False after a stabilised increment (viscous forces)
         self.states = [r.state.copy() if r.state is not None else s for r, s in zip(responses, self.states)]
         self.loads = P.copy()
         self.prescribed[self.cons_node, self.cons_dof] = [self.dof_value(n, d) for n, d in

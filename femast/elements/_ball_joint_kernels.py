@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from ..rotations import logm_so3, skew, ts_inv
 
@@ -151,10 +151,10 @@ def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out
     return 0.5 * Fn * Fn / k_pen + 0.5 * mm / k_s, err
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def ball_joint_family_kernel(nodes, x, R, d0, k_pen, k_s, mu, B, state, f, K, new, out, energy, err):
     """All joints of a family at once (see :func:`ball_joint_element`)."""
-    for e in prange(nodes.shape[0]):
+    for e in range(nodes.shape[0]):
         a = nodes[e, 0]
         b = nodes[e, 1]
         en, code = ball_joint_element(x[a], x[b], R[a], R[b], d0[e], k_pen[e], k_s[e], mu[e], B[e],

@@ -4,9 +4,9 @@ Viscous forces proportional to the nodal pseudo-velocities are added to the resi
 
     f_v = C Du / dt,    C = c D,
 
-with Du the increment of the free DOFs, dt the increment of step time, D the diagonal of the
-tangent stiffness at the start of the step (a DOF with no stiffness, the mechanism the
-stabilisation is for, gets the mean of its field) and c (s, pseudo-time) the damping factor.
+with Du the increment of the free DOFs, dt the increment of step time, D the median diagonal
+stiffness of the DOF's field (translations, rotations) in the tangent at the start of the step
+(one value per field, like a uniform mass) and c (s, pseudo-time) the damping factor.
 
 Given a dissipated-energy fraction f (Abaqus' default 2e-4) rather than c directly, femast sets
 c = f dt_0 / 2 with dt_0 the step's initial increment: for a DOF that moves elastically,
@@ -48,16 +48,18 @@ class Stabilize:
             raise ModelError(f"Stabilize: energy_fraction = {self.energy_fraction} must be positive")
 
     def damping(self, K_diag, is_rot, dt0):
-        """The diagonal C (per free DOF) from the start-of-step tangent diagonal."""
-        D = np.abs(np.asarray(K_diag, dtype=float)).copy()
+        """The diagonal C (per free DOF): c times the median stiffness of the DOF's field
+        (translations or rotations) of the start-of-step tangent.  One value per field, like a
+        uniform mass: penalty ties and stiff members do not make their DOFs stickier, and the
+        mechanism DOFs (zero stiffness), which the damping is for, get the typical value."""
+        d = np.abs(np.asarray(K_diag, dtype=float))
+        D = np.empty_like(d)
         for field in (~is_rot, is_rot):
             if not field.any():
                 continue
-            vals = D[field]
+            vals = d[field]
             pos = vals[vals > 1e-12 * vals.max(initial=0.0)]
-            fill = pos.mean() if pos.size else 1.0
-            vals[vals <= 1e-12 * vals.max(initial=0.0)] = fill
-            D[field] = vals
+            D[field] = np.median(pos) if pos.size else 1.0
         c = self.factor if self.factor is not None else 0.5 * self.energy_fraction * dt0
         return c * D
 
