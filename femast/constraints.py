@@ -93,12 +93,60 @@ class Constraints:
         return bool(self.dependent.any())
 
     def setup(self, dofmap, X0):
+        """Fix the sparsity of T once; each iteration only refills the lever-arm values."""
         self.eq = dofmap.eq
         self.n_ind = dofmap.n_free + dofmap.n_constrained
         self.n_active = dofmap.n_active
         s, r = self.rigid_slave[:, 0], self.rigid_slave[:, 1]
         self.X_rel = X0[s] - X0[r]
         self.X0 = X0
+        eq = self.eq
+        if len(s) and np.any(eq[r][:, 3:] < 0):
+            raise ModelError("a rigid-body reference node has no rotational DOFs")
+        rows, cols, vals = [], [], []
+        flat = eq.ravel()
+        ind = flat[(flat >= 0) & (flat < self.n_ind)]
+        rows.append(ind), cols.append(ind), vals.append(np.ones(ind.size))
+        # rigid slaves: dx_s = dx_r - [d]x dw_r, dw_s = dw_r
+        for i in range(6):
+            es = eq[s, i]
+            ok = es >= 0
+            rows.append(es[ok]), cols.append(eq[r[ok], i]), vals.append(np.ones(ok.sum()))
+        lever_rows, lever_cols, lever_k, lever_c, lever_sign = [], [], [], [], []
+        # -[d]x entries (i, j): (0,1) d2, (0,2) -d1, (1,0) -d2, (1,2) d0, (2,0) d1, (2,1) -d0
+        for i, j, c, sign in ((0, 1, 2, 1.0), (0, 2, 1, -1.0), (1, 0, 2, -1.0), (1, 2, 0, 1.0),
+                              (2, 0, 1, 1.0), (2, 1, 0, -1.0)):
+            es = eq[s, i]
+            ok = np.flatnonzero(es >= 0)
+            lever_rows.append(es[ok]), lever_cols.append(eq[r[ok], 3 + j])
+            lever_k.append(ok), lever_c.append(np.full(ok.size, c)), lever_sign.append(np.full(ok.size, sign))
+        for sl, m, d in self.tie:
+            es, em = eq[sl, d], eq[m, d]
+            if es >= 0:
+                if em < 0:
+                    raise ModelError(f"tie: master node {m} has no active DOF {d} to tie to")
+                rows.append([es]), cols.append([em]), vals.append([1.0])
+        fixed_rows = np.concatenate(rows).astype(np.int64)
+        fixed_cols = np.concatenate(cols).astype(np.int64)
+        self._fixed_vals = np.concatenate(vals)
+        self._lever_k = np.concatenate(lever_k).astype(np.int64) if lever_k else np.zeros(0, np.int64)
+        self._lever_c = np.concatenate(lever_c).astype(np.int64) if lever_c else np.zeros(0, np.int64)
+        self._lever_sign = np.concatenate(lever_sign) if lever_sign else np.zeros(0)
+        all_rows = np.concatenate([fixed_rows] + lever_rows)
+        all_cols = np.concatenate([fixed_cols] + lever_cols)
+        n_entries = all_rows.size
+        T = sp.coo_matrix((np.arange(1, n_entries + 1, dtype=float), (all_rows, all_cols)),
+                          shape=(self.n_active, self.n_ind)).tocsr()
+        self._T = T
+        self._T_pos = np.empty(n_entries, dtype=np.int64)
+        self._T_pos[T.data.astype(np.int64) - 1] = np.arange(T.nnz)   # entry -> position in T.data
+        self._n_fixed = fixed_rows.size
+        # geometric term: 9 entries per rigid slave on its reference's rotation block
+        if len(s):
+            er = eq[r][:, 3:6]
+            self._G_rows = np.repeat(er, 3, axis=1).ravel()
+            self._G_cols = np.tile(er, (1, 3)).ravel()
+            self._slave_trans_eq = eq[s][:, :3]
 
     def update_slaves(self, x, R, spin):
         """Put every dependent node where its constraint says (exact for any rotation)."""
@@ -123,51 +171,24 @@ class Constraints:
 
     def transformation(self, x):
         """T (n_active x n_ind): variations of all active DOFs from the independent ones."""
-        rows, cols, vals = [], [], []
-        eq = self.eq
-        ind = np.flatnonzero((eq.ravel() >= 0) & (eq.ravel() < self.n_ind))
-        e = eq.ravel()[ind]
-        rows.append(e), cols.append(e), vals.append(np.ones(e.size))
-        for s, r in self.rigid_slave:
+        vals = np.empty(self._T_pos.size)
+        vals[: self._n_fixed] = self._fixed_vals
+        if self._lever_k.size:
+            s, r = self.rigid_slave[:, 0], self.rigid_slave[:, 1]
             d = x[s] - x[r]
-            Sd = _skew(d)
-            for i in range(6):
-                es = eq[s, i]
-                if es < 0:
-                    continue
-                if i < 3:
-                    rows.append([es]), cols.append([eq[r, i]]), vals.append([1.0])
-                    for j in range(3):
-                        if Sd[i, j] != 0.0:
-                            er = eq[r, 3 + j]
-                            if er < 0:
-                                raise ModelError("rigid body reference node has no rotational DOFs")
-                            rows.append([es]), cols.append([er]), vals.append([-Sd[i, j]])
-                else:
-                    rows.append([es]), cols.append([eq[r, i]]), vals.append([1.0])
-        for s, m, d in self.tie:
-            es, em = eq[s, d], eq[m, d]
-            if es >= 0:
-                if em < 0:
-                    raise ModelError(f"tie: the master node has no active DOF {d} to tie to")
-                rows.append([es]), cols.append([em]), vals.append([1.0])
-        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                             shape=(self.n_active, self.n_ind))
+            vals[self._n_fixed:] = self._lever_sign * d[self._lever_k, self._lever_c]
+        self._T.data[self._T_pos] = vals
+        return self._T
 
     def geometric(self, x, f_net):
-        """G (n_ind x n_ind): derivative of the lever arms, sum_s [f_s]x [d_s]x on reference rotations."""
+        """G (n_ind x n_ind): derivative of the lever arms, sum_s [f_s]x [d_s]x = d f^T - (f.d) I
+        on the reference rotation block."""
         n = self.n_ind
         if not len(self.rigid_slave):
             return sp.csr_matrix((n, n))
-        blocks = {}
-        for s, r in self.rigid_slave:
-            fs = np.array([f_net[self.eq[s, i]] if self.eq[s, i] >= 0 else 0.0 for i in range(3)])
-            d = x[s] - x[r]
-            blocks[r] = blocks.get(r, 0.0) + _skew(fs) @ _skew(d)
-        rows, cols, vals = [], [], []
-        for r, B in blocks.items():
-            er = self.eq[r, 3:6]
-            for i in range(3):
-                for j in range(3):
-                    rows.append(er[i]), cols.append(er[j]), vals.append(B[i, j])
-        return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+        s, r = self.rigid_slave[:, 0], self.rigid_slave[:, 1]
+        d = x[s] - x[r]
+        eqs = self._slave_trans_eq
+        f = np.where(eqs >= 0, f_net[np.maximum(eqs, 0)], 0.0)
+        B = d[:, :, None] * f[:, None, :] - np.einsum("ki,ki->k", f, d)[:, None, None] * np.eye(3)
+        return sp.csr_matrix((B.ravel(), (self._G_rows, self._G_cols)), shape=(n, n))
