@@ -197,7 +197,7 @@ class Analysis:
         self.strain_energy = 0.0
         self._stab_energy = 0.0
         self._stab_force = (0.0, 0.0)
-        self._at_equilibrium = True
+        self._at_equilibrium = False   # the initial state may hold unbalanced pretension
         self._zero_force = None
 
     # ------------------------------------------------------------ helpers
