@@ -486,14 +486,6 @@ class Analysis:
             P = loads_now(lam)
             responses, F, r = evaluate(P)
             for it in range(self.convergence.max_iterations + 1):
-                ta = _time.perf_counter()
-                K, Kfc = self._tangent(responses, with_fc=(it == 0 and np.any(dpres)))
-                if stab is not None:
-                    if self._stab_C is None:  # damping from the tangent at the start of the step
-                        self._stab_C = stab.damping(K.diagonal(), self.is_rot, self._stab_dt0)
-                        self._stab_C0 = self._stab_C.copy()
-                    K = (K + sp.diags(self._stab_C / dt)).tocsr()
-                self.summary.assembly_time += _time.perf_counter() - ta
                 if (it == 0 and not uses_lam and not np.any(dpres) and not np.any(Du) and stab is None
                         and self._at_equilibrium and np.array_equal(P, self.loads)):
                     # nothing changes (e.g. a step that repeats the previous loads): the committed
@@ -521,6 +513,15 @@ class Analysis:
                     if it >= 8 and rnorm_hist[-1] > rnorm_hist[-2] > rnorm_hist[-3] > rnorm_hist[-4]:
                         return self._fail(saved, iters, f"residual diverging (ratio {ratio:.3g}, worst at "
                                           f"{self._worst(r)})")
+                # the tangent only when another iteration is needed
+                ta = _time.perf_counter()
+                K, Kfc = self._tangent(responses, with_fc=(it == 0 and np.any(dpres)))
+                if stab is not None:
+                    if self._stab_C is None:  # damping from the tangent at the start of the step
+                        self._stab_C = stab.damping(K.diagonal(), self.is_rot, self._stab_dt0)
+                        self._stab_C0 = self._stab_C.copy()
+                    K = (K + sp.diags(self._stab_C / dt)).tocsr()
+                self.summary.assembly_time += _time.perf_counter() - ta
                 ts = _time.perf_counter()
                 try:
                     self.solver.factorize(K)
