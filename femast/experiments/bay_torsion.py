@@ -173,12 +173,22 @@ def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None 
     t0 = time.perf_counter()
     am = build_bay(bay_parameters(inputs), fold=int(fold))
     add_initial_steps(am, hold_control=("ux", "uy", "rz"))
+    drive = np.asarray(drive, float)
     m = len(drive)
-    t = np.arange(m + 1, dtype=float)
-    tab = np.vstack([np.zeros((1, 3)), np.asarray(drive, float)])
-    step = am.model.step("path", period=float(m), initial_increment=1.0, max_increment=1.0, min_increment=1e-5,
-                         max_increments=100 * m + 100)
-    step.follow(am.control, t, rz=tab[:, 0], ux=tab[:, 1], uy=tab[:, 2])
+    # table of distinct states: the pretensioned state (t = 0) unless the first row is it, then every
+    # row that differs from the one before (a repeated row repeats its state: no zero-change increment)
+    state = np.empty(m, dtype=int)
+    tab = [np.zeros(3)]
+    for k in range(m):
+        if not np.array_equal(drive[k], tab[-1]):
+            tab.append(drive[k])
+        state[k] = len(tab) - 1
+    tab = np.array(tab)
+    t = np.arange(len(tab), dtype=float)
+    if len(tab) > 1:
+        step = am.model.step("path", period=float(t[-1]), initial_increment=1.0, max_increment=1.0,
+                             min_increment=1e-5, max_increments=100 * len(tab) + 100)
+        step.follow(am.control, t, rz=tab[:, 0], ux=tab[:, 1], uy=tab[:, 2])
     fam = am.latch_family
     with tempfile.TemporaryDirectory(prefix="femast_bay_") as d:
         an = Analysis(am.model, d, progress=False, convergence=CONVERGENCE)
@@ -188,12 +198,13 @@ def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None 
         steps = res.steps
         tt = res.time
         i_eq = max(i for i, s in enumerate(steps) if s != "path")  # end of the initial (pretension) step(s)
+        frame_of = [i_eq] + [max(i for i in range(i_eq + 1, len(res)) if abs(tt[i] - tt[i_eq] - j) < 1e-7)
+                             for j in range(1, len(tab))]
         out = {k: np.empty(m) for k in ("Mz", "uz")}
         out.update({k: np.empty((m, 4)) for k in ("bead", "dT")})
         out["zone"] = np.empty((m, 4), dtype=int)
         for k in range(m):
-            cand = [i for i in range(i_eq + 1, len(res)) if abs(tt[i] - tt[i_eq] - (k + 1)) < 1e-7]
-            fr = res.frame(cand[-1])
+            fr = res.frame(frame_of[state[k]])
             out["Mz"][k] = -(fr["P"][row, 5] + fr["RF"][row, 5])
             out["uz"][k] = fr["U"][row, 2]
             out["bead"][k] = fr[f"el/{fam}/bead_position"]

@@ -171,9 +171,10 @@ class Experiment:
     fit_options : settings of :func:`scipy.optimize.least_squares` for this model, overriding the
         defaults of :func:`~femast.experiments.fitting.fit` (``xtol = ftol = gtol = 1e-10``, 2-point
         differences with scipy's default step, ``max_nfev = 100 (p + 1)``).  An expensive model
-        (the FE experiments: about a second per evaluation) sets looser tolerances, a finite
-        difference step (``diff_step``, relative to the scaled parameters) larger than the
-        convergence noise of its solver and a lower ``max_nfev_per_param`` (``max_nfev = that x
+        (the FE experiments: about a second per evaluation) sets looser tolerances, a forward
+        difference step ``diff_step`` (``step x max(1, |u|)`` in the parameters scaled by their
+        ``typical`` size, never smaller, so also at an effect's zero default) larger than the
+        convergence noise of its solver, and a lower ``max_nfev_per_param`` (``max_nfev = that x
         (p + 1)``).
     source : where it came from (a built-in name or a script path), set by the registry.
     """

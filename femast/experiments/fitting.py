@@ -183,6 +183,41 @@ def _covariance(J, cost, n, scale):
     return stderr, cov, note
 
 
+def _forward_differences(fun, step: float, lo, hi):
+    """(fun, jac) for least_squares with forward differences of ``step x max(1, |u_i|)`` in the scaled
+    parameters u (the ``diff_step`` of ``Experiment.fit_options``).
+
+    scipy's own ``diff_step`` is relative to ``|u_i|`` and falls back to 1.5e-8 at ``u_i = 0``, the
+    start of an effect whose default is "absent" (a pretension error dT0 = 0): an FE model resolves
+    that step no better than its Newton tolerance, and the derivative comes out with the wrong sign.
+    Here the step never drops below ``step``; it is taken backwards where it would leave the upper
+    bound.  The value at the point itself is reused from the last call of ``fun`` (scipy evaluates
+    it just before asking for the Jacobian)."""
+    last = {}
+
+    def f(u):
+        key = np.asarray(u, float).tobytes()
+        if key not in last:
+            last.clear()
+            last[key] = fun(u)
+        return last[key]
+
+    def jac(u, *args):
+        u = np.asarray(u, float)
+        f0 = f(u)
+        J = np.empty((f0.size, u.size))
+        for i in range(u.size):
+            h = step * max(1.0, abs(u[i]))
+            if u[i] + h > hi[i]:
+                h = -h
+            up = u.copy()
+            up[i] += h
+            J[:, i] = (fun(up) - f0) / h
+        return J
+
+    return f, jac
+
+
 def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, multistart: bool = True,
         max_nfev: int | None = None) -> OptimizeResult:
     """Fit the baseline parameters and those of the switched-on ``effects`` to the data.
@@ -245,6 +280,7 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
             starts.append(x)
     fo = dict(exp.fit_options)
     per_param = int(fo.pop("max_nfev_per_param", 100))
+    fd_step = fo.pop("diff_step", None)
     kw = dict(method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10, x_scale=1.0)
     kw.update(fo)
     kw["max_nfev"] = max_nfev or kw.get("max_nfev") or per_param * (len(specs) + 1)
@@ -252,6 +288,8 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     def solve(sigma, candidates):
         best = None
         fun = make_fun(sigma)
+        if fd_step:
+            fun, kw["jac"] = _forward_differences(fun, float(fd_step), lo, hi)
         nfev = 0
         for x in candidates:
             u0 = np.clip(x / scale, lo, hi)
