@@ -225,6 +225,7 @@ def test_tip_baseline_is_the_issue5_mast_under_the_table1_sequence():
 
 def test_tip_effects_and_options():
     exp = get_experiment("tip-cycle", n_bays=3, ball_mu=0.0)
+    assert [p.name for p in exp.parameters] == ["cable_EA"]  # the wall is an option: tip data cannot see it
     assert {e.name for e in applicable_effects(exp)} == {
         "ball_joint_friction", "latch_hysteresis", "pretension_loss"}
     (nm, impl), = resolve(exp, ["ball_joint_friction"])
@@ -235,9 +236,10 @@ def test_tip_effects_and_options():
 # =============================================================================== tip-cycle, slow
 TIP_CASES = [
     # (effect, truth, path kwargs, n_bays, seed): ball-joint friction leaves a residual at zero load;
-    # latch hysteresis acts only once the beads leave their backstops (tip torque above ~15 N m here)
-    ("ball_joint_friction", {"mu": 0.1}, dict(points_per_ramp=3, cycles=2, kind="table1"), 2, 1),
-    ("latch_hysteresis", {"F_h": 10.0}, dict(points_per_ramp=3, cycles=2, M_Nm=22.0, kind="varying"), 2, 2),
+    # latch hysteresis acts only once the beads leave their backstops (tip torque above ~15 N m here),
+    # and only while the force on a bead exceeds F_h (at 22 N m the response saturates above ~6 N)
+    ("ball_joint_friction", {"mu": 0.1}, dict(points_per_ramp=3, cycles=2, kind="table1", hold=2), 2, 1),
+    ("latch_hysteresis", {"F_h": 4.0}, dict(points_per_ramp=3, cycles=2, M_Nm=22.0, kind="varying", hold=2), 2, 2),
 ]
 
 
@@ -267,8 +269,8 @@ def test_tip_hidden_effect_is_localised_ranked_first_and_identified(effect, trut
 @pytest.mark.slow
 def test_tip_null_case_nothing_is_missing():
     exp = get_experiment("tip-cycle", n_bays=2)
-    data, _ = tip_cycle_data({"cable_EA": 3.6e4}, {}, tip_cycle_path(points_per_ramp=3, cycles=2, kind="shear",
-                                                                      seed=3), seed=3, experiment=exp)
+    path = tip_cycle_path(points_per_ramp=3, cycles=2, kind="shear", hold=2, seed=3)
+    data, _ = tip_cycle_data({"cable_EA": 3.6e4}, {}, path, seed=3, experiment=exp)
     d = diagnose(exp, data, workers=2)
     assert d.verdict["missing_effect"] is None and d.verdict["explained"] is True
 
@@ -284,3 +286,27 @@ def test_cli_diagnose_bay_torsion_example(tmp_path, capsys):
     assert rep["verdict"]["missing_effect"] == "latch_hysteresis"  # what the example hides (8 N)
     f_h = rep["ranking"][0]["params"]["F_h"]
     assert abs(f_h["value"] - 8.0) <= N_SIGMA * f_h["stderr"]
+
+
+def test_a_refit_that_cannot_run_is_reported_not_fatal():
+    # an FE refit can fail to converge at the effect's start values; diagnose reports it and goes on
+    from femast.effects import Effect, Implementation, Parameter, register_effect, unregister_effect
+
+    def _boom(bay, p, ctx):
+        raise fm.errors.ModelError("no convergence (test)")
+
+    register_effect(Effect(name="test_boom", title="an effect whose FE run fails", physics="-" * 90,
+                           signature="none", implementations={"bay-torsion": Implementation(
+                               hook="bay_parameters", apply=_boom,
+                               parameters=(Parameter("a", "-", 1.0, 0.0, 2.0, "a parameter"),))}))
+    try:
+        path = {"theta_deg": 0.6 * (1.0 - np.abs(np.linspace(-1.0, 1.0, 11)))}
+        data, _ = bay_torsion_data({}, {"latch_hysteresis": {"F_h": 10.0}}, path, noise_Nm=0.15, seed=22)
+        d = diagnose(BT, data, ["test_boom", "latch_hysteresis"], workers=1)
+    finally:
+        unregister_effect("test_boom")
+    assert [e["effect"] for e in d.ranking] == ["latch_hysteresis", "test_boom"]  # the failed one last
+    failed = d.ranking[1]
+    assert failed["failed"] and not failed["significant"] and "no convergence (test)" in failed["reading"]
+    assert d.report["ranking"][1]["failed"] is True
+    assert d.verdict["missing_effect"] == "latch_hysteresis"

@@ -180,7 +180,7 @@ def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None 
     state = np.empty(m, dtype=int)
     tab = [np.zeros(3)]
     for k in range(m):
-        if not np.array_equal(drive[k], tab[-1]):
+        if np.any(np.abs(drive[k] - tab[-1]) > 1e-12):  # 1e-12 rad or m: round-off, not a motion
             tab.append(drive[k])
         state[k] = len(tab) - 1
     tab = np.array(tab)
@@ -217,8 +217,8 @@ def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None 
 
 def solve(inputs: dict, drive: np.ndarray, options: dict) -> dict:
     """:func:`run_bay`, cached (:mod:`femast.experiments.fe_cache`).  An FE run that fails (no
-    convergence, parameters that describe no bay) raises ValueError, which a fit treats as a
-    rejected parameter set."""
+    convergence, parameters that describe no bay) raises ModelError (a ValueError), which a fit
+    treats as a rejected parameter set."""
     fold = int(options["fold"])
 
     def compute():
@@ -229,7 +229,7 @@ def solve(inputs: dict, drive: np.ndarray, options: dict) -> dict:
 
     out = cached("bay-torsion", (inputs, np.asarray(drive, float), fold), compute, options)
     if "error" in out:
-        raise ValueError(out["error"])
+        raise ModelError(out["error"])
     return out
 
 
@@ -274,7 +274,7 @@ def extra_segments(data: Measured, params: dict, options: dict):
     """Rows where any latch of the fitted baseline is in each zone of seed Fig. 6."""
     try:
         zones = latch_zones(params, data, options)
-    except ValueError:
+    except ValueError:  # the FE run failed (ModelError): no zone segments
         return []
     return [(ZONE_KINDS[z], np.any(zones == z, axis=1)) for z in range(4)]
 

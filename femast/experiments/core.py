@@ -18,7 +18,8 @@ noise floor, segmentation, ranking of effects, figures, history) is generic.
 
 Built-in experiments live in :mod:`femast.experiments.mast_top`,
 :mod:`femast.experiments.latch_pull`, :mod:`femast.experiments.bay_torsion` and
-:mod:`femast.experiments.tip_cycle` (FE models); a user adds one from a Python script that defines a module-level ``experiment`` (see ``docs/experiments.md``).
+:mod:`femast.experiments.tip_cycle` (FE models); a user adds one from a Python script that
+defines a module-level ``experiment`` (see ``docs/experiments.md``).
 """
 
 from __future__ import annotations

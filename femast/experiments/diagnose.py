@@ -42,7 +42,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 from ..effects.base import applicable_effects, get_effect, load_script, loaded_scripts, resolve
-from ..errors import ModelError
+from ..errors import FemastError, ModelError
 from .compare import analyse
 from .core import Experiment, Measured
 from .figures import diagnose_figure, display_scale
@@ -63,9 +63,19 @@ def _refit_task(payload: dict) -> OptimizeResult:
         load_script(script)
     exp = experiment_from_source(payload["source"], payload["options"])
     data = Measured(payload["data_experiment"], payload["columns"], payload["path"], payload["lines"])
-    res = fit(exp, data, payload["effects"], start=payload["start"], noise=payload["noise"])
+    res = _safe_fit(exp, data, payload["effects"], start=payload["start"], noise=payload["noise"])
     res.pid = os.getpid()
     return res
+
+
+def _safe_fit(exp, data, effects, start, noise) -> OptimizeResult:
+    """:func:`fit`, or a result with ``failed = True`` and the error as ``message`` when the model
+    cannot be evaluated even at the start of the refit (an FE run that does not converge with the
+    effect's default parameters): one failed candidate must not end the whole diagnosis."""
+    try:
+        return fit(exp, data, effects, start=start, noise=noise)
+    except (ValueError, FemastError, FloatingPointError, ZeroDivisionError) as e:
+        return OptimizeResult(failed=True, success=False, message=f"{type(e).__name__}: {e}", effects=tuple(effects))
 
 
 def _rebuildable(exp: Experiment) -> bool:
@@ -199,7 +209,7 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
                 "lines": data.lines, "start": start, "noise": sigma}
     payloads = [{**payload0, "effects": base_effects + [c]} for c in candidates]
     if payloads and not _rebuildable(exp):
-        fits_list = [fit(exp, data, p["effects"], start=start, noise=sigma) for p in payloads]
+        fits_list = [_safe_fit(exp, data, p["effects"], start=start, noise=sigma) for p in payloads]
         how = "serial (experiment defined in memory: worker processes cannot rebuild it)"
     elif payloads and workers is None and scheduler is None and 6.0 * t_base * len(payloads) < SERIAL_BELOW_S:
         fits_list = [_refit_task(p) for p in payloads]
@@ -215,6 +225,12 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     ranking, fits = [], {}
     for name, res in zip(candidates, fits_list):
         fits[name] = res
+        if getattr(res, "failed", False):
+            ranking.append({"effect": name, "rms": float(baseline.rms), "ratio": float(r0), "delta_bic": 0.0,
+                            "params": {}, "significant": False, "explained_fraction": 0.0, "baseline_params": {},
+                            "success": False, "at_bound": [], "failed": True,
+                            "reading": f"The refit with {get_effect(name).title} failed: {res.message}"})
+            continue
         d = float(res.bic - baseline.bic)
         excess0 = r0**2 - 1.0
         frac = float(np.clip((r0**2 - res.ratio**2) / excess0, 0.0, 1.0)) if excess0 > 0 else 0.0
@@ -226,7 +242,7 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
                  "success": bool(res.success), "at_bound": list(res.at_bound)}
         entry["reading"] = _reading(name, entry, baseline, res, a["masks"], nch, worst_kind)
         ranking.append(entry)
-    ranking.sort(key=lambda e: e["delta_bic"])
+    ranking.sort(key=lambda e: (e.get("failed", False), e["delta_bic"]))
     best = ranking[0] if ranking and ranking[0]["significant"] else None
     base_ok = r0 <= AT_NOISE
     alternatives = [e["effect"] for e in ranking[1:] if best and e["significant"] and e["ratio"] <= AT_NOISE
@@ -262,8 +278,9 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         "noise_rms": noise_rms,
         "baseline": {"rms": float(baseline.rms), "params": base_table, "ratio": float(r0),
                      "effects": list(base_effects), "bic": float(baseline.bic)},
-        "ranking": [{k: e[k] for k in ("effect", "rms", "delta_bic", "params", "significant", "ratio",
-                                       "explained_fraction", "reading")} for e in ranking],
+        "ranking": [{**{k: e[k] for k in ("effect", "rms", "delta_bic", "params", "significant", "ratio",
+                                          "explained_fraction", "reading")}, **({"failed": True} if e.get("failed")
+                                                                               else {})} for e in ranking],
         "verdict": verdict,
         "data": str(data.path),
         "error_unit": exp.error_unit,
@@ -276,7 +293,8 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         experiment=exp.name, n_samples=data.n, noise=sigma, noise_rms=noise_rms,
         baseline={"rms": float(baseline.rms), "ratio": float(r0), "bic": float(baseline.bic),
                   "params": base_table, "effects": list(base_effects)},
-        baseline_fit=baseline, ranking=ranking, fits=fits, best_fit=fits[ranking[0]["effect"]] if ranking else None,
+        baseline_fit=baseline, ranking=ranking, fits=fits,
+        best_fit=fits[ranking[0]["effect"]] if ranking and not ranking[0].get("failed") else None,
         verdict=verdict, report=report, executor=how, files={}, at_noise=AT_NOISE,
         success=bool(baseline.success) and all(e["success"] for e in ranking), message=conclusion,
         by_kind=a["by_kind"], signatures=a["signatures"])
@@ -304,6 +322,9 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
                                                           for k in result.by_kind[:3]))
     lines.append(f"  {'rank':>4s}  {'effect':<22s} {'RMS':>10s} {'x noise':>8s} {'dBIC':>9s}  sig  parameters")
     for i, e in enumerate(result.ranking):
+        if e.get("failed"):
+            lines.append(f"  {i + 1:>4d}  {e['effect']:<22s} {'refit failed':>10s}  {e['reading'][:90]}")
+            continue
         ps = ", ".join(f"{k} = {v['value']:.4g}" + (f" +- {v['stderr']:.2g}" if v["stderr"] is not None else "")
                        + f" {v['unit']}" for k, v in e["params"].items())
         lines.append(f"  {i + 1:>4d}  {e['effect']:<22s} {f * e['rms']:>10.4g} {e['ratio']:>8.2f} "

@@ -242,9 +242,11 @@ def bay_torsion_data(params=None, effects=None, path=None, noise_Nm: float = 0.2
 
 # --------------------------------------------------------------------------- tip-cycle (FE)
 def tip_cycle_path(points_per_ramp: int = 3, cycles: int = 2, M_Nm: float = 6.8, F_N: float = 14.0,
-                   kind: str = "table1", seed: int = 0) -> dict:
+                   kind: str = "table1", hold: int = 0, seed: int = 0) -> dict:
     """Tip load paths ``{fx_N, ..., mz_Nm}``: the sequence 0, +P, 0, -P, 0 ... with ``P`` = M about z and
     F along x (seed 001 Table 1), ``cycles`` times, each ramp sampled at ``points_per_ramp`` rows.
+    hold : extra rows at every turning load and at every return to zero (the load held while the
+    tip is measured, as in Table 1; the FE model repeats the state, so they cost nothing).
 
     kind : ``"table1"`` (every peak at full load), ``"varying"`` (peaks of 55-100 % of P, different
         from cycle to cycle, and a partial unloading to 30-50 % in each cycle: reversals away from
@@ -270,10 +272,11 @@ def tip_cycle_path(points_per_ramp: int = 3, cycles: int = 2, M_Nm: float = 6.8,
                 knots.append(part * peak)
                 knots.append(peak * rng.uniform(0.8, 1.0))
             knots.append(np.zeros(6))
-    rows = [knots[0]]
+    rows = [knots[0]] * (1 + hold)
     for a, b in zip(knots[:-1], knots[1:]):
-        for k in range(1, points_per_ramp + 1):
+        for k in range(1, points_per_ramp):
             rows.append(a + (b - a) * k / points_per_ramp)
+        rows += [b] * (1 + hold)  # the knot itself, exactly (a hold must repeat it bit for bit)
     w = np.array(rows)
     return dict(zip(("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"), w.T))
 
@@ -284,7 +287,7 @@ def tip_cycle_data(params=None, effects=None, path=None, noise_m: float = 2e-6, 
     hidden ``effects`` along the load ``path`` (:func:`tip_cycle_path`), plus Gaussian noise
     (``noise_m`` on displacements, ``noise_rad`` on rotations).
 
-    params : baseline ``{cable_EA, longeron_t}``.  drift_m : a slow drift of the tip along x and y
+    params : baseline ``{cable_EA}``.  drift_m : a slow drift of the tip along x and y
     (m) that no effect models.  Returns ``(data, truth)`` with the noise-free channels."""
     from .registry import get_experiment
 
