@@ -9,6 +9,8 @@ tests/test_experiments_fe.py``.
 """
 
 import json
+import re
+import shlex
 import tempfile
 from pathlib import Path
 
@@ -277,14 +279,33 @@ def test_tip_null_case_nothing_is_missing():
 
 # =============================================================================== CLI and docs (slow)
 @pytest.mark.slow
-def test_cli_diagnose_bay_torsion_example(tmp_path, capsys):
+def test_tutorial_section8_commands_print_what_the_page_quotes(tmp_path, capsys, monkeypatch):
+    # docs/compare_and_diagnose.md section 8 (FE bay): its `text` blocks hold commands with their times
     from femast.cli import main
 
-    assert main(["diagnose", "bay-torsion", str(ROOT / "benchmarks" / "data" / "bay_torsion_example.csv"), "--json",
-                 "--out", str(tmp_path)]) == 0
-    rep = json.loads(capsys.readouterr().out)
-    assert rep["verdict"]["missing_effect"] == "latch_hysteresis"  # what the example hides (8 N)
+    text = (ROOT / "docs" / "compare_and_diagnose.md").read_text()
+    sec = text[text.index("## 8. An FE experiment"):text.index("## What was hidden")]
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "benchmarks").symlink_to(ROOT / "benchmarks")
+    checked = 0
+    for block in re.findall(r"```text\n(.*?)```", sec, re.S):
+        out = ""
+        for line in block.splitlines():
+            if line.startswith("$ "):
+                cmd = shlex.split(re.sub(r"\s+\(\d+(\.\d+)? s\)$", "", line[2:]))
+                if cmd[0] == "femast":
+                    assert main(cmd[1:]) == 0, line
+                    out = capsys.readouterr().out
+                elif cmd[0] == "head":
+                    out = "".join((tmp_path / cmd[-1]).read_text().splitlines(True)[:int(cmd[1][1:])])
+                continue
+            if line.strip() and "local processes" not in line:  # the process count follows the machine
+                assert line.rstrip() in out, f"section 8 quotes a line the command does not print:\n{line}"
+                checked += 1
+    assert checked > 30
+    rep = json.loads((tmp_path / "tutorial" / "bay" / "diagnose.json").read_text())
     f_h = rep["ranking"][0]["params"]["F_h"]
+    assert rep["verdict"]["missing_effect"] == "latch_hysteresis"  # what the example hides (8 N)
     assert abs(f_h["value"] - 8.0) <= N_SIGMA * f_h["stderr"]
 
 
