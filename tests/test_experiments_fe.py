@@ -153,7 +153,7 @@ BAY_CASES = [
      {"latch_k": 1.1e5, "latch_mu": 0.06}, 1),
     ("ball_joint_friction", {"mu": 0.15}, dict(n=41, theta_max_deg=3.0, kind="partial"), 0.25,
      {"latch_k": 0.95e5, "latch_mu": 0.07}, 2),
-    ("pretension_loss", {"dT0": -40.0}, dict(n=45, theta_max_deg=3.4, kind="release"), 0.15,
+    ("pretension_loss", {"dT0": -40.0}, dict(n=61, theta_max_deg=3.4, kind="release"), 0.15,
      {"latch_k": 1.0e5, "latch_mu": 0.08}, 3),
     ("off_axis_motion", {"e": 0.015}, dict(n=41, theta_max_deg=3.2, kind="cycle"), 0.2,
      {"latch_k": 1.05e5, "latch_mu": 0.065}, 4),
@@ -180,7 +180,7 @@ def test_bay_hidden_effect_is_localised_ranked_first_and_identified(effect, trut
         assert abs(est - value) <= N_SIGMA * se, (name, est, se, value)
         assert abs(est - value) <= REL_TOL * abs(value), (name, est, value)
     assert top["rms"] <= REFIT_TOL * _sample_noise(BT, data, tr)
-    assert top["ratio"] <= AT_NOISE
+    assert top["ratio"] <= d.at_noise  # at the (estimated) noise floor; short data: 1.33-1.41 (95 % of pure noise)
 
 
 @pytest.mark.slow
@@ -265,7 +265,8 @@ def test_tip_hidden_effect_is_localised_ranked_first_and_identified(effect, trut
         est, se = top["params"][name]["value"], top["params"][name]["stderr"]
         assert abs(est - value) <= N_SIGMA * se, (name, est, se, value)
         assert abs(est - value) <= REL_TOL * abs(value), (name, est, value)
-    assert top["ratio"] <= AT_NOISE
+    assert top["rms"] <= REFIT_TOL * _sample_noise(exp, data, tr)
+    assert top["ratio"] <= d.at_noise
 
 
 @pytest.mark.slow

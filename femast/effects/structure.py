@@ -80,7 +80,7 @@ OFF_AXIS = register_effect(Effect(
         "drift of the rig; with them, a measurement point off the frame centre."),
     signature="the latches do not release together: the moment differs where they leave the rollers (zone (c)) "
               "and around release and relatching, where the idealised model has one sharp step",
-    acts_where=("zone (c) in front of roller axis", "loading", "unloading"),
+    acts_where=("latch release/relatch", "zone (c) in front of roller axis", "zone (d) no contact"),
     seed="seed 001 Sec. VI.B, Fig. 17",
     implementations={"bay-torsion": Implementation(
         hook="control_path", order=50,

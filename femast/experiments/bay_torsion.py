@@ -270,13 +270,25 @@ def latch_zones(params: dict, data: Measured, options: dict, effects=None) -> np
     return fe["zone"][near]
 
 
+RELEASE_KIND = "latch release/relatch"
+
+
 def extra_segments(data: Measured, params: dict, options: dict):
-    """Rows where any latch of the fitted baseline is in each zone of seed Fig. 6."""
+    """Rows where any latch of the fitted baseline is in each zone of seed Fig. 6, and the rows around
+    a release or relatch (a latch passing between zones (c) and (d): two rows either side of the
+    change), where an asymmetric release (off-axis motion) shows first."""
     try:
         zones = latch_zones(params, data, options)
     except ValueError:  # the FE run failed (ModelError): no zone segments
         return []
-    return [(ZONE_KINDS[z], np.any(zones == z, axis=1)) for z in range(4)]
+    out = [(ZONE_KINDS[z], np.any(zones == z, axis=1)) for z in range(4)]
+    cd = np.isin(zones, (2, 3))
+    change = np.any(cd[1:] & cd[:-1] & (zones[1:] != zones[:-1]), axis=1)  # between rows i and i + 1
+    rel = np.zeros(data.n, bool)
+    for i in np.flatnonzero(change):
+        rel[max(i - 1, 0):i + 3] = True  # rows i - 1 .. i + 2: two either side of the change
+    out.append((RELEASE_KIND, rel))
+    return out
 
 
 def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: dict) -> None:

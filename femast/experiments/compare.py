@@ -19,7 +19,8 @@ from .figures import compare_figure, display_scale
 from .fitting import fit as _fit
 from .fitting import params_table, run_model
 from .history import append_history, plot_history
-from .residuals import TURN_FRACTION, noise_floor, segment_path, segment_report, signatures, turning_points
+from .residuals import (TURN_FRACTION, at_noise_threshold, noise_floor, segment_path, segment_report, signatures,
+                        turning_points)
 
 
 def load_path(exp: Experiment, data: Measured) -> np.ndarray:
@@ -96,6 +97,7 @@ def compare(exp: Experiment, data: Measured, effects=(), *, fit: bool = False, p
         "signatures": a["signatures"][:3],
         "message": run.message,
         "success": bool(run.success),
+        "at_noise": at_noise_threshold(data.n, len(exp.channels)),
     }
     files, version = {}, None
     if out is not None:
@@ -155,10 +157,11 @@ def format_compare(exp: Experiment, result: OptimizeResult) -> str:
         lines.append(f"    #{k + 1} {s['kind']:>28s}: rows {s['start_row']}-{s['end_row']} (file lines "
                      f"{s.get('first_line', '?')}-{s.get('last_line', '?')}), {s['ratio']:.2f}x noise, RMS "
                      f"{_fmt(s['rms'], exp.error_unit)}")
-    if result.ratio > 1.2 and result.signatures and result.signatures[0]["fraction"] > 0.2:
+    at = r.get("at_noise", 1.2)
+    if result.ratio > at and result.signatures and result.signatures[0]["fraction"] > 0.2:
         sg = result.signatures[0]
         lines.append(f"  reading: {100 * sg['fraction']:.0f} % of the excess error is {sg['reading']}")
-    elif result.ratio <= 1.2:
+    elif result.ratio <= at:
         lines.append("  reading: the model is at the noise floor")
     if result.files:
         lines.append("  wrote " + ", ".join(result.files.values()))
