@@ -343,7 +343,8 @@ EXPERIMENT = Experiment(
     plot_measured=plot_measured,
     error_unit="N m",
     min_rows=10,
-    fit_options={"diff_step": 1e-3, "xtol": 1e-4, "ftol": 1e-4, "gtol": 1e-8, "max_nfev_per_param": 10},
+    fit_options={"diff_step": 1e-3, "xtol": 1e-4, "ftol": 1e-4, "gtol": 1e-8, "max_nfev_per_param": 10,
+                 "expensive": True},
     source="bay-torsion",
 )
 

@@ -176,7 +176,8 @@ class Experiment:
         difference step ``diff_step`` (``step x max(1, |u|)`` in the parameters scaled by their
         ``typical`` size, never smaller, so also at an effect's zero default) larger than the
         convergence noise of its solver, and a lower ``max_nfev_per_param`` (``max_nfev = that x
-        (p + 1)``).
+        (p + 1)``).  ``expensive: True`` makes ``diagnose`` refit in parallel by default even when
+        the baseline fit was fast (its runs came from a cache).
     source : where it came from (a built-in name or a script path), set by the registry.
     """
 

@@ -216,7 +216,8 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     if payloads and not _rebuildable(exp):
         fits_list = [_safe_fit(exp, data, p["effects"], start=start, noise=sigma) for p in payloads]
         how = "serial (experiment defined in memory: worker processes cannot rebuild it)"
-    elif payloads and workers is None and scheduler is None and 6.0 * t_base * len(payloads) < SERIAL_BELOW_S:
+    elif (payloads and workers is None and scheduler is None and not exp.fit_options.get("expensive")
+          and 6.0 * t_base * len(payloads) < SERIAL_BELOW_S):
         fits_list = [_refit_task(p) for p in payloads]
         how = f"serial (refits estimated at {6.0 * t_base * len(payloads):.2f} s: cheaper than starting processes)"
     elif payloads:

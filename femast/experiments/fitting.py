@@ -280,6 +280,7 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
             starts.append(x)
     fo = dict(exp.fit_options)
     per_param = int(fo.pop("max_nfev_per_param", 100))
+    fo.pop("expensive", None)  # a hint for diagnose, not a least_squares option
     fd_step = fo.pop("diff_step", None)
     kw = dict(method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10, x_scale=1.0)
     kw.update(fo)

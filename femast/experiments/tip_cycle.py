@@ -292,7 +292,8 @@ EXPERIMENT = Experiment(
     channel_weights={"rx_rad": L_MAST_40, "ry_rad": L_MAST_40, "rz_rad": L_MAST_40},
     error_unit="m",
     min_rows=5,
-    fit_options={"diff_step": 1e-3, "xtol": 1e-4, "ftol": 1e-4, "gtol": 1e-8, "max_nfev_per_param": 10},
+    fit_options={"diff_step": 1e-3, "xtol": 1e-4, "ftol": 1e-4, "gtol": 1e-8, "max_nfev_per_param": 10,
+                 "expensive": True},
     source="tip-cycle",
 )
 
