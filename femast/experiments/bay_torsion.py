@@ -110,7 +110,7 @@ def fe_rows(theta, ux, uy, max_rows: int) -> np.ndarray:
 
 def path_coordinate(theta_deg, ux, uy) -> np.ndarray:
     """Strictly increasing coordinate along the drive path: twist travelled (deg) plus translation
-    travelled (mm / 10), plus 1e-9 per row so that holds stay ordered."""
+    travelled (cm: 1 cm of drift counts like 1 degree), plus 1e-9 per row so that holds stay ordered."""
     d = np.abs(np.diff(theta_deg)) + 100.0 * np.hypot(np.diff(ux), np.diff(uy))
     return np.concatenate([[0.0], np.cumsum(d)]) + 1e-9 * np.arange(len(theta_deg))
 
