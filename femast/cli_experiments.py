@@ -7,7 +7,7 @@
                     [--effects a,b]
 
 EXPERIMENT is a built-in name (``mast-top``, ``latch-pull``; ``bay-torsion`` and ``tip-cycle`` are
-pending a model) or the path of a Python script defining ``experiment``.  An ``--effects`` entry
+both FE models of femast.adam) or the path of a Python script defining ``experiment``.  An ``--effects`` entry
 is an effect name, ``SCRIPT.py`` (every effect the script registers) or ``SCRIPT.py:name``.
 ``diagnose --effects`` names the effects already in the model being diagnosed (an extension of
 issue 7: after adding the missing effect, diagnose the new model).
