@@ -181,9 +181,16 @@ class Analysis:
         self.cons_node, self.cons_dof = self.dofmap.slots(np.arange(nf, ni))
         self.act_node, self.act_dof = self.dofmap.slots(np.arange(self.dofmap.n_active))
         self.is_rot = self.free_dof >= 3
+        self._free_split = (self.free_node, self.free_dof, self.free_dof < 3)
+        self._cons_split = (self.cons_node, self.cons_dof, self.cons_dof < 3)
         self.length = float(np.ptp(self.X0, axis=0).max()) or 1.0
         self.symmetric = all(getattr(f, "symmetric", False) for f in self.families)
         self.solver = SparseLU(symmetric=self.symmetric)
+        if not self.constraints.active:
+            # symbolic analysis (the ordering) from the assembly pattern, once, at set-up; a
+            # constrained model's reduced pattern T^T K T is only known at its first iteration
+            self.solver.analyse(self.assembler.K_ff)
+        self._direct = None   # (solver layout, positions): K_ff assembled into the solver's matrix
         # configuration and committed state
         self.x = self.X0.copy()
         self.R = np.tile(np.eye(3), (n, 1, 1))
@@ -198,18 +205,40 @@ class Analysis:
         self._stab_energy = 0.0
         self._stab_force = (0.0, 0.0)
         self._at_equilibrium = False   # the initial state may hold unbalanced pretension
+        self._version = 0              # configuration counter, bumped by every _update
+        self._last_converged = None    # (version, responses) of the last committed increment
         self._zero_force = None
 
     # ------------------------------------------------------------ helpers
     def dof_value(self, idx, dof):
         return self.x[idx, dof] - self.X0[idx, dof] if dof < 3 else self.spin[idx, dof - 3]
 
-    def _evaluate(self, ctx):
-        responses = [f.evaluate(self.x, self.R, s, ctx) for f, s in zip(self.families, self.states)]
-        for f, r in zip(self.families, responses):
-            if not (np.all(np.isfinite(r.f)) and np.all(np.isfinite(r.k))):
+    def _evaluate(self, ctx, reuse=False):
+        """Element responses at the current configuration.  With ``reuse``, a path-independent
+        family whose converged response belongs to this very configuration (nothing has moved
+        since the last commit) is not evaluated again; families with history always are, since
+        their response at the start of an increment (trial state = committed state) differs from
+        the converged one (e.g. an elastic instead of an elastoplastic tangent)."""
+        last = self._last_converged
+        cached = last[1] if reuse and last is not None and last[0] == self._version else None
+        responses = []
+        for i, (f, s) in enumerate(zip(self.families, self.states)):
+            if cached is not None and f.path_independent:
+                responses.append(cached[i])
+                continue
+            r = f.evaluate(self.x, self.R, s, ctx)
+            if not np.all(np.isfinite(r.f)):
                 raise FloatingPointError(f"non-finite internal forces in element family '{f.name}'")
+            responses.append(r)
         return responses
+
+    def _nonfinite_tangent(self, responses):
+        """Why a factorisation or solve failed, if an element tangent holds a NaN or inf (tested
+        only then: a scan of every element matrix costs as much as assembling them)."""
+        for f, r in zip(self.families, responses):
+            if not np.all(np.isfinite(r.k)):
+                return f"non-finite tangent stiffness in element family '{f.name}'"
+        return None
 
     def _residual(self, responses, P):
         """Residual P - F on the independent DOFs (free first, then constrained)."""
@@ -227,6 +256,33 @@ class Analysis:
         if self.constraints.active:
             Pa = self._T.T @ Pa
         return Pa[: self.dofmap.n_free]
+
+    def _factorize_tangent(self, responses, with_fc):
+        """Assemble and factorise K_ff; returns (K_ff or None, K_fc or None).
+
+        An unconstrained model's element matrices go straight into the linear solver's permuted
+        matrix (positions composed once: no CSR fill and no gather per iteration), and K_ff is
+        then not formed (None).  Constrained models, and the first tangent (whose diagonal sets
+        the zero-force floors), go through :meth:`_tangent`."""
+        ta = _time.perf_counter()
+        if self.constraints.active or self._zero_force is None or self.solver.chosen is None:
+            K, Kfc = self._tangent(responses, with_fc)
+            self.summary.assembly_time += _time.perf_counter() - ta
+            ts = _time.perf_counter()
+            self.solver.factorize(K)
+            self.summary.solve_time += _time.perf_counter() - ts
+            return K, Kfc
+        if self._direct is None or self._direct[0] != self.solver.layout:
+            self._direct = (self.solver.layout,
+                            [self.solver.permuted_positions(p) for p in self.assembler.pos_ff])
+        k_list = [q.k for q in responses]
+        Kfc = self.assembler.coupling(k_list) if with_fc else None
+        self.assembler.tangent_into(k_list, self.solver.values, self._direct[1])
+        self.summary.assembly_time += _time.perf_counter() - ta
+        ts = _time.perf_counter()
+        self.solver.factorize_values()
+        self.summary.solve_time += _time.perf_counter() - ts
+        return None, Kfc
 
     def _tangent(self, responses, with_fc):
         """(K_ff, K_fc) at the configuration of the last :meth:`_residual` call."""
@@ -249,14 +305,15 @@ class Analysis:
         return K, Kfc
 
     def _update(self, du_free, du_cons=None):
+        self._version += 1
         W = np.zeros_like(self.spin)
-        for node, dof, du in ((self.free_node, self.free_dof, du_free),
-                              (self.cons_node, self.cons_dof, du_cons)):
+        # each (node, dof) pair appears once among the free and once among the constrained
+        # equations, so plain fancy-index += is exact (no np.add.at needed)
+        for (node, dof, t), du in ((self._free_split, du_free), (self._cons_split, du_cons)):
             if du is None:
                 continue
-            t = dof < 3
-            np.add.at(self.x, (node[t], dof[t]), du[t])
-            np.add.at(W, (node[~t], dof[~t] - 3), du[~t])
+            self.x[node[t], dof[t]] += du[t]
+            W[node[~t], dof[~t] - 3] = du[~t]
         self.spin += W
         _apply_spins(self.R, W)
         if self.constraints.active:
@@ -437,7 +494,7 @@ class Analysis:
     def _increment(self, step, control, t, dt, load_start, pres_start, line_search=False):
         """Try one increment; on success commit and return (True, iterations, '', responses);
         on failure restore the committed configuration and return (False, iterations, why, None)."""
-        saved = (self.x.copy(), self.R.copy(), self.spin.copy(), self.lam)
+        saved = (self.x.copy(), self.R.copy(), self.spin.copy(), self.lam, self._version)
         frac = (t + dt) / step.period
         period = step.period
         ctx = IncrementContext(time=t + dt, dtime=dt, total_time=self.total_time + dt, x_committed=saved[0],
@@ -452,10 +509,12 @@ class Analysis:
         pres = self._values(step.prescribed, pres_start, frac, period)
         dpres = pres[self.cons_node, self.cons_dof] - self.prescribed[self.cons_node, self.cons_dof]
         dpres[self.fixed[self.cons_node, self.cons_dof]] = 0.0
+        has_dpres = bool(np.any(dpres))
         nf = self.dofmap.n_free
         Du = np.zeros(nf)
         iters = 0
         rnorm_hist = []
+        responses = None
 
         def loads_now(lam_):
             return (self._values(step.loads, load_start, frac, period) if not uses_lam
@@ -463,9 +522,9 @@ class Analysis:
 
         stab = step.stabilize
 
-        def evaluate(P, Dtrial=None):
+        def evaluate(P, Dtrial=None, reuse=False):
             ta = _time.perf_counter()
-            resp = self._evaluate(ctx)
+            resp = self._evaluate(ctx, reuse=reuse)
             res_ = self._residual(resp, P)
             self.summary.assembly_time += _time.perf_counter() - ta
             if not np.all(np.isfinite(res_)):
@@ -475,7 +534,7 @@ class Analysis:
                 r_ = r_ - self._stab_C / dt * (Du if Dtrial is None else Dtrial)
             return resp, res_, r_
 
-        if self.extrapolate and self._last_Du is not None and not np.any(dpres):
+        if self.extrapolate and self._last_Du is not None and not has_dpres:
             # Abaqus' linear extrapolation: start from the previous increment's solution, scaled
             scale = dt / self._last_dt
             Du += scale * self._last_Du
@@ -484,9 +543,9 @@ class Analysis:
         lam_start = self.lam
         try:
             P = loads_now(lam)
-            responses, F, r = evaluate(P)
+            responses, F, r = evaluate(P, reuse=True)
             for it in range(self.convergence.max_iterations + 1):
-                if (it == 0 and not uses_lam and not np.any(dpres) and not np.any(Du) and stab is None
+                if (it == 0 and not uses_lam and not has_dpres and not np.any(Du) and stab is None
                         and self._at_equilibrium and np.array_equal(P, self.loads)):
                     # nothing changes (e.g. a step that repeats the previous loads): the committed
                     # state is the converged solution
@@ -514,21 +573,31 @@ class Analysis:
                         return self._fail(saved, iters, f"residual diverging (ratio {ratio:.3g}, worst at "
                                           f"{self._worst(r)})")
                 # the tangent only when another iteration is needed
-                ta = _time.perf_counter()
-                K, Kfc = self._tangent(responses, with_fc=(it == 0 and np.any(dpres)))
-                if stab is not None:
-                    if self._stab_C is None:  # damping from the tangent at the start of the step
-                        self._stab_C = stab.damping(K.diagonal(), self.is_rot, self._stab_dt0)
-                        self._stab_C0 = self._stab_C.copy()
-                    K = (K + sp.diags(self._stab_C / dt)).tocsr()
-                self.summary.assembly_time += _time.perf_counter() - ta
-                ts = _time.perf_counter()
+                K = None
                 try:
-                    self.solver.factorize(K)
+                    if stab is None:
+                        K, Kfc = self._factorize_tangent(responses, with_fc=(it == 0 and has_dpres))
+                    else:
+                        ta = _time.perf_counter()
+                        K, Kfc = self._tangent(responses, with_fc=(it == 0 and has_dpres))
+                        if self._stab_C is None:  # damping from the tangent at the start of the step
+                            self._stab_C = stab.damping(K.diagonal(), self.is_rot, self._stab_dt0)
+                            self._stab_C0 = self._stab_C.copy()
+                        K = (K + sp.diags(self._stab_C / dt)).tocsr()
+                        self.summary.assembly_time += _time.perf_counter() - ta
+                        ts = _time.perf_counter()
+                        self.solver.factorize(K)
+                        self.summary.solve_time += _time.perf_counter() - ts
                 except SingularModelError:
+                    bad = self._nonfinite_tangent(responses)
+                    if bad:
+                        return self._fail(saved, iters, bad)
                     if self.summary.increments == 0 and it == 0:
+                        if K is None:
+                            K, _ = self._tangent(responses, with_fc=False)
                         raise SingularModelError(self._singular_message(K, f"step '{step.name}'")) from None
                     return self._fail(saved, iters, "singular tangent (bifurcation or mechanism)")
+                ts = _time.perf_counter()
                 rhs = r if Kfc is None else r - Kfc @ dpres
                 du = self.solver.solve(rhs)
                 if uses_lam:
@@ -539,7 +608,7 @@ class Analysis:
                     lam += dlam
                 self.summary.solve_time += _time.perf_counter() - ts
                 iters += 1
-                search = line_search and not uses_lam and not (it == 0 and np.any(dpres))
+                search = line_search and not uses_lam and not (it == 0 and has_dpres)
                 before = (self.x.copy(), self.R.copy(), self.spin.copy()) if search else None
                 self._update(du, dpres if it == 0 else None)
                 P = loads_now(lam)
@@ -552,6 +621,9 @@ class Analysis:
                     Du = Du_before + du
                 r = r_new
         except (FloatingPointError, SingularModelError, ValueError) as exc:
+            bad = self._nonfinite_tangent(responses) if isinstance(exc, SingularModelError) and responses else None
+            if bad:
+                return self._fail(saved, iters, bad)
             if isinstance(exc, SingularModelError) and self.summary.increments == 0 and iters == 0:
                 raise
             if isinstance(exc, ModelError):
@@ -643,15 +715,16 @@ class Analysis:
 
     def _increment_arc(self, step, control, dl, prev, load_start, P_ref_full):
         """One arc-length increment; returns (ok, iterations, note, responses, dl, Du, dlambda)."""
-        saved = (self.x.copy(), self.R.copy(), self.spin.copy(), self.lam)
+        saved = (self.x.copy(), self.R.copy(), self.spin.copy(), self.lam, self._version)
         ctx = IncrementContext(time=self.lam, dtime=0.0, total_time=self.total_time, x_committed=saved[0],
                                R_committed=saved[1], step_name=step.name)
         nf = self.dofmap.n_free
         lam = lam0 = self.lam
         iters = 0
+        responses = None
         try:
             P = load_start + lam * P_ref_full
-            responses = self._evaluate(ctx)
+            responses = self._evaluate(ctx, reuse=True)
             res = self._residual(responses, P)
             K, _ = self._tangent(responses, with_fc=False)
             self.solver.factorize(K)
@@ -697,7 +770,8 @@ class Analysis:
                 iters += 1
             return self._fail_arc(saved, iters, f"no convergence in {iters} iterations", dl)
         except (FloatingPointError, SingularModelError) as exc:
-            return self._fail_arc(saved, iters, str(exc), dl)
+            bad = self._nonfinite_tangent(responses) if isinstance(exc, SingularModelError) and responses else None
+            return self._fail_arc(saved, iters, bad or str(exc), dl)
 
     def _fail_arc(self, saved, iters, why, dl):
         self._fail(saved, iters, why)
@@ -723,11 +797,12 @@ class Analysis:
         return self.convergence.check(r, du, Du, self.is_rot, ref_f, ref_m, L)
 
     def _fail(self, saved, iters, why):
-        self.x, self.R, self.spin, self.lam = saved[0], saved[1], saved[2], saved[3]
+        self.x, self.R, self.spin, self.lam, self._version = saved
         return False, iters, why, None
 
     def _commit(self, responses, P, res, lam, equilibrium=True):
         self._at_equilibrium = equilibrium   # False after a stabilised increment (viscous forces)
+        self._last_converged = (self._version, responses)
         self.states = [r.state.copy() if r.state is not None else s for r, s in zip(responses, self.states)]
         self.loads = P.copy()
         self.prescribed[self.cons_node, self.cons_dof] = [self.dof_value(n, d) for n, d in
@@ -742,8 +817,8 @@ class Analysis:
         if responses is not None:
             RF[self.cons_node, self.cons_dof] = self._reactions
         data = {"step": step_name, "increment": inc, "time": time, "total_time": self.total_time,
-                "load_factor": self.lam, "iterations": iterations, "U": self.x - self.X0, "R": self.R,
-                "UR": rotation_vectors(self.R), "URA": self.spin, "RF": RF, "P": self.loads,
+                "load_factor": self.lam, "iterations": iterations, "U": self.x - self.X0, "R": self.R.copy(),
+                "UR": rotation_vectors(self.R), "URA": self.spin.copy(), "RF": RF, "P": self.loads.copy(),
                 "strain_energy": self.strain_energy, "stabilization_energy": self._stab_energy}
         if responses is None:
             responses = self._evaluate(IncrementContext(x_committed=self.x, R_committed=self.R))

@@ -97,6 +97,21 @@ class Assembler:
             _scatter_vector(f, eqs, out)
         return out
 
+    def tangent_into(self, k_list, data, positions):
+        """Zero ``data`` and add the element matrices at ``positions`` (one (n_el, m, m) array per
+        family, -1 outside): K_ff assembled straight into another layout of its entries, such
+        as the linear solver's permuted matrix."""
+        data[:] = 0.0
+        for k, pos in zip(k_list, positions):
+            _scatter_matrix(k, pos, data)
+
+    def coupling(self, k_list):
+        """K_fc alone (the free-constrained block)."""
+        self.K_fc.data[:] = 0.0
+        for k, pos in zip(k_list, self.pos_fc):
+            _scatter_matrix(k, pos, self.K_fc.data)
+        return self.K_fc
+
     def tangent(self, k_list, with_fc=False):
         self.K_ff.data[:] = 0.0
         for k, pos in zip(k_list, self.pos_ff):

@@ -52,6 +52,7 @@ class JointSprings(ElementFamily):
 
     active_dofs = (3, 4, 5)
     symmetric = False
+    path_independent = True
 
     def __init__(self, nodes, k, name: str = "adam_joint_spring"):
         self.name = name

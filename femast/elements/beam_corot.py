@@ -379,6 +379,7 @@ class BeamFamily(ElementFamily):
     name = "beam"
     active_dofs = (0, 1, 2, 3, 4, 5)
     n_state = 0
+    path_independent = True
     symmetric = False
 
     def __init__(self, nodes, E0, l0, EA, GJ, EIy, EIz, labels=None, name="beam"):

@@ -237,6 +237,7 @@ class ShroudCableFamily(ElementFamily):
     """
 
     n_state = 0
+    path_independent = True
 
     def __init__(self, nodes, L0, law=None, offsets=None, labels=None, name: str = "shroud"):
         self.name = name

@@ -60,6 +60,7 @@ class TrussFamily(ElementFamily):
     name = "truss"
     active_dofs = (0, 1, 2)
     n_state = 0
+    path_independent = True
     symmetric = True
 
     def __init__(self, nodes, L0, EA, tension_only, labels=None, name="truss"):

@@ -4,9 +4,14 @@ The tangent keeps its sparsity pattern from one Newton iteration to the next (th
 fills the same CSR arrays in place), so the fill-reducing ordering -- the symbolic part that can
 be reused with SuperLU as scipy exposes it -- is computed once per pattern:
 
-* on the first factorisation of a pattern, two symmetric orderings are tried on the actual
-  values, reverse Cuthill-McKee (best for slender, chain-like structures such as masts and
-  cantilevers) and SuperLU's minimum degree on A^T + A; the one with less fill is kept;
+* reverse Cuthill-McKee (RCM, best for slender, chain-like structures such as masts and
+  cantilevers) is computed first, from the pattern alone.  When its envelope (the fill an LU
+  without pivoting can have in that order) holds at most twice the entries of K, it is kept
+  straight away: no ordering can give factors smaller than K itself, so no other could save
+  more than that factor.  This test needs no values, so :meth:`SparseLU.analyse` can run it when
+  the model is set up, with the assembly pattern (symbolic analysis, as in Abaqus' pre-processing);
+* otherwise, on the first factorisation of the pattern, RCM and SuperLU's minimum degree on
+  A^T + A are both tried on the actual values and the one with less fill is kept;
 * every later factorisation of the same pattern gathers the values into the permuted CSC
   matrix P K P^T (one precomputed index, no CSR -> CSC conversion) and factorises it with the
   NATURAL column order in SuperLU's symmetric mode (diagonal pivots preferred, the structure of
@@ -32,6 +37,7 @@ tests every factorisation).
 from __future__ import annotations
 
 import warnings
+from time import perf_counter
 
 import numpy as np
 import scipy.linalg
@@ -78,12 +84,98 @@ class SparseLU:
         self._sub_pos = None
         self.analyses = 0       # orderings computed (1 for a fixed-pattern run)
         self.chosen = None      # name of the ordering in use
+        self._validated = None  # (indptr, indices) objects last found equal to the master pattern
+        self.superlu_seconds = 0.0  # wall time inside SuperLU (kept factorisations + solves), s
+        self.factorizations = 0     # numeric factorisations kept (trial orderings not counted)
+        self.layout = 0         # bumped whenever the permuted matrix (its pattern or ordering) changes
 
     # ------------------------------------------------------------------ symbolic part
     @staticmethod
     def _same(pattern, K):
         return (pattern is not None and pattern[0] == K.shape and np.array_equal(pattern[1], K.indptr)
                 and np.array_equal(pattern[2], K.indices))
+
+    def _is_master(self, K):
+        """K has the master pattern.  The assembler refills the same CSR arrays every iteration, so
+        arrays once found equal are recognised by identity (same objects, same lengths)."""
+        v = self._validated
+        if v is not None and v[0] is K.indptr and v[1] is K.indices and v[2] == K.indices.size:
+            return True
+        if self._same(self._pattern, K):
+            self._validated = (K.indptr, K.indices, K.indices.size)
+            return True
+        return False
+
+    @staticmethod
+    def _rcm(K):
+        """RCM permutation of K's pattern and whether its envelope bounds the LU fill to at most
+        twice nnz(K) (then no other ordering is worth a trial factorisation)."""
+        perm = np.asarray(reverse_cuthill_mckee(K, symmetric_mode=True), dtype=np.int64)
+        n = K.shape[0]
+        inv = np.empty(n, dtype=np.int64)
+        inv[perm] = np.arange(n)
+        rows = np.repeat(inv, np.diff(K.indptr))
+        cols = inv[K.indices]
+        lo = np.full(n, n, dtype=np.int64)   # leftmost column of each permuted row (symmetric pattern)
+        np.minimum.at(lo, rows, cols)
+        np.minimum.at(lo, cols, rows)
+        envelope = int(np.sum(np.arange(n) - np.minimum(lo, np.arange(n))))
+        return perm, 2 * envelope + n <= 2 * K.nnz
+
+    def analyse(self, K):
+        """Symbolic analysis from the pattern of K alone (values unused), if RCM is the ordering to
+        keep (see the module docstring); otherwise it is left to the first factorisation.
+        Returns the ordering chosen, or None."""
+        if self.ordering not in ("auto", "rcm"):
+            return None
+        K = K if K.format == "csr" else K.tocsr()
+        perm, enough = self._rcm(K)
+        if self.ordering == "auto" and not enough:
+            return None
+        self.analyses += 1
+        self._set_master(K)
+        self.chosen = "rcm"
+        self._perm = perm
+        self._B, self._gather = self._permuted(K, perm)
+        return self.chosen
+
+    def permuted_positions(self, pos):
+        """Positions in :attr:`values` of the entries at positions ``pos`` (-1: none) of the data
+        array of a matrix with the master pattern: an assembler can then fill the solver's
+        permuted matrix directly (no gather per factorisation; see :meth:`factorize_values`)."""
+        if self._gather is None:
+            raise RuntimeError("SparseLU.permuted_positions: no pattern analysed yet")
+        inv = np.empty(self._gather.size, dtype=np.int64)
+        inv[self._gather] = np.arange(self._gather.size)
+        pos = np.asarray(pos)
+        return np.where(pos >= 0, inv[np.maximum(pos, 0)], -1)
+
+    @property
+    def values(self):
+        """The values of the permuted matrix that :meth:`factorize_values` factorises (write them
+        in place, at the positions given by :meth:`permuted_positions`)."""
+        return self._B.data
+
+    def factorize_values(self):
+        """Factorise the matrix whose values were written into :attr:`values` (same checks and
+        errors as :meth:`factorize`)."""
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", spla.MatrixRankWarning)
+                self._lu = self._factor_timed(self._B)
+        except (RuntimeError, spla.MatrixRankWarning) as exc:
+            self._lu = None
+            raise SingularModelError(str(exc)) from None
+        self._checked = False
+        if self.pivot_check == "always" or self._dmax is None:
+            self._check_pivots()
+
+    def _set_master(self, K):
+        self.layout += 1
+        self._pattern = (K.shape, K.indptr.copy(), K.indices.copy())
+        self._master_keys = self._keys(K.shape, K.indptr, K.indices)
+        self._sub = None
+        self._validated = None
 
     @staticmethod
     def _keys(shape, indptr, indices):
@@ -112,6 +204,13 @@ class SparseLU:
         return spla.splu(B, permc_spec="NATURAL", diag_pivot_thresh=self.pivot_threshold,
                          options=dict(SymmetricMode=True))
 
+    def _factor_timed(self, B):
+        t0 = perf_counter()
+        lu = self._factor_permuted(B)
+        self.superlu_seconds += perf_counter() - t0
+        self.factorizations += 1
+        return lu
+
     def _analyse(self, K):
         """Choose the ordering for the pattern of K (the master pattern from now on); returns the
         LU of K in that ordering.  The first pattern tries every candidate ordering; a later one
@@ -122,8 +221,9 @@ class SparseLU:
         first = None
         error = RuntimeError("Factor is exactly singular")
         for kind in kinds:
+            enough = False
             if kind == "rcm":
-                perm = np.asarray(reverse_cuthill_mckee(K, symmetric_mode=True), dtype=np.int64)
+                perm, enough = self._rcm(K)  # enough: its fill is within 2x of any ordering's
             else:
                 try:
                     lu = spla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=self.pivot_threshold,
@@ -135,15 +235,17 @@ class SparseLU:
             B, gather = self._permuted(K, perm)
             first = first or (kind, perm, B, gather)
             try:
+                t0 = perf_counter()
                 lu = self._factor_permuted(B)
+                dt = perf_counter() - t0
             except RuntimeError as exc:
                 error = exc
                 continue
             if best is None or lu.nnz < best[0]:
-                best = (lu.nnz, (kind, perm, B, gather), lu)
-        self._pattern = (K.shape, K.indptr.copy(), K.indices.copy())
-        self._master_keys = self._keys(K.shape, K.indptr, K.indices)
-        self._sub = None
+                best = (lu.nnz, (kind, perm, B, gather), lu, dt)
+            if enough:
+                break
+        self._set_master(K)
         if best is None:  # singular: keep an ordering so that the pattern is not analysed again
             if first is None:
                 perm = np.arange(K.shape[0])
@@ -151,12 +253,14 @@ class SparseLU:
             self.chosen, self._perm, self._B, self._gather = first
             raise error
         self.chosen, self._perm, self._B, self._gather = best[1]
+        self.superlu_seconds += best[3]   # the kept factorisation; the trial of the other is overhead
+        self.factorizations += 1
         return best[2]
 
     def _master_data(self, K):
         """K's values laid out on the master pattern, or None after a new analysis (which has
         factorised already; the LU is in self._lu)."""
-        if self._same(self._pattern, K):
+        if self._is_master(K):
             return K.data
         if self._same(self._sub, K):
             pos = self._sub_pos
@@ -186,7 +290,11 @@ class SparseLU:
                 warnings.simplefilter("error", spla.MatrixRankWarning)
                 if self.ordering == "colamd":
                     self._perm = None
-                    self._lu = spla.splu(K.tocsc())
+                    Kc = K.tocsc()
+                    t0 = perf_counter()
+                    self._lu = spla.splu(Kc)
+                    self.superlu_seconds += perf_counter() - t0
+                    self.factorizations += 1
                     analysed = True
                 else:
                     K = K if K.format == "csr" else K.tocsr()
@@ -201,7 +309,7 @@ class SparseLU:
                         analysed = data is None
                         if not analysed:
                             np.take(data, self._gather, out=self._B.data)
-                            self._lu = self._factor_permuted(self._B)
+                            self._lu = self._factor_timed(self._B)
         except (RuntimeError, spla.MatrixRankWarning) as exc:
             self._lu = None
             raise SingularModelError(str(exc)) from None
@@ -222,9 +330,14 @@ class SparseLU:
     def solve(self, rhs):
         rhs = np.asarray(rhs, dtype=float)
         if self._perm is None:
+            t0 = perf_counter()
             x = self._lu.solve(rhs)
+            self.superlu_seconds += perf_counter() - t0
         else:
-            y = self._lu.solve(rhs[self._perm])
+            b = rhs[self._perm]
+            t0 = perf_counter()
+            y = self._lu.solve(b)
+            self.superlu_seconds += perf_counter() - t0
             x = np.empty_like(y)
             x[self._perm] = y
         if not np.all(np.isfinite(x)):
