@@ -611,7 +611,8 @@ class Analysis:
                 search = line_search and not uses_lam and not (it == 0 and has_dpres)
                 before = (self.x.copy(), self.R.copy(), self.spin.copy()) if search else None
                 self._update(du, dpres if it == 0 else None)
-                P = loads_now(lam)
+                if uses_lam:  # under load control the loads are those of the increment's end
+                    P = loads_now(lam)
                 Du_before = Du.copy()
                 Du += du
                 responses, F, r_new = evaluate(P)

@@ -1,0 +1,170 @@
+"""Issue 8: the fast paths of the Newton loop give the same answers as the plain ones.
+
+* converged responses of path-independent families reused at the next increment's start;
+* the symbolic analysis (ordering) done from the assembly pattern at set-up;
+* K_ff assembled straight into the linear solver's permuted matrix;
+* frames written by a background thread;
+* a NaN in an element tangent named in the error, although element matrices are not scanned.
+"""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+import femast as fm
+from femast.analysis import Analysis
+from femast.elements.base import ElementFamily, ElementResponse
+from femast.errors import ConvergenceError
+from femast.results import ResultsWriter
+from femast.solvers.linear import SparseLU
+
+
+def _frame_model(n_bays=3):
+    """A small 3D frame under a tip torque and shear: beams only, 4 load increments."""
+    m = fm.Model("frame")
+    sec = fm.circular_tube(0.02, 0.018, E=70e9)
+    corners = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    rows = [[m.node(x, y, float(z)) for x, y in corners] for z in range(n_bays + 1)]
+    for z in range(n_bays + 1):
+        for i in range(4):
+            if z > 0:
+                m.beam(rows[z - 1][i], rows[z][i], sec, up=(1, 1, 0))
+                m.beam(rows[z - 1][i], rows[z][(i + 1) % 4], sec, up=(0, 0, 1))
+            m.beam(rows[z][i], rows[z][(i + 1) % 4], sec, up=(0, 0, 1))
+    for a in rows[0]:
+        m.fix(a)
+    st = m.step("load", initial_increment=0.25, max_increment=0.25)
+    for a, (fx, fy) in zip(rows[-1], [(0, -1), (1, 0), (0, 1), (-1, 0)]):
+        st.load(a, fx=300.0 * fx + 100.0, fy=300.0 * fy)
+    return m, rows
+
+
+class _Counting:
+    """Count evaluations of every family of an analysis."""
+
+    def __init__(self, an):
+        self.calls = 0
+        for f in an.families:
+            original = f.evaluate
+
+            def evaluate(*args, _original=original, **kw):
+                self.calls += 1
+                return _original(*args, **kw)
+
+            f.evaluate = evaluate
+
+
+def test_reused_responses_save_one_evaluation_per_increment_and_change_nothing(tmp_path):
+    m, rows = _frame_model()
+    fast = Analysis(m, tmp_path / "fast", progress=False)
+    count = _Counting(fast)
+    fast.run()
+    # one evaluation per Newton iteration, plus the first increment's start (plus the initial frame)
+    assert count.calls == fast.summary.iterations + 2
+    slow = Analysis(m, tmp_path / "slow", progress=False)
+    for f in slow.families:
+        f.path_independent = False   # the instance attribute hides the class's True
+    count_slow = _Counting(slow)
+    slow.run()
+    assert count_slow.calls == slow.summary.iterations + slow.summary.increments + 1
+    # the reused response is the very response of that configuration: identical, bit for bit
+    assert slow.summary.iterations == fast.summary.iterations
+    np.testing.assert_array_equal(fast.x, slow.x)
+    np.testing.assert_array_equal(fast.R, slow.R)
+
+
+def test_direct_assembly_into_the_solver_matches_a_csr_tangent(tmp_path):
+    m, rows = _frame_model()
+    an = Analysis(m, tmp_path / "r", progress=False)
+    assert an.solver.chosen == "rcm" and an.solver.analyses == 1   # ordering chosen at set-up
+    an.run()
+    assert an.solver.analyses == 1   # never re-analysed
+    resp = an._evaluate(None)
+    an._residual(resp, an.loads)
+    K, _ = an._tangent(resp, with_fc=False)
+    Kfc, none = an._factorize_tangent(resp, with_fc=False)
+    assert Kfc is None and none is None   # went straight into the solver's matrix
+    rhs = np.random.default_rng(1).normal(size=K.shape[0])
+    x_direct = an.solver.solve(rhs)
+    x_ref = spla.spsolve(K.tocsc(), rhs)
+    # same matrix, same pivots up to ordering: agreement to round-off times the condition number
+    np.testing.assert_allclose(x_direct, x_ref, rtol=1e-8, atol=1e-12 * np.abs(x_ref).max())
+
+
+def _grid_laplacian(n):
+    """3D n^3 grid Laplacian plus identity: compact, not chain-like (RCM envelope >> nnz)."""
+    one = sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])
+    eye = sp.identity(n)
+    L = (sp.kron(sp.kron(one, eye), eye) + sp.kron(sp.kron(eye, one), eye) + sp.kron(sp.kron(eye, eye), one))
+    return (L + sp.identity(n ** 3)).tocsr()
+
+
+def test_rcm_kept_from_the_pattern_only_when_its_envelope_bounds_the_fill():
+    # a banded (chain-like) matrix: the RCM envelope holds nnz(K) entries, RCM is kept at once
+    n = 200
+    band = sp.diags([np.ones(n - 2), -np.ones(n - 1), 4 * np.ones(n), -np.ones(n - 1), np.ones(n - 2)],
+                    [-2, -1, 0, 1, 2]).tocsr()
+    s = SparseLU()
+    assert s.analyse(band) == "rcm"
+    s.factorize(band)
+    b = np.arange(n, dtype=float)
+    np.testing.assert_allclose(band @ s.solve(b), b, rtol=1e-12)   # well conditioned (diag. dominant)
+    # a compact 3D grid: envelope >> 2 nnz, so the choice is left to trial factorisations
+    G = _grid_laplacian(8)
+    s = SparseLU()
+    assert s.analyse(G) is None and s.chosen is None
+    s.factorize(G)
+    assert s.chosen == "mmd"   # minimum degree beats RCM on a 3D grid
+    b = np.ones(G.shape[0])
+    np.testing.assert_allclose(G @ s.solve(b), b, rtol=1e-10)   # condition number ~25
+
+
+def test_background_writer_keeps_every_frame_and_reports_a_write_error(tmp_path):
+    m, rows = _frame_model()
+    res = fm.solve(m, tmp_path / "r", progress=False)
+    assert len(res) == 1 + 4   # the initial frame and the 4 increments, all on disk after the run
+    u = [res.frame(i)["U"] for i in range(len(res))]
+    assert all(np.abs(a - b).max() > 0 for a, b in zip(u, u[1:]))   # distinct frames, in order
+
+    class Frozen:
+        node_labels = np.array([1])
+        coordinates = np.zeros((1, 3))
+
+    w = ResultsWriter(tmp_path / "w", Frozen(), [])
+    (tmp_path / "w" / "frames").rename(tmp_path / "w" / "gone")   # the frames folder vanishes
+    w.frame(U=np.zeros((1, 3)))
+    with pytest.raises(OSError, match="could not write results"):
+        w.close({})
+
+
+class _NaNTangent(ElementFamily):
+    """A spring between the x DOFs of its two nodes whose tangent carries a NaN off the diagonal."""
+
+    name = "broken_spring"
+    active_dofs = (0, 1, 2)
+
+    def __init__(self, nodes):
+        self.nodes = np.asarray(nodes, dtype=np.int64).reshape(1, 2)
+
+    def evaluate(self, x, R, state, ctx=None):
+        f = np.zeros((1, 12))
+        k = np.zeros((1, 12, 12))
+        k[0, 0, 0] = k[0, 6, 6] = 1e3
+        k[0, 0, 6] = np.nan
+        k[0, 6, 0] = -1e3
+        return ElementResponse(f=f, k=k, state=state)
+
+
+def test_a_nan_in_an_element_tangent_is_named(tmp_path):
+    m = fm.Model("nan")
+    a, b, c = m.node(0, 0, 0), m.node(1, 0, 0), m.node(2, 0, 0)
+    m.truss(a, b, EA=1e6)
+    m.truss(b, c, EA=1e6)
+    m.fix(a)
+    for n in (b, c):
+        m.fix(n, "uy", "uz")
+    m.add_family(_NaNTangent([b, c]))
+    m.step("pull").load(c, fx=1.0)
+    with pytest.raises(ConvergenceError, match="non-finite tangent stiffness in element family 'broken_spring'"):
+        fm.solve(m, tmp_path / "r", progress=False)
