@@ -266,15 +266,15 @@ class Analysis:
         the zero-force floors), go through :meth:`_tangent`."""
         ta = _time.perf_counter()
         if self.constraints.active or self._zero_force is None or self.solver.chosen is None:
-            K, Kfc = self._tangent(responses, with_fc)
-            self.summary.assembly_time += _time.perf_counter() - ta
-            ts = _time.perf_counter()
-            self.solver.factorize(K)
-            self.summary.solve_time += _time.perf_counter() - ts
-            return K, Kfc
+            return self._factorize_csr(responses, with_fc, ta)
         if self._direct is None or self._direct[0] != self.solver.layout:
-            self._direct = (self.solver.layout,
-                            [self.solver.permuted_positions(p) for p in self.assembler.pos_ff])
+            # a stabilised step may have widened the solver's pattern (a diagonal entry K_ff lacks):
+            # the direct path needs the solver's pattern to be K_ff's own
+            same = self.solver.has_pattern(self.assembler.K_ff)
+            self._direct = (self.solver.layout, [self.solver.permuted_positions(p) for p in self.assembler.pos_ff]
+                            if same else None)
+        if self._direct[1] is None:
+            return self._factorize_csr(responses, with_fc, ta)
         k_list = [q.k for q in responses]
         Kfc = self.assembler.coupling(k_list) if with_fc else None
         self.assembler.tangent_into(k_list, self.solver.values, self._direct[1])
@@ -283,6 +283,14 @@ class Analysis:
         self.solver.factorize_values()
         self.summary.solve_time += _time.perf_counter() - ts
         return None, Kfc
+
+    def _factorize_csr(self, responses, with_fc, ta):
+        K, Kfc = self._tangent(responses, with_fc)
+        self.summary.assembly_time += _time.perf_counter() - ta
+        ts = _time.perf_counter()
+        self.solver.factorize(K)
+        self.summary.solve_time += _time.perf_counter() - ts
+        return K, Kfc
 
     def _tangent(self, responses, with_fc):
         """(K_ff, K_fc) at the configuration of the last :meth:`_residual` call."""

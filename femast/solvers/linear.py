@@ -139,6 +139,10 @@ class SparseLU:
         self._B, self._gather = self._permuted(K, perm)
         return self.chosen
 
+    def has_pattern(self, K) -> bool:
+        """True if K has exactly the pattern the current ordering was analysed for."""
+        return self._pattern is not None and self._is_master(K)
+
     def permuted_positions(self, pos):
         """Positions in :attr:`values` of the entries at positions ``pos`` (-1: none) of the data
         array of a matrix with the master pattern: an assembler can then fill the solver's
