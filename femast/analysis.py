@@ -560,7 +560,7 @@ class Analysis:
                     self._commit(responses, P, F, lam)
                     return True, 0, "", responses
                 if it > 0:
-                    ok, ratio = self._converged(r, du, Du, responses, P)
+                    ok, ratio = self._converged(r, du, Du, responses, P, iters)
                     rnorm_hist.append(ratio)
                     if ok:
                         if stab is not None:
@@ -758,7 +758,7 @@ class Analysis:
                 r = res[:nf]
                 if not np.all(np.isfinite(r)):
                     raise FloatingPointError("non-finite residual")
-                ok, ratio = self._converged(r, du, Du, responses, P)
+                ok, ratio = self._converged(r, du, Du, responses, P, iters)
                 rhist.append(ratio)
                 if ok:
                     self._commit(responses, P, res, lam)
@@ -789,7 +789,7 @@ class Analysis:
     def _worst(self, r):
         return self.dofmap.describe(int(np.argmax(np.abs(r))))
 
-    def _converged(self, r, du, Du, responses, P):
+    def _converged(self, r, du, Du, responses, P, iteration=0):
         """Force/moment residual against the largest element nodal force/moment or applied load
         (Abaqus' 'flux' magnitude), displacement correction against the increment."""
         fmax = mmax = 0.0
@@ -803,7 +803,7 @@ class Analysis:
         L = self.length
         ref_f = max(fmax, 1e-2 * mmax / L, self._zero_force)
         ref_m = max(mmax, 1e-2 * fmax * L, self._zero_force * L)
-        return self.convergence.check(r, du, Du, self.is_rot, ref_f, ref_m, L)
+        return self.convergence.check(r, du, Du, self.is_rot, ref_f, ref_m, L, iteration)
 
     def _fail(self, saved, iters, why):
         self.x, self.R, self.spin, self.lam, self._version = saved

@@ -101,7 +101,9 @@ def test_non_convergence_keeps_converged_increments_and_says_where(tmp_path):
     assert steps.count("pull") == 2                      # both converged increments of step 1 kept
     assert steps.count("push") >= 4                       # the push increments before the cable went slack
     t_last = res.scalar_history("time")[-1]
-    assert 0.45 < t_last < 0.5                            # cut back towards the slack point, then gave up
+    # cut back towards the slack point, then gave up; the slack point itself (load = N = 0 at t = 0.5)
+    # is an equilibrium that a linear increment reaches in one iteration
+    assert 0.45 < t_last <= 0.5
     assert res.summary is not None and res.summary["completed"] is False
     N = res.element_history("cable", 1, "N")
     # the kept frames are equilibrium states: cable force = applied load.  Residual tolerance:
