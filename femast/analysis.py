@@ -315,8 +315,8 @@ class Analysis:
     def _update(self, du_free, du_cons=None):
         self._version += 1
         W = np.zeros_like(self.spin)
-        # each (node, dof) pair appears once among the free and once among the constrained
-        # equations, so plain fancy-index += is exact (no np.add.at needed)
+        # a (node, dof) pair is at most one equation, free or constrained: no index repeats, so
+        # plain fancy-index updates are exact (no np.add.at needed)
         for (node, dof, t), du in ((self._free_split, du_free), (self._cons_split, du_cons)):
             if du is None:
                 continue

@@ -103,11 +103,6 @@ class ResultsWriter:
         self.count += 1
         self._queue.put(((self.folder / "frames" / f"{self.count:06d}.npz",), data))
 
-    def flush(self):
-        """Wait until every queued frame is on disk."""
-        self._queue.join()
-        self._raise_error()
-
     def close(self, summary: dict):
         if self._thread.is_alive():
             self._queue.put(None)
