@@ -27,6 +27,7 @@ from .dofs import number_dofs
 from .elements.base import DOF_NAMES, IncrementContext
 from .elements.beam_corot import BeamFamily, element_frame
 from .elements.truss import TrussFamily
+from .reduction import ReducedTangent
 from .errors import ConvergenceError, ModelError, SingularModelError
 from .results import Results, ResultsWriter
 from .rotations import apply_spins as _apply_spins  # R <- exp(W) R, plain loops (fast to compile)
@@ -191,6 +192,10 @@ class Analysis:
             # constrained model's reduced pattern T^T K T is only known at its first iteration
             self.solver.analyse(self.assembler.K_ff)
         self._direct = None   # (solver layout, positions): K_ff assembled into the solver's matrix
+        # constrained models: T^T K T + G on a pattern computed once (femast/reduction.py)
+        self._reduced = (ReducedTangent(self.assembler.K_aa, self.constraints.transformation(self.X0),
+                                        *self.constraints.geometric_entries(), self.dofmap.n_free)
+                         if self.constraints.active else None)
         # configuration and committed state
         self.x = self.X0.copy()
         self.R = np.tile(np.eye(3), (n, 1, 1))
@@ -298,11 +303,9 @@ class Analysis:
         if not self.constraints.active:
             K, Kfc = self.assembler.tangent(k_list, with_fc=with_fc)
         else:
-            nf = self.dofmap.n_free
-            T = self._T
-            Kind = (T.T @ self.assembler.full_tangent(k_list) @ T
-                    + self.constraints.geometric(self.x, self._net)).tocsr()
-            K, Kfc = Kind[:nf, :nf], (Kind[:nf, nf:] if with_fc else None)
+            K_aa = self.assembler.full_tangent(k_list)
+            K, Kfc = self._reduced.fill(K_aa.data, self._T.data, self.constraints.geometric_values(self.x, self._net))
+            Kfc = Kfc if with_fc else None
         if self._zero_force is None:
             dk = np.abs(K.diagonal())
             kt, kr = (float(np.median(v[v > 0])) if np.any(v > 0) else 0.0

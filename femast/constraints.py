@@ -180,15 +180,19 @@ class Constraints:
         self._T.data[self._T_pos] = vals
         return self._T
 
-    def geometric(self, x, f_net):
-        """G (n_ind x n_ind): derivative of the lever arms, sum_s [f_s]x [d_s]x = d f^T - (f.d) I
-        on the reference rotation block."""
-        n = self.n_ind
+    def geometric_entries(self):
+        """(rows, cols) in independent numbering of the entries :meth:`geometric_values` fills."""
         if not len(self.rigid_slave):
-            return sp.csr_matrix((n, n))
+            return np.zeros(0, np.int64), np.zeros(0, np.int64)
+        return self._G_rows, self._G_cols
+
+    def geometric_values(self, x, f_net):
+        """Values of G at :meth:`geometric_entries`: per rigid slave, d f^T - (f.d) I (3x3, row-major)."""
+        if not len(self.rigid_slave):
+            return np.zeros(0)
         s, r = self.rigid_slave[:, 0], self.rigid_slave[:, 1]
         d = x[s] - x[r]
         eqs = self._slave_trans_eq
         f = np.where(eqs >= 0, f_net[np.maximum(eqs, 0)], 0.0)
         B = d[:, :, None] * f[:, None, :] - np.einsum("ki,ki->k", f, d)[:, None, None] * np.eye(3)
-        return sp.csr_matrix((B.ravel(), (self._G_rows, self._G_cols)), shape=(n, n))
+        return B.ravel()

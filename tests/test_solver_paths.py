@@ -168,3 +168,27 @@ def test_a_nan_in_an_element_tangent_is_named(tmp_path):
     m.step("pull").load(c, fx=1.0)
     with pytest.raises(ConvergenceError, match="non-finite tangent stiffness in element family 'broken_spring'"):
         fm.solve(m, tmp_path / "r", progress=False)
+
+
+def test_reduced_tangent_matches_the_sparse_product():
+    # T^T K T + G on the fixed pattern against scipy's product, random values on random patterns
+    from femast.reduction import ReducedTangent
+
+    rng = np.random.default_rng(3)
+    n_act, n_ind, nf = 40, 30, 24
+    K = sp.random(n_act, n_act, density=0.15, random_state=4, format="csr") + sp.identity(n_act, format="csr")
+    K.sort_indices()
+    T = (sp.random(n_act, n_ind, density=0.06, random_state=5, format="csr")
+         + sp.eye(n_act, n_ind, format="csr")).tocsr()
+    T.sort_indices()
+    g_rows, g_cols = rng.integers(0, n_ind, 12), rng.integers(0, n_ind, 12)
+    red = ReducedTangent(K, T, g_rows, g_cols, nf)
+    for _ in range(2):   # refilled in place with new values on the same patterns
+        K.data[:] = rng.normal(size=K.nnz)
+        T.data[:] = rng.normal(size=T.nnz)
+        g = rng.normal(size=12)
+        K_ff, K_fc = red.fill(K.data, T.data, g)
+        full = (T.T @ K @ T + sp.csr_matrix((g, (g_rows, g_cols)), shape=(n_ind, n_ind))).toarray()
+        # same sums in another order: agreement to round-off of O(10) terms of size O(1)
+        np.testing.assert_allclose(K_ff.toarray(), full[:nf, :nf], atol=1e-12)
+        np.testing.assert_allclose(K_fc.toarray(), full[:nf, nf:], atol=1e-12)
