@@ -123,12 +123,18 @@ class Analysis:
         increment (Abaqus' default linear extrapolation); off after a step change.
     easy_iterations : an increment converged in at most this many iterations is easy (Abaqus'
         I_G = 4 with looser tolerances; 6 with femast's tighter defaults).
+    on_frame : a recorder, called with each frame's dict (the arrays written to
+        ``frames/NNNNNN.npz``; the first call is the initial state) as soon as its increment has
+        converged.  A script that needs a few quantities keeps them in memory this way instead of
+        reading the results folder back (which costs about as much as the analysis of a small
+        model).  Do not modify the arrays: the same ones are being written to disk.
     """
 
     def __init__(self, model, out="results", convergence: Convergence | None = None, progress: bool = True,
                  cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
-                 extrapolate: bool = False):
+                 extrapolate: bool = False, on_frame=None):
         self.model = model
+        self.on_frame = on_frame
         self.out = out
         self.convergence = convergence or Convergence()
         self.progress = progress
@@ -838,6 +844,8 @@ class Analysis:
             for key, val in r.output.items():
                 data[f"el/{f.name}/{key}"] = val
         writer.frame(**data)
+        if self.on_frame is not None:
+            self.on_frame(data)
 
 
 def solve(model, out="results", **options) -> Results:

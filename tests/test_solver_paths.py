@@ -122,10 +122,18 @@ def test_rcm_kept_from_the_pattern_only_when_its_envelope_bounds_the_fill():
 
 def test_background_writer_keeps_every_frame_and_reports_a_write_error(tmp_path):
     m, rows = _frame_model()
-    res = fm.solve(m, tmp_path / "r", progress=False)
+    recorded = []
+    res = fm.Analysis(m, tmp_path / "r", progress=False, on_frame=recorded.append).run()
     assert len(res) == 1 + 4   # the initial frame and the 4 increments, all on disk after the run
     u = [res.frame(i)["U"] for i in range(len(res))]
     assert all(np.abs(a - b).max() > 0 for a, b in zip(u, u[1:]))   # distinct frames, in order
+    # the recorder saw exactly what is on disk, frame by frame
+    assert len(recorded) == len(res)
+    for i, fr in enumerate(recorded):
+        disk = res.frame(i)
+        assert set(fr) == set(disk)
+        for key in fr:
+            np.testing.assert_array_equal(np.asarray(fr[key]), disk[key])
 
     class Frozen:
         node_labels = np.array([1])

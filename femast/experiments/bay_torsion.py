@@ -190,26 +190,28 @@ def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None 
                              min_increment=1e-5, max_increments=100 * len(tab) + 100)
         step.follow(am.control, t, rz=tab[:, 0], ux=tab[:, 1], uy=tab[:, 2])
     fam = am.latch_family
+    row = am.model.index(am.control)
+    rec = []   # per converged increment, what this experiment needs (kept in memory: no read-back)
+
+    def record(fr):
+        rec.append((str(fr["step"]), float(fr["total_time"]), -(fr["P"][row, 5] + fr["RF"][row, 5]),
+                    fr["U"][row, 2], fr[f"el/{fam}/bead_position"], fr[f"el/{fam}/latch_dT"],
+                    fr[f"el/{fam}/latch_zone"]))
+
     with tempfile.TemporaryDirectory(prefix="femast_bay_") as d:
-        an = Analysis(am.model, d, progress=False, convergence=CONVERGENCE)
+        an = Analysis(am.model, d, progress=False, convergence=CONVERGENCE, on_frame=record)
         with kernel_threads(threads):
-            res = an.run()
-        row = int(np.flatnonzero(res.node_labels == am.control)[0])
-        steps = res.steps
-        tt = res.time
-        i_eq = max(i for i, s in enumerate(steps) if s != "path")  # end of the initial (pretension) step(s)
-        frame_of = [i_eq] + [max(i for i in range(i_eq + 1, len(res)) if abs(tt[i] - tt[i_eq] - j) < 1e-7)
-                             for j in range(1, len(tab))]
-        out = {k: np.empty(m) for k in ("Mz", "uz")}
-        out.update({k: np.empty((m, 4)) for k in ("bead", "dT")})
-        out["zone"] = np.empty((m, 4), dtype=int)
-        for k in range(m):
-            fr = res.frame(frame_of[state[k]])
-            out["Mz"][k] = -(fr["P"][row, 5] + fr["RF"][row, 5])
-            out["uz"][k] = fr["U"][row, 2]
-            out["bead"][k] = fr[f"el/{fam}/bead_position"]
-            out["dT"][k] = fr[f"el/{fam}/latch_dT"]
-            out["zone"][k] = fr[f"el/{fam}/latch_zone"]
+            an.run()
+    steps = [r[0] for r in rec]
+    tt = np.array([r[1] for r in rec])
+    i_eq = max(i for i, s in enumerate(steps) if s != "path")  # end of the initial (pretension) step(s)
+    frame_of = [i_eq] + [max(i for i in range(i_eq + 1, len(rec)) if abs(tt[i] - tt[i_eq] - j) < 1e-7)
+                         for j in range(1, len(tab))]
+    out = {k: np.empty(m) for k in ("Mz", "uz")}
+    out.update({k: np.empty((m, 4)) for k in ("bead", "dT")})
+    out["zone"] = np.empty((m, 4), dtype=int)
+    for k in range(m):
+        _, _, out["Mz"][k], out["uz"][k], out["bead"][k], out["dT"][k], out["zone"][k] = rec[frame_of[state[k]]]
     out.update(increments=an.summary.increments, iterations=an.summary.iterations,
                wall_time=time.perf_counter() - t0)
     return out

@@ -170,22 +170,22 @@ def run_mast(inputs: dict, loads: np.ndarray, n_bays: int, fold: int = 1, altern
         prev = loads[k]
     fam = am.latch_family
     n_lat = 4 * am.n_bays
+    row = am.model.index(am.control)
+    steps, rec = [], []   # per converged increment, what this experiment needs (in memory: no read-back)
+
+    def record(fr):
+        steps.append(str(fr["step"]))
+        rec.append((np.concatenate([fr["U"][row], fr["URA"][row]]), fr[f"el/{fam}/bead_position"][:n_lat],
+                    fr[f"el/{fam}/latch_zone"][:n_lat]))
+
     with tempfile.TemporaryDirectory(prefix="femast_mast_") as d:
-        an = Analysis(am.model, d, progress=False, convergence=CONVERGENCE)
+        an = Analysis(am.model, d, progress=False, convergence=CONVERGENCE, on_frame=record)
         with kernel_threads(threads):
-            res = an.run()
-        row = int(np.flatnonzero(res.node_labels == am.control)[0])
-        steps = res.steps
-        i_ref = max(i for i, s in enumerate(steps) if not s.startswith("row"))
-        ends = [max(i for i, s in enumerate(steps) if s == nm) for nm in names]
-
-        def grab(i):
-            fr = res.frame(i)
-            return (np.concatenate([fr["U"][row], fr["URA"][row]]), fr[f"el/{fam}/bead_position"][:n_lat],
-                    fr[f"el/{fam}/latch_zone"][:n_lat])
-
-        ref, bead0, zone0 = grab(i_ref)
-        got = [grab(i) for i in ends]
+            an.run()
+    i_ref = max(i for i, s in enumerate(steps) if not s.startswith("row"))
+    ends = [max(i for i, s in enumerate(steps) if s == nm) for nm in names]
+    ref, bead0, zone0 = rec[i_ref]
+    got = [rec[i] for i in ends]
     motion = np.empty((m, 6))
     bead = np.empty((m, n_lat))
     zone = np.empty((m, n_lat), dtype=int)
