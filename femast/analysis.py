@@ -246,10 +246,14 @@ class Analysis:
     def _nonfinite_tangent(self, responses):
         """Why a factorisation or solve failed, if an element tangent holds a NaN or inf (tested
         only then: a scan of every element matrix costs as much as assembling them)."""
-        for f, r in zip(self.families, responses):
+        for f, r in zip(self.families, responses or ()):
             if not np.all(np.isfinite(r.k)):
                 return f"non-finite tangent stiffness in element family '{f.name}'"
         return None
+
+    def _bad_tangent(self, exc, responses):
+        """The named non-finite element tangent behind a failed factorisation or solve, or None."""
+        return self._nonfinite_tangent(responses) if isinstance(exc, SingularModelError) else None
 
     def _residual(self, responses, P):
         """Residual P - F on the independent DOFs (free first, then constrained)."""
@@ -275,9 +279,8 @@ class Analysis:
         matrix (positions composed once: no CSR fill and no gather per iteration), and K_ff is
         then not formed (None).  Constrained models, and the first tangent (whose diagonal sets
         the zero-force floors), go through :meth:`_tangent`."""
-        ta = _time.perf_counter()
         if self.constraints.active or self._zero_force is None or self.solver.chosen is None:
-            return self._factorize_csr(responses, with_fc, ta)
+            return self._factorize_csr(responses, with_fc)
         if self._direct is None or self._direct[0] != self.solver.layout:
             # a stabilised step may have widened the solver's pattern (a diagonal entry K_ff lacks):
             # the direct path needs the solver's pattern to be K_ff's own
@@ -285,7 +288,8 @@ class Analysis:
             self._direct = (self.solver.layout, [self.solver.permuted_positions(p) for p in self.assembler.pos_ff]
                             if same else None)
         if self._direct[1] is None:
-            return self._factorize_csr(responses, with_fc, ta)
+            return self._factorize_csr(responses, with_fc)
+        ta = _time.perf_counter()
         k_list = [q.k for q in responses]
         Kfc = self.assembler.coupling(k_list) if with_fc else None
         self.assembler.tangent_into(k_list, self.solver.values, self._direct[1])
@@ -295,8 +299,13 @@ class Analysis:
         self.summary.solve_time += _time.perf_counter() - ts
         return None, Kfc
 
-    def _factorize_csr(self, responses, with_fc, ta):
+    def _factorize_csr(self, responses, with_fc, adjust=None):
+        """Assemble K_ff as a CSR matrix (passed through ``adjust`` if given, e.g. to add damping)
+        and factorise it; returns (K_ff, K_fc or None)."""
+        ta = _time.perf_counter()
         K, Kfc = self._tangent(responses, with_fc)
+        if adjust is not None:
+            K = adjust(K)
         self.summary.assembly_time += _time.perf_counter() - ta
         ts = _time.perf_counter()
         self.solver.factorize(K)
@@ -539,6 +548,13 @@ class Analysis:
 
         stab = step.stabilize
 
+        def damped(K):
+            """K + C/dt: the viscous term of the stabilisation (*STABILIZE)."""
+            if self._stab_C is None:  # damping from the tangent at the start of the step
+                self._stab_C = stab.damping(K.diagonal(), self.is_rot, self._stab_dt0)
+                self._stab_C0 = self._stab_C.copy()
+            return (K + sp.diags(self._stab_C / dt)).tocsr()
+
         def evaluate(P, Dtrial=None, reuse=False):
             ta = _time.perf_counter()
             resp = self._evaluate(ctx, reuse=reuse)
@@ -595,16 +611,7 @@ class Analysis:
                     if stab is None:
                         K, Kfc = self._factorize_tangent(responses, with_fc=(it == 0 and has_dpres))
                     else:
-                        ta = _time.perf_counter()
-                        K, Kfc = self._tangent(responses, with_fc=(it == 0 and has_dpres))
-                        if self._stab_C is None:  # damping from the tangent at the start of the step
-                            self._stab_C = stab.damping(K.diagonal(), self.is_rot, self._stab_dt0)
-                            self._stab_C0 = self._stab_C.copy()
-                        K = (K + sp.diags(self._stab_C / dt)).tocsr()
-                        self.summary.assembly_time += _time.perf_counter() - ta
-                        ts = _time.perf_counter()
-                        self.solver.factorize(K)
-                        self.summary.solve_time += _time.perf_counter() - ts
+                        K, Kfc = self._factorize_csr(responses, with_fc=(it == 0 and has_dpres), adjust=damped)
                 except SingularModelError:
                     bad = self._nonfinite_tangent(responses)
                     if bad:
@@ -639,7 +646,7 @@ class Analysis:
                     Du = Du_before + du
                 r = r_new
         except (FloatingPointError, SingularModelError, ValueError) as exc:
-            bad = self._nonfinite_tangent(responses) if isinstance(exc, SingularModelError) and responses else None
+            bad = self._bad_tangent(exc, responses)
             if bad:
                 return self._fail(saved, iters, bad)
             if isinstance(exc, SingularModelError) and self.summary.increments == 0 and iters == 0:
@@ -788,7 +795,7 @@ class Analysis:
                 iters += 1
             return self._fail_arc(saved, iters, f"no convergence in {iters} iterations", dl)
         except (FloatingPointError, SingularModelError) as exc:
-            bad = self._nonfinite_tangent(responses) if isinstance(exc, SingularModelError) and responses else None
+            bad = self._bad_tangent(exc, responses)
             return self._fail_arc(saved, iters, bad or str(exc), dl)
 
     def _fail_arc(self, saved, iters, why, dl):

@@ -111,6 +111,7 @@ class ReducedTangent:
 
 
 def _indptr(rows, n):
+    """CSR row pointer of row-sorted entries in rows ``rows`` of an n-row matrix."""
     ptr = np.zeros(n + 1, np.int64)
-    np.add.at(ptr, rows + 1, 1)
-    return np.cumsum(ptr)
+    ptr[1:] = np.cumsum(np.bincount(rows, minlength=n))
+    return ptr

@@ -17,7 +17,6 @@ import numpy as np
 
 from . import references as ref
 from .analysis import Analysis
-from .amplitudes import Amplitude
 from .model import Model
 from .sections import Section, square_tube
 from .solvers.control import DisplacementControl
@@ -101,7 +100,6 @@ def elastica(n_elements=20, loads=(1, 2, 3, 4, 5, 6, 7, 8, 9, 10), out_dir=None,
 def bend45(n_elements=16, out_dir=None, progress=False):
     """Bathe-Bolourchi 45-degree bend: R = 100, unit square section, E = 1e7, G = E/2, tip load
     along +Z up to 600; tip positions at 300, 450, 600 against a converged rod solution."""
-    b = ref.BEND45 if hasattr(ref, "BEND45") else {}
     R, E = 100.0, 1.0e7
     sec = Section(E=E, G=E / 2.0, A=1.0, Iy=1.0 / 12, Iz=1.0 / 12, J=0.140577, name="unit square")
     m = Model("bend45")

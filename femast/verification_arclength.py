@@ -7,8 +7,6 @@ from __future__ import annotations
 
 import tempfile
 
-import numpy as np
-
 from . import references as ref
 from .analysis import Analysis
 from .model import Model

@@ -1,27 +1,15 @@
 """The ```python examples of docs/adam_bay.md and docs/adam_mast.md run, and print what the pages
 say they print (the quoted numbers are the benchmark's; the examples never rot)."""
 
-import os
 import re
-from pathlib import Path
 
 import pytest
-
-DOCS = Path(__file__).resolve().parents[1] / "docs"
+from doc_examples import DOCS, run_python_blocks
 
 
 @pytest.mark.parametrize("page", ["adam_bay.md", "adam_mast.md"])
 def test_adam_page_examples_run(page, tmp_path, capsys):
-    text = (DOCS / page).read_text()
-    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
-    assert blocks, f"{page} has no python example"
-    cwd = os.getcwd()
-    os.chdir(tmp_path)
-    try:
-        for i, src in enumerate(blocks):
-            exec(compile(src, f"{page}[{i}]", "exec"), {"__name__": "__doc_example__"})
-    finally:
-        os.chdir(cwd)
+    text = run_python_blocks(page, cwd=tmp_path)
     out = capsys.readouterr().out
     quoted = re.findall(r"prints `([^`]+)`", text)
     block = re.search(r"\nprints\n\n((?:    [^\n]+\n)+)", text)

@@ -4,11 +4,9 @@ commit/rollback, a two-beam model solved with fm.solve, bad input."""
 
 from __future__ import annotations
 
-import re
-from pathlib import Path
-
 import numpy as np
 import pytest
+from doc_examples import run_python_blocks
 
 import femast as fm
 from femast.elements.ball_joint import (
@@ -348,8 +346,4 @@ def test_default_stiffnesses_follow_the_connected_members():
 
 # ----------------------------------------------------------------------------- docs
 def test_doc_examples_run():
-    text = (Path(__file__).resolve().parents[1] / "docs" / "ball_joint.md").read_text()
-    code = re.findall(r"```python\n(.*?)```", text, re.S)
-    assert code, "no python example in docs/ball_joint.md"
-    for i, src in enumerate(code):
-        exec(compile(src, f"ball_joint.md[{i}]", "exec"), {"__name__": "__doc_example__"})
+    run_python_blocks("ball_joint.md")

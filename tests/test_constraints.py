@@ -1,6 +1,5 @@
 """Issue 3, item 1: rigid bodies and ties, exact for large rotations."""
 
-import math
 import tempfile
 
 import numpy as np

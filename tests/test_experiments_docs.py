@@ -6,6 +6,8 @@ from pathlib import Path
 
 import pytest
 
+from doc_examples import run_python_blocks
+
 from femast.cli import main
 from femast.effects import list_effects, unregister_effect
 
@@ -14,15 +16,10 @@ DOCS = ROOT / "docs"
 
 
 @pytest.mark.parametrize("page", ["experiments.md", "compare_and_diagnose.md"])
-def test_python_examples_run(page, capsys, monkeypatch):
-    text = (DOCS / page).read_text()
-    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
-    assert blocks
-    monkeypatch.chdir(ROOT)  # the examples read the shipped data by relative path
+def test_python_examples_run(page, capsys):
     before = {e.name for e in list_effects()}
-    try:
-        for i, src in enumerate(blocks):
-            exec(compile(src, f"{page}[{i}]", "exec"), {"__name__": "__doc_example__"})
+    try:  # the examples read the shipped data by relative path: run them from the repository root
+        text = run_python_blocks(page, cwd=ROOT)
     finally:  # an example's user effect must not become a candidate of later diagnoses
         for e in list_effects():
             if e.name not in before:

@@ -1,7 +1,6 @@
 """Issue 2, item 7: results on disk, histories, VTK series, PNG rendering and the CLI."""
 
 import json
-import math
 import xml.etree.ElementTree as ET
 
 import meshio

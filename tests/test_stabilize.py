@@ -1,7 +1,6 @@
 """Issue 3, item 3: viscous stabilisation (*STABILIZE) of an initially unstable step."""
 
 import tempfile
-import warnings
 
 import numpy as np
 import pytest

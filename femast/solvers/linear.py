@@ -163,16 +163,12 @@ class SparseLU:
     def factorize_values(self):
         """Factorise the matrix whose values were written into :attr:`values` (same checks and
         errors as :meth:`factorize`)."""
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("error", spla.MatrixRankWarning)
-                self._lu = self._factor_timed(self._B)
-        except (RuntimeError, spla.MatrixRankWarning) as exc:
-            self._lu = None
-            raise SingularModelError(str(exc)) from None
-        self._checked = False
-        if self.pivot_check == "always" or self._dmax is None:
-            self._check_pivots()
+
+        def step():
+            self._lu = self._timed(self._factor_permuted, self._B)
+            return False
+
+        self._guarded(step)
 
     def _set_master(self, K):
         self.layout += 1
@@ -208,9 +204,10 @@ class SparseLU:
         return spla.splu(B, permc_spec="NATURAL", diag_pivot_thresh=self.pivot_threshold,
                          options=dict(SymmetricMode=True))
 
-    def _factor_timed(self, B):
+    def _timed(self, factor, *args):
+        """``factor(*args)``: a kept numeric factorisation, its wall time added to superlu_seconds."""
         t0 = perf_counter()
-        lu = self._factor_permuted(B)
+        lu = factor(*args)
         self.superlu_seconds += perf_counter() - t0
         self.factorizations += 1
         return lu
@@ -289,31 +286,35 @@ class SparseLU:
 
     # ------------------------------------------------------------------ numeric part
     def factorize(self, K):
+        self._guarded(lambda: self._factorize_matrix(K))
+
+    def _factorize_matrix(self, K):
+        """Set self._lu to the LU of K; returns True if K's pattern was (re)analysed."""
+        if self.ordering == "colamd":
+            self._perm = None
+            self._lu = self._timed(spla.splu, K.tocsc())
+            return True
+        K = K if K.format == "csr" else K.tocsr()
+        if not K.has_canonical_format:
+            K = K.copy()
+            K.sum_duplicates()
+        if self._pattern is None:
+            self._lu = self._analyse(K)
+            return True
+        data = self._master_data(K)
+        if data is None:   # a new analysis, which has factorised already
+            return True
+        np.take(data, self._gather, out=self._B.data)
+        self._lu = self._timed(self._factor_permuted, self._B)
+        return False
+
+    def _guarded(self, step):
+        """Run ``step()`` (sets self._lu; True if the pattern was newly analysed) with SuperLU's
+        failures raised as SingularModelError, then the zero-pivot test when it is due."""
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("error", spla.MatrixRankWarning)
-                if self.ordering == "colamd":
-                    self._perm = None
-                    Kc = K.tocsc()
-                    t0 = perf_counter()
-                    self._lu = spla.splu(Kc)
-                    self.superlu_seconds += perf_counter() - t0
-                    self.factorizations += 1
-                    analysed = True
-                else:
-                    K = K if K.format == "csr" else K.tocsr()
-                    if not K.has_canonical_format:
-                        K = K.copy()
-                        K.sum_duplicates()
-                    if self._pattern is None:
-                        self._lu = self._analyse(K)
-                        analysed = True
-                    else:
-                        data = self._master_data(K)
-                        analysed = data is None
-                        if not analysed:
-                            np.take(data, self._gather, out=self._B.data)
-                            self._lu = self._factor_timed(self._B)
+                analysed = step()
         except (RuntimeError, spla.MatrixRankWarning) as exc:
             self._lu = None
             raise SingularModelError(str(exc)) from None
