@@ -2,6 +2,7 @@
 
 import os
 import re
+import shlex
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
@@ -22,3 +23,26 @@ def run_python_blocks(page: str, cwd=None) -> str:
     finally:
         os.chdir(old)
     return text
+
+
+def replay_transcript(block: str, folder, capsys, ignore=lambda line: False, what: str = "the page") -> int:
+    """Run the commands of a quoted console transcript in ``folder`` (the current directory) --
+    ``$ femast ...`` through femast.cli.main, ``$ head -N FILE`` -- and check that every other
+    non-blank line (unless ``ignore(line)``) is in what the command before it printed.  A run time
+    quoted after a command, ``(12.3 s)``, is not part of it.  Returns the number of lines checked."""
+    from femast.cli import main
+
+    out, checked = "", 0
+    for line in block.splitlines():
+        if line.startswith("$ "):
+            cmd = shlex.split(re.sub(r"\s+\(\d+(\.\d+)? s\)$", "", line[2:]))
+            if cmd[0] == "femast":
+                assert main(cmd[1:]) == 0, line
+                out = capsys.readouterr().out
+            elif cmd[0] == "head":
+                out = "".join((Path(folder) / cmd[-1]).read_text().splitlines(True)[:int(cmd[1][1:])])
+            continue
+        if line.strip() and not ignore(line):
+            assert line.rstrip() in out, f"{what} quotes a line the command does not print:\n{line}"
+            checked += 1
+    return checked

@@ -1,14 +1,11 @@
 """The experiments docs run: python examples execute, and the tutorial's commands print what the page quotes."""
 
 import re
-import shlex
 from pathlib import Path
 
 import pytest
+from doc_examples import replay_transcript, run_python_blocks
 
-from doc_examples import run_python_blocks
-
-from femast.cli import main
 from femast.effects import list_effects, unregister_effect
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,19 +32,6 @@ def test_tutorial_commands_print_what_the_page_quotes(tmp_path, capsys, monkeypa
     assert len(blocks) >= 5
     monkeypatch.chdir(tmp_path)  # outputs (tutorial/...) go to a temporary folder
     (tmp_path / "benchmarks").symlink_to(ROOT / "benchmarks")
-    checked = 0
-    for block in blocks:
-        cmd, out = None, ""
-        for line in block.splitlines() + ["$ end"]:
-            if line.startswith("$ "):
-                cmd = shlex.split(line[2:])
-                if cmd[0] == "femast":
-                    assert main(cmd[1:]) == 0, line
-                    out = capsys.readouterr().out
-                elif cmd[0] == "head":
-                    out = "".join((tmp_path / cmd[-1]).read_text().splitlines(True)[:int(cmd[1][1:])])
-                continue
-            if line.strip() and line.strip() != "...":
-                assert line.rstrip() in out, f"the tutorial quotes a line the command does not print:\n{line}"
-                checked += 1
+    checked = sum(replay_transcript(block, tmp_path, capsys, ignore=lambda line: line.strip() == "...",
+                                    what="the tutorial") for block in blocks)
     assert checked > 40

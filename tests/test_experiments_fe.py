@@ -10,7 +10,6 @@ tests/test_experiments_fe.py``.
 
 import json
 import re
-import shlex
 import tempfile
 from pathlib import Path
 
@@ -283,27 +282,16 @@ def test_tip_null_case_nothing_is_missing():
 @pytest.mark.slow
 def test_tutorial_section8_commands_print_what_the_page_quotes(tmp_path, capsys, monkeypatch):
     # docs/compare_and_diagnose.md section 8 (FE bay): its `text` blocks hold commands with their times
-    from femast.cli import main
+    from doc_examples import replay_transcript
 
     text = (ROOT / "docs" / "compare_and_diagnose.md").read_text()
     sec = text[text.index("## 8. An FE experiment"):text.index("## What was hidden")]
     monkeypatch.chdir(tmp_path)
     (tmp_path / "benchmarks").symlink_to(ROOT / "benchmarks")
-    checked = 0
-    for block in re.findall(r"```text\n(.*?)```", sec, re.S):
-        out = ""
-        for line in block.splitlines():
-            if line.startswith("$ "):
-                cmd = shlex.split(re.sub(r"\s+\(\d+(\.\d+)? s\)$", "", line[2:]))
-                if cmd[0] == "femast":
-                    assert main(cmd[1:]) == 0, line
-                    out = capsys.readouterr().out
-                elif cmd[0] == "head":
-                    out = "".join((tmp_path / cmd[-1]).read_text().splitlines(True)[:int(cmd[1][1:])])
-                continue
-            if line.strip() and "local processes" not in line:  # the process count follows the machine
-                assert line.rstrip() in out, f"section 8 quotes a line the command does not print:\n{line}"
-                checked += 1
+    checked = sum(replay_transcript(block, tmp_path, capsys, what="section 8",
+                                    # the process count follows the machine
+                                    ignore=lambda line: "local processes" in line)
+                  for block in re.findall(r"```text\n(.*?)```", sec, re.S))
     assert checked > 30  # the section quotes 40 lines besides the process count
     rep = json.loads((tmp_path / "tutorial" / "bay" / "diagnose.json").read_text())
     f_h = rep["ranking"][0]["params"]["F_h"]

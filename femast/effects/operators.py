@@ -18,31 +18,14 @@ from numba import njit
 
 @njit(cache=True)
 def _play(u, r, p0):
+    """Play operator with half-width r[i, j] >= 0 at each input u[i, j] (columns independent)."""
     n, m = u.shape
     out = np.empty_like(u)
     for j in range(m):
         p = p0
         for i in range(n):
-            lo = u[i, j] - r
-            hi = u[i, j] + r
-            if p < lo:
-                p = lo
-            elif p > hi:
-                p = hi
-            out[i, j] = p
-    return out
-
-
-@njit(cache=True)
-def _proportional_play(u, eta, p0):
-    n, m = u.shape
-    out = np.empty_like(u)
-    for j in range(m):
-        p = p0
-        for i in range(n):
-            r = eta * abs(u[i, j])
-            lo = u[i, j] - r
-            hi = u[i, j] + r
+            lo = u[i, j] - r[i, j]
+            hi = u[i, j] + r[i, j]
             if p < lo:
                 p = lo
             elif p > hi:
@@ -55,11 +38,11 @@ def play(u, r: float, p0: float = 0.0) -> np.ndarray:
     """Play operator of half-width ``r`` (unit of ``u``, >= 0) on each column of ``u`` (n,) or (n, k)."""
     u = np.asarray(u, dtype=float)
     u2 = np.ascontiguousarray(u.reshape(u.shape[0], -1))
-    return _play(u2, max(float(r), 0.0), float(p0)).reshape(u.shape)
+    return _play(u2, np.full_like(u2, max(float(r), 0.0)), float(p0)).reshape(u.shape)
 
 
 def proportional_play(u, eta: float, p0: float = 0.0) -> np.ndarray:
     """Play operator with half-width ``eta |u|`` (eta dimensionless, >= 0) on each column of ``u``."""
     u = np.asarray(u, dtype=float)
     u2 = np.ascontiguousarray(u.reshape(u.shape[0], -1))
-    return _proportional_play(u2, max(float(eta), 0.0), float(p0)).reshape(u.shape)
+    return _play(u2, max(float(eta), 0.0) * np.abs(u2), float(p0)).reshape(u.shape)
