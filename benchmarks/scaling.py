@@ -19,6 +19,10 @@ solved --repeat times and the medians are printed:
 Targets: time per iteration <= 1.5 x (factorisation + solve of the same tangent); time per
 increment growing at most linearly with the number of bays from 40 to 1000 bays.
 
+The figure ``benchmarks/out/scaling.png`` (time per iteration and the iteration/solve ratio against
+the size; ``--docs`` copies it to docs/figures/performance_scaling.png) and the table
+``benchmarks/out/scaling.json`` are written at the end; ``--plot`` redraws the figure from the table.
+
     python benchmarks/scaling.py --profile 400
 
 prints the cProfile of building and solving the 400-bay mast (numba cache warm), the profile shown
@@ -41,13 +45,17 @@ import argparse
 import json
 import os
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = Path(HERE).parent
+OUT = ROOT / "benchmarks" / "out"
 sys.path.insert(0, os.path.join(HERE, "peers"))
 
 
@@ -230,6 +238,8 @@ def main(argv=None):
     ap.add_argument("--profile", type=int, metavar="BAYS", help="cProfile of one run of this size instead")
     ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--jit-probe", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--docs", action="store_true", help="also copy the figure to docs/figures")
+    ap.add_argument("--plot", action="store_true", help="redraw the figure from the last run's table")
     args = ap.parse_args(argv)
     if args.jit_probe:
         return jit_probe()
@@ -239,6 +249,9 @@ def main(argv=None):
         return profile(args.profile, args.increments)
     if args.child:
         return child(args.child, args.increments, args.repeat, args.reps)
+    if args.plot:
+        plot(json.loads((OUT / "scaling.json").read_text()), OUT / "scaling.png")
+        return print(f"figure {OUT / 'scaling.png'}")
     rows = []
     for nb in args.bays:
         cmd = [sys.executable, os.path.abspath(__file__), "--child", str(nb), "--increments", str(args.increments),
@@ -309,6 +322,44 @@ def main(argv=None):
     print(f"CPU time per iteration / (factorisation + solve), worst: {worst_c:.2f} against bare SuperLU "
           f"({'met' if worst_c <= 1.5 else 'NOT MET'}), {worst_sc:.2f} against scipy's default splu "
           f"({'met' if worst_sc <= 1.5 else 'NOT MET'}); growth at most linear: {'yes' if ok_lin_c else 'NO'}")
+    OUT.mkdir(parents=True, exist_ok=True)
+    (OUT / "scaling.json").write_text(json.dumps(rows, indent=1))
+    plot(rows, OUT / "scaling.png")
+    print(f"figure {OUT / 'scaling.png'}, table {OUT / 'scaling.json'}")
+    if args.docs:
+        shutil.copy(OUT / "scaling.png", ROOT / "docs" / "figures" / "performance_scaling.png")
+
+
+def plot(rows, path):
+    """Time per increment and per iteration against the model size, and the iteration over the
+    solve in the same run against the 1.5 target."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    bays = [r["bays"] for r in rows]
+    it = [1e3 * r["wall"] / r["iterations"] for r in rows]
+    slu = [1e3 * r["superlu_in_run"] / r["iterations"] for r in rows]
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    a.loglog(bays, it, "o-", label="Newton iteration (everything)")
+    a.loglog(bays, slu, "s-", label="inside SuperLU (factorise + solve), same run")
+    a.loglog(bays, [1.5 * v for v in slu], ":", color="gray", label="1.5 x SuperLU (target)")
+    a.loglog(bays, [it[0] * n / bays[0] for n in bays], "--", color="k", lw=0.8, label="linear growth from the first size")
+    a.set(xlabel="bays (24 DOFs each)", ylabel="ms per Newton iteration",
+          title="truss mast of beam-columns, 10 load increments")
+    a.grid(alpha=0.3, which="both")
+    a.legend(fontsize=8)
+    b.semilogx(bays, [r["iter_over_superlu"] for r in rows], "o-", label="iteration / SuperLU in the same run")
+    b.semilogx(bays, [r["wall"] / r["iterations"] / r["t_bare"] for r in rows], "^--", alpha=0.6,
+               label="iteration / isolated bare LU (hot caches)")
+    b.axhline(1.5, color="r", ls=":", label="target 1.5")
+    b.set(xlabel="bays", ylabel="ratio", title="how close an iteration is to the linear solve", ylim=(1.0, None))
+    b.grid(alpha=0.3, which="both")
+    b.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 if __name__ == "__main__":
