@@ -8,7 +8,8 @@ and prints the time per iteration of each part next to the time spent inside Sup
 (factorisation + triangular solves, measured by femast's SparseLU in the same runs).  Timers cost
 about 1 us per call, a few per iteration.
 
-Parts that do not exist in an older femast are skipped, so the same command measures a checkout
+It draws ``benchmarks/out/iteration_breakdown.png``: one bar per size, each part in units of the
+SuperLU time.  Parts that do not exist in an older femast are skipped, so the same command measures a checkout
 put first on ``PYTHONPATH`` (the "before" column of docs/performance.md).
 """
 
@@ -85,6 +86,40 @@ def breakdown(n_bays, runs):
     for label, t in sorted(acc.items(), key=lambda kv: -kv[1]):
         print(f"  {label:<48} {t * ms:8.3f}")
     print(f"  iteration / SuperLU: {total / superlu:.2f} (target <= 1.5)")
+    return {"bays": n_bays, "whole": total * ms, "superlu": superlu * ms, "parts": {k: v * ms for k, v in acc.items()}}
+
+
+def plot(results, path):
+    """One bar per size: each part of an iteration in units of the SuperLU time of the same runs."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    shown = ["beam kernel (element forces + tangents)", "tangent assembly into the solver's matrix",
+             "tangent assembly into CSR", "residual assembly", "convergence test", "configuration update",
+             "results frame (gather + hand-over)", "status line (.sta)"]
+    fig, ax = plt.subplots(figsize=(9, 1.2 + 0.9 * len(results)))
+    for y, r in enumerate(results):
+        left = 1.0
+        ax.barh(y, 1.0, color="0.75", edgecolor="k", label="SuperLU (factorise + solve)" if y == 0 else None)
+        for i, name in enumerate(shown):
+            w = r["parts"].get(name, 0.0) / r["superlu"]
+            if w > 0:
+                ax.barh(y, w, left=left, color=f"C{i}", label=name if y == 0 else None)
+                left += w
+        rest = r["whole"] / r["superlu"] - left
+        ax.barh(y, max(rest, 0.0), left=left, color="w", edgecolor="k", hatch="//",
+                label="the rest (Python between the parts)" if y == 0 else None)
+        ax.text(r["whole"] / r["superlu"] + 0.02, y, f"{r['whole'] / r['superlu']:.2f}", va="center")
+    ax.axvline(1.5, color="r", ls=":", label="target 1.5")
+    ax.set(yticks=range(len(results)), yticklabels=[f"{r['bays']} bays" for r in results],
+           xlabel="time per Newton iteration / SuperLU time in the same runs",
+           title="where a Newton iteration goes (truss mast of beam-columns)")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.35), ncol=3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 def main(argv=None):
@@ -95,8 +130,12 @@ def main(argv=None):
     import femast
 
     print(f"femast at {os.path.dirname(femast.__file__)}")
-    for nb in args.bays:
-        breakdown(nb, args.runs)
+    results = [breakdown(nb, args.runs) for nb in args.bays]
+    if all(r["superlu"] == r["superlu"] for r in results):   # an old femast has no SuperLU timer (nan)
+        out = os.path.join(HERE, "out", "iteration_breakdown.png")
+        os.makedirs(os.path.dirname(out), exist_ok=True)
+        plot(results, out)
+        print(f"\nfigure {out}")
 
 
 if __name__ == "__main__":
