@@ -12,6 +12,9 @@ rotation vector dtheta gives the spin dw with skew(dw) = dR R^T,
     Ts^-1(theta) = I - S/2 + eta(t) S^2,   eta = (1 - (t/2) cot(t/2)) / t^2
 
 (e.g. Battini & Pacoste 2002, CMAME 191:1755, Eqs. 14-17).
+
+The ``*_into`` helpers and ``_eta`` are ``inline='always'``: they are inlined into the element
+kernels that call them, so those kernels' scratch arrays stay on the stack (femast.elements._stack).
 """
 
 from __future__ import annotations
@@ -62,7 +65,7 @@ def expm_so3(v):
     return np.eye(3) + a * S + b * _sq(S)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def logm_so3_into(R, out):
     """Rotation vector (rad, |v| <= pi) of the rotation matrix ``R`` written into ``out`` (3,),
     without allocating.  Uses the quaternion of R (Spurrier's method), accurate near 0 and pi."""
@@ -119,7 +122,7 @@ def logm_so3(R):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _eta(t):
     """eta(t) = (1 - (t/2) cot(t/2)) / t^2 and eta'(t)/t."""
     if t < 0.05:
@@ -136,7 +139,7 @@ def _eta(t):
     return eta, deta / t
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def ts_inv_into(theta, out):
     """Ts^-1(theta) = I - S/2 + eta S^2 written into the 3x3 ``out`` (S^2 = theta theta^T - t^2 I)."""
     t2 = theta[0] * theta[0] + theta[1] * theta[1] + theta[2] * theta[2]
@@ -161,7 +164,7 @@ def ts_inv(theta):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def ts_inv_T_times_derivative_into(theta, m, out):
     """d/dtheta [Ts^-T(theta) m] for fixed m written into the 3x3 ``out`` (Battini & Pacoste 2002, K_h)."""
     tt = theta[0] * theta[0] + theta[1] * theta[1] + theta[2] * theta[2]
