@@ -22,6 +22,7 @@ import scipy.sparse as sp
 from tqdm.auto import tqdm
 
 from .assembly import Assembler
+from .configuration import update_configuration
 from .constraints import Constraints
 from .dofs import number_dofs
 from .elements.base import DOF_NAMES, IncrementContext
@@ -30,10 +31,9 @@ from .elements.truss import TrussFamily
 from .reduction import ReducedTangent
 from .errors import ConvergenceError, ModelError, SingularModelError
 from .results import Results, ResultsWriter
-from .rotations import apply_spins as _apply_spins  # R <- exp(W) R, plain loops (fast to compile)
 from .rotations import rotation_vectors
 from .solvers.control import LoadControl
-from .solvers.convergence import Convergence
+from .solvers.convergence import Convergence, force_moment_abs_max
 from .solvers.linear import SparseLU, mechanism_dofs
 
 
@@ -188,8 +188,8 @@ class Analysis:
         self.cons_node, self.cons_dof = self.dofmap.slots(np.arange(nf, ni))
         self.act_node, self.act_dof = self.dofmap.slots(np.arange(self.dofmap.n_active))
         self.is_rot = self.free_dof >= 3
-        self._free_split = (self.free_node, self.free_dof, self.free_dof < 3)
-        self._cons_split = (self.cons_node, self.cons_dof, self.cons_dof < 3)
+        self._W = np.zeros((n, 3))     # scratch spins of the configuration update
+        self._no_update = np.zeros(0)
         self.length = float(np.ptp(self.X0, axis=0).max()) or 1.0
         self.symmetric = all(getattr(f, "symmetric", False) for f in self.families)
         self.solver = SparseLU(symmetric=self.symmetric)
@@ -332,16 +332,9 @@ class Analysis:
 
     def _update(self, du_free, du_cons=None):
         self._version += 1
-        W = np.zeros_like(self.spin)
-        # a (node, dof) pair is at most one equation, free or constrained: no index repeats, so
-        # plain fancy-index updates are exact (no np.add.at needed)
-        for (node, dof, t), du in ((self._free_split, du_free), (self._cons_split, du_cons)):
-            if du is None:
-                continue
-            self.x[node[t], dof[t]] += du[t]
-            W[node[~t], dof[~t] - 3] = du[~t]
-        self.spin += W
-        _apply_spins(self.R, W)
+        update_configuration(self.x, self.spin, self.R, self._W, self.free_node, self.free_dof,
+                             np.ascontiguousarray(du_free, dtype=float), self.cons_node, self.cons_dof,
+                             self._no_update if du_cons is None else np.ascontiguousarray(du_cons, dtype=float))
         if self.constraints.active:
             self.constraints.update_slaves(self.x, self.R, self.spin)
 
@@ -808,14 +801,11 @@ class Analysis:
     def _converged(self, r, du, Du, responses, P, iteration=0):
         """Force/moment residual against the largest element nodal force/moment or applied load
         (Abaqus' 'flux' magnitude), displacement correction against the increment."""
-        fmax = mmax = 0.0
+        fmax, mmax = force_moment_abs_max(P)
         for resp in responses:
-            fe = resp.f.reshape(resp.f.shape[0], -1, 6)
-            if fe.size:
-                fmax = max(fmax, float(np.abs(fe[:, :, :3]).max()))
-                mmax = max(mmax, float(np.abs(fe[:, :, 3:]).max()))
-        fmax = max(fmax, float(np.abs(P[:, :3]).max(initial=0.0)))
-        mmax = max(mmax, float(np.abs(P[:, 3:]).max(initial=0.0)))
+            ff, mm = force_moment_abs_max(resp.f)
+            fmax = max(fmax, ff)
+            mmax = max(mmax, mm)
         L = self.length
         ref_f = max(fmax, 1e-2 * mmax / L, self._zero_force)
         ref_m = max(mmax, 1e-2 * fmax * L, self._zero_force * L)

@@ -120,6 +120,26 @@ def test_rcm_kept_from_the_pattern_only_when_its_envelope_bounds_the_fill():
     np.testing.assert_allclose(G @ s.solve(b), b, rtol=1e-10)   # condition number ~25
 
 
+def test_direct_superlu_call_gives_splus_factorisation_bit_for_bit():
+    # an unsymmetric matrix with weak diagonals, so that threshold pivoting interchanges rows
+    rng = np.random.default_rng(3)
+    n = 120
+    K = (sp.random(n, n, density=0.05, random_state=rng) + sp.diags(rng.uniform(-1e-3, 1.0, n))).tocsr()
+    K = (K + abs(K).T * 0.0).tocsr()   # structurally symmetric, as femast tangents are
+    K.sort_indices()
+    s = SparseLU(ordering="rcm")
+    assert s.analyse(K) == "rcm"
+    s.values[:] = K.data[s._gather]
+    s.factorize_values()                          # the direct binding
+    B = s._B
+    ref = spla.splu(B, permc_spec="NATURAL", diag_pivot_thresh=s.pivot_threshold,
+                    options=dict(SymmetricMode=True))
+    b = rng.standard_normal(n)
+    assert np.array_equal(s._lu.solve(b), ref.solve(b))          # same pivots, same arithmetic
+    assert np.array_equal(s._lu.perm_r, ref.perm_r) and s._lu.nnz == ref.nnz
+    assert np.any(ref.perm_r != np.arange(n))                   # rows were interchanged
+
+
 def test_background_writer_keeps_every_frame_and_reports_a_write_error(tmp_path):
     m, rows = _frame_model()
     recorded = []
