@@ -190,6 +190,7 @@ class Analysis:
         self.is_rot = self.free_dof >= 3
         self._W = np.zeros((n, 3))     # scratch spins of the configuration update
         self._no_update = np.zeros(0)
+        self._Pa = None                # (loads array, its values on the active DOFs)
         self.length = float(np.ptp(self.X0, axis=0).max()) or 1.0
         self.symmetric = all(getattr(f, "symmetric", False) for f in self.families)
         self.solver = SparseLU(symmetric=self.symmetric)
@@ -258,8 +259,9 @@ class Analysis:
     def _residual(self, responses, P):
         """Residual P - F on the independent DOFs (free first, then constrained)."""
         F = self.assembler.forces([q.f for q in responses])
-        Pa = P[self.act_node, self.act_dof]
-        self._net = F - Pa
+        if self._Pa is None or self._Pa[0] is not P:   # the loads are fixed within an increment
+            self._Pa = (P, P[self.act_node, self.act_dof])
+        self._net = F - self._Pa[1]
         if not self.constraints.active:
             return -self._net
         self._T = self.constraints.transformation(self.x)
@@ -820,8 +822,10 @@ class Analysis:
         self._last_converged = (self._version, responses)
         self.states = [r.state.copy() if r.state is not None else s for r, s in zip(responses, self.states)]
         self.loads = P.copy()
-        self.prescribed[self.cons_node, self.cons_dof] = [self.dof_value(n, d) for n, d in
-                                                          zip(self.cons_node, self.cons_dof)]
+        t = self.cons_dof < 3   # the values reached: displacements x - X0, rotations the accumulated spins
+        self.prescribed[self.cons_node[t], self.cons_dof[t]] = (self.x[self.cons_node[t], self.cons_dof[t]]
+                                                                - self.X0[self.cons_node[t], self.cons_dof[t]])
+        self.prescribed[self.cons_node[~t], self.cons_dof[~t]] = self.spin[self.cons_node[~t], self.cons_dof[~t] - 3]
         self.lam = lam
         self.strain_energy = float(sum(np.sum(r.energy) for r in responses if r.energy is not None))
         self._reactions = -res[self.dofmap.n_free:]
