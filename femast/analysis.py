@@ -51,6 +51,9 @@ class AnalysisSummary:
     cutbacks: int = 0
     line_searches: int = 0
     wall_time: float = 0.0
+    # wall time in the steps' increments (s): the run without its results-folder set-up, initial
+    # frame, final drain of the writer and summary (per-run costs, not per-iteration ones)
+    increment_time: float = 0.0
     assembly_time: float = 0.0
     solve_time: float = 0.0
     message: str = ""
@@ -181,7 +184,8 @@ class Analysis:
                                   dependent=self.constraints.dependent)
         if self.dofmap.n_free == 0:
             raise ModelError(f"model '{model.name}' has no free DOFs")
-        self.assembler = Assembler(self.dofmap, self.families, full=self.constraints.active)
+        self._constrained = self.constraints.active   # fixed from here on (asked every iteration)
+        self.assembler = Assembler(self.dofmap, self.families, full=self._constrained)
         self.constraints.setup(self.dofmap, self.X0)
         nf, ni = self.dofmap.n_free, self.dofmap.n_independent
         self.free_node, self.free_dof = self.dofmap.slots(np.arange(nf))
@@ -194,7 +198,7 @@ class Analysis:
         self.length = float(np.ptp(self.X0, axis=0).max()) or 1.0
         self.symmetric = all(getattr(f, "symmetric", False) for f in self.families)
         self.solver = SparseLU(symmetric=self.symmetric)
-        if not self.constraints.active:
+        if not self._constrained:
             # symbolic analysis (the ordering) from the assembly pattern, once, at set-up; a
             # constrained model's reduced pattern T^T K T is only known at its first iteration
             self.solver.analyse(self.assembler.K_ff)
@@ -202,7 +206,7 @@ class Analysis:
         # constrained models: T^T K T + G on a pattern computed once (femast/reduction.py)
         self._reduced = (ReducedTangent(self.assembler.K_aa, self.constraints.transformation(self.X0),
                                         *self.constraints.geometric_entries(), self.dofmap.n_free)
-                         if self.constraints.active else None)
+                         if self._constrained else None)
         # configuration and committed state
         self.x = self.X0.copy()
         self.R = np.tile(np.eye(3), (n, 1, 1))
@@ -262,7 +266,7 @@ class Analysis:
         if self._Pa is None or self._Pa[0] is not P:   # the loads are fixed within an increment
             self._Pa = (P, P[self.act_node, self.act_dof])
         self._net = F - self._Pa[1]
-        if not self.constraints.active:
+        if not self._constrained:
             return -self._net
         self._T = self.constraints.transformation(self.x)
         return -(self._T.T @ self._net)
@@ -270,7 +274,7 @@ class Analysis:
     def _reduce_load(self, P):
         """A nodal load array (n, 6) as a vector on the free DOFs (through the constraints)."""
         Pa = P[self.act_node, self.act_dof]
-        if self.constraints.active:
+        if self._constrained:
             Pa = self._T.T @ Pa
         return Pa[: self.dofmap.n_free]
 
@@ -281,7 +285,7 @@ class Analysis:
         matrix (positions composed once: no CSR fill and no gather per iteration), and K_ff is
         then not formed (None).  Constrained models, and the first tangent (whose diagonal sets
         the zero-force floors), go through :meth:`_tangent`."""
-        if self.constraints.active or self._zero_force is None or self.solver.chosen is None:
+        if self._constrained or self._zero_force is None or self.solver.chosen is None:
             return self._factorize_csr(responses, with_fc)
         if self._direct is None or self._direct[0] != self.solver.layout:
             # a stabilised step may have widened the solver's pattern (a diagonal entry K_ff lacks):
@@ -317,7 +321,7 @@ class Analysis:
     def _tangent(self, responses, with_fc):
         """(K_ff, K_fc) at the configuration of the last :meth:`_residual` call."""
         k_list = [q.k for q in responses]
-        if not self.constraints.active:
+        if not self._constrained:
             K, Kfc = self.assembler.tangent(k_list, with_fc=with_fc)
         else:
             K_aa = self.assembler.full_tangent(k_list)
@@ -337,7 +341,7 @@ class Analysis:
         update_configuration(self.x, self.spin, self.R, self._W, self.free_node, self.free_dof,
                              np.ascontiguousarray(du_free, dtype=float), self.cons_node, self.cons_dof,
                              self._no_update if du_cons is None else np.ascontiguousarray(du_cons, dtype=float))
-        if self.constraints.active:
+        if self._constrained:
             self.constraints.update_slaves(self.x, self.R, self.spin)
 
     def _values(self, conds, start, frac_time, period, lam=None):
@@ -407,6 +411,7 @@ class Analysis:
         t0 = _time.perf_counter()
         writer = ResultsWriter(self.out, self.model, self.families)
         self._write(writer, step_name="initial", inc=0, time=0.0, iterations=0, responses=None)
+        ti = _time.perf_counter()
         try:
             for k, step in enumerate(self.model.steps):
                 self._run_step(k, step, writer)
@@ -415,6 +420,7 @@ class Analysis:
             self.summary.message = str(exc)
             raise
         finally:
+            self.summary.increment_time = _time.perf_counter() - ti
             self.summary.wall_time = _time.perf_counter() - t0
             writer.close({**self.summary.__dict__, "strain_energy": self.strain_energy})
             if self.progress:

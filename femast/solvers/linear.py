@@ -37,7 +37,6 @@ tests every factorisation).
 from __future__ import annotations
 
 import math
-import warnings
 from time import perf_counter
 
 import numpy as np
@@ -56,6 +55,7 @@ except ImportError:  # pragma: no cover - a scipy that moved it: splu is used in
 _DIRECT = {"gstrf": _gstrf}   # set to None if the binding's signature ever differs
 
 ORDERINGS = ("auto", "rcm", "mmd", "colamd")
+_FLOAT_MAX = float(np.finfo(float).max)
 
 
 @njit(cache=True)
@@ -65,7 +65,7 @@ def _unpermute(y, perm, x):
     for i in range(y.shape[0]):
         v = y[i]
         a = abs(v)
-        if not a <= 1.7976931348623157e308:
+        if not a <= 1.7976931348623157e308:   # NaN or inf
             return math.nan
         x[perm[i]] = v
         if a > m:
@@ -349,11 +349,9 @@ class SparseLU:
     def _guarded(self, step):
         """Run ``step()`` (sets self._lu; True if the pattern was newly analysed) with SuperLU's
         failures raised as SingularModelError, then the zero-pivot test when it is due."""
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("error", spla.MatrixRankWarning)
-                analysed = step()
-        except (RuntimeError, spla.MatrixRankWarning) as exc:
+        try:   # SuperLU reports a singular matrix as RuntimeError (only spsolve warns instead)
+            analysed = step()
+        except RuntimeError as exc:
             self._lu = None
             raise SingularModelError(str(exc)) from None
         self._checked = False
@@ -384,7 +382,7 @@ class SparseLU:
             self.superlu_seconds += perf_counter() - t0
             x = np.empty_like(y)
             xmax = _unpermute(y, self._perm, x)
-        if not xmax <= np.finfo(float).max:
+        if not xmax <= _FLOAT_MAX:
             raise SingularModelError("non-finite solution of the linear system")
         if not self._checked and xmax * self._dmax > 1e11 * np.abs(rhs).max(initial=0.0):
             # an amplification this large means a pivot within ~1e-11 of the largest: test them
