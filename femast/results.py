@@ -15,9 +15,9 @@ axis, beyond 2 pi), ``RF`` (n, 6) reactions (N, N m), ``P`` (n, 6) applied loads
 element outputs as ``el/<family>/<name>``.  Read them with numpy.load, or with
 :class:`Results`.
 
-Frames and status lines are written by a background thread, so that the analysis goes on with the next increment
-while the last one is stored (``np.savez`` of a frame takes ~1.5 ms, a quarter of a Newton iteration
-of a small model).  A frame is queued the moment its increment converges and the queue is drained
+Frames and status lines are written by a background thread, so that the analysis goes on with the
+next increment while the last one is stored (``np.savez`` of a frame takes ~1.5 ms, a quarter of a
+Newton iteration of a small model).  A frame is queued the moment its increment converges and the queue is drained
 by :meth:`ResultsWriter.close`, which the analysis calls however the run ends (normally, on a
 convergence failure, on Ctrl-C); only a process killed outright can lose the last queued frame or
 two.  A write error (a full disk) is raised in the analysis at the next frame or at the close.
