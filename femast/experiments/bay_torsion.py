@@ -57,7 +57,7 @@ friction), ``ball_B_m`` (4e-3, ball end radius used by ``ball_joint_friction``),
 bay folds under a positive twist), ``off_axis_side`` (0: ``off_axis_motion`` moves the axis
 towards the centre of this side), ``bay`` (dict of further :class:`~femast.adam.BayParameters`
 changes, e.g. ``{"b": 0.3}``), ``max_fe_rows`` (80), ``cache_dir`` (None), ``threads`` (1: numba
-threads of the ball-joint kernel during a run, see :class:`~femast.experiments.fe_cache.kernel_threads`).
+threads of parallel kernels during a run, see :class:`~femast.experiments.fe_cache.kernel_threads`).
 
 Hooks (where effects act)
 -------------------------

@@ -97,10 +97,10 @@ def _rebuildable(exp: Experiment) -> bool:
 
 
 def _mp_context():
-    """Start method of the local pool: ``_START_METHOD`` if set; else 'forkserver' once a numba
-    kernel has started GNU OpenMP threads in this process (the FE experiments' ball-joint kernel
-    is parallel; forking after that aborts the child: "fork() called from a process already using
-    GNU OpenMP"); else the platform's default (fork on Linux: the fastest start)."""
+    """Start method of the local pool: ``_START_METHOD`` if set; else 'forkserver' once numba has
+    started GNU OpenMP threads in this process (the FE experiments' ``kernel_threads`` does, and so
+    would a parallel user kernel; forking after that aborts the child: "fork() called from a process
+    already using GNU OpenMP"); else the platform's default (fork on Linux: the fastest start)."""
     if _START_METHOD:
         return multiprocessing.get_context(_START_METHOD)
     try:

@@ -121,10 +121,13 @@ def clear() -> None:
 
 
 class kernel_threads:
-    """Context manager running numba's parallel kernels (the ball joints) on ``n`` threads, then
-    restoring the previous count.  The FE experiments run on one: the bay's and a short mast's
-    kernels have a few dozen joints, too few to share, and on a busy machine (or with the refits of
-    ``diagnose`` already using every core) thread synchronisation made a single-bay run 3x slower."""
+    """Context manager running numba's parallel kernels on ``n`` threads, then restoring the
+    previous count.  femast's own element kernels are serial at present (a parallel ball-joint
+    kernel made a single-bay run 3x slower on a busy machine, and a parallel beam kernel gained
+    at most 3 %, docs/performance.md); the setting matters for user elements with parallel
+    kernels.  The FE experiments run on one thread: the refits of ``diagnose`` already use every
+    core.  Setting the count starts numba's thread pool, so ``diagnose`` then starts its workers
+    with forkserver (see ``diagnose._mp_context``)."""
 
     def __init__(self, n: int | None = 1):
         self.n = n

@@ -48,8 +48,8 @@ Options: ``n_bays`` (40: the seed's 6.84 m mast; 2-8 for fast studies), ``fold``
 ``ball_B_m`` (4e-3), ``latch_hysteresis_length_m`` (3e-4), ``increments_per_row`` (1), ``bay``
 (dict of further :class:`~femast.adam.BayParameters` changes), ``max_fe_rows`` (60: longer files are run through
 the turning points of the load and rows spread along the path, and interpolated between them),
-``cache_dir`` (None; see :mod:`femast.experiments.fe_cache`), ``threads`` (1, numba threads of the
-ball-joint kernel during a run).
+``cache_dir`` (None; see :mod:`femast.experiments.fe_cache`), ``threads`` (1, numba threads of
+parallel kernels during a run, see :class:`~femast.experiments.fe_cache.kernel_threads`).
 
 The overall error is in m at the tip: rotations are weighted by the 40-bay length, 6.84 m,
 whatever ``n_bays`` (``channel_weights``); fits whiten every channel by its own noise, so the
