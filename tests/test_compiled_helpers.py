@@ -1,0 +1,83 @@
+"""The compiled helpers of the Newton loop (issue 8) against the numpy/scipy expressions they replace."""
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.linalg import expm
+
+from femast.configuration import update_configuration
+from femast.constraints import transpose_times
+from femast.rotations import skew
+from femast.solvers.convergence import field_abs_max, force_moment_abs_max
+from femast.solvers.linear import _unpermute
+
+RNG = np.random.default_rng(11)
+
+
+def test_field_maxima_equal_numpys_masked_maxima_and_flag_nan_and_empty_fields():
+    v = RNG.standard_normal(40)
+    is_rot = RNG.random(40) < 0.4
+    t, r = field_abs_max(v, is_rot)
+    assert t == np.abs(v[~is_rot]).max() and r == np.abs(v[is_rot]).max()   # a max is exact
+    assert field_abs_max(v, np.zeros(40, bool))[1] == -1.0                      # no rotational DOF
+    v[7] = np.nan
+    assert all(np.isnan(field_abs_max(v, is_rot)))                             # never "converged"
+
+
+def test_force_and_moment_maxima_of_six_per_node_vectors():
+    f = RNG.standard_normal((9, 12))
+    fe = f.reshape(9, 2, 6)
+    assert force_moment_abs_max(f) == (np.abs(fe[:, :, :3]).max(), np.abs(fe[:, :, 3:]).max())
+    assert force_moment_abs_max(np.zeros((0, 12))) == (0.0, 0.0)
+
+
+def test_transpose_times_gives_scipys_product_bit_for_bit():
+    T = sp.random(60, 25, density=0.1, random_state=3, format="csr")
+    v = RNG.standard_normal(60)
+    assert np.array_equal(transpose_times(T, v), T.T @ v)   # same order of summation
+
+
+def test_unpermute_scatters_and_reports_the_largest_entry_or_nan():
+    y = RNG.standard_normal(30)
+    perm = RNG.permutation(30)
+    x = np.empty(30)
+    assert _unpermute(y, perm, x) == np.abs(y).max()
+    ref = np.empty(30)
+    ref[perm] = y
+    assert np.array_equal(x, ref)
+    y[4] = np.inf
+    assert np.isnan(_unpermute(y, perm, np.empty(30)))
+
+
+def test_configuration_update_adds_translations_and_spins_and_rotates_by_the_exponential():
+    n = 4
+    x, spin = RNG.standard_normal((n, 3)), RNG.standard_normal((n, 3))
+    R = np.array([expm(skew(w)) for w in RNG.standard_normal((n, 3))])
+    free_node, free_dof = np.array([0, 0, 1, 2, 2, 2]), np.array([0, 4, 2, 3, 4, 5])
+    cons_node, cons_dof = np.array([3]), np.array([1])
+    du, dc = 0.1 * RNG.standard_normal(6), np.array([0.05])
+    x0, s0, R0 = x.copy(), spin.copy(), R.copy()
+    update_configuration(x, spin, R, np.empty((n, 3)), free_node, free_dof, du, cons_node, cons_dof, dc)
+    W = np.zeros((n, 3))
+    W[0, 1], W[2] = du[1], du[3:]
+    np.testing.assert_array_equal(x, x0 + [[du[0], 0, 0], [0, 0, du[2]], [0, 0, 0], [0, dc[0], 0]])
+    np.testing.assert_array_equal(spin, s0 + W)
+    for i in range(n):   # Rodrigues in the kernel against scipy's matrix exponential
+        np.testing.assert_allclose(R[i], expm(skew(W[i])) @ R0[i], rtol=0, atol=1e-14)   # round-off of 3x3 products
+
+
+def test_stack_buffers_are_separate_arrays_of_the_requested_size():
+    from numba import carray, njit
+
+    from femast.elements._stack import stack_buffer
+
+    @njit
+    def fill(v):
+        a = carray(stack_buffer(3), (3,))
+        b = carray(stack_buffer(9), (3, 3))
+        for i in range(3):
+            a[i] = v[i]
+            for j in range(3):
+                b[i, j] = -v[i] * v[j]
+        return a.sum(), b.sum()
+
+    assert fill(np.array([1.0, 2.0, 3.0])) == (6.0, -36.0)   # writing b left a intact
