@@ -40,7 +40,7 @@ def minimal_run(mast, n_inc):
     from femast.elements.beam_corot import beam_family_kernel
     from femast.results import ResultsWriter
     from femast.rotations import rotation_vectors
-    from femast.solvers.convergence import Convergence, field_abs_max, force_moment_abs_max
+    from femast.solvers.convergence import Convergence, force_moment_abs_max
     from femast.solvers.linear import _unpermute
 
     m, _ = femast_mast.model(mast, n_inc)
@@ -76,13 +76,10 @@ def minimal_run(mast, n_inc):
             F[:] = 0.0
             _scatter_vector(f, eqs, F)
             r = P - F[:nf]
-            if du is not None:   # femast's convergence test (force and moment fields, correction)
+            if du is not None:   # femast's convergence test, with the analysis' reference forces
                 fm, mm = force_moment_abs_max(f)
-                rt, rr = field_abs_max(r, an.is_rot)
-                dt, dr = field_abs_max(du, an.is_rot)
-                Dt, Dr = field_abs_max(Du, an.is_rot)
-                if (rt <= tol * max(fm, 1e-2 * mm / L) and rr <= tol * max(mm, 1e-2 * fm * L)
-                        and dt <= tol * max(Dt, 1e-9 * L) and dr <= tol * max(Dr, 1e-9)):
+                if an.convergence.check(r, du, Du, an.is_rot, max(fm, 1e-2 * mm / L), max(mm, 1e-2 * fm * L),
+                                        L, iters)[0]:
                     break
             B.data[:] = 0.0
             _scatter_matrix(K, pos, B.data)
