@@ -58,7 +58,7 @@ from ._ball_joint_kernels import (
     N_STATE,
     ball_joint_family_kernel,
 )
-from .base import ElementFamily, ElementResponse, IncrementContext
+from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput
 
 __all__ = ["BallJointFamily", "add_ball_joints", "default_stiffnesses", "friction_loop_energy",
            "PENALTY_FACTOR", "STICK_FACTOR", "SEED_MU", "SEED_B"]
@@ -198,7 +198,7 @@ class BallJointFamily(ElementFamily):
             if err[el] == ERR_BIG_INCREMENT:
                 raise FloatingPointError(f"{self._who(el)}: relative rotation increment above "
                                          f"{MAX_INCREMENT} rad in one increment; use smaller increments")
-        output = {
+        output = LazyOutput(lambda: {
             "moment": out[:, 0:3].copy(),
             "force": out[:, 3:6].copy(),
             "F": out[:, 6].copy(),
@@ -207,7 +207,7 @@ class BallJointFamily(ElementFamily):
             "slip_angle": out[:, 9].copy(),
             "dissipated": out[:, 10].copy(),
             "moment_norm": np.linalg.norm(out[:, 0:3], axis=1),
-        }
+        })
         return ElementResponse(f=f, k=K, state=new, output=output, energy=energy)
 
     # ------------------------------------------------------------------ helpers

@@ -19,7 +19,9 @@ state (the state at the start of the increment):
   as R <- expm(skew(dw)) R;
 * ``state``: (n_el, n_state) trial state variables;
 * ``output``: a dict of per-element output arrays (section forces, status, ...)
-  with shape (n_el, ...), written to the results at converged increments.
+  with shape (n_el, ...), written to the results at converged increments.  Outputs that
+  cost more than gathering them may be a :class:`LazyOutput`, computed only if read: most
+  iterations' responses are never written.
 
 The analysis owns commit and rollback: the trial state returned at the converged
 iteration is copied into the committed state; on a cut-back it is simply
@@ -31,6 +33,7 @@ plain arrays; ``evaluate`` only gathers arrays and calls them.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -61,6 +64,36 @@ class IncrementContext:
     step_name: str = ""
 
 
+class LazyOutput(Mapping):
+    """A read-only output dict computed by ``make()`` on first access.
+
+    Only the response of a converged iteration is written to the results; computing the outputs
+    of a small model's cable/latch and ball-joint families at every iteration took ~15 % of a
+    bay run (issue 8).  ``make`` must only read arrays that nobody modifies afterwards (the
+    family's own fresh arrays of this evaluation)."""
+
+    __slots__ = ("_make", "_data")
+
+    def __init__(self, make):
+        self._make = make
+        self._data = None
+
+    def _get(self) -> dict:
+        if self._data is None:
+            self._data = self._make()
+            self._make = None
+        return self._data
+
+    def __getitem__(self, key):
+        return self._get()[key]
+
+    def __iter__(self):
+        return iter(self._get())
+
+    def __len__(self):
+        return len(self._get())
+
+
 @dataclass
 class ElementResponse:
     """What :meth:`ElementFamily.evaluate` returns (see module docstring)."""
@@ -68,7 +101,7 @@ class ElementResponse:
     f: np.ndarray
     k: np.ndarray
     state: np.ndarray
-    output: dict = field(default_factory=dict)
+    output: Mapping = field(default_factory=dict)
     # Strain energy per element, J (used for stabilisation energy ratios and reports).
     energy: np.ndarray | None = None
 

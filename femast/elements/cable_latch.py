@@ -55,7 +55,7 @@ from ._cable_kernels import (
     STICK,
     cable_latch_kernel,
 )
-from .base import ElementFamily, ElementResponse, IncrementContext
+from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput
 
 STATUS_NAMES = {STICK: "stick", SLIP_OUT: "slip out", SLIP_IN: "slip in", BACKSTOP: "backstop"}
 
@@ -302,11 +302,16 @@ class CableLatchFamily(ElementFamily):
             else:  # pragma: no cover
                 msg = f"kernel error {code}"
             raise ModelError(f"{self.name} element {el}: {msg}")
+        return ElementResponse(f=f, k=k, state=new, output=LazyOutput(lambda: self._output(X, T, dT, new)),
+                               energy=energy)
+
+    def _output(self, X, T, dT, new):
+        """The output dict of :meth:`evaluate` (computed when first read)."""
         L0sec = new[:, 2:]
         Lsec = np.linalg.norm(np.diff(X, axis=1), axis=2)
         has = self.latch_node > 0
         zone = np.where(has, latch_zone(new[:, 0], self.latch), -1)
-        output = {
+        return {
             "tension": T,
             "unstretched_length": L0sec.copy(),
             "strain": np.where(T > 0.0, Lsec / L0sec - 1.0, 0.0),
@@ -315,7 +320,6 @@ class CableLatchFamily(ElementFamily):
             "latch_zone": zone,
             "latch_dT": dT,
         }
-        return ElementResponse(f=f, k=k, state=new, output=output, energy=energy)
 
 
 def cable_equations(X, T, L0_sections, EA, L0, *, latch_node=None, bead=None, latch=None,
