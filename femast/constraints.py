@@ -37,6 +37,50 @@ def _csr_transpose_matvec(indptr, indices, data, v, out):
             out[indices[k]] += data[k] * vi
 
 
+@njit(cache=True)
+def _update_slaves(x, R, spin, rigid, X_rel, X0, tie_trans, tie_rot, tie_full):
+    """Rigid slaves x_s = x_r + R_r X_rel, R_s = R_r, spin_s = spin_r; then ties (translations
+    u_s = u_m, rotation components spin_s = spin_m, R_s = R_m where all three are tied)."""
+    for k in range(rigid.shape[0]):
+        s = rigid[k, 0]
+        r = rigid[k, 1]
+        for i in range(3):
+            x[s, i] = x[r, i] + (R[r, i, 0] * X_rel[k, 0] + R[r, i, 1] * X_rel[k, 1] + R[r, i, 2] * X_rel[k, 2])
+            spin[s, i] = spin[r, i]
+            for j in range(3):
+                R[s, i, j] = R[r, i, j]
+    for k in range(tie_trans.shape[0]):
+        s, m, d = tie_trans[k, 0], tie_trans[k, 1], tie_trans[k, 2]
+        x[s, d] = X0[s, d] + (x[m, d] - X0[m, d])
+    for k in range(tie_rot.shape[0]):
+        s, m, d = tie_rot[k, 0], tie_rot[k, 1], tie_rot[k, 2]
+        spin[s, d - 3] = spin[m, d - 3]
+    for k in range(tie_full.shape[0]):
+        s, m = tie_full[k, 0], tie_full[k, 1]
+        for i in range(3):
+            for j in range(3):
+                R[s, i, j] = R[m, i, j]
+
+
+@njit(cache=True)
+def _geometric_values(x, rigid, trans_eq, f_net, out):
+    """Per rigid slave, the 9 values (row-major) of d f^T - (f . d) I, d = x_s - x_r, f the net
+    force on the slave's translations (0 on a DOF without an equation)."""
+    d = np.empty(3)
+    f = np.empty(3)
+    for k in range(rigid.shape[0]):
+        s = rigid[k, 0]
+        r = rigid[k, 1]
+        for i in range(3):
+            d[i] = x[s, i] - x[r, i]
+            q = trans_eq[k, i]
+            f[i] = f_net[q] if q >= 0 else 0.0
+        fd = (f[0] * d[0] + f[2] * d[2]) + f[1] * d[1]   # numpy einsum's order: the same bits as before
+        for i in range(3):
+            for j in range(3):
+                out[9 * k + 3 * i + j] = d[i] * f[j] - (fd if i == j else 0.0)
+
+
 def transpose_times(T, v):
     """T^T v for a CSR matrix T, without forming T^T (scipy builds and checks a new matrix for
     ``T.T`` on every call: 8 % of a small constrained model's run, issue 8).  Same order of
@@ -118,6 +162,9 @@ class Constraints:
         s, r = self.rigid_slave[:, 0], self.rigid_slave[:, 1]
         self.X_rel = X0[s] - X0[r]
         self.X0 = X0
+        self._X_rel = np.ascontiguousarray(self.X_rel, dtype=float)
+        self._X0 = np.ascontiguousarray(X0, dtype=float)
+        self._tie_split = None
         eq = self.eq
         if len(s) and np.any(eq[r][:, 3:] < 0):
             raise ModelError("a rigid-body reference node has no rotational DOFs")
@@ -164,28 +211,20 @@ class Constraints:
             er = eq[r][:, 3:6]
             self._G_rows = np.repeat(er, 3, axis=1).ravel()
             self._G_cols = np.tile(er, (1, 3)).ravel()
-            self._slave_trans_eq = eq[s][:, :3]
+            self._slave_trans_eq = np.ascontiguousarray(eq[s][:, :3], dtype=np.int64)
 
     def update_slaves(self, x, R, spin):
-        """Put every dependent node where its constraint says (exact for any rotation)."""
-        if len(self.rigid_slave):
-            s, r = self.rigid_slave[:, 0], self.rigid_slave[:, 1]
-            x[s] = x[r] + np.einsum("nij,nj->ni", R[r], self.X_rel)
-            R[s] = R[r]
-            spin[s] = spin[r]
-        if len(self.tie):
-            for s, m, d in self.tie:
-                if d < 3:
-                    x[s, d] = self.X0[s, d] + (x[m, d] - self.X0[m, d])
-                else:
-                    spin[s, d - 3] = spin[m, d - 3]
-            full = {}
-            for s, m, d in self.tie:
-                if d >= 3:
-                    full.setdefault((s, m), set()).add(d)
-            for (s, m), ds in full.items():
-                if len(ds) == 3:
-                    R[s] = R[m]
+        """Put every dependent node where its constraint says (exact for any rotation): one
+        compiled pass (numpy's fancy indexing on a dozen 3-vectors cost ~4 % of a bay run)."""
+        if self._tie_split is None:
+            t = self.tie
+            trans, rot = t[t[:, 2] < 3], t[t[:, 2] >= 3]
+            pairs = {}
+            for sl, m, d in rot:
+                pairs.setdefault((int(sl), int(m)), set()).add(int(d))
+            full = np.array([p for p, ds in pairs.items() if len(ds) == 3], dtype=np.int64).reshape(-1, 2)
+            self._tie_split = (np.ascontiguousarray(trans), np.ascontiguousarray(rot), full)
+        _update_slaves(x, R, spin, self.rigid_slave, self._X_rel, self._X0, *self._tie_split)
 
     def transformation(self, x):
         """T (n_active x n_ind): variations of all active DOFs from the independent ones."""
@@ -208,9 +247,6 @@ class Constraints:
         """Values of G at :meth:`geometric_entries`: per rigid slave, d f^T - (f.d) I (3x3, row-major)."""
         if not len(self.rigid_slave):
             return np.zeros(0)
-        s, r = self.rigid_slave[:, 0], self.rigid_slave[:, 1]
-        d = x[s] - x[r]
-        eqs = self._slave_trans_eq
-        f = np.where(eqs >= 0, f_net[np.maximum(eqs, 0)], 0.0)
-        B = d[:, :, None] * f[:, None, :] - np.einsum("ki,ki->k", f, d)[:, None, None] * np.eye(3)
-        return B.ravel()
+        out = np.empty(9 * len(self.rigid_slave))
+        _geometric_values(x, self.rigid_slave, self._slave_trans_eq, np.ascontiguousarray(f_net, dtype=float), out)
+        return out

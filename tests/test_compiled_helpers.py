@@ -81,3 +81,71 @@ def test_stack_buffers_are_separate_arrays_of_the_requested_size():
         return a.sum(), b.sum()
 
     assert fill(np.array([1.0, 2.0, 3.0])) == (6.0, -36.0)   # writing b left a intact
+
+
+def _constrained_analysis():
+    """A rigid body (reference + 2 nodes), a translation tie, an all-DOF tie and a one-rotation tie."""
+    import tempfile
+
+    import femast as fm
+    from femast.analysis import Analysis
+
+    m = fm.Model("ties")
+    sec = fm.circular_tube(0.02, 0.016, E=70e9, nu=0.33)
+    a, b, c = m.node(0, 0, 0), m.node(1, 0, 0), m.node(1, 1, 0)
+    d, e, f, g = m.node(1, 1, 0), m.node(1, 1, 0), m.node(1, 1, 0), m.node(0, 1, 1)
+    for p, q in ((a, b), (b, c), (c, g), (d, g), (e, g), (f, g)):
+        m.beam(p, q, sec, up=(0, 0, 1))
+    ref = m.node(0.5, 0.5, 0.5)
+    m.rigid_body(ref, [b, g])
+    m.tie(c, d)               # translations
+    m.tie(c, e, "all")        # R_e = R_c
+    m.tie(c, f, "rz")         # one rotation component
+    m.fix(a)
+    m.step("s").load(ref, fx=1.0)
+    return Analysis(m, tempfile.mkdtemp(), progress=False)
+
+
+def test_slave_update_equals_the_numpy_expressions_it_replaces():
+    an = _constrained_analysis()
+    c = an.constraints
+    n = len(an.x)
+    x = an.X0 + RNG.standard_normal((n, 3))
+    R = np.array([expm(skew(w)) for w in RNG.standard_normal((n, 3))])
+    spin = RNG.standard_normal((n, 3))
+    xr, Rr, sr = x.copy(), R.copy(), spin.copy()
+    s, r = c.rigid_slave[:, 0], c.rigid_slave[:, 1]   # the expressions of the numpy version
+    xr[s] = xr[r] + np.einsum("nij,nj->ni", Rr[r], c.X_rel)
+    Rr[s], sr[s] = Rr[r], sr[r]
+    for sl, ms, dof in c.tie:
+        if dof < 3:
+            xr[sl, dof] = c.X0[sl, dof] + (xr[ms, dof] - c.X0[ms, dof])
+        else:
+            sr[sl, dof - 3] = sr[ms, dof - 3]
+    full = {}
+    for sl, ms, dof in c.tie:
+        if dof >= 3:
+            full.setdefault((sl, ms), set()).add(dof)
+    for (sl, ms), ds in full.items():
+        if len(ds) == 3:
+            Rr[sl] = Rr[ms]
+    assert len(c.rigid_slave) == 2 and len(full) == 2      # the model has what the test is about
+    c.update_slaves(x, R, spin)
+    assert np.array_equal(R, Rr) and np.array_equal(spin, sr)                # copies
+    # R_r X_rel: 3-term sums, which einsum may order otherwise (2 ulp of the largest term)
+    np.testing.assert_allclose(x, xr, rtol=0, atol=4 * np.finfo(float).eps * np.abs(xr).max())
+
+
+def test_geometric_values_equal_the_numpy_expression_they_replace():
+    an = _constrained_analysis()
+    c = an.constraints
+    x = an.X0 + RNG.standard_normal(an.X0.shape)
+    f_net = RNG.standard_normal(an.dofmap.n_active)
+    s, r = c.rigid_slave[:, 0], c.rigid_slave[:, 1]
+    d = x[s] - x[r]
+    eqs = c._slave_trans_eq
+    f = np.where(eqs >= 0, f_net[np.maximum(eqs, 0)], 0.0)
+    B = d[:, :, None] * f[:, None, :] - np.einsum("ki,ki->k", f, d)[:, None, None] * np.eye(3)
+    # f.d: 3-term sums, which einsum may order otherwise (2 ulp of the largest term)
+    np.testing.assert_allclose(c.geometric_values(x, f_net), B.ravel(), rtol=0,
+                               atol=4 * np.finfo(float).eps * np.abs(B).max())
