@@ -30,7 +30,7 @@ from .elements.beam_corot import BeamFamily, element_frame
 from .elements.truss import TrussFamily
 from .reduction import ReducedTangent
 from .errors import ConvergenceError, ModelError, SingularModelError
-from .results import Results, ResultsWriter
+from .results import NullWriter, Results, ResultsWriter
 from .rotations import rotation_vectors
 from .solvers.control import LoadControl
 from .solvers.convergence import Convergence, force_moment_abs_max
@@ -115,6 +115,10 @@ def build_families(model):
 class Analysis:
     """A static, geometrically nonlinear analysis of ``model`` writing to folder ``out``.
 
+    out : the results folder, or None to write nothing (no folder, frames or status file): each
+        frame then only goes to ``on_frame``, and :meth:`run` returns None.  For scripts and fits
+        that keep what they need in memory (an FE experiment's many short runs).
+
     convergence : :class:`~femast.solvers.convergence.Convergence` (tolerances, max iterations).
     progress : show a tqdm progress bar per step.
     cutback : factor applied to a failed increment (Abaqus: 0.25).
@@ -139,6 +143,9 @@ class Analysis:
         self.model = model
         self.on_frame = on_frame
         self.out = out
+        if out is None and on_frame is None:
+            warnings.warn("Analysis(out=None) without on_frame keeps no results: only the final state "
+                          "(Analysis.x, .R, .summary) remains", stacklevel=2)
         self.convergence = convergence or Convergence()
         self.progress = progress
         self.cutback = cutback
@@ -407,9 +414,10 @@ class Analysis:
         return Kaa - Kab @ lu.solve(K[rest][:, keep].toarray())
 
     # ------------------------------------------------------------ the run
-    def run(self) -> Results:
+    def run(self) -> Results | None:
+        """Run all steps; returns the :class:`Results` of the folder, or None with ``out=None``."""
         t0 = _time.perf_counter()
-        writer = ResultsWriter(self.out, self.model, self.families)
+        writer = NullWriter() if self.out is None else ResultsWriter(self.out, self.model, self.families)
         self._write(writer, step_name="initial", inc=0, time=0.0, iterations=0, responses=None)
         ti = _time.perf_counter()
         try:
@@ -425,7 +433,7 @@ class Analysis:
             writer.close({**self.summary.__dict__, "strain_energy": self.strain_energy})
             if self.progress:
                 tqdm.write(str(self.summary))
-        return Results(self.out)
+        return None if self.out is None else Results(self.out)
 
     def _run_step(self, k, step, writer):
         if getattr(step.control, "arc_length", False):
@@ -481,7 +489,7 @@ class Analysis:
                     raise ConvergenceError(
                         f"step '{step.name}': increment fell below the minimum {dt_min:.3g} s at step time "
                         f"{t:.6g} s (total time {self.total_time:.6g} s): {note}. The {self.summary.increments} "
-                        f"converged increments are saved in '{self.out}'.")
+                        f"converged increments are {self._kept()}.")
             inc += 1
             t += dt
             self.total_time += dt
@@ -719,7 +727,7 @@ class Analysis:
                     raise ConvergenceError(
                         f"step '{step.name}': arc length fell below the minimum ({control.min_arc:g} of the first) "
                         f"at load factor {self.lam:.6g}: {note}. The {self.summary.increments} converged "
-                        f"increments are saved in '{self.out}'.")
+                        f"increments are {self._kept()}.")
             inc += 1
             prev = (Du, dlam)
             dt = dl_used / dl0 * control.initial_load_factor
@@ -836,7 +844,13 @@ class Analysis:
         self.strain_energy = float(sum(np.sum(r.energy) for r in responses if r.energy is not None))
         self._reactions = -res[self.dofmap.n_free:]
 
+    def _kept(self) -> str:
+        """Where the converged increments of a run that gives up are (for its error message)."""
+        return "passed to on_frame (out=None: nothing written)" if self.out is None else f"saved in '{self.out}'"
+
     def _write(self, writer, step_name, inc, time, iterations, responses, period=1.0):
+        if self.out is None and self.on_frame is None:
+            return
         n = len(self.X0)
         RF = np.zeros((n, 6))
         if responses is not None:
@@ -855,7 +869,8 @@ class Analysis:
             self.on_frame(data)
 
 
-def solve(model, out="results", **options) -> Results:
-    """Run all steps of ``model``; write results to folder ``out``; return :class:`Results`.
+def solve(model, out="results", **options) -> Results | None:
+    """Run all steps of ``model``; write results to folder ``out``; return :class:`Results` (None
+    with ``out=None``, see :class:`Analysis`).
     Options are those of :class:`Analysis`."""
     return Analysis(model, out, **options).run()

@@ -118,6 +118,21 @@ class ResultsWriter:
         self._raise_error()
 
 
+class NullWriter:
+    """The writer of an analysis with ``out=None``: keeps nothing (frames go only to on_frame)."""
+
+    count = 0
+
+    def status(self, *args, **kwargs):
+        pass
+
+    def frame(self, **data):
+        self.count += 1
+
+    def close(self, summary: dict):
+        pass
+
+
 class Results:
     """Read a results folder: ``Results("results/run")``.
 

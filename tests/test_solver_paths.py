@@ -140,6 +140,23 @@ def test_direct_superlu_call_gives_splus_factorisation_bit_for_bit():
     assert np.any(ref.perm_r != np.arange(n))                   # rows were interchanged
 
 
+def test_out_none_writes_nothing_and_passes_the_same_frames_to_the_recorder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    m, rows = _frame_model()
+    on_disk = fm.Analysis(m, tmp_path / "r", progress=False).run()
+    recorded = []
+    assert fm.Analysis(m, None, progress=False, on_frame=recorded.append).run() is None
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r"]   # no folder, frame or status file
+    assert len(recorded) == len(on_disk) == 1 + 4
+    for i, fr in enumerate(recorded):   # the same solution, bit for bit (writing does not change it)
+        np.testing.assert_array_equal(fr["U"], on_disk.frame(i)["U"])
+        np.testing.assert_array_equal(fr["el/beam/section_forces"], on_disk.frame(i)["el/beam/section_forces"])
+    with pytest.warns(UserWarning, match="keeps no results"):
+        an = fm.Analysis(m, None, progress=False)
+    an.run()
+    np.testing.assert_array_equal(an.x - an.X0, recorded[-1]["U"])   # the final state is kept
+
+
 def test_background_writer_keeps_every_frame_and_reports_a_write_error(tmp_path):
     m, rows = _frame_model()
     recorded = []

@@ -76,7 +76,6 @@ Every hook call passes ``data``, ``options``, ``params`` and ``prep`` (``theta``
 
 from __future__ import annotations
 
-import tempfile
 import time
 
 import numpy as np
@@ -198,10 +197,9 @@ def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None 
                     fr["U"][row, 2], fr[f"el/{fam}/bead_position"], fr[f"el/{fam}/latch_dT"],
                     fr[f"el/{fam}/latch_zone"]))
 
-    with tempfile.TemporaryDirectory(prefix="femast_bay_") as d:
-        an = Analysis(am.model, d, progress=False, convergence=CONVERGENCE, on_frame=record)
-        with kernel_threads(threads):
-            an.run()
+    an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=record)   # no files
+    with kernel_threads(threads):
+        an.run()
     steps = [r[0] for r in rec]
     tt = np.array([r[1] for r in rec])
     i_eq = max(i for i, s in enumerate(steps) if s != "path")  # end of the initial (pretension) step(s)

@@ -68,7 +68,6 @@ the FE rows, ``s`` the load-path coordinate, ``load`` the signed load measure, `
 
 from __future__ import annotations
 
-import tempfile
 import time
 
 import numpy as np
@@ -178,10 +177,9 @@ def run_mast(inputs: dict, loads: np.ndarray, n_bays: int, fold: int = 1, altern
         rec.append((np.concatenate([fr["U"][row], fr["URA"][row]]), fr[f"el/{fam}/bead_position"][:n_lat],
                     fr[f"el/{fam}/latch_zone"][:n_lat]))
 
-    with tempfile.TemporaryDirectory(prefix="femast_mast_") as d:
-        an = Analysis(am.model, d, progress=False, convergence=CONVERGENCE, on_frame=record)
-        with kernel_threads(threads):
-            an.run()
+    an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=record)   # no files
+    with kernel_threads(threads):
+        an.run()
     i_ref = max(i for i, s in enumerate(steps) if not s.startswith("row"))
     ends = [max(i for i, s in enumerate(steps) if s == nm) for nm in names]
     ref, bead0, zone0 = rec[i_ref]
