@@ -35,7 +35,6 @@ equilibrium (deformed) positions, tensions from the FE, spins about C_i3, tangen
 
 from __future__ import annotations
 
-import tempfile
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -123,7 +122,7 @@ class MastFE:
             length = np.linalg.norm(sh.lower - sh.upper, axis=1)
             self.L0 = np.asarray(unstretched_length(self.law, sh.tension, length), dtype=float)
         self.analysis: Analysis | None = None
-        self._tmp = tempfile.TemporaryDirectory(prefix="femast_fe_mast_")
+        self._frames = []   # per converged increment of the last solve: (step, top [u, spins], tensions)
 
     # ----------------------------------------------------------------- model
     def build(self, wrenches=(), step_names=None) -> Model:
@@ -167,9 +166,19 @@ class MastFE:
         return m
 
     def solve(self, wrenches=(), out=None) -> Analysis:
-        """Run the pretension step (and the load steps); keeps and returns the :class:`Analysis`."""
+        """Run the pretension step (and the load steps); keeps and returns the :class:`Analysis`.
+        out : a results folder, or None (default) to write no files (the top's motion and the shroud
+        tensions of every converged increment are kept in memory for :meth:`run_wrenches`)."""
         model = self.build(wrenches)
-        an = Analysis(model, out or self._tmp.name, convergence=self.convergence, progress=False)
+        row = model.index(self.top)
+        key = f"el/{SHROUD_FAMILY}/tension"
+        self._frames = []
+
+        def record(fr):
+            self._frames.append((str(fr["step"]), np.concatenate([fr["U"][row], fr["URA"][row]]),
+                                 np.asarray(fr.get(key, np.zeros(0)), dtype=float)))
+
+        an = Analysis(model, out, convergence=self.convergence, progress=False, on_frame=record)
         an.run()
         self.analysis = an
         return an
@@ -213,8 +222,6 @@ class MastFE:
         call it first).  Returns a dict with, at the end of the pretension step (``"u0"``) and of each
         load step (``"u"``, (k, 6)): the top displacement [ux, uy, uz] (m) and accumulated spins (rad)
         from the initial geometry, and the shroud tensions ``"tension0"``, ``"tension"`` (k, q) in N."""
-        from ..results import Results
-
         wrenches = np.asarray(wrenches, dtype=float).reshape(-1, 6)
         # a step that repeats the previous load is skipped (its state is the previous one): the core's
         # displacement-correction test cannot pass when the increment is pure round-off
@@ -230,16 +237,10 @@ class MastFE:
             prev = w
             step_of[k] = len(unique) - 1
         self.solve(np.array(unique).reshape(-1, 6))
-        res = Results(self._tmp.name)
-        steps = res.steps
-        last = {s: i for i, s in enumerate(steps)}
-        row = int(np.flatnonzero(res.node_labels == self.top)[0])
+        last = {fr[0]: i for i, fr in enumerate(self._frames)}
 
         def pick(i):
-            fr = res.frame(i)
-            u = np.concatenate([fr["U"][row], fr["URA"][row]])
-            tau = fr.get(f"el/{SHROUD_FAMILY}/tension", np.zeros(0))
-            return u, np.asarray(tau, dtype=float)
+            return self._frames[i][1], self._frames[i][2]
 
         u0, t0 = pick(last["pretension"])
         picked = [pick(last[f"load{k + 1:04d}"]) for k in range(len(unique))]
