@@ -13,7 +13,6 @@ it succeeds; ``sensitivity`` (d log response / d log parameter) tells how well e
 
 from __future__ import annotations
 
-import tempfile
 import time
 
 import numpy as np
@@ -43,15 +42,16 @@ def tip_response(params: BayParameters, n_bays: int = 40, M: float = TABLE1_M, F
     add_initial_steps(am)
     am.model.step("M+F", initial_increment=1.0).load(am.control, mz=M, fx=F)
     t0 = time.perf_counter()
-    with tempfile.TemporaryDirectory() as out:
-        an = Analysis(am.model, out, progress=False, convergence=CONVERGENCE)
-        res = an.run()
-        row = int(np.flatnonzero(res.node_labels == am.control)[0])
-        steps = res.steps
-        i0 = len(steps) - 1 - steps[::-1].index("pretension")
-        f0, f1 = res.frame(i0), res.frame(len(res) - 1)
-        u = f1["U"][row] - f0["U"][row]
-        th = f1["URA"][row] - f0["URA"][row]
+    row = am.model.index(am.control)
+    rec = []   # (step, U, URA) of the control node per converged increment (no files written)
+    an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE,
+                  on_frame=lambda fr: rec.append((str(fr["step"]), fr["U"][row], fr["URA"][row])))
+    an.run()
+    steps = [r[0] for r in rec]
+    i0 = len(steps) - 1 - steps[::-1].index("pretension")
+    (_, u0, th0), (_, u1, th1) = rec[i0], rec[-1]
+    u = u1 - u0
+    th = th1 - th0
     return {"u": u, "theta": th, "iterations": an.summary.iterations, "wall_time": time.perf_counter() - t0}
 
 
