@@ -418,6 +418,7 @@ class Analysis:
         """Run all steps; returns the :class:`Results` of the folder, or None with ``out=None``."""
         t0 = _time.perf_counter()
         writer = NullWriter() if self.out is None else ResultsWriter(self.out, self.model, self.families)
+        self._pending_frame = None   # a converged increment not written yet (Step.output_frequency)
         self._write(writer, step_name="initial", inc=0, time=0.0, iterations=0, responses=None)
         ti = _time.perf_counter()
         try:
@@ -426,6 +427,9 @@ class Analysis:
         except ConvergenceError as exc:
             self.summary.completed = False
             self.summary.message = str(exc)
+            if self._pending_frame is not None:   # the state is that of the last converged increment
+                self._write(writer, *self._pending_frame)
+                self._pending_frame = None
             raise
         finally:
             self.summary.increment_time = _time.perf_counter() - ti
@@ -494,7 +498,8 @@ class Analysis:
             t += dt
             self.total_time += dt
             self.summary.increments += 1
-            self._write(writer, step.name, inc, t, iters, responses, period=period)
+            self._frame_due(writer, step, inc, not t < period * (1 - 1e-12), step.name, inc, t, iters, responses,
+                            period)
             note = ""
             if step.stabilize is not None:
                 note = (f"stabilisation/strain energy {self.stabilization_ratio:.3g}, largest viscous force "
@@ -733,10 +738,11 @@ class Analysis:
             dt = dl_used / dl0 * control.initial_load_factor
             self.total_time += dt
             self.summary.increments += 1
-            self._write(writer, step.name, inc, self.lam, iters, responses)
+            frac = control.progress(self, self.lam)
+            self._frame_due(writer, step, inc, frac >= 1.0 - 1e-12 or inc >= step.max_increments,
+                            step.name, inc, self.lam, iters, responses)
             writer.status(step.name, inc, attempt, iters, self.lam, self.total_time, dl_used, self.lam,
                           f"arc length {dl_used:.4g}")
-            frac = control.progress(self, self.lam)
             bar.n = min(max(frac, 0.0), 1.0)
             bar.refresh()
             dl = dl_used * min(max(math.sqrt(control.desired_iterations / max(iters, 1)), 0.5), 2.0)
@@ -844,9 +850,20 @@ class Analysis:
         self.strain_energy = float(sum(np.sum(r.energy) for r in responses if r.energy is not None))
         self._reactions = -res[self.dofmap.n_free:]
 
+    def _frame_due(self, writer, step, inc, last, *frame):
+        """Write the frame ``frame`` (the arguments of :meth:`_write`) of increment ``inc`` if the
+        step's output frequency asks for it or it is the step's ``last``; else keep it pending."""
+        if last or inc % step.output_frequency == 0:
+            self._write(writer, *frame)
+            self._pending_frame = None
+        else:
+            self._pending_frame = frame
+
     def _kept(self) -> str:
         """Where the converged increments of a run that gives up are (for its error message)."""
-        return "passed to on_frame (out=None: nothing written)" if self.out is None else f"saved in '{self.out}'"
+        sparse = any(st.output_frequency > 1 for st in self.model.steps)
+        where = "passed to on_frame (out=None: nothing written)" if self.out is None else f"saved in '{self.out}'"
+        return where + (" at the steps' output frequency, the last one included" if sparse else "")
 
     def _write(self, writer, step_name, inc, time, iterations, responses, period=1.0):
         if self.out is None and self.on_frame is None:

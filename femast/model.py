@@ -95,6 +95,10 @@ class Step:
     stabilize : None, or a :class:`femast.solvers.stabilize.Stabilize` (issue 3).
     hit_times : step times (s) at which an increment must end (amplitude table points
         are added automatically).
+    output_frequency : write a frame (and call the analysis' ``on_frame``) every this many
+        increments and at the step's last increment (Abaqus *OUTPUT, FREQUENCY); 1 (default):
+        every increment.  Frames cost a small model more than its Newton iterations (issue 8);
+        a run that gives up still writes its last converged increment.
     """
 
     name: str
@@ -106,6 +110,7 @@ class Step:
     control: object = None
     stabilize: object = None
     hit_times: tuple = ()
+    output_frequency: int = 1
     loads: list = field(default_factory=list)
     prescribed: list = field(default_factory=list)
     _model: "Model" = field(default=None, repr=False)
@@ -367,6 +372,10 @@ class Model:
         s._model = self
         if not (s.period > 0 and math.isfinite(s.period)):
             raise ModelError(f"step '{name}': period = {s.period} s must be positive")
+        if isinstance(s.output_frequency, bool) or not isinstance(s.output_frequency, (int, np.integer)) \
+                or s.output_frequency < 1:
+            raise ModelError(f"step '{name}': output_frequency = {s.output_frequency!r} must be a whole number "
+                             ">= 1 (a frame every that many increments)")
         self.steps.append(s)
         return s
 

@@ -237,3 +237,53 @@ def test_reduced_tangent_matches_the_sparse_product():
         # same sums in another order: agreement to round-off of O(10) terms of size O(1)
         np.testing.assert_allclose(K_ff.toarray(), full[:nf, :nf], atol=1e-12)
         np.testing.assert_allclose(K_fc.toarray(), full[:nf, nf:], atol=1e-12)
+
+
+def _cantilever(freq, **step_options):
+    m = fm.Model("frequency")
+    a, b = m.node(0, 0, 0), m.node(1, 0, 0)
+    m.beam(a, b, fm.circular_tube(0.02, 0.016, E=70e9), n=4)
+    m.fix(a)
+    m.step("load", initial_increment=0.1, max_increment=0.1, output_frequency=freq, **step_options).load(b, fz=-50.0)
+    m.step("back", initial_increment=0.25, max_increment=0.25).load(b, fz=0.0)
+    return m
+
+
+def test_output_frequency_writes_every_nth_and_the_last_increment_of_a_step(tmp_path):
+    every = fm.solve(_cantilever(1), tmp_path / "every", progress=False)
+    sparse = fm.solve(_cantilever(3), tmp_path / "sparse", progress=False)
+    assert sparse.steps == ["initial"] + ["load"] * 4 + ["back"] * 4
+    assert sparse.scalar_history("increment").tolist() == [0, 3, 6, 9, 10, 1, 2, 3, 4]
+    same = [0, 3, 6, 9, 10, 11, 12, 13, 14]   # the frames of the every-increment run at those increments
+    for i, j in enumerate(same):              # the solution does not depend on what is written
+        np.testing.assert_array_equal(sparse.frame(i)["U"], every.frame(j)["U"])
+        np.testing.assert_array_equal(sparse.frame(i)["RF"], every.frame(j)["RF"])
+
+
+def test_a_run_that_gives_up_writes_its_last_converged_increment(tmp_path):
+    every = fm.solve(_cantilever(1), tmp_path / "every", progress=False)
+    with pytest.raises(ConvergenceError, match="max_increments=5"):
+        fm.solve(_cantilever(3, max_increments=5), tmp_path / "sparse", progress=False)
+    sparse = fm.Results(tmp_path / "sparse")
+    assert sparse.scalar_history("increment").tolist() == [0, 3, 5]    # 5: written when the step gave up
+    np.testing.assert_array_equal(sparse.frame(2)["U"], every.frame(5)["U"])
+    np.testing.assert_array_equal(sparse.frame(2)["RF"], every.frame(5)["RF"])
+
+
+def test_output_frequency_in_an_arc_length_step_keeps_its_last_increment(monkeypatch):
+    import femast.verification_arclength as va
+
+    full = va.von_mises_truss()["results"]
+    orig = va.Model.step
+    # the same truss and arc-length step, with a frame every 7 increments
+    monkeypatch.setattr(va.Model, "step", lambda self, name=None, **kw: orig(self, name, output_frequency=7, **kw))
+    sparse = va.von_mises_truss()["results"]
+    n = len(full) - 1
+    assert sparse.scalar_history("increment").tolist() == [0] + list(range(7, n, 7)) + ([n] if n % 7 else [])
+    np.testing.assert_array_equal(sparse.frame(len(sparse) - 1)["U"], full.frame(n)["U"])
+
+
+@pytest.mark.parametrize("bad", [0, -2, 1.5, True])
+def test_output_frequency_must_be_a_positive_whole_number(bad):
+    with pytest.raises(fm.ModelError, match="step 'load': output_frequency"):
+        _cantilever(bad)
