@@ -15,12 +15,16 @@ axis, beyond 2 pi), ``RF`` (n, 6) reactions (N, N m), ``P`` (n, 6) applied loads
 element outputs as ``el/<family>/<name>``.  Read them with numpy.load, or with
 :class:`Results`.
 
-The mesh, the frames and the status lines are written by a background thread, so that the analysis goes on with the
-next increment while the last one is stored (``np.savez`` of a frame takes ~1.5 ms, a quarter of a
-Newton iteration of a small model).  A frame is queued the moment its increment converges and the queue is drained
-by :meth:`ResultsWriter.close`, which the analysis calls however the run ends (normally, on a
-convergence failure, on Ctrl-C); only a process killed outright can lose the last queued frame or
-two.  A write error (a full disk) is raised in the analysis at the next frame or at the close.
+The mesh, the frames and the status lines are written by a background thread, so that the analysis
+goes on with the next increment while the last one is stored.  ``np.savez`` of a frame takes 1.5-3 ms
+and holds Python's GIL for most of it: in a large model the writer works while SuperLU factorises,
+but a small model's Newton loop is mostly Python, and there writing every frame can take longer
+than solving (an ADAM bay run: 0.08-0.14 s without files, 0.2-0.4 s with; see
+``Step.output_frequency`` and ``Analysis(out=None)``).  A frame is queued the moment its increment
+converges and the queue is drained by :meth:`ResultsWriter.close`, which the analysis calls however
+the run ends (normally, on a convergence failure, on Ctrl-C); only a process killed outright can
+lose the last queued frame or two.  A write error (a full disk) is raised in the analysis at the
+next frame or at the close.
 """
 
 from __future__ import annotations
