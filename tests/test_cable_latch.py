@@ -335,3 +335,16 @@ def test_initial_state_layout():
     np.testing.assert_allclose(st[:, 2:].sum(axis=1), 0.9, rtol=1e-14)  # Eq. 4
     r = evaluate(fam, X, st)
     assert np.isnan(r.output["bead_position"][1]) and r.output["latch_zone"][1] == -1
+
+
+def test_committed_configuration_is_checked_once_per_increment_but_for_every_new_one():
+    fam = CableLatchFamily([[0, 1, 2]], EA=EA, L0=0.85, latch_node=1, bead=0.4, latch=P, name="side_C")
+    st = fam.initial_state()
+    Xc = X3.copy()
+    fam.evaluate(X3, None, st, IncrementContext(x_committed=Xc))     # fine
+    fam.L0 = np.array([0.5])      # now too short for the anchors (a user change between increments)
+    # another iteration of the same increment (the same committed array): not checked again
+    fam.evaluate(X3, None, st, IncrementContext(x_committed=Xc))
+    # the next increment passes a new committed array with the same values: checked, and it fails
+    with pytest.raises(ModelError, match="side_C element 0.*too short"):
+        fam.evaluate(X3, None, st, IncrementContext(x_committed=Xc.copy()))

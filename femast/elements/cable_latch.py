@@ -261,14 +261,19 @@ class CableLatchFamily(ElementFamily):
         """
         x = np.asarray(x, dtype=float)
         X = np.ascontiguousarray(x[self.nodes])
-        Xc = X if ctx is None or ctx.x_committed is None else np.asarray(ctx.x_committed, float)[self.nodes]
         # the committed configuration is that of the whole increment: check it once per increment, not
-        # every iteration (10 % of a bay run); the key holds everything the check reads
-        key = (Xc, self.L0, self.bead, self.latch, self.latch_node, self.max_strain)
-        last = getattr(self, "_checked", None)
-        if last is None or not all(np.array_equal(a, b) for a, b in zip(last, key)):
-            self._check_configuration(Xc)
-            self._checked = tuple(np.array(a, copy=True) for a in key)
+        # every iteration (10 % of a bay run).  The analysis passes the same x_committed array to every
+        # iteration of an increment (kept referenced here, so it cannot be another array at the same
+        # address); a new one is compared by value with what the last check read
+        src = None if ctx is None else ctx.x_committed
+        if src is None or src is not getattr(self, "_checked_src", None):
+            Xc = X if src is None else np.asarray(src, float)[self.nodes]
+            key = (Xc, self.L0, self.bead, self.latch, self.latch_node, self.max_strain)
+            last = getattr(self, "_checked", None)
+            if last is None or not all(np.array_equal(a, b) for a, b in zip(last, key)):
+                self._check_configuration(Xc)
+                self._checked = tuple(np.array(a, copy=True) for a in key)
+            self._checked_src = src
         state = np.asarray(state, dtype=float)
         n_el, nn = self.nodes.shape
         n = self.n_sections
