@@ -230,6 +230,7 @@ class Analysis:
         self._at_equilibrium = False   # the initial state may hold unbalanced pretension
         self._version = 0              # configuration counter, bumped by every _update
         self._last_converged = None    # (version, responses) of the last committed increment
+        self._diag_cache = None        # (K's indptr, indices, K + diag buffer, diagonal positions)
         self._zero_force = None
 
     # ------------------------------------------------------------ helpers
@@ -567,7 +568,7 @@ class Analysis:
             if self._stab_C is None:  # damping from the tangent at the start of the step
                 self._stab_C = stab.damping(K.diagonal(), self.is_rot, self._stab_dt0)
                 self._stab_C0 = self._stab_C.copy()
-            return (K + sp.diags(self._stab_C / dt)).tocsr()
+            return self._plus_diagonal(K, self._stab_C / dt)
 
         def evaluate(P, Dtrial=None, reuse=False):
             ta = _time.perf_counter()
@@ -849,6 +850,31 @@ class Analysis:
         self.lam = lam
         self.strain_energy = float(sum(np.sum(r.energy) for r in responses if r.energy is not None))
         self._reactions = -res[self.dofmap.n_free:]
+
+    def _plus_diagonal(self, K, c):
+        """K + diag(c) on K's own pattern, explicit zeros kept (the viscous term of a stabilised step).
+
+        scipy's sum drops entries that are zero, and early in a stabilised step many are (latches
+        and joints not loaded yet): each new nonzero then changed the pattern, and the solver
+        analysed a new ordering, three or four times per run of an ADAM model.  On K's pattern the
+        stabilised and the later steps share one ordering.  The result is one matrix refilled in
+        place; a K without its whole diagonal falls back to scipy's sum."""
+        cache = self._diag_cache
+        if cache is None or cache[0] is not K.indptr or cache[1] is not K.indices:
+            n = K.shape[0]
+            rows = np.repeat(np.arange(n), np.diff(K.indptr))
+            d = np.flatnonzero(K.indices == rows)
+            if K.has_canonical_format and d.size == n:   # one diagonal entry per row
+                out = sp.csr_matrix((K.data.copy(), K.indices, K.indptr), shape=K.shape)
+            else:
+                out = d = None
+            cache = self._diag_cache = (K.indptr, K.indices, out, d)
+        out, d = cache[2], cache[3]
+        if out is None:
+            return (K + sp.diags(c)).tocsr()
+        np.copyto(out.data, K.data)
+        out.data[d] += c
+        return out
 
     def _frame_due(self, writer, step, inc, last, *frame):
         """Write the frame ``frame`` (the arguments of :meth:`_write`) of increment ``inc`` if the

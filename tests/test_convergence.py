@@ -45,6 +45,7 @@ def test_a_round_off_load_change_converges_with_friction_joints():
         assert an.summary.steps[-1]["increments"] == 1 and an.summary.steps[-1]["iterations"] <= 1
         u = [res.node_history(am.control, c) for c in ("ux", "rz")]
     # the state does not move: the load changed by 1e-14 relative; 1e-9 is the force tolerance of
-    # the ADAM runs, which bounds how far either state is from exact equilibrium
+    # the ADAM runs, which bounds how far either state is from exact equilibrium, so the two differ
+    # by at most twice that
     for h in u:
-        assert abs(h[-1] - h[-2]) <= 1e-9 * max(abs(h[-2]), 1e-12)
+        assert abs(h[-1] - h[-2]) <= 2e-9 * max(abs(h[-2]), 1e-12)

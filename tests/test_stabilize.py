@@ -82,3 +82,39 @@ def test_large_damping_warns():
     m, top = _guyed_mast(fm.Stabilize(factor=50.0))
     with pytest.warns(fm.analysis.StabilizationWarning, match="stabilisation energy is"):
         fm.Analysis(m, tempfile.mkdtemp(), progress=False).run()
+
+
+def test_damped_tangent_keeps_the_tangents_pattern_and_equals_scipys_sum():
+    import scipy.sparse as sp
+
+    from femast.analysis import Analysis
+
+    an = Analysis(_guyed_mast()[0], tempfile.mkdtemp(), progress=False)
+    rng = np.random.default_rng(5)
+    K = sp.random(6, 6, density=0.4, random_state=5, format="csr") + sp.eye(6, format="csr")
+    K.data[::3] = 0.0                                   # explicit zeros, as early in a stabilised step
+    c = rng.random(6)
+    D = an._plus_diagonal(K, c)
+    np.testing.assert_array_equal(D.toarray(), (K + sp.diags(c)).toarray())   # the same sums, same bits
+    assert np.array_equal(D.indptr, K.indptr) and np.array_equal(D.indices, K.indices)  # zeros kept:
+    assert D.nnz == K.nnz                                                                # one pattern
+    assert an._plus_diagonal(K, 2 * c) is D                                     # refilled in place
+    np.testing.assert_array_equal(D.toarray(), (K + sp.diags(2 * c)).toarray())
+    K2 = sp.csr_matrix(np.triu(np.ones((4, 4)), 1))     # no diagonal entries: scipy's sum
+    np.testing.assert_array_equal(an._plus_diagonal(K2, np.ones(4)).toarray(), np.triu(np.ones((4, 4)), 1) + np.eye(4))
+
+
+def test_a_stabilised_adam_run_analyses_one_ordering():
+    # before, scipy's sum dropped the zero entries of the early damped tangents: each new nonzero
+    # made a new pattern and a new ordering analysis (four per run of a mast)
+    from femast.adam import build_mast
+    from femast.adam.steps import CONVERGENCE, add_initial_steps
+    from femast.analysis import Analysis
+
+    am = build_mast(2)
+    add_initial_steps(am)
+    assert any(st.stabilize is not None for st in am.model.steps)
+    am.model.step("load", initial_increment=0.5).load(am.control, mz=6.8, fx=5.0)
+    an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=lambda fr: None)
+    an.run()
+    assert an.solver.analyses == 1
