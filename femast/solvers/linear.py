@@ -306,8 +306,7 @@ class SparseLU:
         K with the master pattern gives (K.data, gather).  K with a pattern inside it (a stabilised
         step's damped tangent, or a reduced tangent after the union of two patterns was analysed)
         gives its values with a trailing zero and an index composed once per pattern: one copy and
-        one gather per factorisation instead of a scatter onto the master pattern (~0.5 ms an
-        iteration of a 40-bay ADAM mast)."""
+        one gather per factorisation (the same values as a scatter onto the master pattern)."""
         if self._is_master(K):
             return K.data, self._gather
         ids = self._sub_ids
