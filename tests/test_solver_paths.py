@@ -287,3 +287,31 @@ def test_output_frequency_in_an_arc_length_step_keeps_its_last_increment(monkeyp
 def test_output_frequency_must_be_a_positive_whole_number(bad):
     with pytest.raises(fm.ModelError, match="step 'load': output_frequency"):
         _cantilever(bad)
+
+
+def test_sparse_lu_solves_matrices_inside_and_outside_the_analysed_pattern():
+    rng = np.random.default_rng(9)
+    n = 30
+    A = sp.random(n, n, density=0.15, random_state=9, format="csr") + 10 * sp.eye(n, format="csr")
+    A = (A + A.T).tocsr()
+    s = SparseLU(ordering="mmd")
+    s.factorize(A)
+    b = rng.standard_normal(n)
+    np.testing.assert_allclose(s.solve(b), spla.spsolve(A.tocsc(), b), rtol=1e-12)   # well conditioned
+    # a pattern inside the analysed one (entries dropped), refilled in place twice
+    sub = A.copy()
+    sub.data[np.abs(sub.data) < 0.3] = 0.0
+    sub.eliminate_zeros()
+    assert sub.nnz < A.nnz
+    for scale in (1.0, 2.0):
+        sub.data *= scale
+        s.factorize(sub)
+        np.testing.assert_allclose(s.solve(b), spla.spsolve(sub.tocsc(), b), rtol=1e-12)
+    assert s.analyses == 1                      # no new ordering for a sub-pattern
+    # an entry outside it: the union is analysed once, then solved
+    i, j = np.argwhere(A.toarray() == 0)[0]    # a structural zero of A
+    out = (A + sp.csr_matrix(([1e-3, 1e-3], ([i, j], [j, i])), shape=(n, n))).tocsr()
+    assert out.nnz > A.nnz
+    s.factorize(out)
+    np.testing.assert_allclose(s.solve(b), spla.spsolve(out.tocsc(), b), rtol=1e-12)
+    assert s.analyses == 2
