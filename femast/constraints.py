@@ -160,11 +160,16 @@ class Constraints:
         self.n_ind = dofmap.n_free + dofmap.n_constrained
         self.n_active = dofmap.n_active
         s, r = self.rigid_slave[:, 0], self.rigid_slave[:, 1]
-        self.X_rel = X0[s] - X0[r]
-        self.X0 = X0
-        self._X_rel = np.ascontiguousarray(self.X_rel, dtype=float)
-        self._X0 = np.ascontiguousarray(X0, dtype=float)
-        self._tie_split = None
+        self.X0 = np.ascontiguousarray(X0, dtype=float)
+        self.X_rel = self.X0[s] - self.X0[r]
+        # the ties split for the compiled slave update: translations, rotation components, and the
+        # (slave, master) pairs with all three rotations tied (R_s = R_m)
+        t = self.tie
+        pairs = {}
+        for sl, m, d in t[t[:, 2] >= 3]:
+            pairs.setdefault((int(sl), int(m)), set()).add(int(d))
+        full = np.array([p for p, ds in pairs.items() if len(ds) == 3], dtype=np.int64).reshape(-1, 2)
+        self._tie_split = (np.ascontiguousarray(t[t[:, 2] < 3]), np.ascontiguousarray(t[t[:, 2] >= 3]), full)
         eq = self.eq
         if len(s) and np.any(eq[r][:, 3:] < 0):
             raise ModelError("a rigid-body reference node has no rotational DOFs")
@@ -216,15 +221,7 @@ class Constraints:
     def update_slaves(self, x, R, spin):
         """Put every dependent node where its constraint says (exact for any rotation): one
         compiled pass (numpy's fancy indexing on a dozen 3-vectors cost ~4 % of a bay run)."""
-        if self._tie_split is None:
-            t = self.tie
-            trans, rot = t[t[:, 2] < 3], t[t[:, 2] >= 3]
-            pairs = {}
-            for sl, m, d in rot:
-                pairs.setdefault((int(sl), int(m)), set()).add(int(d))
-            full = np.array([p for p, ds in pairs.items() if len(ds) == 3], dtype=np.int64).reshape(-1, 2)
-            self._tie_split = (np.ascontiguousarray(trans), np.ascontiguousarray(rot), full)
-        _update_slaves(x, R, spin, self.rigid_slave, self._X_rel, self._X0, *self._tie_split)
+        _update_slaves(x, R, spin, self.rigid_slave, self.X_rel, self.X0, *self._tie_split)
 
     def transformation(self, x):
         """T (n_active x n_ind): variations of all active DOFs from the independent ones."""
