@@ -1,7 +1,7 @@
 """The compare -> diagnose -> add effect loop on the shipped data sets (docs/compare_and_diagnose.md).
 
     python benchmarks/compare_demo.py            # run the loop, copy the figures to docs/figures
-    python benchmarks/compare_demo.py --data     # (re)generate the example data in benchmarks/data
+    python benchmarks/compare_demo.py --data     # (re)generate the example data in femast/examples (package data)
 
 The example data sets are synthetic (deterministic seeds) with hidden effects; what is hidden
 is stated at the end of the tutorial.  The tip-cycle file holds the seed 001 Table 1 FE
@@ -24,7 +24,7 @@ from femast.experiments import Measured, get_experiment, write_data
 from femast.experiments.synthetic import latch_pull_data, mast_top_data, mast_top_path
 
 ROOT = Path(__file__).resolve().parents[1]
-DATA = ROOT / "benchmarks" / "data"
+DATA = ROOT / "femast" / "examples"
 FIGS = ROOT / "docs" / "figures"
 OUT = ROOT / "benchmarks" / "out" / "compare_demo"
 
@@ -36,7 +36,7 @@ LATCH_TRUTH = {"effects": {"latch_hysteresis": {"F_h": 8.0, "ell": 4e-4}}, "nois
 
 
 def make_data() -> None:
-    """Write the example data files of the four built-in experiments to benchmarks/data."""
+    """Write the example data files of the four built-in experiments to femast/examples (package data)."""
     exp = get_experiment("mast-top")
     path = mast_top_path(n=500, kind="cycles", amplitude_N=150.0, cycles=4, angle_deg=30.0,
                          seed=MAST_TOP_TRUTH["seed"])

@@ -3,7 +3,7 @@ example data set it runs on.
 
     python benchmarks/diagnose_bay_torsion.py                 # time compare --fit and diagnose (CLI, cold)
     python benchmarks/diagnose_bay_torsion.py --workers 1     # ... with the refits in one process
-    python benchmarks/diagnose_bay_torsion.py --data          # (re)generate benchmarks/data/bay_torsion_example.csv
+    python benchmarks/diagnose_bay_torsion.py --data          # (re)generate femast/examples/bay_torsion_example.csv
     python benchmarks/diagnose_bay_torsion.py --docs          # also copy the figures to docs/figures
     python benchmarks/diagnose_bay_torsion.py --tip-cycle     # also a tip-cycle example (2-bay mast, in-process)
 
@@ -31,7 +31,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-DATA = ROOT / "benchmarks" / "data" / "bay_torsion_example.csv"
+DATA = ROOT / "femast" / "examples" / "bay_torsion_example.csv"
 OUT = ROOT / "benchmarks" / "out" / "diagnose_bay_torsion"
 FIGS = ROOT / "docs" / "figures"
 
@@ -40,7 +40,7 @@ TRUTH = {"params": {"latch_k": 1.08e5, "latch_mu": 0.065}, "effects": {"latch_hy
 
 
 def make_data() -> None:
-    """Write benchmarks/data/bay_torsion_example.csv (see the module docstring)."""
+    """Write femast/examples/bay_torsion_example.csv (see the module docstring)."""
     from femast.experiments import get_experiment, write_data
     from femast.experiments.synthetic import bay_torsion_data, bay_torsion_path
 

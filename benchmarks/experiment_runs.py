@@ -5,7 +5,7 @@
 Times, in this process with a warm numba cache:
 
 * one bay-torsion FE run (``femast.experiments.bay_torsion.run_bay``: the ADAM bay driven along the
-  49 rows of ``benchmarks/data/bay_torsion_example.csv``), as the experiment runs it (no files,
+  49 rows of ``femast/examples/bay_torsion_example.csv``), as the experiment runs it (no files,
   ``Analysis(out=None)``) and with its frames written to a temporary results folder (what it did
   before), alternating;
 * ``MastFE.run_wrenches`` of the guyed mast (pretension step + 3 top wrenches);
@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-DATA = ROOT / "benchmarks" / "data" / "bay_torsion_example.csv"
+DATA = ROOT / "femast" / "examples" / "bay_torsion_example.csv"
 
 
 def _times(fn, repeat):

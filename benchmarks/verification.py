@@ -14,6 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from femast import progress
 from femast import references as ref
 from femast import verification as v
 from femast.render import render_png
@@ -28,6 +29,15 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     fig, axes = plt.subplots(2, 2, figsize=(12, 9))
+    bar = progress.counter(7, "verification cases", unit="cases")  # per case; erased when done
+
+    def case(name):
+        bar.set_postfix_str(name, refresh=True)
+
+    def done():
+        bar.update(1)
+
+    case("roll-up, one turn")
 
     # roll-up: deformed shapes at several load levels
     r1, res = v.roll_up(n_elements=16, turns=1, out_dir=out)
@@ -43,11 +53,15 @@ def main():
     ax.set_aspect("equal")
     ax.set_title("Cantilever under end moment (16 elements)")
     ax.legend(fontsize=7)
+    done()
+    case("roll-up, two turns")
     rows += v.roll_up(n_elements=16, turns=2, out_dir=out)[0]
+    done()
     pvd = export_vtk(res, out / "rollup_vtk")
     render_png(res, out / "rollup_shape.png", title="roll-up under M = 2 pi EI/L")
 
     # elastica
+    case("elastica")
     r2, res = v.elastica(n_elements=20, out_dir=out)
     rows += r2
     ax = axes[0, 1]
@@ -64,7 +78,9 @@ def main():
     ax.set_title("Cantilever under a dead end load (20 elements)")
     ax.legend(fontsize=8)
 
+    done()
     # 45-degree bend
+    case("45-degree bend")
     r3, res = v.bend45(n_elements=16, out_dir=out)
     rows += r3
     ax = axes[1, 0]
@@ -82,9 +98,13 @@ def main():
     ax.set_title("45-degree bend (16 elements)")
     ax.legend(fontsize=8)
 
+    done()
+    case("linear compliance")
     rows += v.linear_compliance(out_dir=out)[0]
+    done()
 
     # Euler column
+    case("Euler column")
     r5, res = v.euler_column(n_elements=16, out_dir=out)
     rows += r5
     ax = axes[1, 1]
@@ -102,8 +122,12 @@ def main():
     ax.set_title("Pinned column with imperfection (displacement control)")
     ax.legend(fontsize=8)
 
+    done()
+    case("figures")
     fig.tight_layout()
     fig.savefig(out / "verification.png", dpi=110)
+    done()
+    bar.close()
     table = v.format_table(rows)
     print(table)
     (out / "verification_table.txt").write_text(table + "\n")

@@ -29,3 +29,7 @@ __all__ = [
     "FemastError", "ModelError", "SingularModelError", "ConvergenceError", "DataFileError",
 ]
 __version__ = "0.1.0"
+
+from .jit import watch as _watch_compile
+
+_watch_compile()  # announce the first-run numba compile once (femast.jit)

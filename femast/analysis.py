@@ -21,6 +21,7 @@ import numpy as np
 import scipy.sparse as sp
 from tqdm.auto import tqdm
 
+from . import progress as _progress
 from .assembly import Assembler
 from .configuration import update_configuration
 from .constraints import Constraints, transpose_times
@@ -463,7 +464,7 @@ class Analysis:
         t, inc, easy = 0.0, 0, 0
         self.lam = 0.0
         step_iters = 0
-        bar = tqdm(total=period, desc=f"step {step.name}", unit="s", disable=not self.progress, leave=False,
+        bar = tqdm(total=period, desc=f"step {step.name}", unit="s", disable=not (self.progress and _progress.enabled()), leave=False,
                    bar_format="{desc}: {percentage:3.0f}%|{bar}| t={n:.4g}/{total:.4g} [{elapsed}<{remaining}]")
         while t < period * (1 - 1e-12):
             if inc >= step.max_increments:
@@ -710,7 +711,7 @@ class Analysis:
         dl0 = dl = None
         prev = None
         inc = step_iters = 0
-        bar = tqdm(total=1.0, desc=f"step {step.name} (arc length)", disable=not self.progress, leave=False,
+        bar = tqdm(total=1.0, desc=f"step {step.name} (arc length)", disable=not (self.progress and _progress.enabled()), leave=False,
                    bar_format="{desc}: {percentage:3.0f}%|{bar}| [{elapsed}<{remaining}]")
         while True:
             attempt = 0

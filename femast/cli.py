@@ -1,5 +1,7 @@
-"""Command line: ``femast run SCRIPT``, ``femast vtk RESULTS``, ``femast render RESULTS PNG``,
-``femast info RESULTS``.  ``femast --help`` lists them."""
+"""Command line: ``femast run SCRIPT``, ``femast vtk RESULTS``, ``femast render RESULTS [PNG]``,
+``femast info RESULTS``, ``femast warmup``; ``compare``, ``diagnose``, ``experiments``, ``effects``,
+``examples`` (:mod:`femast.cli_experiments`).  ``femast --help`` lists them, ``femast CMD --help``
+explains each argument with its default.  ``femast --quiet CMD`` shows no progress bars."""
 
 from __future__ import annotations
 
@@ -26,11 +28,40 @@ def _vtk(args):
     print(f"wrote {pvd} (open it in ParaView; apply 'Warp By Vector' with U to see the deformed shape)")
 
 
-def _render(args):
-    from .render import render_png
+def _frame_arg(text: str):
+    """``--frame``: a frame number (negative counts from the end), ``last``, or ``max`` (largest
+    displacement)."""
+    t = text.strip().lower()
+    if t in ("last", "max"):
+        return t
+    try:
+        return int(t)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--frame {text!r}: give a frame number, 'last' or 'max'") from None
 
-    png = render_png(args.results, args.png, frame=args.frame, scale=args.scale)
-    print(f"wrote {png}")
+
+def _render(args):
+    from .render import largest_displacement_frame, render_png
+    from .results import Results
+
+    res = Results(args.results)
+    if args.frame == "max":
+        frame, umax = largest_displacement_frame(res)
+        why = f"frame {frame} of {len(res)}, the largest displacement ({umax:.4g} m); --frame N|last for another"
+    else:
+        frame = len(res) - 1 if args.frame == "last" else args.frame
+        why = f"frame {range(len(res))[frame] if -len(res) <= frame < len(res) else frame} of {len(res)}"
+    png = Path(args.png) if args.png else Path("render") / f"{Path(args.results).resolve().name}_frame{frame}.png"
+    png = render_png(res, png, frame=frame, scale=args.scale)
+    print(f"wrote {png} ({why}; displacements x {args.scale:g})")
+
+
+def _warmup(args):
+    from .jit import warmup
+
+    print("compiling (or loading from numba's cache) every femast kernel:")
+    t = warmup()
+    print(f"done in {t:.1f} s; later runs load the kernels from the cache")
 
 
 def _info(args):
@@ -48,37 +79,78 @@ def _info(args):
             print(f"  {s['message']}")
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(prog="femast", description="Nonlinear FE for jointed deployable masts")
-    sub = parser.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("run", help="run a model or benchmark script")
-    p.add_argument("script")
-    p.add_argument("script_args", nargs=argparse.REMAINDER)
+class _Help(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Help text with each option's default (argparse's own, unless the help already says it)."""
+
+    def _get_help_string(self, action):
+        h = action.help or ""
+        if "default" in h or action.default in (None, False, argparse.SUPPRESS) or not action.option_strings:
+            return h
+        return h + " (default: %(default)s)"
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """femast's argument parser (every command; the lists in the help come from the registries)."""
+    parser = argparse.ArgumentParser(prog="femast", description="Nonlinear FE for jointed deployable masts. "
+                                     "`femast COMMAND --help` explains a command.", formatter_class=_Help)
+    parser.add_argument("--quiet", action="store_true", help="no progress bars or first-run notices (they never "
+                                                             "show when stderr is not a terminal)")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    p = sub.add_parser("run", help="run a model or benchmark script", formatter_class=_Help,
+                       description="Run a Python script (a model, a benchmark) as `python SCRIPT ARGS` would.")
+    p.add_argument("script", help="path of the Python script to run")
+    p.add_argument("script_args", nargs=argparse.REMAINDER, help="arguments passed on to the script (default: none)")
     p.set_defaults(func=_run)
-    p = sub.add_parser("vtk", help="export a results folder to .vtu files and a .pvd series")
-    p.add_argument("results")
-    p.add_argument("--out", default=None, help="output folder (default RESULTS/vtk)")
+    p = sub.add_parser("vtk", help="export a results folder to .vtu files and a .pvd series", formatter_class=_Help,
+                       description="Write one .vtu file per frame and a .pvd series for ParaView (open the .pvd, "
+                                   "apply 'Warp By Vector' with U).")
+    p.add_argument("results", help="results folder written by an analysis (fm.solve(model, FOLDER))")
+    p.add_argument("--out", default=None, help="output folder (default: RESULTS/vtk)")
     p.add_argument("--every", type=int, default=1, help="write every n-th frame")
     p.set_defaults(func=_vtk)
-    p = sub.add_parser("render", help="render the deformed shape to PNG off-screen")
-    p.add_argument("results")
-    p.add_argument("png")
-    p.add_argument("--frame", type=int, default=-1)
+    p = sub.add_parser("render", help="render the deformed shape to PNG off-screen", formatter_class=_Help,
+                       description="Render one frame's deformed shape (coloured by |U|, over the undeformed "
+                                   "shape) to a PNG, without a display.  By default the frame of largest "
+                                   "displacement; the output says which frame it drew.")
+    p.add_argument("results", help="results folder written by an analysis")
+    p.add_argument("png", nargs="?", default=None,
+                   help="PNG file to write (default: ./render/RESULTSNAME_frameN.png in the working directory)")
+    p.add_argument("--frame", type=_frame_arg, default="max",
+                   help="frame number (negative from the end), 'last', or 'max' for the largest displacement")
     p.add_argument("--scale", type=float, default=1.0, help="displacement magnification")
     p.set_defaults(func=_render)
-    p = sub.add_parser("info", help="summarise a results folder")
-    p.add_argument("results")
+    p = sub.add_parser("info", help="summarise a results folder", formatter_class=_Help,
+                       description="Frames, nodes, element families and the run summary of a results folder.")
+    p.add_argument("results", help="results folder written by an analysis")
     p.set_defaults(func=_info)
+    p = sub.add_parser("warmup", help="compile every femast kernel now (for CI images and cluster workers)",
+                       formatter_class=_Help,
+                       description="Compile femast's numba kernels into numba's on-disk cache by running small "
+                                   "models of every element family, so that the first real run does not wait "
+                                   "for the compiler.  Quick when the cache is already written.")
+    p.set_defaults(func=_warmup)
     try:
         from .cli_experiments import register  # compare / diagnose (issue 7), when present
     except ImportError:
         register = None
     if register is not None:
-        register(sub)
-    args = parser.parse_args(argv)
+        register(sub, _Help)
+    for name, sp in sub.choices.items():  # --quiet also after the command (SUPPRESS: keeps the main one's value)
+        if name != "run":
+            sp.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS,
+                            help="no progress bars or first-run notices")
+    return parser
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    from . import progress
+
+    progress.set_quiet(args.quiet)
     try:
         args.func(args)
     except FemastError as exc:
+        progress.close_all()  # a bar left on the line would run into the message
         print(f"femast: error: {exc}", file=sys.stderr)
         return 2
     return 0

@@ -1,13 +1,18 @@
-"""``femast compare`` and ``femast diagnose`` (issue 7), registered by :mod:`femast.cli`.
+"""``femast compare``, ``diagnose`` (issue 7), ``experiments``, ``effects``, ``examples`` (issue 17),
+registered by :mod:`femast.cli`.
 
 ::
 
     femast compare EXPERIMENT DATA.csv [--effects a,b] [--fit] [--out DIR] [--json]
     femast diagnose EXPERIMENT DATA.csv [--out DIR] [--json] [--workers N] [--scheduler ADDRESS]
                     [--effects a,b]
+    femast experiments [--json]            femast effects [EXPERIMENT] [--json]
+    femast examples [--copy DIR]
 
-EXPERIMENT is a built-in name (``mast-top``, ``latch-pull``; ``bay-torsion`` and ``tip-cycle`` are
-both FE models of femast.adam) or the path of a Python script defining ``experiment``.  An ``--effects`` entry
+EXPERIMENT is a registered name (``femast experiments`` lists them) or the path of a Python script
+defining ``experiment``; DATA is a CSV file or ``example`` (the experiment's shipped example,
+:mod:`femast.examples`).  Outputs go to ``--out``, by default ``./compare/EXPERIMENT_DATASTEM``
+(``./diagnose/...``) in the working directory.  An ``--effects`` entry
 is an effect name, ``SCRIPT.py`` (every effect the script registers) or ``SCRIPT.py:name``.
 ``diagnose --effects`` names the effects already in the model being diagnosed (an extension of
 issue 7: after adding the missing effect, diagnose the new model).
@@ -38,14 +43,112 @@ def _effect_names(arg):
     return names
 
 
+def _first_sentence(text: str) -> str:
+    """The first sentence of ``text`` on one line."""
+    text = " ".join((text or "").split())
+    for i in range(len(text) - 1):
+        if text[i] == "." and text[i + 1] == " " and not text[max(0, i - 3):i].endswith(("Eq", "Sec", "e.g", "i.e", "Fig", "Eqs", "Tab")):
+            return text[:i + 1]
+    return text
+
+
+def experiment_rows() -> list[dict]:
+    """Every registered experiment: name, title, its example data file (or None), its effects."""
+    from . import examples
+    from .effects import applicable_effects
+    from .experiments import list_experiments
+
+    return [{"name": e.name, "title": e.title, "physics": _first_sentence(e.doc) if e.doc else e.title,
+             "example": examples.BY_EXPERIMENT.get(e.name),
+             "effects": [f.name for f in applicable_effects(e)]} for e in list_experiments()]
+
+
+def effect_rows(experiment=None) -> list[dict]:
+    """Every registered effect (or those applicable to ``experiment``): name, title, one sentence of
+    physics, the experiments it is implemented for."""
+    from .effects import list_effects
+
+    rows = []
+    for e in list_effects():
+        exps = [n for n in e.implementations if e.applies_to(n)]
+        if experiment is not None and experiment not in exps:
+            continue
+        rows.append({"name": e.name, "title": e.title, "physics": _first_sentence(e.physics), "experiments": exps,
+                     "seed": e.seed})
+    return rows
+
+
+def _experiments(args):
+    rows = experiment_rows()
+    if args.json:
+        print(json.dumps(rows, indent=2))
+        return
+    print("experiments (femast compare|diagnose EXPERIMENT DATA.csv; DATA 'example' uses the shipped example):")
+    for r in rows:
+        print(f"  {r['name']:<12s} {r['title']}")
+        print(f"  {'':<12s} example data: {r['example'] or '(none shipped)'}; effects: {', '.join(r['effects'])}")
+
+
+def _effects(args):
+    exp = None
+    if args.experiment:
+        from .experiments import get_experiment
+
+        exp = get_experiment(args.experiment).name
+    rows = effect_rows(exp)
+    if args.json:
+        print(json.dumps(rows, indent=2))
+        return
+    print(f"effects{' of ' + exp if exp else ''} (femast compare ... --effects NAME[,NAME]):")
+    for r in rows:
+        print(f"  {r['name']:<22s} {r['title']} [{', '.join(r['experiments'])}]")
+        print(f"  {'':<22s} {r['physics']}")
+
+
+def _examples(args):
+    import shutil
+
+    from . import examples
+
+    if args.copy:
+        dest = Path(args.copy)
+        dest.mkdir(parents=True, exist_ok=True)
+        for n in examples.names():
+            shutil.copy(examples.path(n), dest / n)
+        print(f"copied {len(examples.names())} example files to {dest}")
+        return
+    by_file = {v: k for k, v in examples.BY_EXPERIMENT.items()}
+    print(f"example data shipped with femast (in {examples.FOLDER}):")
+    for n in examples.names():
+        use = f"  ('example' for {by_file[n]})" if n in by_file else ""
+        print(f"  {n:<30s} {examples.describe(n)}{use}")
+
+
+def resolve_data(exp, data: str):
+    """(path to read, name to show) of the DATA argument: a file, or ``example`` for the experiment's
+    shipped example (:mod:`femast.examples`)."""
+    from . import examples
+
+    if data == "example":
+        p = examples.for_experiment(exp.name)
+        return p, f"example {p.name}"
+    if not Path(data).exists() and data in examples.names():
+        return examples.path(data), f"example {data}"
+    return Path(data), data
+
+
 def _setup(args):
+    from dataclasses import replace
+
     from .experiments import get_experiment, read_data
 
     exp = get_experiment(args.experiment)
     effects = _effect_names(getattr(args, "effects", None))
     exp.require_model(f"femast {args.command}")
-    data = read_data(exp, args.data)
-    out = Path(args.out) if args.out else Path("femast_out") / f"{exp.name}_{Path(args.data).stem}"
+    path, shown = resolve_data(exp, args.data)
+    data = replace(read_data(exp, path), path=shown)
+    stem = Path(shown.split()[-1]).stem
+    out = Path(args.out) if args.out else Path(args.command) / f"{exp.name}_{stem}"
     return exp, data, effects, out
 
 
@@ -65,31 +168,68 @@ def _diagnose(args):
     print(json.dumps(res.report, indent=2) if args.json else format_diagnose(exp, res))
 
 
-def register(subparsers) -> None:
-    """Add the ``compare`` and ``diagnose`` sub-commands to femast's argument parser."""
+def register(subparsers, fmt=None) -> None:
+    """Add ``compare``, ``diagnose``, ``experiments``, ``effects`` and ``examples`` to femast's parser;
+    the lists in the help come from the registries."""
+    from .effects import list_effects
+    from .experiments import list_experiments
+
+    exps = ", ".join(e.name for e in list_experiments())
+    effs = ", ".join(e.name for e in list_effects())
+    kw = {"formatter_class": fmt} if fmt else {}
+    exp_help = (f"built-in experiment ({exps}; `femast experiments` says what each is) or the path of a Python "
+                "script defining `experiment`")
+    data_help = ("measured data, a CSV file with a header row (formats: `femast experiments`, docs/experiments.md), "
+                 "or 'example' for the example shipped with femast")
+    out_help = "output folder (default: ./%(prog_cmd)s/EXPERIMENT_DATASTEM in the working directory)"
     p = subparsers.add_parser(
-        "compare", help="run a model along measured data and show where it fails",
-        description="Run the model of EXPERIMENT along the measured path of DATA.csv (fitting its parameters "
+        "compare", help="run a model along measured data and show where it fails", **kw,
+        description="Run the model of EXPERIMENT along the measured path of DATA (fitting its parameters "
                     "with --fit); print the overall and per-channel RMS error, the noise floor and the worst "
-                    "segments of the path; write compare.png, compare.json and append to history.jsonl in DIR.")
-    p.add_argument("experiment", help="built-in experiment name (mast-top, latch-pull) or a Python script path")
-    p.add_argument("data", help="measured data, CSV with a header row (see docs/experiments.md)")
-    p.add_argument("--effects", default=None, help="comma-separated effects to switch on (names, SCRIPT.py or "
-                                                   "SCRIPT.py:name)")
-    p.add_argument("--fit", action="store_true", help="fit the model and effect parameters")
-    p.add_argument("--out", default=None, help="output folder (default femast_out/EXPERIMENT_DATASTEM)")
+                    "segments of the path; write compare.png, compare.json and append to history.jsonl in the "
+                    "output folder.  Example: femast compare mast-top example --fit")
+    p.add_argument("experiment", help=exp_help)
+    p.add_argument("data", help=data_help)
+    p.add_argument("--effects", default=None, help=f"comma-separated effects to switch on: names ({effs}; "
+                                                   "`femast effects EXPERIMENT`), SCRIPT.py or SCRIPT.py:name "
+                                                   "(default: none)")
+    p.add_argument("--fit", action="store_true", help="fit the model and effect parameters (default: run with "
+                                                      "the default parameters)")
+    p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "compare"})
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.set_defaults(func=_compare)
     p = subparsers.add_parser(
-        "diagnose", help="rank the physical effects the model may be missing",
+        "diagnose", help="rank the physical effects the model may be missing", **kw,
         description="Fit the model of EXPERIMENT, refit it with each applicable candidate effect (in parallel), "
                     "rank them by BIC and conclude: the missing effect, 'nothing is missing' or 'none of the "
-                    "candidates explains this'. Writes diagnose.png and diagnose.json in DIR.")
-    p.add_argument("experiment", help="built-in experiment name (mast-top, latch-pull) or a Python script path")
-    p.add_argument("data", help="measured data, CSV with a header row")
-    p.add_argument("--out", default=None, help="output folder (default femast_out/EXPERIMENT_DATASTEM)")
+                    "candidates explains this'. Writes diagnose.png and diagnose.json in the output folder.  "
+                    "Example: femast diagnose mast-top example")
+    p.add_argument("experiment", help=exp_help)
+    p.add_argument("data", help=data_help)
+    p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "diagnose"})
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
-    p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all CPUs)")
-    p.add_argument("--scheduler", default=None, help="dask.distributed scheduler address (tcp://host:port)")
-    p.add_argument("--effects", default=None, help="effects already in the model being diagnosed")
+    p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all CPUs, or "
+                                                              "none when the refits are quick)")
+    p.add_argument("--scheduler", default=None, help="dask.distributed scheduler address tcp://host:port "
+                                                     "(default: local processes)")
+    p.add_argument("--effects", default=None, help="comma-separated effects already in the model being "
+                                                   "diagnosed (default: none)")
     p.set_defaults(func=_diagnose)
+    p = subparsers.add_parser("experiments", help="list the experiments compare/diagnose know, one line each", **kw,
+                              description="List every registered experiment with what it models, its shipped "
+                                          "example data and the effects implemented for it.")
+    p.add_argument("--json", action="store_true", help="print a JSON list instead of text")
+    p.set_defaults(func=_experiments)
+    p = subparsers.add_parser("effects", help="list the physical effects (all, or those of one experiment)", **kw,
+                              description="List the registered effects with one sentence of physics each and "
+                                          "the experiments they are implemented for.")
+    p.add_argument("experiment", nargs="?", default=None,
+                   help=f"only the effects implemented for this experiment ({exps}; default: all)")
+    p.add_argument("--json", action="store_true", help="print a JSON list instead of text")
+    p.set_defaults(func=_effects)
+    p = subparsers.add_parser("examples", help="list the example data shipped with femast", **kw,
+                              description="List the example data files installed with femast (usable as "
+                                          "'example' in compare/diagnose, or femast.examples.path(NAME) in "
+                                          "Python).")
+    p.add_argument("--copy", metavar="DIR", default=None, help="copy them to folder DIR (default: only list them)")
+    p.set_defaults(func=_examples)

@@ -14,7 +14,7 @@ from femast.experiments import diagnose, get_experiment, read_data, read_history
 from femast.experiments.synthetic import mast_top_data, mast_top_path
 
 ROOT = Path(__file__).resolve().parents[1]
-MT_DATA = ROOT / "benchmarks" / "data" / "mast_top_example.csv"
+MT_DATA = ROOT / "femast" / "examples" / "mast_top_example.csv"
 
 USER_EXPERIMENT = textwrap.dedent('''
     """A user experiment: a spring pulled back and forth, and a user effect (slip at zero force)."""
@@ -130,12 +130,12 @@ def test_diagnose_json_schema_of_issue_7(tmp_path, capsys):
 
 
 def test_text_output(tmp_path, capsys):
-    assert main(["compare", "latch-pull", str(ROOT / "benchmarks/data/latch_pull_example.csv"), "--fit",
+    assert main(["compare", "latch-pull", str(ROOT / "femast/examples/latch_pull_example.csv"), "--fit",
                  "--out", str(tmp_path)]) == 0
     text = capsys.readouterr().out
     assert "overall RMS error" in text and "noise floor" in text and "worst segments:" in text
     assert "x_backstop =" in text and "file lines" in text
-    assert main(["diagnose", "latch-pull", str(ROOT / "benchmarks/data/latch_pull_example.csv"),
+    assert main(["diagnose", "latch-pull", str(ROOT / "femast/examples/latch_pull_example.csv"),
                  "--out", str(tmp_path), "--workers", "1"]) == 0
     text = capsys.readouterr().out
     assert "verdict: missing effect: latch_hysteresis" in text and "reading of #1" in text

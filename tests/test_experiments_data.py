@@ -11,7 +11,7 @@ from femast.experiments import compare, diagnose, from_arrays, get_experiment, r
 from femast.experiments.synthetic import mast_top_data
 
 ROOT = Path(__file__).resolve().parents[1]
-DATA = ROOT / "benchmarks" / "data"
+DATA = ROOT / "femast" / "examples"
 MT = get_experiment("mast-top")
 HEADER = "fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_m,dy_m,dz_m"
 

@@ -286,8 +286,7 @@ def test_tutorial_section8_commands_print_what_the_page_quotes(tmp_path, capsys,
 
     text = (ROOT / "docs" / "compare_and_diagnose.md").read_text()
     sec = text[text.index("## 8. An FE experiment"):text.index("## What was hidden")]
-    monkeypatch.chdir(tmp_path)
-    (tmp_path / "benchmarks").symlink_to(ROOT / "benchmarks")
+    monkeypatch.chdir(tmp_path)  # the data are femast's shipped examples: any folder works
     checked = sum(replay_transcript(block, tmp_path, capsys, what="section 8",
                                     # the process count follows the machine
                                     ignore=lambda line: "local processes" in line)

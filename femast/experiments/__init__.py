@@ -9,9 +9,10 @@ tip load cycles, seed 001 Table 1).
 
 Typical use::
 
+    import femast.examples
     from femast.experiments import get_experiment, read_data, compare, diagnose
     exp = get_experiment("mast-top")
-    data = read_data(exp, "benchmarks/data/mast_top_example.csv")
+    data = read_data(exp, femast.examples.path("mast_top_example.csv"))
     c = compare(exp, data, fit=True, out="out/mast")          # where does the model fail?
     d = diagnose(exp, data, out="out/mast")                   # which effect is missing?
     c2 = compare(exp, data, [d.verdict["best_candidate"]], fit=True, out="out/mast")  # error falls

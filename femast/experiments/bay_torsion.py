@@ -80,6 +80,7 @@ import time
 
 import numpy as np
 
+from .. import progress
 from ..errors import ConvergenceError, FemastError, ModelError
 from .core import Column, Experiment, Measured, Parameter, prepared
 from .fe_cache import cached, kernel_threads
@@ -222,6 +223,7 @@ def solve(inputs: dict, drive: np.ndarray, options: dict) -> dict:
     fold = int(options["fold"])
 
     def compute():
+        progress.tick("FE runs")
         try:
             return run_bay(inputs, drive, fold, options.get("threads", 1))
         except (ConvergenceError, FemastError) as e:  # includes ModelError from invalid inputs

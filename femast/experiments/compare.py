@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import OptimizeResult
 
+from .. import progress
 from .core import Experiment, Measured
 from .figures import compare_figure, display_scale
 from .fitting import fit as _fit
@@ -66,8 +67,10 @@ def compare(exp: Experiment, data: Measured, effects=(), *, fit: bool = False, p
     if isinstance(effects, str):
         effects = [e for e in effects.split(",") if e.strip()]
     effects = list(effects)
+    variant = exp.name + "".join(" + " + e for e in effects)
     if fit:
-        run = _fit(exp, data, effects, noise=noise)
+        with progress.task(f"fitting {variant}"):
+            run = _fit(exp, data, effects, noise=noise)
     else:
         params = dict(params or {})
         base = {k: v for k, v in params.items() if "." not in k}
@@ -76,7 +79,8 @@ def compare(exp: Experiment, data: Measured, effects=(), *, fit: bool = False, p
             if "." in k:
                 e, p = k.split(".", 1)
                 eff.setdefault(e, {})[p] = v
-        run = run_model(exp, data, base, eff, noise=noise)
+        with progress.task(f"running {variant}"):
+            run = run_model(exp, data, base, eff, noise=noise)
     a = analyse(exp, data, run)
     report = {
         "experiment": exp.name,

@@ -40,12 +40,13 @@ import json
 import multiprocessing
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
 from scipy.optimize import OptimizeResult
 
+from .. import progress
 from ..effects.base import applicable_effects, get_effect, load_script, loaded_scripts, resolve
 from ..errors import FemastError, ModelError
 from .compare import analyse
@@ -126,7 +127,14 @@ def _run_tasks(payloads, workers, scheduler):
         client = Client(scheduler) if own else scheduler
         try:
             address = client.scheduler.address if client.scheduler is not None else str(scheduler)
+            from distributed import as_completed as dask_completed
+
             futures = client.map(_refit_task, payloads, pure=False)
+            names = {f.key: _candidate(p) for f, p in zip(futures, payloads)}
+            with progress.counter(len(futures), "diagnose: refits on the cluster", unit="refits") as bar:
+                for fut in dask_completed(futures):
+                    bar.set_postfix_str(f"done: {names[fut.key]}", refresh=False)
+                    bar.update(1)
             results = client.gather(futures)
         finally:
             if own:
@@ -137,10 +145,28 @@ def _run_tasks(payloads, workers, scheduler):
         raise ModelError(f"--workers must be >= 1, got {workers}")
     n = min(n, len(payloads))
     if n <= 1:
-        return [_refit_task(p) for p in payloads], "serial (1 process)"
+        return _serial_refits(payloads), "serial (1 process)"
     with ProcessPoolExecutor(max_workers=n, mp_context=_mp_context()) as pool:
-        results = list(pool.map(_refit_task, payloads))
+        futures = [pool.submit(_refit_task, p) for p in payloads]
+        with progress.counter(len(futures), f"diagnose: refits on {n} processes", unit="refits") as bar:
+            for fut in as_completed(futures):
+                bar.set_postfix_str(f"done: {_candidate(payloads[futures.index(fut)])}", refresh=False)
+                bar.update(1)
+        results = [fut.result() for fut in futures]
     return results, f"{n} local processes"
+
+
+def _candidate(payload) -> str:
+    return payload["effects"][-1]
+
+
+def _serial_refits(payloads):
+    """The refits one after the other in this process, a progress bar per refit naming its candidate."""
+    results = []
+    for i, p in enumerate(payloads):
+        with progress.task(f"diagnose: refit {i + 1}/{len(payloads)} with {_candidate(p)}"):
+            results.append(_refit_task(p))
+    return results
 
 
 # --------------------------------------------------------------------------- readings
@@ -205,7 +231,8 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         if dup:
             raise ModelError(f"candidate effect(s) {', '.join(sorted(dup))} are already in the model")
     t0 = time.perf_counter()
-    baseline = fit(exp, data, base_effects)
+    with progress.task(f"diagnose: fitting the baseline {exp.name}" + "".join(" + " + e for e in base_effects)):
+        baseline = fit(exp, data, base_effects)
     t_base = time.perf_counter() - t0
     sigma = baseline.noise
     start = dict(zip(baseline.names, baseline.x))
@@ -214,11 +241,14 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
                 "lines": data.lines, "start": start, "noise": sigma}
     payloads = [{**payload0, "effects": base_effects + [c]} for c in candidates]
     if payloads and not _rebuildable(exp):
-        fits_list = [_safe_fit(exp, data, p["effects"], start=start, noise=sigma) for p in payloads]
+        fits_list = []
+        for i, p in enumerate(payloads):
+            with progress.task(f"diagnose: refit {i + 1}/{len(payloads)} with {_candidate(p)}"):
+                fits_list.append(_safe_fit(exp, data, p["effects"], start=start, noise=sigma))
         how = "serial (experiment defined in memory: worker processes cannot rebuild it)"
     elif (payloads and workers is None and scheduler is None and not exp.fit_options.get("expensive")
           and 6.0 * t_base * len(payloads) < SERIAL_BELOW_S):
-        fits_list = [_refit_task(p) for p in payloads]
+        fits_list = _serial_refits(payloads)
         how = f"serial (refits estimated at {6.0 * t_base * len(payloads):.2f} s: cheaper than starting processes)"
     elif payloads:
         fits_list, how = _run_tasks(payloads, workers, scheduler)

@@ -29,6 +29,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult, least_squares
 
 from ..effects.base import resolve
+from .. import progress
 from ..errors import ModelError
 from .core import EffectStack, Experiment, Measured
 from .residuals import noise_floor
@@ -85,6 +86,7 @@ def predict(exp: Experiment, data: Measured, params=None, effects=None) -> dict:
     missing = [c for c in exp.channels if c not in out]
     if missing:
         raise ModelError(f"the model of {exp.name} did not return channel(s) {', '.join(missing)}")
+    progress.tick()
     return {c: np.asarray(out[c], dtype=float).reshape(data.n) for c in exp.channels}
 
 

@@ -72,6 +72,7 @@ import time
 
 import numpy as np
 
+from .. import progress
 from ..errors import ConvergenceError, FemastError, ModelError
 from .bay_torsion import LATCH_FIELDS, bay_parameters
 from .core import Column, Experiment, Measured, Parameter, prepared
@@ -201,6 +202,7 @@ def solve(inputs: dict, loads: np.ndarray, options: dict) -> dict:
            bool(options["alternate"]), int(options["increments_per_row"]))
 
     def compute():
+        progress.tick("FE runs")
         try:
             return run_mast(inputs, loads, *key[2:], threads=options.get("threads", 1))
         except (ConvergenceError, FemastError) as e:

@@ -1,0 +1,70 @@
+"""Example data shipped with femast (package data), usable from any folder.
+
+    import femast.examples
+    femast.examples.path("mast_top_example.csv")      # a pathlib.Path inside the installed package
+
+On the command line the example of an experiment is its short name ``example``::
+
+    femast compare mast-top example --fit
+
+and ``femast examples`` lists the files (``--copy DIR`` copies them to a folder of yours).
+
+=============================  ==============  ================================================
+file                           experiment      what it is
+=============================  ==============  ================================================
+mast_top_example.csv           mast-top        500 samples of load cycles on a mast top (synthetic)
+latch_pull_example.csv         latch-pull      two latch pull cycles (synthetic)
+bay_torsion_example.csv        bay-torsion     moment-rotation test of one ADAM bay (synthetic)
+bay_torsion_format.csv         bay-torsion     the bay-torsion format, schematic values only
+tip_cycle_seed001_table1.csv   tip-cycle       seed 001 Table 1 (the seed's FE prediction)
+=============================  ==============  ================================================
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import DataFileError
+
+FOLDER = Path(__file__).resolve().parent
+
+# experiment -> its example data file (the short name ``example`` on the command line)
+BY_EXPERIMENT = {
+    "mast-top": "mast_top_example.csv",
+    "latch-pull": "latch_pull_example.csv",
+    "bay-torsion": "bay_torsion_example.csv",
+    "tip-cycle": "tip_cycle_seed001_table1.csv",
+}
+
+
+def names() -> list[str]:
+    """File names of the shipped example data."""
+    return sorted(p.name for p in FOLDER.glob("*.csv"))
+
+
+def path(name: str) -> Path:
+    """Path of the shipped example file ``name`` (e.g. ``"mast_top_example.csv"``)."""
+    p = FOLDER / name
+    if not p.is_file() or p.suffix != ".csv":
+        raise DataFileError(f"no example data file '{name}' in femast; shipped: {', '.join(names())}")
+    return p
+
+
+def for_experiment(experiment: str) -> Path:
+    """The example data file of a built-in experiment (what ``example`` means on the command line)."""
+    try:
+        return path(BY_EXPERIMENT[experiment])
+    except KeyError:
+        raise DataFileError(f"experiment '{experiment}' has no shipped example; examples exist for "
+                            f"{', '.join(BY_EXPERIMENT)}") from None
+
+
+def describe(name: str) -> str:
+    """The first comment line of an example file (what it is)."""
+    for line in path(name).read_text().splitlines():
+        if line.startswith("#"):
+            text = line.lstrip("# ").strip()
+            if text.count("(") > text.count(")"):  # the remark goes on below: keep the complete part
+                text = text[:text.rindex("(")].rstrip(" ,:;")
+            return text
+    return ""

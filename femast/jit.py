@@ -1,0 +1,183 @@
+"""The first-run compile of femast's numba kernels: a notice when it happens, and ``femast warmup``.
+
+numba compiles each kernel the first time it is called and keeps it in its on-disk cache (beside
+the installed package, or in ``NUMBA_CACHE_DIR``); only kernels a model calls are compiled.  On a
+fresh install the first analysis therefore waits for the compiler.  :func:`watch` (installed by
+:class:`femast.Analysis` and the experiments) prints, once per process and only if something is
+actually being compiled, ::
+
+    femast: compiling femast kernels, first run only, ~12 s (`femast warmup` does it ahead)
+
+to stderr; ``femast --quiet`` or ``FEMAST_QUIET=1`` silences it.  The estimate is the sum of
+the measured cold-compile CPU times (:data:`COMPILE_S`) of the kernels of the loaded femast modules
+whose cache is missing.
+
+:func:`warmup` compiles every kernel ahead by running small models of each element family (for
+CI images and cluster workers, whose first job should not pay for it).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+# cold compile CPU time of the main kernels, s (numba 0.68, one core of the development machine,
+# recorded with numba's compile events; benchmarks/cold_start.py measures the whole first run).
+COMPILE_S = {
+    "femast.elements.beam_corot.beam_family_kernel": 11.0,
+    "femast.configuration.update_configuration": 1.9,
+    "femast.rotations.apply_spins": 1.0,
+    "femast.solvers.convergence.force_moment_abs_max": 0.9,
+    "femast.rotations._rotation_vectors": 0.6,
+}
+
+_announced = False
+_installed = False
+
+
+def _dispatchers():
+    """(qualified name, dispatcher) of every cacheable, non-inlined numba kernel of the loaded
+    femast modules."""
+    try:
+        from numba.core.registry import CPUDispatcher
+    except ImportError:  # pragma: no cover
+        return []
+    seen, out = set(), []
+    for mod_name, mod in list(sys.modules.items()):
+        if not mod_name.startswith("femast") or mod is None:
+            continue
+        for obj in list(vars(mod).values()):
+            if isinstance(obj, CPUDispatcher) and id(obj) not in seen:
+                seen.add(id(obj))
+                if obj.targetoptions.get("inline", "never") != "never" or getattr(obj, "_cache", None) is None:
+                    continue
+                if not obj.py_func.__module__.startswith("femast"):
+                    continue
+                out.append((f"{obj.py_func.__module__}.{obj.py_func.__name__}", obj))
+    return out
+
+
+def uncached(dispatchers=None):
+    """Qualified names of the kernels (default: those of the loaded femast modules) with no
+    compiled code on disk yet."""
+    names = []
+    for name, d in dispatchers if dispatchers is not None else _dispatchers():
+        try:
+            index = d._cache._cache_file._index_path
+        except AttributeError:  # another numba cache layout: assume compiled
+            continue
+        if not os.path.exists(index) and not d.signatures:
+            names.append(name)
+    return names
+
+
+def estimate_s(names) -> float:
+    """Estimated compile time of ``names``, s: the measured costs of the big kernels (the small
+    ones, 0.2-0.4 s each, are not counted: a loaded module's kernel is not always called)."""
+    return sum(COMPILE_S.get(n, 0.0) for n in names)
+
+
+def _on_compile(event):
+    global _announced
+    if _announced or not event.is_start:
+        return
+    try:
+        mod = event.data["dispatcher"].py_func.__module__
+    except (KeyError, AttributeError):
+        return
+    if not mod.startswith("femast"):
+        return
+    _announced = True
+    from .progress import quiet
+
+    if quiet():
+        return
+    est = max(estimate_s(uncached()), 1.0)
+    print(f"femast: compiling femast kernels, first run only, ~{est:.0f} s (`femast warmup` does it ahead)",
+          file=sys.stderr, flush=True)
+
+
+def watch() -> None:
+    """Print the compile notice the first time numba compiles a femast kernel in this process."""
+    global _installed
+    if _installed:
+        return
+    _installed = True
+    try:
+        from numba.core import event
+    except ImportError:  # pragma: no cover
+        return
+
+    class _Listener(event.Listener):
+        def on_start(self, ev):
+            _on_compile(ev)
+
+        def on_end(self, ev):
+            pass
+
+    event.register("numba:compile", _Listener())
+
+
+# --------------------------------------------------------------------------- warm-up
+def _warm_core():
+    """A beam + truss cantilever with a rigid body, a load step and an arc-length step."""
+    import femast as fm
+
+    m = fm.Model("warmup")
+    a = m.node(0.0, 0.0, 0.0)
+    b = m.node(1.0, 0.0, 0.0)
+    c = m.node(1.0, 0.5, 0.0)
+    m.beam(a, b, fm.circular_tube(0.03, 0.026, E=70e9), up=(0, 0, 1), n=4)
+    m.truss(b, c, EA=1e6)
+    m.fix(a)
+    m.fix(c)
+    m.step("load", initial_increment=0.5).load(b, fz=-10.0, mx=1.0)
+    fm.Analysis(m, None, progress=False, on_frame=lambda frame: None).run()
+
+
+def _warm_adam():
+    """The ADAM bay (cables over pulleys and latches, friction ball joints, joint springs, rigid
+    bodies and ties) through its preload and a short twist."""
+    import femast as fm
+    from femast.adam import build_bay
+    from femast.adam.steps import CONVERGENCE, add_idealised_torsion, add_initial_steps
+
+    am = build_bay()
+    add_initial_steps(am)
+    add_idealised_torsion(am, 0.01, max_increment=0.5, unload=False)
+    fm.Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=lambda frame: None).run()
+
+
+def _warm_guyed():
+    """The guyed mast of seed 000 with its shroud cables: pretension and one small wrench."""
+    from femast.guyed.fe_mast import MastFE
+
+    MastFE(400.0, n_beam=4).run_wrenches([[1.0, 0.0, 0.0, 0.0, 0.0, 0.0]])
+
+
+def _warm_laws():
+    """The latch law and the hysteresis operators of the effects, called from Python."""
+    import numpy as np
+
+    from femast.effects.operators import play, proportional_play
+    from femast.latch import latch_force
+
+    x = np.linspace(-1e-3, 1e-3, 5)
+    latch_force(x, 1.0, derivative=True)
+    play(x, 1e-4)
+    proportional_play(x, 0.1)
+
+
+PARTS = (("core: beams, trusses, solver", _warm_core), ("ADAM bay: cables, latches, ball joints", _warm_adam),
+         ("guyed mast: shroud cables", _warm_guyed), ("latch law and effect operators", _warm_laws))
+
+
+def warmup(report=print) -> float:
+    """Compile (or load from the cache) every femast kernel; returns the wall time, s."""
+    t_all = time.perf_counter()
+    for what, fn in PARTS:
+        t0 = time.perf_counter()
+        fn()
+        report(f"  {what}: {time.perf_counter() - t0:.1f} s")
+    return time.perf_counter() - t_all
