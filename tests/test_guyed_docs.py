@@ -18,10 +18,21 @@ def test_docs_example_runs_and_matches_its_printed_output():
         exec(compile(code, str(DOC), "exec"), {})
     got = out.getvalue().strip().splitlines()
     assert len(got) == len(expected)
-    # every printed number must match; the last line is scipy's termination message, which
-    # depends on the scipy version, so only its residual part is compared
-    assert got[:-1] == expected[:-1]
-    assert got[-1].split(";")[0] == expected[-1].split(";")[0]
+    # every printed number must match to 3 units of its last quoted digit (doc_examples._same_line),
+    # except the equilibrium residual, which is round-off: its size follows the order of summation
+    # (1.4e-13 or 2.1e-13 N on the same machine), so it is only bounded, at 1e-9 N (forces are ~1e3 N,
+    # a real equilibrium error would show at 1e-3 N or more).  The last line ends with scipy's
+    # termination message, which depends on the scipy version: only its part before ';' is compared.
+    from doc_examples import _same_line
+
+    res = re.compile(r"residual ([-+.\de]+) N")
+    for g, e in zip(got, expected):
+        m = res.search(e)
+        if m:
+            assert float(res.search(g).group(1)) < 1e-9, g
+            g, e = res.sub("residual # N", g), res.sub("residual # N", e)
+        g, e = g.split(";")[0], e.split(";")[0]
+        assert _same_line(e.strip(), g.strip()), f"guyed_masts.md quotes {e!r}, the example prints {g!r}"
 
 
 def test_benchmark_accepts_a_fourth_model():

@@ -54,8 +54,8 @@ def compare(exp: Experiment, data: Measured, effects=(), *, fit: bool = False, p
     fit : fit the baseline and effect parameters (:func:`~femast.experiments.fitting.fit`);
         otherwise use ``params`` (baseline ``{name: value}`` and ``"effect.param"`` entries) or the
         defaults.
-    out : output folder for ``compare.json``, ``compare.png``, ``history.jsonl``, ``history.png``
-        (nothing is written if None).  history : append the run to the history file.
+    out : output folder for ``compare.json``, ``compare.png``, ``history.jsonl``, ``history.png`` and
+        ``compare_report.html`` (self-contained, figures inlined; nothing is written if None).  history : append the run to the history file.
 
     Returns an ``OptimizeResult`` with ``experiment``, ``n_samples``, ``effects``, ``fitted``,
     ``run`` (the model run/fit result), ``params`` (table with stderr and units), ``rms``
@@ -126,8 +126,12 @@ def compare(exp: Experiment, data: Measured, effects=(), *, fit: bool = False, p
         if history:
             files["history"] = str(out / "history.jsonl")
             files["history_png"] = str(plot_history(out))
+        from .report import compare_report
+
+        files["html"] = str(out / "compare_report.html")  # named in the JSON it inlines nothing of
         report["files"] = files
         Path(files["json"]).write_text(json.dumps(report, indent=2))
+        compare_report(exp, data, result, out)
     return result
 
 

@@ -209,7 +209,8 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         -- twice the baseline fit time each -- to take less than ``SERIAL_BELOW_S`` = 1 s in all, which
         is less than starting the processes costs; 1 runs in this process).
     scheduler : a dask.distributed scheduler address (``tcp://...``) or ``distributed.Client``.
-    out : folder for ``diagnose.json`` and ``diagnose.png`` (nothing written if None).
+    out : folder for ``diagnose.json``, ``diagnose.png`` and ``diagnose_report.html`` (self-contained,
+        figures inlined; nothing written if None).
 
     Returns an ``OptimizeResult`` with ``experiment``, ``n_samples``, ``noise`` (per channel),
     ``noise_rms``, ``baseline`` (``{"rms", "ratio", "bic", "params", "effects"}``), ``baseline_fit``,
@@ -341,8 +342,12 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         out.mkdir(parents=True, exist_ok=True)
         result.files["png"] = str(diagnose_figure(exp, data, result, out / "diagnose.png"))
         result.files["json"] = str(out / "diagnose.json")
+        result.files["html"] = str(out / "diagnose_report.html")
         report["files"] = result.files
         Path(result.files["json"]).write_text(json.dumps(report, indent=2))
+        from .report import diagnose_report
+
+        diagnose_report(exp, data, result, out)
     return result
 
 

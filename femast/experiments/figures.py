@@ -1,4 +1,5 @@
-"""Figures of ``compare`` and ``diagnose`` (matplotlib, Agg backend, PNG)."""
+"""Figures of ``compare`` and ``diagnose`` (matplotlib, Agg backend, PNG), in the style of
+:mod:`femast.plotstyle`."""
 
 from __future__ import annotations
 
@@ -6,21 +7,18 @@ from pathlib import Path
 
 import numpy as np
 
-_SCALES = {"m": (1e3, "mm"), "rad": (1e3, "mrad"), "mm": (1.0, "mm"), "N": (1.0, "N"), "N m": (1.0, "N m")}
-
-
-def display_scale(unit: str):
-    """(factor, label) to show values of ``unit`` in a readable unit (m -> mm, rad -> mrad)."""
-    return _SCALES.get(unit, (1.0, unit))
+from .. import plotstyle
+from ..plotstyle import column_label, display_scale, fit_title, num  # noqa: F401  (display_scale: re-exported)
 
 
 def _plt():
-    import matplotlib
+    return plotstyle.pyplot()
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
-    return plt
+def _common_unit(exp, channels):
+    """The display unit shared by ``channels`` (None if they differ)."""
+    units = {display_scale(exp.unit_of(c))[1] for c in channels}
+    return units.pop() if len(units) == 1 else None
 
 
 def compare_figure(exp, data, result, png) -> Path:
@@ -44,51 +42,50 @@ def compare_figure(exp, data, result, png) -> Path:
         ax0.plot(f * data[c], f * pred[c], ".", ms=3)
         lim = [f * min(data[c].min(), pred[c].min()), f * max(data[c].max(), pred[c].max())]
         ax0.plot(lim, lim, "k--", lw=0.8)
-        ax0.set_xlabel(f"measured {c} ({ul})")
-        ax0.set_ylabel(f"model {c} ({ul})")
+        ax0.set_xlabel("measured " + column_label(c, ul))
+        ax0.set_ylabel("model " + column_label(c, ul))
     for i, c in enumerate(exp.channels):
         f, ul = display_scale(exp.unit_of(c))
         ax1.plot(rows, f * data[c], ".", ms=2, color=f"C{i}", alpha=0.6)
-        ax1.plot(rows, f * pred[c], "-", lw=1.0, color=f"C{i}", label=f"{c} ({ul})")
+        ax1.plot(rows, f * pred[c], "-", lw=1.0, color=f"C{i}", label=column_label(c, ul))
     ax1.set_title("measured (dots) and model (lines) along the path")
-    ax1.set_xlabel("row")
-    ax1.legend(fontsize=8, ncol=min(3, len(exp.channels)))
+    ax1.set_xlabel("data row (time order)")
+    uc = _common_unit(exp, exp.channels)
+    ax1.set_ylabel(f"measured and model ({uc})" if uc else "measured and model (unit: legend)")
+    ax1.legend(ncol=min(3, len(exp.channels)))
     s = result.load
     ax2.plot(rows, s, "-", color="0.3", lw=1.0)
     for kind, color in (("near-zero load", "C1"), ("reversal", "C4"), ("peak", "C2")):
         m = result.masks.get(kind)
         if m is not None and m.any():
             ax2.plot(rows[m], s[m], ".", ms=3, color=color, label=kind)
-    ax2.set_ylabel(exp.load_label, fontsize=8)
-    ax2.legend(fontsize=7, ncol=3, loc="upper right")
-    ax2.grid(alpha=0.3)
+    lab = exp.load_label
+    ax2.set_ylabel(lab.replace(" (", "\n(", 1) if len(lab) > 24 else lab)  # a long label on two lines
+    ax2.set_title("load along the path: near-zero load, reversals and peaks marked")
+    ax2.legend(ncol=3, loc="upper right")
     for i, c in enumerate(exp.channels):
         f, ul = display_scale(exp.unit_of(c))
-        ax3.plot(rows, f * result.residuals[c], "-", lw=0.8, color=f"C{i}", label=f"{c} ({ul})")
+        ax3.plot(rows, f * result.residuals[c], "-", lw=0.8, color=f"C{i}", label=column_label(c, ul))
         ax3.axhline(f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
         ax3.axhline(-f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
     from .diagnose import AT_NOISE
 
     for k, seg in enumerate([w for w in result.worst[:3] if w["ratio"] > AT_NOISE]):
         ax3.axvspan(seg["start_row"] - 0.5, seg["end_row"] + 0.5, color="C3", alpha=0.18 - 0.04 * k, lw=0)
-        ax3.text(0.5 * (seg["start_row"] + seg["end_row"]), 0.97 - 0.13 * k,
-                 f"#{k + 1} {seg['kind']} {seg['ratio']:.1f}x", transform=ax3.get_xaxis_transform(),
-                 ha="center", va="top", fontsize=7, color="C3",
+        mid = 0.5 * (seg["start_row"] + seg["end_row"])
+        ha = "right" if mid > 0.85 * data.n else ("left" if mid < 0.15 * data.n else "center")  # inside the axes
+        ax3.text(mid, 0.97 - 0.13 * k, f"#{k + 1} {seg['kind']} {seg['ratio']:.1f}x noise",
+                 transform=ax3.get_xaxis_transform(), ha=ha, va="top", fontsize=7.5, color="C3",
                  bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.7))
-    ax3.set_xlabel("row (time order)")
-    ax3.set_ylabel("residual measured - model")
-    ax3.set_title(f"residual (dotted: noise floor); worst segments above {AT_NOISE:g}x noise shaded; "
-                  f"RMS {result.ratio:.2f}x noise")
-    ax3.legend(fontsize=8, ncol=min(3, len(exp.channels)), loc="lower right")
-    ax3.grid(alpha=0.3)
+    ax3.set_xlabel("data row (time order)")
+    ax3.set_ylabel(f"residual, measured - model ({uc})" if uc else "residual, measured - model (unit: legend)")
+    ax3.set_title(fit_title(ax3, f"residual (dotted: noise floor); worst segments above {num(AT_NOISE)}x noise "
+                                 f"shaded; RMS {num(result.ratio)}x noise"))
+    ax3.legend(ncol=min(3, len(exp.channels)), loc="lower right")
     eff = "+".join(result.effects) or "baseline"
-    fig.suptitle(f"femast compare {exp.name} -- {Path(data.path).name} -- model: {eff}"
-                 + (" (fitted)" if result.fitted else " (given parameters)"), fontsize=11)
-    fig.tight_layout()
-    png.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(png, dpi=100)
-    plt.close(fig)
-    return png
+    fig.suptitle(fit_title(fig, f"femast compare {exp.name} -- {Path(str(data.path).split()[-1]).name} -- model: "
+                                f"{eff}" + (" (fitted)" if result.fitted else " (given parameters)"), 11.5))
+    return plotstyle.save(fig, png, dpi=100)
 
 
 def diagnose_figure(exp, data, result, png) -> Path:
@@ -108,7 +105,7 @@ def diagnose_figure(exp, data, result, png) -> Path:
     ax0.set_yticklabels([e[0] for e in entries], fontsize=9)
     ax0.axvline(f * result.noise_rms, color="k", ls="--", lw=1, label="noise floor")
     ax0.axvline(f * result.noise_rms * result.at_noise, color="k", ls=":", lw=1,
-                label=f"{result.at_noise:g} x noise")
+                label=f"at-noise threshold, {num(result.at_noise, 2)} x noise")
     for yy, e in zip(y, entries):
         if e[2] is not None:
             ax0.text(f * e[1], yy, f"  dBIC {e[2]:+.0f}", va="center", fontsize=8)
@@ -116,8 +113,8 @@ def diagnose_figure(exp, data, result, png) -> Path:
     v = result.verdict
     verdict = (f"missing: {v['missing_effect']}" if v["missing_effect"] else
                ("nothing is missing" if v["explained"] else "none of the candidates explains this"))
-    ax0.set_title(f"{exp.name}: refit with each candidate (green: significant)\nverdict: {verdict}", fontsize=10)
-    ax0.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
+    ax0.set_title(fit_title(ax0, f"{exp.name}: refit with each candidate (green: significant); verdict: {verdict}"))
+    ax0.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     xmax = max(f * e[1] for e in entries)
     ax0.set_xlim(0, 1.35 * xmax)
     rows = np.arange(data.n)
@@ -127,13 +124,8 @@ def diagnose_figure(exp, data, result, png) -> Path:
         zc = result.best_fit.fun.reshape(len(exp.channels), -1)
         ax1.plot(rows, np.sqrt((zc**2).mean(0)), "-", lw=0.8, color="C2", label=f"with {result.ranking[0]['effect']}")
     ax1.axhline(1.0, color="k", ls="--", lw=0.8)
-    ax1.set_xlabel("row (time order)")
-    ax1.set_ylabel("|residual| / noise (RMS over channels)")
+    ax1.set_xlabel("data row (time order)")
+    ax1.set_ylabel("|residual| / noise, RMS over channels (-)")
     ax1.set_title("residual along the path")
-    ax1.legend(fontsize=8)
-    ax1.grid(alpha=0.3)
-    fig.tight_layout()
-    png.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(png, dpi=100)
-    plt.close(fig)
-    return png
+    ax1.legend()
+    return plotstyle.save(fig, png, dpi=100)

@@ -47,12 +47,10 @@ def _label(rec: dict) -> str:
 
 def plot_history(folder, png=None):
     """Plot the RMS error (and the noise floor) against the model version; returns the PNG path."""
-    import matplotlib
+    from .. import plotstyle
+    from ..plotstyle import display_scale, fit_title
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .figures import display_scale
+    plt = plotstyle.pyplot()
 
     recs = read_history(folder)
     if not recs:
@@ -67,11 +65,9 @@ def plot_history(folder, png=None):
     ax.set_xticks(v)
     ax.set_xticklabels([_label(r) for r in recs], rotation=25, ha="right", fontsize=8)
     ax.set_ylabel(f"RMS error ({ulabel})")
+    ax.set_xlabel("model version")
     ax.set_ylim(bottom=0)
-    ax.set_title(f"{recs[-1]['experiment']}: error against model version ({Path(recs[-1]['data']).name})")
-    ax.grid(alpha=0.3)
+    ax.set_title(fit_title(ax, f"{recs[-1]['experiment']}: error against model version "
+                               f"({Path(str(recs[-1]['data']).split()[-1]).name})"))
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(png, dpi=110)
-    plt.close(fig)
-    return png
+    return plotstyle.save(fig, png, dpi=110)
