@@ -112,6 +112,9 @@ def main(argv=None):
     import matplotlib
 
     matplotlib.use("Agg")
+    from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+
+    plotstyle.use()
     import matplotlib.pyplot as plt
 
     fig, axs = plt.subplots(1, 3, figsize=(14.0, 4.6))
@@ -141,7 +144,7 @@ def main(argv=None):
     axs[2].legend(fontsize=8)
     png = out / "hysteresis.png"
     fig.tight_layout()
-    fig.savefig(png, dpi=120)
+    plotstyle.save(fig, png, dpi=120)
     plt.close(fig)
     if args.docs:
         shutil.copy(png, DOCS / "adam_hysteresis.png")

@@ -9,6 +9,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+
+plotstyle.use()
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -48,7 +51,7 @@ def main(out="benchmarks/out"):
         a.grid(alpha=0.3)
         a.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "arc_length.png", dpi=100)
+    plotstyle.save(fig, out / "arc_length.png", dpi=100)
     pre = tog["v"] < 0.4
     print(f"von Mises truss: max |P - P_exact| / P_limit = {err_vm:.2e} over {len(vm['w'])} increments")
     print(f"Lee's frame: limit load {lee['P'].max():.1f} (elastica {P_lim:.1f}, Simo-Vu-Quoc 18532), "

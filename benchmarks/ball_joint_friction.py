@@ -27,6 +27,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+
+plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
@@ -127,7 +130,7 @@ def main(show=False):
     OUT.mkdir(parents=True, exist_ok=True)
     DOCS.mkdir(parents=True, exist_ok=True)
     png = OUT / "ball_joint_loop.png"
-    fig.savefig(png, dpi=150)
+    plotstyle.save(fig, png, dpi=150)
     shutil.copy(png, DOCS / "ball_joint_loop.png")
     (OUT / "ball_joint_friction.txt").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))

@@ -24,6 +24,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+
+plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
@@ -170,7 +173,7 @@ def plot(sw, path):
                  "(s = 1: the real load at the initial pose)")
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    plotstyle.save(fig, path, dpi=110)
     plt.close(fig)
 
 

@@ -42,6 +42,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+
+plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
@@ -178,7 +181,7 @@ def plot(res, path: Path):
     fig.suptitle("Seed 000: mast-1 top displacement from the initial pose, analytic and FE models (cf. Fig. 6)")
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    plotstyle.save(fig, path, dpi=110)
     plt.close(fig)
 
 

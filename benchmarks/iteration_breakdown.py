@@ -97,6 +97,9 @@ def plot(results, path):
     import matplotlib
 
     matplotlib.use("Agg")
+    from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+
+    plotstyle.use()
     import matplotlib.pyplot as plt
 
     shown = ["beam kernel (element forces + tangents)", "tangent assembly into the solver's matrix",
@@ -121,7 +124,7 @@ def plot(results, path):
            title="where a Newton iteration goes (truss mast of beam-columns)")
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.35), ncol=3)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    plotstyle.save(fig, path, dpi=110)
     plt.close(fig)
 
 

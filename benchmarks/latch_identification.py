@@ -18,6 +18,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+
+plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
@@ -94,7 +97,7 @@ def main(n_monte_carlo: int = 50) -> dict:
     fig.tight_layout()
     OUT.mkdir(parents=True, exist_ok=True)
     png = OUT / "latch_identification.png"
-    fig.savefig(png, dpi=150)
+    plotstyle.save(fig, png, dpi=150)
     plt.close(fig)
     DOCS.mkdir(parents=True, exist_ok=True)
     shutil.copy(png, DOCS / "latch_identification.png")

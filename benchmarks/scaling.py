@@ -361,6 +361,9 @@ def plot(rows, path):
     import matplotlib
 
     matplotlib.use("Agg")
+    from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+
+    plotstyle.use()
     import matplotlib.pyplot as plt
 
     bays = [r["bays"] for r in rows]
@@ -386,7 +389,7 @@ def plot(rows, path):
     b.grid(alpha=0.3, which="both")
     b.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    plotstyle.save(fig, path, dpi=110)
     plt.close(fig)
 
 

@@ -9,6 +9,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+
+plotstyle.use()
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -46,7 +49,7 @@ def main(out="benchmarks/out"):
     ax[1].set(xlabel="step time", ylabel="stabilisation / strain energy", title="energy ratio")
     ax[1].legend()
     fig.tight_layout()
-    fig.savefig(out / "stabilize_energy.png", dpi=100)
+    plotstyle.save(fig, out / "stabilize_energy.png", dpi=100)
     print(f"final ratio {an.summary.steps[0]['stabilization_ratio']:.4f}; "
           f"lean stabilised {res.frame(int(np.flatnonzero(sel)[-1]))['U'][1, 0] * 1e3:.4f} mm, "
           f"equilibrium {res.frame(-1)['U'][1, 0] * 1e3:.4f} mm; figure {out / 'stabilize_energy.png'}")

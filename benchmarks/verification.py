@@ -11,6 +11,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+
+plotstyle.use()
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -51,6 +54,8 @@ def main():
     x, y, _ = ref.pure_bending_shape(2 * math.pi, 1.0, 1.0, s)
     ax.plot(x, y, "k--", lw=1, label="exact circle")
     ax.set_aspect("equal")
+    ax.set_xlabel("x / L (-)")
+    ax.set_ylabel("y / L (-)")
     ax.set_title("Cantilever under end moment (16 elements)")
     ax.legend(fontsize=7)
     done()
@@ -73,8 +78,8 @@ def main():
     ex = [ref.elastica_tip_load(q) for q in kk]
     ax.plot([e.v_over_L for e in ex], kk, "k-", lw=1, label="elastica (exact)")
     ax.plot([e.u_over_L for e in ex], kk, "k--", lw=1)
-    ax.set_xlabel("tip displacement / L")
-    ax.set_ylabel("P L^2 / EI")
+    ax.set_xlabel("tip displacement / L (-)")
+    ax.set_ylabel("load P L^2 / EI (-)")
     ax.set_title("Cantilever under a dead end load (20 elements)")
     ax.legend(fontsize=8)
 
@@ -93,8 +98,8 @@ def main():
         for load, pos in table.items():
             ax.plot([load] * 3, pos, "k+", ms=8)
     ax.plot([], [], "k+", label="published (Bathe-Bolourchi, Simo-Vu-Quoc, Crisfield, ...)")
-    ax.set_xlabel("tip load P")
-    ax.set_ylabel("tip coordinate")
+    ax.set_xlabel("tip load P (consistent units of the case: R = 100, E = 1e7)")
+    ax.set_ylabel("tip coordinate (same length unit as R)")
     ax.set_title("45-degree bend (16 elements)")
     ax.legend(fontsize=8)
 
@@ -116,8 +121,8 @@ def main():
     ax.plot(pb[:, 1], pb[:, 0], "k-", lw=1, label="elastica (perfect column)")
     ww = np.linspace(0.001, 0.02, 50)
     ax.plot(ww, 1 - 1e-3 / ww, "k--", lw=1, label="linear amplification e0/(1-P/Pcr)")
-    ax.set_xlabel("midspan deflection / L")
-    ax.set_ylabel("P / P_cr")
+    ax.set_xlabel("midspan deflection / L (-)")
+    ax.set_ylabel("load P / P_cr (-)")
     ax.set_ylim(0, 1.3)
     ax.set_title("Pinned column with imperfection (displacement control)")
     ax.legend(fontsize=8)
@@ -125,7 +130,7 @@ def main():
     done()
     case("figures")
     fig.tight_layout()
-    fig.savefig(out / "verification.png", dpi=110)
+    plotstyle.save(fig, out / "verification.png", dpi=110)
     done()
     bar.close()
     table = v.format_table(rows)

@@ -10,19 +10,85 @@ DOCS = Path(__file__).resolve().parents[1] / "docs"
 
 def run_python_blocks(page: str, cwd=None) -> str:
     """Execute every ```python block of docs/``page`` in order, each in a fresh namespace, in folder
-    ``cwd`` (default: the current one); returns the page's text.  Fails if the page has none."""
+    ``cwd`` (default: the current one); returns the page's text.  Fails if the page has none.
+
+    A block followed by a quoted ``Output:`` (a fenced or indented block) must print those lines,
+    number by number (:func:`check_output`), so that quoted output cannot drift (issue 17)."""
+    import contextlib
+    import io
+    import sys
+
     text = (DOCS / page).read_text()
-    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
+    blocks = list(re.finditer(r"```python\n(.*?)```", text, re.S))
     assert blocks, f"{page} has no python example"
     old = os.getcwd()
     if cwd is not None:
         os.chdir(cwd)
     try:
-        for i, src in enumerate(blocks):
-            exec(compile(src, f"{page}[{i}]", "exec"), {"__name__": "__doc_example__"})
+        for i, m in enumerate(blocks):
+            buf = io.StringIO()
+            tee = _Tee(sys.stdout, buf)
+            with contextlib.redirect_stdout(tee):
+                exec(compile(m.group(1), f"{page}[{i}]", "exec"), {"__name__": "__doc_example__"})
+            quoted = quoted_output(text[m.end():])
+            if quoted is not None:
+                check_output(quoted, buf.getvalue(), f"{page}, example {i + 1}")
     finally:
         os.chdir(old)
     return text
+
+
+class _Tee:
+    def __init__(self, *streams):
+        self.streams = streams
+
+    def write(self, s):
+        for st in self.streams:
+            st.write(s)
+        return len(s)
+
+    def flush(self):
+        for st in self.streams:
+            st.flush()
+
+
+def quoted_output(after: str):
+    """The lines of the ``Output:`` block that follows a code block (None if none follows)."""
+    m = re.match(r"\s*Output:\s*\n\n(?:```\w*\n(.*?)```|((?:    [^\n]*\n|\n)+))", after, re.S)
+    if m is None:
+        return None
+    body = m.group(1) if m.group(1) is not None else "\n".join(ln[4:] for ln in m.group(2).splitlines())
+    return [ln for ln in body.strip("\n").splitlines() if ln.strip()]
+
+
+def check_output(quoted, printed: str, where: str) -> None:
+    """Every quoted line is printed, in order, numbers to 3 units of their last quoted digit
+    (:func:`_same_line`).  Two allowances, each for a reason: a quoted number below 1e-9 in
+    magnitude is round-off (a residual) and only has to stay below 1e-9, since its digits follow
+    the order of summation; text after ';' on a line naming a scipy termination condition is
+    scipy's own message, which changes between scipy versions."""
+    got = [ln for ln in printed.splitlines() if ln.strip()]
+    assert len(got) == len(quoted), f"{where}: quotes {len(quoted)} lines of output, the example prints {len(got)}"
+    for q, g in zip(quoted, got):
+        if "termination condition" in q:
+            q, g = q.split(";")[0], g.split(";")[0]
+        q2, g2 = _roundoff(q), _roundoff(g)
+        assert q2[1] == g2[1] or not q2[1], f"{where}: round-off value above 1e-9 in {g!r}"
+        assert _same_line(q2[0].strip(), g2[0].strip()), f"{where}: the page quotes {q!r}, the example prints {g!r}"
+
+
+def _roundoff(line: str):
+    """(line with numbers of magnitude < 1e-9 replaced by '~0', whether there were any and all are < 1e-9)."""
+    tiny = []
+
+    def sub(m):
+        v = float(m.group(0))
+        if v != 0.0 and abs(v) < 1e-9:
+            tiny.append(v)
+            return "~0"
+        return m.group(0)
+
+    return _NUMBER.sub(sub, line), bool(tiny)
 
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")

@@ -216,3 +216,20 @@ def test_render_defaults_to_the_largest_displacement(tmp_path, monkeypatch, caps
     assert (tmp_path / "render" / f"lu_frame{k}.png").is_file()
     assert main(["render", str(tmp_path / "lu"), "--frame", "last"]) == 0
     assert f"frame {len(res) - 1} of {len(res)}" in capsys.readouterr().out
+
+
+# ------------------------------------------------------------------ docs index
+def test_index_has_the_task_entries_and_its_links_resolve():
+    import re
+
+    text = (ROOT / "docs" / "index.md").read_text()
+    for task in ("Build your own mast", "Run a load cycle", "View in ParaView", "Compare your own data",
+                 "Add your own effect", "Run on a cluster"):
+        assert f"**{task}**" in text, task
+    for page, anchor in re.findall(r"\]\(([\w.]+\.md)(?:#([\w-]+))?\)", text):
+        doc = ROOT / "docs" / page
+        assert doc.is_file(), page
+        if anchor:  # GitHub's heading slug: lower case, punctuation dropped, spaces to '-'
+            slugs = {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-")
+                     for h in re.findall(r"^#+ (.*)$", doc.read_text(), re.M)}
+            assert anchor in slugs, f"{page}#{anchor}"

@@ -110,6 +110,9 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
     import matplotlib
 
     matplotlib.use("Agg")
+    from .. import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+
+    plotstyle.use()
     import matplotlib.pyplot as plt
     from matplotlib.patches import Patch
 
@@ -161,7 +164,7 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
     tw.set_ylabel("rotation (deg)")
     handles = [Patch(color=ZONE_COLORS[z], label=ZONE_LABELS[z]) for z in range(4)]
     bx.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.38), ncol=4, fontsize=8, frameon=False)
-    fig.savefig(png, dpi=130, bbox_inches="tight")
+    plotstyle.save(fig, png, dpi=130)
     plt.close(fig)
     return Path(png)
 
