@@ -50,8 +50,13 @@ def _render(args):
         why = f"frame {frame} of {len(res)}, the largest displacement ({umax:.4g} m); --frame N|last for another"
     else:
         frame = len(res) - 1 if args.frame == "last" else args.frame
-        why = f"frame {range(len(res))[frame] if -len(res) <= frame < len(res) else frame} of {len(res)}"
-    png = Path(args.png) if args.png else Path("render") / f"{Path(args.results).resolve().name}_frame{frame}.png"
+        if not -len(res) <= frame < len(res):
+            raise FemastError(f"--frame {frame}: {args.results} has {len(res)} frames (0 to {len(res) - 1}); give "
+                              "a frame in that range, 'last' or 'max'")
+        frame = range(len(res))[frame]
+        why = f"frame {frame} of {len(res)}"
+    name = f"{Path(args.results).resolve().name}_frame{frame}.png"
+    png = Path(args.png) if args.png else Path(args.out) / name
     png = render_png(res, png, frame=frame, scale=args.scale)
     print(f"wrote {png} ({why}; displacements x {args.scale:g})")
 
@@ -114,7 +119,9 @@ def build_parser() -> argparse.ArgumentParser:
                                    "displacement; the output says which frame it drew.")
     p.add_argument("results", help="results folder written by an analysis")
     p.add_argument("png", nargs="?", default=None,
-                   help="PNG file to write (default: ./render/RESULTSNAME_frameN.png in the working directory)")
+                   help="PNG file to write (default: OUT/RESULTSNAME_frameN.png)")
+    p.add_argument("--out", default="render", help="folder of the PNG when no PNG is named (default: ./render in "
+                                                   "the working directory)")
     p.add_argument("--frame", type=_frame_arg, default="max",
                    help="frame number (negative from the end), 'last', or 'max' for the largest displacement")
     p.add_argument("--scale", type=float, default=1.0, help="displacement magnification")

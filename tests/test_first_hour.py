@@ -233,3 +233,10 @@ def test_index_has_the_task_entries_and_its_links_resolve():
             slugs = {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-")
                      for h in re.findall(r"^#+ (.*)$", doc.read_text(), re.M)}
             assert anchor in slugs, f"{page}#{anchor}"
+
+
+def test_render_frame_out_of_range_is_a_femast_error(tmp_path, capsys):
+    _load_unload(tmp_path / "lu")
+    assert main(["render", str(tmp_path / "lu"), "--frame", "99", "--out", str(tmp_path / "pics")]) == 2
+    err = capsys.readouterr().err
+    assert "--frame 99" in err and "frames (0 to" in err and "Traceback" not in err
