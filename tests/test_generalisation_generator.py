@@ -203,6 +203,19 @@ def test_verdict_adapter_reads_old_and_new_reports():
     assert is_right("null", (), read_verdict(null)) and not is_right("null", (), read_verdict(none))
 
 
+def test_verdict_adapter_reads_the_issue14_kinds():
+    pair = {"verdict": {"kind": "missing_pair", "missing_effect": None, "missing_effects": ["latch_hysteresis",
+                        "stretch_error"], "mechanism": None, "conclusion": "missing effects: ..."}}
+    assert read_verdict(pair)["kind"] == "missing"
+    assert read_verdict(pair)["effects"] == ["latch_hysteresis", "stretch_error"]
+    form = {"verdict": {"kind": "form_imperfect", "missing_effect": None, "missing_effects": [],
+                        "mechanism": "joint_clearance", "best_candidate": "joint_clearance", "conclusion": "..."}}
+    assert read_verdict(form)["kind"] == "form_imperfect" and read_verdict(form)["effects"] == ["joint_clearance"]
+    for kind, expect in (("nothing_missing", "nothing"), ("not_explained", "not_explained"),
+                         ("missing_effect", "missing"), ("better_form", "missing")):
+        assert read_verdict({"verdict": {"kind": kind, "conclusion": "?"}})["kind"] == expect
+
+
 def test_score_weighs_each_null_case_as_one_case():
     rows = ([{"case": "a", "expect": "effect", "right": True}, {"case": "b", "expect": "ool", "right": False}]
             + [{"case": "n", "expect": "null", "right": i < 15} for i in range(20)])

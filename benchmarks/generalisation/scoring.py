@@ -1,11 +1,12 @@
 """Reading a ``diagnose`` JSON report as a verdict, and the scoring rule of the benchmark.
 
-The adapter reads today's report (``verdict.missing_effect`` / ``explained`` /
-``best_candidate`` / ``conclusion``) and the fields planned by issue 14 (a verdict ``kind``, the
-named ``effect`` or ``effects``, a ``pair``; ``/work/coord/diagnose_json.md`` during the session,
-``docs/diagnose_generalisation.md`` afterwards): the structured fields when present, else the
-conclusion text, whose first words are fixed ("missing effect:", "mechanism found, form
-imperfect", "not explained" / "none of the candidates explains this", "nothing is missing").
+The adapter reads the report of before issue 14 (``verdict.missing_effect`` / ``explained`` /
+``best_candidate`` / ``conclusion``) and the fields issue 14 adds: ``verdict.kind`` in
+``nothing_missing``, ``missing_effect``, ``missing_pair``, ``form_imperfect``, ``better_form``,
+``not_explained``; ``verdict.missing_effects`` ([X] or [X, Y]); ``verdict.mechanism`` (the X of
+a form-imperfect verdict).  The structured fields are used when present, else the conclusion
+text, whose first words are fixed ("missing effect:", "mechanism found, form imperfect", "not
+explained" / "none of the candidates explains this", "nothing is missing").
 
 Verdict kinds: ``missing`` (X brings the model to the noise), ``form_imperfect`` (X explains
 most of the excess, structure remains), ``not_explained``, ``nothing``.
@@ -34,6 +35,7 @@ KINDS = ("missing", "form_imperfect", "not_explained", "nothing")
 
 _KIND_WORDS = (  # (pattern in a kind field or in the conclusion, kind), first match wins
     (r"form.?imperfect|mechanism found", "form_imperfect"),
+    (r"better.?form", "missing"),  # only after --effects: the generalised form of an added effect explains
     (r"nothing.?(is.?)?missing|^nothing", "nothing"),
     (r"not.?explained|none of the candidates", "not_explained"),
     (r"missing", "missing"),
@@ -81,8 +83,7 @@ def read_verdict(report: dict) -> dict:
         kind = "missing" if v.get("missing_effect") else ("nothing" if v.get("explained") else "not_explained")
     effects = []
     if kind in ("missing", "form_imperfect"):
-        for key in ("effects", "pair", "missing_effects", "missing_effect", "effect", "form_imperfect",
-                    "mechanism", "best_candidate"):
+        for key in ("missing_effects", "missing_effect", "mechanism", "effects", "effect", "best_candidate"):
             if v.get(key):
                 effects = _names(v[key])
                 if effects:
