@@ -61,6 +61,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from generalisation.cases import CASES, Case, generate  # noqa: E402
+from generalisation.gallery import gallery  # noqa: E402
 from generalisation.scoring import is_right, read_verdict, score  # noqa: E402
 
 QUICK = ("mt_friction_jenkins", "mt_clearance_tanh", "mt_progressive_asinh", "mt_pair_clearance_friction",
@@ -279,6 +280,8 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2, help="parallel processes (default 2)")
     ap.add_argument("--out", default=str(HERE / "out" / "diagnose_generalisation"), help="output folder")
     ap.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
+    ap.add_argument("--docs", action="store_true",
+                    help="also copy the figures to docs/figures/diagnose_generalisation_*.png")
     a = ap.parse_args(argv)
     cases = select(a.cases, a.quick)
     redraws = a.redraws if a.redraws is not None else (QUICK_REDRAWS if a.quick else 20)
@@ -301,7 +304,11 @@ def main(argv=None) -> int:
           f"{summary['null_runs']} null redraws not called 'nothing is missing')  [target <= 5 %]")
     print(f"{len(rows)} runs in {wall:.0f} s wall with {a.workers} workers, {summary['cpu_s_runs']:.0f} s CPU in "
           f"the runs; load average {summary['load'][0]:.1f}; commit {summary['commit']}")
-    paths = [] if a.no_figures else figures(rows, summary, out)
+    paths = [] if a.no_figures else figures(rows, summary, out) + [Path(gallery(out / "forms.png"))]
+    if a.docs and paths:
+        import shutil
+        for p in paths:
+            shutil.copy(p, HERE.parent / "docs" / "figures" / f"diagnose_generalisation_{p.name}")
     (out / "results.json").write_text(json.dumps({"summary": summary, "runs": rows}, indent=1, default=float))
     print(f"wrote {out / 'results.json'}" + "".join(f", {p}" for p in paths))
     return 0

@@ -26,7 +26,7 @@ from .rigs import (K_JOINTS, LATCH, hold_force, joint_moments, latch_law, latch_
 
 SIGMA_TRACKER_M = 50e-6  # laser tracker noise per axis (m), mast top
 SIGMA_LOADCELL_N = 0.5  # load cell noise (N), latch pull
-EQ15 = {"C": 2.5e-6, "sigma_T": 0.4, "sigma_d": 4e-6}  # cable compliance m/N, load-cell N, distance m
+EQ15 = {"C": 2.5e-6, "sigma_T": 0.4, "sigma_d": 8e-6}  # cable compliance m/N, load-cell N, distance m
 AR_PHI = 0.6  # lag-1 autocorrelation of the correlated noise
 
 
@@ -44,6 +44,7 @@ class Case:
     n: int = 500
     path: str = "cycles30"
     redraws: int = 1
+    amp: float = 10.0
     doc: str = ""
     tags: tuple = field(default_factory=tuple)
 
@@ -56,12 +57,12 @@ def _m(name, form, **params):
 CASES = (
     # ---------------------------------------------------------------- mast top, one mechanism
     Case("mt_friction_dahl", "mast-top", "effect", ("friction_hysteresis",),
-         (_m("friction", "dahl", F_c=16.0, sigma=3e5, alpha=1.0),), doc="Dahl joint friction, smooth loops"),
+         (_m("friction", "dahl", F_c=8.0, sigma=3e5, alpha=1.0),), level=0.5, doc="Dahl joint friction, smooth loops"),
     Case("mt_friction_boucwen", "mast-top", "effect", ("friction_hysteresis",),
-         (_m("friction", "boucwen", F_y=14.0, u_y=5e-5, n=2.0),), path="biaxial", n=400,
+         (_m("friction", "boucwen", F_y=10.0, u_y=5e-5, n=2.0),), path="biaxial", n=400, level=0.5,
          doc="Bouc-Wen joint friction, biaxial excursions"),
     Case("mt_friction_jenkins", "mast-top", "effect", ("friction_hysteresis",),
-         (_m("friction", "jenkins", k_s=2.5e5, F_s=10.0),), noise="ar1", n=600,
+         (_m("friction", "jenkins", k_s=2.5e5, F_s=7.0),), noise="ar1", n=600, level=0.5,
          doc="elasto-slip joint (finite stick stiffness), AR(1) noise"),
     Case("mt_clearance_tanh", "mast-top", "effect", ("joint_clearance",),
          (_m("clearance", "tanh", c=1.0e-4, m0=6.0),), doc="clearance closing smoothly over ~10 N m"),
@@ -72,18 +73,18 @@ CASES = (
          (_m("clearance", "piecewise", c=0.5e-4, k0=2.5e4, k1=5e6),), level=0.4, n=800,
          doc="play with a soft inner spring then linear contact, low noise, 800 samples"),
     Case("mt_progressive_duffing", "mast-top", "effect", ("progressive_stiffness",),
-         (_m("stiffening", "duffing", k3_rel=1.0e8),), doc="cubic hardening of the joints"),
+         (_m("stiffening", "duffing", k3_rel=1.0e8),), amp=40.0, level=0.7, doc="cubic hardening of the joints"),
     Case("mt_progressive_asinh", "mast-top", "effect", ("progressive_stiffness",),
-         (_m("stiffening", "asinh", m0=12.0),), noise="ar1", n=400,
+         (_m("stiffening", "asinh", m0=6.0),), noise="ar1", n=400, amp=40.0, level=0.7,
          doc="tangent stiffness growing with the load, AR(1) noise"),
     Case("mt_cable_loop_quadratic", "mast-top", "effect", ("cable_hysteresis",),
-         (_m("cable_loop", "quadratic", eps=1.0),), doc="shroud loop closing at zero, quadratic return"),
+         (_m("cable_loop", "quadratic", eps=1.0),), amp=20.0, level=0.7, doc="shroud loop closing at zero, quadratic return"),
     Case("mt_cable_loop_power", "mast-top", "effect", ("cable_hysteresis",),
-         (_m("cable_loop", "power", eps=1.0),), noise="hetero", doc="shroud loop, power-law return branch"),
+         (_m("cable_loop", "power", eps=1.0),), noise="hetero", amp=20.0, level=0.7, doc="shroud loop, power-law return branch"),
     Case("mt_pretension_exp", "mast-top", "effect", ("pretension_loss",),
-         (_m("drift", "exp", lam=0.6, tau0=0.3),), path="onesided", doc="creep relaxation of the shrouds"),
+         (_m("drift", "exp", lam=0.6, tau0=0.3),), path="onesided", amp=20.0, level=0.6, doc="creep relaxation of the shrouds"),
     Case("mt_pretension_step", "mast-top", "effect", ("pretension_loss",),
-         (_m("drift", "step", lam=0.25),), noise="ar1", doc="a shroud slips in its grip half-way"),
+         (_m("drift", "step", lam=0.5),), noise="ar1", amp=20.0, doc="a shroud slips in its grip half-way"),
     Case("mt_beam_timoshenko", "mast-top", "effect", ("beam_flexibility",),
          (_m("beam", "timoshenko", EI=0.8e5, GA=2e5),), path="moments",
          doc="lattice mast as a Timoshenko beam (bending + shear), top moments in the path"),
@@ -92,10 +93,10 @@ CASES = (
          doc="two-section (telescopic) beam, top moments in the path"),
     # ---------------------------------------------------------------- mast top, pairs and out of library
     Case("mt_pair_clearance_friction", "mast-top", "pair", ("joint_clearance", "friction_hysteresis"),
-         (_m("clearance", "tanh", c=0.6e-4, m0=5.0), _m("friction", "jenkins", k_s=3e5, F_s=10.0)),
+         (_m("clearance", "tanh", c=0.6e-4, m0=5.0), _m("friction", "jenkins", k_s=3e5, F_s=7.0)),
          doc="smooth clearance and elasto-slip friction together"),
     Case("mt_pair_stiffening_pretension", "mast-top", "pair", ("progressive_stiffness", "pretension_loss"),
-         (_m("stiffening", "duffing", k3_rel=1.0e8), _m("drift", "exp", lam=0.5, tau0=0.3)),
+         (_m("stiffening", "duffing", k3_rel=1.0e8), _m("drift", "exp", lam=0.5, tau0=0.3)), amp=30.0,
          doc="hardening joints and a pretension creeping away"),
     Case("mt_ool_thermal_drift", "mast-top", "ool", (),
          (_m("thermal", "sine", A=0.25e-3, cycles=1.3),), doc="thermal drift of the top, independent of the load"),
@@ -200,7 +201,7 @@ def _joint_rotation(m, k, mechs, t, tau):
 
 
 def _mast(case: Case, rng) -> dict:
-    w, t = mast_path(case.path, case.n, rng)
+    w, t = mast_path(case.path, case.n, rng, amplitude_N=case.amp)
     tau = (t - t[0]) / (t[-1] - t[0])
     M = joint_moments(w)
     theta = np.zeros_like(M)
