@@ -246,13 +246,20 @@ def figures(rows, summary, out: Path) -> list:
     a1.set_yticks(y, [f"{r['case']} -> {verdict_label(r)}" for r in single], fontsize=7)
     a1.invert_yaxis()
     a1.set_xscale("log")
-    a1.set_xlabel("RMS error / noise floor")
+    from matplotlib.ticker import FixedLocator, NullLocator, ScalarFormatter
+    a1.xaxis.set_major_locator(FixedLocator([0.8, 1, 1.2, 1.5, 2, 3, 4, 6, 8, 10]))
+    a1.xaxis.set_major_formatter(ScalarFormatter())
+    a1.xaxis.set_minor_locator(NullLocator())
+    a1.set_xlabel("RMS error / noise floor (as diagnose estimates it)")
     a1.legend(fontsize=7, loc="lower right")
     names = list(nulls)
     fa = [sum(not r["right"] for r in nulls[n]) / len(nulls[n]) for n in names]
     a2.barh(np.arange(len(names)), fa, color="C3")
     a2.axvline(0.05, color="k", ls="--", lw=0.8)
-    a2.set_yticks(np.arange(len(names)), [f"{n} ({len(nulls[n])})" for n in names], fontsize=7)
+    for i, n in enumerate(names):
+        wrong = sum(not r["right"] for r in nulls[n])
+        a2.text(0.02, i, f"{wrong}/{len(nulls[n])}", va="center", fontsize=8)
+    a2.set_yticks(np.arange(len(names)), [f"{n} ({len(nulls[n])} redraws)" for n in names], fontsize=7)
     a2.invert_yaxis()
     a2.set_xlim(0, 1)
     a2.set_xlabel("false-alarm rate (target 0.05)")

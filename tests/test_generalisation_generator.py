@@ -239,3 +239,9 @@ def test_benchmark_harness_smoke(tmp_path):
     assert "confusion table" in text and "lp_ool_ripple" in text
     paths = bench.figures(rows, s, tmp_path)
     assert all(p.stat().st_size > 10_000 for p in paths)  # a real PNG, not an empty canvas
+
+
+def test_docs_page_example_runs():
+    from doc_examples import run_python_blocks
+
+    run_python_blocks("diagnose_generalisation.md", cwd=BENCH.parent)

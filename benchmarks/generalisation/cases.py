@@ -65,7 +65,7 @@ CASES = (
          (_m("friction", "jenkins", k_s=2.5e5, F_s=7.0),), noise="ar1", n=600, level=0.5,
          doc="elasto-slip joint (finite stick stiffness), AR(1) noise"),
     Case("mt_clearance_tanh", "mast-top", "effect", ("joint_clearance",),
-         (_m("clearance", "tanh", c=1.0e-4, m0=6.0),), doc="clearance closing smoothly over ~10 N m"),
+         (_m("clearance", "tanh", c=1.0e-4, m0=3.0),), doc="clearance closing smoothly over ~10 % of the load"),
     Case("mt_clearance_hertz", "mast-top", "effect", ("joint_clearance",),
          (_m("clearance", "hertz", c=0.5e-4, k0=2e4, K=5.7e7),), noise="hetero", n=300,
          doc="play then Hertzian contact, heteroscedastic noise, 300 samples"),
