@@ -177,3 +177,32 @@ def test_negative_mass_per_length_and_point_mass():
         m.point_mass(b, -1.0)
     with pytest.raises(ModelError, match="negative principal value"):
         m.point_mass(b, 1.0, inertia=(1.0, -1.0, 1.0))
+
+
+def test_modes_of_every_saved_increment_follow_the_axial_load(tmp_path):
+    """ModesRecorder: the pin-ended beam's first frequency at each increment of a load ramp
+    against f0^2 (1 + P/P_E) (tolerance 1e-3 f0^2, as in the verification case), written to the
+    results folder; and the animated VTK series of the last frame's modes."""
+    from femast.modal_output import ModesRecorder, export_modes_vtk
+    from femast.verification_modal import pinned_beam_axial
+
+    E, EI, EA, L = 1e4, 1.0, 1e6, 1.0
+    sec = fm.Section(E=E, G=E / 2, A=EA / E, Iy=EI / E, Iz=EI / E, J=2 * EI / E, rho=E / EA)
+    m = fm.Model("ramp")
+    a, b = m.node(0, 0, 0), m.node(L, 0, 0)
+    m.beam(a, b, sec, up=(0, 1, 0), n=48)
+    m.fix(a, "ux", "uy", "uz", "rx")
+    m.fix(b, "uy", "uz")
+    PE = math.pi ** 2 * EI / L ** 2
+    m.step("pull", initial_increment=0.25, max_increment=0.25).load(b, fx=0.8 * PE)
+    an = fm.Analysis(m, tmp_path / "res", progress=False)
+    rec = ModesRecorder(an, n_modes=2)
+    an.run()
+    P = np.array([0.0, 0.2, 0.4, 0.6, 0.8])
+    f0sq = (math.pi / 2) ** 2
+    f = rec.frequencies[:, 0]
+    assert f.shape == (5,)
+    np.testing.assert_allclose(f ** 2, f0sq * (1 + P), atol=1e-3 * f0sq)
+    assert len(list((tmp_path / "res" / "modes").glob("frame_*.npz"))) == 5
+    pvd = export_modes_vtk(rec.modes[-1], tmp_path / "vtk", n_frames=8)
+    assert len(pvd) == 2 and len(list(pvd[0].parent.glob("*.vtu"))) == 8
