@@ -23,7 +23,7 @@ RHO_STEEL = 7850.0         # kg/m^3
 E_STEEL = 200e9            # Pa
 #: Effective mass of a pulley-and-latch unit, kg: identified from seed 001 Eq. 16 by
 #: ``benchmarks/adam_vibration.py`` (femast.adam.vibration.identify_unit_mass).
-UNIT_MASS = 0.0207
+UNIT_MASS = 0.0211
 CORNER_MASS = 0.02         # kg
 
 
