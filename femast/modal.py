@@ -117,9 +117,15 @@ class Modes:
 def _state(analysis):
     """(K_ff, residual on the free DOFs, reference force, reference moment) at the analysis'
     current configuration and committed state."""
-    responses = analysis._evaluate(IncrementContext(x_committed=analysis.x, R_committed=analysis.R))
-    res = analysis._residual(responses, analysis.loads)
-    K, _ = analysis._tangent(responses, with_fc=False)
+    sys_ = getattr(analysis, "system", None)   # the analysis package of issue 15: System holds the assembly
+    if sys_ is not None:
+        responses = sys_.evaluate(sys_.committed_context())
+        res = sys_.residual(responses, analysis.loads)
+        K, _ = sys_.tangent(responses, with_fc=False)
+    else:
+        responses = analysis._evaluate(IncrementContext(x_committed=analysis.x, R_committed=analysis.R))
+        res = analysis._residual(responses, analysis.loads)
+        K, _ = analysis._tangent(responses, with_fc=False)
     fmax, mmax = force_moment_abs_max(analysis.loads)
     for r in responses:
         ff, mm = force_moment_abs_max(r.f)

@@ -87,8 +87,13 @@ class ModesRecorder:
         self.options = options
         self.modes = []
         self.frames = []
-        self._chain = analysis.on_frame
-        analysis.on_frame = self
+        out = getattr(analysis, "output", None)
+        if out is not None and hasattr(out, "recorders"):   # the analysis package (issue 15): an observer's list
+            self._chain = None
+            out.recorders.append(self)
+        else:
+            self._chain = analysis.on_frame
+            analysis.on_frame = self
 
     def __call__(self, data):
         if self._chain is not None:

@@ -412,6 +412,14 @@ class Model:
         self.steps.append(s)
         return s
 
+    def frequency_step(self, name: str | None = None, n_modes: int = 10, shift_hz: float | None = None,
+                       vtk: bool = False):
+        """Append a step that computes the lowest ``n_modes`` vibration modes of the state reached so
+        far (prestress and loads included; see :mod:`femast.frequency_step`); returns it."""
+        from .frequency_step import add_frequency_step
+
+        return add_frequency_step(self, name, n_modes, shift_hz, vtk)
+
     def __repr__(self):
         return (f"Model({self.name!r}: {len(self._node_labels)} nodes, {len(self.beams)} beams, "
                 f"{len(self.trusses)} trusses, {len(self.families)} other families, {len(self.steps)} steps)")
