@@ -375,3 +375,9 @@ def test_user_device_law():
     assert T[1] - T[0] == pytest.approx(F, rel=1e-12)  # brake law, Newton to round-off
     assert T[2] / T[1] == pytest.approx(math.exp(0.2 * math.pi / 2), rel=1e-12)  # capstan, phi = pi/2
     check_tangent(fam, Xp, fam.initial_state(), [1, 1])
+
+
+def test_docs_page_examples_run(tmp_path):
+    from doc_examples import run_python_blocks
+
+    run_python_blocks("cable_devices.md", cwd=tmp_path)

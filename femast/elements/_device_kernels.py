@@ -171,6 +171,9 @@ def _newton(S, L, phi, EA, L0, kinds, P, modes, targets, smax, bufs):
     front = np.empty(m)
     has_front = np.zeros(m, dtype=np.bool_)
     start = np.empty(m)
+    S_prev = np.empty(m)
+    step_prev = np.zeros(m)
+    halvings = 0
     for d in range(m):
         back[d] = S[d + 1]
         front[d] = S[d + 1]
@@ -188,6 +191,14 @@ def _newton(S, L, phi, EA, L0, kinds, P, modes, targets, smax, bufs):
             _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi, T, dT_dl0, de_dl0, e)
         rhs = -R
         if not _solve_small(A, rhs, dS):
+            if it > 0 and halvings < 80:
+                # the last step took a sliding device's both sides slack (a flat residual): go back
+                # halfway, so that the device stops where its cable just becomes slack
+                halvings += 1
+                for d in range(m):
+                    step_prev[d] *= 0.5
+                    S[d + 1] = S_prev[d] + step_prev[d]
+                continue
             # find a sliding device with an (almost) empty row: both sides slack
             for d in range(m):
                 if modes[d] == SLIP_OUT or modes[d] == SLIP_IN:
@@ -254,6 +265,8 @@ def _newton(S, L, phi, EA, L0, kinds, P, modes, targets, smax, bufs):
             if dl < -0.9 * l0:
                 alpha = min(alpha, 0.9 * l0 / (-dl))
         for d in range(m):
+            S_prev[d] = S[d + 1]
+            step_prev[d] = alpha * dS[d]
             S[d + 1] += alpha * dS[d]
             if modes[d] == SLIP_IN and S[d + 1] > smax[d]:
                 S[d + 1] = smax[d]  # the next iteration decides whether it stays at the stop
