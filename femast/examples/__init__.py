@@ -17,6 +17,7 @@ latch_pull_example.csv         latch-pull      two latch pull cycles (synthetic)
 bay_torsion_example.csv        bay-torsion     moment-rotation test of one ADAM bay (synthetic)
 bay_torsion_format.csv         bay-torsion     the bay-torsion format, schematic values only
 tip_cycle_seed001_table1.csv   tip-cycle       seed 001 Table 1 (the seed's FE prediction)
+vibration_example.csv          vibration       latch resonance at nine tension settings (synthetic)
 =============================  ==============  ================================================
 """
 
@@ -34,6 +35,7 @@ BY_EXPERIMENT = {
     "latch-pull": "latch_pull_example.csv",
     "bay-torsion": "bay_torsion_example.csv",
     "tip-cycle": "tip_cycle_seed001_table1.csv",
+    "vibration": "vibration_example.csv",
 }
 
 
