@@ -120,7 +120,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("results", help="results folder written by an analysis")
     p.add_argument("png", nargs="?", default=None,
                    help="PNG file to write (default: OUT/RESULTSNAME_frameN.png)")
-    p.add_argument("--out", default="render", help="folder of the PNG when no PNG is named (default: ./render in "
+    p.add_argument("--out", default="render", help="folder of the PNG when no PNG is named (default: render, in "
                                                    "the working directory)")
     p.add_argument("--frame", type=_frame_arg, default="max",
                    help="frame number (negative from the end), 'last', or 'max' for the largest displacement")
