@@ -1,7 +1,8 @@
 """How each control strategy walks a step: the increment plans.
 
-A control strategy (femast/solvers/control.py, arclength.py: the user's parameters) makes, through
-its ``plan(analysis, step)`` method, a *plan* for one step.  The plan is all that differs between
+A control strategy (femast/solvers/control.py, arclength.py: the user's parameters) gets a *plan*
+for each step (:func:`plan_for`; a control of your own makes it with its ``plan(analysis, step)``
+method, see docs/architecture.md).  The plan is all that differs between
 strategies in the step loop (stepping.py): it proposes each increment (times, loads, predictor,
 load-factor constraint: a :class:`~femast.analysis.newton.Increment`), shrinks it after a failure
 (cutback) and sizes the next one after a success.  The Newton loop and the output are shared.
@@ -44,12 +45,55 @@ def step_values(model, conds, start, frac_time, period):
     return out
 
 
-class TimeIncrements:
+def plan_for(analysis, step, control):
+    """The plan of ``step`` under ``control``: the control's own (its ``plan`` method) if it has one."""
+    if hasattr(control, "plan"):
+        return control.plan(analysis, step)
+    if getattr(control, "arc_length", False):
+        return ArcIncrements(analysis, step, control)
+    return TimeIncrements(analysis, step, control)
+
+
+class Plan:
+    """What the step loop asks of a plan; the base has the defaults a simple plan keeps.
+
+    done() : is the step over?  next_increment() : size the coming increment (once per increment).
+    propose(attempt) : the :class:`Increment` to solve (attempt 1, 2, ... after cutbacks).
+    trial() : (step time, total time, size, load factor) of the increment tried, for status lines.
+    cutback(note) : shrink the increment after a failure, or raise ConvergenceError.
+    accept(outcome) : advance past a converged increment; returns (step time, size, last, note).
+    grow(outcome, bar) : size the next increment, move the progress bar.  finish(info) : the step's
+    summary dict.  ``analysis.state.increment`` counts the step's converged increments.
+    """
+
+    def __init__(self, analysis, step, control=None):
+        self.an, self.step, self.control = analysis, step, control
+        self.state = analysis.state
+
+    def bar(self, disable):
+        return tqdm(total=self.step.period, desc=f"step {self.step.name}", unit="s", disable=disable, leave=False)
+
+    def next_increment(self):
+        pass
+
+    def trial(self):
+        st = self.state
+        return st.step_time + (st.size or 0.0), st.total_time + (st.size or 0.0), st.size or 0.0, st.lam
+
+    def grow(self, outcome, bar):
+        bar.n = self.state.step_time
+        bar.refresh()
+
+    def finish(self, info):
+        return info
+
+
+class TimeIncrements(Plan):
     """The increments of a load- or displacement-controlled step (see module docstring)."""
 
     def __init__(self, analysis, step, control):
-        self.an, self.step, self.control = analysis, step, control
-        st = self.state = analysis.state
+        super().__init__(analysis, step, control)
+        st = self.state
         period = self.period = step.period
         self.dt_min = step.min_increment or period * 1e-5
         self.dt_max = step.max_increment or period
@@ -180,12 +224,12 @@ class TimeIncrements:
         return info
 
 
-class ArcIncrements:
+class ArcIncrements(Plan):
     """The increments of an arc-length step (:class:`~femast.solvers.arclength.ArcLength`)."""
 
     def __init__(self, analysis, step, control):
-        self.an, self.step, self.control = analysis, step, control
-        st = self.state = analysis.state
+        super().__init__(analysis, step, control)
+        st = self.state
         self.load_start = st.loads.copy()
         self.P_ref = step_values(analysis.model, step.loads, self.load_start, 1.0, step.period) - self.load_start
         st.lam = 0.0
@@ -200,9 +244,6 @@ class ArcIncrements:
 
     def done(self) -> bool:
         return self.finished
-
-    def next_increment(self):
-        pass
 
     def _predict(self, du_p):
         """Load-factor predictor: the arc length along the tangent, in the previous increment's direction."""

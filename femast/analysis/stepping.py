@@ -8,6 +8,7 @@ increments, has the algorithm (newton.py) solve each one, retries failed attempt
 from __future__ import annotations
 
 from ..solvers.control import LoadControl
+from .controls import plan_for
 
 
 def run_step(analysis, step):
@@ -16,7 +17,7 @@ def run_step(analysis, step):
     an, st, summary = analysis, analysis.state, analysis.summary
     control = step.control or LoadControl()
     control.setup(an, step)
-    plan = control.plan(an, step)
+    plan = plan_for(an, step, control)
     an.algorithm.new_step()
     st.increment = 0
     step_iters = 0

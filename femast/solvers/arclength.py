@@ -69,12 +69,6 @@ class ArcLength:
             self.monitor_start = analysis.dof_value(idx, d)
             self.monitor_value = float(value)
 
-    def plan(self, analysis, step):
-        """The increments of ``step`` (femast/analysis/controls.py)."""
-        from ..analysis.controls import ArcIncrements
-
-        return ArcIncrements(analysis, step, self)
-
     def norm2(self, v):
         return float(v @ (self.weights * v))
 

@@ -27,12 +27,6 @@ class LoadControl:
     def setup(self, analysis, step):
         pass
 
-    def plan(self, analysis, step):
-        """The increments of ``step`` (femast/analysis/controls.py)."""
-        from ..analysis.controls import TimeIncrements
-
-        return TimeIncrements(analysis, step, self)
-
 
 @dataclass
 class DisplacementControl:
@@ -56,12 +50,6 @@ class DisplacementControl:
         if not step.loads:
             raise ModelError(f"step '{step.name}': displacement control needs a reference load pattern; "
                              "define at least one load in the step")
-
-    def plan(self, analysis, step):
-        """The increments of ``step`` (femast/analysis/controls.py)."""
-        from ..analysis.controls import TimeIncrements
-
-        return TimeIncrements(analysis, step, self)
 
     def target(self, fraction):
         return self.start + fraction * (self.value - self.start)
