@@ -59,6 +59,10 @@ class Parameter:
         if not (self.lower <= self.default <= self.upper):
             raise ModelError(f"parameter {self.name}: default {self.default!r} {self.unit} lies outside its "
                              f"bounds [{self.lower!r}, {self.upper!r}]")
+        for s in self.starts:
+            if not (self.lower <= s <= self.upper):
+                raise ModelError(f"parameter {self.name}: start {s!r} {self.unit} lies outside its bounds "
+                                 f"[{self.lower!r}, {self.upper!r}]; give starts within the bounds")
 
     @property
     def typical(self) -> float:
