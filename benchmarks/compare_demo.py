@@ -102,29 +102,27 @@ def tutorial() -> None:
     """Run the tutorial's commands and copy their figures to docs/figures."""
     if OUT.exists():
         shutil.rmtree(OUT)
-    mt = DATA / "mast_top_example.csv"
     o = OUT / "mast_top"
     rel = lambda p: p.relative_to(ROOT)  # noqa: E731
     t0 = time.perf_counter()
-    run(f"compare mast-top {rel(mt)} --out {rel(o)}")
-    run(f"compare mast-top {rel(mt)} --fit --out {rel(o)}")
+    run(f"compare mast-top example --out {rel(o)}")
+    run(f"compare mast-top example --fit --out {rel(o)}")
     shutil.copy(o / "compare.png", FIGS / "experiments_compare_baseline.png")
-    run(f"diagnose mast-top {rel(mt)} --out {rel(o)}")
+    run(f"diagnose mast-top example --out {rel(o)}")
     shutil.copy(o / "diagnose.png", FIGS / "diagnose_mast_top_1.png")
-    run(f"compare mast-top {rel(mt)} --effects joint_clearance --fit --out {rel(o)}")
+    run(f"compare mast-top example --effects joint_clearance --fit --out {rel(o)}")
     shutil.copy(o / "compare.png", FIGS / "experiments_compare_clearance.png")
-    run(f"diagnose mast-top {rel(mt)} --effects joint_clearance --out {rel(o)}")
+    run(f"diagnose mast-top example --effects joint_clearance --out {rel(o)}")
     shutil.copy(o / "diagnose.png", FIGS / "diagnose_mast_top_2.png")
-    run(f"compare mast-top {rel(mt)} --effects joint_clearance,friction_hysteresis --fit --out {rel(o)}")
+    run(f"compare mast-top example --effects joint_clearance,friction_hysteresis --fit --out {rel(o)}")
     shutil.copy(o / "compare.png", FIGS / "experiments_compare_final.png")
     shutil.copy(o / "history.png", FIGS / "experiments_history.png")
-    lp = DATA / "latch_pull_example.csv"
     o = OUT / "latch_pull"
-    run(f"compare latch-pull {rel(lp)} --fit --out {rel(o)}")
+    run(f"compare latch-pull example --fit --out {rel(o)}")
     shutil.copy(o / "compare.png", FIGS / "experiments_latch_pull_baseline.png")
-    run(f"diagnose latch-pull {rel(lp)} --out {rel(o)}")
+    run(f"diagnose latch-pull example --out {rel(o)}")
     shutil.copy(o / "diagnose.png", FIGS / "diagnose_latch_pull.png")
-    run(f"compare latch-pull {rel(lp)} --effects latch_hysteresis --fit --out {rel(o)}")
+    run(f"compare latch-pull example --effects latch_hysteresis --fit --out {rel(o)}")
     shutil.copy(o / "compare.png", FIGS / "experiments_latch_pull_hysteresis.png")
     print(f"\ntutorial loop done in {time.perf_counter() - t0:.1f} s; figures copied to {rel(FIGS)}")
 
