@@ -133,3 +133,9 @@ def test_bad_inputs():
         masts_3r(500.0)
     with pytest.raises(ModelError, match="pulley radius"):
         CableRobot(rocaspect_geometry(), pulley_radius=-0.1)
+
+
+def test_docs_page_examples_run(tmp_path):
+    from doc_examples import run_python_blocks
+
+    run_python_blocks("platform_pose.md", cwd=tmp_path)
