@@ -191,7 +191,12 @@ class Analysis:
         try:
             for k, step in enumerate(self.model.steps):
                 self._state.step = k
-                run_step(self, step)
+                if getattr(step, "kind", "static") == "frequency":   # modes of the state (issue 18)
+                    from ..frequency_step import run_frequency_step
+
+                    run_frequency_step(self, step)
+                else:
+                    run_step(self, step)
         except ConvergenceError as exc:
             self.summary.completed = False
             self.summary.message = str(exc)
