@@ -123,6 +123,19 @@ def _same_line(quoted: str, printed: str) -> bool:
     return all(abs(float(a) - float(b)) <= t for a, b, t in zip(q, p, tol))
 
 
+def quoted_in(quoted: str, out: str) -> bool:
+    """``quoted`` (a phrase a page says an example prints) occurs in ``out`` with its numbers equal
+    to what :func:`_same_line` allows -- never compared as text."""
+    parts = _NUMBER.split(quoted)
+    nums = _NUMBER.findall(quoted)
+    pattern = "".join(re.escape(t) + ("(" + _NUMBER.pattern + ")" if i < len(nums) else "")
+                      for i, t in enumerate(parts))
+    for m in re.finditer(pattern, out):
+        if _same_line(quoted, m.group(0)):
+            return True
+    return False
+
+
 def _printed(line: str, out: str) -> bool:
     if line in out:
         return True

@@ -3,7 +3,7 @@
 import re
 
 import pytest
-from doc_examples import run_python_blocks
+from doc_examples import quoted_in, run_python_blocks
 PAGES = ["getting_started.md", "model.md", "solver.md", "results.md", "stabilize.md", "arc_length.md",
          "constraints.md"]
 
@@ -17,7 +17,7 @@ def test_page_examples_run(page, tmp_path, capsys):
     quoted += re.findall(r"^    (tip deflection[^\n]+)$", text, re.M)
     quoted += re.findall(r"^`(top lean[^`]+)`", text, re.M)
     for q in quoted:
-        assert q in out, f"{page}: the page says it prints {q!r}"
+        assert quoted_in(q, out), f"{page}: the page says it prints {q!r}"
 
 
 def test_quoted_transcript_numbers_match_to_three_units_of_their_last_digit():
@@ -28,3 +28,14 @@ def test_quoted_transcript_numbers_match_to_three_units_of_their_last_digit():
     assert not _same_line("F_h = 8.04317 N (stderr 0.21)", "F_h = 8.04321 N (stderr 0.21)")   # 4 units off
     assert _same_line("p = 3.2e-07", "p = 3.4e-07") and not _same_line("p = 3.2e-07", "p = 3.6e-07")
     assert not _same_line("F_h = 8.04317 N", "F_h = 8.04317 kN")                             # the words count
+
+
+def test_quoted_phrases_and_fitted_values_match_as_numbers():
+    from doc_examples import _same_line, quoted_in
+
+    assert quoted_in("x = 1740 um", "pre x = 1741 um, post")            # inside a line, 1 unit off
+    assert not quoted_in("x = 1740 um", "x = 1750 um")                   # 10 units off
+    assert not quoted_in("x = 1740 um", "x = 1740 mm")
+    # a value quoted with its standard error may move by a tenth of it (the fits' stopping rule)
+    assert _same_line("mu = 0.04745 +- 0.02 -", "mu = 0.04759 +- 0.02 -")
+    assert not _same_line("mu = 0.04745 +- 0.02 -", "mu = 0.0520 +- 0.02 -")
