@@ -196,6 +196,9 @@ def test_verdict_adapter_reads_old_and_new_reports():
     pair = {"verdict": {"kind": "missing_effect", "missing_effect": "joint_clearance+friction_hysteresis",
                         "conclusion": "missing effect: joint_clearance + friction_hysteresis"}}
     assert read_verdict(pair)["effects"] == ["friction_hysteresis", "joint_clearance"]
+    slashed = {"verdict": {"kind": "missing_effect", "missing_effect": "friction_hysteresis/jenkins",
+                           "conclusion": "?"}}
+    assert read_verdict(slashed)["effects"] == ["friction_hysteresis"]  # a form names its mechanism
     v = read_verdict(pair)
     assert is_right("pair", ("joint_clearance", "friction_hysteresis"), v)
     assert not is_right("effect", ("joint_clearance",), v)
