@@ -298,11 +298,12 @@ def main(argv=None) -> int:
     redraws = a.redraws if a.redraws is not None else (QUICK_REDRAWS if a.quick else 20)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    commit = _commit()  # the code the runs use (HEAD when they start)
     t0 = time.perf_counter()
     rows = run_all(cases, redraws, a.workers, progress=True)
     wall = time.perf_counter() - t0
     summary = score(rows)
-    summary.update(commit=_commit(), wall_s=wall, workers=a.workers, runs=len(rows),
+    summary.update(commit=commit, wall_s=wall, workers=a.workers, runs=len(rows),
                    cpu_s_runs=float(sum(r["cpu_s"] for r in rows)),
                    cpu_s_parent=resource.getrusage(resource.RUSAGE_SELF).ru_utime,
                    load=os.getloadavg(), quick=a.quick, cases_filter=a.cases, redraws=redraws)
