@@ -40,7 +40,7 @@ def test_mast_top_effect_applies_and_equals_its_linear_equivalent():
     got = np.column_stack([pred[c] for c in ("x_m", "y_m", "z_m")])
     base = np.column_stack([v for v in predict(exp, data_from(ref.pose)).values()])
     assert np.abs(ref.pose[:, :3] - base).max() > 1e-3  # the effect moves the platform by mm
-    np.testing.assert_allclose(got, ref.pose[:, :3], atol=1e-9)  # secant passes to 1e-7 of the tops; linear effect
+    np.testing.assert_allclose(got, ref.pose[:, :3], atol=1e-9)  # a linear effect: the secant compliance is exact after one pass
 
 
 def test_fitted_baseline_follows_data_from_another_model():

@@ -37,7 +37,7 @@ The effects of ``mast-top`` apply (``effects_from="mast-top"``) with the 3R base
 with the linear masts, each mast's wrench history (from calibration) runs through the ``mast-top``
 model with the effects (hooks ``joint_moment``, ``joint_rotation``, ``top_displacement``); the
 difference of its top translations from the linear 3R ones is fed back into the equilibrium, and
-the pass repeated until the tops move by less than 1e-7 m (as the FE masts are).
+the pass repeated until the tops move by less than 1 um (as the FE masts are).
 """
 
 from __future__ import annotations

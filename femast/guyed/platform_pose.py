@@ -372,7 +372,7 @@ def _fe_response(masts: MastSet):
 
 
 def pose_trajectory(robot: CableRobot, masts: MastSet, poses, *, tensions=None, calibrate=None,
-                    method: str = "barycenter", response=None, fe_tol: float = 1e-7, max_fe_passes: int = 6,
+                    method: str = "barycenter", response=None, fe_tol: float = 1e-6, max_fe_passes: int = 6,
                     progress=None) -> TrajectoryResult:
     """Pose errors along ``poses`` (k, 3|6).  The exit geometry is calibrated at ``calibrate`` (default
     the first pose): the masts' displacements are counted from their state there.  tensions : (k, m)
@@ -382,7 +382,7 @@ def pose_trajectory(robot: CableRobot, masts: MastSet, poses, *, tensions=None, 
     for the wrench history ``w_hist`` (k, n, 6) from the calibration wrenches ``w_cal`` (n, 6); FE
     masts (``masts.fe``) bring their own.  The first pass uses the linear ``masts.compliance``; then
     the remainder ``response - C (w - w_cal)`` is fed back and the pass repeated until the tops move
-    by less than ``fe_tol`` (m, rad).  progress : e.g. ``tqdm`` (wrapper of an iterable) or None."""
+    by less than ``fe_tol`` (m, rad; 1 um is 1e-4 of the pose errors of the Rocaspect).  progress : e.g. ``tqdm`` (wrapper of an iterable) or None."""
     poses = np.atleast_2d(np.asarray(poses, float))
     if poses.shape[1] == 3:
         poses = np.hstack([poses, np.zeros((len(poses), 3))])
