@@ -18,6 +18,7 @@ bay_torsion_example.csv        bay-torsion     moment-rotation test of one ADAM 
 bay_torsion_format.csv         bay-torsion     the bay-torsion format, schematic values only
 tip_cycle_seed001_table1.csv   tip-cycle       seed 001 Table 1 (the seed's FE prediction)
 vibration_example.csv          vibration       latch resonance at nine tension settings (synthetic)
+platform_pose_example.csv      platform-pose   commanded and measured platform poses (synthetic)
 =============================  ==============  ================================================
 """
 
@@ -36,6 +37,7 @@ BY_EXPERIMENT = {
     "bay-torsion": "bay_torsion_example.csv",
     "tip-cycle": "tip_cycle_seed001_table1.csv",
     "vibration": "vibration_example.csv",
+    "platform-pose": "platform_pose_example.csv",
 }
 
 
