@@ -30,7 +30,7 @@ from .elements.beam_corot import BeamFamily, element_frame
 from .elements.truss import TrussFamily
 from .reduction import ReducedTangent
 from .errors import ConvergenceError, ModelError, SingularModelError
-from .results import NullWriter, Results, ResultsWriter
+from .results import NullWriter, Results, ResultsWriter, run_outcome
 from .rotations import rotation_vectors
 from .solvers.control import LoadControl
 from .solvers.convergence import Convergence, force_moment_abs_max
@@ -45,7 +45,8 @@ class StabilizationWarning(UserWarning):
 class AnalysisSummary:
     """What a run did: counts, wall time and where it stopped."""
 
-    completed: bool = True
+    completed: bool = False      # True only once every step has run (status "completed")
+    status: str = "running"      # "running", then "completed", "failed" or "interrupted"
     increments: int = 0
     iterations: int = 0
     cutbacks: int = 0
@@ -60,7 +61,7 @@ class AnalysisSummary:
     steps: list = field(default_factory=list)
 
     def __str__(self):
-        state = "completed" if self.completed else "STOPPED"
+        state = {"completed": "completed", "interrupted": "INTERRUPTED"}.get(self.status, "FAILED")
         return (f"femast: analysis {state}: {self.increments} increments, {self.iterations} Newton iterations, "
                 f"{self.cutbacks} cutbacks, wall time {self.wall_time:.2f} s "
                 f"(assembly {self.assembly_time:.2f} s, linear solve {self.solve_time:.2f} s)"
@@ -420,20 +421,21 @@ class Analysis:
         t0 = _time.perf_counter()
         writer = NullWriter() if self.out is None else ResultsWriter(self.out, self.model, self.families)
         self._pending_frame = None   # a converged increment not written yet (Step.output_frequency)
-        self._write(writer, step_name="initial", inc=0, time=0.0, iterations=0, responses=None)
-        ti = _time.perf_counter()
+        ti = None
         try:
+            self._write(writer, step_name="initial", inc=0, time=0.0, iterations=0, responses=None)
+            ti = _time.perf_counter()
             for k, step in enumerate(self.model.steps):
                 self._run_step(k, step, writer)
-        except ConvergenceError as exc:
-            self.summary.completed = False
-            self.summary.message = str(exc)
-            if self._pending_frame is not None:   # the state is that of the last converged increment
-                self._write(writer, *self._pending_frame)
+            self.summary.status, self.summary.completed = "completed", True
+        except BaseException as exc:   # the summary says how the run ended, then the error goes on
+            self.summary.status, self.summary.message = run_outcome(exc)
+            if isinstance(exc, ConvergenceError) and self._pending_frame is not None:
+                self._write(writer, *self._pending_frame)   # the state of the last converged increment
                 self._pending_frame = None
             raise
         finally:
-            self.summary.increment_time = _time.perf_counter() - ti
+            self.summary.increment_time = _time.perf_counter() - ti if ti is not None else 0.0
             self.summary.wall_time = _time.perf_counter() - t0
             writer.close({**self.summary.__dict__, "strain_energy": self.strain_energy})
             if self.progress:

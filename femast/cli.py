@@ -40,8 +40,8 @@ def _info(args):
     print(f"{res.folder}: {len(res)} frames, {len(res.node_labels)} nodes, families: {', '.join(res.families)}")
     if res.summary:
         s = res.summary
-        print(f"  completed: {s['completed']}; increments {s['increments']}, iterations {s['iterations']}, "
-              f"cutbacks {s['cutbacks']}, wall time {s['wall_time']:.2f} s")
+        print(f"  status: {res.status}; increments {s.get('increments', 0)}, iterations {s.get('iterations', 0)}, "
+              f"cutbacks {s.get('cutbacks', 0)}, wall time {s.get('wall_time', 0.0):.2f} s")
         for st in s.get("steps", []):
             print(f"  step {st['name']}: {st['increments']} increments, {st['iterations']} iterations")
         if s.get("message"):
