@@ -32,6 +32,7 @@ from .reduction import ReducedTangent
 from .errors import ConvergenceError, ModelError, SingularModelError
 from .results import NullWriter, Results, ResultsWriter, run_outcome
 from .rotations import rotation_vectors
+from . import validation
 from .solvers.control import LoadControl
 from .solvers.convergence import Convergence, force_moment_abs_max
 from .solvers.linear import SparseLU, mechanism_dofs
@@ -159,6 +160,8 @@ class Analysis:
             raise ModelError(f"model '{model.name}' has no steps; add one with model.step()")
         if not (model.beams or model.trusses or model.families):
             raise ModelError(f"model '{model.name}' has no elements")
+        for s in model.steps:   # (again: a step's fields may have been set after model.step())
+            validation.step_increments(s)
         self.X0 = model.coordinates
         n = len(self.X0)
         self.families = build_families(model)
@@ -192,6 +195,8 @@ class Analysis:
                                   dependent=self.constraints.dependent)
         if self.dofmap.n_free == 0:
             raise ModelError(f"model '{model.name}' has no free DOFs")
+        validation.loads_on_active_dofs(model, self.dofmap)
+        self._check_balance = validation.self_equilibrated(self.families)
         self._constrained = self.constraints.active   # fixed from here on (asked every iteration)
         self.assembler = Assembler(self.dofmap, self.families, full=self._constrained)
         self.constraints.setup(self.dofmap, self.X0)
@@ -852,6 +857,13 @@ class Analysis:
         self.lam = lam
         self.strain_energy = float(sum(np.sum(r.energy) for r in responses if r.energy is not None))
         self._reactions = -res[self.dofmap.n_free:]
+        if equilibrium and self._check_balance:   # issue 16: reactions balance the loads
+            RF = np.zeros_like(P)
+            RF[self.cons_node, self.cons_dof] = self._reactions
+            validation.check_equilibrium(self.x, P, RF, res[:self.dofmap.n_free], self.free_dof,
+                                         f"increment {self.summary.increments + 1}",
+                                         internal=float(sum(np.abs(q.f).sum() for q in responses)),
+                                         labels=self.model.node_labels)
 
     def _plus_diagonal(self, K, c):
         """K + diag(c) on K's own pattern, explicit zeros kept (the viscous term of a stabilised step).

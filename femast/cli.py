@@ -50,6 +50,8 @@ def _info(args):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="femast", description="Nonlinear FE for jointed deployable masts")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the full Python traceback of an error (default: one line naming the item)")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("run", help="run a model or benchmark script")
     p.add_argument("script")
@@ -75,13 +77,78 @@ def main(argv=None):
         register = None
     if register is not None:
         register(sub)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    # --debug anywhere before a script's own arguments (``femast vtk R --debug``, ``femast --debug run S``)
+    cut = argv.index("run") + 2 if "run" in argv else len(argv)
+    debug = "--debug" in argv[:cut]
+    argv = [a for a in argv[:cut] if a != "--debug"] + argv[cut:]
     args = parser.parse_args(argv)
+    return _guarded(args.func, args, debug=debug or args.debug)
+
+
+def _guarded(func, args, debug=False) -> int:
+    """Run a command: every error becomes one line on stderr and exit code 2 (``--debug``: the
+    traceback); a closed output pipe (``femast info R | head -1``) ends the command silently."""
     try:
-        args.func(args)
-    except FemastError as exc:
-        print(f"femast: error: {exc}", file=sys.stderr)
+        func(args)
+    except BrokenPipeError:
+        _silence_stdout()
+        return 1
+    except KeyboardInterrupt:
+        if debug:
+            raise
+        print("femast: interrupted", file=sys.stderr)
+        return 130
+    except SystemExit:
+        raise
+    except Exception as exc:
+        if debug:
+            raise
+        try:
+            print(f"femast: error: {error_line(exc, getattr(args, 'script', None))}", file=sys.stderr)
+        except BrokenPipeError:
+            pass
         return 2
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _silence_stdout()
+        return 1
     return 0
+
+
+def _silence_stdout():
+    """After a broken pipe: point stdout at /dev/null so that Python's exit flush stays silent."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+
+
+def error_line(exc: BaseException, script=None) -> str:
+    """One line for an error: a femast error's own message; an OS error's file and reason; any
+    other error with where it happened (the line of ``script`` if it is there) and the hint to rerun
+    with --debug."""
+    if isinstance(exc, FemastError):
+        return str(exc).replace("\n", " ")
+    if isinstance(exc, OSError) and exc.filename is not None:
+        return f"{exc.filename}: {exc.strerror or exc}; check the path and its permissions"
+    where = ""
+    tb = exc.__traceback__
+    frames = []
+    while tb is not None:
+        frames.append((tb.tb_frame.f_code.co_filename, tb.tb_lineno))
+        tb = tb.tb_next
+    if script is not None:
+        mine = [f for f in frames if Path(f[0]).resolve() == Path(script).resolve()]
+        if mine:
+            where = f"{script} line {mine[-1][1]}: "
+    msg = str(exc).splitlines()[0] if str(exc) else ""
+    return (f"{where}{type(exc).__name__}{': ' + msg if msg else ''} (not a femast error: rerun with "
+            "--debug for the traceback, and report it if the input looks right)")
 
 
 if __name__ == "__main__":

@@ -23,3 +23,7 @@ class ConvergenceError(FemastError):
 
 class DataFileError(FemastError, ValueError):
     """A measured-data file is malformed."""
+
+
+class EquilibriumError(FemastError):
+    """A converged increment whose reactions do not balance the applied loads (a lost load)."""

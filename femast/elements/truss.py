@@ -58,6 +58,7 @@ class TrussFamily(ElementFamily):
     ``tension_only`` (bool per element)."""
 
     name = "truss"
+    self_equilibrated = True   # equal and opposite forces along the chord (issue 16 check)
     active_dofs = (0, 1, 2)
     n_state = 0
     path_independent = True
