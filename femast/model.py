@@ -252,8 +252,8 @@ class Model:
         up = np.array([_finite(u, f"beam {n1}-{n2}: up-vector") for u in up_arr])
         e = (b - a) / L
         if np.linalg.norm(up - (up @ e) * e) < 1e-6 * max(np.linalg.norm(up), 1e-300):
-            raise ModelError(f"beam {n1}-{n2}: up-vector {tuple(up)} is parallel to the element axis "
-                             f"{tuple(np.round(e, 6))}; choose an up-vector not along the beam")
+            raise ModelError(f"beam {n1}-{n2}: up-vector {tuple(float(u) for u in up)} is parallel to the element axis "
+                             f"{tuple(float(v) for v in np.round(e, 6))}; choose an up-vector not along the beam")
         chain = [n1] + [self.node(*(a + (b - a) * k / n)) for k in range(1, n)] + [n2]
         labels = []
         for p, q in zip(chain[:-1], chain[1:]):

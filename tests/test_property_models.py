@@ -14,22 +14,37 @@ import femast as fm
 
 BAD_NUMBERS = [float("nan"), float("inf"), -1.0, 0.0, 1e200, -1e300]
 
-coord = st.sampled_from([-1.0, -0.5, 0.0, 0.5, 1.0, 1.5])
-maybe_bad = st.one_of(st.floats(0.5, 2.0), st.sampled_from(BAD_NUMBERS))
+direction = st.sampled_from([(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 0), (0, 1, 1), (1, 0, 1), (-1, 0, 0),
+                             (0, -1, 0), (0, 0, -1), (1, -1, 1)])
+pair = st.tuples(st.integers(0, 5), st.integers(0, 5))
+kind = st.sampled_from(["beam", "beam", "truss"])
 
 
 @st.composite
 def random_model(draw):
+    """A connected chain of 2-6 nodes (random directions and lengths 0.3-1.5 m, so nodes rarely
+    coincide) of beams and trusses, with extra random members, node 0 clamped and random other
+    supports; loads of up to 50 N (N m) on random nodes.  One model in four carries one adversarial
+    number (NaN, inf, 0, negative, 1e200...) in a modulus, an EA, a load, a coordinate or the
+    initial increment."""
     n = draw(st.integers(2, 6))
-    pts = [(draw(coord), draw(coord), draw(coord)) for _ in range(n)]
-    elements = draw(st.lists(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1), st.sampled_from(["beam", "truss"]),
-                                       st.floats(0.3, 3.0), st.sampled_from([(0, 0, 1), (0, 1, 0), (1, 0, 0)])),
-                             min_size=1, max_size=8))
-    fixes = draw(st.lists(st.tuples(st.integers(0, n - 1), st.sampled_from(["all", "translations", "ux", "rz"])),
-                          min_size=0, max_size=3))
-    loads = draw(st.lists(st.tuples(st.integers(0, n - 1), st.sampled_from(["fx", "fy", "fz", "mx", "my", "mz"]),
+    pts = [(0.0, 0.0, 0.0)]
+    for _ in range(n - 1):
+        d = np.array(draw(direction), float)
+        step = draw(st.floats(0.3, 1.5)) * d / np.linalg.norm(d)
+        pts.append(tuple(np.array(pts[-1]) + step))
+    up_choices = st.sampled_from([(0, 0, 1), (0, 1, 0), (1, 0, 0)])
+    elements = [(k, k + 1, draw(kind), draw(st.floats(0.3, 3.0)), draw(up_choices)) for k in range(n - 1)]
+    extra = draw(st.lists(pair, max_size=3))
+    elements += [(i % n, j % n, draw(kind), draw(st.floats(0.3, 3.0)), draw(up_choices))
+                 for i, j in extra if i % n != j % n]
+    fixes = [(0, "all")] + draw(st.lists(st.tuples(st.integers(1, n - 1),
+                                                   st.sampled_from(["all", "translations", "ux", "rz"])),
+                                         max_size=2))
+    loads = draw(st.lists(st.tuples(st.integers(1, n - 1), st.sampled_from(["fx", "fy", "fz", "mx", "my", "mz"]),
                                     st.floats(-50.0, 50.0)), min_size=1, max_size=4))
-    adversarial = draw(st.sampled_from([None, None, None, "E", "EA", "load", "coord", "increment"]))
+    adversarial = draw(st.sampled_from([None, None, None, None, None, None, None, None,
+                                        "E", "EA", "load", "coord", "increment"]))
     bad = draw(st.sampled_from(BAD_NUMBERS))
     inc = draw(st.sampled_from([None, 0.5, 0.25]))
     return dict(pts=pts, elements=elements, fixes=fixes, loads=loads, adversarial=adversarial, bad=bad, inc=inc)
@@ -39,10 +54,13 @@ def _build_and_run(spec):
     m = fm.Model("random")
     pts = [list(p) for p in spec["pts"]]
     if spec["adversarial"] == "coord":
-        pts[0][1] = spec["bad"]
+        pts[-1][1] = spec["bad"]
     labels = [m.node(*p) for p in pts]
     for i, j, kind, scale, up in spec["elements"]:
         if kind == "beam":
+            d = np.subtract(pts[j], pts[i])
+            if np.all(np.isfinite(d)) and np.linalg.norm(np.cross(d, up)) < 1e-3 * np.linalg.norm(d):
+                up = tuple(np.eye(3)[np.argmin(np.abs(d))])   # the least parallel global axis
             E = spec["bad"] if spec["adversarial"] == "E" else 70e9 * scale
             m.beam(labels[i], labels[j], fm.circular_tube(0.02, 0.016, E=E), up=up)
         else:
@@ -59,6 +77,13 @@ def _build_and_run(spec):
     frames = []
     fm.solve(m, None, progress=False, on_frame=frames.append)
     return m, frames
+
+
+def spec_EA(spec):
+    """Largest axial stiffness EA (N) of the model's elements (finite ones)."""
+    A = fm.circular_tube(0.02, 0.016, E=1.0).A
+    vals = [70e9 * A * sc if k == "beam" else 1e6 * sc for _, _, k, sc, _ in spec["elements"]]
+    return max(vals)
 
 
 def _check(spec):
@@ -78,18 +103,27 @@ def _check(spec):
     arm = max(float(np.abs(x).max()), 1.0)
     # converged to force_tol = 1e-6 of the largest nodal force per DOF; <= 6 nodes x 6 DOFs of it,
     # plus moment arms of a few m: 1e-4 of the load scale bounds an honest solution, while a lost
-    # load leaves an imbalance of the order of the load itself; 1e-9 N (N m) is the round-off floor
-    # of a model without loads (stiffnesses ~1e7 N/m times displacements at round-off, ~1e-16 m)
-    assert np.linalg.norm(force) <= 1e-4 * scale + 1e-9, (force, scale)
-    assert np.linalg.norm(moment) <= (1e-4 * scale + 1e-9) * arm, (moment, scale)
+    # load leaves an imbalance of the order of the load itself.  Floor: element forces at round-off
+    # strain (~1e-16 per operation, a few hundred operations) times the largest axial stiffness EA
+    # (<= 2.4e7 N here): 1e-12 EA, for models whose loads are (nearly) zero
+    floor = 1e-12 * max(spec_EA(spec), 1.0)
+    assert np.linalg.norm(force) <= 1e-4 * scale + floor, (force, scale)
+    assert np.linalg.norm(moment) <= (1e-4 * scale + floor) * arm, (moment, scale)
     return "solved"
 
 
-@settings(max_examples=200, deadline=None, derandomize=True, database=None,
-          suppress_health_check=[HealthCheck.too_slow])
-@given(random_model())
-def test_random_models_solve_in_equilibrium_or_fail_cleanly(spec):
-    _check(spec)
+def test_random_models_solve_in_equilibrium_or_fail_cleanly():
+    outcomes = []
+
+    @settings(max_examples=200, deadline=None, derandomize=True, database=None,
+              suppress_health_check=[HealthCheck.too_slow])
+    @given(random_model())
+    def run(spec):
+        outcomes.append(_check(spec))
+
+    run()
+    # the property is not vacuous: the sample holds models that solve and models that fail
+    assert outcomes.count("solved") >= 10 and outcomes.count("error") >= 10, outcomes
 
 
 @pytest.mark.slow
@@ -97,23 +131,3 @@ def test_random_models_solve_in_equilibrium_or_fail_cleanly(spec):
 @given(random_model())
 def test_random_models_slow(spec):
     _check(spec)
-
-
-def test_the_generator_makes_both_outcomes():
-    """The property is not vacuous: a sample of the generator has models that solve and models
-    that fail."""
-    from hypothesis import find
-
-    solved = find(random_model(), lambda s: _safe(s) == "solved", settings=settings(max_examples=500, deadline=None,
-                                                                                     database=None))
-    assert solved is not None
-    failed = find(random_model(), lambda s: _safe(s) == "error", settings=settings(max_examples=500, deadline=None,
-                                                                                    database=None))
-    assert failed is not None
-
-
-def _safe(spec):
-    try:
-        return _check(spec)
-    except AssertionError:
-        return "bad"
