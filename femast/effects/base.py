@@ -10,6 +10,15 @@ is not implemented yet (e.g. for experiments pending an FE model).
 
 Users register their own effects from a script with :func:`register_effect` (or add an
 implementation to an existing effect with :func:`add_implementation`).
+
+Forms
+-----
+An implementation may carry generalised *forms* of its mechanism (``Implementation.forms``:
+``{form name: Implementation}``), each a documented physical model of which the implementation's
+own form (``Implementation.form``) is a special case, e.g. ``friction_hysteresis`` with its rigid
+stick (``play``), a finite stick stiffness (``jenkins``) and distributed micro-slip (``iwan``).  A
+form is switched on as ``effect/form`` (``--effects friction_hysteresis/jenkins``); ``diagnose``
+fits every form of a candidate and keeps the one the information criterion prefers.
 """
 
 from __future__ import annotations
@@ -35,6 +44,9 @@ class Implementation:
         ``ctx`` the keyword arguments of the hook call.  None: applicable but not implemented yet.
     order : effects on the same hook are applied in increasing ``order``.
     doc : how the effect enters this experiment (equation in words).
+    form : name of this form of the mechanism (e.g. "play"); "" for an effect with one form.
+    forms : ``{name: Implementation}`` of generalised forms (see the module docstring), selected as
+        ``effect/name``; each has its own parameters and ``doc``.
     """
 
     hook: str
@@ -42,6 +54,23 @@ class Implementation:
     apply: Callable | None = None
     order: int = 50
     doc: str = ""
+    form: str = ""
+    forms: dict = field(default_factory=dict)
+
+    def variant(self, form: str | None) -> "Implementation":
+        """This implementation (``form`` None, "" or its own form name) or its generalised ``form``."""
+        if not form or form == self.form:
+            return self
+        try:
+            return self.forms[form]
+        except KeyError:
+            names = [self.form or "(default)", *self.forms]
+            raise ModelError(f"unknown form '{form}'; accepted forms: {', '.join(names)}") from None
+
+    @property
+    def form_names(self) -> tuple:
+        """Its own form then the generalised ones ("" for the default of a one-form effect)."""
+        return (self.form, *self.forms)
 
     @property
     def implemented(self) -> bool:
@@ -97,10 +126,16 @@ def register_effect(effect: Effect, replace_existing: bool = False) -> Effect:
     if effect.name in _REGISTRY and not replace_existing and _REGISTRY[effect.name] is not effect:
         raise ModelError(f"an effect called '{effect.name}' is already registered; choose another name or pass "
                          "replace_existing=True")
+    if "/" in effect.name or "." in effect.name:
+        raise ModelError(f"effect name '{effect.name}': no '/' or '.' (they separate forms and parameters)")
     for exp, impl in effect.implementations.items():
-        names = [p.name for p in impl.parameters]
-        if len(set(names)) != len(names):
-            raise ModelError(f"effect {effect.name} on {exp}: duplicate parameter names {names}")
+        for label, im in [(impl.form or "default", impl), *impl.forms.items()]:
+            names = [p.name for p in im.parameters]
+            if len(set(names)) != len(names):
+                raise ModelError(f"effect {effect.name} on {exp} (form {label}): duplicate parameter names {names}")
+            if im.hook != impl.hook:
+                raise ModelError(f"effect {effect.name} on {exp}: form {label} acts on hook '{im.hook}', its "
+                                 f"default form on '{impl.hook}'; the forms of one effect share a hook")
     _REGISTRY[effect.name] = effect
     return effect
 
@@ -137,10 +172,17 @@ def applicable_effects(experiment) -> tuple:
     return tuple(e for e in _REGISTRY.values() if e.applies_to(key))
 
 
+def split_form(name: str) -> tuple:
+    """``"effect/form"`` -> ``("effect", "form")``; ``"effect"`` -> ``("effect", "")``."""
+    base, _, form = name.partition("/")
+    return base.strip(), form.strip()
+
+
 def resolve(experiment, names) -> list:
     """Check effect names for ``experiment`` and return ``[(name, Implementation)]``.
 
-    Raises ModelError for an unknown name, an effect that does not apply to the experiment, or
+    A name may select a form of the effect (``effect/form``, see the module docstring); the
+    implementation returned is then that form's.  Raises ModelError for an unknown name, an effect that does not apply to the experiment, or
     one registered for it but not implemented yet, listing the accepted names each time.
     """
     key = experiment.effect_key
@@ -150,6 +192,7 @@ def resolve(experiment, names) -> list:
         name = name.strip()
         if not name:
             continue
+        full, (name, form) = name, split_form(name)
         if name in seen:
             raise ModelError(f"effect '{name}' given twice")
         seen.add(name)
@@ -167,8 +210,26 @@ def resolve(experiment, names) -> list:
         if experiment.hooks and impl.hook not in experiment.hooks:
             raise ModelError(f"effect '{name}' acts on hook '{impl.hook}', which {experiment.name} does not have; "
                              f"its hooks: {', '.join(experiment.hooks)}")
-        out.append((name, impl))
+        try:
+            impl = impl.variant(form)
+        except ModelError as e:
+            raise ModelError(f"effect '{full}' on {experiment.name}: {e}") from None
+        out.append((full if form and form != impl_form(eff, key) else name, impl))
     return out
+
+
+def impl_form(effect: Effect, experiment_key: str) -> str:
+    """Name of the default form of ``effect`` on an experiment ("" if it has one form)."""
+    impl = effect.implementations.get(experiment_key)
+    return impl.form if impl else ""
+
+
+def forms_of(effect_name: str, experiment_key: str) -> tuple:
+    """Names to switch on each form of an effect on an experiment: ``("effect", "effect/form", ...)``."""
+    impl = get_effect(effect_name).implementations.get(experiment_key)
+    if impl is None:
+        return ()
+    return (effect_name, *(f"{effect_name}/{f}" for f in impl.forms))
 
 
 def load_script(path) -> object:

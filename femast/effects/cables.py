@@ -19,7 +19,8 @@ FE = ("bay-torsion", "tip-cycle")
 def _progressive_mast_top(theta, p, ctx):
     m = ctx["prep"]["m"][:, :2]
     theta = theta.copy()
-    theta[:, :2] /= 1.0 + p["beta"] * np.abs(m)
+    a = np.abs(m)
+    theta[:, :2] /= 1.0 + p["beta"] * a + p.get("beta2", 0.0) * a * a
     return theta
 
 
@@ -41,8 +42,17 @@ PROGRESSIVE_STIFFNESS = register_effect(Effect(
             hook="joint_rotation", order=20,
             parameters=(Parameter("beta", "1/(N m)", 1e-4, 0.0, 0.1, "relative stiffening per unit joint moment",
                                   scale=1e-4, starts=(1e-5, 1e-3)),),
-            apply=_progressive_mast_top,
-            doc="theta_k = m_k / (k_k (1 + beta |m_k|)), k = 1, 2 (secant stiffness rising with the moment)."),
+            apply=_progressive_mast_top, form="linear",
+            doc="theta_k = m_k / (k_k (1 + beta |m_k|)), k = 1, 2 (secant stiffness rising with the moment).",
+            forms={"quadratic": Implementation(
+                hook="joint_rotation", order=20,
+                parameters=(Parameter("beta", "1/(N m)", 1e-4, -0.1, 0.1, "relative stiffening per unit joint "
+                                      "moment", scale=1e-4, starts=(1e-5, 1e-3)),
+                            Parameter("beta2", "1/(N m)^2", 0.0, 0.0, 1e-2, "relative stiffening per unit moment "
+                                      "squared (the k2 tau^2 term of Eq. 25)", scale=1e-6, starts=(1e-7, 1e-5))),
+                apply=_progressive_mast_top,
+                doc="theta_k = m_k / (k_k (1 + beta |m_k| + beta2 m_k^2)): both terms of Eq. 25 (beta2 = 0: the "
+                    "linear form).")}),
     },
 ))
 
@@ -102,6 +112,9 @@ def _pretension_fe(bay, p, ctx):
 def _pretension_mast_top(theta, p, ctx):
     theta = theta.copy()
     tau = ctx["prep"]["tau"][:, None]
+    tc = p.get("t_c")
+    if tc is not None:  # saturating (creep-like) loss, normalised to lam at the end of the test
+        tau = -np.expm1(-tau / tc) / -np.expm1(-1.0 / tc)
     theta[:, :2] /= 1.0 - p["lam"] * tau
     return theta
 
@@ -123,8 +136,16 @@ PRETENSION = register_effect(Effect(
         "mast-top": Implementation(
             hook="joint_rotation", order=60,
             parameters=(Parameter("lam", "-", 0.1, 0.0, 0.9, "relative stiffness loss over the test", scale=0.1),),
-            apply=_pretension_mast_top,
-            doc="k_k(t) = k_k (1 - lam tau), tau = normalised time in [0, 1] (t_s column or row index)."),
+            apply=_pretension_mast_top, form="linear",
+            doc="k_k(t) = k_k (1 - lam tau), tau = normalised time in [0, 1] (t_s column or row index).",
+            forms={"saturating": Implementation(
+                hook="joint_rotation", order=60,
+                parameters=(Parameter("lam", "-", 0.1, 0.0, 0.9, "relative stiffness loss over the test", scale=0.1),
+                            Parameter("t_c", "-", 0.3, 0.01, 100.0, "time constant of the loss, as a fraction of "
+                                      "the test's duration", scale=0.3, starts=(0.05, 3.0))),
+                apply=_pretension_mast_top,
+                doc="k_k(t) = k_k (1 - lam (1 - exp(-tau / t_c)) / (1 - exp(-1 / t_c))): a loss that levels off "
+                    "(creep, slip of a termination); t_c -> inf is the linear form.")}),
         **{e: Implementation(
             hook="bay_parameters", order=60,
             parameters=(Parameter("dT0", "N", 0.0, -150.0, 150.0, "error of the cable pretension against the "

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..experiments.core import Parameter
 from .base import Effect, Implementation, register_effect
-from .operators import play
+from .operators import iwan, jenkins, play
 
 FE = ("bay-torsion", "tip-cycle")
 
@@ -33,8 +33,19 @@ def _clearance_mast_top(theta, p, ctx):
     return theta
 
 
+def _clearance_mast_top_smooth(theta, p, ctx):
+    m = ctx["prep"]["m"][:, :2]
+    theta = theta.copy()
+    theta[:, :2] += p["c"] * np.tanh(m / p["m_c"])
+    return theta
+
+
 def _clearance_latch_pull(x, p, ctx):
     return x - p["c"] * np.tanh(ctx["prep"]["dT"] / 1.0)
+
+
+def _clearance_latch_pull_smooth(x, p, ctx):
+    return x - p["c"] * np.tanh(ctx["prep"]["dT"] / p["F_c"])
 
 
 JOINT_CLEARANCE = register_effect(Effect(
@@ -47,6 +58,8 @@ JOINT_CLEARANCE = register_effect(Effect(
         "assembly point).  Elastic (no hysteresis): the side of the gap follows the sign of the load, not the "
         "direction of loading."),
     signature="a step in the displacement where the load changes sign; the error is largest near zero load",
+    # forms: "sharp" (closing scale fixed at 1 % of the largest load: a nearly sharp gap) and "smooth"
+    # (closing scale fitted: a contact that stiffens over a range of load, the sharp gap its limit)
     acts_where=("near-zero load",),
     seed="seed 000 Sec. IV-C",
     implementations={
@@ -54,15 +67,36 @@ JOINT_CLEARANCE = register_effect(Effect(
             hook="joint_rotation", order=30,
             parameters=(Parameter("c", "rad", 1e-4, 0.0, 0.02, "half play of each bending joint", scale=1e-4,
                                   starts=(1e-5, 1e-3)),),
-            apply=_clearance_mast_top,
+            apply=_clearance_mast_top, form="sharp",
             doc="theta_k += c tanh(m_k / m_s), k = 1, 2 (bending joints); m_s = 1 % of the largest |m_k| in the "
-                "data (the contact stiffness that closes the gap)."),
+                "data (a nearly sharp gap: the contact closes within 1 % of the load range).",
+            forms={"smooth": Implementation(
+                hook="joint_rotation", order=30,
+                parameters=(Parameter("c", "rad", 1e-4, 0.0, 0.02, "half play of each bending joint", scale=1e-4,
+                                      starts=(1e-5, 1e-3, 3e-4)),
+                            Parameter("m_c", "N m", 5.0, 1e-3, 1e4, "closing moment scale of the contact (the "
+                                      "gap is closed to tanh(1) = 76 % at m_c)", scale=5.0,
+                                      starts=(0.5, 30.0, 5.0))),
+                apply=_clearance_mast_top_smooth,
+                doc="theta_k += c tanh(m_k / m_c), k = 1, 2: the contact closing the gap stiffens over a moment "
+                    "range m_c (a contact stiffness of about c / m_c rad per N m); m_c -> 0 is the sharp gap, "
+                    "m_c = 1 % of max |m_k| the default form.")}),
         "latch-pull": Implementation(
             hook="bead_position", order=30,
             parameters=(Parameter("c", "m", 5e-5, 0.0, 2e-3, "half play of the latch body on its mount",
                                   scale=1e-4, starts=(1e-5, 3e-4)),),
-            apply=_clearance_latch_pull,
-            doc="x_bead = x - c tanh(dT / 1 N): the latch shifts by c towards the pulling cable."),
+            apply=_clearance_latch_pull, form="sharp",
+            doc="x_bead = x - c tanh(dT / 1 N): the latch shifts by c towards the pulling cable (closing within "
+                "about 1 N, the force noise of the seed's rig).",
+            forms={"smooth": Implementation(
+                hook="bead_position", order=30,
+                parameters=(Parameter("c", "m", 5e-5, 0.0, 2e-3, "half play of the latch body on its mount",
+                                      scale=1e-4, starts=(1e-5, 3e-4)),
+                            Parameter("F_c", "N", 1.0, 1e-3, 200.0, "force over which the mount's contact closes",
+                                      scale=1.0, starts=(0.2, 10.0))),
+                apply=_clearance_latch_pull_smooth,
+                doc="x_bead = x - c tanh(dT / F_c): a mount whose contact stiffens over F_c (F_c = 1 N: the "
+                    "default form).")}),
     },
 ))
 
@@ -71,6 +105,18 @@ JOINT_CLEARANCE = register_effect(Effect(
 def _friction_mast_top(m, p, ctx):
     m = m.copy()
     m[:, :2] = play(m[:, :2], p["M_f"])
+    return m
+
+
+def _friction_mast_top_jenkins(m, p, ctx):
+    m = m.copy()
+    m[:, :2] = jenkins(m[:, :2], p["M_f"], p["alpha"])
+    return m
+
+
+def _friction_mast_top_iwan(m, p, ctx):
+    m = m.copy()
+    m[:, :2] = iwan(m[:, :2], p["M_f"], p["beta"], p["alpha"])
     return m
 
 
@@ -98,9 +144,34 @@ FRICTION_HYSTERESIS = register_effect(Effect(
             hook="joint_moment", order=40,
             parameters=(Parameter("M_f", "N m", 10.0, 0.0, 1e5, "friction moment of each bending joint",
                                   scale=10.0, starts=(1.0, 100.0)),),
-            apply=_friction_mast_top,
+            apply=_friction_mast_top, form="play",
             doc="m_k -> play(m_k; M_f), k = 1, 2: the elastic joint sees the moment less the friction, which "
-                "holds until the moment has changed by 2 M_f after a reversal."),
+                "holds until the moment has changed by 2 M_f after a reversal (the joint is rigid while it "
+                "sticks).",
+            forms={
+                "jenkins": Implementation(
+                    hook="joint_moment", order=40,
+                    parameters=(Parameter("M_f", "N m", 10.0, 0.0, 1e5, "slip moment of the Jenkins slider",
+                                          scale=10.0, starts=(2.0, 50.0, 10.0)),
+                                Parameter("alpha", "-", 0.3, 0.0, 1.0, "compliance of the stuck joint relative "
+                                          "to the slipping one, k / (k + k_s)", scale=0.3,
+                                          starts=(0.05, 0.6, 0.3))),
+                    apply=_friction_mast_top_jenkins,
+                    doc="m_k -> alpha m_k + play((1 - alpha) m_k; M_f): the elastic joint k in parallel with a "
+                        "Jenkins element (spring k_s = k (1 - alpha) / alpha in series with a slider of strength "
+                        "M_f); stuck, the joint is k + k_s stiff, slipping k.  alpha = 0 is the play form."),
+                "iwan": Implementation(
+                    hook="joint_moment", order=40,
+                    parameters=(Parameter("M_f", "N m", 20.0, 0.0, 1e5, "largest slip moment of the micro-slip "
+                                          "elements", scale=20.0, starts=(4.0, 100.0, 20.0)),
+                                Parameter("beta", "-", 1.0, 0.05, 50.0, "shape of the slip-strength distribution "
+                                          "P(r <= s) = (s / M_f)^beta", scale=1.0, starts=(3.0, 0.5, 1.0)),
+                                Parameter("alpha", "-", 0.1, 0.0, 1.0, "share of the load path that never slips",
+                                          scale=0.1, starts=(0.0, 0.3, 0.1))),
+                    apply=_friction_mast_top_iwan,
+                    doc="m_k -> alpha m_k + (1 - alpha) mean_j play(m_k; r_j): a series Iwan model of 24 "
+                        "elasto-slip elements with slip strengths r_j = M_f q_j^(1/beta) (distributed micro-slip: "
+                        "smooth Masing loops; beta -> inf, alpha = 0 is the play form).")}),
         "latch-pull": Implementation(
             hook="branch_force", order=40,
             parameters=(Parameter("F_f", "N", 1.0, 0.0, 200.0, "friction force on the moving bead or cable",

@@ -6,14 +6,25 @@
 * :func:`proportional_play` -- the same with a threshold ``eta |u|`` proportional to the current
   input: the loop width grows with the load and closes at zero load (inter-fibre friction of a
   rope whose normal force grows with its tension).
+* :func:`jenkins` -- an elastic joint in parallel with a Jenkins element (a spring in series with
+  a Coulomb slider) driven by its load: ``alpha u + play((1 - alpha) u; r)``.  ``alpha = 0`` is the
+  play operator (rigid stick), ``alpha = 1`` the elastic joint alone.
+* :func:`iwan` -- a series Iwan model (elasto-slip elements with a distribution of slip strengths)
+  driven by its load: ``alpha u + (1 - alpha) mean_j play(u; r_j)`` with the slip strengths
+  ``r_j = R q_j^(1/beta)`` at the mid quantiles ``q_j`` of the power-law distribution
+  ``P(r <= s) = (s / R)^beta`` on ``[0, R]``.  It is a Prandtl-Ishlinskii operator, so its loops obey
+  the Masing rules; ``beta -> inf`` gives the play operator of width ``R``, ``beta = 1`` (uniform
+  strengths) a parabolic virgin curve ``u^2 / (2 R)`` below ``R``.
 
-Both start from the state 0 (relaxed at zero load change) and act column by column.
+All start from the state 0 (relaxed at zero load) and act column by column.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+IWAN_ELEMENTS = 24  # slip strengths of the discretised Iwan model (error of the loop ~ 1 / N^2 of R)
 
 
 @njit(cache=True)
@@ -34,15 +45,79 @@ def _play(u, r, p0):
     return out
 
 
+@njit(cache=True)
+def _play_sum(u, radii, weights):
+    """sum_k weights[k] play(u; radii[k]) on each column of u (n, m), every play from state 0."""
+    n, m = u.shape
+    out = np.zeros_like(u)
+    nk = radii.size
+    state = np.zeros(nk)
+    for j in range(m):
+        for k in range(nk):
+            state[k] = 0.0
+        for i in range(n):
+            acc = 0.0
+            x = u[i, j]
+            for k in range(nk):
+                p = state[k]
+                r = radii[k]
+                if p < x - r:
+                    p = x - r
+                elif p > x + r:
+                    p = x + r
+                state[k] = p
+                acc += weights[k] * p
+            out[i, j] = acc
+    return out
+
+
+def _as2d(u):
+    u = np.asarray(u, dtype=float)
+    return u, np.ascontiguousarray(u.reshape(u.shape[0], -1))
+
+
 def play(u, r: float, p0: float = 0.0) -> np.ndarray:
     """Play operator of half-width ``r`` (unit of ``u``, >= 0) on each column of ``u`` (n,) or (n, k)."""
-    u = np.asarray(u, dtype=float)
-    u2 = np.ascontiguousarray(u.reshape(u.shape[0], -1))
+    u, u2 = _as2d(u)
     return _play(u2, np.full_like(u2, max(float(r), 0.0)), float(p0)).reshape(u.shape)
 
 
 def proportional_play(u, eta: float, p0: float = 0.0) -> np.ndarray:
     """Play operator with half-width ``eta |u|`` (eta dimensionless, >= 0) on each column of ``u``."""
-    u = np.asarray(u, dtype=float)
-    u2 = np.ascontiguousarray(u.reshape(u.shape[0], -1))
+    u, u2 = _as2d(u)
     return _play(u2, max(float(eta), 0.0) * np.abs(u2), float(p0)).reshape(u.shape)
+
+
+def jenkins(u, r: float, alpha: float) -> np.ndarray:
+    """Elastic joint in parallel with a Jenkins element, driven by its load ``u`` (n,) or (n, k).
+
+    Returns the load carried by the elastic joint: ``alpha u + play((1 - alpha) u; r)``.  r : slip
+    strength of the slider (unit of u, >= 0); alpha : compliance of the stuck joint relative to the
+    slipping one, ``k / (k + k_s)`` in [0, 1] (k the joint's, k_s the Jenkins spring's stiffness).
+    While stuck the joint turns by ``alpha du / k``, while slipping by ``du / k``; the slider carries
+    ``(1 - alpha) u`` of every load change until it reaches ``+-r``.  alpha = 0: :func:`play`.
+    """
+    a = min(max(float(alpha), 0.0), 1.0)
+    u, u2 = _as2d(u)
+    return (a * u2 + _play(u2 * (1.0 - a), np.full_like(u2, max(float(r), 0.0)), 0.0)).reshape(u.shape)
+
+
+def iwan_strengths(R: float, beta: float, n: int = IWAN_ELEMENTS) -> np.ndarray:
+    """Slip strengths ``R q_j^(1/beta)`` at the mid quantiles ``q_j = (j - 1/2) / n`` (unit of R)."""
+    q = (np.arange(n) + 0.5) / n
+    return max(float(R), 0.0) * q ** (1.0 / max(float(beta), 1e-6))
+
+
+def iwan(u, R: float, beta: float, alpha: float = 0.0, n: int = IWAN_ELEMENTS) -> np.ndarray:
+    """Series Iwan model driven by its load ``u`` (n,) or (n, k): the load carried by the elastic part.
+
+    ``alpha u + (1 - alpha) / n sum_j play(u; r_j)``, ``r_j`` from :func:`iwan_strengths`.  R : largest
+    slip strength (unit of u, >= 0); beta : shape of the strength distribution ``P(r <= s) = (s/R)^beta``
+    (> 0; large: all near R, Coulomb-like; 1: uniform; small: most slip early, nearly elastic);
+    alpha : share that never slips, in [0, 1].
+    """
+    a = min(max(float(alpha), 0.0), 1.0)
+    radii = iwan_strengths(R, beta, n)
+    u, u2 = _as2d(u)
+    w = np.full(radii.size, (1.0 - a) / radii.size)
+    return (a * u2 + _play_sum(u2, radii, w)).reshape(u.shape)

@@ -59,6 +59,10 @@ class Parameter:
         if not (self.lower <= self.default <= self.upper):
             raise ModelError(f"parameter {self.name}: default {self.default!r} {self.unit} lies outside its "
                              f"bounds [{self.lower!r}, {self.upper!r}]")
+        for s in self.starts:
+            if not (self.lower <= s <= self.upper):
+                raise ModelError(f"parameter {self.name}: start {s!r} {self.unit} lies outside its bounds "
+                                 f"[{self.lower!r}, {self.upper!r}]; give starts within the bounds")
 
     @property
     def typical(self) -> float:
@@ -74,12 +78,15 @@ class Column:
 
     unit : the unit of the values in the file.  doc : what is measured, frame and sign.
     required : False for optional columns (missing means "not measured").
+    codes : ``((text, value), ...)`` words a data file may write instead of the number (e.g. the
+        loaded side of a latch pull test, ``("out", 1.0), ("in", -1.0)``); values are stored as floats.
     """
 
     name: str
     unit: str
     doc: str = ""
     required: bool = True
+    codes: tuple = ()
 
 
 #: Optional time column accepted by every experiment (s); without it time is the row index.

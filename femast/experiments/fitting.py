@@ -219,7 +219,7 @@ def _forward_differences(fun, step: float, lo, hi):
 
 
 def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, multistart: bool = True,
-        max_nfev: int | None = None) -> OptimizeResult:
+        max_nfev: int | None = None, given_start_clip: bool = False) -> OptimizeResult:
     """Fit the baseline parameters and those of the switched-on ``effects`` to the data.
 
     effects : effect names (``femast.effects``) applicable to the experiment.
@@ -228,6 +228,8 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     noise : ``{channel: sigma}`` fixed weights; default: estimated from the residuals of a first
         fit, then refitted with them.
     multistart : also start the effect parameters from their ``starts`` and keep the best fit.
+    given_start_clip : clip given starts outside the bounds into them (diagnose passes the values of
+        other fits) instead of raising ModelError naming the parameter.
 
     Returns an ``OptimizeResult`` with ``x``, ``names``, ``units``, ``stderr``, ``cov``,
     ``params`` (baseline ``{name: value}``), ``effect_params`` (``{effect: {name: value}}``),
@@ -250,7 +252,13 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     guess = exp.initial_guess(data, exp.options) if exp.initial_guess else {}
     x0 = []
     for full, p, owner in specs:
-        v = start.get(full, guess.get(full, p.default) if owner is None else p.default)
+        if full in start:
+            v = float(start[full])
+            if not (p.lower <= v <= p.upper) and not given_start_clip:
+                raise ModelError(f"fit start: {full} = {v!r} {p.unit} lies outside its bounds [{p.lower!r}, "
+                                 f"{p.upper!r}]; give a start within the bounds")
+        else:
+            v = guess.get(full, p.default) if owner is None else p.default
         x0.append(float(np.clip(v, p.lower, p.upper)))
     x0 = np.array(x0)
     scale = np.array([p.typical for _, p, _ in specs])
