@@ -27,3 +27,8 @@ class DataFileError(FemastError, ValueError):
 
 class EquilibriumError(FemastError):
     """A converged increment whose reactions do not balance the applied loads (a lost load)."""
+
+
+class StateError(FemastError, ValueError):
+    """An analysis state cannot be used as asked (e.g. a modal analysis of a state that is not in
+    equilibrium)."""
