@@ -277,12 +277,16 @@ def family_mass_blocks(model, families, x, R, X0):
 def check_point_masses(model, dofmap):
     """A point mass whose node has no active translation (no element, no rigid body) is lost:
     ModelError naming it."""
-    for p in getattr(model, "point_masses", []):
-        i = model.index(p.node)
-        if p.mass > 0 and np.all(dofmap.eq[i, :3] < 0):
-            raise ModelError(f"{p.name or 'point mass'} at node {p.node}: the node has no element or rigid body, "
-                             "so its mass moves with nothing; put the mass on a node of the structure (or a "
-                             "rigid body's reference node)")
+    pms = [p for p in getattr(model, "point_masses", []) if p.mass > 0]
+    if not pms:
+        return
+    rows = np.array([model.index(p.node) for p in pms])
+    lost = np.flatnonzero(np.all(dofmap.eq[rows, :3] < 0, axis=1))
+    if lost.size:
+        p = pms[int(lost[0])]
+        raise ModelError(f"{p.name or 'point mass'} at node {p.node}: the node has no element or rigid body, "
+                         "so its mass moves with nothing; put the mass on a node of the structure (or a "
+                         "rigid body's reference node)")
 
 
 def assemble_mass(analysis):
@@ -294,8 +298,17 @@ def assemble_mass(analysis):
     na, nf = dm.n_active, dm.n_free
     if not blocks:
         return sp.csr_matrix((nf, nf)), sp.csr_matrix((na, na))
-    asm = Assembler(dm, blocks, full=True)
-    M_aa = asm.full_tangent([b.matrices for b in blocks]).copy()
+    # the pattern depends on the blocks' node rows only: kept on the analysis for the next call (the
+    # modes of every increment of a run)
+    key = (id(dm), tuple((b.name, b.nodes.shape) for b in blocks))
+    cached = getattr(analysis, "_mass_assembler", None)
+    if cached is None or cached[0] != key:
+        cached = (key, Assembler(dm, blocks, full=True))
+        try:
+            analysis._mass_assembler = cached
+        except AttributeError:   # an analysis object that takes no new attributes: no cache
+            pass
+    M_aa = cached[1].full_tangent([b.matrices for b in blocks]).copy()
     if analysis.constraints.active:
         T = analysis.constraints.transformation(analysis.x).copy()
         M_ind = (T.T @ M_aa @ T).tocsr()

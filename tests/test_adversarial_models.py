@@ -313,3 +313,26 @@ def test_bad_results_folder(maker, tmp_path):
 
 def test_battery_size():
     assert len(CASES) + 2 >= 60
+
+
+def test_equilibrium_check_catches_a_lost_load_and_passes_a_balanced_one():
+    from femast.validation import check_equilibrium
+
+    x = np.array([[0.0, 0, 0], [1.0, 0, 0]])
+    P = np.zeros((2, 6))
+    P[1, 2] = -10.0                          # 10 N down at the tip
+    RF = np.zeros((2, 6))
+    RF[0, 2], RF[0, 4] = 10.0, -10.0         # the clamp: 10 N up and the moment of the tip load
+    r_free = np.zeros(6)
+    free_dof = np.arange(6)
+    check_equilibrium(x, P, RF, r_free, free_dof, "increment 1")          # balanced: silent
+    with pytest.raises(fm.EquilibriumError, match=r"increment 3: the reactions do not balance .* node 2"):
+        check_equilibrium(x, P, np.zeros((2, 6)), r_free, free_dof, "increment 3", labels=np.array([1, 2]))
+
+
+def test_analysis_checks_the_balance_of_beam_and_truss_models():
+    m, a, b = _cantilever()
+    m.step("s").load(b, fz=-1.0)
+    an = fm.Analysis(m, None, progress=False, on_frame=lambda d: None)
+    assert an.system.check_balance          # every family self-equilibrated: checked each increment
+    an.run()
