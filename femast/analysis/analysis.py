@@ -195,7 +195,12 @@ class Analysis:
             ti = _time.perf_counter()
             for k, step in enumerate(self.model.steps):
                 self._state.step = k
-                run_step(self, step)
+                if getattr(step, "kind", "static") == "frequency":   # modes of the state (issue 18)
+                    from ..frequency_step import run_frequency_step
+
+                    run_frequency_step(self, step)
+                else:
+                    run_step(self, step)
             self.summary.status, self.summary.completed = "completed", True
         except BaseException as exc:   # the summary says how the run ended (issue 16), then the error goes on
             self.summary.status, self.summary.message = run_outcome(exc)
