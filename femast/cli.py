@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import runpy
 import sys
 from pathlib import Path
@@ -15,8 +16,32 @@ def _run(args):
     script = Path(args.script)
     if not script.exists():
         raise FemastError(f"no such script: {script}")
-    sys.argv = [str(script)] + list(args.script_args)
-    runpy.run_path(str(script), run_name="__main__")
+    script_args = list(args.script_args)
+    restart = args.restart
+    if "--restart" in script_args:   # femast run SCRIPT --restart FOLDER
+        i = script_args.index("--restart")
+        if i + 1 >= len(script_args):
+            raise FemastError("--restart needs the results folder of the run to continue: --restart FOLDER")
+        restart = script_args[i + 1]
+        del script_args[i:i + 2]
+    if restart is not None:
+        # the analyses of the script whose results folder is RESTART continue from its restart point
+        from .analysis.restart import ENV, RESTART_DIR
+
+        if not (Path(restart) / RESTART_DIR / "restart.json").is_file():
+            raise FemastError(f"{restart}: no restart point; run the analysis with restart_every=n to be able "
+                              "to restart it")
+        old = os.environ.get(ENV)
+        os.environ[ENV] = str(restart)
+    sys.argv = [str(script)] + script_args
+    try:
+        runpy.run_path(str(script), run_name="__main__")
+    finally:
+        if restart is not None:   # (main() may be called again in the same process)
+            if old is None:
+                os.environ.pop(ENV, None)
+            else:
+                os.environ[ENV] = old
 
 
 def _vtk(args):
@@ -54,6 +79,9 @@ def main(argv=None):
                         help="show the full Python traceback of an error (default: one line naming the item)")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("run", help="run a model or benchmark script")
+    p.add_argument("--restart", metavar="FOLDER", default=None,
+                   help="continue the run whose results folder is FOLDER from its last restart point "
+                        "(also accepted after SCRIPT)")
     p.add_argument("script")
     p.add_argument("script_args", nargs=argparse.REMAINDER)
     p.set_defaults(func=_run)

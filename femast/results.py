@@ -128,14 +128,22 @@ class ResultsWarning(UserWarning):
 class ResultsWriter:
     """Writes a results folder as the analysis runs (see module docstring)."""
 
-    def __init__(self, folder, model, families):
+    def __init__(self, folder, model, families, resume: int | None = None):
+        """``resume``: continue a restarted run whose first ``resume`` frames are on disk (kept;
+        later frames and partial files are removed; status lines are appended)."""
         self.folder = prepare_folder(folder)
         self._started = _time.time()
         # the stale summary of an earlier run goes first: a kill from here on leaves "running"
         write_json_atomic(self.folder / "summary.json", self._running())
         for pattern in ("*.npz", "*" + TMP_SUFFIX):
             for old in (self.folder / "frames").glob(pattern):
-                old.unlink()
+                if resume is None or not _FRAME_NAME.match(old.name) or int(old.name[:-4]) > resume:
+                    old.unlink()
+        if resume is None:   # an earlier run's restart point does not belong to this run's frames
+            (self.folder / "restart" / "restart.json").unlink(missing_ok=True)
+        if resume is not None and len(list((self.folder / "frames").glob("*.npz"))) != resume:
+            raise FemastError(f"{self.folder}: the restart point names {resume} frames but fewer are on disk; "
+                              "run the analysis again from the start")
         for old in (self.folder / "mesh.npz", self.folder / ("mesh.npz" + TMP_SUFFIX)):
             old.unlink(missing_ok=True)
         mesh = {"node_labels": model.node_labels, "X": model.coordinates,
@@ -143,13 +151,16 @@ class ResultsWriter:
         for f in families:
             mesh[f"conn/{f.name}"] = model.node_labels[np.asarray(f.nodes)]
             mesh[f"labels/{f.name}"] = np.asarray(getattr(f, "labels", np.arange(1, f.n_elements + 1)))
-        self.count = 0
+        self.count = resume or 0
         self._queue = queue.Queue(maxsize=16)   # bounded: a slow disk slows the analysis, not memory
         self._error = None
         self._queue.put(((self.folder / "mesh.npz",), mesh))   # written first, by the writer thread
-        self.sta = open(self.folder / "status.sta", "w")
-        self.sta.write(f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} {'TOTAL TIME':>11} "
-                       f"{'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n")
+        self.sta = open(self.folder / "status.sta", "w" if resume is None else "a")
+        if resume is not None:
+            self.sta.write(f"{'':>12} restarted from frame {resume}\n")
+        else:
+            self.sta.write(f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} {'TOTAL TIME':>11} "
+                           f"{'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n")
         self._thread = threading.Thread(target=self._drain, name="femast-results-writer", daemon=True)
         self._thread.start()
 
@@ -159,6 +170,11 @@ class ResultsWriter:
         self._raise_error()
         self._queue.put((f"{step:>12.12} {inc:5d} {attempt:3d} {iterations:4d} {time:11.4e} {total_time:11.4e} "
                          f"{dtime:11.4e} {lam:12.5e}  {note}\n", None))
+
+    def flush(self):
+        """Wait until every queued frame and status line is on disk (a restart point names them)."""
+        self._queue.join()
+        self._raise_error()
 
     def _drain(self):
         while True:
@@ -218,6 +234,9 @@ class NullWriter:
 
     def frame(self, **data):
         self.count += 1
+
+    def flush(self):
+        pass
 
     def close(self, summary: dict):
         pass

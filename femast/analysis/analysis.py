@@ -27,6 +27,7 @@ from .. import validation
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
+from .restart import RestartOutput, load_restart, restart_folder, restore
 from .state import State
 from .stepping import run_step
 from .summary import AnalysisSummary
@@ -67,7 +68,8 @@ class Analysis:
 
     def __init__(self, model, out="results", convergence: Convergence | None = None, progress: bool = True,
                  cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
-                 extrapolate: bool = False, on_frame=None, tangent: str = "full", observers=()):
+                 extrapolate: bool = False, on_frame=None, tangent: str = "full", observers=(), restart=None,
+                 restart_every: int | None = None):
         self.model = model
         self.on_frame = on_frame
         self.out = out
@@ -94,6 +96,13 @@ class Analysis:
         self.state = State.initial(self.system.X0, self.families)
         self.output = ResultsOutput(out, [on_frame])
         self.observers = [self.output, *observers]
+        # restart (issue 16, restart.py): save a restart point every n increments; continue from one
+        self.restart = restart_folder(out, restart)
+        self.resume = None
+        if restart_every is not None:
+            self.observers.append(RestartOutput(validation.whole(restart_every, "restart_every", minimum=1)))
+        elif self.restart is not None:   # a restarted run goes on saving restart points
+            self.observers.append(RestartOutput(None))
 
     # ------------------------------------------------------------ the parts, by their usual names
     @property
@@ -190,17 +199,26 @@ class Analysis:
         t0 = _time.perf_counter()
         ti = None
         try:
+            first = 0
+            if self.restart is not None:
+                self.resume = load_restart(self.restart, self)   # None: the point is the start
+                if self.resume is not None:
+                    restore(self, self.resume)
+                    first = self.resume["step"] + (1 if self.resume["step_done"] else 0)
             for obs in self.observers:
                 obs.started(self)
             ti = _time.perf_counter()
             for k, step in enumerate(self.model.steps):
+                if k < first:
+                    continue
                 self._state.step = k
                 if getattr(step, "kind", "static") == "frequency":   # modes of the state (issue 18)
                     from ..frequency_step import run_frequency_step
 
                     run_frequency_step(self, step)
                 else:
-                    run_step(self, step)
+                    inside = self.resume is not None and k == self.resume["step"] and not self.resume["step_done"]
+                    run_step(self, step, resume=self.resume if inside else None)
             self.summary.status, self.summary.completed = "completed", True
         except BaseException as exc:   # the summary says how the run ended (issue 16), then the error goes on
             self.summary.status, self.summary.message = run_outcome(exc)
