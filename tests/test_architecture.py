@@ -54,6 +54,21 @@ def test_state_saves_and_loads_bit_for_bit(tmp_path):
     assert not back.equal(st)
 
 
+def test_a_loaded_state_replaces_the_analysis_state_and_its_cached_responses(tmp_path):
+    m, c = _frame(steps=2)
+    an = Analysis(m, None, progress=False, on_frame=lambda fr: None)
+    an.run()
+    p = tmp_path / "s.npz"
+    an.state.save(p)
+    other = Analysis(m, None, progress=False, on_frame=lambda fr: None)   # at the initial state
+    other.system.last_converged = an.system.last_converged                 # a stale cache...
+    other.state = State.load(p)                                             # ...is dropped
+    assert other.system.state is other.state and other.system.last_converged is None
+    np.testing.assert_array_equal(other.x, an.x)
+    # the same tangent from the loaded state as from the analysis that produced it
+    np.testing.assert_array_equal(other.tangent().toarray(), an.tangent().toarray())
+
+
 def test_state_load_rejects_a_foreign_file(tmp_path):
     p = tmp_path / "other.npz"
     np.savez(p, x=np.zeros(3))

@@ -111,8 +111,11 @@ class Analysis:
 
     @state.setter
     def state(self, state: State):
+        """Replace the state (e.g. by one read with :meth:`State.load`): the system follows it and
+        forgets the responses it kept of the old one's last converged configuration."""
         self._state = state
         self.system.state = state
+        self.system.last_converged = None
 
     X0 = property(lambda self: self.system.X0)
     dofmap = property(lambda self: self.system.dofmap)
