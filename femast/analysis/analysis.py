@@ -24,6 +24,7 @@ from ..errors import ConvergenceError, ModelError, SingularModelError
 from ..results import Results, run_outcome
 from ..solvers.convergence import Convergence
 from .. import validation
+from ..thermal import FieldLoads, check_controls, has_fields
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
@@ -91,6 +92,9 @@ class Analysis:
         for s in model.steps:   # (again: a step's fields may have been set after model.step(); issue 16)
             validation.step_increments(s)
         self.families = build_families(model)
+        check_controls(model)
+        # length errors and temperatures (issue 20): None when the model has neither
+        self.fields = FieldLoads(model, self.families) if has_fields(model) else None
         self.summary = AnalysisSummary()
         self.system = System(model, self.families, self.summary)
         self.state = State.initial(self.system.X0, self.families)
