@@ -129,7 +129,7 @@ def test_malformed_data_file(name, experiment, content, message, tmp_path):
 ARRAY_CASES = [
     ("lengths-differ", dict(x_mm=np.arange(12.0), dT_N=np.arange(11.0)), r"different lengths"),
     ("nan", dict(x_mm=np.arange(12.0), dT_N=np.r_[np.arange(11.0), np.nan]), r"row 11, column 'dT_N'"),
-    ("constant", dict(x_mm=np.arange(12.0), dT_N=np.full(12, 2.0)), r"column 'dT_N' has the same value"),
+    ("inf", dict(x_mm=np.arange(12.0), dT_N=np.r_[np.inf, np.arange(11.0)]), r"row 0, column 'dT_N'"),
     ("huge", dict(x_mm=np.arange(12.0) * 1e16, dT_N=np.arange(12.0)), r"column 'x_mm': 1e\+16 mm is beyond"),
 ]
 

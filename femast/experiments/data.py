@@ -57,9 +57,11 @@ def _separator_error(path, line, text, exp):
     return None
 
 
-def check_values(exp: Experiment, cols: dict, path: str, lines) -> None:
-    """Plausibility of the values of a data set (see the module docstring): magnitudes, all-zero or
-    constant measured channels (errors), consecutive duplicated rows (a :class:`DataWarning`)."""
+def check_values(exp: Experiment, cols: dict, path: str, lines, measured: bool = True) -> None:
+    """Plausibility of the values of a data set (see the module docstring): magnitudes; for
+    ``measured`` data (a file) also all-zero or constant measured channels (errors) and consecutive
+    duplicated rows (a :class:`DataWarning`).  Arrays built in code (:func:`from_arrays`, e.g. an
+    experiment's model-side placeholders) get the magnitude check only."""
     for name, a in cols.items():
         big = np.flatnonzero(np.abs(a) > MAX_VALUE)
         if big.size:
@@ -67,6 +69,8 @@ def check_values(exp: Experiment, cols: dict, path: str, lines) -> None:
             unit = exp.column(name).unit
             raise DataFileError(f"{path} line {lines[i]}, column '{name}': {a[i]:g} {unit} is beyond {MAX_VALUE:g} "
                                 f"{unit}, not a plausible measurement (a corrupt cell?); fix or remove the row")
+    if not measured:
+        return
     for name in exp.channels:
         if name not in cols or cols[name].size == 0:
             continue
@@ -215,7 +219,7 @@ def from_arrays(exp: Experiment, **columns) -> Measured:
     n = next(iter(sizes.values()))
     if n < exp.min_rows:
         raise DataFileError(f"<arrays>: {n} rows; {exp.name} needs at least {exp.min_rows}")
-    check_values(exp, arrs, "<arrays>", np.arange(n))
+    check_values(exp, arrs, "<arrays>", np.arange(n), measured=False)
     return Measured(exp.name, arrs)
 
 
