@@ -76,8 +76,8 @@ def _render(args):
     else:
         frame = len(res) - 1 if args.frame == "last" else args.frame
         if not -len(res) <= frame < len(res):
-            raise FemastError(f"--frame {frame}: {args.results} has {len(res)} frames (0 to {len(res) - 1}); give "
-                              "a frame in that range, 'last' or 'max'")
+            raise FemastError(f"--frame {frame}: frame {frame} does not exist; {args.results} has {len(res)} frames "
+                              f"(0 to {len(res) - 1}); give a frame in that range, 'last' or 'max'")
         frame = range(len(res))[frame]
         why = f"frame {frame} of {len(res)}"
     name = f"{Path(args.results).resolve().name}_frame{frame}.png"
