@@ -157,6 +157,20 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
     ax.legend(fontsize=7)
 
 
+def noise_covariates(data: Measured, params: dict, options: dict, fit=None) -> dict:
+    """What the force noise grows with (issue 14): the slope |d dT / dx| (N/m) of the fitted law's
+    branch in the direction of motion at each sample.  Eq. 15 removes the cable stretch T L / EA
+    from the measured distance, so the load-cell noise enters x as well, and a noise dx in x shows
+    in the force as (d dT / dx) dx: the noise is largest on the steep latching branch."""
+    prep = prepared(data, _prepare, options)
+    p = np.array([float(params[n]) for n in ("r", "x_backstop", "k", "mu")] + [float(options["h_m"]),
+                                                                              float(options["R_m"])])
+    x = np.maximum(prep["x"], -p[1])
+    direction = np.where(prep["sigma"] > 0, UNLATCHING, LATCHING)
+    _, slope = latch_force(x, direction, p, derivative=True)
+    return {"dT_N": {"slope of the latch law (Eq. 15 puts the load-cell noise into x)": np.abs(slope)}}
+
+
 EXPERIMENT = Experiment(
     name="latch-pull",
     title="latch pull test (seed 001 Eqs. 12-15)",
@@ -184,6 +198,7 @@ EXPERIMENT = Experiment(
     load_label="dT (N)",
     extra_segments=extra_segments,
     plot_measured=plot_measured,
+    noise_covariates=noise_covariates,
     error_unit="N",
     min_rows=10,
     source="latch-pull",
