@@ -132,7 +132,7 @@ def test_no_header_duplicate_column_time_backwards_missing_file(tmp_path):
 def test_latch_pull_bad_column_lists_the_latch_columns(tmp_path):
     p = _write(tmp_path, ["x_m,dT_N"] + [f"{i},{i}" for i in range(12)])
     with pytest.raises(DataFileError, match=r"column 'x_m' is not a latch-pull column \(did you mean 'x_mm'\?\); "
-                                            r"accepted columns: x_mm, dT_N, t_s \(optional\)"):
+                                            r"accepted columns: x_mm, dT_N, side \(optional\), t_s \(optional\)"):
         read_data(get_experiment("latch-pull"), p)
 
 

@@ -78,12 +78,15 @@ class Column:
 
     unit : the unit of the values in the file.  doc : what is measured, frame and sign.
     required : False for optional columns (missing means "not measured").
+    codes : ``((text, value), ...)`` words a data file may write instead of the number (e.g. the
+        loaded side of a latch pull test, ``("out", 1.0), ("in", -1.0)``); values are stored as floats.
     """
 
     name: str
     unit: str
     doc: str = ""
     required: bool = True
+    codes: tuple = ()
 
 
 #: Optional time column accepted by every experiment (s); without it time is the row index.

@@ -8,7 +8,9 @@ Format
   included (``fx_N``, ``x_mm``), in any order.  Every required column must be present, an
   optional column may be, and no other column is accepted.  ``t_s`` (time, s) is accepted
   by every experiment.
-* Each further line is one sample, rows in time order, one finite decimal number per column.
+* Each further line is one sample, rows in time order, one finite decimal number per column
+  (a column with ``codes`` also accepts its words, e.g. ``out`` / ``in`` for the loaded side of a
+  latch pull test).
 
 Every error is a :class:`~femast.errors.DataFileError` naming the file, the line and the
 column, and listing the accepted values.
@@ -107,12 +109,14 @@ def read_data(exp: Experiment, path) -> Measured:
         for c, text in enumerate(cells):
             col = exp.column(header[c])
             s = text.strip()
+            codes = dict((t.lower(), v) for t, v in col.codes)
             try:
-                v = float(s)
+                v = codes[s.lower()] if s.lower() in codes else float(s)
             except ValueError:
                 what = "an empty cell" if not s else f"'{s}' is not a number"
+                words = f" or one of {', '.join(t for t, _ in col.codes)}" if col.codes else ""
                 raise DataFileError(f"{path} line {line}, column '{header[c]}': {what}; every cell must be a "
-                                    f"decimal number in {col.unit}") from None
+                                    f"decimal number in {col.unit}{words}") from None
             if not math.isfinite(v):
                 raise DataFileError(f"{path} line {line}, column '{header[c]}': {s} is not a finite number; "
                                     f"every cell must be a finite decimal number in {col.unit} "

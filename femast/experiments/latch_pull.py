@@ -8,32 +8,52 @@ column  unit  meaning
 x_mm    mm    bead position, cable stretch removed (seed 001 Eq. 15), positive outside the latch
               ("distance to latch" of seed 001 Figs. 6 and 10; the backstop is at -x_backstop)
 dT_N    N     force jump across the latch ``dT = T2 - T1`` (Eq. 5; > 0 pulls the bead out)
+side    -     optional: the loaded cable of the pass, ``out`` (or +1: the outer cable pulls, the
+              unlatching rig, ``dT >= 0``) or ``in`` (or -1: the inner cable through the backstop
+              pulls, the latching rig, ``dT <= 0``)
 t_s     s     optional time
 ======  ====  =================================================================================
 
-Rows are in time order; a file may hold several latching and unlatching passes and holds
-against the backstop.  The direction of motion of the bead is taken from the x path: a
-reversal is confirmed when x moves back by more than ``max(5 noise, 5 % of its range)`` (or the
-``turn_threshold_m`` option); the bead counts as possibly at rest until it has moved
-``max(3 noise, 1 % of the range)`` from the turning point.
+Rows are in time order; a file may hold several latching and unlatching passes, partial passes
+reversed part-way, and holds against the backstop.  The direction of motion of the loaded
+cable's grip is taken from the x path: a reversal is confirmed when x moves back by more than
+``max(5 noise, 5 % of its range)`` (or the ``turn_threshold_m`` option); the bead counts as
+possibly at rest within ``max(3 noise, 1 % of the range)`` of the turning point.
+
+The loaded side is a property of the test pass, not of the direction of motion (seed 001 Sec.
+III.B: "only two diagonally opposed cables were loaded at a time, leaving the cable on the other
+side of the latch slack").  Without a ``side`` column it is inferred from the sign of dT
+(:func:`infer_side`): each row with ``|dT|`` above 5 noise names its side, and a change of side is
+placed at the farthest point the old pass reached (outermost x after an outer-cable pass,
+innermost after an inner-cable one).
 
 Baseline model
 --------------
 The latch law of seed 001 Eqs. 12-14 (:mod:`femast.latch`) with ``r``, ``x_backstop``, ``k``,
 ``mu`` fitted and ``h``, ``R`` options (measured; defaults 1.5 mm and 2.4 mm as in the seed).
-Each sample is compared with the nearest state the law allows (as in
-:mod:`femast.latch_identification`):
+Each sample is compared with the nearest state the law allows along the path
+(:func:`admissible_band`):
 
-* moving bead: the branch of Eq. 14 in the direction of motion, ``dT_in(x)`` latching,
-  ``dT_out(x)`` unlatching (clipped to the sign the pulling cable can give when the option
-  ``one_sided`` is True, the seed's rig);
-* bead at rest just after a reversal: any ``dT`` in the static band ``[dT_in(x), dT_out(x)]``;
-* bead on the backstop: any ``dT <= dT_out(-x_backstop)``; a sample off the backstop by ``dx``
-  counts ``backstop_N_per_m * dx`` of error (default 5e4 N/m = 0.5 N per 0.01 mm, the ratio of the
-  force and position noise of the seed's rig).
+* loaded cable taut, bead moving: the branch of Eq. 14 in the direction of motion, ``dT_in(x)``
+  moving in, ``dT_out(x)`` moving out -- whichever the loaded cable is.  An outer cable reversed
+  behind the roller axis (zone (b)) holds the bead back on the latching branch ``dT_in > 0``; an
+  inner cable reversed in front of ``x = mu y`` (zone (c)) holds it on ``dT_out < 0``;
+* with ``one_sided`` (the seed's rig, default) the loaded cable can only pull: both branches are
+  clipped to its half-line (``dT >= 0`` outer, ``<= 0`` inner).  Where the cable would have to
+  push, it goes slack (``dT = 0``) and the bead is held by the rollers' static friction where it
+  stopped, or runs ahead of the cable to where it is held or onto the backstop; the cable takes
+  it up again when its grip comes back to the bead;
+* bead at rest just after a reversal: any ``dT`` in the static band ``[dT_in(x), dT_out(x)]``
+  (Eq. 9, third case), clipped to the loaded side;
+* bead on the backstop: any ``dT <= dT_out(-x_backstop)`` (clipped to the loaded side); a sample
+  off the backstop by ``dx`` counts ``backstop_N_per_m * dx`` of error (default 5e4 N/m = 0.5 N
+  per 0.01 mm, the ratio of the force and position noise of the seed's rig).
 
 The predicted ``dT_N`` is the force of that nearest admissible state, so ``dT_N - predicted`` is
-the error of the sample in N.
+the error of the sample in N.  The FE cable/latch element (:mod:`femast.elements.cable_latch`)
+solves the same law with the same stick/slip/slack states from the cable's geometry; see
+``docs/experiments.md`` (latch-pull) for how the two relate and the check of one partial-reversal
+path against an FE run.
 
 Hooks (where effects act)
 -------------------------
@@ -44,16 +64,69 @@ Hooks (where effects act)
   one-sided clipping (friction, latch hysteresis).
 
 Every hook call passes ``data``, ``options``, ``params`` and ``prep`` (``x`` m, ``dT`` N,
-``sigma`` (n,) direction +1 unlatching / -1 latching, ``rest`` (n,) bool, ``tau``).
+``sigma`` (n,) direction +1 out / -1 in, ``rest`` (n,) bool, ``side`` (n,) loaded side +1 outer /
+-1 inner cable, ``tau``).
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
+from ..errors import DataFileError
 from ..latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force, latch_zone
 from .core import Column, Experiment, Measured, Parameter, prepared
 from .residuals import noise_floor, turning_points
+
+
+SIDE_OUT = 1  # the outer cable (section 2) is loaded: unlatching rig, dT = T2 >= 0
+SIDE_IN = -1  # the inner cable (section 1, through the backstop) is loaded: latching rig, dT = -T1 <= 0
+
+
+def infer_side(x, dT, sigma=None) -> np.ndarray:
+    """Loaded side (+1 outer cable, -1 inner cable) of each row, inferred from the sign of dT.
+
+    x : bead positions (n,), m.  dT : force jumps (n,), N.  sigma : unused (kept for callers).
+    A one-sided rig can only give ``dT >= 0`` with the outer cable loaded and ``dT <= 0`` with
+    the inner one (seed 001 Sec. III.B), so every row with ``|dT|`` above 5 noise (the noise of dT
+    from its second differences) names its side.  Between the last decisive row of one sign and
+    the first of the other the loaded cable changes; the change is placed just after the farthest
+    point reached in the old pass's direction of pull (the outermost x when the outer cable was
+    loaded, the innermost when the inner one was), where the rig is turned round.  Rows before the
+    first decisive row take its side; without any decisive row every row is +1.
+    """
+    x = np.asarray(x, float)
+    dT = np.asarray(dT, float)
+    n = dT.size
+    thr = max(5.0 * noise_floor(dT), 1e-6 * float(np.max(np.abs(dT), initial=0.0)), 1e-9)
+    dec = np.flatnonzero(np.abs(dT) > thr)
+    side = np.full(n, SIDE_OUT, dtype=np.int64)
+    if dec.size == 0:
+        return side
+    sg = np.where(dT[dec] > 0, SIDE_OUT, SIDE_IN)
+    cur, start = int(sg[0]), 0
+    for a, b, sa, sb in zip(dec[:-1], dec[1:], sg[:-1], sg[1:]):
+        if sb == sa:
+            continue
+        seg = np.arange(a, b)  # rows a..b-1: the switch falls after one of them
+        k = int(seg[np.argmax(sa * x[seg])])
+        side[start:k + 1] = cur
+        cur, start = int(sb), k + 1
+    side[start:] = cur
+    return side
+
+
+def _side_column(data: Measured) -> np.ndarray | None:
+    if "side" not in data:
+        return None
+    s = data["side"]
+    bad = np.flatnonzero((s != SIDE_OUT) & (s != SIDE_IN))
+    if bad.size:
+        i = int(bad[0])
+        raise DataFileError(f"{data.path} line {int(data.lines[i])}, column 'side': {s[i]:g} is not a loaded side; "
+                            "write 'out' (or +1: outer cable loaded, unlatching rig) or 'in' (or -1: inner cable "
+                            "loaded, latching rig)")
+    return s.astype(np.int64)
 
 
 def _prepare(data: Measured, options: dict) -> dict:
@@ -67,13 +140,103 @@ def _prepare(data: Measured, options: dict) -> dict:
     tps, sigma = turning_points(x, float(h))
     h_rest = max(3.0 * sx, 0.01 * float(np.ptp(x)), 1e-9)
     rest = np.zeros(data.n, bool)
-    for t in [0, *tps]:
+    for t in [0, *tps]:  # the bead sticks while the grip turns: rows within h_rest of the turning point
         j = t
         while j < data.n and abs(x[j] - x[t]) <= h_rest:
             rest[j] = True
             j += 1
+        j = t - 1
+        while t > 0 and j >= 0 and abs(x[j] - x[t]) <= h_rest:
+            rest[j] = True
+            j -= 1
+    # position of the grip at its last turning point (row 0 before the first)
+    last = np.zeros(data.n, np.int64)
+    last[np.asarray(tps, dtype=np.int64)] = np.asarray(tps, dtype=np.int64)
+    x_turn = x[np.maximum.accumulate(last)]
+    side = _side_column(data)
+    side_given = side is not None
+    if side is None:
+        side = infer_side(x, dT)
     return {"x": x, "dT": dT, "sigma": sigma, "rest": rest, "tau": data.tau, "noise_x": sx, "turn_m": float(h),
-            "turning_points": tps}
+            "turning_points": tps, "side": side, "side_given": side_given, "rest_m": float(h_rest), "x_turn": x_turn}
+
+
+@njit(cache=True)
+def admissible_band(x, sigma, rest, side, D, one_sided, h_rest, x_stop, x_turn):
+    """Interval [lo, hi] (N) of the force jump each row admits off the backstop, following the bead.
+
+    x (n,) m, sigma (n,) direction of motion of the loaded cable's end (+1 out, -1 in), rest (n,)
+    bool (just after a reversal), side (n,) loaded side (+1 outer, -1 inner cable), D (n, 2) N the
+    branches [dT_in, dT_out] at x (Eq. 14 with effects), one_sided (the seed's rig), h_rest (m)
+    the position noise within which a slack cable may be taking up again, x_stop = -x_backstop (m),
+    x_turn (n,) m the position at the last turning point of the grip (the bead's when it stuck).
+
+    With the loaded cable taut the bead is at x: a moving bead gives the branch of its direction,
+    a bead at rest after a reversal any dT in the static band [dT_in, dT_out] (Eq. 9, third case).
+    The loaded cable can only pull (``side * dT >= 0``): both branches are clipped to that half-line.
+    A moving bead whose branch the cable would have to push (``side * D < 0``) leaves the cable:
+    the cable goes slack (dT = 0) and the bead stays where static friction holds it (parked at x_p,
+    the turning point where it stuck), or runs ahead of the cable to where it is held or onto the
+    backstop (x_p taken where the cable let go: on the way on to the bead the clipped law is 0).
+    The cable takes the bead again when its end comes back to x_p (within h_rest: any dT of the
+    band from 0 there, tension building at rest).  A change of side starts a new pass with the
+    new cable taut.  An outer cable whose grip goes on inwards behind the seated bead
+    (x <= x_stop) goes slack: the backstop holds the bead.
+    """
+    n = x.shape[0]
+    lo = np.empty(n)
+    hi = np.empty(n)
+    engaged = True
+    xp = 0.0
+    for i in range(n):
+        s = side[i]
+        if i > 0 and s != side[i - 1]:
+            engaged = True
+        a_in = D[i, 0]
+        a_out = D[i, 1]
+        if one_sided:
+            if s > 0:
+                a_in = max(a_in, 0.0)
+                a_out = max(a_out, 0.0)
+            else:
+                a_in = min(a_in, 0.0)
+                a_out = min(a_out, 0.0)
+        blo = min(a_in, a_out)
+        bhi = max(a_in, a_out)
+        if one_sided and not engaged:
+            gap = s * (x[i] - xp)  # > 0: the cable's end has come back past the parked bead
+            if gap > h_rest:
+                engaged = True
+            elif gap >= -h_rest:
+                lo[i] = min(blo, 0.0)
+                hi[i] = max(bhi, 0.0)
+                continue
+            else:
+                lo[i] = 0.0
+                hi[i] = 0.0
+                continue
+        if rest[i]:
+            lo[i] = blo
+            hi[i] = bhi
+            continue
+        v = D[i, 1] if sigma[i] > 0 else D[i, 0]
+        if one_sided and s > 0 and sigma[i] < 0 and x[i] <= x_stop:
+            # the outer cable follows its grip in behind the seated bead: slack, the backstop holds
+            engaged = False
+            xp = x_stop
+            lo[i] = 0.0
+            hi[i] = 0.0
+        elif one_sided and s * v < 0.0:
+            engaged = False
+            # grip moving against the pull: the bead stays where the cable held it at the turn;
+            # grip moving with the pull: the bead runs ahead of it from here
+            xp = x_turn[i] if s * sigma[i] < 0 else x[i]
+            lo[i] = 0.0
+            hi[i] = 0.0
+        else:
+            lo[i] = v
+            hi[i] = v
+    return lo, hi
 
 
 def model(params: dict, data: Measured, effects, options: dict) -> dict:
@@ -87,13 +250,15 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
     D = np.column_stack([latch_force(X, LATCHING, p), latch_force(X, UNLATCHING, p)])
     if effects:
         D = effects.apply("branch_force", D, x=X, **ctx)
-    if options["one_sided"]:
-        D = np.column_stack([np.minimum(D[:, 0], 0.0), np.maximum(D[:, 1], 0.0)])
-    Dn, hi_stop = D[:-1], D[-1, 1]
+    one = bool(options["one_sided"])
+    side = prep["side"]
+    lo, hi = admissible_band(x, prep["sigma"].astype(np.float64), prep["rest"], side,
+                             np.ascontiguousarray(D[:-1], dtype=np.float64), one, float(prep["rest_m"]), -xb,
+                             prep["x_turn"])
+    d_stop = D[-1, 1]
+    hi_stop = np.where(side > 0, max(d_stop, 0.0), min(d_stop, 0.0)) if one else np.full(x.size, d_stop)
     dT = prep["dT"]
-    r_curve = dT - np.where(prep["sigma"] > 0, Dn[:, 1], Dn[:, 0])
-    r_rest = dT - np.clip(dT, np.minimum(Dn[:, 0], Dn[:, 1]), np.maximum(Dn[:, 0], Dn[:, 1]))
-    r_curve = np.where(prep["rest"] & (np.abs(r_rest) < np.abs(r_curve)), r_rest, r_curve)
+    r_curve = dT - np.clip(dT, lo, hi)
     hx = (x + xb) * float(options["backstop_N_per_m"])
     over = dT - hi_stop
     r_stop = np.where(over > 0, np.where(hx >= 0, 1.0, -1.0) * np.hypot(hx, over), hx)
@@ -148,8 +313,12 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
     """dT against bead position, measured against model (seed 001 Fig. 10 style)."""
     prep = prepared(data, _prepare, options)
     up = prep["sigma"] > 0
-    ax.plot(data["x_mm"][up], data["dT_N"][up], ".", ms=2.5, color="C0", label="measured, unlatching")
-    ax.plot(data["x_mm"][~up], data["dT_N"][~up], ".", ms=2.5, color="C2", label="measured, latching")
+    out = prep["side"] > 0
+    for m, c, lab in ((up & out, "C0", "moving out"), (~up & out, "C2", "moving in"),
+                      (up & ~out, "C1", "moving out"), (~up & ~out, "C4", "moving in")):
+        if m.any():
+            ax.plot(data["x_mm"][m], data["dT_N"][m], ".", ms=2.5, color=c,
+                    label=f"measured, {'outer' if c in ('C0', 'C2') else 'inner'} cable, {lab}")
     ax.plot(data["x_mm"], predicted["dT_N"], "-", lw=1.0, color="C3", label="model (path order)")
     ax.set_xlabel("distance to latch x (mm)")
     ax.set_ylabel("dT (N)")
@@ -175,7 +344,10 @@ EXPERIMENT = Experiment(
     name="latch-pull",
     title="latch pull test (seed 001 Eqs. 12-15)",
     columns=(Column("x_mm", "mm", "bead position, cable stretch removed (Eq. 15), positive outside the latch"),
-             Column("dT_N", "N", "force jump across the latch T2 - T1 (Eq. 5)")),
+             Column("dT_N", "N", "force jump across the latch T2 - T1 (Eq. 5)"),
+             Column("side", "-", "optional loaded side of the pass: out (+1, outer cable pulls, unlatching rig) or "
+                    "in (-1, inner cable pulls, latching rig); default inferred from the sign of dT",
+                    required=False, codes=(("out", 1.0), ("in", -1.0)))),
     channels=("dT_N",),
     parameters=(
         Parameter("r", "m", 1.1e-3, 1e-5, 2e-2, "roller radius", scale=1e-3),
