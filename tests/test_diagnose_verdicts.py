@@ -110,3 +110,20 @@ def test_piecewise_linear_clearance_is_found_with_its_closing_scale():
     assert top["form"] == "smooth" and top["ratio"] <= d.at_noise
     # tanh(m / m_c) against clip(m / 20): the fitted closing scale is of the order of 20 N m
     assert 5.0 < top["params"]["m_c"]["value"] < 40.0
+
+
+@pytest.mark.slow
+def test_latch_pull_null_redraws_with_eq15_noise_and_a_small_friction():
+    from femast.experiments.synthetic import latch_pull_data
+
+    exp = get_experiment("latch-pull")
+    for seed in range(5):  # docs/experiments.md "Limits": 5 of 5 nothing missing
+        data, _ = latch_pull_data(seed=seed, noise_N=0.3, noise_mm=0.02)
+        d = diagnose(exp, data, workers=1)
+        assert d.verdict["kind"] == "nothing_missing", (seed, d.verdict["conclusion"])
+        assert d.noise_model["dT_N"].kind.startswith("heteroscedastic")
+    for seed in range(3):  # ... and a bead friction of 0.4 N claimed 3 of 3
+        data, _ = latch_pull_data(effects={"friction_hysteresis": {"F_f": 0.4}}, seed=seed, noise_N=0.3,
+                                  noise_mm=0.02)
+        d = diagnose(exp, data, workers=1)
+        assert d.verdict["missing_effects"] == ["friction_hysteresis"], (seed, d.verdict["conclusion"])
