@@ -102,7 +102,10 @@ def diagnose_figure(exp, data, result, png) -> Path:
     png = Path(png)
     f, ul = display_scale(exp.error_unit)
     entries = [("baseline", result.baseline["rms"], None, False)] + [
-        (r["effect"], r["rms"], r["delta_bic"], r["significant"]) for r in result.ranking]
+        (r["effect"] + (f" ({r['form']})" if r.get("form") else ""), r["rms"], r["delta_bic"], r["significant"])
+        for r in result.ranking] + [
+        (" + ".join(p["effects"]), p["rms"], p["delta_bic"], p["significant"]) for p in
+        (getattr(result, "pairs", None) or [])[:3]]
     fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(13, max(4.0, 0.45 * len(entries) + 2)),
                                    gridspec_kw={"width_ratios": [1, 1.3]})
     y = np.arange(len(entries))[::-1]
@@ -123,7 +126,8 @@ def diagnose_figure(exp, data, result, png) -> Path:
                "form_imperfect": f"mechanism found ({v.get('mechanism')}), form imperfect",
                "better_form": f"better form of {v.get('mechanism')}: {v.get('form')}",
                "nothing_missing": "nothing is missing"}.get(v.get("kind"), "none of the candidates explains this")
-    ax0.set_title(f"{exp.name}: refit with each candidate (green: significant)\nverdict: {verdict}", fontsize=10)
+    ax0.set_title(f"{exp.name}: refit with each candidate and pair (green: significant)\nverdict: {verdict}",
+                  fontsize=10)
     ax0.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     xmax = max(f * e[1] for e in entries)
     ax0.set_xlim(0, 1.35 * xmax)
