@@ -52,7 +52,7 @@ from .compare import analyse
 from .core import Experiment, Measured
 from .figures import diagnose_figure, display_scale
 from .fitting import fit, params_table
-from .noise import noise_model, with_correlation
+from .noise import noise_model
 from .residuals import AT_NOISE, at_noise_threshold
 from .verdict import MIN_SHARE, SIGNIFICANT_DBIC, conclude, flags, pair_candidates, score, share
 _START_METHOD = None  # multiprocessing start method of the local pool (None: the platform's default)
@@ -281,7 +281,7 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         jobs += jobs2
         fits_list = list(fits_list) + list(more)
     ok = [f for f in fits_list if not getattr(f, "failed", False)]
-    s0 = score(baseline, models, chans, data.n)
+    s0 = score(baseline, models, chans, data.n)  # under the noise model of the refits' weights
     r0, ic0 = s0["ratio"], s0["ic"]
     thr = at_noise_threshold(data.n, nch)
     a = analyse(exp, data, _with_noise(baseline, sigma))
@@ -303,28 +303,42 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
                 "success": bool(res.success), "at_bound": list(res.at_bound), "n_params": int(res.n_params),
                 "_z": sc["z"]}
 
-    by_effect, form_check, fits = {}, [], {}
-    for (stage, effect, spec, *_), res in zip(jobs, fits_list):
-        e = entry_of(effect, spec, res)
-        if stage == "form_check":
-            form_check.append({k: e[k] for k in ("effect", "form", "ratio", "delta_bic", "explained_fraction",
-                                                  "significant", "params")})
-            continue
-        by_effect.setdefault(effect, []).append((e, res))
-    ranking = []
-    for effect, items in by_effect.items():
-        good = [it for it in items if not it[0].get("failed")]
-        e, res = min(good, key=lambda it: it[0]["delta_bic"]) if good else items[0]
-        e["forms"] = [{"form": x["form"], "ratio": x["ratio"], "delta_bic": x["delta_bic"],
-                       "n_params": x.get("n_params", 0), **({"failed": True} if x.get("failed") else {})}
-                      for x, _ in items]
-        if not e.get("failed"):
-            e["reading"] = _reading(effect, e, s0["z"], e["_z"], a["masks"], nch, worst_kind, thr)
-        fits[effect] = res
-        ranking.append(e)
-    ranking.sort(key=lambda e: (e.get("failed", False), e["delta_bic"]))
+    def rank():
+        """(ranking, fits, form_check) of the refits under the current noise model."""
+        by_effect, fc, fts = {}, [], {}
+        for (stage, effect, spec, *_), res in zip(jobs, fits_list):
+            e = entry_of(effect, spec, res)
+            if stage == "form_check":
+                fc.append({k: e[k] for k in ("effect", "form", "ratio", "delta_bic", "explained_fraction",
+                                             "significant", "params")})
+            else:
+                by_effect.setdefault(effect, []).append((e, res))
+        out = []
+        for effect, items in by_effect.items():
+            good = [it for it in items if not it[0].get("failed")]
+            e, res = min(good, key=lambda it: it[0]["delta_bic"]) if good else items[0]
+            e["forms"] = [{"form": x["form"], "ratio": x["ratio"], "delta_bic": x["delta_bic"],
+                           "n_params": x.get("n_params", 0), **({"failed": True} if x.get("failed") else {})}
+                          for x, _ in items]
+            if not e.get("failed"):
+                e["reading"] = _reading(effect, e, s0["z"], e["_z"], a["masks"], nch, worst_kind, thr)
+            fts[effect] = res
+            out.append(e)
+        out.sort(key=lambda e: (e.get("failed", False), e["delta_bic"]))
+        return out, fts, fc
+
+    def pair_entry(x, y, res, by):
+        sc = score(res, models, chans, data.n)
+        d, frac = sc["ic"] - ic0, share(r0, sc["ratio"])
+        return {"effects": [x, y], "forms": [by[x]["form"], by[y]["form"]], "ratio": sc["ratio"],
+                "rms": float(res.rms), "delta_bic": float(d), "explained_fraction": frac, **flags(d, frac),
+                "gain_over_best_single": float(d - min(by[x]["delta_bic"], by[y]["delta_bic"])),
+                "share_over_best_single": float(frac - max(by[x]["explained_fraction"], by[y]["explained_fraction"])),
+                "_fit": res}
+
+    ranking, fits, form_check = rank()
     # pairs of the top candidates, fitted jointly, when no single one explains the data
-    pair_list = []
+    pair_fits = []
     top = pair_candidates(ranking)
     single_ok = ranking and ranking[0]["significant"] and ranking[0]["ratio"] <= thr
     if pairs and len(top) >= 2 and not single_ok and r0 > thr:
@@ -335,27 +349,13 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
             st = dict(start)
             for z in (x, y):
                 st.update({f"{by[z]['spec']}.{k}": v["value"] for k, v in by[z]["params"].items()})
-            pl.append({**payload0, "noise": sigma, "start": st, "effects": base_effects + [by[x]["spec"],
-                                                                                            by[y]["spec"]]})
+            pl.append({**payload0, "start": st, "effects": base_effects + [by[x]["spec"], by[y]["spec"]]})
         pfits, _ = _dispatch(exp, data, pl, start, sigma, workers, scheduler, t_base)
-        for (x, y), res in zip(combos, pfits):
-            if getattr(res, "failed", False):
-                continue
-            sc = score(res, models, chans, data.n)
-            d, frac = sc["ic"] - ic0, share(r0, sc["ratio"])
-            b1 = min(by[x]["delta_bic"], by[y]["delta_bic"])
-            r1 = min(by[x]["ratio"], by[y]["ratio"])
-            pair_list.append({"effects": [x, y], "forms": [by[x]["form"], by[y]["form"]], "ratio": sc["ratio"],
-                              "rms": float(res.rms), "delta_bic": float(d), "explained_fraction": frac,
-                              **flags(d, frac), "gain_over_best_single": float(d - b1),
-                              "share_over_best_single": float(share(r0, sc["ratio"]) - share(r0, r1)),
-                              "_fit": res})
-        pair_list.sort(key=lambda p: p["delta_bic"])
+        pair_fits = [(x, y, res) for (x, y), res in zip(combos, pfits) if not getattr(res, "failed", False)]
     # final noise model from the residual of the best model (femast.experiments.noise), everything rescored
-    best_res = min([baseline, *ok, *(p["_fit"] for p in pair_list)], key=lambda f: score(f, models, chans, data.n)["rss"])
+    cands = [baseline, *ok, *(res for *_, res in pair_fits)]
+    best_res = min(cands, key=lambda f: score(f, models, chans, data.n)["rss"])
     models = noise_model(exp, data, best_res)
-    if any(m.kind == "given" for m in models.values()):
-        models = {c: (models[c] if models[c].kind == "given" else m) for c, m in models.items()}
     sigma = {c: models[c].sigma for c in chans}
     s0 = score(baseline, models, chans, data.n)
     r0, ic0 = s0["ratio"], s0["ic"]
@@ -363,25 +363,9 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     thr = at_noise_threshold(int(round(n_eff)), nch)
     a = analyse(exp, data, _with_noise(baseline, sigma))
     worst_kind = a["by_kind"][0]["kind"] if a["by_kind"] else None
-    for e in ranking:
-        _rescore(e, fits[e["effect"]], models, chans, data.n, r0, ic0)
-        if not e.get("failed"):
-            e["reading"] = _reading(e["effect"], e, s0["z"], e["_z"], a["masks"], nch, worst_kind, thr)
-    ranking.sort(key=lambda e: (e.get("failed", False), e["delta_bic"]))
+    ranking, fits, form_check = rank()
     by = {e["effect"]: e for e in ranking}
-    for p in pair_list:
-        _rescore(p, p["_fit"], models, chans, data.n, r0, ic0)
-        x, y = p["effects"]
-        p["gain_over_best_single"] = float(p["delta_bic"] - min(by[x]["delta_bic"], by[y]["delta_bic"]))
-        p["share_over_best_single"] = float(p["explained_fraction"] - max(by[x]["explained_fraction"],
-                                                                           by[y]["explained_fraction"]))
-    pair_list.sort(key=lambda p: p["delta_bic"])
-    form_check = []
-    for (stage, effect, spec, *_), res in zip(jobs, fits_list):
-        if stage == "form_check":
-            e = entry_of(effect, spec, res)
-            form_check.append({k: e[k] for k in ("effect", "form", "ratio", "delta_bic", "explained_fraction",
-                                                  "significant", "params")})
+    pair_list = sorted((pair_entry(x, y, res, by) for x, y, res in pair_fits), key=lambda p: p["delta_bic"])
     best_e = next((e for e in ranking if e["significant"]), None)
     where = _remaining_where(a["masks"], best_e["_z"] if best_e else s0["z"], nch, thr)
     titles = {e["effect"]: get_effect(e["effect"]).title for e in ranking}
@@ -433,17 +417,6 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         report["files"] = result.files
         Path(result.files["json"]).write_text(json.dumps(report, indent=2))
     return result
-
-
-def _rescore(entry: dict, res, models, chans, n, r0, ic0) -> None:
-    """Update an entry's ratio, delta_bic, share and flags under the final noise model."""
-    if entry.get("failed") or getattr(res, "failed", False):
-        entry["ratio"], entry["baseline_ratio"] = r0, r0
-        return
-    sc = score(res, models, chans, n)
-    d, frac = sc["ic"] - ic0, share(r0, sc["ratio"])
-    entry.update(ratio=sc["ratio"], delta_bic=float(d), explained_fraction=frac, baseline_ratio=r0, _z=sc["z"],
-                 **flags(d, frac))
 
 
 def _form(spec: str, effect: str, key: str) -> str:
