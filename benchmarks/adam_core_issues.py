@@ -34,7 +34,7 @@ def issue_stabilize():
     s.prescribe(am.control, ux=0.0, uy=0.0, rz=0.0)
     an = fm.Analysis(am.model, tempfile.mkdtemp(), progress=False)
     res = an.run()
-    r = an._residual(an._evaluate(IncrementContext(x_committed=an.x, R_committed=an.R)), an.loads)
+    r = an.system.residual(an.system.evaluate(IncrementContext(x_committed=an.x, R_committed=an.R)), an.loads)
     print(f"1. Stabilize(): energy ratio {an.summary.steps[0]['stabilization_ratio']:.1e}, but the largest "
           f"residual force without the viscous term is {np.abs(r[:an.dofmap.n_free]).max():.0f} N and the "
           f"longerons carry {-res.frame(-1)['el/adam_longeron/section_forces'][0, 0, 0]:.0f} N instead of 192 N")

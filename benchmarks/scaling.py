@@ -108,13 +108,13 @@ def child(n_bays, n_inc, repeat, reps):
     an = run["analysis"]
     s = an.summary
     # the converged tangent, in isolation
-    responses = an._evaluate(None)
+    responses = an.system.evaluate(None)
     an.assembler.forces([q.f for q in responses])
     K, _ = an.assembler.tangent([q.k for q in responses])
     rhs = np.random.default_rng(0).normal(size=K.shape[0])
 
     def assemble():
-        resp = an._evaluate(None)
+        resp = an.system.evaluate(None)
         an.assembler.forces([q.f for q in resp])
         an.assembler.tangent([q.k for q in resp])
 

@@ -104,6 +104,7 @@ def main():
 
     fig.tight_layout()
     fig.savefig(out / "verification.png", dpi=110)
+    rows += modal_cases(out)
     table = v.format_table(rows)
     print(table)
     (out / "verification_table.txt").write_text(table + "\n")
@@ -111,6 +112,54 @@ def main():
     print(f"\n{len(rows) - n_bad} of {len(rows)} checks within tolerance; figures in {out}/verification.png, "
           f"VTK series {pvd}")
     return 1 if n_bad else 0
+
+
+def modal_cases(out):
+    """Issue 18: modal analysis against closed forms; figure modal_verification.png."""
+    from femast import verification_modal as vm
+
+    rows = []
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    r, modes = vm.taut_string()
+    rows += r
+    rows += vm.taut_string(cable=False)[0]
+    ax = axes[0]
+    order = np.argsort(modes.x[:, 0])
+    for k in (0, 2, 4):
+        ax.plot(modes.x[order, 0], modes.shapes[k, order, 1] + modes.shapes[k, order, 2],
+                label=f"f = {modes.frequencies[k]:.4f} Hz (exact {25 * (k // 2 + 1):.0f})")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("transverse mode shape (mass-normalised)")
+    ax.set_title("Taut string, T = 100 N, m' = 0.01 kg/m, 100 cables")
+    ax.legend(fontsize=8)
+    r, modes = vm.cantilever()
+    rows += r
+    ax = axes[1]
+    order = np.argsort(modes.x[:, 0])
+    for k in (0, 2, 4):
+        w = modes.shapes[k, order, 1] + modes.shapes[k, order, 2]
+        ax.plot(modes.x[order, 0], w / np.abs(w).max(), label=f"f = {modes.frequencies[k]:.5f} Hz")
+    ax.set_xlabel("x / L")
+    ax.set_title("Cantilever, EI = m = L = 1, 20 beams")
+    ax.legend(fontsize=8)
+    r, (ratios, f2, exact) = vm.pinned_beam_axial()
+    rows += r
+    ax = axes[2]
+    pp = np.linspace(-1.3, 1.0, 50)
+    ax.plot(pp, exact[ratios == 0][0] * (1 + pp), "k-", lw=1, label="f0^2 (1 + P/P_E)")
+    ax.plot(ratios, f2, "o", label="femast, 48 beams (sign(f) f^2)")
+    ax.axhline(0, color="0.6", lw=0.8)
+    ax.axvline(-1, color="0.6", lw=0.8, ls="--")
+    ax.set_xlabel("axial force P / P_E (tension > 0)")
+    ax.set_ylabel("f_1^2 (Hz^2)")
+    ax.set_title("Pin-ended beam under axial force")
+    ax.legend(fontsize=8)
+    rows += vm.rigid_body_springs()[0]
+    rows += vm.pendulum()[0]
+    fig.tight_layout()
+    fig.savefig(out / "modal_verification.png", dpi=110)
+    plt.close(fig)
+    return rows
 
 
 if __name__ == "__main__":

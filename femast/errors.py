@@ -23,3 +23,8 @@ class ConvergenceError(FemastError):
 
 class DataFileError(FemastError, ValueError):
     """A measured-data file is malformed."""
+
+
+class StateError(FemastError, ValueError):
+    """An analysis state cannot be used as asked (e.g. a modal analysis of a state that is not in
+    equilibrium)."""

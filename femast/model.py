@@ -59,6 +59,7 @@ class BeamSpec:
     section: Section
     up: np.ndarray
     family: str
+    mass_per_length: float | None = None   # kg/m; None: section.rho * section.A
 
 
 @dataclass
@@ -70,6 +71,7 @@ class TrussSpec:
     pretension: float | None
     tension_only: bool
     family: str
+    mass_per_length: float = 0.0   # kg/m (modal analyses, issue 18)
 
 
 @dataclass
@@ -183,6 +185,7 @@ class Model:
         self.rigid_bodies: list = []
         self.ties: list = []
         self.steps: list[Step] = []
+        self.point_masses: list = []   # femast.mass.PointMassSpec (modal analyses)
         self._next_element = 1
 
     # ---------------------------------------------------------------- nodes
@@ -233,10 +236,12 @@ class Model:
             raise ModelError(f"{where}: unknown node {label!r} ({hint}); create it with model.node(x, y, z)")
 
     # ------------------------------------------------------------- elements
-    def beam(self, n1, n2, section: Section, up=(0.0, 0.0, 1.0), n: int = 1, family: str = "beam") -> list[int]:
+    def beam(self, n1, n2, section: Section, up=(0.0, 0.0, 1.0), n: int = 1, family: str = "beam",
+             mass_per_length: float | None = None) -> list[int]:
         """Beam(s) from node ``n1`` to ``n2``, split into ``n`` equal elements (new nodes are
         created in between).  ``up`` (global vector) sets the local y axis: it is made
         orthogonal to the element; Iz resists bending in the plane of the axis and ``up``.
+        ``mass_per_length`` (kg/m) overrides the section's ``rho * A`` for modal analyses.
         Returns the element labels."""
         self._check_node(n1, "beam")
         self._check_node(n2, "beam")
@@ -255,19 +260,25 @@ class Model:
         if np.linalg.norm(up - (up @ e) * e) < 1e-6 * max(np.linalg.norm(up), 1e-300):
             raise ModelError(f"beam {n1}-{n2}: up-vector {tuple(up)} is parallel to the element axis "
                              f"{tuple(np.round(e, 6))}; choose an up-vector not along the beam")
+        if mass_per_length is not None:
+            mass_per_length = _finite(mass_per_length, f"beam {n1}-{n2}: mass_per_length")
+            if mass_per_length < 0:
+                raise ModelError(f"beam {n1}-{n2}: mass_per_length = {mass_per_length} kg/m must be >= 0")
         chain = [n1] + [self.node(*(a + (b - a) * k / n)) for k in range(1, n)] + [n2]
         labels = []
         for p, q in zip(chain[:-1], chain[1:]):
             labels.append(self._next_element)
-            self.beams.append(BeamSpec(self._next_element, (p, q), section, up, family))
+            self.beams.append(BeamSpec(self._next_element, (p, q), section, up, family, mass_per_length))
             self._next_element += 1
         return labels
 
     def truss(self, n1, n2, EA: float, L0: float | None = None, pretension: float | None = None,
-              tension_only: bool = False, family: str | None = None) -> int:
+              tension_only: bool = False, family: str | None = None, mass_per_length: float = 0.0) -> int:
         """Truss (or, with ``tension_only=True``, cable) from ``n1`` to ``n2``; EA in N.
         Give the unstretched length ``L0`` (m) or the ``pretension`` (N) it carries in the
-        initial geometry; neither means stress-free.  Returns the element label."""
+        initial geometry; neither means stress-free.  ``mass_per_length`` (kg/m of the initial
+        length; modal analyses): consistent mass for trusses, lumped at the ends for cables.
+        Returns the element label."""
         self._check_node(n1, "truss")
         self._check_node(n2, "truss")
         EA = _finite(EA, f"truss {n1}-{n2}: EA")
@@ -286,10 +297,13 @@ class Model:
             pretension = _finite(pretension, f"truss {n1}-{n2}: pretension")
             if pretension <= -EA:
                 raise ModelError(f"truss {n1}-{n2}: pretension {pretension} N <= -EA is impossible")
+        mass_per_length = _finite(mass_per_length, f"truss {n1}-{n2}: mass_per_length")
+        if mass_per_length < 0:
+            raise ModelError(f"truss {n1}-{n2}: mass_per_length = {mass_per_length} kg/m must be >= 0")
         label = self._next_element
         self._next_element += 1
         fam = family or ("cable" if tension_only else "truss")
-        self.trusses.append(TrussSpec(label, (n1, n2), EA, L0, pretension, bool(tension_only), fam))
+        self.trusses.append(TrussSpec(label, (n1, n2), EA, L0, pretension, bool(tension_only), fam, mass_per_length))
         return label
 
     def add_family(self, family):
@@ -321,10 +335,26 @@ class Model:
         self.fixed.setdefault(int(node), set()).update(idx)
 
     # ------------------------------------------------------------ constraints
-    def rigid_body(self, reference, nodes, name: str | None = None):
+    def point_mass(self, node, mass: float = 0.0, inertia=None, offset=None, name: str = ""):
+        """A mass ``mass`` (kg) with rotary ``inertia`` (kg m^2 about its centre of mass: a scalar,
+        3 principal values along the global axes or a 3x3 matrix, initial global axes) at
+        ``node``, its centre of mass ``offset`` (m) from the node (modal analyses, issue 18).
+        Returns the :class:`femast.mass.PointMassSpec`."""
+        from .mass import point_mass_spec
+
+        self._check_node(node, "point mass")
+        spec = point_mass_spec(node, mass, inertia, offset, name)
+        self.point_masses.append(spec)
+        return spec
+
+    def rigid_body(self, reference, nodes, name: str | None = None, mass: float = 0.0, inertia=None,
+                   centre=None):
         """Tie ``nodes`` rigidly to the ``reference`` node (exact for large rotations, as Abaqus
         *RIGID BODY with a REF NODE).  Load, fix or drive the reference node; the tied nodes
-        follow.  The reference node may be a node without elements (e.g. a control node)."""
+        follow.  The reference node may be a node without elements (e.g. a control node).
+        ``mass`` (kg) and ``inertia`` (kg m^2 about the centre of mass, see :meth:`point_mass`)
+        of the body, its centre of mass at ``centre`` (m, global; default the reference node),
+        are a point mass at the reference node."""
         from .constraints import RigidBodySpec
 
         name = name or f"rigid-{len(self.rigid_bodies) + 1}"
@@ -339,6 +369,9 @@ class Model:
         if len(set(int(n) for n in others)) != len(others):
             raise ModelError(f"rigid body '{name}': a node is listed twice")
         spec = RigidBodySpec(name, int(reference), tuple(int(n) for n in others))
+        if mass or inertia is not None:
+            off = None if centre is None else np.asarray(centre, float) - self.xyz(reference)
+            self.point_mass(reference, mass, inertia, off, name=f"rigid body '{name}'")
         self.rigid_bodies.append(spec)
         return spec
 
@@ -378,6 +411,14 @@ class Model:
                              ">= 1 (a frame every that many increments)")
         self.steps.append(s)
         return s
+
+    def frequency_step(self, name: str | None = None, n_modes: int = 10, shift_hz: float | None = None,
+                       vtk: bool = False):
+        """Append a step that computes the lowest ``n_modes`` vibration modes of the state reached so
+        far (prestress and loads included; see :mod:`femast.frequency_step`); returns it."""
+        from .frequency_step import add_frequency_step
+
+        return add_frequency_step(self, name, n_modes, shift_hz, vtk)
 
     def __repr__(self):
         return (f"Model({self.name!r}: {len(self._node_labels)} nodes, {len(self.beams)} beams, "

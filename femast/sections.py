@@ -33,6 +33,8 @@ class Section:
     Iy, Iz : second moments of area about local y and z, m^4.
     J : St Venant torsion constant, m^4.
     name : optional label used in messages and output.
+    rho : density, kg/m^3 (default 0: massless; only modal analyses use it, issue 18).  Give it
+        with ``sec.with_(rho=2700.0)``.
     """
 
     E: float
@@ -42,6 +44,7 @@ class Section:
     Iz: float
     J: float
     name: str = "section"
+    rho: float = 0.0
 
     def __post_init__(self):
         for field in ("E", "G", "A", "Iy", "Iz", "J"):
@@ -57,6 +60,13 @@ class Section:
                     f"section '{self.name}': property {field}={value!r} must be a finite positive number (SI units)"
                 )
             object.__setattr__(self, field, value)
+        try:
+            rho = float(self.rho)
+        except (TypeError, ValueError):
+            raise ModelError(f"section '{self.name}': density rho={self.rho!r} is not a number (kg/m^3)") from None
+        if not math.isfinite(rho) or rho < 0.0:
+            raise ModelError(f"section '{self.name}': density rho={self.rho!r} kg/m^3 must be finite and >= 0")
+        object.__setattr__(self, "rho", rho)
 
     @property
     def EA(self) -> float:

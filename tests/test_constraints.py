@@ -82,14 +82,14 @@ def test_reduced_tangent_with_rigid_body_matches_finite_differences():
 
     def residual(shift):
         x0, R0, s0 = an.x.copy(), an.R.copy(), an.spin.copy()
-        an._update(shift)
-        r = an._residual(an._evaluate(ctx), P)[:nf]
+        an.system.update(shift)
+        r = an.system.residual(an.system.evaluate(ctx), P)[:nf]
         an.x, an.R, an.spin = x0, R0, s0
         return r
 
-    resp = an._evaluate(ctx)
-    an._residual(resp, P)
-    K = an._tangent(resp, False)[0].toarray()
+    resp = an.system.evaluate(ctx)
+    an.system.residual(resp, P)
+    K = an.system.tangent(resp, False)[0].toarray()
     h = 1e-7
     Kfd = -np.column_stack([(residual(h * e) - residual(-h * e)) / (2 * h) for e in np.eye(nf)])
     assert np.abs(K - Kfd).max() <= 1e-6 * np.abs(K).max()  # FD truncation/roundoff ~1e-9 relative

@@ -20,7 +20,13 @@ def test_docs_example_runs_and_matches_its_printed_output():
     assert len(got) == len(expected)
     # every printed number must match; the last line is scipy's termination message, which
     # depends on the scipy version, so only its residual part is compared
-    assert got[:-1] == expected[:-1]
+    # an equilibrium residual at round-off (~1e-13 N) changes with the BLAS and the thread count:
+    # it is checked to be below 1e-9 N, not compared as text
+    resid = re.compile(r"residual (\S+) N")
+    for line in got[:-1]:
+        for v in resid.findall(line):
+            assert float(v) < 1e-9, line
+    assert [resid.sub("residual ~0 N", g) for g in got[:-1]] == [resid.sub("residual ~0 N", e) for e in expected[:-1]]
     assert got[-1].split(";")[0] == expected[-1].split(";")[0]
 
 

@@ -187,3 +187,28 @@ def test_side_column_words_and_errors(tmp_path):
     bad.write_text("x_mm,dT_N,side\n" + "0.1,1.0,1\n" * 12 + "0.1,1.0,0.5\n")
     with pytest.raises(DataFileError, match="line 14, column 'side'.*out.*in"):
         predict(EXP, read_data(EXP, bad), TRUE)
+
+
+def test_partial_reversal_matches_an_fe_run_of_one_cable_latch_element():
+    # Item 3: a femast Model with one cable/latch element (two sections, inner one slack), the outer
+    # grip driven out until the bead is at -0.8 mm and back behind its start.  The element solves the
+    # same law from the cable's geometry with its own stick/slip/backstop return mapping; the
+    # experiment sees only (Eq. 15 position, dT, side = out).
+    from latch_pull_partial import fe_partial_unlatching
+
+    from femast.elements.cable_latch import BACKSTOP, SLIP_IN, SLIP_OUT, STICK
+
+    fe = fe_partial_unlatching()
+    st = fe["status"]
+    # the FE path goes through every state the pull-test model distinguishes
+    assert {STICK, SLIP_OUT, SLIP_IN, BACKSTOP} <= set(np.unique(st).astype(int))
+    assert np.all(fe["T"][:, 0] == 0.0)  # inner section slack: a one-sided test
+    back = st == SLIP_IN
+    assert fe["dT"][back].min() > 20.0  # pulled back by the rollers, held by the taut outer cable
+    np.testing.assert_allclose(fe["x15"][fe["T"][:, 1] > 0], fe["x"][fe["T"][:, 1] > 0],
+                               atol=1e-12)  # Eq. 15 with the loaded length inverts Eq. 2 (round-off of 0.5 m)
+    data = from_arrays(EXP, x_mm=1e3 * fe["x15"], dT_N=fe["dT"], side=np.ones(fe["dT"].size))
+    pred = predict(EXP, data, TRUE)["dT_N"]
+    # the element solves the bead position to ~1e-12 m; times branch slopes up to 1.3e5 N/m that is
+    # ~1e-7 N: 1e-6 N leaves a 10x margin and still fails any branch or state error (>= 0.1 N)
+    np.testing.assert_allclose(pred, fe["dT"], rtol=0, atol=1e-6)

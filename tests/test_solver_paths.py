@@ -80,10 +80,10 @@ def test_direct_assembly_into_the_solver_matches_a_csr_tangent(tmp_path):
     assert an.solver.chosen == "rcm" and an.solver.analyses == 1   # ordering chosen at set-up
     an.run()
     assert an.solver.analyses == 1   # never re-analysed
-    resp = an._evaluate(None)
-    an._residual(resp, an.loads)
-    K, _ = an._tangent(resp, with_fc=False)
-    Kfc, none = an._factorize_tangent(resp, with_fc=False)
+    resp = an.system.evaluate(None)
+    an.system.residual(resp, an.loads)
+    K, _ = an.system.tangent(resp, with_fc=False)
+    Kfc, none = an.system.factorize_tangent(resp, with_fc=False)
     assert Kfc is None and none is None   # went straight into the solver's matrix
     rhs = np.random.default_rng(1).normal(size=K.shape[0])
     x_direct = an.solver.solve(rhs)

@@ -94,14 +94,14 @@ def test_damped_tangent_keeps_the_tangents_pattern_and_equals_scipys_sum():
     K = sp.random(6, 6, density=0.4, random_state=5, format="csr") + sp.eye(6, format="csr")
     K.data[::3] = 0.0                                   # explicit zeros, as early in a stabilised step
     c = rng.random(6)
-    D = an._plus_diagonal(K, c)
+    D = an.system.plus_diagonal(K, c)
     np.testing.assert_array_equal(D.toarray(), (K + sp.diags(c)).toarray())   # the same sums, same bits
     assert np.array_equal(D.indptr, K.indptr) and np.array_equal(D.indices, K.indices)  # zeros kept:
     assert D.nnz == K.nnz                                                                # one pattern
-    assert an._plus_diagonal(K, 2 * c) is D                                     # refilled in place
+    assert an.system.plus_diagonal(K, 2 * c) is D                                     # refilled in place
     np.testing.assert_array_equal(D.toarray(), (K + sp.diags(2 * c)).toarray())
     K2 = sp.csr_matrix(np.triu(np.ones((4, 4)), 1))     # no diagonal entries: scipy's sum
-    np.testing.assert_array_equal(an._plus_diagonal(K2, np.ones(4)).toarray(), np.triu(np.ones((4, 4)), 1) + np.eye(4))
+    np.testing.assert_array_equal(an.system.plus_diagonal(K2, np.ones(4)).toarray(), np.triu(np.ones((4, 4)), 1) + np.eye(4))
 
 
 def test_a_stabilised_adam_run_analyses_one_ordering():

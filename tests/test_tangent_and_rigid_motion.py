@@ -91,14 +91,14 @@ def test_assembled_tangent_matches_finite_difference_of_residual():
     an = Analysis(m, out=None or __import__("tempfile").mkdtemp(), progress=False)
     rng = np.random.default_rng(7)
     du = 0.05 * rng.normal(size=an.dofmap.n_free)
-    an._update(du)
+    an.system.update(du)
     K = an.tangent().toarray()
     ctx = IncrementContext()
 
     def internal(shift):
         x0, R0, s0 = an.x.copy(), an.R.copy(), an.spin.copy()
-        an._update(shift)
-        F = an.assembler.forces([r.f for r in an._evaluate(ctx)])[: an.dofmap.n_free]
+        an.system.update(shift)
+        F = an.assembler.forces([r.f for r in an.system.evaluate(ctx)])[: an.dofmap.n_free]
         an.x, an.R, an.spin = x0, R0, s0
         return F
 

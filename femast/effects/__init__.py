@@ -23,7 +23,7 @@ On the FE experiments (bay-torsion, tip-cycle) the effects change what the FE mo
 ``docs/experiments.md`` documents each one and shows how to register an effect from a script.
 """
 
-from . import joints, structure, cables, latch  # noqa: F401,I001  (register the built-in effects, in this order)
+from . import joints, structure, cables, latch, vibration  # noqa: F401,I001  (register the built-in effects, in this order)
 from .base import (Effect, Implementation, Parameter, add_implementation, applicable_effects, get_effect, list_effects,
                    load_script, loaded_scripts, register_effect, resolve, unregister_effect)
 from .operators import play, proportional_play

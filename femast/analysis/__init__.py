@@ -1,0 +1,23 @@
+"""The static analysis, in small parts with one job each (see docs/architecture.md).
+
+* :mod:`.analysis`: :class:`Analysis` (set-up and the run) and :func:`solve`;
+* :mod:`.system`: DOF numbering, constraints, assembly, linear solver (:class:`System`);
+* :mod:`.state`: everything an increment commits, with commit / rollback / save / load (:class:`State`);
+* :mod:`.newton`: the one Newton loop, for every control (:class:`Newton`, :class:`Increment`);
+* :mod:`.controls`: how each control strategy walks a step (increment plans);
+* :mod:`.stepping`: the step loop (increments, cutbacks, observers);
+* :mod:`.viscous`: the viscous term of a stabilised step;
+* :mod:`.output`: output as an observer (results writer, ``on_frame`` recorders);
+* :mod:`.families`, :mod:`.summary`: element families from a model; the run summary.
+"""
+
+from .analysis import Analysis, solve
+from .families import build_families
+from .newton import Increment, Newton, Outcome
+from .output import Observer, ResultsOutput
+from .state import State
+from .summary import AnalysisSummary, StabilizationWarning
+from .system import System
+
+__all__ = ["Analysis", "solve", "build_families", "Increment", "Newton", "Outcome", "Observer", "ResultsOutput",
+           "State", "AnalysisSummary", "StabilizationWarning", "System"]

@@ -1,0 +1,221 @@
+"""The static analysis: set-up, then the steps.
+
+``Analysis(model, out).run()`` builds the element families and the numbered system
+(system.py), starts from the initial :class:`State` (state.py) and walks the model's steps
+(stepping.py).  For each increment the step's control strategy (controls.py) proposes the load
+level, the Newton algorithm (newton.py) iterates with the exact tangent, and when the increment
+converges the state is committed and the observers (output.py: the results writer, the
+``on_frame`` recorders) are told.  A diverging increment is retried with a quarter of the
+increment (Abaqus' cutback); easy increments grow by 1.5.  If the increment falls below the
+minimum, the run stops with :class:`~femast.errors.ConvergenceError` saying where and why; every
+converged increment is already on disk.  See docs/architecture.md.
+"""
+
+from __future__ import annotations
+
+import time as _time
+import warnings
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from ..elements.base import DOF_NAMES
+from ..errors import ConvergenceError, ModelError, SingularModelError
+from ..results import Results
+from ..solvers.convergence import Convergence
+from .families import build_families
+from .newton import Newton
+from .output import ResultsOutput
+from .state import State
+from .stepping import run_step
+from .summary import AnalysisSummary
+from .system import System
+
+
+class Analysis:
+    """A static, geometrically nonlinear analysis of ``model`` writing to folder ``out``.
+
+    out : the results folder, or None to write nothing (no folder, frames or status file): each
+        frame then only goes to ``on_frame``, and :meth:`run` returns None.  For scripts and fits
+        that keep what they need in memory (an FE experiment's many short runs).
+
+    convergence : :class:`~femast.solvers.convergence.Convergence` (tolerances, max iterations).
+    progress : show a tqdm progress bar per step.
+    cutback : factor applied to a failed increment (Abaqus: 0.25).
+    growth : factor applied after two easy increments (Abaqus: 1.5).
+    line_search : secant line search when a Newton step overshoots (load control): True, False, or
+        "auto" (default): only when retrying an increment that failed, where plain Newton
+        already went astray (a line search slows the easy increments down).
+    tangent : "full" (default: a new tangent every iteration), "modified" (one per increment) or
+        "initial" (one per step): see :class:`~femast.analysis.newton.Newton`.
+    extrapolate : start each increment from the previous increment's solution scaled to the new
+        increment (Abaqus' default linear extrapolation); off after a step change.
+    easy_iterations : an increment converged in at most this many iterations is easy (Abaqus'
+        I_G = 4 with looser tolerances; 6 with femast's tighter defaults).
+    on_frame : a recorder, called with each frame's dict (the arrays written to
+        ``frames/NNNNNN.npz``; the first call is the initial state) as soon as its increment has
+        converged.  A script that needs a few quantities keeps them in memory this way instead of
+        reading the results folder back (which costs about as much as the analysis of a small
+        model).  Do not modify the arrays: the same ones are being written to disk.
+    observers : more observers of the run (:class:`~femast.analysis.output.Observer`).
+
+    After construction: ``state`` (:class:`State`: configuration, element states, loads...),
+    ``system`` (:class:`System`: numbering, assembly, linear solver), ``algorithm``
+    (:class:`Newton`), ``observers`` and ``summary`` (:class:`AnalysisSummary`).
+    """
+
+    def __init__(self, model, out="results", convergence: Convergence | None = None, progress: bool = True,
+                 cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
+                 extrapolate: bool = False, on_frame=None, tangent: str = "full", observers=()):
+        self.model = model
+        self.on_frame = on_frame
+        self.out = out
+        if out is None and on_frame is None:
+            warnings.warn("Analysis(out=None) without on_frame keeps no results: only the final state "
+                          "(Analysis.x, .R, .summary) remains", stacklevel=2)
+        self.convergence = convergence or Convergence()
+        self.progress = progress
+        self.cutback = cutback
+        self.growth = growth
+        self.easy_iterations = easy_iterations
+        self.line_search = line_search
+        self.extrapolate = extrapolate
+        self.algorithm = Newton(self.convergence, line_search=line_search, tangent=tangent)
+        if not model.steps:
+            raise ModelError(f"model '{model.name}' has no steps; add one with model.step()")
+        if not (model.beams or model.trusses or model.families):
+            raise ModelError(f"model '{model.name}' has no elements")
+        self.families = build_families(model)
+        self.summary = AnalysisSummary()
+        self.system = System(model, self.families, self.summary)
+        self.state = State.initial(self.system.X0, self.families)
+        self.output = ResultsOutput(out, [on_frame])
+        self.observers = [self.output, *observers]
+
+    # ------------------------------------------------------------ the parts, by their usual names
+    @property
+    def state(self) -> State:
+        return self._state
+
+    @state.setter
+    def state(self, state: State):
+        self._state = state
+        self.system.state = state
+
+    X0 = property(lambda self: self.system.X0)
+    dofmap = property(lambda self: self.system.dofmap)
+    assembler = property(lambda self: self.system.assembler)
+    constraints = property(lambda self: self.system.constraints)
+    solver = property(lambda self: self.system.solver)
+    length = property(lambda self: self.system.length)
+    is_rot = property(lambda self: self.system.is_rot)
+    fixed = property(lambda self: self.system.fixed)
+    free_node = property(lambda self: self.system.free_node)
+    free_dof = property(lambda self: self.system.free_dof)
+    act_node = property(lambda self: self.system.act_node)
+    act_dof = property(lambda self: self.system.act_dof)
+    # the committed state, read-only views by name
+    states = property(lambda self: self._state.families)
+    loads = property(lambda self: self._state.loads)
+    prescribed = property(lambda self: self._state.prescribed)
+    lam = property(lambda self: self._state.lam)
+    total_time = property(lambda self: self._state.total_time)
+    strain_energy = property(lambda self: self._state.strain_energy)
+
+    # the configuration (assignable: tests perturb and restore it)
+    def _set(name):
+        return property(lambda self: getattr(self._state, name), lambda self, v: setattr(self._state, name, v))
+
+    x, R, spin = _set("x"), _set("R"), _set("spin")
+    del _set
+
+    @property
+    def stabilization_ratio(self) -> float:
+        """Stabilisation energy dissipated in the current step / strain energy (dimensionless)."""
+        st = self._state
+        return st.stabilization_energy / st.strain_energy if st.strain_energy > 0 else (
+            0.0 if st.stabilization_energy == 0 else float("inf"))
+
+    def dof_value(self, idx, dof):
+        """Displacement (m) or accumulated rotation (rad) of DOF ``dof`` of node index ``idx``."""
+        return self.system.dof_value(idx, dof)
+
+    # ------------------------------------------------------------ tangent queries
+    def tangent(self):
+        """Tangent stiffness K_ff (scipy CSR, free DOFs) at the current configuration and
+        committed state; use :meth:`free_equation` to find a node's rows."""
+        sys_ = self.system
+        responses = sys_.evaluate(sys_.committed_context())
+        sys_.residual(responses, self._state.loads)
+        K, _ = sys_.tangent(responses, with_fc=False)
+        return K.copy()
+
+    def free_equation(self, label, dof) -> int:
+        """Equation number of a free DOF (dof index 0..5 or name); ModelError if not free."""
+        from ..model import dof_index
+
+        d = dof if isinstance(dof, (int, np.integer)) else dof_index(dof)
+        eq = int(self.dofmap.eq[self.model.index(label), d])
+        if not 0 <= eq < self.dofmap.n_free:
+            raise ModelError(f"node {label} {DOF_NAMES[d]} is not a free DOF (fixed, prescribed or unused)")
+        return eq
+
+    def condensed_stiffness(self, labels, dofs=range(6)):
+        """Stiffness (N/m, N, N m/rad) seen at ``dofs`` of nodes ``labels``: the current tangent
+        with every other free DOF condensed out (Schur complement).  Rows/columns ordered
+        node by node, DOF by DOF."""
+        import scipy.sparse.linalg as spla
+
+        K = self.tangent().tocsc()
+        keep = np.array([self.free_equation(l, d) for l in np.atleast_1d(labels) for d in dofs])
+        rest = np.setdiff1d(np.arange(K.shape[0]), keep)
+        Kaa = K[keep][:, keep].toarray()
+        if rest.size == 0:
+            return Kaa
+        Kab = K[keep][:, rest]
+        Kbb = K[rest][:, rest]
+        try:
+            lu = spla.splu(Kbb.tocsc())
+        except RuntimeError:
+            raise SingularModelError("condensed_stiffness: the model is singular once the retained DOFs are "
+                                     "held; it has a mechanism besides them") from None
+        return Kaa - Kab @ lu.solve(K[rest][:, keep].toarray())
+
+    # ------------------------------------------------------------ the run
+    def run(self) -> Results | None:
+        """Run all steps; returns the :class:`Results` of the folder, or None with ``out=None``."""
+        t0 = _time.perf_counter()
+        for obs in self.observers:
+            obs.started(self)
+        ti = _time.perf_counter()
+        try:
+            for k, step in enumerate(self.model.steps):
+                self._state.step = k
+                run_step(self, step)
+        except ConvergenceError as exc:
+            self.summary.completed = False
+            self.summary.message = str(exc)
+            for obs in self.observers:
+                obs.stopped(self)
+            raise
+        finally:
+            self.summary.increment_time = _time.perf_counter() - ti
+            self.summary.wall_time = _time.perf_counter() - t0
+            for obs in self.observers:
+                obs.finished(self)
+            if self.progress:
+                tqdm.write(str(self.summary))
+        return None if self.out is None else Results(self.out)
+
+    def kept(self) -> str:
+        """Where the converged increments of a run that gives up are (for its error message)."""
+        sparse = any(st.output_frequency > 1 for st in self.model.steps)
+        where = "passed to on_frame (out=None: nothing written)" if self.out is None else f"saved in '{self.out}'"
+        return where + (" at the steps' output frequency, the last one included" if sparse else "")
+
+
+def solve(model, out="results", **options) -> Results | None:
+    """Run all steps of ``model``; write results to folder ``out``; return :class:`Results` (None
+    with ``out=None``, see :class:`Analysis`).
+    Options are those of :class:`Analysis`."""
+    return Analysis(model, out, **options).run()

@@ -1,0 +1,274 @@
+"""The one incremental-iterative solution algorithm: Newton-Raphson, with its options.
+
+:meth:`Newton.solve` solves one increment for every control strategy.  The control (through the
+:class:`Increment` it proposes) supplies what differs between strategies:
+
+* the loads: fixed for the increment (load control), or ``P_start + lambda P_ref`` with the load
+  factor lambda an unknown (displacement control, arc length);
+* the predictor: nothing, a linear extrapolation of the previous increment, or the arc-length
+  tangent predictor (``predict``);
+* the constraint on the load factor: ``dlambda(du_r, du_p, Du)`` picks the load-factor correction
+  of every iteration from the two solutions K du_r = r and K du_p = P_ref;
+* the prescribed-value increment ``dpres`` and the viscous term of a stabilised step.
+
+Options of the algorithm: a secant line search (``line_search``) and the tangent update
+(``tangent``): ``"full"`` (a new tangent every iteration, the default), ``"modified"`` (one per
+increment attempt) or ``"initial"`` (one per step, formed again only where an increment needs its
+own: prescribed values or a viscous term).  Every Newton iteration: tangent (if due), solve,
+correct the load factor, update the configuration, evaluate the residual, test convergence.
+On convergence the state is committed, on failure rolled back (both one call).
+"""
+
+from __future__ import annotations
+
+import time as _time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..elements.base import IncrementContext
+from ..errors import ModelError, SingularModelError
+from ..solvers.convergence import Convergence
+
+
+@dataclass
+class Increment:
+    """One increment as a control strategy proposes it to :meth:`Newton.solve`.
+
+    time, dtime, total_time : step time at its end, its size and the analysis time at its end (s),
+    passed to the elements.  step_name : for messages.  lam : load factor at its start (load
+    control: its fixed value).  P : the loads (n, 6), N and N m, if fixed for the increment; else
+    ``P_start + lam * P_ref`` with P_ref the reference pattern (n, 6).  dpres : increment of the
+    constrained DOFs' values (prescribed displacements, rad for rotations), or None.
+    predictor : (du, dlam) added before the first iteration (linear extrapolation), or None.
+    predict : ``predict(du_p) -> dlam``, the tangent predictor of the load factor from
+    K du_p = P_ref (arc length), or None.  dlambda : ``dlambda(du_r, du_p, Du) -> dlam or None``,
+    the load-factor correction of an iteration (None: the constraint has no solution).
+    viscous : a :class:`~femast.analysis.viscous.ViscousTerm` (stabilised step), or None.
+    direct : assemble straight into the solver's matrix where possible (off for arc length, whose
+    verified results were computed through the CSR tangent; the two differ at round-off).
+    """
+
+    time: float
+    dtime: float
+    total_time: float
+    step_name: str
+    lam: float
+    P: np.ndarray | None = None
+    P_start: np.ndarray | None = None
+    P_ref: np.ndarray | None = None
+    dpres: np.ndarray | None = None
+    predictor: tuple | None = None
+    predict: object = None
+    dlambda: object = None
+    viscous: object = None
+    direct: bool = True
+
+    def loads(self, lam):
+        return self.P if self.P_ref is None else self.P_start + lam * self.P_ref
+
+
+@dataclass
+class Outcome:
+    """What :meth:`Newton.solve` did: ``ok``; ``iterations``; ``note`` (why it failed); the converged
+    element ``responses``; the converged increment ``Du`` (free DOFs) and load-factor change ``dlam``."""
+
+    ok: bool
+    iterations: int
+    note: str = ""
+    responses: list | None = None
+    Du: np.ndarray | None = None
+    dlam: float = 0.0
+
+
+class Newton:
+    """Newton-Raphson iterations on one increment (see module docstring).
+
+    convergence : :class:`~femast.solvers.convergence.Convergence`.
+    line_search : secant line search when a step overshoots (fixed loads only): True, False, or
+        "auto": only when retrying an increment that failed.
+    tangent : "full", "modified" or "initial" (see module docstring).
+    """
+
+    def __init__(self, convergence: Convergence | None = None, line_search="auto", tangent="full"):
+        if tangent not in ("full", "modified", "initial"):
+            raise ModelError(f"Newton: tangent='{tangent}' is not one of 'full', 'modified', 'initial'")
+        self.convergence = convergence or Convergence()
+        self.line_search = line_search
+        self.tangent = tangent
+        self.factorized = False   # a usable factorisation exists (modified / initial Newton)
+
+    def new_step(self):
+        """Called at the start of every step (the initial-stiffness tangent is formed again)."""
+        self.factorized = False
+
+    def _refactor(self, it, inc, has_dpres):
+        if self.tangent == "full" or not self.factorized:
+            return True
+        if self.tangent == "modified":
+            return it == 0
+        return it == 0 and (has_dpres or inc.viscous is not None)
+
+    def solve(self, system, state, inc: Increment, attempt: int = 1) -> Outcome:
+        """Solve increment ``inc`` from the committed ``state``: commit it and return
+        ``Outcome(ok=True, ...)``, or roll back and return why it failed."""
+        x0, R0 = state.checkpoint()
+        ctx = IncrementContext(time=inc.time, dtime=inc.dtime, total_time=inc.total_time, x_committed=x0,
+                               R_committed=R0, step_name=inc.step_name)
+        summary = system.summary
+        uses_lam = inc.P_ref is not None
+        lam = inc.lam
+        dpres = inc.dpres
+        has_dpres = dpres is not None and bool(np.any(dpres))
+        nf = system.n_free
+        Du = np.zeros(nf)
+        iters = 0
+        rnorm_hist = []
+        responses = None
+        visc = inc.viscous
+        dt = inc.dtime
+        line_search = self.line_search is True or (self.line_search == "auto" and attempt > 1)
+        conv = self.convergence
+
+        def fail(why):
+            state.rollback()
+            return Outcome(False, iters, why)
+
+        def evaluate(P, Dtrial=None, reuse=False):
+            ta = _time.perf_counter()
+            resp = system.evaluate(ctx, reuse=reuse)
+            res_ = system.residual(resp, P)
+            summary.assembly_time += _time.perf_counter() - ta
+            if not np.isfinite(res_).all():
+                raise FloatingPointError("non-finite residual")
+            r_ = res_[:nf]
+            if visc is not None and visc.C is not None:
+                r_ = r_ - visc.C / dt * (Du if Dtrial is None else Dtrial)
+            return resp, res_, r_
+
+        if inc.predictor is not None:
+            pdu, pdlam = inc.predictor
+            Du += pdu
+            system.update(pdu)
+            lam += pdlam if uses_lam else 0.0
+        lam_start = state.lam
+        try:
+            P = inc.loads(lam)
+            responses, F, r = evaluate(P, reuse=True)
+            for it in range(conv.max_iterations + 1):
+                if (it == 0 and not uses_lam and not has_dpres and not np.any(Du) and visc is None
+                        and state.at_equilibrium and np.array_equal(P, state.loads)):
+                    # nothing changes (e.g. a step that repeats the previous loads): the committed
+                    # state is the converged solution
+                    system.commit(responses, P, F, lam)
+                    return Outcome(True, 0, "", responses, Du, 0.0)
+                if it > 0:
+                    ok, ratio = system.converged(conv, r, du, Du, responses, P, iters)
+                    rnorm_hist.append(ratio)
+                    if ok:
+                        if visc is not None:
+                            visc.converged(state, Du, dt, responses)
+                        state.last_increment, state.last_size, state.last_dlam = Du.copy(), dt, lam - lam_start
+                        system.commit(responses, P, F, lam, equilibrium=visc is None)
+                        return Outcome(True, iters, "", responses, Du, lam - lam_start)
+                    if it == conv.max_iterations:
+                        return fail(f"no convergence in {iters} iterations "
+                                    f"(residual ratio {ratio:.3g}, worst at {system.worst(r)})")
+                    if it >= 8 and rnorm_hist[-1] > rnorm_hist[-2] > rnorm_hist[-3] > rnorm_hist[-4]:
+                        return fail(f"residual diverging (ratio {ratio:.3g}, worst at {system.worst(r)})")
+                # the tangent only when another iteration is needed
+                K = Kfc = None
+                with_fc = it == 0 and has_dpres
+                if self._refactor(it, inc, has_dpres):
+                    try:
+                        if visc is not None:
+                            K, Kfc = system.factorize_csr(responses, with_fc, adjust=lambda K_: visc.tangent(K_, dt))
+                        elif inc.direct:
+                            K, Kfc = system.factorize_tangent(responses, with_fc)
+                        else:
+                            K, Kfc = system.factorize_csr(responses, with_fc)
+                        self.factorized = True
+                    except SingularModelError:
+                        bad = system.nonfinite_tangent(responses)
+                        if bad:
+                            return fail(bad)
+                        if summary.increments == 0 and it == 0:
+                            if K is None:
+                                K, _ = system.tangent(responses, with_fc=False)
+                            raise SingularModelError(system.singular_message(K, f"step '{inc.step_name}'")) from None
+                        return fail("singular tangent (bifurcation or mechanism)")
+                elif with_fc:
+                    Kfc = system.assembler.coupling([q.k for q in responses])
+                ts = _time.perf_counter()
+                if it == 0 and inc.predict is not None:
+                    du_p = system.solver.solve(system.reduce_load(inc.P_ref))
+                    dlam = inc.predict(du_p)
+                    du = dlam * du_p
+                    lam += dlam
+                else:
+                    rhs = r if Kfc is None else r - Kfc @ dpres
+                    du = system.solver.solve(rhs)
+                    if uses_lam:
+                        du_p = system.solver.solve(system.reduce_load(inc.P_ref))
+                        dlam = inc.dlambda(du, du_p, Du)
+                        if dlam is None:
+                            summary.solve_time += _time.perf_counter() - ts
+                            return fail("arc-length constraint has no real root")
+                        du = du + dlam * du_p
+                        lam += dlam
+                summary.solve_time += _time.perf_counter() - ts
+                iters += 1
+                search = line_search and not uses_lam and not (it == 0 and has_dpres)
+                before = (state.x.copy(), state.R.copy(), state.spin.copy()) if search else None
+                system.update(du, dpres if it == 0 else None)
+                if uses_lam:  # under load control the loads are those of the increment's end
+                    P = inc.loads(lam)
+                Du_before = Du.copy()
+                Du += du
+                responses, F, r_new = evaluate(P)
+                if search:
+                    du, responses, F, r_new = line_search_step(system, state, du, r, r_new, responses, F, before,
+                                                               evaluate, P, Du_before)
+                    Du = Du_before + du
+                r = r_new
+        except (FloatingPointError, SingularModelError, ValueError) as exc:
+            bad = system.bad_tangent(exc, responses)
+            if bad:
+                return fail(bad)
+            if isinstance(exc, SingularModelError) and summary.increments == 0 and iters == 0:
+                raise
+            if isinstance(exc, ModelError):
+                raise
+            return fail(str(exc))
+        return fail("no convergence")
+
+
+def line_search_step(system, state, du, r0, r1, responses, F, before, evaluate, P, Du_before, eta=0.8,
+                     max_steps=5):
+    """Secant line search on g(s) = du . r(u + s du) (Crisfield 1991, sec. 9.3): only when the
+    full step leaves |g(1)| > eta |g(0)|.  Returns the accepted step and its evaluation (``F``: the
+    residual on the independent DOFs of the trial point, kept for the commit)."""
+    g0 = float(du @ r0)
+    g1 = float(du @ r1)
+    if g0 == 0.0 or abs(g1) <= eta * abs(g0):
+        return du, responses, F, r1
+    s_prev, g_prev, s, g = 0.0, g0, 1.0, g1
+    best = (abs(g1), 1.0, responses, F, r1)
+    for _ in range(max_steps):
+        s_new = s - g * (s - s_prev) / (g - g_prev) if g != g_prev else 0.5 * s
+        s_new = min(max(s_new, 0.05), 1.0)
+        state.x, state.R, state.spin = before[0].copy(), before[1].copy(), before[2].copy()
+        system.update(s_new * du)
+        resp, F_, r_ = evaluate(P, Du_before + s_new * du)
+        g_new = float(du @ r_)
+        if abs(g_new) < best[0]:
+            best = (abs(g_new), s_new, resp, F_, r_)
+        if abs(g_new) <= eta * abs(g0):
+            break
+        s_prev, g_prev, s, g = s, g, s_new, g_new
+    _, s_best, resp, F_, r_ = best
+    if s_best != s_new:
+        state.x, state.R, state.spin = before[0].copy(), before[1].copy(), before[2].copy()
+        system.update(s_best * du)
+    system.summary.line_searches += 1
+    return s_best * du, resp, F_, r_

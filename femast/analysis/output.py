@@ -1,0 +1,112 @@
+"""Output as an observer: the results writer and the ``on_frame`` recorders.
+
+The step loop (stepping.py) knows nothing of files.  It tells its observers what happened:
+
+* ``started(analysis)``: before the first step (the initial state);
+* ``cutback(analysis, step, increment, attempt, iterations, time, total_time, dtime, lam, note)``:
+  an attempt failed and is retried smaller;
+* ``converged(analysis, step, increment, attempt, iterations, time, dtime, last, responses, note)``:
+  an increment converged and is committed (``last``: the step's last increment);
+* ``stopped(analysis)``: the run gives up (after a :class:`~femast.errors.ConvergenceError`);
+* ``finished(analysis)``: the run is over, however it ended (the summary is final).
+
+An observer implements the methods it needs (:class:`Observer` has them all, doing nothing).
+:class:`ResultsOutput` is the one every analysis has: it builds a frame (the arrays of
+``frames/NNNNNN.npz``, femast/results.py) at the step's output frequency and hands it to the
+results writer and to every ``on_frame`` recorder.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..results import NullWriter, ResultsWriter
+from ..rotations import rotation_vectors
+
+
+class Observer:
+    """Does nothing on every event; subclass and override the events you need."""
+
+    def started(self, analysis):
+        pass
+
+    def cutback(self, analysis, step, increment, attempt, iterations, time, total_time, dtime, lam, note):
+        pass
+
+    def converged(self, analysis, step, increment, attempt, iterations, time, dtime, last, responses, note):
+        pass
+
+    def stopped(self, analysis):
+        pass
+
+    def finished(self, analysis):
+        pass
+
+
+class ResultsOutput(Observer):
+    """Frames and status lines of a run: to the results folder ``out`` (None: no folder) and to the
+    ``recorders`` (callables taking a frame dict; do not modify its arrays: they are being written)."""
+
+    def __init__(self, out, recorders=()):
+        self.out = out
+        self.recorders = [r for r in recorders if r is not None]
+        self.writer = None
+        self.pending = None   # a converged increment not written yet (Step.output_frequency)
+
+    @property
+    def active(self) -> bool:
+        """Whether frames go anywhere (a folder or a recorder)."""
+        return self.out is not None or bool(self.recorders)
+
+    def started(self, analysis):
+        self.writer = (NullWriter() if self.out is None
+                       else ResultsWriter(self.out, analysis.model, analysis.families))
+        self.pending = None
+        self.frame(analysis, step_name="initial", inc=0, time=0.0, iterations=0, responses=None)
+
+    def cutback(self, analysis, step, increment, attempt, iterations, time, total_time, dtime, lam, note):
+        self.writer.status(step.name, increment, attempt, iterations, time, total_time, dtime, lam,
+                           f"cutback: {note}")
+
+    def converged(self, analysis, step, increment, attempt, iterations, time, dtime, last, responses, note):
+        """Write the frame of increment ``increment`` if the step's output frequency asks for it or
+        it is the step's ``last``; else keep it pending.  Then the status line."""
+        frame = (step.name, increment, time, iterations, responses)
+        if last or increment % step.output_frequency == 0:
+            self.frame(analysis, *frame)
+            self.pending = None
+        else:
+            self.pending = frame
+        st = analysis.state
+        self.writer.status(step.name, increment, attempt, iterations, time, st.total_time, dtime, st.lam, note)
+
+    def stopped(self, analysis):
+        if self.pending is not None:   # the state is that of the last converged increment
+            self.frame(analysis, *self.pending)
+            self.pending = None
+
+    def finished(self, analysis):
+        if self.writer is not None:
+            self.writer.close({**analysis.summary.__dict__, "strain_energy": analysis.state.strain_energy})
+
+    def frame(self, analysis, step_name, inc, time, iterations, responses):
+        """Build the frame of the current (converged) state and hand it to the writer and recorders."""
+        if not self.active:
+            return
+        st, sys_ = analysis.state, analysis.system
+        n = len(sys_.X0)
+        RF = np.zeros((n, 6))
+        if responses is not None:
+            RF[sys_.cons_node, sys_.cons_dof] = st.reactions
+        data = {"step": step_name, "increment": inc, "time": time, "total_time": st.total_time,
+                "load_factor": st.lam, "iterations": iterations, "U": st.x - sys_.X0, "R": st.R.copy(),
+                "UR": rotation_vectors(st.R), "URA": st.spin.copy(), "RF": RF, "P": st.loads.copy(),
+                "strain_energy": st.strain_energy, "stabilization_energy": st.stabilization_energy}
+        if responses is None:
+            responses = sys_.evaluate(sys_.committed_context())
+        for f, r in zip(analysis.families, responses):
+            for key, val in r.output.items():
+                data[f"el/{f.name}/{key}"] = val
+        self.writer.frame(**data)
+        for record in self.recorders:
+            record(data)

@@ -1,0 +1,50 @@
+"""The step loop: one for every control strategy.
+
+For each step, the step's control strategy makes a plan (controls.py); the loop asks it for
+increments, has the algorithm (newton.py) solve each one, retries failed attempts smaller
+(cutbacks) and tells the observers (output.py) about every cutback and converged increment.
+"""
+
+from __future__ import annotations
+
+from ..solvers.control import LoadControl
+from .controls import plan_for
+
+
+def run_step(analysis, step):
+    """Walk ``step`` of ``analysis`` from its committed state to the step's end (or raise
+    :class:`~femast.errors.ConvergenceError` when an increment cannot be made small enough)."""
+    an, st, summary = analysis, analysis.state, analysis.summary
+    control = step.control or LoadControl()
+    control.setup(an, step)
+    plan = plan_for(an, step, control)
+    an.algorithm.new_step()
+    st.increment = 0
+    step_iters = 0
+    bar = plan.bar(disable=not an.progress)
+    try:
+        while not plan.done():
+            plan.next_increment()
+            attempt = 0
+            while True:
+                attempt += 1
+                out = an.algorithm.solve(an.system, st, plan.propose(attempt), attempt)
+                step_iters += out.iterations
+                summary.iterations += out.iterations
+                if out.ok:
+                    break
+                time, total_time, dtime, lam = plan.trial()
+                for obs in an.observers:
+                    obs.cutback(an, step, st.increment + 1, attempt, out.iterations, time, total_time, dtime, lam,
+                                out.note)
+                summary.cutbacks += 1
+                plan.cutback(out.note)
+            st.increment += 1
+            summary.increments += 1
+            time, dtime, last, note = plan.accept(out)
+            for obs in an.observers:
+                obs.converged(an, step, st.increment, attempt, out.iterations, time, dtime, last, out.responses, note)
+            plan.grow(out, bar)
+    finally:
+        bar.close()
+    summary.steps.append(plan.finish({"name": step.name, "increments": st.increment, "iterations": step_iters}))

@@ -1,0 +1,36 @@
+"""What a run did (:class:`AnalysisSummary`) and the warning of a stabilised step."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+class StabilizationWarning(UserWarning):
+    """The stabilisation energy of a step exceeds its warning ratio of the strain energy."""
+
+
+@dataclass
+class AnalysisSummary:
+    """What a run did: counts, wall time and where it stopped."""
+
+    completed: bool = True
+    increments: int = 0
+    iterations: int = 0
+    cutbacks: int = 0
+    line_searches: int = 0
+    wall_time: float = 0.0
+    # wall time in the steps' increments (s): the run without its results-folder set-up, initial
+    # frame, final drain of the writer and summary (per-run costs, not per-iteration ones)
+    increment_time: float = 0.0
+    assembly_time: float = 0.0
+    solve_time: float = 0.0
+    message: str = ""
+    steps: list = field(default_factory=list)
+
+    def __str__(self):
+        state = "completed" if self.completed else "STOPPED"
+        return (f"femast: analysis {state}: {self.increments} increments, {self.iterations} Newton iterations, "
+                f"{self.cutbacks} cutbacks, wall time {self.wall_time:.2f} s "
+                f"(assembly {self.assembly_time:.2f} s, linear solve {self.solve_time:.2f} s)"
+                + (f"\n  {self.message}" if self.message else ""))
+

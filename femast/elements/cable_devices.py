@@ -1,0 +1,376 @@
+"""A cable over an ordered list of devices: pulleys (frictionless or capstan, point or sized),
+latches, clamps and user devices (issue 19; seed 001 Sec. II.B.2, Eqs. 2-5).
+
+Seed 001 writes the cable element for a cable over any number of pulleys, latches or other
+devices, each with its own law for the jump ``Delta T_i = T_{i+1} - T_i``.  One element here is
+one cable of n sections between n + 1 nodes; ``devices[k]`` sits at interior node k + 1.  The
+equations and the stick/slip return mapping are in :mod:`._device_kernels`, the laws (and the
+contract a user law follows) in :mod:`._device_laws`, the geometry of sized pulleys in
+:mod:`._cable_geometry`; see ``docs/cable_devices.md``.
+
+State per element (``n_state = 2 (n - 1)``): the material coordinates S_k (m, unstretched
+length from node 0) of the cable at each device, then each device's mode (0 stick, +1 sliding
+with the out side pulling, -1 with the in side pulling, 2 at a stop, 3 frictionless).
+
+:class:`femast.elements.cable_latch.CableLatchFamily` (frictionless point pulleys and one latch)
+is unchanged; this family reproduces it (tests) and generalises it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from ..errors import ModelError
+from ..latch import LatchParameters, _as_param_array, validate_latch_array
+from ._cable_geometry import (GEO_ADJACENT_PULLEYS, GEO_INSIDE_PULLEY, GEO_NOT_FINITE, GEO_OK,
+                              GEO_PLANE_UNDEFINED, GEO_ZERO_LENGTH, cable_geometry)
+from ._device_kernels import ERR_ACTIVE_SET, ERR_SHORT, SLIDE_FREE, STOP, device_kernel, kernel_for_law
+from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, N_PARAM, USER, builtin_law
+from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput
+
+MODE_NAMES = {0: "stick", 1: "slide (out side pulls)", -1: "slide (in side pulls)", 2: "at stop", 3: "frictionless"}
+
+__all__ = ["Pulley", "Latch", "Clamp", "UserDevice", "CableDeviceFamily", "MODE_NAMES", "wrap_geometry"]
+
+
+@dataclass(frozen=True)
+class Pulley:
+    """A pulley at a node.  radius : m (0: a point pulley; > 0: the cable leaves on the tangent
+    points and wraps the pulley, see :mod:`._cable_geometry`).  mu : Coulomb friction coefficient
+    between cable and pulley (0: frictionless; > 0: capstan law ``exp(-mu phi) <= T_out/T_in <=
+    exp(mu phi)`` with the wrap angle phi from the current geometry)."""
+
+    radius: float = 0.0
+    mu: float = 0.0
+
+
+@dataclass(frozen=True)
+class Latch:
+    """A roller latch of seed 001 (Eqs. 5, 14) at a node; the bead is on the cable.
+
+    params : :class:`~femast.latch.LatchParameters` (default the seed's fit).
+    bead : material coordinate Lb of the bead, m (unstretched length from node 0); ``None`` with
+        :meth:`CableDeviceFamily.pretensioned` puts it at ``x0`` in the initial geometry.
+    x0 : initial bead position, m (default ``-x_backstop``: latched, on the backstop).
+    hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.latch` (N, m).
+    The section before the latch runs through the backstop (as in :class:`CableLatchFamily`)."""
+
+    params: LatchParameters | None = None
+    bead: float | None = None
+    x0: float | None = None
+    hysteresis_force: float = 0.0
+    hysteresis_length: float = 3e-4
+
+
+@dataclass(frozen=True)
+class Clamp:
+    """A clamp: the cable is fixed to the node (no sliding)."""
+
+
+@dataclass(frozen=True)
+class UserDevice:
+    """A device with a user law: a numba ``@njit`` function
+
+        law(sigma, T_in, T_out, s, phi, p) -> (r, dr/dT_in, dr/dT_out, dr/ds, dr/dphi)
+
+    (floats; N, m, rad) following the contract of :mod:`._device_laws`: r is the unbalanced force of
+    the branch on which the cable slides in direction sigma (+1: the out side pulls, ds < 0; -1: the
+    in side pulls); the device sticks while r(+1) <= 0 <= r(-1).  params : up to 10 floats, passed as
+    ``p``.  All user devices of one family share one law function (dispatch on ``p`` for several)."""
+
+    law: object
+    params: tuple = ()
+
+
+def _kind_and_params(dev, k, name):
+    p = np.zeros(N_PARAM)
+    if isinstance(dev, Pulley):
+        for what, v in (("radius", dev.radius), ("mu", dev.mu)):
+            if not (np.isfinite(v) and v >= 0.0):
+                raise ModelError(f"{name} device {k} (Pulley): {what} = {v!r} must be finite and >= 0 "
+                                 f"({'m' if what == 'radius' else 'friction coefficient'})")
+        if dev.mu > 0.0:
+            p[0] = dev.mu
+            return CAPSTAN, p, float(dev.radius)
+        return FREE, p, float(dev.radius)
+    if isinstance(dev, Latch):
+        arr = _as_param_array(dev.params)
+        validate_latch_array(arr, f"{name} device {k} (Latch)")
+        p[:6] = arr
+        p[7] = dev.hysteresis_force
+        p[8] = dev.hysteresis_length
+        if not (np.isfinite(p[7]) and p[7] >= 0.0 and np.isfinite(p[8]) and p[8] > 0.0):
+            raise ModelError(f"{name} device {k} (Latch): hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
+        return LATCH, p, 0.0
+    if isinstance(dev, Clamp):
+        return CLAMP, p, 0.0
+    if isinstance(dev, UserDevice):
+        q = np.asarray(dev.params, dtype=float).ravel()
+        if q.size > N_PARAM or not np.all(np.isfinite(q)):
+            raise ModelError(f"{name} device {k} (UserDevice): give at most {N_PARAM} finite parameters")
+        p[: q.size] = q
+        return USER, p, 0.0
+    raise ModelError(f"{name} device {k}: {dev!r} is not a device; use Pulley, Latch, Clamp or UserDevice")
+
+
+_COMBINED = {}
+
+
+def _combined_law(user):
+    """The built-in laws plus one user law, as one numba function (compiled on first use)."""
+    if user not in _COMBINED:
+        @njit
+        def law(kind, sigma, T_in, T_out, s, phi, p):
+            if kind == USER:
+                r, a, b, c, d = user(sigma, T_in, T_out, s, phi, p)
+                return float(r), float(a), float(b), float(c), float(d)
+            return builtin_law(kind, sigma, T_in, T_out, s, phi, p)
+
+        _COMBINED[user] = law
+    return _COMBINED[user]
+
+
+def _geometry(X, radius):
+    """Section lengths (n,) and wrap angles (n-1,) of one cable, with the geometry error code."""
+    nn = X.shape[0]
+    n = nn - 1
+    L = np.zeros(n)
+    G = np.zeros((n, 3 * nn))
+    H = np.zeros((1, 1, 1))
+    phi = np.zeros(max(n - 1, 1))
+    dphi = np.zeros((max(n - 1, 1), 3 * nn))
+    code, where = cable_geometry(np.ascontiguousarray(X, dtype=float), radius, False, L, G, H, phi, dphi)
+    return code, where, L, phi[: n - 1], G, dphi[: n - 1]
+
+
+def wrap_geometry(X, radius):
+    """Section lengths L (n,) in m, wrap angles phi (n-1,) in rad, and their gradients for one cable
+    with nodes X (n+1, 3) in m and pulley radii ``radius`` (n+1,) in m (0 at point devices and the
+    ends).  Raises :class:`ModelError` for an impossible geometry (a neighbour inside a pulley, ...)."""
+    X = np.asarray(X, dtype=float)
+    radius = np.ascontiguousarray(radius, dtype=float)
+    code, where, L, phi, G, dphi = _geometry(X, radius)
+    if code != GEO_OK:
+        raise ModelError(_geometry_message(code, where, "cable", np.arange(X.shape[0]), radius, X))
+    return L, phi, G, dphi
+
+
+def _geometry_message(code, where, name, nodes, radius, X):
+    if code == GEO_ZERO_LENGTH:
+        return (f"{name}: section {where} between nodes {nodes[where]} and {nodes[where + 1]} has zero length; "
+                "anchors and devices must not coincide")
+    if code == GEO_NOT_FINITE:
+        return f"{name}: node {nodes[where]} has non-finite coordinates"
+    if code == GEO_INSIDE_PULLEY:
+        k = where
+        pk = k + 1 if k + 1 < len(radius) and radius[k + 1] > 0 else k - 1
+        d = float(np.linalg.norm(X[k] - X[pk]))
+        return (f"{name}: node {nodes[k]} is {d:.6g} m from the centre of the pulley at node {nodes[pk]} of radius "
+                f"{radius[pk]:.6g} m: no tangent exists (impossible wrap angle). Move the node out of the pulley "
+                "or reduce the radius")
+    if code == GEO_PLANE_UNDEFINED:
+        return (f"{name}: the pulley of radius {radius[where]:.6g} m at node {nodes[where]} lies on the straight line "
+                f"through its neighbours {nodes[where - 1]} and {nodes[where + 1]}: the wrap plane is undefined. "
+                "Offset the pulley from that line or make it a point pulley (radius 0)")
+    if code == GEO_ADJACENT_PULLEYS:
+        return (f"{name}: sections {where} joins two pulleys of finite radius (nodes {nodes[where]} and "
+                f"{nodes[where + 1]}); put a point device between them or give one of them radius 0")
+    return f"{name}: geometry error {code}"  # pragma: no cover
+
+
+class CableDeviceFamily(ElementFamily):
+    """A batch of cables, each over the same ordered list of devices (module note).
+
+    Parameters
+    ----------
+    nodes : (n_el, n+1) int, node indices in cable order (anchor, devices, anchor).
+    EA : axial rigidity, N (scalar or per element).
+    L0 : total unstretched length, m (Eq. 4; scalar or per element).
+    devices : list of n-1 devices (:class:`Pulley`, :class:`Latch`, :class:`Clamp`,
+        :class:`UserDevice`), one per interior node, in cable order.
+    s0 : (n_el, n-1) or (n-1,) initial material coordinates of the cable at the devices, m
+        (needed where the cable is gripped: capstans, clamps, user devices; a latch's comes from
+        its bead: s = Lb - x0).  Use :meth:`pretensioned` to get them from a geometry.
+    name : label used in messages and results.
+    """
+
+    active_dofs = (0, 1, 2)
+    symmetric = False
+
+    def __init__(self, nodes, EA, L0, devices, *, s0=None, name: str = "cable_devices"):
+        self.name = name
+        nodes = np.asarray(nodes)
+        if nodes.ndim == 1:
+            nodes = nodes[None, :]
+        if nodes.ndim != 2 or nodes.shape[1] < 2 or not np.issubdtype(nodes.dtype, np.integer):
+            raise ModelError(f"{name}: nodes must be an (n_el, n+1) integer array with n+1 >= 2, got {nodes.shape}")
+        self.nodes = np.ascontiguousarray(nodes, dtype=np.int64)
+        n_el, nn = self.nodes.shape
+        n = nn - 1
+        self.n_sections = n
+        devices = list(devices)
+        if len(devices) != n - 1:
+            raise ModelError(
+                f"{name}: {len(devices)} devices given for a cable of {n} sections ({nn} nodes per element); "
+                f"give exactly one device per interior node ({n - 1}), in cable order")
+        self.devices = tuple(devices)
+        self.n_state = 2 * (n - 1)
+        self.EA = self._per_element(EA, "EA (N)")
+        self.L0 = self._per_element(L0, "L0 (m)")
+        for what, arr, unit in (("EA", self.EA, "N"), ("L0", self.L0, "m")):
+            bad = np.flatnonzero(~(np.isfinite(arr) & (arr > 0.0)))
+            if bad.size:
+                raise ModelError(f"{name} element {bad[0]}: {what} = {arr[bad[0]]!r} {unit} must be finite and > 0")
+        kinds, radius, P = [], np.zeros(nn), np.zeros((n_el, max(n - 1, 1), N_PARAM))
+        users = set()
+        for k, dev in enumerate(devices):
+            kind, p, r = _kind_and_params(dev, k, name)
+            kinds.append(kind)
+            radius[k + 1] = r
+            P[:, k] = p
+            if kind == USER:
+                users.add(dev.law)
+        if len(users) > 1:
+            raise ModelError(f"{name}: the user devices use {len(users)} different law functions; one family takes "
+                             "one user law (dispatch on the parameters p inside it)")
+        self.kinds = np.array(kinds if kinds else [FREE], dtype=np.int64)[: max(n - 1, 0)]
+        self.radius = radius
+        self.P = P
+        self._law = _combined_law(users.pop()) if users else None
+        # initial material coordinates
+        S0 = np.full((n_el, n - 1), np.nan)
+        if s0 is not None:
+            try:
+                S0[:] = np.broadcast_to(np.asarray(s0, dtype=float), (n_el, n - 1))
+            except ValueError:
+                raise ModelError(f"{name}: s0 must have shape (n_el, n-1) = ({n_el}, {n - 1}) or ({n - 1},), in m")
+        for k, dev in enumerate(devices):
+            if isinstance(dev, Latch):
+                x0 = -P[0, k, 1] if dev.x0 is None else float(dev.x0)
+                if dev.bead is None:
+                    if s0 is None:
+                        raise ModelError(f"{name} device {k} (Latch): give bead= (material coordinate of the bead, m) "
+                                         "or build with CableDeviceFamily.pretensioned")
+                    self.P[:, k, 6] = S0[:, k] + x0
+                else:
+                    self.P[:, k, 6] = dev.bead
+                    S0[:, k] = dev.bead - x0
+                if x0 < -P[0, k, 1] * (1 + 1e-12):
+                    raise ModelError(f"{name} device {k} (Latch): x0 = {x0!r} m is behind the backstop "
+                                     f"(x0 >= -x_backstop = {-P[0, k, 1]!r} m)")
+        need = [k for k, kd in enumerate(self.kinds) if kd != FREE]
+        for k in need:
+            if np.any(np.isnan(S0[:, k])):
+                raise ModelError(f"{name} device {k} ({type(devices[k]).__name__}) grips the cable: give s0 (the "
+                                 "material coordinate of the cable at the device, m) or build with "
+                                 "CableDeviceFamily.pretensioned(nodes, X, EA, T0, devices)")
+        # frictionless devices: a uniform share (a placeholder, the first evaluation replaces it)
+        cols = np.arange(1, n)[None, :]
+        S0 = np.where(np.isnan(S0), self.L0[:, None] * cols / n, S0)
+        full = np.column_stack([np.zeros(n_el), S0, self.L0])
+        bad = np.argwhere(~(np.diff(full, axis=1) > 0.0))
+        if bad.size:
+            el, i = bad[0]
+            raise ModelError(f"{name} element {el}: the material coordinates s0 = {S0[el]} m must increase strictly "
+                             f"from 0 to L0 = {self.L0[el]:.6g} m along the cable (section {i} has none)")
+        self.S0 = S0
+
+    def _per_element(self, value, what):
+        a = np.asarray(value, dtype=float)
+        try:
+            return np.broadcast_to(a, (self.nodes.shape[0],)).astype(float).copy()
+        except ValueError:
+            raise ModelError(f"{self.name}: {what} must be a scalar or one value per element "
+                             f"({self.nodes.shape[0]}), got shape {a.shape}") from None
+
+    # ------------------------------------------------------------------ construction helpers
+    @classmethod
+    def pretensioned(cls, nodes, X, EA, T0, devices, **kw):
+        """Cables at uniform tension T0 (N) in the geometry X ((n_nodes, 3), m): L0 and the material
+        coordinates at the devices follow from the (sized-pulley) section lengths."""
+        nodes = np.atleast_2d(np.asarray(nodes, dtype=np.int64))
+        X = np.asarray(X, dtype=float)
+        n_el, nn = nodes.shape
+        devices = list(devices)
+        if len(devices) != nn - 2:
+            raise ModelError(f"pretensioned: {len(devices)} devices for {nn - 1} sections; give one per interior node "
+                             f"({nn - 2})")
+        radius = np.zeros(nn)
+        for k, d in enumerate(devices):
+            radius[k + 1] = d.radius if isinstance(d, Pulley) else 0.0
+        EA_ = np.broadcast_to(np.asarray(EA, float), (n_el,))
+        T0_ = np.broadcast_to(np.asarray(T0, float), (n_el,))
+        if np.any(~(T0_ >= 0)):
+            raise ModelError("pretensioned: T0 must be >= 0 N (a cable cannot carry compression)")
+        Ls = []
+        for e in range(n_el):
+            code, where, L, _, _, _ = _geometry(X[nodes[e]], radius)
+            if code != GEO_OK:
+                raise ModelError(_geometry_message(code, where, "pretensioned", nodes[e], radius, X[nodes[e]]))
+            Ls.append(L)
+        Ls = np.array(Ls)
+        stretch = 1.0 + T0_ / EA_
+        L0 = Ls.sum(axis=1) / stretch
+        s0 = np.cumsum(Ls, axis=1)[:, :-1] / stretch[:, None]
+        return cls(nodes, EA, L0, devices, s0=s0, **kw)
+
+    # ------------------------------------------------------------------ contract
+    def initial_state(self) -> np.ndarray:
+        n_el = self.n_elements
+        m = self.n_sections - 1
+        st = np.zeros((n_el, self.n_state))
+        st[:, :m] = self.S0
+        mode = np.where(self.kinds == FREE, SLIDE_FREE, 0)
+        smax = np.where(self.kinds == LATCH, self.P[:, :m, 6] + self.P[:, :m, 1], np.inf)
+        st[:, m:] = np.where(self.S0 >= smax - 1e-12 * self.L0[:, None], STOP, mode[None, :])
+        return st
+
+    def evaluate(self, x, R, state, ctx: IncrementContext | None = None) -> ElementResponse:
+        """Forces f (N), tangent k (N/m), trial state, output and energy (J) of all elements.
+
+        x : (n_nodes, 3) nodal positions, m.  R : ignored.  state : (n_el, n_state) committed."""
+        X = np.ascontiguousarray(np.asarray(x, dtype=float)[self.nodes])
+        state = np.ascontiguousarray(state, dtype=float)
+        n_el, nn = self.nodes.shape
+        m = self.n_sections - 1
+        f = np.empty((n_el, 6 * nn))
+        k = np.empty((n_el, 6 * nn, 6 * nn))
+        new = np.empty_like(state)
+        T = np.zeros((n_el, self.n_sections))
+        phi = np.zeros((n_el, max(m, 1)))
+        energy = np.zeros(n_el)
+        err = np.zeros(n_el, dtype=np.int64)
+        where = np.zeros(n_el, dtype=np.int64)
+        P = np.ascontiguousarray(self.P)
+        args = (X, self.radius, self.EA, self.L0, self.kinds, P, state, f, k, new, T, phi, energy, err, where)
+        (device_kernel if self._law is None else kernel_for_law(self._law))(*args)
+        bad = np.flatnonzero(err)
+        if bad.size:
+            el = bad[0]
+            self._raise(el, int(err[el]), int(where[el]), X[el])
+        return ElementResponse(f=f, k=k, state=new, energy=energy,
+                               output=LazyOutput(lambda: self._output(T, new, phi[:, :m])))
+
+    def _raise(self, el, code, where, X):
+        name = f"{self.name} element {el}"
+        if code < 10:
+            raise ModelError(_geometry_message(code, where, name, self.nodes[el], self.radius, X))
+        if code == ERR_SHORT:
+            raise ModelError(f"{name}: the cable (L0 = {self.L0[el]:.6g} m) is far too short for the node positions: "
+                             "a section would need a non-positive unstretched length. Check the units of L0 and the "
+                             "coordinates, or build with CableDeviceFamily.pretensioned")
+        what = "cycled between stick and slip" if code == ERR_ACTIVE_SET else "did not converge"
+        raise ModelError(f"{name}: the device equations {what} (devices {[type(d).__name__ for d in self.devices]}); "
+                         "take smaller load increments")
+
+    def _output(self, T, new, phi):
+        m = self.n_sections - 1
+        S = np.column_stack([np.zeros(len(T)), new[:, :m], self.L0])
+        latch = self.kinds == LATCH
+        bead = np.where(latch[None, :], self.P[:, :m, 6] - new[:, :m], np.nan)
+        return {"tension": T, "unstretched_length": np.diff(S, axis=1), "material_coordinate": new[:, :m].copy(),
+                "device_mode": new[:, m:].copy(), "wrap_angle": phi.copy(), "bead_position": bead}
