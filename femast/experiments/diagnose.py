@@ -210,7 +210,7 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         which is less than starting the processes costs; 1 runs in this process).
     scheduler : a dask.distributed scheduler address (``tcp://...``) or ``distributed.Client``.
     out : folder for ``diagnose.json`` and ``diagnose.png`` (nothing written if None).
-    pairs : refit pairs of the top candidates jointly when no single one explains the data.
+    pairs : refit pairs of the top candidates jointly (their verdict: femast.experiments.verdict).
 
     Returns an ``OptimizeResult`` with ``experiment``, ``n_samples``, ``noise`` (per channel: the
     per-row noise, (n,) arrays), ``noise_model`` (``{channel: ChannelNoise}``), ``noise_rms``,
@@ -238,7 +238,7 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     baseline = fit(exp, data, base_effects)
     t_base = time.perf_counter() - t0
     nch, chans = len(exp.channels), exp.channels
-    models = noise_model(exp, data, baseline, correlate=False)  # weights of the refits
+    models = noise_model(exp, data, baseline, correlate=False, generic=False)  # weights of the refits
     sigma = {c: models[c].sigma for c in chans}
     if any(m.kind.startswith(("heteroscedastic", "given")) for m in models.values()):
         baseline = fit(exp, data, base_effects, start=dict(zip(baseline.names, baseline.x)), noise=sigma,
@@ -337,11 +337,10 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
                 "_fit": res}
 
     ranking, fits, form_check = rank()
-    # pairs of the top candidates, fitted jointly, when no single one explains the data
+    # pairs of the top candidates with an information-criterion gain, fitted jointly
     pair_fits = []
     top = pair_candidates(ranking)
-    single_ok = ranking and ranking[0]["significant"] and ranking[0]["ratio"] <= thr
-    if pairs and len(top) >= 2 and not single_ok and r0 > thr:
+    if pairs and len(top) >= 2 and r0 > thr:
         by = {e["effect"]: e for e in ranking}
         combos = [(x, y) for i, x in enumerate(top) for y in top[i + 1:]]
         pl = []

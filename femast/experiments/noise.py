@@ -17,18 +17,19 @@ changes little from one row to the next, the noise does; see
   (from the baseline's residual) plus two standard errors.  For AR(1) noise of marginal
   standard deviation ``sigma`` the second differences have variance ``2 sigma^2 (1 - phi)(3 - phi)``
   (``6 sigma^2`` when white), which gives the level from their robust scale.
-* **heteroscedastic** -- the variance of row i is ``a^2 + b^2 g_i^2`` for a covariate ``g`` the
-  experiment names (``Experiment.noise_covariates``: for latch-pull the local slope of the latch
-  law, since Eq. 15 puts the load-cell noise into the bead position x; for every experiment the
-  size of the reading).  ``a, b`` are the Gaussian maximum-likelihood fit of the second
-  differences, whose variance is ``(1 - phi)(3 - phi) / 3 x (v_{i-1} + 4 v_i + v_{i+1})`` (exact
-  for independent noise), with rows beyond 6 standard deviations left out (jumps of the model
-  error).  The model is kept when its likelihood-ratio statistic exceeds ``HETERO_LR`` = 11.5, the
-  99th percentile of that statistic on white noise (Monte Carlo, 3000-4000 draws of 60-1500 rows
-  along several covariates: 9.9-11.4; the second differences are correlated, so it exceeds the
-  chi-square value 6.6) and the standard deviation
-  it gives varies by at least ``HETERO_MIN_RANGE`` = 1.3 over the data (smaller variations change
-  no verdict).
+* **heteroscedastic** -- the variance of row i is ``A + B g_i + D g_i^2`` for a covariate ``g`` the
+  experiment names (``Experiment.noise_covariates``: for latch-pull the signed slope ``s`` of the
+  latch law, since Eq. 15 removes the cable stretch with the measured force, so the residual of a
+  row is ``e_T (1 + s C) - s e_d`` with variance ``sigma_T^2 (1 + s C)^2 + s^2 sigma_d^2``, a
+  quadratic in s; for every experiment the size of the reading).  ``A, B, D`` are the Gaussian
+  maximum-likelihood fit (Fisher scoring) of the second differences, whose variance is
+  ``(1 - phi)(3 - phi) / 3 x (v_{i-1} + 4 v_i + v_{i+1})`` (exact for independent noise), with
+  rows beyond 6 standard deviations left out (jumps of the model error).  The model is kept when
+  its likelihood-ratio statistic against one level exceeds ``HETERO_LR`` = 18.5, the 99th
+  percentile of that statistic on white noise (Monte Carlo, 2000 draws of 100-1500 rows along
+  signed and unsigned covariates: 16.0-19.8; the second differences are correlated, so it exceeds
+  the chi-square value 9.2 for two parameters) and the standard deviation it gives varies by at
+  least ``HETERO_MIN_RANGE`` = 1.3 over the data (smaller variations change no verdict).
 * **given** -- a ``sigma_<channel>`` column (same unit as the channel) gives the standard
   uncertainty of every row; it is used as it is.
 
@@ -50,7 +51,7 @@ from ..errors import DataFileError, ModelError
 MIN_ROWS = 8
 MIN_ROWS_STRUCTURE = 60
 HETERO_MIN_RANGE = 1.3
-HETERO_LR = 11.5
+HETERO_LR = 18.5
 QUANTILE = 0.99
 _MAD = 1.482602218505602  # 1 / Phi^-1(3/4): MAD -> standard deviation of a normal variable
 _SEED = 20241124
@@ -130,30 +131,24 @@ def _g3(g2):
     return (g2[:-2] + 4.0 * g2[1:-1] + g2[2:]) / 6.0
 
 
-def _fit_variance(d2sq, G, iters: int = 8):
-    """Maximum-likelihood ``(A, B)`` of ``d2^2 ~ v (chi^2_1)``, ``v = A + B G`` (A > 0, B >= 0), batched
-    over the leading axis of ``d2sq`` (draws, m); rows beyond 36 v are left out.  Returns (A, B, keep, ll)."""
-    A = np.median(d2sq, axis=-1, keepdims=True) / 0.4549  # median of chi^2_1
-    B = np.zeros_like(A)
-    keep = np.ones_like(d2sq, dtype=bool)
-    X = np.stack([np.ones_like(G), G], axis=-1)  # (m, 2)
+def _fit_variance(d2sq, X, iters: int = 10):
+    """Maximum-likelihood ``beta`` of ``d2^2 ~ v chi^2_1``, ``v = X beta`` (design X (m, k)), batched over
+    the leading axis of ``d2sq`` (draws, m), by Fisher scoring (weighted least squares of d2^2 on X,
+    weights 1 / v^2); v is kept above 1e-3 of the mean d2^2 and rows beyond 36 v are left out.
+    Returns (beta (draws, k), v (draws, m), keep, log-likelihood (draws,))."""
+    floor = 1e-3 * np.mean(d2sq, axis=-1, keepdims=True)
+    v = np.broadcast_to(np.median(d2sq, axis=-1, keepdims=True) / 0.4549, d2sq.shape)  # median of chi^2_1
+    beta = None
     for _ in range(iters):
-        v = np.maximum(A + B * G, 1e-300)
         keep = d2sq < 36.0 * v
-        w = keep / v**2  # Fisher scoring = weighted least squares of d2^2 on [1, G]
+        w = keep / v**2
         XtW = X.T[None, :, :] * w[:, None, :]
-        M = XtW @ X
-        rhs = (XtW @ d2sq[..., None])[..., 0]
-        sol = np.linalg.solve(M, rhs[..., None])[..., 0]
-        floor = 1e-4 * np.mean(d2sq, axis=-1, keepdims=True)
-        A = np.maximum(sol[:, :1], floor)
-        B = np.maximum(sol[:, 1:], 0.0)
-        zero = B[:, 0] == 0.0  # where B hit zero, A is the plain mean of the kept d2^2
-        if np.any(zero):
-            A[zero, 0] = np.sum(d2sq[zero] * keep[zero], axis=1) / np.maximum(keep[zero].sum(axis=1), 1)
-    v = np.maximum(A + B * G, 1e-300)
+        M = XtW @ X + 1e-12 * np.eye(X.shape[1])
+        beta = np.linalg.solve(M, (XtW @ d2sq[..., None]))[..., 0]
+        v = np.maximum(beta @ X.T, floor)
+    keep = d2sq < 36.0 * v
     ll = -0.5 * np.sum(keep * (d2sq / v + np.log(v)), axis=-1)
-    return A[:, 0], B[:, 0], keep, ll
+    return beta, v, keep, ll
 
 
 def _fit_constant(d2sq, keep):
@@ -162,27 +157,34 @@ def _fit_constant(d2sq, keep):
     return A, ll
 
 
-def _lr(d2sq, G):
-    A, B, keep, ll1 = _fit_variance(d2sq, G)
+def _design(g):
+    """Design of the variance of a second difference for ``v_i = A + B g_i + D g_i^2``: columns
+    ``[1, g3(g), g3(g^2)]`` (:func:`_g3`)."""
+    return np.column_stack([np.ones(g.size - 2), _g3(g), _g3(g * g)])
+
+
+def _lr(d2sq, X):
+    beta, v, keep, ll1 = _fit_variance(d2sq, X)
     _, ll0 = _fit_constant(d2sq, keep)
-    return 2.0 * (ll1 - ll0), A, B
+    return 2.0 * (ll1 - ll0), beta, v
 
 
 def heteroscedastic_fit(r, g, phi: float = 0.0) -> dict:
-    """Fit ``Var(noise_i) = a^2 + b^2 g_i^2`` to a residual r (n,) with covariate g (n,) (module
-    docstring).  Returns ``{a, b, lr, threshold, sigma (n,), range}``; ``range`` is max/min sigma."""
-    r, g = np.asarray(r, float), np.abs(np.asarray(g, float))
-    gs = float(np.max(g)) or 1.0
-    g2 = (g / gs) ** 2
-    G = _g3(g2)
-    c = ar1_factor(phi)  # 6 c (a^2 + ...) = Var(d2) of AR(1) noise
+    """Fit ``Var(noise_i) = A + B g_i + D g_i^2`` to a residual r (n,) with covariate g (n,) (signed or
+    not; module docstring).  For the latch-pull covariate (the signed slope s of the law) this is
+    seed 001 Eq. 15's ``sigma_T^2 (1 + s C)^2 + s^2 sigma_d^2``.  Returns ``{coef (A, B, D) in the
+    units of r^2 and g, lr, threshold, sigma (n,), range}``; ``range`` is max/min sigma."""
+    r, g = np.asarray(r, float), np.asarray(g, float)
+    gs = float(np.max(np.abs(g))) or 1.0
+    u = g / gs
+    c = ar1_factor(phi)  # Var(d2) = 6 c v for AR(1) noise
     d2 = r[2:] - 2.0 * r[1:-1] + r[:-2]
-    lr, A, B = _lr((d2**2)[None, :], G)
-    thr = HETERO_LR
-    a2 = float(A[0]) / (6.0 * c)
-    b2 = float(B[0]) / (6.0 * c) / gs**2  # so that b^2 g^2 has g in its own unit
-    sigma = np.sqrt(a2 + b2 * g**2)
-    return {"a": math.sqrt(a2), "b": math.sqrt(b2), "lr": float(lr[0]), "threshold": thr, "sigma": sigma,
+    lr, beta, _ = _lr((d2**2)[None, :], _design(u))
+    A, B, D = (float(x) / (6.0 * c) for x in beta[0])
+    v = A + B * u + D * u * u
+    v = np.maximum(v, 1e-3 * max(float(np.mean(v)), 1e-300))
+    sigma = np.sqrt(v)
+    return {"coef": (A, B / gs, D / gs**2), "lr": float(lr[0]), "threshold": HETERO_LR, "sigma": sigma,
             "range": float(sigma.max() / sigma.min())}
 
 
@@ -226,7 +228,7 @@ def channel_noise(channel: str, r, n_channel_rows: int, covariates=None, given=N
                             "or a varying noise level")
     best = None
     for name, g in (covariates or {}).items():
-        g = np.abs(np.asarray(g, float))
+        g = np.asarray(g, float)
         if g.shape != (n,) or not np.all(np.isfinite(g)) or np.ptp(g) <= 0.0:
             continue
         h = heteroscedastic_fit(r, g)
@@ -237,11 +239,12 @@ def channel_noise(channel: str, r, n_channel_rows: int, covariates=None, given=N
                              "constant level (no covariate explains a varying level)")
     else:
         name, h = best
+        A, B, D = h["coef"]
         model = ChannelNoise(
             channel, "heteroscedastic", np.maximum(h["sigma"], 1e-300), 0.0, float(n), name,
-            f"level varies with {name}: sigma^2 = a^2 + b^2 g^2, a = {h['a']:.3g}, b = {h['b']:.3g} (likelihood "
-            f"ratio {h['lr']:.0f} > {h['threshold']:.0f}, the 99th percentile on white noise; sigma from "
-            f"{h['sigma'].min():.3g} to {h['sigma'].max():.3g})", {"a": h["a"], "b": h["b"]})
+            f"level varies with {name}: sigma^2 = A + B g + D g^2, A = {A:.3g}, B = {B:.3g}, D = {D:.3g} "
+            f"(likelihood ratio {h['lr']:.0f} > {h['threshold']:.0f}, the 99th percentile on white noise; sigma "
+            f"from {h['sigma'].min():.3g} to {h['sigma'].max():.3g})", {"variance_coefficients": [A, B, D]})
     return with_correlation(model, r) if correlate else model
 
 
@@ -272,13 +275,15 @@ def with_correlation(model: ChannelNoise, r) -> ChannelNoise:
                         f"{why}; {reason}", {**model.extra, "level_reason": reason})
 
 
-def noise_model(exp, data, fit_result, correlate: bool = True) -> dict:
+def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = True) -> dict:
     """``{channel: ChannelNoise}`` from a fit's residuals (``diagnose``: first the baseline's without the
-    correlation test, for the weights of the refits; then the best model's, for the verdict)."""
+    correlation test and with the experiment's own covariates only -- a structured residual would pass
+    for noise growing with the reading --, for the weights of the refits; then the best model's, for
+    the verdict).  generic : also test the size of the reading as a covariate."""
     covs = {}
     pred = fit_result.predicted
     for c in exp.channels:
-        covs[c] = {"size of the reading": np.abs(pred[c])}
+        covs[c] = {"size of the reading": np.abs(pred[c])} if generic else {}
     if getattr(exp, "noise_covariates", None) is not None:
         extra = exp.noise_covariates(data, dict(fit_result.params), exp.options, fit_result) or {}
         for c, d in extra.items():

@@ -24,10 +24,12 @@ Conclusions (``verdict["kind"]``)
 * ``better_form`` -- the effects already in the model (``--effects``) are first refitted in their
   generalised forms; one that is significant and brings the model to the noise floor is a shape
   mismatch of the added effect, not a new mechanism;
-* ``missing_effect`` -- the best significant candidate brings the model to the noise floor;
-* ``missing_pair`` -- no single candidate does, the best pair of the top candidates fitted
-  jointly does, and the pair is significantly better than its best member alone (information
-  criterion -10 and another 10 % of the excess);
+* ``missing_effect`` -- the best significant candidate brings the model to the noise floor (and no
+  pair does significantly better);
+* ``missing_pair`` -- the best pair of the top four candidates, fitted jointly, brings the model
+  to the noise floor and is significantly better than its best member alone (information
+  criterion -10 and another 10 % of the excess), also when that member alone reaches the floor
+  (a small second effect);
 * ``form_imperfect`` -- the best candidate explains at least ``FORM_SHARE`` = 60 % of the excess
   but leaves structure: the mechanism is there, its form is not right (the verdict names where the
   rest sits and what to try);
@@ -44,7 +46,7 @@ from .noise import information_criterion
 SIGNIFICANT_DBIC = -10.0
 MIN_SHARE = 0.10
 FORM_SHARE = 0.60
-PAIR_TOP = 3
+PAIR_TOP = 4
 
 
 def score(fit, models: dict, channels, n_rows: int) -> dict:
@@ -91,6 +93,12 @@ def conclude(r0: float, thr: float, ranking: list, pairs: list, form_check: list
         return v
     if fc is not None:
         v["try_next"].append(f"{fc['effect']}/{fc['form']} (a better form of an added effect: {fc['ratio']:.2f}x)")
+    if pair_ok:  # also when the best single one reaches the noise: the pair is significantly better
+        v.update(kind="missing_pair", missing_effects=list(bp["effects"]), explained=True)
+        v["conclusion"] = (f"missing effects: {' + '.join(bp['effects'])} (fitted together); the pair brings the "
+                           f"error from {r0:.2f}x to {bp['ratio']:.2f}x the noise, significantly below its best "
+                           "member alone")
+        return v
     if best is not None and best["ratio"] <= thr:
         alts = [e["effect"] for e in ranking if e is not best and e["significant"] and e["ratio"] <= thr
                 and e["delta_bic"] - best["delta_bic"] < 10.0]
@@ -101,12 +109,6 @@ def conclude(r0: float, thr: float, ranking: list, pairs: list, form_check: list
                            f"{r0:.2f}x to {best['ratio']:.2f}x the noise")
         if alts:
             v["conclusion"] += f"; also consistent with the data: {', '.join(alts)}"
-        return v
-    if pair_ok:
-        v.update(kind="missing_pair", missing_effects=list(bp["effects"]), explained=True)
-        v["conclusion"] = (f"missing effects: {' + '.join(bp['effects'])} (fitted together); no single effect "
-                           f"explains the data, the pair brings the error from {r0:.2f}x to {bp['ratio']:.2f}x "
-                           "the noise")
         return v
     if bp is not None and bp["significant"] and bp["ratio"] < (best["ratio"] if best else r0):
         v["try_next"].append(f"the pair {' + '.join(bp['effects'])} ({bp['ratio']:.2f}x the noise)")
