@@ -126,10 +126,12 @@ def modal_cases(out):
     ax = axes[0]
     order = np.argsort(modes.x[:, 0])
     for k in (0, 2, 4):
-        ax.plot(modes.x[order, 0], modes.shapes[k, order, 1] + modes.shapes[k, order, 2],
+        yz = modes.shapes[k, order, 1:3]      # a mode of a degenerate (y, z) pair: w(x) along one direction
+        w = yz @ np.linalg.svd(yz, full_matrices=False)[2][0]
+        ax.plot(modes.x[order, 0], w * np.sign(w[len(w) // 4 or 1]),
                 label=f"f = {modes.frequencies[k]:.4f} Hz (exact {25 * (k // 2 + 1):.0f})")
     ax.set_xlabel("x (m)")
-    ax.set_ylabel("transverse mode shape (mass-normalised)")
+    ax.set_ylabel("transverse mode shape (mass-normalised, m/sqrt(kg))")
     ax.set_title("Taut string, T = 100 N, m' = 0.01 kg/m, 100 cables")
     ax.legend(fontsize=8)
     r, modes = vm.cantilever()
@@ -137,8 +139,9 @@ def modal_cases(out):
     ax = axes[1]
     order = np.argsort(modes.x[:, 0])
     for k in (0, 2, 4):
-        w = modes.shapes[k, order, 1] + modes.shapes[k, order, 2]
-        ax.plot(modes.x[order, 0], w / np.abs(w).max(), label=f"f = {modes.frequencies[k]:.5f} Hz")
+        yz = modes.shapes[k, order, 1:3]
+        w = yz @ np.linalg.svd(yz, full_matrices=False)[2][0]
+        ax.plot(modes.x[order, 0], w / w[np.argmax(np.abs(w))], label=f"f = {modes.frequencies[k]:.5f} Hz")
     ax.set_xlabel("x / L")
     ax.set_title("Cantilever, EI = m = L = 1, 20 beams")
     ax.legend(fontsize=8)

@@ -54,6 +54,21 @@ def test_state_saves_and_loads_bit_for_bit(tmp_path):
     assert not back.equal(st)
 
 
+def test_a_loaded_state_replaces_the_analysis_state_and_its_cached_responses(tmp_path):
+    m, c = _frame(steps=2)
+    an = Analysis(m, None, progress=False, on_frame=lambda fr: None)
+    an.run()
+    p = tmp_path / "s.npz"
+    an.state.save(p)
+    other = Analysis(m, None, progress=False, on_frame=lambda fr: None)   # at the initial state
+    other.system.last_converged = an.system.last_converged                 # a stale cache...
+    other.state = State.load(p)                                             # ...is dropped
+    assert other.system.state is other.state and other.system.last_converged is None
+    np.testing.assert_array_equal(other.x, an.x)
+    # the same tangent from the loaded state as from the analysis that produced it
+    np.testing.assert_array_equal(other.tangent().toarray(), an.tangent().toarray())
+
+
 def test_state_load_rejects_a_foreign_file(tmp_path):
     p = tmp_path / "other.npz"
     np.savez(p, x=np.zeros(3))
@@ -162,3 +177,28 @@ def test_the_loop_knows_nothing_of_files():
     for name in ("newton.py", "stepping.py", "controls.py", "system.py", "state.py"):
         src = (PKG / "analysis" / name).read_text()
         assert "ResultsWriter" not in src and "results import" not in src, name
+
+
+def _imports(path):
+    """Module names a file imports (relative ones resolved against femast/)."""
+    tree = ast.parse(path.read_text())
+    pkg = path.relative_to(PKG.parent).with_suffix("").parts[:-1]
+    names = set()
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Import):
+            names |= {a.name for a in n.names}
+        elif isinstance(n, ast.ImportFrom):
+            base = list(pkg[: len(pkg) - n.level + 1]) if n.level else []
+            mod = ".".join(base + ([n.module] if n.module else []))
+            names |= {mod} | {f"{mod}.{a.name}" for a in n.names}
+    return names
+
+
+def test_import_rules():
+    for p in list((PKG / "elements").glob("*.py")) + [PKG / "results.py", PKG / "vtk.py", PKG / "render.py"]:
+        bad = {m for m in _imports(p) if m.startswith("femast.analysis")}
+        assert not bad, f"{p.name} imports the analysis ({bad}): elements and post-processing must not"
+    for p in (PKG / "analysis").glob("*.py"):
+        if p.name not in ("output.py", "analysis.py"):
+            bad = {m for m in _imports(p) if m.startswith("femast.results")}
+            assert not bad, f"analysis/{p.name} imports the results writer ({bad}): only output.py may"

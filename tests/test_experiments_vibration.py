@@ -74,3 +74,31 @@ def test_diagnose_finds_the_hidden_pretension_loss(tmp_path):
     # the generator's hidden loss is 15 N: within 3 standard errors of the fit (0.12 Hz noise, 9 rows)
     est, se = top["params"]["dT0"]["value"], top["params"]["dT0"]["stderr"]
     assert abs(est + 15.0) <= 3 * se
+
+
+def _string_builder(T, m_unit, load, options):
+    """A user's model: a taut string of 2 m with a bead (the unit mass) at its middle."""
+    import femast as fm
+
+    mod = fm.Model("bead on a string")
+    a, c, b = mod.node(0, 0, 0), mod.node(1.0, 0, 0), mod.node(2.0, 0, 0)
+    mod.truss(a, c, EA=1e7, pretension=T)
+    mod.truss(c, b, EA=1e7, pretension=T)
+    mod.fix(a)
+    mod.fix(b)
+    mod.point_mass(c, m_unit)
+    mod.step("hold")
+    return mod, c
+
+
+def test_user_model_builder():
+    """Bead m on a massless string, tension T, halves of 1 m: omega^2 = 2 T / (m 1 m) (exact up to
+    the Newton tolerance of the state, 1e-6)."""
+    exp = get_experiment("vibration", builder=_string_builder, drive_direction=(0.0, 0.0, 1.0), unit_mass_kg=0.05)
+    data = from_arrays(exp, mode=[1, 1], f_Hz=[10.0, 12.0], pretension_N=[50.0, 80.0])
+    f = predict(exp, data, params={"pretension": 170.0})["f_Hz"]
+    np.testing.assert_allclose(f, np.sqrt(2 * np.array([50.0, 80.0]) / 0.05) / (2 * math.pi), rtol=1e-6)
+    # the joint_stick spring acts along the drive direction (z): it stiffens one of the two
+    # transverse modes, k = 2T/L + k_stick
+    g = predict(exp, data, {"pretension": 170.0}, {"joint_stick": {"k_stick": 100.0}})["f_Hz"]
+    np.testing.assert_allclose(g, f, rtol=1e-6)   # mode 1 is the y mode, the spring is along z

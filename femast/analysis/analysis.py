@@ -99,8 +99,11 @@ class Analysis:
 
     @state.setter
     def state(self, state: State):
+        """Replace the state (e.g. by one read with :meth:`State.load`): the system follows it and
+        forgets the responses it kept of the old one's last converged configuration."""
         self._state = state
         self.system.state = state
+        self.system.last_converged = None
 
     X0 = property(lambda self: self.system.X0)
     dofmap = property(lambda self: self.system.dofmap)
@@ -191,7 +194,12 @@ class Analysis:
         try:
             for k, step in enumerate(self.model.steps):
                 self._state.step = k
-                run_step(self, step)
+                if getattr(step, "kind", "static") == "frequency":   # modes of the state (issue 18)
+                    from ..frequency_step import run_frequency_step
+
+                    run_frequency_step(self, step)
+                else:
+                    run_step(self, step)
         except ConvergenceError as exc:
             self.summary.completed = False
             self.summary.message = str(exc)

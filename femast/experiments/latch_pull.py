@@ -83,10 +83,10 @@ SIDE_OUT = 1  # the outer cable (section 2) is loaded: unlatching rig, dT = T2 >
 SIDE_IN = -1  # the inner cable (section 1, through the backstop) is loaded: latching rig, dT = -T1 <= 0
 
 
-def infer_side(x, dT, sigma=None) -> np.ndarray:
+def infer_side(x, dT) -> np.ndarray:
     """Loaded side (+1 outer cable, -1 inner cable) of each row, inferred from the sign of dT.
 
-    x : bead positions (n,), m.  dT : force jumps (n,), N.  sigma : unused (kept for callers).
+    x : bead positions (n,), m.  dT : force jumps (n,), N.
     A one-sided rig can only give ``dT >= 0`` with the outer cable loaded and ``dT <= 0`` with
     the inner one (seed 001 Sec. III.B), so every row with ``|dT|`` above 5 noise (the noise of dT
     from its second differences) names its side.  Between the last decisive row of one sign and

@@ -1,0 +1,408 @@
+"""Pose of a CDPR platform carried by compliant masts (seed 000, Fig. 7; issue 19 item 3).
+
+The controller works in a rigid frame: for the commanded pose ``p_c`` it computes, with the
+exit geometry measured at calibration, the cable lengths (with the swivel-pulley kinematics of
+:mod:`.pulley_kinematics`) and a tension distribution ``tau_c`` (Eq. 2, tension limits), and
+winds each cable to the unstretched length ``l0_j = l_j(p_c) / (1 + tau_c,j / EA)``.  In the
+rigid frame the platform would sit exactly at ``p_c``.  The real masts deflect under the cable
+wrenches (Eq. 7), their tops carry the pulleys, the exit points move, and the platform settles at
+the pose ``p`` where platform, cables and masts are in equilibrium together:
+
+* platform (Eq. 2): ``sum_j tau_j (-u_j) + m g = 0`` and the moments about its origin;
+* cables: ``tau_j = EA (l_j - l0_j) / l0_j``, ``l_j = |D_j - F_j| + r beta_j + |B_j - E_j|``
+  (winch F_j to the swivel entry D_j, wrap, free span to the anchor B_j);
+* masts: ``dc_i = C_i (w_i - w_i,cal) + delta_i`` -- the top displacement (m, rad) of a linear
+  compliance model (3R Eqs. 4-6, cantilever Eqs. 8-15, beam + shrouds Eqs. 16-26) or of the FE
+  guyed mast (its condensed tangent plus the nonlinear remainder ``delta_i`` from the FE run),
+  relative to the calibration state; ``w_i`` the wrench of its cables on the pulleys (Eq. 7, moments
+  about the displaced top).  The pulley entry D_j and swivel axis move with the mast top.
+
+Unknowns: the platform translation and small rotation from ``p_c`` (6) and the mast top
+displacements (6 per mast); Newton with a finite-difference Jacobian (the system is small and
+smooth), continued along a trajectory.  Output: the pose error ``p - p_c`` (what the rigid-frame
+controller does not see), the tensions, and the exit points at equilibrium (what a controller
+should use instead of the calibrated ones).
+
+Assumptions (not in the seed): steel cables of EA = 1.0e6 N (about 4 mm), swivel pulleys of
+radius 0.03 m with vertical axes through the calibrated exit points, cables returning vertically to
+winches at the mast feet (as :mod:`.rocaspect`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..errors import ModelError
+from ._common import fmt_pose
+from .cdpr import GRAVITY, CdprGeometry, tension_distribution
+from .pulley_kinematics import swivel_exit
+
+CABLE_EA = 1.0e6
+"""Assumed axial rigidity of the Rocaspect cables, N (about a 4 mm steel rope)."""
+PULLEY_RADIUS = 0.03
+"""Assumed swivel-pulley radius, m."""
+
+
+@dataclass(frozen=True)
+class CableRobot:
+    """A CDPR whose exit pulleys sit on masts.
+
+    geom : :class:`~.cdpr.CdprGeometry`; its ``exit_points`` are the swivel entry points D_j as
+        calibrated (m) and ``winch_points`` the winches F_j (m).
+    EA : cable axial rigidity, N.  pulley_radius : m (0: point exits, the seed's Eq. 1).
+    """
+
+    geom: CdprGeometry
+    EA: float = CABLE_EA
+    pulley_radius: float = PULLEY_RADIUS
+
+    def __post_init__(self):
+        if not (np.isfinite(self.EA) and self.EA > 0):
+            raise ModelError(f"cable EA = {self.EA!r} N must be finite and > 0")
+        if not (np.isfinite(self.pulley_radius) and self.pulley_radius >= 0):
+            raise ModelError(f"pulley radius = {self.pulley_radius!r} m must be finite and >= 0")
+
+    @property
+    def axes(self) -> np.ndarray:
+        """Unit swivel axes (m, 3): from the winch up to the pulley."""
+        d = self.geom.exit_points - self.geom.winch_points
+        return d / np.linalg.norm(d, axis=1)[:, None]
+
+
+@dataclass
+class MastSet:
+    """The masts of the robot as seen by the platform solve.
+
+    name : label.  compliance : (n, 6, 6) top compliances (m/N, ... rad/(N m)), about each top,
+    base axes; zeros for rigid masts.  fe : optional list of :class:`~.fe_mast.MastFE` (one per
+    mast, equilibrated) whose nonlinear response replaces the linear one (``compliance`` is then
+    their condensed tangent)."""
+
+    name: str
+    compliance: np.ndarray
+    fe: list | None = None
+
+
+@dataclass
+class PoseSolution:
+    """Equilibrium at one commanded pose (SI: m, rad, N).
+
+    pose : (6,) actual pose [x, y, z, roll, pitch, yaw].  error : (6,) [dx, dy, dz] (m) and the
+    rotation vector of R R_c^T (rad).  tension : (m,) N.  exit_points : (m, 3) exit points E_j at
+    equilibrium, m.  top_displacement : (n, 6) mast tops from calibration (m, rad).  wrench : (n, 6)
+    cable wrenches on the masts (N, N m).  feasible : False when no tension distribution exists or
+    a cable would go slack; ``reason`` says which.
+    """
+
+    pose: np.ndarray
+    error: np.ndarray
+    tension: np.ndarray
+    exit_points: np.ndarray
+    top_displacement: np.ndarray
+    wrench: np.ndarray
+    feasible: bool = True
+    reason: str = ""
+    iterations: int = 0
+
+
+def _rot(angles):
+    return Rotation.from_euler("xyz", angles).as_matrix()
+
+
+def _cross(a, b):
+    """Row-wise cross product (faster than numpy.cross for these small stacks)."""
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
+def _rotvec_batch(V):
+    """Rotation matrices (k, 3, 3) of rotation vectors V (k, 3), rad (Rodrigues)."""
+    th = np.sqrt(np.einsum("ki,ki->k", V, V))
+    K = np.zeros((len(V), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -V[:, 2], V[:, 1], -V[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = V[:, 2], -V[:, 1], V[:, 0]
+    small = th < 1e-8
+    ths = np.where(small, 1.0, th)
+    a = np.where(small, 1.0, np.sin(ths) / ths)
+    b = np.where(small, 0.5, (1.0 - np.cos(ths)) / ths**2)
+    return np.eye(3) + a[:, None, None] * K + b[:, None, None] * (K @ K)
+
+
+def _rotvec(v):
+    """Rotation matrix of the rotation vector v (rad), Rodrigues."""
+    th = float(np.sqrt(v @ v))
+    K = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    if th < 1e-8:
+        return np.eye(3) + K + 0.5 * K @ K
+    return np.eye(3) + np.sin(th) / th * K + (1.0 - np.cos(th)) / th**2 * K @ K
+
+
+class _System:
+    """Residuals of platform + cables + masts at one commanded pose (module note)."""
+
+    def __init__(self, robot: CableRobot, masts: MastSet, pose_c, l0, w_cal, delta):
+        g = robot.geom
+        self.robot, self.g = robot, g
+        self.Rc = _rot(pose_c[3:])
+        self.tc = np.asarray(pose_c[:3], float)
+        self.l0 = l0
+        self.C = masts.compliance
+        self.w_cal = w_cal
+        self.delta = delta
+        self.mast = g.mast_of_cable
+        self.n = g.n_masts
+        self.D0 = g.exit_points
+        self.F = g.winch_points
+        self.top0 = g.mast_tops
+        self.fg = np.array([0.0, 0.0, -g.mass * GRAVITY])
+        self.gather = (np.arange(self.n)[:, None] == self.mast[None, :]).astype(float)  # (n, m) cable -> mast
+        self.w0 = robot.axes
+        self.mg = np.cross(self.Rc @ g.cog, self.fg)
+
+    def state(self, z):
+        """Geometry, tensions and mast wrenches for unknowns z (N,) or a batch (k, N)."""
+        z = np.asarray(z, float)
+        single = z.ndim == 1
+        Z = z[None] if single else z
+        k = Z.shape[0]
+        t = self.tc + Z[:, :3]
+        R = _rotvec_batch(Z[:, 3:6]) @ self.Rc  # (k, 3, 3)
+        dc = Z[:, 6:].reshape(k, self.n, 6)
+        dT, dR = dc[:, self.mast, :3], dc[:, self.mast, 3:]
+        D = self.D0 + dT + _cross(dR, self.D0 - self.top0[self.mast])
+        w = self.w0 + _cross(dR, self.w0)
+        w /= np.linalg.norm(w, axis=-1)[..., None]
+        Rb = np.einsum("kij,mj->kmi", R, self.g.anchor_points)
+        B = Rb + t[:, None, :]
+        m = self.mast.size
+        ex = swivel_exit(D.reshape(-1, 3), w.reshape(-1, 3), B.reshape(-1, 3), self.robot.pulley_radius)
+        u, E, C = (ex[key].reshape(k, m, 3) for key in ("u", "E", "C"))
+        DF = self.F - D
+        lDF = np.linalg.norm(DF, axis=-1)
+        length = lDF + ex["length"].reshape(k, m)
+        tau = self.robot.EA * (length - self.l0) / self.l0
+        v = DF / lDF[..., None]
+        fp = tau[..., None] * (u + v)  # force of each cable on its pulley (Eq. 7)
+        top = self.top0 + dc[:, :, :3]
+        mom = _cross(C - top[:, self.mast], fp)
+        wr = np.einsum("nm,kmj->knj", self.gather, np.concatenate([fp, mom], axis=-1))
+        out = dict(t=t, R=R, dc=dc, tau=tau, u=u, Rb=Rb, E=E, wrench=wr)
+        return {key: val[0] for key, val in out.items()} if single else out
+
+    def residual(self, z):
+        """Residuals (N,) (or (k, N) for a batch of z) and the state."""
+        z = np.asarray(z, float)
+        single = z.ndim == 1
+        s = self.state(z[None] if single else z)
+        f = -(s["tau"][..., None] * s["u"])
+        cog = np.einsum("kij,j->ki", s["R"], self.g.cog)
+        rp = np.concatenate([f.sum(axis=1) + self.fg, _cross(s["Rb"], f).sum(axis=1) + _cross(cog, self.fg)], axis=1)
+        rm = s["dc"] - np.einsum("nij,knj->kni", self.C, s["wrench"] - self.w_cal) - self.delta
+        r = np.concatenate([rp, rm.reshape(len(rp), -1)], axis=1)
+        if single:
+            return r[0], {key: val[0] for key, val in s.items()}
+        return r, s
+
+
+def _jacobian(sys: _System, z):
+    """Central finite differences (h = 1e-7: truncation ~h^2, round-off ~1e-16/h relative), all columns
+    in one batched evaluation."""
+    h = 1e-7
+    N = z.size
+    Z = np.vstack([z + h * np.eye(N), z - h * np.eye(N)])
+    r = sys.residual(Z)[0]
+    return (r[:N] - r[N:]).T / (2 * h)
+
+
+def _newton(sys: _System, z0, J=None, tol=1e-11, max_iter=60, full=False):
+    """Newton with a finite-difference Jacobian, reused (from the previous pose of a trajectory, too)
+    while it contracts fast and refreshed when it does not.  Returns z, state, iterations, J."""
+    z = z0.copy()
+    age = 0
+    if J is None:
+        J = _jacobian(sys, z)
+    last = np.inf
+    for it in range(max_iter):
+        r, s = sys.residual(z)
+        dz = np.linalg.solve(J, -r)
+        step = np.abs(dz).max()
+        if age > 0 and (full or step > 0.8 * last):
+            J = _jacobian(sys, z)  # slow contraction: refresh the Jacobian
+            age = 0
+            dz = np.linalg.solve(J, -r)
+            step = np.abs(dz).max()
+        z += dz
+        age += 1
+        last = step
+        if step < tol:
+            r, s = sys.residual(z)
+            return z, s, it + 1, J
+    raise ModelError(f"platform/cable/mast equilibrium did not converge in {max_iter} iterations "
+                     f"(last correction {step:.3g})")
+
+
+def controller(robot: CableRobot, pose_c, tau=None, method: str = "barycenter"):
+    """What the rigid-frame controller sets at the commanded pose: the rigid exit geometry, the tension
+    distribution (Eq. 2 with the swivel-pulley exit points and the tension limits, or ``tau`` given, N)
+    and the unstretched cable lengths l0 (m).  Raises ModelError when no distribution exists."""
+    g = robot.geom
+    p = np.asarray(pose_c, float)
+    R = _rot(p[3:])
+    B = g.anchor_points @ R.T + p[:3]
+    ex = swivel_exit(g.exit_points, robot.axes, B, robot.pulley_radius)
+    if tau is None:
+        gE = dataclasses.replace(g, exit_points=ex["E"], winch_points=g.winch_points + (ex["E"] - g.exit_points))
+        tau = tension_distribution(gE, p, method=method).tau
+    tau = np.asarray(tau, float)
+    if tau.shape != (g.n_cables,) or np.any(~np.isfinite(tau)):
+        raise ModelError(f"give one finite tension (N) per cable ({g.n_cables}); got {tau!r}")
+    if np.any(tau <= 0):
+        raise ModelError(f"commanded tensions {tau} N: a cable cannot push (tension must be > 0 N)")
+    length = np.linalg.norm(g.winch_points - g.exit_points, axis=1) + ex["length"]
+    return tau, length / (1.0 + tau / robot.EA)
+
+
+def rigid_masts(n: int = 4) -> MastSet:
+    """Rigid masts (zero compliance)."""
+    return MastSet("rigid", np.zeros((n, 6, 6)))
+
+
+def solve_pose(robot: CableRobot, masts: MastSet, pose_c, *, tau=None, w_cal=None, delta=None, z0=None,
+               method: str = "barycenter", J=None) -> PoseSolution:
+    """Equilibrium of platform, cables and masts at the commanded pose ``pose_c`` ([x, y, z] m, angles rad).
+
+    tau : commanded tensions (N) or None (Eq. 2 distribution).  w_cal : (n, 6) mast wrenches at
+    calibration (default: zero, i.e. displacements from the unloaded masts).  delta : (n, 6) nonlinear
+    remainder of FE masts (m, rad).  z0 : start (from the previous pose of a trajectory).
+    An infeasible pose is returned with ``feasible=False`` and the reason, not raised."""
+    g = robot.geom
+    p = np.asarray(pose_c, float).ravel()
+    if p.size == 3:
+        p = np.concatenate([p, np.zeros(3)])
+    if p.size != 6 or not np.all(np.isfinite(p)):
+        raise ModelError(f"commanded pose {pose_c!r} must be [x, y, z] (m) or [x, y, z, roll, pitch, yaw] (m, rad)")
+    n = g.n_masts
+    C = np.asarray(masts.compliance, float)
+    if C.shape != (n, 6, 6):
+        raise ModelError(f"mast set '{masts.name}': compliance must be ({n}, 6, 6), one per mast; got {C.shape}")
+    nan = np.full(6, np.nan)
+    if tau is not None:
+        tau = np.asarray(tau, float)
+        if tau.shape != (g.n_cables,) or np.any(~np.isfinite(tau)) or np.any(tau <= 0):
+            raise ModelError(f"commanded tensions {tau} N: give one finite tension > 0 N per cable ({g.n_cables}); "
+                             "a cable cannot push")
+    try:
+        tau_c, l0 = controller(robot, p, tau, method)
+    except ModelError as exc:
+        return PoseSolution(nan, nan, np.full(g.n_cables, np.nan), np.full((g.n_cables, 3), np.nan),
+                            np.full((n, 6), np.nan), np.full((n, 6), np.nan), False, str(exc))
+    sys = _System(robot, masts, p, l0, np.zeros((n, 6)) if w_cal is None else w_cal,
+                  np.zeros((n, 6)) if delta is None else delta)
+    start = np.zeros(6 + 6 * n) if z0 is None else z0
+    try:
+        z, s, it, J = _newton(sys, start, J)
+    except (ModelError, np.linalg.LinAlgError):
+        z, s, it, J = _newton(sys, np.zeros(6 + 6 * n), None, full=True)  # plain Newton from the commanded pose
+    rotvec = z[3:6]
+    pose = np.concatenate([s["t"], Rotation.from_matrix(s["R"]).as_euler("xyz")])
+    sol = PoseSolution(pose, np.concatenate([z[:3], rotvec]), s["tau"], s["E"], s["dc"], s["wrench"], True, "", it)
+    sol._z, sol._J = z, J
+    if np.any(s["tau"] <= 0):
+        k = int(np.argmin(s["tau"]))
+        sol.feasible = False
+        sol.reason = (f"cable {g.labels[k]} goes slack (tension {s['tau'][k]:.3g} N) at the equilibrium reached from "
+                      f"the commanded pose ({fmt_pose(p)}): the cables cannot hold the platform there")
+    return sol
+
+
+@dataclass
+class TrajectoryResult:
+    """Pose errors along a trajectory (k poses).  commanded (k, 6); pose (k, 6); error (k, 6) (m, rad);
+    tension (k, m) N; exit_points (k, m, 3) m; top_displacement (k, n, 6); feasible (k,) bool;
+    reasons (list of str); fe_passes: number of FE corrections (0 for linear masts)."""
+
+    commanded: np.ndarray
+    pose: np.ndarray
+    error: np.ndarray
+    tension: np.ndarray
+    exit_points: np.ndarray
+    top_displacement: np.ndarray
+    wrench: np.ndarray
+    feasible: np.ndarray
+    reasons: list = field(default_factory=list)
+    fe_passes: int = 0
+
+    @property
+    def position_error(self) -> np.ndarray:
+        """|dx, dy, dz| per pose, m."""
+        return np.linalg.norm(self.error[:, :3], axis=1)
+
+    @property
+    def orientation_error(self) -> np.ndarray:
+        """|rotation vector| per pose, rad."""
+        return np.linalg.norm(self.error[:, 3:], axis=1)
+
+
+def _pass(robot, masts, poses, tau, w_cal, delta, method, progress):
+    sols = []
+    z = J = None
+    it = poses if progress is None else progress(poses)
+    for k, p in enumerate(it):
+        s = solve_pose(robot, masts, p, tau=None if tau is None else tau[k], w_cal=w_cal,
+                       delta=None if delta is None else delta[k], z0=z, method=method, J=J)
+        if s.feasible:
+            z, J = s._z, s._J
+        sols.append(s)
+    return sols
+
+
+def pose_trajectory(robot: CableRobot, masts: MastSet, poses, *, tensions=None, calibrate=None,
+                    method: str = "barycenter", fe_tol: float = 1e-7, max_fe_passes: int = 4,
+                    progress=None) -> TrajectoryResult:
+    """Pose errors along ``poses`` (k, 3|6).  The exit geometry is calibrated at ``calibrate`` (default
+    the first pose): the masts' displacements are counted from their state there.  tensions : (k, m)
+    commanded tensions, N, or None (Eq. 2).  FE masts: the linear pass uses their condensed tangent,
+    then the FE runs the whole wrench history per mast and the remainder is fed back until the top
+    displacements change by less than ``fe_tol`` (m, rad).  progress : e.g. ``tqdm`` (wrapper of an
+    iterable) or None."""
+    poses = np.atleast_2d(np.asarray(poses, float))
+    if poses.shape[1] == 3:
+        poses = np.hstack([poses, np.zeros((len(poses), 3))])
+    if tensions is not None:
+        tensions = np.asarray(tensions, float)
+        if tensions.shape != (len(poses), robot.geom.n_cables):
+            raise ModelError(f"tensions must be (k, m) = ({len(poses)}, {robot.geom.n_cables}) in N; got {tensions.shape}")
+    cal = poses[0] if calibrate is None else np.asarray(calibrate, float)
+    # the calibration state: the wrench the masts carry at the calibration pose (rigid-frame model)
+    c0 = solve_pose(robot, rigid_masts(robot.geom.n_masts), cal, method=method,
+                    tau=None if (tensions is None or calibrate is not None) else tensions[0])
+    if not c0.feasible:
+        raise ModelError(f"the calibration pose is infeasible: {c0.reason}")
+    w_cal = c0.wrench
+    delta = None
+    sols = _pass(robot, masts, poses, tensions, w_cal, delta, method, progress)
+    passes = 0
+    if masts.fe is not None:
+        for passes in range(1, max_fe_passes + 1):
+            wr = np.array([s.wrench for s in sols])
+            ok = np.array([s.feasible for s in sols])
+            new = np.zeros((len(poses), robot.geom.n_masts, 6))
+            for i, fe in enumerate(masts.fe):
+                hist = np.where(ok[:, None], wr[:, i], w_cal[i])
+                out = fe.run_wrenches(np.vstack([w_cal[i], hist]))
+                u = out["u"][1:] - out["u"][0]
+                new[:, i] = u - (hist - w_cal[i]) @ masts.compliance[i].T
+            change = np.inf if delta is None else np.abs(new - delta).max()
+            delta = new
+            sols = _pass(robot, masts, poses, tensions, w_cal, delta, method, progress)
+            if change < fe_tol:
+                break
+    pick = lambda key: np.array([getattr(s, key) for s in sols])  # noqa: E731
+    return TrajectoryResult(poses, pick("pose"), pick("error"), pick("tension"), pick("exit_points"),
+                            pick("top_displacement"), pick("wrench"), pick("feasible"),
+                            [s.reason for s in sols], passes)
