@@ -54,7 +54,7 @@ from .figures import diagnose_figure, display_scale
 from .fitting import fit, params_table
 from .noise import noise_model
 from .residuals import AT_NOISE, at_noise_threshold
-from .verdict import MIN_SHARE, SIGNIFICANT_DBIC, conclude, flags, pair_candidates, score, share
+from .verdict import MIN_SHARE, SIGNIFICANT_DBIC, conclude, flags, pair_candidates, robust_delta, score, share
 _START_METHOD = None  # multiprocessing start method of the local pool (None: the platform's default)
 REFIT_NFEV = 25  # evaluations per parameter and start of a refit (a converging refit needs 5-20; a direction the
 # data do not determine -- beam flexibility against the joint stiffness under top forces -- would use 100)
@@ -295,9 +295,11 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
                     "reading": f"The refit with {get_effect(effect).title} failed: {res.message}"}
         sc = score(res, models, chans, data.n)
         d, frac = sc["ic"] - ic0, share(r0, sc["ratio"])
+        dr = robust_delta(s0["z"], sc["z"], data.n, models, int(baseline.n_params), int(res.n_params))
         table = params_table(res)
         return {"effect": effect, "form": _form(spec, effect, key), "spec": spec, "rms": float(res.rms),
-                "ratio": sc["ratio"], "delta_bic": float(d), "explained_fraction": frac, **flags(d, frac),
+                "ratio": sc["ratio"], "delta_bic": float(d), "explained_fraction": frac, **flags(d, frac, dr),
+                "delta_bic_robust": float(dr),
                 "params": {k.split(".", 1)[1]: v for k, v in table.items() if k.startswith(spec + ".")},
                 "baseline_params": {k: v for k, v in table.items() if "." not in k}, "baseline_ratio": r0,
                 "success": bool(res.success), "at_bound": list(res.at_bound), "n_params": int(res.n_params),
@@ -330,8 +332,9 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     def pair_entry(x, y, res, by):
         sc = score(res, models, chans, data.n)
         d, frac = sc["ic"] - ic0, share(r0, sc["ratio"])
+        dr = robust_delta(s0["z"], sc["z"], data.n, models, int(baseline.n_params), int(res.n_params))
         return {"effects": [x, y], "forms": [by[x]["form"], by[y]["form"]], "ratio": sc["ratio"],
-                "rms": float(res.rms), "delta_bic": float(d), "explained_fraction": frac, **flags(d, frac),
+                "rms": float(res.rms), "delta_bic": float(d), "explained_fraction": frac, **flags(d, frac, dr),
                 "gain_over_best_single": float(d - min(by[x]["delta_bic"], by[y]["delta_bic"])),
                 "share_over_best_single": float(frac - max(by[x]["explained_fraction"], by[y]["explained_fraction"])),
                 "_fit": res}
@@ -373,7 +376,7 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     base_table = params_table(baseline)
     noise_rms = float(np.sqrt(np.mean([np.mean((exp.weight(c) * sigma[c]) ** 2) for c in chans])))
     public = ("effect", "rms", "delta_bic", "params", "significant", "ratio", "explained_fraction", "reading",
-              "form", "forms", "ic_gain", "share_ok")
+              "form", "forms", "ic_gain", "share_ok", "delta_bic_robust")
     report = {
         "experiment": exp.name,
         "n_samples": int(data.n),

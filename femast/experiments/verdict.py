@@ -12,6 +12,9 @@ A candidate is *significant* when both
 
 * ``delta_bic < SIGNIFICANT_DBIC`` (-10: "very strong" evidence on the Kass-Raftery scale; for one
   parameter and 1500 residuals a chi-square drop of 17, p < 4e-5 under the null), and
+* the same holds with the 2 % of rows (at least 3) that gain most left out (a mechanism acts on
+  many rows; a gain from a handful of rows -- outliers, a model artefact at one spot of the path
+  such as the break-out from the latch backstop -- is not evidence of it), and
 * ``explained_fraction >= MIN_SHARE`` (10 %).  With hundreds of residuals a change of shape that
   removes 2 % of a large excess error passes any information criterion, yet it is not the missing
   mechanism: such gains come from a flexible effect bending into a structure it does not model
@@ -47,6 +50,7 @@ SIGNIFICANT_DBIC = -10.0
 MIN_SHARE = 0.10
 FORM_SHARE = 0.60
 PAIR_TOP = 4
+FEW_ROWS = 0.02
 
 
 def score(fit, models: dict, channels, n_rows: int) -> dict:
@@ -56,15 +60,35 @@ def score(fit, models: dict, channels, n_rows: int) -> dict:
             "ic": information_criterion(z, n_rows, {c: models[c] for c in channels}, int(fit.n_params)), "z": z}
 
 
+def robust_delta(z0, zc, n_rows: int, models: dict, p0: int, pc: int) -> float:
+    """delta BIC of a variant (whitened residuals zc, pc parameters) against the baseline (z0, p0) with
+    the ``FEW_ROWS`` share of rows (at least 3) that gain most left out of both: a mechanism acts on
+    many rows, a gain that comes from a handful of them (a few outliers, a model artefact at one
+    spot of the path) is not evidence of it."""
+    nch = len(models)
+    g = (np.asarray(z0).reshape(nch, n_rows) ** 2 - np.asarray(zc).reshape(nch, n_rows) ** 2).sum(axis=0)
+    k = max(3, int(np.ceil(FEW_ROWS * n_rows)))
+    if n_rows - k < 5:
+        return -np.inf
+    keep = np.ones(n_rows, bool)
+    keep[np.argsort(-g)[:k]] = False
+    sub = {c: m for c, m in models.items()}
+    a = np.asarray(z0).reshape(nch, n_rows)[:, keep].ravel()
+    b = np.asarray(zc).reshape(nch, n_rows)[:, keep].ravel()
+    m = int(keep.sum())
+    return information_criterion(b, m, sub, pc) - information_criterion(a, m, sub, p0)
+
+
 def share(r0: float, r: float) -> float:
     """Share of the excess error ``r0^2 - 1`` removed by going from ratio r0 to r (0 if no excess)."""
     excess = r0**2 - 1.0
     return float(np.clip((r0**2 - r**2) / excess, 0.0, 1.0)) if excess > 0 else 0.0
 
 
-def flags(delta_ic: float, frac: float) -> dict:
-    """``ic_gain``, ``share_ok`` and ``significant`` (both) of a variant."""
-    ic_gain = bool(delta_ic < SIGNIFICANT_DBIC)
+def flags(delta_ic: float, frac: float, delta_robust: float = -np.inf) -> dict:
+    """``ic_gain`` (delta_ic and the delta without the few rows that gain most both below -10),
+    ``share_ok`` and ``significant`` (both) of a variant."""
+    ic_gain = bool(delta_ic < SIGNIFICANT_DBIC and delta_robust < SIGNIFICANT_DBIC)
     share_ok = bool(frac >= MIN_SHARE)
     return {"ic_gain": ic_gain, "share_ok": share_ok, "significant": ic_gain and share_ok}
 
