@@ -54,16 +54,18 @@ def test_white_noise_is_called_white_and_the_thresholds_are_the_99th_percentiles
 
 
 def test_heteroscedastic_law_is_recovered():
+    # seed 001 Eq. 15: residual e_T (1 + s C) - s e_d, variance sigma_T^2 (1 + s C)^2 + s^2 sigma_d^2
     rng = np.random.default_rng(7)
     n = 600
-    g = np.abs(np.sin(np.linspace(0, 9, n))) * 3e4  # a slope, N/m
-    a, b = 0.5, 2e-5  # N, m: sigma_i^2 = a^2 + b^2 g_i^2 (0.5 N to 0.78 N... to 0.78)
-    fits = [heteroscedastic_fit(rng.normal(0, 1, n) * np.sqrt(a**2 + (b * g) ** 2), g) for _ in range(20)]
-    A = np.mean([f["a"] for f in fits])
-    B = np.mean([f["b"] for f in fits])
-    # 20 draws of 600 rows: the means within 10 % (per-draw scatter ~15-25 %, measured)
-    assert abs(A / a - 1) < 0.1 and abs(B / b - 1) < 0.1
-    m = channel_noise("dT_N", rng.normal(0, 1, n) * np.sqrt(a**2 + (b * g) ** 2), n, {"slope": g})
+    s = np.sin(np.linspace(0, 9, n)) * 3e5  # signed slope of the law, N/m
+    C, sT, sd = 2.5e-6, 0.4, 2e-6
+    true = np.sqrt(sT**2 * (1 + s * C) ** 2 + (s * sd) ** 2)  # 0.4 N ... 0.85 / 0.65 N by the sign of s
+    fits = [heteroscedastic_fit(rng.normal(0, 1, n) * true, s) for _ in range(20)]
+    A, B, D = np.mean([f["coef"] for f in fits], axis=0)
+    # 20 draws of 600 rows: the mean law within 5 % of the true one at every slope
+    np.testing.assert_allclose(np.sqrt(A + B * s + D * s * s), true, rtol=0.05)
+    np.testing.assert_allclose([A, B], [sT**2, 2 * C * sT**2], rtol=0.25)
+    m = channel_noise("dT_N", rng.normal(0, 1, n) * true, n, {"slope": s})
     assert m.kind == "heteroscedastic" and m.covariate == "slope"
 
 

@@ -127,3 +127,21 @@ def test_latch_pull_null_redraws_with_eq15_noise_and_a_small_friction():
                                   noise_mm=0.02)
         d = diagnose(exp, data, workers=1)
         assert d.verdict["missing_effects"] == ["friction_hysteresis"], (seed, d.verdict["conclusion"])
+
+
+def test_a_gain_from_a_handful_of_rows_is_not_significant():
+    from femast.experiments.noise import ChannelNoise, information_criterion
+    from femast.experiments.verdict import robust_delta
+
+    rng = np.random.default_rng(0)
+    n = 300
+    m = {"c": ChannelNoise("c", "white", np.ones(n), 0.0, float(n))}
+    zc = rng.normal(0, 1, n)
+    z0 = zc.copy()
+    z0[[10, 100, 200]] += 8.0  # three outlier rows that a variant absorbs, nothing else
+    d = information_criterion(zc, n, m, 3) - information_criterion(z0, n, m, 2)
+    assert d < -10 and robust_delta(z0, zc, n, m, 2, 3) > -10
+    assert flags(d, 0.9, robust_delta(z0, zc, n, m, 2, 3))["significant"] is False
+    # the same total gain spread over every row survives leaving the best 2 % out
+    z0 = zc + 0.6 * np.sign(zc)
+    assert robust_delta(z0, zc, n, m, 2, 3) < -10
