@@ -206,3 +206,29 @@ def test_modes_of_every_saved_increment_follow_the_axial_load(tmp_path):
     assert len(list((tmp_path / "res" / "modes").glob("frame_*.npz"))) == 5
     pvd = export_modes_vtk(rec.modes[-1], tmp_path / "vtk", n_frames=8)
     assert len(pvd) == 2 and len(list(pvd[0].parent.glob("*.vtu"))) == 8
+
+
+def test_cable_device_family_with_mass_per_length_is_a_beaded_string():
+    """A cable over 19 frictionless point pulleys (femast.elements.cable_devices) with a mass per
+    length: lumped beads m' h on a string at tension T; the discrete closed form
+    omega_n = 2 sqrt(T / (m' h^2)) sin(n pi / (2 N)) holds exactly (1e-6: the equilibrium check of
+    the state; the transverse stiffness of a frictionless pulley is the string's T/h either side)."""
+    from femast.elements.cable_devices import CableDeviceFamily, Pulley
+
+    N, L, T, mpl = 20, 2.0, 150.0, 0.01
+    m = fm.Model("cable over pulleys")
+    labels = [m.node(L * k / N, 0, 0) for k in range(N + 1)]
+    fam = CableDeviceFamily.pretensioned(np.arange(N + 1), m.coordinates, 1e6, T, [Pulley()] * (N - 1),
+                                         name="cable")
+    fam.nodes = np.asarray([labels])
+    fam.mass_per_length = mpl
+    m.add_family(fam)
+    m.fix(labels[0])
+    m.fix(labels[-1])
+    for lab in labels[1:-1]:
+        m.fix(lab, "ux")   # the pulleys slide the cable, not themselves: hold them along it
+    m.step("hold")
+    f = modal_analysis(_fresh(m), 4).frequencies.reshape(2, 2).mean(axis=1)
+    h = L / N
+    exact = [2 * math.sqrt(T / (mpl * h * h)) * math.sin(n * math.pi / (2 * N)) / (2 * math.pi) for n in (1, 2)]
+    np.testing.assert_allclose(f, exact, rtol=1e-6)
