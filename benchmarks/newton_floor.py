@@ -72,7 +72,8 @@ def minimal_run(mast, n_inc):
         while True:
             f, K = np.empty((n, 12)), np.empty((n, 12, 12))
             sf, energy = np.empty((n, 2, 6)), np.empty(n)
-            beam_family_kernel(fam.nodes, x, R, fam.E0, fam.l0, fam.EA, fam.GJ, fam.EIy, fam.EIz, f, K, sf, energy)
+            beam_family_kernel(fam.nodes, x, R, fam.E0, fam.l0, fam.EA, fam.GJ, fam.EIy, fam.EIz, fam.length_factor,
+                               f, K, sf, energy)
             F[:] = 0.0
             _scatter_vector(f, eqs, F)
             r = P - F[:nf]

@@ -115,6 +115,7 @@ class Step:
     output_frequency: int = 1
     loads: list = field(default_factory=list)
     prescribed: list = field(default_factory=list)
+    temperatures: list = field(default_factory=list)   # (labels, values K or degC, amplitude): issue 20
     _model: "Model" = field(default=None, repr=False)
 
     def load(self, node, amplitude: Amplitude | None = None, **components):
@@ -146,6 +147,18 @@ class Step:
         return self
 
 
+def _step_temperature(self, T, elements=None, family=None, where=None, amplitude: Amplitude | None = None):
+    """Temperature ``T`` (K or degC; one value or one per element) of beam and truss elements at the
+    end of the step (as Abaqus *TEMPERATURE): picked by ``elements`` (labels), ``family`` (name) and
+    ``where`` (a function of the element midpoint, m: a region); none: all.  With a coefficient of
+    thermal expansion (:meth:`Model.thermal_expansion`) it strains the elements by
+    alpha (T - T_init).  It ramps from the step's start temperature linearly in step time, or as
+    ``T_start + a(t) (T - T_start)`` with an ``amplitude`` a(t); see :mod:`femast.thermal`."""
+    from .thermal import add_step_temperature
+
+    return add_step_temperature(self, T, elements, family, where, amplitude)
+
+
 def _step_rotate(self, node, axis, angle: float, amplitude: Amplitude | None = None):
     """Prescribe a rotation of ``node`` by ``angle`` (rad) about the fixed global ``axis`` (any
     direction) at the end of the step: the three rotation components are driven together, which
@@ -167,6 +180,7 @@ def _step_follow(self, node, times, **tables):
 
 
 Step.rotate = _step_rotate
+Step.temperature = _step_temperature
 Step.follow = _step_follow
 
 
@@ -186,6 +200,9 @@ class Model:
         self.ties: list = []
         self.steps: list[Step] = []
         self.point_masses: list = []   # femast.mass.PointMassSpec (modal analyses)
+        self.length_errors: dict = {}         # element label -> m (lack of fit, issue 20)
+        self.expansion: dict = {}             # element label -> 1/K
+        self.initial_temperatures: dict = {}  # element label -> K or degC
         self._next_element = 1
 
     # ---------------------------------------------------------------- nodes
@@ -237,11 +254,15 @@ class Model:
 
     # ------------------------------------------------------------- elements
     def beam(self, n1, n2, section: Section, up=(0.0, 0.0, 1.0), n: int = 1, family: str = "beam",
-             mass_per_length: float | None = None) -> list[int]:
+             mass_per_length: float | None = None, length_error_m: float = 0.0,
+             alpha_per_K: float = 0.0) -> list[int]:
         """Beam(s) from node ``n1`` to ``n2``, split into ``n`` equal elements (new nodes are
         created in between).  ``up`` (global vector) sets the local y axis: it is made
         orthogonal to the element; Iz resists bending in the plane of the axis and ``up``.
         ``mass_per_length`` (kg/m) overrides the section's ``rho * A`` for modal analyses.
+        ``length_error_m`` (m): the member is stress free when that much longer than its nodes'
+        distance (lack of fit, spread evenly over its ``n`` elements); ``alpha_per_K`` (1/K): its
+        coefficient of thermal expansion (see :meth:`length_error`, :meth:`thermal_expansion`).
         Returns the element labels."""
         self._check_node(n1, "beam")
         self._check_node(n2, "beam")
@@ -270,15 +291,48 @@ class Model:
             labels.append(self._next_element)
             self.beams.append(BeamSpec(self._next_element, (p, q), section, up, family, mass_per_length))
             self._next_element += 1
+        self._error_sources(labels, length_error_m, alpha_per_K)
         return labels
 
+    def _error_sources(self, labels, length_error_m, alpha_per_K):
+        if length_error_m != 0.0:
+            self.length_error(labels, _finite(length_error_m, f"element {labels[0]}: length_error_m (m)")
+                              / len(labels))
+        if alpha_per_K != 0.0:
+            self.thermal_expansion(alpha_per_K, elements=labels)
+
+    def length_error(self, elements, dL_m):
+        """Lack of fit: element(s) ``elements`` (labels of beams or trusses) are stress free at their
+        reference length + ``dL_m`` (m; one value or one per element; a beam's reference is its
+        nodes' distance, a truss's its unstretched length).  Acts from the first step."""
+        from .thermal import set_length_errors
+
+        return set_length_errors(self, elements, dL_m)
+
+    def thermal_expansion(self, alpha_per_K, elements=None, family=None, where=None):
+        """Coefficient of thermal expansion (1/K; one value or one per element) of beam and truss
+        elements picked by labels, family name or region (``where``: a function of the element
+        midpoint, m); none: all.  Returns the labels."""
+        from .thermal import set_expansion
+
+        return set_expansion(self, alpha_per_K, elements, family, where)
+
+    def initial_temperature(self, T, elements=None, family=None, where=None):
+        """Initial temperature (K or degC, default 0) of beam and truss elements (as Abaqus *INITIAL
+        CONDITIONS, TYPE=TEMPERATURE): the elements are stress free at it.  Returns the labels."""
+        from .thermal import set_initial_temperature
+
+        return set_initial_temperature(self, T, elements, family, where)
+
     def truss(self, n1, n2, EA: float, L0: float | None = None, pretension: float | None = None,
-              tension_only: bool = False, family: str | None = None, mass_per_length: float = 0.0) -> int:
+              tension_only: bool = False, family: str | None = None, mass_per_length: float = 0.0,
+              length_error_m: float = 0.0, alpha_per_K: float = 0.0) -> int:
         """Truss (or, with ``tension_only=True``, cable) from ``n1`` to ``n2``; EA in N.
         Give the unstretched length ``L0`` (m) or the ``pretension`` (N) it carries in the
         initial geometry; neither means stress-free.  ``mass_per_length`` (kg/m of the initial
         length; modal analyses): consistent mass for trusses, lumped at the ends for cables.
-        Returns the element label."""
+        ``length_error_m`` (m): stress free at the unstretched length + this (lack of fit);
+        ``alpha_per_K`` (1/K): coefficient of thermal expansion.  Returns the element label."""
         self._check_node(n1, "truss")
         self._check_node(n2, "truss")
         EA = _finite(EA, f"truss {n1}-{n2}: EA")
@@ -304,6 +358,7 @@ class Model:
         self._next_element += 1
         fam = family or ("cable" if tension_only else "truss")
         self.trusses.append(TrussSpec(label, (n1, n2), EA, L0, pretension, bool(tension_only), fam, mass_per_length))
+        self._error_sources([label], length_error_m, alpha_per_K)
         return label
 
     def add_family(self, family):

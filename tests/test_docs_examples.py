@@ -5,7 +5,7 @@ import re
 import pytest
 from doc_examples import run_python_blocks
 PAGES = ["getting_started.md", "model.md", "solver.md", "results.md", "stabilize.md", "arc_length.md",
-         "constraints.md"]
+         "constraints.md", "misfit_and_thermal.md"]
 
 
 @pytest.mark.parametrize("page", PAGES)

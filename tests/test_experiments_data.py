@@ -162,7 +162,7 @@ experiment = Experiment(name="rig-x", title="a rig whose model is not written ye
 
 def test_unknown_and_pending_experiments(tmp_path):
     with pytest.raises(ModelError, match=r"unknown experiment 'mast'; accepted: mast-top, latch-pull, bay-torsion, "
-                                         r"tip-cycle, vibration or the path of a Python script"):
+                                         r"tip-cycle, vibration, platform-pose or the path of a Python script"):
         get_experiment("mast")
     # an experiment may be registered with its data format before its model exists (model=None)
     script = tmp_path / "rig_x.py"

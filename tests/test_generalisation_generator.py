@@ -178,6 +178,30 @@ def test_latch_rig_matches_the_seed_law():
     assert np.allclose(latch_law(x, +1), latch_force(x, UNLATCHING, p), atol=1e-9)
 
 
+@pytest.mark.parametrize("name", ["mt_null_white", "mt_null_hetero", "lp_null_white", "lp_null_ar1"])
+def test_noise_free_null_data_is_the_seed_baseline(name):
+    # the null cases must be exactly what the experiment's baseline model predicts at the seed's
+    # parameters, or every null redraw carries a systematic error (a hold pulled past the
+    # breakaway force once did: 4 samples 1-4 N above the static band on the backstop)
+    from dataclasses import replace
+
+    from femast.experiments import from_arrays, get_experiment
+    from femast.experiments.core import NO_EFFECTS
+    from generalisation.cases import get_case, generate
+    from generalisation.rigs import K_JOINTS
+
+    case = replace(get_case(name), level=1e-12)
+    exp = get_experiment(case.experiment)
+    for seed in range(3):
+        cols = generate(case, seed)
+        data = from_arrays(exp, **cols)
+        params = {"k_theta1": K_JOINTS[0], "k_theta2": K_JOINTS[1]} if case.experiment == "mast-top" else exp.defaults()
+        pred = exp.model(params, data, NO_EFFECTS, exp.options)
+        scale = max(np.max(np.abs(cols[ch])) for ch in pred)  # dz is zero in the 3R model: one scale
+        for ch, p in pred.items():
+            assert np.max(np.abs(cols[ch] - p)) < 1e-9 * scale, (name, seed, ch)  # round-off of the two codes
+
+
 # --------------------------------------------------------------------------- scoring and the harness
 def test_verdict_adapter_reads_old_and_new_reports():
     old = {"verdict": {"missing_effect": "joint_clearance", "explained": True, "best_candidate": "joint_clearance",
@@ -196,6 +220,9 @@ def test_verdict_adapter_reads_old_and_new_reports():
     pair = {"verdict": {"kind": "missing_effect", "missing_effect": "joint_clearance+friction_hysteresis",
                         "conclusion": "missing effect: joint_clearance + friction_hysteresis"}}
     assert read_verdict(pair)["effects"] == ["friction_hysteresis", "joint_clearance"]
+    slashed = {"verdict": {"kind": "missing_effect", "missing_effect": "friction_hysteresis/jenkins",
+                           "conclusion": "?"}}
+    assert read_verdict(slashed)["effects"] == ["friction_hysteresis"]  # a form names its mechanism
     v = read_verdict(pair)
     assert is_right("pair", ("joint_clearance", "friction_hysteresis"), v)
     assert not is_right("effect", ("joint_clearance",), v)

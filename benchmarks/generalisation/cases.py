@@ -270,6 +270,7 @@ def latch_truth(case: Case, rng):
                                p["A"] * np.sin(2 * np.pi * (x + xb) / p["wavelength"]), 0.0)
     dT = np.where(kind > 0, np.maximum(dT, 0.0), np.where(kind < 0, np.minimum(dT, 0.0), dT))
     # holds: pushed onto the backstop, released, pulled up to the force at which the bead moves
+    # (the first sample of the next pass, still at x = -x_b: the top of the static band, Eq. 9)
     i = 0
     for k, s in segs:
         if k == "hold":

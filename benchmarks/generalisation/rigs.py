@@ -155,6 +155,8 @@ def latch_path(n: int, rng, x_max_m=(4.0e-3, 3.0e-3), push_N: float = 40.0, p=LA
         k = max(8, int(round(n * length / total)))
         if kind == "hold":
             segs.append((kind, np.full(k, -xb)))
+        elif kind == "out":  # starts on the backstop: the hold's pull ends at the breakaway dT_out(-x_b)
+            segs.append((kind, np.linspace(ends[0], ends[1], k)))
         else:
             segs.append((kind, np.linspace(ends[0], ends[1], k + 1)[1:]))
     return segs

@@ -64,7 +64,8 @@ def _names(value) -> list:
         for v in value:
             out += _names(v)
         return out
-    return [s.strip() for s in re.split(r"[+,&]| and ", str(value)) if s.strip()]
+    # "X/form" names a form of X: the mechanism is X
+    return [s.strip().split("/")[0] for s in re.split(r"[+,&]| and ", str(value)) if s.strip()]
 
 
 def read_verdict(report: dict) -> dict:

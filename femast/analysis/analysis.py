@@ -23,6 +23,7 @@ from ..elements.base import DOF_NAMES
 from ..errors import ConvergenceError, ModelError, SingularModelError
 from ..results import Results
 from ..solvers.convergence import Convergence
+from ..thermal import FieldLoads, check_controls, has_fields
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
@@ -86,6 +87,9 @@ class Analysis:
         if not (model.beams or model.trusses or model.families):
             raise ModelError(f"model '{model.name}' has no elements")
         self.families = build_families(model)
+        check_controls(model)
+        # length errors and temperatures (issue 20): None when the model has neither
+        self.fields = FieldLoads(model, self.families) if has_fields(model) else None
         self.summary = AnalysisSummary()
         self.system = System(model, self.families, self.summary)
         self.state = State.initial(self.system.X0, self.families)

@@ -144,6 +144,11 @@ class TimeIncrements(Plan):
         sys_ = an.system
         t, dt = st.step_time, st.size
         frac = (t + dt) / period
+        fields = getattr(an, "fields", None)
+        if fields is not None and fields.set(st.step, frac):
+            # the element properties changed (temperature): the committed response is not this one's
+            sys_.last_converged = None
+            st.at_equilibrium = False
         inc = Increment(time=t + dt, dtime=dt, total_time=st.total_time + dt, step_name=step.name, lam=frac,
                         viscous=self.viscous)
         if self.uses_lam:

@@ -9,7 +9,8 @@ Formulation (Crisfield 1990; Battini & Pacoste 2002, CMAME 191:1755):
 * local deformations: ubar = l - l0 and the local rotations
   theta_a = log(Rr^T T_a), a = 1, 2 (exact for any rigid rotation: a rigidly rotated
   element has zero local deformation);
-* local response: the linear cubic Euler-Bernoulli beam, N = EA ubar / l0,
+* local response: the linear cubic Euler-Bernoulli beam, N = EA ubar / l0 (ubar = l - l0 s with
+  s the ``length_factor`` of a length error or thermal strain, 1 by default),
   torsion GJ / l0, bending 2EI / l0 [[2, 1], [1, 2]] about local y and z;
 * global forces f = B^T f_l and the consistent tangent K = df/dd with respect to
   nodal translations and spatial spins (d = [dx1, dw1, dx2, dw2]), including every
@@ -44,9 +45,13 @@ SECTION_FORCE_NAMES = ("N", "Vy", "Vz", "T", "My", "Mz")
 
 
 @njit(cache=True)
-def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, fs, Ks, sfs, energy):
+def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_factor, fs, Ks, sfs, energy):
     """Internal forces ``fs`` (n, 12), tangents ``Ks`` (n, 12, 12), section forces ``sfs``
     (n, 2, 6) and strain energies ``energy`` (J) of all the corotational beams of a family.
+
+    ``length_factor`` (dimensionless, per element): the axially stress-free length is
+    ``l0 * factor`` (a length error and a thermal strain, femast/thermal.py): ubar = l - l0 factor,
+    N = EA ubar / l0 (strain on l0, so dN/dl = EA / l0 is unchanged); bending and torsion keep l0.
 
     One loop over the elements with the element's work written out in its body (not a call)
     and every scratch array on the stack (:mod:`._stack`): the compiler then keeps values in
@@ -142,7 +147,8 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, fs, Ks, sfs,
         q2c = q[0] * Rr[0, 1] + q[1] * Rr[1, 1] + q[2] * Rr[2, 1]
 
         # local response (7 dofs: ubar, theta1, theta2)
-        ubar = (l * l - l0 * l0) / (l + l0)
+        lf = l0 * length_factor[e]
+        ubar = (l * l - lf * lf) / (l + lf)
         N = EA * ubar / l0
         kt = GJ / l0
         ky = 2.0 * EIy / l0
@@ -382,6 +388,7 @@ class BeamFamily(ElementFamily):
         self.GJ = np.ascontiguousarray(GJ, dtype=float)
         self.EIy = np.ascontiguousarray(EIy, dtype=float)
         self.EIz = np.ascontiguousarray(EIz, dtype=float)
+        self.length_factor = np.ones(len(self.nodes))   # stress-free length / l0 (femast/thermal.py)
         self.labels = np.arange(1, len(self.nodes) + 1) if labels is None else np.asarray(labels)
 
     def evaluate(self, x, R, state, ctx=None):
@@ -391,5 +398,5 @@ class BeamFamily(ElementFamily):
         sf = np.empty((n, 2, 6))
         energy = np.empty(n)
         beam_family_kernel(self.nodes, np.ascontiguousarray(x), np.ascontiguousarray(R), self.E0, self.l0,
-                           self.EA, self.GJ, self.EIy, self.EIz, f, K, sf, energy)
+                           self.EA, self.GJ, self.EIy, self.EIz, self.length_factor, f, K, sf, energy)
         return ElementResponse(f=f, k=K, state=state, output={"section_forces": sf}, energy=energy)

@@ -1,7 +1,8 @@
 """Two-node truss / cable element (the analogue of Abaqus T3D2), geometrically exact.
 
 Axial force N = EA (l - L0) / L0 with L0 the unstretched length (engineering strain
-on the reference length, large rotations exact).  A tension-only element (a cable)
+on the reference length, large rotations exact).  A length error or thermal strain makes the
+stress-free length L0 s (``length_factor`` s): N = EA (l - L0 s) / L0.  A tension-only element (a cable)
 carries N = max(N, 0).  Given a pretension N0 instead of L0, the unstretched length
 is chosen so that the element carries N0 in the initial geometry: L0 = l_init / (1 + N0/EA).
 
@@ -19,9 +20,13 @@ from .base import ElementFamily, ElementResponse
 
 
 @njit(cache=True)
-def truss_family_kernel(nodes, x, L0, EA, tension_only, f, K, N_out, energy):
+def truss_family_kernel(nodes, x, L0, EA, tension_only, length_factor, f, K, N_out, energy):
     """All trusses at once; writes the translational entries of ``f`` and ``K`` (the rotational
-    rows and columns stay as given: zero).  Scalars only, no allocation."""
+    rows and columns stay as given: zero).  Scalars only, no allocation.
+
+    ``length_factor`` (dimensionless, per element): the stress-free length is ``L0 * factor``
+    (a length error and a thermal strain, femast/thermal.py); the strain is measured on ``L0``:
+    N = EA (l - L0 factor) / L0, so dN/dl = EA / L0 is unchanged."""
     for el in range(nodes.shape[0]):
         a = nodes[el, 0]
         b = nodes[el, 1]
@@ -33,12 +38,13 @@ def truss_family_kernel(nodes, x, L0, EA, tension_only, f, K, N_out, energy):
         e1 = d1 / l
         e2 = d2 / l
         k_ax = EA[el] / L0[el]
-        N = k_ax * (l - L0[el])
+        Lf = L0[el] * length_factor[el]
+        N = k_ax * (l - Lf)
         if tension_only[el] and N <= 0.0:
             N = 0.0
             k_ax = 0.0
         N_out[el] = N
-        energy[el] = 0.5 * N * (l - L0[el])
+        energy[el] = 0.5 * N * (l - Lf)
         g = N / l
         for i in range(3):
             ei = e0 if i == 0 else (e1 if i == 1 else e2)
@@ -55,7 +61,8 @@ def truss_family_kernel(nodes, x, L0, EA, tension_only, f, K, N_out, energy):
 
 class TrussFamily(ElementFamily):
     """A batch of trusses / cables: ``L0`` unstretched lengths (m), ``EA`` (N),
-    ``tension_only`` (bool per element)."""
+    ``tension_only`` (bool per element).  ``length_factor`` (dimensionless, ones by default): the
+    stress-free length over ``L0`` (length errors and thermal strain, set by femast/thermal.py)."""
 
     name = "truss"
     active_dofs = (0, 1, 2)
@@ -69,6 +76,7 @@ class TrussFamily(ElementFamily):
         self.L0 = np.ascontiguousarray(L0, dtype=float)
         self.EA = np.ascontiguousarray(EA, dtype=float)
         self.tension_only = np.ascontiguousarray(tension_only, dtype=np.bool_)
+        self.length_factor = np.ones(len(self.nodes))
         self.labels = np.arange(1, len(self.nodes) + 1) if labels is None else np.asarray(labels)
 
     def evaluate(self, x, R, state, ctx=None):
@@ -77,5 +85,6 @@ class TrussFamily(ElementFamily):
         K = np.zeros((n, 12, 12))
         N = np.zeros(n)
         energy = np.zeros(n)
-        truss_family_kernel(self.nodes, np.ascontiguousarray(x), self.L0, self.EA, self.tension_only, f, K, N, energy)
+        truss_family_kernel(self.nodes, np.ascontiguousarray(x), self.L0, self.EA, self.tension_only,
+                            self.length_factor, f, K, N, energy)
         return ElementResponse(f=f, k=K, state=state, output={"N": N}, energy=energy)

@@ -6,7 +6,8 @@ its fittable parameters and the hooks where physical effects (:mod:`femast.effec
 Built-in experiments: ``mast-top`` (seed 000, 3R model), ``latch-pull`` (seed 001 latch law),
 ``bay-torsion`` (FE single ADAM bay, seed 001 Figs. 16-17), ``tip-cycle`` (FE ADAM mast under
 tip load cycles, seed 001 Table 1) and ``vibration`` (measured natural frequencies against the
-prestressed modal analysis, seed 001 Sec. IV).
+prestressed modal analysis, seed 001 Sec. IV), ``platform-pose`` (the CDPR platform on compliant
+masts, seed 000 Fig. 7).
 
 Typical use::
 
@@ -23,10 +24,10 @@ See ``docs/experiments.md`` and ``docs/compare_and_diagnose.md``.
 from .core import Column, EffectStack, Experiment, Measured, Parameter, prepared
 from .data import from_arrays, read_data, write_data
 from .registry import experiment_from_source, get_experiment, list_experiments, register_experiment
-from . import bay_torsion, latch_pull, mast_top, tip_cycle, vibration  # noqa: E402  (built-in experiments)
+from . import bay_torsion, latch_pull, mast_top, platform_pose, tip_cycle, vibration  # noqa: E402  (built-in experiments)
 
 for _e in (mast_top.EXPERIMENT, latch_pull.EXPERIMENT, bay_torsion.EXPERIMENT, tip_cycle.EXPERIMENT,
-           vibration.EXPERIMENT):
+           vibration.EXPERIMENT, platform_pose.EXPERIMENT):
     register_experiment(_e)
 
 from .compare import compare, format_compare  # noqa: E402

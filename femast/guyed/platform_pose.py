@@ -361,15 +361,28 @@ def _pass(robot, masts, poses, tau, w_cal, delta, method, progress):
     return sols
 
 
+def _fe_response(masts: MastSet):
+    def response(hist, w_cal):
+        out = np.empty_like(hist)
+        for i, fe in enumerate(masts.fe):
+            run = fe.run_wrenches(np.vstack([w_cal[i], hist[:, i]]))
+            out[:, i] = run["u"][1:] - run["u"][0]
+        return out
+    return response
+
+
 def pose_trajectory(robot: CableRobot, masts: MastSet, poses, *, tensions=None, calibrate=None,
-                    method: str = "barycenter", fe_tol: float = 1e-7, max_fe_passes: int = 4,
+                    method: str = "barycenter", response=None, fe_tol: float = 1e-6, max_fe_passes: int = 6,
                     progress=None) -> TrajectoryResult:
     """Pose errors along ``poses`` (k, 3|6).  The exit geometry is calibrated at ``calibrate`` (default
     the first pose): the masts' displacements are counted from their state there.  tensions : (k, m)
-    commanded tensions, N, or None (Eq. 2).  FE masts: the linear pass uses their condensed tangent,
-    then the FE runs the whole wrench history per mast and the remainder is fed back until the top
-    displacements change by less than ``fe_tol`` (m, rad).  progress : e.g. ``tqdm`` (wrapper of an
-    iterable) or None."""
+    commanded tensions, N, or None (Eq. 2).
+
+    Nonlinear masts: ``response(w_hist, w_cal) -> dc (k, n, 6)`` gives the top displacements (m, rad)
+    for the wrench history ``w_hist`` (k, n, 6) from the calibration wrenches ``w_cal`` (n, 6); FE
+    masts (``masts.fe``) bring their own.  The first pass uses the linear ``masts.compliance``; then
+    the remainder ``response - C (w - w_cal)`` is fed back and the pass repeated until the tops move
+    by less than ``fe_tol`` (m, rad; 1 um is 1e-4 of the pose errors of the Rocaspect).  progress : e.g. ``tqdm`` (wrapper of an iterable) or None."""
     poses = np.atleast_2d(np.asarray(poses, float))
     if poses.shape[1] == 3:
         poses = np.hstack([poses, np.zeros((len(poses), 3))])
@@ -387,21 +400,33 @@ def pose_trajectory(robot: CableRobot, masts: MastSet, poses, *, tensions=None, 
     delta = None
     sols = _pass(robot, masts, poses, tensions, w_cal, delta, method, progress)
     passes = 0
-    if masts.fe is not None:
+    if masts.fe is not None and response is None:
+        response = _fe_response(masts)
+    if response is not None:
+        # Each pass feeds back the remainder of the nonlinear response over the compliance in use.  That
+        # compliance is updated by the secant least-squares fit of the response to the wrench changes, so
+        # the remainder is the nonlinear part only (a remainder that is a whole extra compliance, e.g. a
+        # mast-top effect, would otherwise be amplified by the cable stiffness and diverge).
+        lin = MastSet(masts.name, masts.compliance.copy(), masts.fe)
+        dc_prev = None
         for passes in range(1, max_fe_passes + 1):
             wr = np.array([s.wrench for s in sols])
             ok = np.array([s.feasible for s in sols])
-            new = np.zeros((len(poses), robot.geom.n_masts, 6))
-            for i, fe in enumerate(masts.fe):
-                hist = np.where(ok[:, None], wr[:, i], w_cal[i])
-                out = fe.run_wrenches(np.vstack([w_cal[i], hist]))
-                u = out["u"][1:] - out["u"][0]
-                new[:, i] = u - (hist - w_cal[i]) @ masts.compliance[i].T
-            change = np.inf if delta is None else np.abs(new - delta).max()
-            delta = new
-            sols = _pass(robot, masts, poses, tensions, w_cal, delta, method, progress)
+            hist = np.where(ok[:, None, None], wr, w_cal[None])
+            dw = hist - w_cal
+            dc = response(hist, w_cal)
+            for i in range(dw.shape[1]):
+                rem = dc[:, i] - dw[:, i] @ lin.compliance[i].T
+                scale = np.abs(dw[:, i]).max()
+                if scale > 0:
+                    A = np.linalg.lstsq(dw[:, i] / scale, rem, rcond=1e-8)[0].T / scale
+                    lin.compliance[i] += A
+            delta = dc - np.einsum("nij,knj->kni", lin.compliance, dw)
+            change = np.inf if passes == 1 else np.abs(dc - dc_prev).max()
+            dc_prev = dc
             if change < fe_tol:
-                break
+                break  # the tops of the last pass are those of the response: converged
+            sols = _pass(robot, lin, poses, tensions, w_cal, delta, method, progress)
     pick = lambda key: np.array([getattr(s, key) for s in sols])  # noqa: E731
     return TrajectoryResult(poses, pick("pose"), pick("error"), pick("tension"), pick("exit_points"),
                             pick("top_displacement"), pick("wrench"), pick("feasible"),
