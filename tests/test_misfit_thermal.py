@@ -303,3 +303,20 @@ def test_bimetallic_strip_bends_with_timoshenkos_curvature():
     # aluminium on top expands more: the strip curls down (+ry).  Uniform curvature is exact for the
     # cubic corotational elements (a circular arc); measured 2e-8 relative, 1e-6 leaves Newton's tolerance
     np.testing.assert_allclose(ry, kappa * L, rtol=1e-6)
+
+
+def test_increments_end_on_the_temperature_amplitudes_points():
+    """A one-increment step still stops at the amplitude's peak (0.3 s), as for loads."""
+    alpha, dT, L = 10e-6, 100.0, 1.0
+    m = fm.Model("peak")
+    n1, n2 = m.node(0, 0, 0), m.node(L, 0, 0)
+    m.truss(n1, n2, 1e6, alpha_per_K=alpha)
+    m.fix(n1)
+    m.fix(n2, "uy", "uz")
+    amp = Amplitude([0.0, 0.3, 1.0], [0.0, 1.0, 0.0])
+    m.step("pulse").temperature(dT, amplitude=amp)
+    _, frames = _run(m)
+    times = [f["time"] for f in frames[1:]]
+    assert times[0] == pytest.approx(0.3, abs=1e-12) and times[-1] == pytest.approx(1.0, abs=1e-12)
+    for f in frames[1:]:   # round-off of displacements of 1e-3 m
+        assert abs(f["U"][m.index(n2), 0] - alpha * dT * L * float(amp(f["time"]))) <= 1e-15

@@ -103,7 +103,9 @@ class TimeIncrements(Plan):
                              "the load factor is an unknown")
         self.hit = sorted({float(h) for h in step.hit_times} |
                           {float(t) for c in step.loads + step.prescribed if c.amplitude is not None
-                           for t in c.amplitude.times if 0 < t < period})
+                           for t in c.amplitude.times if 0 < t < period} |
+                          {float(t) for _, _, amp in getattr(step, "temperatures", ()) if amp is not None
+                           for t in amp.times if 0 < t < period})   # temperature amplitudes (issue 20)
         self.load_start, self.pres_start = st.loads.copy(), st.prescribed.copy()
         st.size = st.first_size = step.initial_increment or min(period, step.max_increment or period)
         st.step_time, st.easy, st.lam = 0.0, 0, 0.0
