@@ -154,7 +154,7 @@ def truth_label(row) -> str:
         return "null"
     if row["expect"] == "ool":
         return "out of library"
-    return " + ".join(row["expected_effects"])
+    return " + ".join(sorted(row["expected_effects"]))  # as the verdict columns
 
 
 def verdict_label(row) -> str:

@@ -14,7 +14,7 @@ Quick start::
 
 from .amplitudes import Amplitude
 from .analysis import Analysis, solve
-from .errors import ConvergenceError, DataFileError, FemastError, ModelError, SingularModelError
+from .errors import ConvergenceError, DataFileError, EquilibriumError, FemastError, ModelError, SingularModelError
 from .model import Model
 from .results import Results
 from .sections import Section, circular_solid, circular_tube, shear_modulus, square_solid, square_tube
@@ -26,6 +26,6 @@ from .solvers.convergence import Convergence
 __all__ = [
     "Amplitude", "Analysis", "solve", "Model", "Results", "Section", "circular_solid", "circular_tube",
     "square_solid", "square_tube", "shear_modulus", "DisplacementControl", "LoadControl", "Convergence", "Stabilize", "ArcLength",
-    "FemastError", "ModelError", "SingularModelError", "ConvergenceError", "DataFileError",
+    "FemastError", "ModelError", "SingularModelError", "ConvergenceError", "DataFileError", "EquilibriumError",
 ]
 __version__ = "0.1.0"

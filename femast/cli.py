@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import runpy
 import sys
 from pathlib import Path
@@ -15,8 +16,32 @@ def _run(args):
     script = Path(args.script)
     if not script.exists():
         raise FemastError(f"no such script: {script}")
-    sys.argv = [str(script)] + list(args.script_args)
-    runpy.run_path(str(script), run_name="__main__")
+    script_args = list(args.script_args)
+    restart = args.restart
+    if "--restart" in script_args:   # femast run SCRIPT --restart FOLDER
+        i = script_args.index("--restart")
+        if i + 1 >= len(script_args):
+            raise FemastError("--restart needs the results folder of the run to continue: --restart FOLDER")
+        restart = script_args[i + 1]
+        del script_args[i:i + 2]
+    if restart is not None:
+        # the analyses of the script whose results folder is RESTART continue from its restart point
+        from .analysis.restart import ENV, RESTART_DIR
+
+        if not (Path(restart) / RESTART_DIR / "restart.json").is_file():
+            raise FemastError(f"{restart}: no restart point; run the analysis with restart_every=n to be able "
+                              "to restart it")
+        old = os.environ.get(ENV)
+        os.environ[ENV] = str(restart)
+    sys.argv = [str(script)] + script_args
+    try:
+        runpy.run_path(str(script), run_name="__main__")
+    finally:
+        if restart is not None:   # (main() may be called again in the same process)
+            if old is None:
+                os.environ.pop(ENV, None)
+            else:
+                os.environ[ENV] = old
 
 
 def _vtk(args):
@@ -40,8 +65,8 @@ def _info(args):
     print(f"{res.folder}: {len(res)} frames, {len(res.node_labels)} nodes, families: {', '.join(res.families)}")
     if res.summary:
         s = res.summary
-        print(f"  completed: {s['completed']}; increments {s['increments']}, iterations {s['iterations']}, "
-              f"cutbacks {s['cutbacks']}, wall time {s['wall_time']:.2f} s")
+        print(f"  status: {res.status}; increments {s.get('increments', 0)}, iterations {s.get('iterations', 0)}, "
+              f"cutbacks {s.get('cutbacks', 0)}, wall time {s.get('wall_time', 0.0):.2f} s")
         for st in s.get("steps", []):
             print(f"  step {st['name']}: {st['increments']} increments, {st['iterations']} iterations")
         if s.get("message"):
@@ -50,8 +75,13 @@ def _info(args):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="femast", description="Nonlinear FE for jointed deployable masts")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the full Python traceback of an error (default: one line naming the item)")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("run", help="run a model or benchmark script")
+    p.add_argument("--restart", metavar="FOLDER", default=None,
+                   help="continue the run whose results folder is FOLDER from its last restart point "
+                        "(also accepted after SCRIPT)")
     p.add_argument("script")
     p.add_argument("script_args", nargs=argparse.REMAINDER)
     p.set_defaults(func=_run)
@@ -75,13 +105,78 @@ def main(argv=None):
         register = None
     if register is not None:
         register(sub)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    # --debug anywhere before a script's own arguments (``femast vtk R --debug``, ``femast --debug run S``)
+    cut = argv.index("run") + 2 if "run" in argv else len(argv)
+    debug = "--debug" in argv[:cut]
+    argv = [a for a in argv[:cut] if a != "--debug"] + argv[cut:]
     args = parser.parse_args(argv)
+    return _guarded(args.func, args, debug=debug or args.debug)
+
+
+def _guarded(func, args, debug=False) -> int:
+    """Run a command: every error becomes one line on stderr and exit code 2 (``--debug``: the
+    traceback); a closed output pipe (``femast info R | head -1``) ends the command silently."""
     try:
-        args.func(args)
-    except FemastError as exc:
-        print(f"femast: error: {exc}", file=sys.stderr)
+        func(args)
+    except BrokenPipeError:
+        _silence_stdout()
+        return 1
+    except KeyboardInterrupt:
+        if debug:
+            raise
+        print("femast: interrupted", file=sys.stderr)
+        return 130
+    except SystemExit:
+        raise
+    except Exception as exc:
+        if debug:
+            raise
+        try:
+            print(f"femast: error: {error_line(exc, getattr(args, 'script', None))}", file=sys.stderr)
+        except BrokenPipeError:
+            pass
         return 2
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _silence_stdout()
+        return 1
     return 0
+
+
+def _silence_stdout():
+    """After a broken pipe: point stdout at /dev/null so that Python's exit flush stays silent."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+
+
+def error_line(exc: BaseException, script=None) -> str:
+    """One line for an error: a femast error's own message; an OS error's file and reason; any
+    other error with where it happened (the line of ``script`` if it is there) and the hint to rerun
+    with --debug."""
+    if isinstance(exc, FemastError):
+        return str(exc).replace("\n", " ")
+    if isinstance(exc, OSError) and exc.filename is not None:
+        return f"{exc.filename}: {exc.strerror or exc}; check the path and its permissions"
+    where = ""
+    tb = exc.__traceback__
+    frames = []
+    while tb is not None:
+        frames.append((tb.tb_frame.f_code.co_filename, tb.tb_lineno))
+        tb = tb.tb_next
+    if script is not None:
+        mine = [f for f in frames if Path(f[0]).resolve() == Path(script).resolve()]
+        if mine:
+            where = f"{script} line {mine[-1][1]}: "
+    msg = str(exc).splitlines()[0] if str(exc) else ""
+    return (f"{where}{type(exc).__name__}{': ' + msg if msg else ''} (not a femast error: rerun with "
+            "--debug for the traceback, and report it if the input looks right)")
 
 
 if __name__ == "__main__":

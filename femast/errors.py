@@ -25,6 +25,10 @@ class DataFileError(FemastError, ValueError):
     """A measured-data file is malformed."""
 
 
+class EquilibriumError(FemastError):
+    """A converged increment whose reactions do not balance the applied loads (a lost load)."""
+
+
 class StateError(FemastError, ValueError):
     """An analysis state cannot be used as asked (e.g. a modal analysis of a state that is not in
     equilibrium)."""

@@ -26,6 +26,7 @@ from .amplitudes import Amplitude
 from .elements.base import DOF_NAMES
 from .errors import ModelError
 from .sections import Section
+from . import validation
 
 LOAD_NAMES = ("fx", "fy", "fz", "mx", "my", "mz")
 _DOF_INDEX = {n: i for i, n in enumerate(DOF_NAMES)}
@@ -42,14 +43,9 @@ def dof_index(name: str) -> int:
     raise ModelError(f"unknown DOF '{name}'; use one of {', '.join(DOF_NAMES)} (or loads {', '.join(LOAD_NAMES)})")
 
 
-def _finite(value, what):
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ModelError(f"{what} = {value!r} is not a number") from None
-    if not math.isfinite(v):
-        raise ModelError(f"{what} = {value!r} is not finite; give a finite number")
-    return v
+def _finite(value, what, unit=""):
+    """A finite number within validation.MAX_MAGNITUDE of its SI unit, or a ModelError naming ``what``."""
+    return validation.number(value, what, unit)
 
 
 @dataclass
@@ -128,7 +124,7 @@ class Step:
             if name.lower() not in _LOAD_INDEX:
                 raise ModelError(f"step '{self.name}': unknown load component '{name}' on node {node}; "
                                  f"use {', '.join(LOAD_NAMES)}")
-            v = _finite(value, f"step '{self.name}': load {name} on node {node}")
+            v = _finite(value, f"step '{self.name}': load {name} on node {node}", "N" if name.lower()[0] == "f" else "N m")
             self.loads.append(Condition(node, _LOAD_INDEX[name.lower()], v, amplitude))
         return self
 
@@ -142,7 +138,8 @@ class Step:
         for name, value in components.items():
             if name.lower() not in _DOF_INDEX:
                 raise ModelError(f"step '{self.name}': unknown DOF '{name}' on node {node}; use {', '.join(DOF_NAMES)}")
-            v = _finite(value, f"step '{self.name}': prescribed {name} on node {node}")
+            v = _finite(value, f"step '{self.name}': prescribed {name} on node {node}",
+                        "m" if name.lower()[0] == "u" else "rad")
             self.prescribed.append(Condition(node, _DOF_INDEX[name.lower()], v, amplitude))
         return self
 
@@ -208,11 +205,11 @@ class Model:
     # ---------------------------------------------------------------- nodes
     def node(self, x: float, y: float, z: float, label: int | None = None) -> int:
         """Add a node at (x, y, z) (m); returns its label (auto-numbered from 1 if not given)."""
-        xyz = tuple(_finite(v, f"node {label if label is not None else len(self._node_labels) + 1} coordinate {c}")
-                    for v, c in zip((x, y, z), "xyz"))
+        xyz = tuple(_finite(v, f"node {label if label is not None else len(self._node_labels) + 1} coordinate {c}",
+                            "m") for v, c in zip((x, y, z), "xyz"))
         if label is None:
             label = (max(self._node_labels) + 1) if self._node_labels else 1
-        label = int(label)
+        label = validation.whole(label, "node label")
         if label in self._node_index:
             raise ModelError(f"node {label} is defined twice; labels must be unique")
         self._node_index[label] = len(self._node_labels)
@@ -222,7 +219,7 @@ class Model:
 
     def nodes(self, coords) -> list[int]:
         """Add several nodes from an (n, 3) array of coordinates (m); returns their labels."""
-        return [self.node(*c) for c in np.asarray(coords, dtype=float).reshape(-1, 3)]
+        return [self.node(*c) for c in validation.coordinates(coords, f"model '{self.name}': nodes()")]
 
     @property
     def node_labels(self) -> np.ndarray:
@@ -244,8 +241,9 @@ class Model:
 
     def _check_node(self, label, where):
         try:
-            ok = int(label) in self._node_index and float(label) == int(label)
-        except (TypeError, ValueError):
+            ok = (not isinstance(label, (str, bytes, bool, np.bool_)) and float(label) == int(label)
+                  and int(label) in self._node_index)
+        except (TypeError, ValueError, OverflowError):
             ok = False
         if not ok:
             known = self._node_labels
@@ -268,19 +266,20 @@ class Model:
         self._check_node(n2, "beam")
         if not isinstance(section, Section):
             raise ModelError(f"beam {n1}-{n2}: section must be a femast Section (got {type(section).__name__})")
-        n = int(n)
-        if n < 1:
-            raise ModelError(f"beam {n1}-{n2}: n = {n} elements; need n >= 1")
+        n = validation.whole(n, f"beam {n1}-{n2}: number of elements n", minimum=1)
         a, b = self.xyz(n1), self.xyz(n2)
         L = float(np.linalg.norm(b - a))
         if L <= 1e-12 * max(1.0, float(np.abs(a).max())):
             raise ModelError(f"beam {n1}-{n2}: nodes {n1} and {n2} coincide (length {L:g} m); "
                              "a beam needs two distinct nodes")
-        up = np.array([_finite(u, f"beam {n1}-{n2}: up-vector") for u in up])
+        up_arr = np.asarray(up, dtype=object)
+        if up_arr.shape != (3,):
+            raise ModelError(f"beam {n1}-{n2}: up-vector {up!r} must be 3 numbers (a global direction)")
+        up = np.array([_finite(u, f"beam {n1}-{n2}: up-vector") for u in up_arr])
         e = (b - a) / L
         if np.linalg.norm(up - (up @ e) * e) < 1e-6 * max(np.linalg.norm(up), 1e-300):
-            raise ModelError(f"beam {n1}-{n2}: up-vector {tuple(up)} is parallel to the element axis "
-                             f"{tuple(np.round(e, 6))}; choose an up-vector not along the beam")
+            raise ModelError(f"beam {n1}-{n2}: up-vector {tuple(float(u) for u in up)} is parallel to the element axis "
+                             f"{tuple(float(v) for v in np.round(e, 6))}; choose an up-vector not along the beam")
         if mass_per_length is not None:
             mass_per_length = _finite(mass_per_length, f"beam {n1}-{n2}: mass_per_length")
             if mass_per_length < 0:
@@ -335,7 +334,7 @@ class Model:
         ``alpha_per_K`` (1/K): coefficient of thermal expansion.  Returns the element label."""
         self._check_node(n1, "truss")
         self._check_node(n2, "truss")
-        EA = _finite(EA, f"truss {n1}-{n2}: EA")
+        EA = _finite(EA, f"truss {n1}-{n2}: EA", "N")
         if EA <= 0:
             raise ModelError(f"truss {n1}-{n2}: EA = {EA} N must be positive")
         L = float(np.linalg.norm(self.xyz(n2) - self.xyz(n1)))
@@ -344,11 +343,11 @@ class Model:
         if L0 is not None and pretension is not None:
             raise ModelError(f"truss {n1}-{n2}: give L0 or pretension, not both")
         if L0 is not None:
-            L0 = _finite(L0, f"truss {n1}-{n2}: L0")
+            L0 = _finite(L0, f"truss {n1}-{n2}: L0", "m")
             if L0 <= 0:
                 raise ModelError(f"truss {n1}-{n2}: unstretched length L0 = {L0} m must be positive")
         if pretension is not None:
-            pretension = _finite(pretension, f"truss {n1}-{n2}: pretension")
+            pretension = _finite(pretension, f"truss {n1}-{n2}: pretension", "N")
             if pretension <= -EA:
                 raise ModelError(f"truss {n1}-{n2}: pretension {pretension} N <= -EA is impossible")
         mass_per_length = _finite(mass_per_length, f"truss {n1}-{n2}: mass_per_length")
@@ -456,10 +455,13 @@ class Model:
         name = name or f"Step-{len(self.steps) + 1}"
         if any(s.name == name for s in self.steps):
             raise ModelError(f"step '{name}' is defined twice; step names must be unique")
+        known = set(Step.__dataclass_fields__) - {"name", "loads", "prescribed", "_model"}
+        for k in options:
+            if k not in known:
+                raise ModelError(f"step '{name}': unknown option '{k}'; step options are {', '.join(sorted(known))}")
         s = Step(name=name, **options)
         s._model = self
-        if not (s.period > 0 and math.isfinite(s.period)):
-            raise ModelError(f"step '{name}': period = {s.period} s must be positive")
+        validation.step_increments(s)
         if isinstance(s.output_frequency, bool) or not isinstance(s.output_frequency, (int, np.integer)) \
                 or s.output_frequency < 1:
             raise ModelError(f"step '{name}': output_frequency = {s.output_frequency!r} must be a whole number "

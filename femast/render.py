@@ -21,8 +21,8 @@ def render_png(results, png, frame: int = -1, scale: float = 1.0, show_undeforme
 
     pv.OFF_SCREEN = True
     res = results if isinstance(results, Results) else Results(results)
-    frame = range(len(res))[frame]
-    fr = res.frame(frame)
+    fr = res.frame(frame)   # a FemastError naming the frame if it does not exist
+    frame = range(len(res))[int(frame)]
     label_to_row = {int(l): i for i, l in enumerate(res.node_labels)}
     segs = []
     for fam in res.families:

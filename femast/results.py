@@ -5,7 +5,15 @@ Layout of a results folder::
     mesh.npz              node labels, reference coordinates, element connectivity per family
     frames/000001.npz     one file per converged increment (written atomically)
     status.sta            one line per increment, like Abaqus' .sta file
-    summary.json          written at the end (or when the run gives up)
+    summary.json          the run's status: written at the start as ``"status": "running"``
+                          (replacing any summary of an earlier run into the folder) and at the
+                          end as "completed" (every step done), "failed" (an error; ``message``
+                          says which) or "interrupted" (Ctrl-C or a stop)
+
+Every file is written to a temporary name and renamed into place (``os.replace``), so a run
+killed outright leaves at most a ``*.tmp`` file, which :class:`Results` ignores with a warning
+naming it.  A summary still saying "running" after its process has gone (a kill -9, a power cut)
+is reported by :attr:`Results.status` as "interrupted".
 
 Each frame holds: ``step`` (name), ``increment``, ``time`` (step time, s),
 ``total_time`` (s), ``load_factor``, ``iterations``, ``U`` (n, 3) displacements (m),
@@ -32,7 +40,11 @@ from __future__ import annotations
 import json
 import os
 import queue
+import re
+import socket
 import threading
+import time as _time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -49,32 +61,106 @@ _COMPONENTS = {
 }
 
 
+TMP_SUFFIX = ".tmp"   # partial files: "<name>.tmp", never matched by the readers' patterns
+_FRAME_NAME = re.compile(r"^\d+\.npz$")
+
+
 def _atomic_savez(path: Path, **arrays):
-    tmp = path.with_name(path.stem + ".tmp.npz")
-    np.savez(tmp, **arrays)
+    """np.savez to ``path`` through a temporary file renamed into place (atomic on one filesystem:
+    a reader sees the whole file or none)."""
+    tmp = path.with_name(path.name + TMP_SUFFIX)
+    with open(tmp, "wb") as fh:   # a file object: np.savez would append ".npz" to a name
+        np.savez(fh, **arrays)
     os.replace(tmp, path)
+
+
+def write_json_atomic(path: Path, data: dict) -> None:
+    """Write ``data`` as JSON to ``path`` through a temporary file renamed into place."""
+    path = Path(path)
+    tmp = path.with_name(path.name + TMP_SUFFIX)
+    with open(tmp, "w") as fh:
+        json.dump(data, fh, indent=2, default=_json_default)
+        fh.flush()
+        os.fsync(fh.fileno())   # the summary is the run's word on its own outcome: make it durable
+    os.replace(tmp, path)
+
+
+def _json_default(v):
+    if isinstance(v, (np.integer,)):
+        return int(v)
+    return float(v)
+
+
+def _process_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True   # exists but not ours, or cannot tell: assume alive
+    return True
+
+
+def prepare_folder(folder) -> Path:
+    """Create results folder ``folder`` (and its ``frames``) or raise a FemastError naming it."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise FemastError(f"results folder '{folder}' is an existing file, not a folder; give out= a folder "
+                          "name (or remove the file)")
+    try:
+        (folder / "frames").mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        raise FemastError(f"results folder '{folder}': a part of the path is an existing file; give out= a "
+                          "folder whose parents are folders") from None
+    except PermissionError as exc:
+        raise FemastError(f"results folder '{folder}': no permission to create it ({exc.strerror}); choose "
+                          "a folder you can write to") from None
+    except OSError as exc:
+        raise FemastError(f"results folder '{folder}' cannot be created ({exc.strerror or exc}); choose "
+                          "another folder") from None
+    return folder
+
+
+class ResultsWarning(UserWarning):
+    """A results folder holds partial files or an unreadable summary (ignored)."""
 
 
 class ResultsWriter:
     """Writes a results folder as the analysis runs (see module docstring)."""
 
-    def __init__(self, folder, model, families):
-        self.folder = Path(folder)
-        (self.folder / "frames").mkdir(parents=True, exist_ok=True)
-        for old in (self.folder / "frames").glob("*.npz"):
-            old.unlink()
+    def __init__(self, folder, model, families, resume: int | None = None):
+        """``resume``: continue a restarted run whose first ``resume`` frames are on disk (kept;
+        later frames and partial files are removed; status lines are appended)."""
+        self.folder = prepare_folder(folder)
+        self._started = _time.time()
+        # the stale summary of an earlier run goes first: a kill from here on leaves "running"
+        write_json_atomic(self.folder / "summary.json", self._running())
+        for pattern in ("*.npz", "*" + TMP_SUFFIX):
+            for old in (self.folder / "frames").glob(pattern):
+                if resume is None or not _FRAME_NAME.match(old.name) or int(old.name[:-4]) > resume:
+                    old.unlink()
+        if resume is None:   # an earlier run's restart point does not belong to this run's frames
+            (self.folder / "restart" / "restart.json").unlink(missing_ok=True)
+        if resume is not None and len(list((self.folder / "frames").glob("*.npz"))) != resume:
+            raise FemastError(f"{self.folder}: the restart point names {resume} frames but fewer are on disk; "
+                              "run the analysis again from the start")
+        for old in (self.folder / "mesh.npz", self.folder / ("mesh.npz" + TMP_SUFFIX)):
+            old.unlink(missing_ok=True)
         mesh = {"node_labels": model.node_labels, "X": model.coordinates,
                 "families": np.array([f.name for f in families])}
         for f in families:
             mesh[f"conn/{f.name}"] = model.node_labels[np.asarray(f.nodes)]
             mesh[f"labels/{f.name}"] = np.asarray(getattr(f, "labels", np.arange(1, f.n_elements + 1)))
-        self.count = 0
+        self.count = resume or 0
         self._queue = queue.Queue(maxsize=16)   # bounded: a slow disk slows the analysis, not memory
         self._error = None
         self._queue.put(((self.folder / "mesh.npz",), mesh))   # written first, by the writer thread
-        self.sta = open(self.folder / "status.sta", "w")
-        self.sta.write(f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} {'TOTAL TIME':>11} "
-                       f"{'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n")
+        self.sta = open(self.folder / "status.sta", "w" if resume is None else "a")
+        if resume is not None:
+            self.sta.write(f"{'':>12} restarted from frame {resume}\n")
+        else:
+            self.sta.write(f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} {'TOTAL TIME':>11} "
+                           f"{'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n")
         self._thread = threading.Thread(target=self._drain, name="femast-results-writer", daemon=True)
         self._thread.start()
 
@@ -84,6 +170,11 @@ class ResultsWriter:
         self._raise_error()
         self._queue.put((f"{step:>12.12} {inc:5d} {attempt:3d} {iterations:4d} {time:11.4e} {total_time:11.4e} "
                          f"{dtime:11.4e} {lam:12.5e}  {note}\n", None))
+
+    def flush(self):
+        """Wait until every queued frame and status line is on disk (a restart point names them)."""
+        self._queue.join()
+        self._raise_error()
 
     def _drain(self):
         while True:
@@ -112,13 +203,24 @@ class ResultsWriter:
         self.count += 1
         self._queue.put(((self.folder / "frames" / f"{self.count:06d}.npz",), data))
 
+    def _running(self) -> dict:
+        return {"status": "running", "completed": False, "pid": os.getpid(), "host": socket.gethostname(),
+                "started": self._started,
+                "message": "the analysis is running (or its process was killed before it could finish)"}
+
     def close(self, summary: dict):
-        if self._thread.is_alive():
-            self._queue.put(None)
-            self._thread.join()
-        self.sta.close()
-        with open(self.folder / "summary.json", "w") as fh:
-            json.dump(summary, fh, indent=2, default=float)
+        """Drain the queue and write the final summary (``summary["status"]`` says how the run ended)."""
+        try:
+            if self._thread.is_alive():
+                self._queue.put(None)
+                self._thread.join()
+        finally:
+            self.sta.close()
+            final = {**summary, "pid": os.getpid(), "host": socket.gethostname(), "started": self._started}
+            if self._error is not None and final.get("status") == "completed":
+                final.update(status="failed", completed=False,
+                             message=f"could not write results to '{self.folder}': {self._error}")
+            write_json_atomic(self.folder / "summary.json", final)
         self._raise_error()
 
 
@@ -132,6 +234,9 @@ class NullWriter:
 
     def frame(self, **data):
         self.count += 1
+
+    def flush(self):
+        pass
 
     def close(self, summary: dict):
         pass
@@ -152,10 +257,41 @@ class Results:
         if not mesh_file.exists():
             raise FemastError(f"{self.folder}: not a femast results folder (no mesh.npz); run an analysis first")
         self._mesh = None    # read on first use (an analysis returns its Results: ~1.5 ms per run saved)
-        self.files = sorted((self.folder / "frames").glob("[0-9]*.npz"))
+        frames = self.folder / "frames"
+        names = sorted(p.name for p in frames.iterdir()) if frames.is_dir() else []
+        self.files = [frames / n for n in names if _FRAME_NAME.match(n)]
+        self.partial = [frames / n for n in names if not _FRAME_NAME.match(n)]
+        if self.partial:
+            warnings.warn(f"{self.folder}: ignoring {len(self.partial)} partial or foreign file(s) in frames/ "
+                          f"({', '.join(p.name for p in self.partial[:5])}{', ...' if len(self.partial) > 5 else ''}"
+                          "): left by a run that was killed while writing", ResultsWarning, stacklevel=2)
         self._cache = {}
         sfile = self.folder / "summary.json"
-        self.summary = json.loads(sfile.read_text()) if sfile.exists() else None
+        self.summary = None
+        if sfile.exists():
+            try:
+                self.summary = json.loads(sfile.read_text())
+            except (ValueError, OSError) as exc:
+                warnings.warn(f"{sfile}: unreadable summary ({exc}); the run's outcome is unknown",
+                              ResultsWarning, stacklevel=2)
+            else:
+                if not isinstance(self.summary, dict):
+                    self.summary = None
+
+    @property
+    def status(self) -> str:
+        """How the run that wrote the folder ended: "completed", "failed", "interrupted",
+        "running" (its process is still alive) or "unknown" (no summary).  A summary saying
+        "running" whose process is gone (killed) reads "interrupted"."""
+        s = self.summary
+        if not s:
+            return "unknown"
+        status = s.get("status") or ("completed" if s.get("completed") else "failed")
+        if status == "running":
+            same_host = s.get("host") == socket.gethostname()
+            if same_host and isinstance(s.get("pid"), int) and not _process_alive(s["pid"]):
+                return "interrupted"
+        return status
 
     def __len__(self):
         return len(self.files)
@@ -164,8 +300,12 @@ class Results:
     def mesh(self) -> dict:
         """The arrays of mesh.npz: node_labels, X (m), families, conn/<family>, labels/<family>."""
         if self._mesh is None:
-            with np.load(self.folder / "mesh.npz") as m:
-                self._mesh = {k: m[k] for k in m.files}
+            try:
+                with np.load(self.folder / "mesh.npz", allow_pickle=False) as m:
+                    self._mesh = {k: m[k] for k in m.files}
+            except Exception as exc:
+                raise FemastError(f"{self.folder / 'mesh.npz'} is unreadable ({type(exc).__name__}: {exc}); "
+                                  "the folder is damaged: rerun the analysis") from None
         return self._mesh
 
     @property
@@ -182,10 +322,19 @@ class Results:
         return [str(f) for f in self.mesh["families"]]
 
     def frame(self, i: int) -> dict:
-        i = range(len(self.files))[i]
+        """The arrays of frame ``i`` (0 = initial state; negative counts from the end)."""
+        try:
+            i = range(len(self.files))[int(i)]
+        except IndexError:
+            raise FemastError(f"{self.folder}: frame {i} does not exist; the folder has {len(self.files)} frames "
+                              f"(0..{len(self.files) - 1}, or -1 for the last)") from None
         if i not in self._cache:
-            with np.load(self.files[i]) as f:
-                self._cache[i] = {k: f[k] for k in f.files}
+            try:
+                with np.load(self.files[i], allow_pickle=False) as f:
+                    self._cache[i] = {k: f[k] for k in f.files}
+            except Exception as exc:   # zipfile.BadZipFile, EOFError, ValueError, OSError...
+                raise FemastError(f"{self.files[i]}: frame {i} is unreadable ({type(exc).__name__}: {exc}); "
+                                  "the file is damaged: rerun the analysis") from None
         return self._cache[i]
 
     def _node_row(self, label):
@@ -235,3 +384,13 @@ class Results:
 
 
 DOF_COMPONENTS = DOF_NAMES
+
+
+def run_outcome(exc: BaseException) -> tuple[str, str]:
+    """(status, message) of a run ended by ``exc``: "interrupted" for Ctrl-C or a stop
+    (KeyboardInterrupt, SystemExit), else "failed" with the error as the reason."""
+    if isinstance(exc, (KeyboardInterrupt, SystemExit)):
+        return "interrupted", f"interrupted ({type(exc).__name__}) before the last increment"
+    if isinstance(exc, FemastError):
+        return "failed", f"{type(exc).__name__}: {exc}"
+    return "failed", f"unexpected {type(exc).__name__}: {exc}"

@@ -16,9 +16,13 @@ also the thick-walled approximation of Roark's formulas for a square tube.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, replace
 
 from .errors import ModelError
+from .validation import MAX_MAGNITUDE, number
+
+_UNITS = {"E": "Pa", "G": "Pa", "A": "m^2", "Iy": "m^4", "Iz": "m^4", "J": "m^4"}
 
 
 @dataclass(frozen=True)
@@ -51,14 +55,18 @@ class Section:
             value = getattr(self, field)
             if value is None:
                 raise ModelError(f"section '{self.name}': property {field} is missing; give it in SI units")
-            try:
-                value = float(value)
-            except (TypeError, ValueError):
-                raise ModelError(f"section '{self.name}': property {field}={value!r} is not a number") from None
+            if isinstance(value, (str, bytes, bool)) or not isinstance(value, numbers.Real):
+                raise ModelError(f"section '{self.name}': property {field}={value!r} is not a number; give it in "
+                                 f"SI units ({_UNITS[field]})")
+            value = float(value)
             if not math.isfinite(value) or value <= 0.0:
                 raise ModelError(
                     f"section '{self.name}': property {field}={value!r} must be a finite positive number (SI units)"
                 )
+            if value > MAX_MAGNITUDE:
+                raise ModelError(f"section '{self.name}': property {field}={value:g} {_UNITS[field]} is beyond "
+                                 f"{MAX_MAGNITUDE:g} (a typing error? it would overflow the stiffness); give it in "
+                                 "SI units")
             object.__setattr__(self, field, value)
         try:
             rho = float(self.rho)
@@ -78,8 +86,11 @@ class Section:
         return replace(self, **changes)
 
 
-def shear_modulus(E: float, nu: float) -> float:
-    """Isotropic shear modulus G = E / (2 (1 + nu)), Pa."""
+def shear_modulus(E: float, nu: float, name: str = "section") -> float:
+    """Isotropic shear modulus G = E / (2 (1 + nu)), Pa.  Poisson's ratio ``nu`` must lie in
+    (-1, 0.5] (an isotropic solid's range; -1 would make G infinite)."""
+    E = number(E, f"section '{name}': Young's modulus E", "Pa", positive=True)
+    nu = number(nu, f"section '{name}': Poisson's ratio nu", "", lo=-1.0, hi=0.5)
     return E / (2.0 * (1.0 + nu))
 
 
@@ -96,7 +107,7 @@ def circular_tube(d_out: float, d_in: float, E: float, nu: float = 0.3, name: st
     _check_dims(name, d_out, d_in)
     A = math.pi * (d_out**2 - d_in**2) / 4.0
     I = math.pi * (d_out**4 - d_in**4) / 64.0
-    return Section(E=E, G=shear_modulus(E, nu), A=A, Iy=I, Iz=I, J=2.0 * I, name=name)
+    return Section(E=E, G=shear_modulus(E, nu, name), A=A, Iy=I, Iz=I, J=2.0 * I, name=name)
 
 
 def square_solid(s: float, E: float, nu: float = 0.3, name: str = "square solid") -> Section:
@@ -104,7 +115,7 @@ def square_solid(s: float, E: float, nu: float = 0.3, name: str = "square solid"
     _check_dims(name, s, 0.0)
     A = s * s
     I = s**4 / 12.0
-    return Section(E=E, G=shear_modulus(E, nu), A=A, Iy=I, Iz=I, J=0.140577 * s**4, name=name)
+    return Section(E=E, G=shear_modulus(E, nu, name), A=A, Iy=I, Iz=I, J=0.140577 * s**4, name=name)
 
 
 def square_tube(s_out: float, s_in: float, E: float, nu: float = 0.3, name: str = "square tube") -> Section:
@@ -122,7 +133,7 @@ def square_tube(s_out: float, s_in: float, E: float, nu: float = 0.3, name: str 
         J = 0.140577 * s_out**4
     else:
         J = t * (s_out - t) ** 3
-    return Section(E=E, G=shear_modulus(E, nu), A=A, Iy=I, Iz=I, J=J, name=name)
+    return Section(E=E, G=shear_modulus(E, nu, name), A=A, Iy=I, Iz=I, J=J, name=name)
 
 
 def seed000_eq10_torsion_constant(s_out: float, L: float) -> float:
@@ -133,7 +144,9 @@ def seed000_eq10_torsion_constant(s_out: float, L: float) -> float:
 
 def _check_dims(name, outer, inner):
     for label, v in (("outer size", outer), ("inner size", inner)):
-        if not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
-            raise ModelError(f"section '{name}': {label}={v!r} must be a finite non-negative length in m")
+        if isinstance(v, (str, bytes, bool)) or not isinstance(v, numbers.Real) or not math.isfinite(v) or v < 0 \
+                or v > 1e3:
+            raise ModelError(f"section '{name}': {label}={v!r} must be a finite non-negative length in m "
+                             "(at most 1000 m)")
     if outer <= 0 or inner >= outer:
         raise ModelError(f"section '{name}': need 0 <= inner ({inner}) < outer ({outer}) size, in m")

@@ -16,6 +16,7 @@ import meshio
 import numpy as np
 
 from .elements.beam_corot import SECTION_FORCE_NAMES
+from .errors import FemastError
 from .results import Results
 
 
@@ -46,8 +47,12 @@ def _cell_fields(frame, families, sizes):
 def export_vtk(results, folder=None, every: int = 1) -> Path:
     """Write ``<folder>/frame_000001.vtu``... and ``<folder>/series.pvd`` from ``results``
     (a :class:`~femast.results.Results` or a results folder).  Returns the .pvd path."""
+    if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
+        raise FemastError(f"every = {every!r}: give a whole number >= 1 (write every n-th frame)")
     res = results if isinstance(results, Results) else Results(results)
     folder = Path(folder) if folder is not None else res.folder / "vtk"
+    if folder.exists() and not folder.is_dir():
+        raise FemastError(f"VTK output folder '{folder}' is an existing file; give another folder")
     folder.mkdir(parents=True, exist_ok=True)
     label_to_row = {int(l): i for i, l in enumerate(res.node_labels)}
     cells, families = [], []

@@ -74,3 +74,41 @@ def replay_transcript(block: str, folder, capsys, ignore=lambda line: False, wha
             assert _printed(line.rstrip(), out), f"{what} quotes a line the command does not print:\n{line}"
             checked += 1
     return checked
+
+
+def assert_same_numbers(quoted: str, printed: str, roundoff: float = 0.0, ulps: float = 1.0) -> None:
+    """Assert that line ``printed`` says what ``quoted`` (a docs page's output) says, number by
+    number: the same text around the numbers; each number within ``ulps`` units of its last quoted
+    digit (a printed value is the true value rounded to that digit, so a round-off change of the
+    true value moves it by at most one unit); and a number quoted below ``roundoff`` in magnitude (a
+    residual at round-off, whose digits depend on the platform's BLAS and summation order) only
+    needs to be below ``roundoff`` too.  Never a comparison of printed floats as text."""
+    assert _NUMBER.sub("#", quoted) == _NUMBER.sub("#", printed), f"text differs:\n{quoted}\n{printed}"
+    q, p = _NUMBER.findall(quoted), _NUMBER.findall(printed)
+    assert len(q) == len(p), f"number count differs:\n{quoted}\n{printed}"
+    for a, b in zip(q, p):
+        if abs(float(a)) < roundoff:
+            assert abs(float(b)) < roundoff, f"{b} is not at round-off (< {roundoff:g}) as quoted {a}:\n{printed}"
+        else:
+            assert abs(float(a) - float(b)) <= ulps * _ulp(a) * (1 + 1e-9), f"{b} differs from quoted {a}:\n{printed}"
+
+
+def printed_in(quoted: str, out: str, ulps: float = 3.0) -> bool:
+    """True if some line of ``out`` contains ``quoted`` (a fragment a docs page says is printed)
+    with the same text around the numbers and each number within ``ulps`` units of its last quoted
+    digit (3, as :func:`_same_line`: round-off in the order of summation moves a 6-digit fit in its
+    last digit).  Numbers are compared as numbers, never as text."""
+    sq = _NUMBER.sub("#", quoted)
+    qn = [float(t) for t in _NUMBER.findall(quoted)]
+    qu = [_ulp(t) for t in _NUMBER.findall(quoted)]
+    for line in out.splitlines():
+        tokens = list(_NUMBER.finditer(line))
+        sl = _NUMBER.sub("#", line)
+        start = sl.find(sq)
+        while start >= 0:
+            k = sl[:start].count("#")   # numbers of the line before the fragment
+            got = [float(m.group()) for m in tokens[k:k + len(qn)]]
+            if len(got) == len(qn) and all(abs(a - b) <= ulps * u * (1 + 1e-9) for a, b, u in zip(qn, got, qu)):
+                return True
+            start = sl.find(sq, start + 1)
+    return False

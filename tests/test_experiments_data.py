@@ -168,7 +168,7 @@ def test_unknown_and_pending_experiments(tmp_path):
     script = tmp_path / "rig_x.py"
     script.write_text(PENDING_SCRIPT)
     rig = get_experiment(str(script))
-    data = from_arrays(rig, F_N=np.arange(12.0), u_m=np.zeros(12))  # the format is checked already
+    data = from_arrays(rig, F_N=np.arange(12.0), u_m=np.linspace(0.0, 1e-3, 12))  # the format is checked already
     with pytest.raises(ModelError, match=r"experiment 'rig-x' is registered with its data format but is pending "
                                          r"a model, so compare cannot run yet"):
         compare(rig, data)

@@ -99,7 +99,7 @@ def test_bay_runs_are_cached_in_memory_and_on_disk(tmp_path):
     a = predict(exp, data)
     b = predict(exp, data)
     assert fe_cache.stats() == {"hits": 1, "disk_hits": 0, "misses": 1}
-    assert len(list(tmp_path.glob("bay-torsion-*.pkl"))) == 1
+    assert len(list(tmp_path.glob("bay-torsion-*.npz"))) == 1
     fe_cache.clear()  # a new process: the disk copy is used
     c = predict(exp, data)
     assert fe_cache.stats()["disk_hits"] == 1

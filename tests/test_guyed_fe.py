@@ -267,4 +267,9 @@ def test_docs_fe_example_runs_and_matches_its_printed_output():
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         exec(compile(code, "guyed_masts.md (FE example)", "exec"), {})
-    assert out.getvalue().strip().splitlines() == expected  # printed to 0.01 mm / 0.1 N: stable
+    got = out.getvalue().strip().splitlines()
+    assert len(got) == len(expected)
+    from doc_examples import assert_same_numbers
+
+    for q, p in zip(expected, got):   # to one unit of the last printed digit (0.01 mm, 0.1 N)
+        assert_same_numbers(q, p)

@@ -184,7 +184,8 @@ def test_side_column_words_and_errors(tmp_path):
     bad.write_text("x_mm,dT_N,side\n" + "0.1,1.0,out\n" * 12 + "0.1,1.0,up\n")
     with pytest.raises(DataFileError, match="side.*'up'.*out, in"):
         read_data(EXP, bad)
-    bad.write_text("x_mm,dT_N,side\n" + "0.1,1.0,1\n" * 12 + "0.1,1.0,0.5\n")
+    # (dT_N varies: a constant measured channel is refused by read_data, issue 16)
+    bad.write_text("x_mm,dT_N,side\n" + "".join(f"0.1,{1.0 + 0.1 * i:.1f},1\n" for i in range(12)) + "0.1,1.0,0.5\n")
     with pytest.raises(DataFileError, match="line 14, column 'side'.*out.*in"):
         predict(EXP, read_data(EXP, bad), TRUE)
 

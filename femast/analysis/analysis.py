@@ -21,12 +21,14 @@ from tqdm.auto import tqdm
 
 from ..elements.base import DOF_NAMES
 from ..errors import ConvergenceError, ModelError, SingularModelError
-from ..results import Results
+from ..results import Results, run_outcome
 from ..solvers.convergence import Convergence
+from .. import validation
 from ..thermal import FieldLoads, check_controls, has_fields
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
+from .restart import RestartOutput, load_restart, restart_folder, restore
 from .state import State
 from .stepping import run_step
 from .summary import AnalysisSummary
@@ -67,7 +69,8 @@ class Analysis:
 
     def __init__(self, model, out="results", convergence: Convergence | None = None, progress: bool = True,
                  cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
-                 extrapolate: bool = False, on_frame=None, tangent: str = "full", observers=()):
+                 extrapolate: bool = False, on_frame=None, tangent: str = "full", observers=(), restart=None,
+                 restart_every: int | None = None):
         self.model = model
         self.on_frame = on_frame
         self.out = out
@@ -86,6 +89,8 @@ class Analysis:
             raise ModelError(f"model '{model.name}' has no steps; add one with model.step()")
         if not (model.beams or model.trusses or model.families):
             raise ModelError(f"model '{model.name}' has no elements")
+        for s in model.steps:   # (again: a step's fields may have been set after model.step(); issue 16)
+            validation.step_increments(s)
         self.families = build_families(model)
         check_controls(model)
         # length errors and temperatures (issue 20): None when the model has neither
@@ -95,6 +100,13 @@ class Analysis:
         self.state = State.initial(self.system.X0, self.families)
         self.output = ResultsOutput(out, [on_frame])
         self.observers = [self.output, *observers]
+        # restart (issue 16, restart.py): save a restart point every n increments; continue from one
+        self.restart = restart_folder(out, restart)
+        self.resume = None
+        if restart_every is not None:
+            self.observers.append(RestartOutput(validation.whole(restart_every, "restart_every", minimum=1)))
+        elif self.restart is not None:   # a restarted run goes on saving restart points
+            self.observers.append(RestartOutput(None))
 
     # ------------------------------------------------------------ the parts, by their usual names
     @property
@@ -192,26 +204,37 @@ class Analysis:
     def run(self) -> Results | None:
         """Run all steps; returns the :class:`Results` of the folder, or None with ``out=None``."""
         t0 = _time.perf_counter()
-        for obs in self.observers:
-            obs.started(self)
-        ti = _time.perf_counter()
+        ti = None
         try:
+            first = 0
+            if self.restart is not None:
+                self.resume = load_restart(self.restart, self)   # None: the point is the start
+                if self.resume is not None:
+                    restore(self, self.resume)
+                    first = self.resume["step"] + (1 if self.resume["step_done"] else 0)
+            for obs in self.observers:
+                obs.started(self)
+            ti = _time.perf_counter()
             for k, step in enumerate(self.model.steps):
+                if k < first:
+                    continue
                 self._state.step = k
                 if getattr(step, "kind", "static") == "frequency":   # modes of the state (issue 18)
                     from ..frequency_step import run_frequency_step
 
                     run_frequency_step(self, step)
                 else:
-                    run_step(self, step)
-        except ConvergenceError as exc:
-            self.summary.completed = False
-            self.summary.message = str(exc)
-            for obs in self.observers:
-                obs.stopped(self)
+                    inside = self.resume is not None and k == self.resume["step"] and not self.resume["step_done"]
+                    run_step(self, step, resume=self.resume if inside else None)
+            self.summary.status, self.summary.completed = "completed", True
+        except BaseException as exc:   # the summary says how the run ended (issue 16), then the error goes on
+            self.summary.status, self.summary.message = run_outcome(exc)
+            if isinstance(exc, ConvergenceError):
+                for obs in self.observers:
+                    obs.stopped(self)
             raise
         finally:
-            self.summary.increment_time = _time.perf_counter() - ti
+            self.summary.increment_time = _time.perf_counter() - ti if ti is not None else 0.0
             self.summary.wall_time = _time.perf_counter() - t0
             for obs in self.observers:
                 obs.finished(self)

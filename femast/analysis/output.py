@@ -59,10 +59,23 @@ class ResultsOutput(Observer):
         return self.out is not None or bool(self.recorders)
 
     def started(self, analysis):
+        resume = getattr(analysis, "resume", None)   # a restarted run (restart.py): frames on disk kept
         self.writer = (NullWriter() if self.out is None
-                       else ResultsWriter(self.out, analysis.model, analysis.families))
+                       else ResultsWriter(self.out, analysis.model, analysis.families,
+                                          resume=None if resume is None else resume["frames"]))
         self.pending = None
-        self.frame(analysis, step_name="initial", inc=0, time=0.0, iterations=0, responses=None)
+        if resume is None:
+            self.frame(analysis, step_name="initial", inc=0, time=0.0, iterations=0, responses=None)
+
+    @property
+    def frames(self) -> int:
+        """Frames written (or queued) so far."""
+        return self.writer.count if self.writer is not None else 0
+
+    def flush(self):
+        """Wait until every queued frame is on disk."""
+        if self.writer is not None:
+            self.writer.flush()
 
     def cutback(self, analysis, step, increment, attempt, iterations, time, total_time, dtime, lam, note):
         self.writer.status(step.name, increment, attempt, iterations, time, total_time, dtime, lam,

@@ -11,16 +11,25 @@ from ..solvers.control import LoadControl
 from .controls import plan_for
 
 
-def run_step(analysis, step):
+def run_step(analysis, step, resume=None):
     """Walk ``step`` of ``analysis`` from its committed state to the step's end (or raise
-    :class:`~femast.errors.ConvergenceError` when an increment cannot be made small enough)."""
+    :class:`~femast.errors.ConvergenceError` when an increment cannot be made small enough).
+    ``resume``: a restart point inside this step (restart.py): the plan is made as at the step's
+    start, then the saved state and the step's start loads are put back."""
     an, st, summary = analysis, analysis.state, analysis.summary
     control = step.control or LoadControl()
     control.setup(an, step)
+    if resume is not None:
+        an.state.loads, an.state.prescribed = resume["step_start"][0].copy(), resume["step_start"][1].copy()
     plan = plan_for(an, step, control)
     an.algorithm.new_step()
     st.increment = 0
     step_iters = 0
+    if resume is not None:
+        from .restart import restore
+
+        restore(an, resume)
+        step_iters = resume["summary"]["step_iterations"]
     bar = plan.bar(disable=not an.progress)
     try:
         while not plan.done():

@@ -21,6 +21,7 @@ from ..configuration import update_configuration
 from ..constraints import Constraints, transpose_times
 from ..dofs import number_dofs
 from ..elements.base import DOF_NAMES, IncrementContext
+from .. import validation
 from ..errors import ModelError, SingularModelError
 from ..reduction import ReducedTangent
 from ..solvers.convergence import force_moment_abs_max
@@ -70,6 +71,8 @@ class System:
                                   dependent=self.constraints.dependent)
         if self.dofmap.n_free == 0:
             raise ModelError(f"model '{model.name}' has no free DOFs")
+        validation.loads_on_active_dofs(model, self.dofmap)   # a load nothing stiffens: an error (issue 16)
+        self.check_balance = validation.self_equilibrated(self.families)
         self._constrained = self.constraints.active   # fixed from here on (asked every iteration)
         self.assembler = Assembler(self.dofmap, self.families, full=self._constrained)
         self.constraints.setup(self.dofmap, self.X0)
@@ -275,6 +278,13 @@ class System:
         st.prescribed[cn[~t], cd[~t]] = st.spin[cn[~t], cd[~t] - 3]
         st.commit([r.state for r in responses], P, lam, -res[self.dofmap.n_free:],
                   float(sum(np.sum(r.energy) for r in responses if r.energy is not None)), equilibrium)
+        if equilibrium and self.check_balance:   # issue 16: the reactions balance the loads
+            RF = np.zeros_like(P)
+            RF[cn, cd] = st.reactions
+            validation.check_equilibrium(st.x, P, RF, res[:self.dofmap.n_free], self.free_dof,
+                                         f"increment {self.summary.increments + 1}",
+                                         internal=float(sum(np.abs(q.f).sum() for q in responses)),
+                                         labels=self.model.node_labels)
 
     # ------------------------------------------------------------ messages
     def worst(self, r):

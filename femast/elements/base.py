@@ -122,6 +122,9 @@ class ElementFamily:
     active_dofs: tuple = (0, 1, 2, 3, 4, 5)
     # True when ``k`` is always symmetric (lets the analysis use a symmetric solver).
     symmetric: bool = False
+    # True when the nodal forces ``f`` of every element have zero resultant force and moment (no
+    # element is tied to the ground): the analysis then checks that the reactions balance the loads
+    self_equilibrated: bool = False
     # True when the response depends on the configuration (x, R) only: no state, no use of the
     # increment context.  The analysis then reuses the converged response of an increment as the
     # start of the next one instead of evaluating the same configuration again.  Leave False for

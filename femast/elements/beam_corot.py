@@ -374,6 +374,7 @@ class BeamFamily(ElementFamily):
     """
 
     name = "beam"
+    self_equilibrated = True   # internal nodal forces: zero resultant force and moment (issue 16 check)
     active_dofs = (0, 1, 2, 3, 4, 5)
     n_state = 0
     path_independent = True

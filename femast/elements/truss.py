@@ -65,6 +65,7 @@ class TrussFamily(ElementFamily):
     stress-free length over ``L0`` (length errors and thermal strain, set by femast/thermal.py)."""
 
     name = "truss"
+    self_equilibrated = True   # equal and opposite forces along the chord (issue 16 check)
     active_dofs = (0, 1, 2)
     n_state = 0
     path_independent = True

@@ -13,7 +13,14 @@ Format
   latch pull test).
 
 Every error is a :class:`~femast.errors.DataFileError` naming the file, the line and the
-column, and listing the accepted values.
+column, and listing the accepted values.  Beyond the format, the values are checked (issue 16):
+every value within 1e15 of its unit (a larger one is a corrupt cell and would overflow the fit);
+no measured channel (``experiment.channels``) all zero or constant (nothing was measured: a
+disconnected sensor or a wrong column); a file separated by ';', tabs or '|' is refused with an
+error saying femast reads comma-separated files.  Consecutive identical rows are accepted with a
+:class:`DataWarning`: a repeated sample weighs twice in a fit, and its zero difference from the
+previous row makes the noise floor estimated from second differences too small (every row doubled
+roughly halves it), so the "at the noise floor" verdicts become too strict.
 """
 
 from __future__ import annotations
@@ -21,12 +28,72 @@ from __future__ import annotations
 import csv
 import difflib
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import DataFileError
 from .core import Experiment, Measured
+
+#: largest accepted magnitude of a data value in the unit of its column
+MAX_VALUE = 1e15
+
+
+class DataWarning(UserWarning):
+    """A data file is readable but has something that biases the results (duplicated rows)."""
+
+
+def _separator_error(path, line, text, exp):
+    for sep, name in ((";", "semicolons (';')"), ("\t", "tabs"), ("|", "bars ('|')")):
+        if sep in text:
+            return DataFileError(f"{path} line {line}: the header is separated by {name}; femast reads "
+                                 "comma-separated files (CSV with ',' between columns and '.' as the decimal "
+                                 f"point): save the file as comma-separated. {exp.name} accepts: {_accepted(exp)}")
+    if len(text.split()) > 1:
+        return DataFileError(f"{path} line {line}: the header is separated by spaces; femast reads comma-separated "
+                             f"files (CSV with ',' between columns): save the file as comma-separated. {exp.name} "
+                             f"accepts: {_accepted(exp)}")
+    return None
+
+
+def check_values(exp: Experiment, cols: dict, path: str, lines, measured: bool = True) -> None:
+    """Plausibility of the values of a data set (see the module docstring): magnitudes; for
+    ``measured`` data (a file) also all-zero or constant measured channels (errors) and consecutive
+    duplicated rows (a :class:`DataWarning`).  Arrays built in code (:func:`from_arrays`, e.g. an
+    experiment's model-side placeholders) get the magnitude check only."""
+    for name, a in cols.items():
+        big = np.flatnonzero(np.abs(a) > MAX_VALUE)
+        if big.size:
+            i = int(big[0])
+            unit = exp.column(name).unit
+            raise DataFileError(f"{path} line {lines[i]}, column '{name}': {a[i]:g} {unit} is beyond {MAX_VALUE:g} "
+                                f"{unit}, not a plausible measurement (a corrupt cell?); fix or remove the row")
+    if not measured:
+        return
+    for name in exp.channels:
+        if name not in cols or cols[name].size == 0:
+            continue
+        a = cols[name]
+        unit = exp.column(name).unit
+        if np.all(a == 0.0):
+            raise DataFileError(f"{path}: column '{name}' is zero on every row: nothing was measured (a disconnected "
+                                f"sensor, or the wrong column?); give the measured {name} in {unit}")
+        if np.all(a == a[0]):
+            raise DataFileError(f"{path}: column '{name}' has the same value {a[0]:g} {unit} on every row: a constant "
+                                "channel carries no measurement (a stuck sensor, or a fill value?); give the "
+                                f"measured {name}")
+    if cols:
+        table = np.column_stack(list(cols.values()))
+        if len(table) > 1:
+            dup = np.flatnonzero(np.all(table[1:] == table[:-1], axis=1)) + 1
+            if dup.size:
+                shown = ", ".join(str(lines[i]) for i in dup[:5]) + (", ..." if dup.size > 5 else "")
+                warnings.warn(f"{path}: {dup.size} row(s) repeat the row before them exactly (line(s) {shown}): a "
+                              "repeated sample counts twice in a fit, and its zero difference from the previous "
+                              "row makes the estimated noise floor too small (every row doubled roughly halves "
+                              "it), so fits look worse than the noise; remove the duplicated rows",
+                              DataWarning, stacklevel=3)
 
 
 def _accepted(exp: Experiment) -> str:
@@ -89,6 +156,10 @@ def read_data(exp: Experiment, path) -> Measured:
                 if not cells or not "".join(cells).strip() or cells[0].lstrip().startswith("#"):
                     continue
                 if header is None:
+                    if len(cells) == 1:
+                        err = _separator_error(path, line, cells[0], exp)
+                        if err is not None:
+                            raise err
                     header, header_line = check_header(exp, cells, str(path), line), line
                     continue
                 rows.append(cells)
@@ -126,6 +197,7 @@ def read_data(exp: Experiment, path) -> Measured:
         raise DataFileError(f"{path}: {len(rows)} data row(s); {exp.name} needs at least {exp.min_rows} "
                             "(one per sample, in time order)")
     cols = {h: values[:, i] for i, h in enumerate(header)}
+    check_values(exp, cols, str(path), lines)
     if "t_s" in cols and np.any(np.diff(cols["t_s"]) < 0):
         bad = int(np.flatnonzero(np.diff(cols["t_s"]) < 0)[0]) + 1
         raise DataFileError(f"{path} line {lines[bad]}, column 't_s': time goes backwards "
@@ -147,6 +219,7 @@ def from_arrays(exp: Experiment, **columns) -> Measured:
     n = next(iter(sizes.values()))
     if n < exp.min_rows:
         raise DataFileError(f"<arrays>: {n} rows; {exp.name} needs at least {exp.min_rows}")
+    check_values(exp, arrs, "<arrays>", np.arange(n), measured=False)
     return Measured(exp.name, arrs)
 
 

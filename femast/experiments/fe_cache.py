@@ -9,10 +9,17 @@ run by a SHA-1 of everything that defines it (the model inputs and the drive pat
 and keeps
 
 * the last ``MEMORY_ENTRIES`` runs of this process in memory (always), and
-* every run as a small pickle in a folder, shared between processes and sessions, when the
+* every run as a small ``.npz`` file in a folder, shared between processes and sessions, when the
   experiment option ``cache_dir`` or the environment variable ``FEMAST_FE_CACHE`` names one
   (worker processes of ``diagnose`` then reuse each other's runs, and a repeated command is
   nearly free).
+
+The disk entries hold data, never code (issue 16): a run's dict of numeric arrays, numbers and
+strings is stored as the arrays of an ``.npz`` (no object arrays; read with ``allow_pickle=False``)
+plus a JSON header in the same file with the entry's key, the scalars and a SHA-256 of the arrays.
+A file that is truncated, corrupt, of another format, or whose key or checksum does not match (a
+file planted or copied into the folder) is a miss: the run is computed again and the entry
+rewritten.  A value that is not such a dict stays in memory only.
 
 A cached run is returned as a fresh copy, so callers may modify it.  ``STATS`` counts hits and
 misses (``stats()``; ``clear()`` empties the memory cache and resets the counts).
@@ -22,8 +29,10 @@ from __future__ import annotations
 
 import copy
 import hashlib
+import io
+import json
+import numbers
 import os
-import pickle
 from collections import OrderedDict
 from pathlib import Path
 
@@ -79,26 +88,101 @@ def cached(kind: str, key_parts, compute, options: dict | None = None):
         STATS["hits"] += 1
         return copy.deepcopy(_MEM[key])
     folder = cache_dir(options)
-    path = folder / f"{key}.pkl" if folder else None
+    path = folder / f"{key}.npz" if folder else None
     if path is not None and path.is_file():
-        try:
-            with open(path, "rb") as fh:
-                value = pickle.load(fh)
+        value = read_entry(path, key)
+        if value is not None:
             STATS["disk_hits"] += 1
             _remember(key, value)
             return copy.deepcopy(value)
-        except Exception:  # a truncated file from a killed process: recompute it
-            pass
     STATS["misses"] += 1
     value = compute()
     _remember(key, value)
     if path is not None:
-        folder.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        with open(tmp, "wb") as fh:
-            pickle.dump(value, fh, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(tmp, path)  # atomic: concurrent workers never read half a file
+        write_entry(path, key, value)
     return copy.deepcopy(value)
+
+
+FORMAT = "femast-fe-cache 1"
+
+
+def _digest(key: str, arrays: dict, scalars: dict) -> str:
+    h = hashlib.sha256(key.encode())
+    h.update(json.dumps(scalars, sort_keys=True).encode())
+    for name in sorted(arrays):
+        a = np.ascontiguousarray(arrays[name])
+        h.update(f"{name}|{a.dtype.str}|{a.shape}|".encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _split(value):
+    """(arrays, scalars) of a storable value: a dict with str keys of numeric/bool arrays, numbers,
+    strings and bools; None if the value is anything else (it then stays in memory only)."""
+    if not isinstance(value, dict):
+        return None
+    arrays, scalars = {}, {}
+    for k, v in value.items():
+        if not isinstance(k, str) or k.startswith("__"):
+            return None
+        if isinstance(v, np.ndarray):
+            if v.dtype.kind not in "biuf":
+                return None
+            arrays[k] = v
+        elif isinstance(v, (bool, np.bool_)):
+            scalars[k] = bool(v)
+        elif isinstance(v, numbers.Integral):
+            scalars[k] = int(v)
+        elif isinstance(v, numbers.Real):
+            if not np.isfinite(float(v)):   # JSON has no NaN/inf
+                return None
+            scalars[k] = float(v)
+        elif isinstance(v, str):
+            scalars[k] = v
+        else:
+            return None
+    return arrays, scalars
+
+
+def write_entry(path: Path, key: str, value) -> bool:
+    """Store ``value`` (see :func:`_split`) as entry ``key`` at ``path`` atomically; False if it
+    cannot be stored as data (then nothing is written)."""
+    parts = _split(value)
+    if parts is None:
+        return False
+    arrays, scalars = parts
+    meta = {"format": FORMAT, "key": key, "scalars": scalars, "arrays": sorted(arrays),
+            "sha256": _digest(key, arrays, scalars)}
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    buf = io.BytesIO()
+    np.savez(buf, __meta__=np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8),
+             **{f"a_{name}": a for name, a in arrays.items()})
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+    with open(tmp, "wb") as fh:
+        fh.write(buf.getvalue())
+    os.replace(tmp, path)  # atomic: concurrent workers never read half a file
+    return True
+
+
+def read_entry(path: Path, key: str):
+    """The value stored as entry ``key`` at ``path``, or None (a miss) if the file is missing,
+    truncated, corrupt, of another format, holds object arrays, or its key or checksum differ."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            meta = json.loads(bytes(z["__meta__"]).decode())
+            if not isinstance(meta, dict) or meta.get("format") != FORMAT or meta.get("key") != key:
+                return None
+            names = meta["arrays"]
+            if sorted(z.files) != sorted(["__meta__"] + [f"a_{n}" for n in names]):
+                return None
+            arrays = {n: z[f"a_{n}"] for n in names}
+        scalars = meta["scalars"]
+        if not isinstance(scalars, dict) or _digest(key, arrays, scalars) != meta["sha256"]:
+            return None
+    except Exception:  # anything unreadable is a miss, never a crash
+        return None
+    return {**arrays, **scalars}
 
 
 def _remember(key, value) -> None:

@@ -1,0 +1,192 @@
+"""Restart (Abaqus *RESTART): save the analysis state at converged increments, continue a killed
+or stopped run from the last one saved.
+
+``Analysis(model, out, restart_every=n)`` saves, every n-th converged increment and at the last
+increment of every step, everything the run needs to go on into ``<out>/restart/``:
+
+* ``state-<k>.npz``: the :class:`~femast.analysis.state.State` (configuration, element states,
+  loads, prescribed values, load factor, times, increment sizes, damping...), bit for bit;
+* ``extra-<k>.npz``: the loads and prescribed values at the start of the step in progress (the
+  step's loads ramp from them);
+* ``restart.json``: which step and increment, how many frames are on disk, the run's counts so far,
+  the convergence floor of the run (its first tangent's), and the names of the two files.  It is
+  written last (atomically), so a run killed while saving keeps the previous restart point.
+
+Before saving, the results writer is drained, so every frame up to the restart point is on disk.
+
+``Analysis(model, out, restart=folder)`` (or ``femast run SCRIPT --restart FOLDER``, which sets the
+environment variable ``FEMAST_RESTART`` for the analyses of the script whose ``out`` is FOLDER)
+loads the restart point of ``folder``, keeps the frames written up to it (later ones, and partial
+files, are removed), and continues: the frames it writes are the uninterrupted run's, bit for bit
+(tested with kill -9 at random moments).  Conditions: the same model and analysis options, the
+default full Newton tangent (a "modified" or "initial" tangent would be formed at another state),
+and, for stabilised steps, a restart point after them or in the first one (the linear solver's
+ordering may otherwise be analysed from another pattern and move the results at round-off).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import fields
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FemastError
+from .output import Observer
+from .state import State
+
+RESTART_DIR = "restart"
+FORMAT = "femast-restart-1"
+ENV = "FEMAST_RESTART"
+
+
+def write_json_atomic(path: Path, data: dict) -> None:
+    """JSON to ``path`` through a temporary file renamed into place (flushed to disk first)."""
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w") as fh:
+        json.dump(data, fh, indent=1)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def restart_folder(out, restart):
+    """The folder to restart from: ``restart`` if given, else ``$FEMAST_RESTART`` when it names the
+    results folder ``out`` (``femast run SCRIPT --restart FOLDER``), else None."""
+    if restart is not None:
+        return Path(restart)
+    env = os.environ.get(ENV)
+    if env and out is not None and Path(env).resolve() == Path(out).resolve():
+        return Path(env)
+    return None
+
+
+class RestartOutput(Observer):
+    """Saves the restart point every ``every`` converged increments and at each step's end."""
+
+    def __init__(self, every: int | None):
+        self.every = every   # None: the restarted run's (1 for a fresh run)
+        self.saves = 0
+        self.folder = None
+        self.step_start = None
+
+    def started(self, analysis):
+        if analysis.out is None:
+            raise FemastError("restart_every needs a results folder (out=None writes nothing to restart from)")
+        self.folder = Path(analysis.out) / RESTART_DIR
+        resume = analysis.resume
+        if resume is None:   # a fresh run: an earlier run's restart point is stale
+            if self.folder.is_dir():
+                for f in self.folder.iterdir():
+                    f.unlink()
+            st = analysis.state
+            self.step_start = (st.loads.copy(), st.prescribed.copy())
+            self.folder.mkdir(parents=True, exist_ok=True)
+            # the start is a restart point too: a run killed before its first save starts over
+            write_json_atomic(self.folder / "restart.json", {"format": FORMAT, "initial": True,
+                                                             **_model_id(analysis)})
+        else:
+            self.saves = resume["saves"]
+            self.step_start = resume["step_start"]
+            if self.every is None:
+                self.every = int(resume.get("every", 1))
+        if self.every is None:
+            self.every = 1
+        self.folder.mkdir(parents=True, exist_ok=True)
+
+    def converged(self, analysis, step, increment, attempt, iterations, time, dtime, last, responses, note):
+        if last or increment % self.every == 0:
+            self.save(analysis, step_done=last)
+        if last:   # the next step starts from this state
+            st = analysis.state
+            self.step_start = (st.loads.copy(), st.prescribed.copy())
+
+    def save(self, analysis, step_done: bool):
+        an, st, summary = analysis, analysis.state, analysis.summary
+        an.output.flush()   # every frame up to here on disk before the restart point names them
+        self.saves += 1
+        k = self.saves
+        state_file, extra_file = f"state-{k}.npz", f"extra-{k}.npz"
+        tmp = self.folder / (state_file + ".tmp")
+        st.save(tmp)
+        os.replace(tmp, self.folder / state_file)
+        tmp = self.folder / (extra_file + ".tmp")
+        with open(tmp, "wb") as fh:
+            np.savez(fh, load_start=self.step_start[0], pres_start=self.step_start[1])
+        os.replace(tmp, self.folder / extra_file)
+        done_iters = sum(s["iterations"] for s in summary.steps)
+        zf = an.system.zero_force
+        info = {"format": FORMAT, "step": int(st.step), "step_name": an.model.steps[st.step].name,
+                "step_done": bool(step_done), "increment": int(st.increment), "frames": an.output.frames,
+                "saves": k, "every": self.every, "state_file": state_file, "extra_file": extra_file,
+                "zero_force": None if zf is None else float(zf).hex(),
+                **_model_id(an),
+                "summary": {"increments": summary.increments, "iterations": summary.iterations,
+                            "cutbacks": summary.cutbacks, "line_searches": summary.line_searches,
+                            "steps": summary.steps, "step_iterations": summary.iterations - done_iters}}
+        write_json_atomic(self.folder / "restart.json", info)
+        for f in self.folder.glob("*-*.npz"):   # the previous restart point's files
+            if f.name not in (state_file, extra_file):
+                f.unlink(missing_ok=True)
+
+
+def _model_id(analysis) -> dict:
+    return {"n_nodes": int(len(analysis.system.X0)), "steps": [s.name for s in analysis.model.steps]}
+
+
+def load_restart(folder, analysis) -> dict | None:
+    """Read the restart point of results folder ``folder`` for ``analysis`` (same model): a dict
+    with the State and what the run needs to go on, or None when the point is the run's start (the
+    run starts over); a FemastError naming the folder otherwise."""
+    folder = Path(folder)
+    rdir = folder / RESTART_DIR
+    jfile = rdir / "restart.json"
+    if not jfile.is_file():
+        raise FemastError(f"{folder}: no restart point ({jfile} is missing); run the analysis with "
+                          "restart_every=n (a restart point every n increments) to be able to restart it")
+    try:
+        info = json.loads(jfile.read_text())
+        if info.get("format") != FORMAT:
+            raise ValueError(f"format {info.get('format')!r}, not {FORMAT}")
+        if info.get("initial"):
+            state = None
+        else:
+            state = State.load(rdir / info["state_file"])
+            with np.load(rdir / info["extra_file"], allow_pickle=False) as z:
+                step_start = (z["load_start"], z["pres_start"])
+    except FemastError:
+        raise
+    except Exception as exc:
+        raise FemastError(f"{folder}: the restart point is unreadable ({type(exc).__name__}: {exc}); "
+                          "run the analysis again from the start") from None
+    model = analysis.model
+    names = [s.name for s in model.steps]
+    if info["n_nodes"] != len(analysis.system.X0) or info["steps"] != names or state is not None and (
+            len(state.families) != len(analysis.families) or
+            any(np.shape(a) != np.shape(f.initial_state()) for a, f in zip(state.families, analysis.families))):
+        raise FemastError(f"{folder}: the restart point belongs to another model ({info['n_nodes']} nodes, steps "
+                          f"{info['steps']}; this one: {len(analysis.system.X0)} nodes, steps {names}); restart "
+                          "with the model that wrote it")
+    if state is None:
+        return None
+    info.update(state=state, step_start=step_start, folder=folder)
+    return info
+
+
+def restore(analysis, info) -> None:
+    """Put the restart point ``info`` into ``analysis``: the state (in place: the analysis' parts
+    hold the State object), the convergence floor and the run's counts."""
+    st = analysis.state
+    saved = info["state"]
+    for f in fields(State):
+        if f.name != "_saved":
+            setattr(st, f.name, getattr(saved, f.name))
+    if info["zero_force"] is not None:
+        analysis.system.zero_force = float.fromhex(info["zero_force"])
+    s = info["summary"]
+    summ = analysis.summary
+    summ.increments, summ.iterations = s["increments"], s["iterations"]
+    summ.cutbacks, summ.line_searches = s["cutbacks"], s["line_searches"]
+    summ.steps = list(s["steps"])

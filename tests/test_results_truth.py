@@ -1,0 +1,164 @@
+"""Issue 16, item 2: results folders that never lie (atomic files, partial files ignored with a
+warning, a summary that says "completed" only after the last increment), and a kill-and-read test."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+import warnings
+
+import numpy as np
+import pytest
+
+import femast as fm
+from femast.results import Results, ResultsWarning
+
+
+def _cantilever(n_inc=4, load=-50.0):
+    m = fm.Model("truth")
+    a, b = m.node(0, 0, 0), m.node(1, 0, 0)
+    m.beam(a, b, fm.circular_tube(0.02, 0.016, E=70e9), n=4)
+    m.fix(a)
+    m.step("load", initial_increment=1.0 / n_inc, max_increment=1.0 / n_inc).load(b, fz=load)
+    return m, b
+
+
+def _summary(folder):
+    return json.loads((folder / "summary.json").read_text())
+
+
+def test_completed_run_says_completed(tmp_path):
+    m, b = _cantilever()
+    res = fm.solve(m, tmp_path / "r", progress=False)
+    s = _summary(tmp_path / "r")
+    assert s["status"] == "completed" and s["completed"] is True and res.status == "completed"
+    assert not list((tmp_path / "r" / "frames").glob("*.tmp"))
+    assert len(res) == 5
+
+
+def test_summary_is_running_during_the_run_and_replaces_a_stale_one(tmp_path):
+    out = tmp_path / "r"
+    m, _ = _cantilever()
+    fm.solve(m, out, progress=False)
+    assert _summary(out)["status"] == "completed"
+    seen = []
+    m2, _ = _cantilever()
+    fm.solve(m2, out, progress=False, on_frame=lambda d: seen.append(_summary(out)["status"]))
+    assert seen and set(seen) == {"running"}   # the earlier run's "completed" is gone from the start
+    assert _summary(out)["status"] == "completed"
+
+
+def test_ctrl_c_is_interrupted(tmp_path, capsys):
+    m, _ = _cantilever()
+
+    def stop(d):
+        if d["increment"] == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        fm.solve(m, tmp_path / "r", progress=True, on_frame=stop)
+    s = _summary(tmp_path / "r")
+    assert s["status"] == "interrupted" and s["completed"] is False
+    assert "analysis completed" not in capsys.readouterr().out
+    assert Results(tmp_path / "r").status == "interrupted"
+
+
+def test_singular_first_increment_is_failed_with_reason(tmp_path, capsys):
+    m = fm.Model()
+    a, b = m.node(0, 0, 0), m.node(1, 0, 0)
+    m.beam(a, b, fm.circular_tube(0.02, 0.016, E=70e9), n=2)
+    m.fix(a, "ux", "uy", "uz", "ry", "rz")   # torsion left free: a mechanism
+    m.step("s").load(b, fy=1.0)
+    with pytest.raises(fm.SingularModelError):
+        fm.solve(m, tmp_path / "r", progress=True)
+    s = _summary(tmp_path / "r")
+    assert s["status"] == "failed" and "SingularModelError" in s["message"] and "rx" in s["message"]
+    out = capsys.readouterr().out
+    assert "analysis completed" not in out and "FAILED" in out
+
+
+def test_raw_exception_is_failed(tmp_path):
+    m, _ = _cantilever()
+
+    def boom(d):
+        if d["increment"] == 1:
+            raise RuntimeError("user callback broke")
+
+    with pytest.raises(RuntimeError):
+        fm.solve(m, tmp_path / "r", progress=False, on_frame=boom)
+    s = _summary(tmp_path / "r")
+    assert s["status"] == "failed" and "user callback broke" in s["message"]
+
+
+def test_partial_and_corrupt_frames(tmp_path):
+    m, b = _cantilever()
+    res = fm.solve(m, tmp_path / "r", progress=False)
+    frames = tmp_path / "r" / "frames"
+    last = res.frame(-1)["U"].copy()
+    (frames / "000006.npz.tmp").write_bytes(b"PK\x03\x04 half a zip")
+    (frames / "000007.tmp.npz").write_bytes(b"PK\x03\x04 half a zip (older femast's name)")
+    with pytest.warns(ResultsWarning, match=r"000006\.npz\.tmp"):
+        r2 = Results(tmp_path / "r")
+    assert len(r2) == 5 and np.array_equal(r2.frame(-1)["U"], last)
+    assert r2.node_history(b, "uz").shape == (5,)
+    (frames / "000004.npz").write_bytes(b"not a zip at all")   # frame 3 (frame 0 is 000001)
+    with pytest.warns(ResultsWarning):
+        r3 = Results(tmp_path / "r")
+    with pytest.raises(fm.FemastError, match=r"000004\.npz: frame 3 is unreadable"):
+        r3.frame(3)
+    with pytest.raises(fm.FemastError, match=r"frame 99 does not exist; the folder has 5 frames"):
+        r2.frame(99)
+
+
+def test_out_is_an_existing_file(tmp_path):
+    m, _ = _cantilever()
+    f = tmp_path / "file.txt"
+    f.write_text("x")
+    with pytest.raises(fm.FemastError, match=r"file\.txt' is an existing file"):
+        fm.solve(m, f, progress=False)
+
+
+_KILL_SCRIPT = textwrap.dedent("""
+    import sys, femast as fm
+    m = fm.Model("kill")
+    a = m.node(0, 0, 0)
+    b = m.node(1, 0, 0)
+    m.beam(a, b, fm.circular_tube(0.02, 0.016, E=70e9), n=20)
+    m.fix(a)
+    m.step("s", initial_increment=1e-4, max_increment=1e-4, max_increments=100000).load(b, fz=-50.0)
+    fm.solve(m, sys.argv[1], progress=False)
+""")
+
+
+def test_kill_9_and_read(tmp_path):
+    """A run killed outright: every frame on disk reads, the summary says "running" but the
+    reader reports "interrupted" (its process is gone), and no partial file is taken for a frame."""
+    out = tmp_path / "r"
+    script = tmp_path / "run.py"
+    script.write_text(_KILL_SCRIPT)
+    # a stale "completed" summary from an earlier run must not survive the kill
+    out.mkdir()
+    (out / "summary.json").write_text(json.dumps({"status": "completed", "completed": True}))
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([os.getcwd(), os.environ.get("PYTHONPATH", "")])}
+    p = subprocess.Popen([sys.executable, str(script), str(out)], env=env)
+    try:
+        deadline = time.time() + 120
+        while time.time() < deadline and len(list((out / "frames").glob("*.npz"))) < 15:
+            time.sleep(0.05)
+        assert p.poll() is None, "the run ended before it could be killed"
+    finally:
+        p.send_signal(signal.SIGKILL)
+        p.wait()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ResultsWarning)   # a *.tmp may or may not be left
+        res = Results(out)
+    assert len(res) >= 15
+    assert _summary(out)["status"] == "running" and res.status == "interrupted"
+    U = np.array([res.frame(i)["U"] for i in range(len(res))])   # every frame reads
+    assert np.all(np.isfinite(U))
+    inc = res.scalar_history("increment")
+    assert np.array_equal(inc, np.arange(len(res)))   # consecutive: nothing lost before the last
+
