@@ -120,9 +120,12 @@ def test_diagnose_json_schema_of_issue_7(tmp_path, capsys):
             assert {"value", "stderr", "unit"} <= set(p)
     assert [e["delta_bic"] for e in r["ranking"]] == sorted(e["delta_bic"] for e in r["ranking"])
     assert set(r["verdict"]) >= {"missing_effect", "explained"}
-    # the example hides two effects: the best single one does not explain it all
-    assert r["verdict"] == {**r["verdict"], "missing_effect": None, "explained": False,
+    # the example hides two effects: the best single one does not explain it all, the pair does (issue 14)
+    assert r["verdict"] == {**r["verdict"], "missing_effect": None, "explained": True, "kind": "missing_pair",
                             "best_candidate": "joint_clearance"}
+    assert sorted(r["verdict"]["missing_effects"]) == ["friction_hysteresis", "joint_clearance"]
+    assert {"noise_model", "n_eff", "pairs", "form_check"} <= set(r)
+    assert {"form", "forms", "ic_gain", "share_ok"} <= set(r["ranking"][0])
     assert (tmp_path / "diagnose.png").stat().st_size > 0 and (tmp_path / "diagnose.json").is_file()
     r = _run_json(capsys, ["diagnose", "mast-top", str(MT_DATA), "--out", str(tmp_path), "--json",
                            "--effects", "joint_clearance", "--workers", "1"])

@@ -112,8 +112,9 @@ def test_out_of_library_thermal_drift_is_not_explained():
 def test_two_hidden_effects_are_found_one_after_the_other():
     data, _ = mast_top_data(effects={"joint_clearance": {"c": 1.5e-4}, "friction_hysteresis": {"M_f": 12.0}},
                             path=mast_top_path(kind="cycles", seed=41), seed=41)
-    d1 = diagnose(EXP, data, workers=1)
-    assert d1.verdict["explained"] is False and d1.verdict["best_candidate"] == "joint_clearance"
+    d1 = diagnose(EXP, data, workers=1)  # issue 14: the pair is fitted jointly and named at once
+    assert d1.verdict["kind"] == "missing_pair" and d1.verdict["best_candidate"] == "joint_clearance"
+    assert sorted(d1.verdict["missing_effects"]) == ["friction_hysteresis", "joint_clearance"]
     d2 = diagnose(EXP, data, base_effects=["joint_clearance"], workers=1)
     assert d2.verdict["missing_effect"] == "friction_hysteresis"
     d3 = diagnose(EXP, data, base_effects=["joint_clearance", "friction_hysteresis"], workers=1)

@@ -186,6 +186,13 @@ class Experiment:
         (p + 1)``).  ``expensive: True`` makes ``diagnose`` refit in parallel by default even when
         the baseline fit was fast (its runs came from a cache).
     source : where it came from (a built-in name or a script path), set by the registry.
+    noise_covariates : optional ``noise_covariates(data, params, options, fit) -> {channel: {name:
+        (n,) array}}`` of quantities the noise level of a channel may grow with, because of how
+        the data are measured (latch-pull: the slope of the law, seed 001 Eq. 15); the noise model
+        of ``diagnose`` (:mod:`femast.experiments.noise`) tests them.
+
+    Every channel ``c`` also accepts an optional column ``sigma_c`` (same unit) with the standard
+    uncertainty of each row; ``diagnose`` then uses it as the noise of that channel.
     """
 
     name: str
@@ -209,6 +216,7 @@ class Experiment:
     effects_from: str | None = None
     fit_options: dict = field(default_factory=dict)
     source: str = ""
+    noise_covariates: Callable | None = None
 
     def __post_init__(self):
         names = [c.name for c in self.columns]
@@ -241,10 +249,18 @@ class Experiment:
 
     @property
     def all_columns(self) -> tuple:
-        """Declared columns plus the optional time column ``t_s``."""
-        if any(c.name == TIME_COLUMN.name for c in self.columns):
-            return tuple(self.columns)
-        return tuple(self.columns) + (TIME_COLUMN,)
+        """Declared columns, the optional time column ``t_s`` and an optional ``sigma_<channel>``
+        (per-row standard uncertainty, the channel's unit) for every channel."""
+        cols = tuple(self.columns)
+        names = {c.name for c in cols}
+        if TIME_COLUMN.name not in names:
+            cols += (TIME_COLUMN,)
+        for ch in self.channels:
+            if f"sigma_{ch}" not in names:
+                unit = next((c.unit for c in self.columns if c.name == ch), "")
+                cols += (Column(f"sigma_{ch}", unit, f"standard uncertainty of {ch} in each row (optional; > 0)",
+                                required=False),)
+        return cols
 
     def unit_of(self, channel: str) -> str:
         """Unit of a channel (column)."""

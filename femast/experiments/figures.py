@@ -66,8 +66,12 @@ def compare_figure(exp, data, result, png) -> Path:
     for i, c in enumerate(exp.channels):
         f, ul = display_scale(exp.unit_of(c))
         ax3.plot(rows, f * result.residuals[c], "-", lw=0.8, color=f"C{i}", label=column_label(c, ul))
-        ax3.axhline(f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
-        ax3.axhline(-f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
+        if np.ndim(result.noise[c]):  # per-row noise (heteroscedastic model)
+            ax3.plot(rows, f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
+            ax3.plot(rows, -f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
+        else:
+            ax3.axhline(f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
+            ax3.axhline(-f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
     from .diagnose import AT_NOISE
 
     for k, seg in enumerate([w for w in result.worst[:3] if w["ratio"] > AT_NOISE]):
@@ -95,7 +99,10 @@ def diagnose_figure(exp, data, result, png) -> Path:
     png = Path(png)
     f, ul = display_scale(exp.error_unit)
     entries = [("baseline", result.baseline["rms"], None, False)] + [
-        (r["effect"], r["rms"], r["delta_bic"], r["significant"]) for r in result.ranking]
+        (r["effect"] + (f" ({r['form']})" if r.get("form") else ""), r["rms"], r["delta_bic"], r["significant"])
+        for r in result.ranking] + [
+        (" + ".join(p["effects"]), p["rms"], p["delta_bic"], p["significant"]) for p in
+        (getattr(result, "pairs", None) or [])[:3]]
     fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(13, max(4.0, 0.45 * len(entries) + 2)),
                                    gridspec_kw={"width_ratios": [1, 1.3]})
     y = np.arange(len(entries))[::-1]
@@ -111,18 +118,24 @@ def diagnose_figure(exp, data, result, png) -> Path:
             ax0.text(f * e[1], yy, f"  dBIC {e[2]:+.0f}", va="center", fontsize=8)
     ax0.set_xlabel(f"RMS error after refit ({ul})")
     v = result.verdict
-    verdict = (f"missing: {v['missing_effect']}" if v["missing_effect"] else
-               ("nothing is missing" if v["explained"] else "none of the candidates explains this"))
-    ax0.set_title(fit_title(ax0, f"{exp.name}: refit with each candidate (green: significant); verdict: {verdict}"))
+    verdict = {"missing_effect": f"missing: {v['missing_effect']}",
+               "missing_pair": f"missing: {' + '.join(v.get('missing_effects', []))}",
+               "form_imperfect": f"mechanism found ({v.get('mechanism')}), form imperfect",
+               "better_form": f"better form of {v.get('mechanism')}: {v.get('form')}",
+               "nothing_missing": "nothing is missing"}.get(v.get("kind"), "none of the candidates explains this")
+    ax0.set_title(fit_title(ax0, f"{exp.name}: refit with each candidate and pair (green: significant); verdict: {verdict}"))
     ax0.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     xmax = max(f * e[1] for e in entries)
     ax0.set_xlim(0, 1.35 * xmax)
     rows = np.arange(data.n)
-    zb = result.baseline_fit.fun.reshape(len(exp.channels), -1)
+    zb = np.asarray(getattr(result, "baseline_z", result.baseline_fit.fun)).reshape(len(exp.channels), -1)
     ax1.plot(rows, np.sqrt((zb**2).mean(0)), "-", lw=0.8, color="C0", label="baseline")
     if result.best_fit is not None:
-        zc = result.best_fit.fun.reshape(len(exp.channels), -1)
-        ax1.plot(rows, np.sqrt((zc**2).mean(0)), "-", lw=0.8, color="C2", label=f"with {result.ranking[0]['effect']}")
+        zc = np.concatenate([result.best_fit.residuals[c] / np.broadcast_to(result.noise[c], (data.n,))
+                             for c in exp.channels]).reshape(len(exp.channels), -1)
+        label = " + ".join(v.get("missing_effects") or []) if v.get("kind") == "missing_pair" else \
+            result.ranking[0]["effect"]
+        ax1.plot(rows, np.sqrt((zc**2).mean(0)), "-", lw=0.8, color="C2", label=f"with {label}")
     ax1.axhline(1.0, color="k", ls="--", lw=0.8)
     ax1.set_xlabel("data row (time order)")
     ax1.set_ylabel("|residual| / noise, RMS over channels (-)")

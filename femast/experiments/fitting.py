@@ -221,17 +221,20 @@ def _forward_differences(fun, step: float, lo, hi):
 
 
 def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, multistart: bool = True,
-        max_nfev: int | None = None, given_start_clip: bool = False) -> OptimizeResult:
+        max_nfev: int | None = None, given_start_clip: bool = False,
+        nfev_per_param: int | None = None) -> OptimizeResult:
     """Fit the baseline parameters and those of the switched-on ``effects`` to the data.
 
     effects : effect names (``femast.effects``) applicable to the experiment.
     start : ``{name: value}`` start values (baseline names, ``"effect.param"`` for effects); the
         default is the experiment's ``initial_guess`` (or its defaults) and the effects' defaults.
-    noise : ``{channel: sigma}`` fixed weights; default: estimated from the residuals of a first
-        fit, then refitted with them.
+    noise : ``{channel: sigma}`` fixed weights, a level or per-row levels (n,) (a heteroscedastic
+        noise model); default: estimated from the residuals of a first fit, then refitted with them.
     multistart : also start the effect parameters from their ``starts`` and keep the best fit.
     given_start_clip : clip given starts outside the bounds into them (diagnose passes the values of
         other fits) instead of raising ModelError naming the parameter.
+    nfev_per_param : cap of the evaluations per start, ``x (p + 1)`` (the smaller of it and the
+        experiment's ``max_nfev_per_param``); diagnose's refits use 25.
 
     Returns an ``OptimizeResult`` with ``x``, ``names``, ``units``, ``stderr``, ``cov``,
     ``params`` (baseline ``{name: value}``), ``effect_params`` (``{effect: {name: value}}``),
@@ -290,6 +293,8 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
             starts.append(x)
     fo = dict(exp.fit_options)
     per_param = int(fo.pop("max_nfev_per_param", 100))
+    if nfev_per_param:
+        per_param = min(per_param, int(nfev_per_param))
     fo.pop("expensive", None)  # a hint for diagnose, not a least_squares option
     fd_step = fo.pop("diff_step", None)
     kw = dict(method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10, x_scale=1.0)
@@ -322,7 +327,7 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
         sol2.nfev_total += sol.nfev_total
         sol = sol2
     else:
-        sigma = {c: float(noise[c]) for c in exp.channels}
+        sigma = {c: _sigma_of(noise, c, data.n) for c in exp.channels}
         sol = solve(sigma, starts)
     x = sol.x * scale
     stderr, cov, note = _covariance(sol.jac, sol.cost, sol.fun.size, scale)
@@ -334,6 +339,17 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     msg = sol.message.rstrip(".") + (f"; {note}" if note else "")
     return _result(exp, data, specs, x, stderr, cov, sigma, predicted, True, bool(sol.success), msg,
                    sol.nfev_total, [i[0] for i in impls])
+
+
+def _sigma_of(noise: dict, channel: str, n: int):
+    """A channel's noise: one level (float) or per-row levels ((n,) array, all > 0), checked."""
+    v = np.asarray(noise[channel], dtype=float)
+    if v.ndim == 0:
+        return float(v)
+    if v.shape != (n,) or not np.all(np.isfinite(v) & (v > 0)):
+        raise ModelError(f"noise of {channel}: need one level or {n} finite positive per-row levels, got shape "
+                         f"{v.shape}")
+    return v
 
 
 def params_table(result: OptimizeResult) -> dict:

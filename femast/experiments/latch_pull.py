@@ -326,6 +326,26 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
     ax.legend(fontsize=7)
 
 
+def noise_covariates(data: Measured, params: dict, options: dict, fit=None) -> dict:
+    """What the force noise varies with (issue 14): the signed slope s = d dT / dx (N/m) of the fitted
+    law's branch in the direction of motion at each sample.  Eq. 15 removes the cable stretch C T
+    from the measured distance with the measured force, so the load-cell noise e_T enters x as
+    well: a row's residual is e_T (1 + s C) - s e_d (e_d the distance noise), a variance quadratic
+    in s (femast.experiments.noise); the noise is largest on the steep latching branch.  On the
+    backstop the residual is ``backstop_N_per_m (x + x_backstop)``, so there the covariate is that
+    stiffness: the returned covariate is the sensitivity dr/dx of each row's residual (N/m)."""
+    prep = prepared(data, _prepare, options)
+    p = np.array([float(params[n]) for n in ("r", "x_backstop", "k", "mu")] + [float(options["h_m"]),
+                                                                              float(options["R_m"])])
+    x = np.maximum(prep["x"], -p[1])
+    direction = np.where(prep["sigma"] > 0, UNLATCHING, LATCHING)
+    _, slope = latch_force(x, direction, p, derivative=True)
+    # at the backstop the residual is backstop_N_per_m x (x + x_backstop): its sensitivity to x
+    tol = max(3.0 * prep["noise_x"], 2e-5)
+    q = np.where(prep["x"] <= -p[1] + tol, float(options["backstop_N_per_m"]), -slope)
+    return {"dT_N": {"sensitivity of the residual to x (Eq. 15 puts the load-cell noise into x)": q}}
+
+
 EXPERIMENT = Experiment(
     name="latch-pull",
     title="latch pull test (seed 001 Eqs. 12-15)",
@@ -356,6 +376,7 @@ EXPERIMENT = Experiment(
     load_label="dT (N)",
     extra_segments=extra_segments,
     plot_measured=plot_measured,
+    noise_covariates=noise_covariates,
     error_unit="N",
     min_rows=10,
     source="latch-pull",

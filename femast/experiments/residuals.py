@@ -207,8 +207,9 @@ def _stats(rows, residuals, sigma, weights):
     e2, z2, means = [], [], {}
     for c, r in residuals.items():
         rr = r[rows]
+        sc = sigma[c][rows] if np.ndim(sigma[c]) else sigma[c]  # per-row noise (heteroscedastic) or one level
         e2.append((weights[c] * rr) ** 2)
-        z2.append((rr / sigma[c]) ** 2)
+        z2.append((rr / sc) ** 2)
         means[c] = float(np.mean(rr)) if rr.size else 0.0
     e2 = np.concatenate(e2)
     z2 = np.concatenate(z2)
