@@ -148,3 +148,18 @@ class ElementFamily:
         ctx : :class:`IncrementContext`.
         """
         raise NotImplementedError
+
+
+def chain_nodes(nodes, name: str) -> np.ndarray:
+    """Node labels of cable elements running through n+1 nodes, as an (n_el, n+1) int64 array.
+
+    One row (a 1-D array) is one element.  Shared by the cable/latch and cable-device families.
+    """
+    from ..errors import ModelError
+
+    nodes = np.asarray(nodes)
+    if nodes.ndim == 1:
+        nodes = nodes[None, :]
+    if nodes.ndim != 2 or nodes.shape[1] < 2 or not np.issubdtype(nodes.dtype, np.integer):
+        raise ModelError(f"{name}: nodes must be an (n_el, n+1) integer array with n+1 >= 2, got {nodes.shape}")
+    return np.ascontiguousarray(nodes, dtype=np.int64)

@@ -30,7 +30,7 @@ from ._cable_geometry import (GEO_ADJACENT_PULLEYS, GEO_INSIDE_PULLEY, GEO_NOT_F
                               GEO_PLANE_UNDEFINED, GEO_ZERO_LENGTH, cable_geometry)
 from ._device_kernels import ERR_ACTIVE_SET, ERR_SHORT, SLIDE_FREE, STOP, device_kernel, kernel_for_law
 from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, N_PARAM, USER, builtin_law
-from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput
+from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput, chain_nodes
 
 MODE_NAMES = {0: "stick", 1: "slide (out side pulls)", -1: "slide (in side pulls)", 2: "at stop", 3: "frictionless"}
 
@@ -203,12 +203,7 @@ class CableDeviceFamily(ElementFamily):
 
     def __init__(self, nodes, EA, L0, devices, *, s0=None, name: str = "cable_devices"):
         self.name = name
-        nodes = np.asarray(nodes)
-        if nodes.ndim == 1:
-            nodes = nodes[None, :]
-        if nodes.ndim != 2 or nodes.shape[1] < 2 or not np.issubdtype(nodes.dtype, np.integer):
-            raise ModelError(f"{name}: nodes must be an (n_el, n+1) integer array with n+1 >= 2, got {nodes.shape}")
-        self.nodes = np.ascontiguousarray(nodes, dtype=np.int64)
+        self.nodes = chain_nodes(nodes, name)
         n_el, nn = self.nodes.shape
         n = nn - 1
         self.n_sections = n

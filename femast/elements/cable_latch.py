@@ -55,7 +55,7 @@ from ._cable_kernels import (
     STICK,
     cable_latch_kernel,
 )
-from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput
+from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput, chain_nodes
 
 STATUS_NAMES = {STICK: "stick", SLIP_OUT: "slip out", SLIP_IN: "slip in", BACKSTOP: "backstop"}
 
@@ -102,12 +102,7 @@ class CableLatchFamily(ElementFamily):
                  max_strain: float = 0.1, hysteresis_force=0.0, hysteresis_length=3e-4,
                  name: str = "cable_latch"):
         self.name = name
-        nodes = np.asarray(nodes)
-        if nodes.ndim == 1:
-            nodes = nodes[None, :]
-        if nodes.ndim != 2 or nodes.shape[1] < 2 or not np.issubdtype(nodes.dtype, np.integer):
-            raise ModelError(f"{name}: nodes must be an (n_el, n+1) integer array with n+1 >= 2, got {nodes.shape}")
-        self.nodes = np.ascontiguousarray(nodes, dtype=np.int64)
+        self.nodes = chain_nodes(nodes, name)
         n_el, nn = self.nodes.shape
         self.n_sections = nn - 1
         self.n_state = self.n_sections + 2
