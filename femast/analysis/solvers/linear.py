@@ -46,7 +46,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-from ..errors import SingularModelError
+from ...errors import SingularModelError
 
 try:  # scipy's SuperLU binding, called directly for the matrix refactorised every iteration
     from scipy.sparse.linalg._dsolve._superlu import gstrf as _gstrf
