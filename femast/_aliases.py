@@ -23,6 +23,7 @@ OLD_PATHS = {
     "femast.constraints": "femast.model.constraints",
     "femast.thermal": "femast.model.thermal",
     "femast.validation": "femast.model.validation",
+    "femast.model_arrays": "femast.model.arrays",
     "femast.assembly": "femast.analysis.assembly",
     "femast.dofs": "femast.analysis.dofs",
     "femast.reduction": "femast.analysis.reduction",
