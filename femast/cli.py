@@ -1,7 +1,7 @@
 """Command line: ``femast run SCRIPT``, ``femast vtk RESULTS``, ``femast render RESULTS [PNG]``,
 ``femast info RESULTS``, ``femast warmup``; ``compare``, ``diagnose``, ``experiments``, ``effects``,
-``examples`` (:mod:`femast.cli_experiments`); ``study`` (:mod:`femast.studies.cli`).  ``femast --help`` lists them, ``femast CMD --help``
-explains each argument with its default.  ``femast --quiet CMD`` shows no progress bars."""
+``examples`` (:mod:`femast.cli_experiments`); ``study`` (:mod:`femast.studies.cli`).  ``femast --help``
+lists them, ``femast CMD --help`` explains each argument with its default.  ``femast --quiet CMD`` shows no progress bars."""
 
 from __future__ import annotations
 
