@@ -20,7 +20,7 @@ def _label(name, idx):
 
 
 def _series(res, rep):
-    """[(label, values)] of the scalar output components (first MAX_PANELS)."""
+    """[(label, values, unit)] of the scalar output components (first MAX_PANELS)."""
     out = []
     shapes = res.store.shapes
     for name in res.output_names:
@@ -29,21 +29,21 @@ def _series(res, rep):
             continue
         shp = shapes.get(name, ())
         for idx in ([()] if not shp else list(np.ndindex(*shp))):
-            out.append((_label(name, idx), v[(slice(None),) + idx]))
+            out.append((_label(name, idx), v[(slice(None),) + idx], res.units.get(name, "")))
             if len(out) >= MAX_PANELS:
                 return out
     return out
 
 
-def distribution_figure(series, png, unit="SI units"):
-    """Histograms of ``series`` [(label, values)] with the 5/50/95/99 % percentiles and their 95 %
+def distribution_figure(series, png):
+    """Histograms of ``series`` [(label, values, unit)] with the 5/50/95/99 % percentiles and their 95 %
     intervals (shaded)."""
     plt = plotstyle.pyplot()
     n = len(series)
     cols = min(n, 3)
     rows = (n + cols - 1) // cols
     fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.2 * rows), squeeze=False)
-    for ax, (label, x) in zip(axes.ravel(), series):
+    for ax, (label, x, unit) in zip(axes.ravel(), series):
         ax.hist(x, bins=min(60, max(10, int(np.sqrt(len(x))))), color="0.75", edgecolor="0.5")
         for q, c in zip(_Q, ("C0", "C1", "C2", "C3")):
             p = percentile(x, q)
@@ -53,14 +53,14 @@ def distribution_figure(series, png, unit="SI units"):
         ax.set_xlabel(plotstyle.axis_label(label, unit))
         ax.set_ylabel("samples")
         ax.set_title(plotstyle.fit_title(ax, f"{label}: {len(x)} samples"))
-        ax.legend(loc="upper right")
+        ax.legend(loc="best", fontsize=7.5)
     for ax in axes.ravel()[n:]:
         ax.set_visible(False)
     fig.tight_layout()
     return plotstyle.save(fig, png)
 
 
-def convergence_figure(series, png, unit="SI units"):
+def convergence_figure(series, png):
     """Mean and 95 % percentile of each series against the number of samples, with their 95 %
     intervals."""
     plt = plotstyle.pyplot()
@@ -68,7 +68,7 @@ def convergence_figure(series, png, unit="SI units"):
     cols = min(n, 3)
     rows = (n + cols - 1) // cols
     fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.2 * rows), squeeze=False)
-    for ax, (label, x) in zip(axes.ravel(), series):
+    for ax, (label, x, unit) in zip(axes.ravel(), series):
         c = convergence(x, q=(0.95,))
         for key, col, txt in (("mean", "C0", "mean"), ("q0.95", "C2", "95 % percentile")):
             e = c[key]

@@ -98,6 +98,11 @@ class NodeOutput(_StepOutput):
                 raise StudyError(f"output '{name}': component {c!r} of {quantity} does not exist; use "
                                  f"{', '.join(names)}" + (f" (or {', '.join(alias)})" if alias else ""))
         self.components = idx[0] if single else np.array(idx)
+        if quantity == "RF":
+            kinds = {"N" if i < 3 else "N m" for i in (idx if not single else [idx[0]])}
+            self.unit = kinds.pop() if len(kinds) == 1 else "N, N m"
+        else:
+            self.unit = "m" if quantity == "U" else "rad"
 
     def check(self, model, families=None):
         model._check_node(self.node, f"output '{self.name}'")   # ModelError names the node
@@ -113,11 +118,13 @@ class ElementOutput(_StepOutput):
 
     elements : None (every element of the family) or positions in the family.
     reduce : None (the array), or 'max', 'min', 'absmax', 'mean', 'sum' over the elements.
+    unit : the unit of the quantity, for tables and figures (e.g. 'N').
     """
 
     def __init__(self, name: str, family: str, key: str, elements=None, reduce: str | None = None, at=None,
-                 relative_to=None):
+                 relative_to=None, unit: str = ""):
         super().__init__(name, at, relative_to)
+        self.unit = str(unit)
         if reduce is not None and reduce not in REDUCTIONS:
             raise StudyError(f"output '{name}': reduce = {reduce!r} is unknown; use None or one of "
                              f"{', '.join(REDUCTIONS)}")

@@ -18,29 +18,32 @@ def _components(shape):
 
 
 def summary_rows(res, quantiles=QUANTILES, confidence=0.95) -> list:
-    """[(output, index, n, {q: percentile dict})] for every output component (first MAX_COMPONENTS)."""
+    """[(output, index, n, {q: percentile dict}, unit)] for every output component (first
+    MAX_COMPONENTS)."""
     rows = []
     shapes = res.store.shapes
     for name in res.output_names:
         v = res.output(name, blocks=("A", "B") if res.sensitivity else ("A",))
         if len(v) == 0:
-            rows.append((name, (), 0, {}))
+            rows.append((name, (), 0, {}, res.units.get(name, "")))
             continue
         for idx in _components(shapes.get(name, ()))[:MAX_COMPONENTS]:
             x = v[(slice(None),) + idx]
-            rows.append((name, idx, len(x), {q: percentile(x, q, confidence) for q in quantiles}))
+            rows.append((name, idx, len(x), {q: percentile(x, q, confidence) for q in quantiles},
+                         res.units.get(name, "")))
     return rows
 
 
 def format_rows(rows) -> str:
-    lines = [f"{'output':<24} {'n':>6} " + " ".join(f"{'q' + format(q * 100, 'g'):>30}" for q in QUANTILES)]
-    for name, idx, n, ps in rows:
+    lines = [f"{'output':<24} {'unit':<6} {'n':>6} " + " ".join(f"{format(q * 100, 'g') + ' %':>30}"
+                                                            for q in QUANTILES)]
+    for name, idx, n, ps, unit in rows:
         label = name + (str(list(idx)) if idx else "")
         if not ps:
-            lines.append(f"{label:<24} {n:>6}  (no successful sample)")
+            lines.append(f"{label:<24} {unit or '-':<6} {n:>6}  (no successful sample)")
             continue
         cells = [f"{p['estimate']:.4g} [{p['low']:.4g}, {p['high']:.4g}]" for p in ps.values()]
-        lines.append(f"{label:<24} {n:>6} " + " ".join(f"{c:>30}" for c in cells))
+        lines.append(f"{label:<24} {unit or '-':<6} {n:>6} " + " ".join(f"{c:>30}" for c in cells))
     return "\n".join(lines)
 
 
@@ -52,8 +55,8 @@ def report(folder, print_table: bool = True, figures: bool = True) -> dict:
     rows = summary_rows(res)
     out = {"rows": rows, "sobol": {}, "figures": []}
     if print_table:
-        print("percentiles: estimate [95 % confidence interval], SI units (blocks A" +
-              (" and B)" if res.sensitivity else ")"))
+        print("percentiles: estimate [95 % confidence interval] (samples of blocks A" +
+              (" and B)" if res.sensitivity else ")") + "; NaN: too few samples for that bound")
         print(format_rows(rows))
     if res.sensitivity:
         shapes = res.store.shapes
@@ -61,8 +64,14 @@ def report(folder, print_table: bool = True, figures: bool = True) -> dict:
             fA, fB, fAB, dropped = res.saltelli(name)
             if len(fA) < 2:
                 continue
+            scale = np.max(np.abs(np.concatenate([fA.ravel(), fB.ravel()]))) if fA.size else 0.0
             for idx in _components(shapes.get(name, ()))[:MAX_COMPONENTS]:
                 sl = (slice(None),) + idx
+                if np.std(np.concatenate([fA[sl], fB[sl]])) <= 1e-9 * scale:
+                    if print_table:
+                        print(f"sensitivity of {name}{list(idx) if idx else ''}: does not vary beyond round-off "
+                              f"(1e-9 of the output's largest value); no indices")
+                    continue
                 try:
                     s = sobol_indices(fA[sl], fB[sl], fAB[(slice(None),) + sl], names=res.input_names)
                 except Exception as exc:   # a constant component has no indices

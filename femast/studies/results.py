@@ -25,6 +25,7 @@ class StudyResults:
         self.samples = m["samples"]
         self.input_names = [x["name"] for x in self.spec["design"]["inputs"]]
         self.output_names = list(self.spec["outputs"])
+        self.units = dict(self.spec.get("units", {}))
         self.sensitivity = bool(self.spec["design"]["sensitivity"])
 
     @property

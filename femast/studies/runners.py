@@ -49,10 +49,11 @@ class RunSummary:
     failed: int = 0         # of them, failed (reasons in the store)
     resumed: int = 0        # runs already on disk when the call started
     wall_time: float = 0.0  # s
-    cpu_time: float = 0.0   # s, this process and its finished children
+    cpu_time: float = 0.0   # s, this process and its local workers (not dask workers), warm-up included
     workers: int = 1
     engine: str = "serial"
-    warmup_time: float = 0.0
+    warmup_time: float = 0.0   # s, wall time of the warm-up (one nominal sample, not recorded)
+    warmup_cpu: float = 0.0    # s, its CPU time in this process (serial, local)
     complete: bool = False
     failures: list = field(default_factory=list)   # (run, reason) of this call's failures (first 20)
 
@@ -97,6 +98,9 @@ def run_chunk(study: Study, runs, base, block, values) -> list:
 
 def _init_local(study):
     global _STUDY
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)   # Ctrl-C is the parent's: it stops the workers
     _STUDY = pickle.loads(study) if isinstance(study, bytes) else study
     if isinstance(study, bytes):   # spawned: warm this process
         warm(_STUDY)
@@ -153,7 +157,7 @@ def run(study: Study, folder, samples: int, workers: int = 1, scheduler=None, ch
     workers : 1 runs in this process; n > 1 runs n local worker processes.
     scheduler : address of a dask.distributed scheduler (e.g. 'tcp://10.0.0.5:8786') or a
         ``distributed.Client``; then the cluster's workers run the samples.
-    chunk_size : runs per chunk (a file of the store; default: about 20 chunks per worker, 1 to 64).
+    chunk_size : runs per chunk (a file of the store; default: about 20 chunks per worker, 1 to 256).
     limit : run at most this many runs now (the rest on a later call).
     Checks everything (inputs, outputs, scheduler) before any sample runs.
     """
@@ -194,7 +198,7 @@ def _drive(study, store, samples, workers, client, chunk_size, limit):
     s = RunSummary(folder=str(store.folder), samples=samples, runs=total, resumed=len(done), workers=workers,
                    engine=engine)
     if chunk_size is None:
-        chunk_size = int(min(64, max(1, math.ceil(len(todo) / (20 * workers)))))
+        chunk_size = int(min(256, max(1, math.ceil(len(todo) / (20 * workers)))))
     chunks = [todo[i:i + chunk_size] for i in range(0, len(todo), chunk_size)]
     sizes = {x.name: x.size for x in study.inputs}
     names = [x.name for x in study.inputs]
@@ -220,9 +224,9 @@ def _drive(study, store, samples, workers, client, chunk_size, limit):
             if not chunks:
                 pass
             elif engine == "serial":
-                tw = time.perf_counter()
+                tw, cw = time.perf_counter(), _cpu()
                 warm(study)
-                s.warmup_time = time.perf_counter() - tw
+                s.warmup_time, s.warmup_cpu = time.perf_counter() - tw, _cpu() - cw
                 for c in chunks:
                     record(run_chunk(study, *make(c)))
             elif engine == "local":
@@ -262,10 +266,11 @@ def _pipeline(chunks, make, record, submit, wait_one, in_flight):
 
 def _run_local(study, chunks, make, record, workers, s):
     methods = mp.get_all_start_methods()
-    tw = time.perf_counter()
+    tw, cw = time.perf_counter(), _cpu()
     if "fork" in methods and os.name == "posix" and not _macos():
         warm(study)                       # the forked workers inherit the loaded kernels
         ctx, arg = mp.get_context("fork"), study
+        s.warmup_cpu = _cpu() - cw
     else:
         try:
             import cloudpickle as cp
@@ -278,6 +283,10 @@ def _run_local(study, chunks, make, record, workers, s):
         _pipeline(chunks, make, record, lambda *a: ex.submit(_local_chunk, *a),
                   lambda p: wait(p, return_when=FIRST_COMPLETED), 2 * workers)
     except BaseException:
+        # interrupted (or a worker died): the chunks in flight are lost, nothing half-written
+        # (only this process writes); stop the workers now rather than after their chunks
+        for p in list(getattr(ex, "_processes", {}).values()):
+            p.terminate()
         ex.shutdown(wait=False, cancel_futures=True)
         raise
     ex.shutdown(wait=True)

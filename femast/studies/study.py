@@ -36,12 +36,13 @@ class Study:
     outputs : with ``model=``: NodeOutput / ElementOutput objects; with ``run=``: output names.
     sampler, seed, sensitivity, correlation : the design (:class:`~femast.studies.sampling.Design`).
     analysis : options of :class:`~femast.Analysis` for ``model=`` studies (e.g. convergence).
+    units : {output name: unit} for tables and figures (``run=`` studies; node outputs know theirs).
     name : a label for summaries and figures.
     """
 
     def __init__(self, model=None, *, run=None, inputs, outputs, sampler: str = "sobol", seed: int = 1,
                  sensitivity: bool = False, correlation: dict | None = None, analysis: dict | None = None,
-                 name: str = "study"):
+                 units: dict | None = None, name: str = "study"):
         if (model is None) == (run is None):
             raise StudyError("give a study either model=FACTORY (returns a femast Model; femast runs it) or "
                              "run=FUNCTION (runs a sample, returns a dict of outputs), not both / neither")
@@ -76,6 +77,11 @@ class Study:
             raise StudyError(f"{', '.join(sorted(clash))}: both an input and an output; rename one")
         self.outputs = outputs
         self.output_names = names
+        self.units = {o.name: o.unit for o in outputs} if model is not None else {n: "" for n in names}
+        for k, u in (units or {}).items():
+            if k not in self.units:
+                raise StudyError(f"units: '{k}' is not an output of the study (outputs: {', '.join(names)})")
+            self.units[k] = str(u)
         self.analysis = dict(analysis or {})
         self.name = str(name)
         self._checked = False
@@ -161,7 +167,7 @@ class Study:
 
     def spec(self) -> dict:
         """Plain description (the manifest of the store: a resumed study must have the same)."""
-        return {"name": self.name, "design": self.design.spec(), "outputs": self.output_names}
+        return {"name": self.name, "design": self.design.spec(), "outputs": self.output_names, "units": self.units}
 
 
 def _as_values(name, v):
