@@ -244,7 +244,6 @@ def test_impossible_distributions_are_refused(make, words):
 
 
 def _never_runs(tmp_path, study, **kw):
-    calls = []
     with pytest.raises(StudyError) as e:
         st.run(study, tmp_path / "bad", samples=4, **kw)
     assert not list((tmp_path / "bad").glob("chunks/*.parquet"))   # no sample ran
@@ -287,10 +286,18 @@ def test_unreachable_scheduler(tmp_path):
     assert "cannot reach the dask scheduler at 'tcp://127.0.0.1:9'" in msg and "drop --scheduler" in msg
 
 
-def test_run_function_missing_output_is_a_recorded_failure(tmp_path):
+def test_run_function_missing_output(tmp_path):
+    # missing at the nominal point (the warm-up): refused before any sample runs
     study = st.Study(run=lambda x: {"y": x}, inputs=[st.Uniform("x", 0, 1)], outputs=["y", "q"])
-    s = st.run(study, tmp_path / "m", samples=4)
-    assert s.failed == 4 and "output(s) q not returned" in st.load(tmp_path / "m").failures()[0][1]
+    msg = _never_runs(tmp_path, study)
+    assert "nominal sample" in msg and "output(s) q not returned" in msg
+    # missing in some samples only: those samples fail, with the reason
+    study = st.Study(run=lambda x: {"y": x, **({"q": 1.0} if x < 0.8 else {})}, inputs=[st.Uniform("x", 0, 1)],
+                     outputs=["y", "q"], sampler="mc")
+    s = st.run(study, tmp_path / "m", samples=50)
+    res = st.load(tmp_path / "m")
+    n_bad = int(np.sum(res.table(["x"])["x"] >= 0.8))
+    assert n_bad > 0 and s.failed == n_bad and all("output(s) q not returned" in r for _, r in res.failures())
 
 
 def test_other_study_in_the_folder_is_refused(tmp_path):
