@@ -429,3 +429,19 @@ def test_ctrl_c_then_resume_equals_one_run(tmp_path):
 
 def _slow_local(a, b):
     return {"y": a * b + np.sin(a), "v": np.array([a, b, a - b])}
+
+
+def test_more_samples_later_extend_the_same_study(tmp_path):
+    # Sobol' points depend on the run index only: 16 samples then 32 equal 32 at once
+    st.run(_ishigami_study(sensitivity=True), tmp_path / "grow", samples=16)
+    s = st.run(_ishigami_study(sensitivity=True), tmp_path / "grow", samples=32)
+    assert s.resumed == 80 and s.ran == 80 and s.complete
+    st.run(_ishigami_study(sensitivity=True), tmp_path / "once", samples=32)
+    a, b = st.load(tmp_path / "grow").table(["y", "x3"]), st.load(tmp_path / "once").table(["y", "x3"])
+    for k in a:
+        assert np.array_equal(a[k], b[k]), k
+    with pytest.raises(StudyError, match="give --samples >= 32"):
+        st.run(_ishigami_study(sensitivity=True), tmp_path / "grow", samples=8)
+    st.run(_ishigami_study(sampler="lhs"), tmp_path / "lhs", samples=8)
+    with pytest.raises(StudyError, match="Latin hypercube of 8 samples cannot be resumed with 16"):
+        st.run(_ishigami_study(sampler="lhs"), tmp_path / "lhs", samples=16)
