@@ -216,7 +216,6 @@ EXCEPTIONS = {
     ("analysis/analysis.py", "modal"),  # a frequency step in the step sequence runs modal.step
     ("analysis/analysis.py", "post"),   # the results folder an Analysis returns (Results, run_outcome)
     ("analysis/output.py", "post"),     # output is the observer that owns the results writer
-    ("elements/shroud_cable.py", "guyed"),   # issue 15 item 3: being fixed
 }
 ALWAYS = {"errors", "rotations", "progress"}
 
@@ -229,6 +228,14 @@ def test_import_rules(package):
         bad = {m for m in _femast_parts(p) - allowed if (rel, m) not in EXCEPTIONS}
         assert not bad, (f"femast/{rel} imports femast.{sorted(bad)}: {package} may import only "
                          f"{sorted(allowed - {package})} (docs/architecture.md)")
+
+
+def test_the_core_never_imports_a_seed_package():
+    # adam/, guyed/ (and experiments, effects, studies) build on the core, never the other way
+    seed = {"adam", "guyed", "experiments", "effects", "studies", "verification"}
+    for package in ("elements", "model", "analysis", "modal", "post"):
+        for p in (PKG / package).rglob("*.py"):
+            assert not _femast_parts(p) & seed, f"{p.relative_to(PKG)} imports {_femast_parts(p) & seed}"
 
 
 def test_post_processing_and_elements_never_import_the_analysis():
@@ -257,6 +264,7 @@ OLD_TO_NEW = [("femast.results", "femast.post.results"), ("femast.vtk", "femast.
               ("femast.mass", "femast.modal.mass"), ("femast.modal_output", "femast.modal.output"),
               ("femast.frequency_step", "femast.modal.step"),
               ("femast.references", "femast.verification.references"),
+              ("femast.guyed.shroud", "femast.elements.shroud_law"),
               ("femast.verification_arclength", "femast.verification.arclength"),
               ("femast.verification_modal", "femast.verification.modal")]
 
