@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import plotstyle
+from ..post import plotstyle
 from .statistics import convergence, percentile
 
 MAX_PANELS = 6
