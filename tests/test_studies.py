@@ -467,3 +467,19 @@ def test_report_names_steps_and_components(tmp_path, capsys):
     # lever arm is shorter by O((w/L)^2) ~ 1e-6 of L (w/L ~ 1e-3 here)
     assert np.allclose(res.output("m_max"), res.inputs("F") * L_M, rtol=1e-5)
     assert len(rep["rows"]) == 5
+
+
+def _dies(x):
+    if x > 0.9:
+        import os
+
+        os._exit(3)   # a worker process dying (a crash in compiled code, the OOM killer)
+    return {"y": x}
+
+
+def test_a_dying_worker_process_is_a_clear_error_and_resumable(tmp_path):
+    study = st.Study(run=_dies, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], sampler="mc", seed=4)
+    with pytest.raises(StudyError, match="a worker process died"):
+        st.run(study, tmp_path / "d", samples=200, workers=2, chunk_size=5)
+    done = st.load(tmp_path / "d").counts()["runs"]
+    assert done < 200   # what finished is kept (and a rerun resumes from it)
