@@ -497,3 +497,30 @@ def test_sobol_convergence_approaches_the_ishigami_indices():
     # (QMC: ~1/n; Monte Carlo would give sqrt(128) ~ 11x)
     assert np.allclose(c["ST"][-1], st.sobol_indices(y[:, 0], y[:, 1], y[:, 2:].T, resamples=10)["ST"])
     assert err[-1] < err[list(c["n"]).index(64)] / 10
+
+
+def test_statistics_refuse_what_they_cannot_estimate():
+    with pytest.raises(StudyError, match="q = 1.5"):
+        st.percentile([1.0, 2.0], 1.5)
+    with pytest.raises(StudyError, match="no values"):
+        st.percentile([], 0.5)
+    with pytest.raises(StudyError, match="not finite"):
+        st.percentile([1.0, np.nan], 0.5)
+    with pytest.raises(StudyError, match="variance 0"):
+        st.sobol_indices(np.ones(8), np.ones(8), np.ones((2, 8)))
+    with pytest.raises(StudyError, match=r"\(k, n\)"):
+        st.sobol_indices(np.arange(8.0), np.arange(8.0), np.ones((2, 7)))
+    p = st.percentile(np.arange(10.0), 0.99)   # 10 samples cannot bound the 99 % percentile from above
+    assert np.isnan(p["high"]) and p["low"] <= p["estimate"]
+
+
+def test_report_of_a_study_whose_samples_all_failed(tmp_path, capsys):
+    from femast.studies.report import report
+
+    study = st.Study(run=lambda x: _flaky(x, -1.0), inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y", "z"],
+                     units={"y": "m"})
+    # the nominal sample fails by non-convergence (not a definition error): the study runs, every sample fails
+    s = st.run(study, tmp_path / "f", samples=4)
+    assert s.failed == 4 and s.ok == 0
+    rep = report(tmp_path / "f", figures=True)
+    assert "(no successful sample)" in capsys.readouterr().out and rep["figures"] == []
