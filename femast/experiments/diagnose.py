@@ -53,7 +53,7 @@ from .compare import analyse
 from .core import Experiment, Measured
 from .figures import diagnose_figure, display_scale
 from .fitting import fit, params_table
-from .noise import noise_model
+from .noise import noise_model, pinned_rows
 from .residuals import AT_NOISE, at_noise_threshold
 from .verdict import MIN_SHARE, SIGNIFICANT_DBIC, conclude, flags, pair_candidates, robust_delta, score, share
 _START_METHOD = None  # multiprocessing start method of the local pool (None: the platform's default)
@@ -385,7 +385,7 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     # final noise model from the residual of the best model (femast.experiments.noise), everything rescored
     cands = [baseline, *ok, *(res for *_, res in pair_fits)]
     best_res = min(cands, key=lambda f: score(f, models, chans, data.n)["rss"])
-    models = noise_model(exp, data, best_res)
+    models = noise_model(exp, data, best_res, pinned=pinned_rows(baseline, chans))
     sigma = {c: models[c].sigma for c in chans}
     s0 = score(baseline, models, chans, data.n)
     r0, ic0 = s0["ratio"], s0["ic"]

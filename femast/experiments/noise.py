@@ -24,7 +24,12 @@ changes little from one row to the next, the noise does; see
   quadratic in s; for every experiment the size of the reading).  ``A, B, D`` are the Gaussian
   maximum-likelihood fit (Fisher scoring) of the second differences, whose variance is
   ``(1 - phi)(3 - phi) / 3 x (v_{i-1} + 4 v_i + v_{i+1})`` (exact for independent noise), with
-  rows beyond 6 standard deviations left out (jumps of the model error).  The model is kept when
+  rows beyond 6 standard deviations left out (jumps of the model error), ``A >= 0`` and ``D >= 0``
+  (the variance at zero covariate and its growth far out cannot be negative; unconstrained, a
+  negative ``A`` put the noise of the rows near zero load at a tenth of its true value and a
+  3-sigma row at 20 "sigma"), and no row's variance below ``VAR_FLOOR`` = 0.04 of the mean (sigma
+  at least 0.2 of its RMS: a few second differences near the end of the covariate's range cannot
+  establish a noise 5x below the typical; seed 001 Eq. 15's range on the seed's latch is 0.45).  The model is kept when
   its likelihood-ratio statistic against one level exceeds ``HETERO_LR`` = 18.5, the 99th
   percentile of that statistic on white noise (Monte Carlo, 2000 draws of 100-1500 rows along
   signed and unsigned covariates: 16.0-19.8; the second differences are correlated, so it exceeds
@@ -32,6 +37,14 @@ changes little from one row to the next, the noise does; see
   least ``HETERO_MIN_RANGE`` = 1.3 over the data (smaller variations change no verdict).
 * **given** -- a ``sigma_<channel>`` column (same unit as the channel) gives the standard
   uncertainty of every row; it is used as it is.
+
+* **pinned rows** -- a model that admits an interval at some rows (latch-pull: the static band of a
+  bead at rest, Eq. 9 third case; the backstop; a slack cable) predicts the measured value itself
+  there, so those residuals are exactly zero (or one constant along a hold): they carry no noise.
+  Left in, they pull every difference-based estimate down (15 % of the rows of a latch-pull test
+  with its holds: the level by up to 25 %, the verdict "not explained" on pure noise).  Rows whose
+  residual is zero or repeats its neighbour's exactly (:func:`informative_rows`) are left out of
+  the estimates, which use the remaining rows in path order; the level then applies to every row.
 
 Fewer than ``MIN_ROWS`` = 8 rows (without ``sigma_`` columns) leave too few differences for any
 estimate: a :class:`~femast.errors.ModelError`.  Correlation and heteroscedasticity are only tested
@@ -45,6 +58,7 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
+from scipy.optimize import lsq_linear
 
 from ..errors import DataFileError, ModelError
 
@@ -52,6 +66,7 @@ MIN_ROWS = 8
 MIN_ROWS_STRUCTURE = 60
 HETERO_MIN_RANGE = 1.3
 HETERO_LR = 18.5
+VAR_FLOOR = 0.04  # smallest variance of a row / the mean variance: sigma >= 0.2 of its RMS (module docstring)
 QUANTILE = 0.99
 _MAD = 1.482602218505602  # 1 / Phi^-1(3/4): MAD -> standard deviation of a normal variable
 _SEED = 20241124
@@ -79,6 +94,21 @@ class ChannelNoise:
                 "sigma_max": float(np.max(self.sigma)), "phi": float(self.phi), "n_eff": float(self.n_eff),
                 "covariate": self.covariate, "reason": self.reason,
                 **{k: v for k, v in self.extra.items() if k != "level_reason"}}
+
+
+def informative_rows(r) -> np.ndarray:
+    """(n,) bool: rows of a residual r (n,) that carry noise -- not zero and not repeating a neighbour
+    exactly (to 1e-12 of the largest |r|): a noisy measurement never does, a model that admits an
+    interval and predicts the measured value inside it (a pinned row) does.  All True when fewer than
+    ``MIN_ROWS`` rows would be left."""
+    r = np.asarray(r, float)
+    tol = 1e-12 * float(np.max(np.abs(r), initial=0.0))
+    pinned = np.abs(r) <= tol
+    tie = np.abs(np.diff(r)) <= tol
+    pinned[1:] |= tie
+    pinned[:-1] |= tie
+    keep = ~pinned
+    return keep if keep.sum() >= MIN_ROWS else np.ones(r.size, bool)
 
 
 def _mad(x) -> float:
@@ -134,17 +164,23 @@ def _g3(g2):
 def _fit_variance(d2sq, X, iters: int = 10):
     """Maximum-likelihood ``beta`` of ``d2^2 ~ v chi^2_1``, ``v = X beta`` (design X (m, k)), batched over
     the leading axis of ``d2sq`` (draws, m), by Fisher scoring (weighted least squares of d2^2 on X,
-    weights 1 / v^2); v is kept above 1e-3 of the mean d2^2 and rows beyond 36 v are left out.
+    weights 1 / v^2) with ``A, D >= 0`` (a variance at zero covariate, a growth far out); v is kept
+    above ``VAR_FLOOR`` of the mean d2^2 and rows beyond 36 v are left out.
     Returns (beta (draws, k), v (draws, m), keep, log-likelihood (draws,))."""
-    floor = 1e-3 * np.mean(d2sq, axis=-1, keepdims=True)
+    floor = VAR_FLOOR * np.mean(d2sq, axis=-1, keepdims=True)
     v = np.broadcast_to(np.median(d2sq, axis=-1, keepdims=True) / 0.4549, d2sq.shape)  # median of chi^2_1
     beta = None
+    lo = np.array([0.0, -np.inf, 0.0])[: X.shape[1]]
     for _ in range(iters):
         keep = d2sq < 36.0 * v
         w = keep / v**2
         XtW = X.T[None, :, :] * w[:, None, :]
         M = XtW @ X + 1e-12 * np.eye(X.shape[1])
         beta = np.linalg.solve(M, (XtW @ d2sq[..., None]))[..., 0]
+        for j in np.flatnonzero(np.any(beta < lo, axis=-1)):  # A, D >= 0: bounded weighted least squares
+            sw = np.sqrt(w[j])
+            sc = np.sqrt(np.sum((X * sw[:, None]) ** 2, axis=0)) + 1e-300
+            beta[j] = lsq_linear(X * sw[:, None] / sc, d2sq[j] * sw, bounds=(lo * sc, np.inf)).x / sc
         v = np.maximum(beta @ X.T, floor)
     keep = d2sq < 36.0 * v
     ll = -0.5 * np.sum(keep * (d2sq / v + np.log(v)), axis=-1)
@@ -182,7 +218,7 @@ def heteroscedastic_fit(r, g, phi: float = 0.0) -> dict:
     lr, beta, _ = _lr((d2**2)[None, :], _design(u))
     A, B, D = (float(x) / (6.0 * c) for x in beta[0])
     v = A + B * u + D * u * u
-    v = np.maximum(v, 1e-3 * max(float(np.mean(v)), 1e-300))
+    v = np.maximum(v, VAR_FLOOR * max(float(np.mean(v)), 1e-300))
     sigma = np.sqrt(v)
     return {"coef": (A, B / gs, D / gs**2), "lr": float(lr[0]), "threshold": HETERO_LR, "sigma": sigma,
             "range": float(sigma.max() / sigma.min())}
@@ -205,12 +241,14 @@ def given_sigma(data, channel: str) -> np.ndarray | None:
 
 
 def channel_noise(channel: str, r, n_channel_rows: int, covariates=None, given=None,
-                  correlate: bool = True) -> ChannelNoise:
+                  correlate: bool = True, pinned=None) -> ChannelNoise:
     """Noise model of one channel from its residual r (n,) (module docstring).
 
     correlate : also test r for serial correlation (:func:`with_correlation`).
     covariates : ``{name: (n,) array}`` heteroscedasticity candidates (>= 0, any unit).
     given : (n,) per-row standard uncertainty (``sigma_`` column), or None.
+    pinned : (n,) bool, rows to leave out besides those :func:`informative_rows` finds (diagnose
+        passes the baseline's pinned rows when it estimates from a variant whose effect unpins them).
     """
     r = np.asarray(r, float)
     n = r.size
@@ -226,29 +264,42 @@ def channel_noise(channel: str, r, n_channel_rows: int, covariates=None, given=N
         return ChannelNoise(channel, "white", np.full(n, max(noise_floor(r), 1e-300)), 0.0, float(n), None,
                             f"white: {n} rows are too few (< {MIN_ROWS_STRUCTURE}) to test for serial correlation "
                             "or a varying noise level")
+    keep = _keep(r, pinned)
+    rk = r[keep]
+    pinned = int(n - keep.sum())
+    note = f"; {pinned} pinned rows (residual exactly zero or repeated: no noise) left out" if pinned else ""
     best = None
     for name, g in (covariates or {}).items():
         g = np.asarray(g, float)
-        if g.shape != (n,) or not np.all(np.isfinite(g)) or np.ptp(g) <= 0.0:
+        if g.shape != (n,) or not np.all(np.isfinite(g)) or np.ptp(g[keep]) <= 0.0:
             continue
-        h = heteroscedastic_fit(r, g)
-        if h["lr"] > h["threshold"] and h["range"] >= HETERO_MIN_RANGE and (best is None or h["lr"] > best[1]["lr"]):
-            best = (name, h)
+        h = heteroscedastic_fit(rk, g[keep])
+        if h["lr"] > h["threshold"] and h["range"] >= HETERO_MIN_RANGE and (best is None or h["lr"] > best[2]["lr"]):
+            best = (name, g, h)
     if best is None:
-        model = ChannelNoise(channel, "white", np.full(n, max(noise_floor(r), 1e-300)), 0.0, float(n), None,
-                             "constant level (no covariate explains a varying level)")
+        model = ChannelNoise(channel, "white", np.full(n, max(noise_floor(rk), 1e-300)), 0.0, float(n), None,
+                             "constant level (no covariate explains a varying level)" + note)
     else:
-        name, h = best
+        name, g, h = best
         A, B, D = h["coef"]
+        v = A + B * g + D * g * g
+        sigma = np.sqrt(np.maximum(v, VAR_FLOOR * max(float(np.mean(v[keep])), 1e-300)))
         model = ChannelNoise(
-            channel, "heteroscedastic", np.maximum(h["sigma"], 1e-300), 0.0, float(n), name,
+            channel, "heteroscedastic", np.maximum(sigma, 1e-300), 0.0, float(n), name,
             f"level varies with {name}: sigma^2 = A + B g + D g^2, A = {A:.3g}, B = {B:.3g}, D = {D:.3g} "
             f"(likelihood ratio {h['lr']:.0f} > {h['threshold']:.0f}, the 99th percentile on white noise; sigma "
-            f"from {h['sigma'].min():.3g} to {h['sigma'].max():.3g})", {"variance_coefficients": [A, B, D]})
-    return with_correlation(model, r) if correlate else model
+            f"from {h['sigma'].min():.3g} to {h['sigma'].max():.3g}){note}", {"variance_coefficients": [A, B, D]})
+    return with_correlation(model, r, pinned) if correlate else model
 
 
-def with_correlation(model: ChannelNoise, r) -> ChannelNoise:
+def _keep(r, pinned=None) -> np.ndarray:
+    keep = informative_rows(r)
+    if pinned is not None and (both := keep & ~np.asarray(pinned, bool)).sum() >= MIN_ROWS:
+        keep = both
+    return keep
+
+
+def with_correlation(model: ChannelNoise, r, pinned=None) -> ChannelNoise:
     """``model`` with its AR(1) coefficient from the residual r (n,) of a (better) model: phi, n_eff,
     kind and reason updated, the level corrected from the white-noise estimate (module docstring)."""
     r = np.asarray(r, float)
@@ -257,9 +308,12 @@ def with_correlation(model: ChannelNoise, r) -> ChannelNoise:
     base_kind = model.kind.replace("+ar1", "").replace("ar1", "white")
     phi0 = model.phi
     reason = model.extra.get("level_reason", model.reason)
-    phi_hat = lag1(r / model.sigma)
-    thr = ar1_threshold(r.size)
-    cap = difference_phi(r / model.sigma) + 2.0 * 1.9 / math.sqrt(r.size)
+    keep = _keep(r, pinned)
+    u = (r / model.sigma)[keep]
+    m = u.size
+    phi_hat = lag1(u)
+    thr = ar1_threshold(m)
+    cap = difference_phi(u) + 2.0 * 1.9 / math.sqrt(m)
     if phi_hat > thr and cap > thr:
         phi = min(phi_hat, cap, 0.95)
         why = (f"serially correlated: AR(1) phi = {phi:.2f} (lag-1 autocorrelation {phi_hat:.2f} > {thr:.2f}, the 99th "
@@ -275,11 +329,13 @@ def with_correlation(model: ChannelNoise, r) -> ChannelNoise:
                         f"{why}; {reason}", {**model.extra, "level_reason": reason})
 
 
-def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = True) -> dict:
+def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = True, pinned=None) -> dict:
     """``{channel: ChannelNoise}`` from a fit's residuals (``diagnose``: first the baseline's without the
     correlation test and with the experiment's own covariates only -- a structured residual would pass
     for noise growing with the reading --, for the weights of the refits; then the best model's, for
-    the verdict).  generic : also test the size of the reading as a covariate."""
+    the verdict).  generic : also test the size of the reading as a covariate.  pinned :
+    ``{channel: (n,) bool}`` rows to leave out besides the fit's own pinned rows (:func:`pinned_rows`
+    of another fit)."""
     covs = {}
     pred = fit_result.predicted
     for c in exp.channels:
@@ -290,8 +346,14 @@ def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = T
             covs.setdefault(c, {}).update(d)
     out = {}
     for c in exp.channels:
-        out[c] = channel_noise(c, fit_result.residuals[c], data.n, covs.get(c), given_sigma(data, c), correlate)
+        out[c] = channel_noise(c, fit_result.residuals[c], data.n, covs.get(c), given_sigma(data, c), correlate,
+                               (pinned or {}).get(c))
     return out
+
+
+def pinned_rows(fit_result, channels) -> dict:
+    """``{channel: (n,) bool}`` rows of a fit's residual that carry no noise (:func:`informative_rows`)."""
+    return {c: ~informative_rows(fit_result.residuals[c]) for c in channels}
 
 
 def information_criterion(fun, n_rows: int, models: dict, n_params: int) -> float:
