@@ -97,3 +97,39 @@ def test_given_sigma_column_is_used_and_checked():
 def test_too_few_rows_for_the_noise_model_is_named():
     with pytest.raises(ModelError, match=r"channel dT_N: 5 rows are too few for the noise model .*sigma_dT_N"):
         channel_noise("dT_N", np.zeros(5), 5)
+
+
+def test_pinned_rows_are_left_out_of_the_level():
+    # a latch-pull residual is exactly zero where the measured force lies in an admissible band (the
+    # static band of a bead at rest, Eq. 9) and one constant along a hold on the backstop: 20 % of the
+    # rows pinned must not pull the level down (with them: ~0.7 of the true level)
+    rng = np.random.default_rng(11)
+    n, sigma = 500, 0.5
+    r = rng.normal(0, sigma, n)
+    r[100:150] = 0.0
+    r[300:350] = 0.012  # a hold: (x + x_backstop) x 5e4 N/m, the same on every row
+    lev = []
+    for _ in range(20):
+        rr = r.copy()
+        rr[~np.isin(np.arange(n), np.r_[100:150, 300:350])] = rng.normal(0, sigma, n - 100)
+        m = channel_noise("dT_N", rr, n)
+        assert "100 pinned rows" in m.reason
+        lev.append(m.sigma_rms)
+    # 400 noisy rows: the robust level scatters ~5 % per draw; the mean of 20 within 4 %
+    assert abs(np.mean(lev) / sigma - 1) < 0.04
+
+
+def test_variance_law_never_goes_below_its_floor():
+    # noise growing with the load's size from 0.4 to 2 of a level: unconstrained, a negative A once put
+    # the rows near zero load at a tenth of their noise.  A, D >= 0 and the floor (0.04 of the mean variance).
+    rng = np.random.default_rng(5)
+    n = 300
+    g = np.abs(np.sin(np.linspace(0, 12, n)))
+    true = 0.4 + 1.6 * g
+    for _ in range(20):
+        h = heteroscedastic_fit(rng.normal(0, 1, n) * true, g)
+        A, B, D = h["coef"]
+        assert A >= 0 and D >= 0
+        v = A + B * g + D * g * g
+        assert np.all(h["sigma"] ** 2 >= 0.04 * np.mean(v) * (1 - 1e-12))  # the floor, to round-off
+        assert np.all(h["sigma"] > 0.25 * true)  # not a tenth of the true noise again (these 20 draws: >= 0.51)
