@@ -77,6 +77,13 @@ def _cable_hysteresis_latch_pull(x, p, ctx):
     return x + np.sign(dT) * ctx["options"]["cable_compliance_m_per_N"] * lag
 
 
+def _cable_hysteresis_latch_pull_iwan(x, p, ctx):
+    dT = ctx["prep"]["dT"]
+    T = np.abs(dT)
+    lag = p["kappa"] * T - p["gain"] * proportional_iwan(T, p["eta"], p["beta"])
+    return x + np.sign(dT) * ctx["options"]["cable_compliance_m_per_N"] * lag
+
+
 CABLE_HYSTERESIS = register_effect(Effect(
     name="cable_hysteresis",
     title="cable hysteresis between loading and unloading",
@@ -114,10 +121,25 @@ CABLE_HYSTERESIS = register_effect(Effect(
             hook="bead_position", order=45,
             parameters=(Parameter("eta", "-", 0.1, 0.0, 0.6, "loop half-width of the test cable's stretch",
                                   scale=0.1, starts=(0.02, 0.3)),),
-            apply=_cable_hysteresis_latch_pull,
+            apply=_cable_hysteresis_latch_pull, form="play",
             doc="x_bead = x + sign(dT) c_cable (|dT| - play(|dT|; eta |dT|)): Eq. 15 removed the mean stretch "
                 "c_cable |dT| (c_cable = L_cable / EA, option cable_compliance_m_per_N), the cable's own "
-                "stretch lags it."),
+                "stretch lags it.",
+            forms={"iwan": Implementation(
+                hook="bead_position", order=45,
+                parameters=(Parameter("eta", "-", 0.5, 0.0, 0.99, "largest friction threshold of the fibre groups "
+                                      "relative to the tension", scale=0.1, starts=(0.9, 0.3, 0.6)),
+                            Parameter("beta", "-", 1.0, 0.05, 50.0, "shape of the threshold distribution "
+                                      "P(e <= s) = (s / eta)^beta", scale=1.0, starts=(1.0, 4.0, 0.5)),
+                            Parameter("gain", "-", 1.0, 0.0, 20.0, "hysteretic stretch compliance relative to "
+                                      "c_cable", scale=1.0, starts=(3.0, 1.0, 6.0)),
+                            Parameter("kappa", "-", 1.0, -20.0, 20.0, "compliance Eq. 15 removed, relative to "
+                                      "c_cable", scale=1.0, starts=(2.0, 1.0, 4.0))),
+                apply=_cable_hysteresis_latch_pull_iwan,
+                doc="x_bead = x + sign(dT) c_cable (kappa |dT| - gain P(|dT|)), P(T) = mean_j play(T; eta_j T), "
+                    "eta_j = eta q_j^(1/beta): the test cable's stretch c_cable gain P(T) follows the tension "
+                    "through fibre groups with a distribution of friction coefficients (smooth loops closing at "
+                    "zero), Eq. 15 removed c_cable kappa T.  kappa = gain = 1, beta -> inf: the play form.")}),
     },
 ))
 

@@ -371,9 +371,12 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     # pairs of the top candidates with an information-criterion gain, fitted jointly
     pair_fits = []
     top = pair_candidates(ranking)
-    if pairs and len(top) >= 2 and r0 > thr:
+    if pairs and top and r0 > thr:
         by = {e["effect"]: e for e in ranking}
         combos = [(x, y) for i, x in enumerate(top) for y in top[i + 1:]]
+        # and the best with every other candidate: a second mechanism whose own gain the first one's
+        # larger error hides (forward selection)
+        combos += [(top[0], e["effect"]) for e in ranking if not e.get("failed") and e["effect"] not in top]
         pl = []
         for x, y in combos:
             st = dict(start)
