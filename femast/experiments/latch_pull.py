@@ -349,6 +349,11 @@ def noise_covariates(data: Measured, params: dict, options: dict, fit=None) -> d
     return {"dT_N": {"sensitivity of the residual to x (Eq. 15 puts the load-cell noise into x)": q}}
 
 
+def path_coordinate(data: Measured, options: dict) -> np.ndarray:
+    """The bead position x (m): the rig drives it along repeated latching and unlatching passes."""
+    return prepared(data, _prepare, options)["x"]
+
+
 EXPERIMENT = Experiment(
     name="latch-pull",
     title="latch pull test (seed 001 Eqs. 12-15)",
@@ -380,6 +385,7 @@ EXPERIMENT = Experiment(
     extra_segments=extra_segments,
     plot_measured=plot_measured,
     noise_covariates=noise_covariates,
+    path_coordinate=path_coordinate,
     error_unit="N",
     min_rows=10,
     source="latch-pull",

@@ -66,6 +66,7 @@ MIN_ROWS = 8
 MIN_ROWS_STRUCTURE = 60
 HETERO_MIN_RANGE = 1.3
 HETERO_LR = 18.5
+CYCLE_MIN_PAIRS = 30  # fewest rows compared across repeated passes for a level (its scatter then <= 13 %)
 VAR_FLOOR = 0.04  # smallest variance of a row / the mean variance: sigma >= 0.2 of its RMS (module docstring)
 QUANTILE = 0.99
 _MAD = 1.482602218505602  # 1 / Phi^-1(3/4): MAD -> standard deviation of a normal variable
@@ -344,16 +345,119 @@ def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = T
         extra = exp.noise_covariates(data, dict(fit_result.params), exp.options, fit_result) or {}
         for c, d in extra.items():
             covs.setdefault(c, {}).update(d)
+    coord = path_coordinate(exp, data) if correlate else None
     out = {}
     for c in exp.channels:
         out[c] = channel_noise(c, fit_result.residuals[c], data.n, covs.get(c), given_sigma(data, c), correlate,
                                (pinned or {}).get(c))
+        if coord is not None:
+            out[c] = with_cycles(out[c], coord, fit_result.residuals[c], (pinned or {}).get(c))
     return out
+
+
+def path_coordinate(exp, data) -> np.ndarray | None:
+    """The quantity the test drives along its passes (``Experiment.path_coordinate``, else the load
+    measure of the segmentation), for :func:`cycle_scatter`; None if it cannot be evaluated."""
+    try:
+        if getattr(exp, "path_coordinate", None) is not None:
+            return np.asarray(exp.path_coordinate(data, exp.options), float)
+        from .compare import load_path
+
+        return np.asarray(load_path(exp, data), float)
+    except Exception:  # a coordinate is optional: no repeated-pass check rather than a failed diagnosis
+        return None
 
 
 def pinned_rows(fit_result, channels) -> dict:
     """``{channel: (n,) bool}`` rows of a fit's residual that carry no noise (:func:`informative_rows`)."""
     return {c: ~informative_rows(fit_result.residuals[c]) for c in channels}
+
+
+def cycle_scatter(coord, r, keep=None, sigma=None, min_pairs: int = CYCLE_MIN_PAIRS):
+    """Noise level from repeated passes along a path coordinate (module docstring, "repeated cycles").
+
+    coord : (n,) the quantity the test drives (latch-pull: the bead position; mast-top: the load),
+    r : (n,) residual (or measurement), keep : (n,) bool rows that carry noise, sigma : (n,) a noise
+    model's per-row level (default 1: the level itself is returned).  Passes are the
+    monotone runs of coord (turning points confirmed by 5 % of its range); each row of a pass is
+    compared with the later passes in the same direction that cover its coordinate: ``d = r_a -
+    interp(r_b)`` has variance ``sigma^2 (1 + w^2 + (1 - w)^2)`` for independent noise (w the
+    interpolation weight), while anything that repeats with the coordinate -- the model's error,
+    a ripple -- cancels.  Rows where the other pass is not sampled (its neighbours further apart
+    than 3 of its median steps, or equal) are left out.  Returns ``(level, pairs)`` -- the robust RMS
+    of ``d`` whitened by the variance sigma gives it (so the level relative to sigma) -- or ``None``
+    with fewer than ``min_pairs`` compared rows."""
+    from .residuals import turning_points
+
+    coord, r = np.asarray(coord, float), np.asarray(r, float)
+    n = coord.size
+    keep = np.ones(n, bool) if keep is None else np.asarray(keep, bool)
+    sg = np.ones(n) if sigma is None else np.broadcast_to(np.asarray(sigma, float), (n,))
+    span = float(np.ptp(coord)) if n else 0.0
+    if n < MIN_ROWS_STRUCTURE or span <= 0.0:
+        return None
+    tps, direction = turning_points(coord, 0.05 * span)
+    bounds = [0, *(int(t) + 1 for t in tps), n]
+    runs = [(np.arange(a, b), float(direction[a])) for a, b in zip(bounds[:-1], bounds[1:]) if b - a >= 3]
+    out = []
+    for i, (ra, da) in enumerate(runs):
+        for rb, db in runs[i + 1:]:
+            if db != da:
+                continue
+            rb = rb[keep[rb]]
+            if rb.size < 3:
+                continue
+            order = np.argsort(coord[rb], kind="stable")
+            cb, vb, sb = coord[rb][order], r[rb][order], sg[rb][order]
+            step = np.diff(cb)
+            med = float(np.median(step[step > 0])) if np.any(step > 0) else 0.0
+            if med <= 0.0:
+                continue
+            rows = ra[keep[ra] & (coord[ra] > cb[0]) & (coord[ra] < cb[-1])]
+            j = np.clip(np.searchsorted(cb, coord[rows]) - 1, 0, cb.size - 2)
+            h = step[j]
+            ok = (h > 0) & (h <= 3.0 * med)
+            rows, j, h = rows[ok], j[ok], h[ok]
+            w = (coord[rows] - cb[j]) / h
+            d = r[rows] - ((1.0 - w) * vb[j] + w * vb[j + 1])
+            out.append(d / np.sqrt(sg[rows] ** 2 + (w * sb[j + 1]) ** 2 + ((1.0 - w) * sb[j]) ** 2))
+    d = np.concatenate(out) if out else np.zeros(0)
+    if d.size < min_pairs:
+        return None
+    return math.sqrt(_trimmed_ms(d)), int(d.size)
+
+
+def with_cycles(model: ChannelNoise, coord, r, pinned=None) -> ChannelNoise:
+    """``model`` checked against the level of the repeated passes (:func:`cycle_scatter`): where its
+    RMS level exceeds that level beyond the estimate's scatter (``1 + 3 / sqrt(2 m)`` for m compared
+    rows), the excess is structure that repeats with the path (a ripple with the position, a model
+    error taken for correlated or growing noise), not noise: the level is scaled down to it and an
+    AR(1) coefficient dropped (kind ``+cycles``).  A lower estimate than the repeated passes' is kept:
+    passes differ also by model errors that do not repeat (hysteresis of other amplitudes, drift)."""
+    if model.kind == "given":
+        return model
+    r = np.asarray(r, float)
+    keep = _keep(r, pinned)
+    cyc = cycle_scatter(coord, r, keep, model.sigma)
+    if cyc is None:
+        return model
+    rho, m = cyc
+    # scatter of the two estimates: 1 / (2 m) for the passes' RMS, ~2 / n for the difference estimate
+    # (the MAD's relative variance 1.36 / n on n - 2 correlated second differences)
+    limit = 1.0 + 3.0 * math.sqrt(1.0 / (2.0 * m) + 2.0 / max(int(keep.sum()), 1))
+    extra = {**model.extra, "cycle_ratio": rho, "cycle_pairs": m}
+    if rho * limit >= 1.0:
+        return ChannelNoise(model.channel, model.kind, model.sigma, model.phi, model.n_eff, model.covariate,
+                            model.reason + f"; repeated passes agree ({rho:.2f}x this level from {m} compared rows)",
+                            extra)
+    n = r.size
+    kind = model.kind.replace("+ar1", "").replace("ar1", "white") + "+cycles"
+    return ChannelNoise(model.channel, kind, model.sigma * rho, 0.0, float(n), model.covariate,
+                        f"level from repeated passes: {rho:.2f}x the difference estimate ({m} rows compared at the "
+                        f"same path position in passes of the same direction; below it beyond the scatter of the "
+                        f"two, 1/{limit:.2f}): what that estimate took for noise"
+                        f"{' (serial correlation)' if model.phi > 0 else ''} repeats with the path; "
+                        f"{model.extra.get('level_reason', model.reason)}", extra)
 
 
 def information_criterion(fun, n_rows: int, models: dict, n_params: int) -> float:
