@@ -5,7 +5,7 @@ the neighbouring frames, so the tangent is a band matrix of half-bandwidth ``b``
 four-longeron truss mast at every length).  LAPACK's blocked band kernels then factorise it with
 dense level-3 BLAS on (b + 1) x n storage, without the sparse bookkeeping of a general sparse LU.
 
-Two factorisations of the permuted matrix ``B`` (the CSC matrix :class:`~femast.solvers.linear.SparseLU`
+Two factorisations of the permuted matrix ``B`` (the CSC matrix :class:`~femast.analysis.solvers.linear.SparseLU`
 refills every iteration, already in RCM order):
 
 * **Cholesky of the symmetric part** (``dpbtrf``/``dpbtrs``) when ``B`` is numerically symmetric:
