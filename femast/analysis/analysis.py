@@ -22,6 +22,7 @@ from tqdm.auto import tqdm
 from ..elements.base import DOF_NAMES
 from ..errors import ConvergenceError, ModelError, SingularModelError
 from ..results import Results, run_outcome
+from ..jit import prepare as prepare_kernels
 from ..solvers.convergence import Convergence
 from .. import validation
 from ..thermal import FieldLoads, check_controls, has_fields
@@ -71,6 +72,7 @@ class Analysis:
                  cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
                  extrapolate: bool = False, on_frame=None, tangent: str = "full", observers=(), restart=None,
                  restart_every: int | None = None):
+        prepare_kernels()   # first run: kernels compile in the background (femast.jit_background)
         self.model = model
         self.on_frame = on_frame
         self.out = out
