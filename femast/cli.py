@@ -1,7 +1,7 @@
 """Command line: ``femast run SCRIPT``, ``femast vtk RESULTS``, ``femast render RESULTS [PNG]``,
 ``femast info RESULTS``, ``femast warmup``; ``compare``, ``diagnose``, ``experiments``, ``effects``,
-``examples`` (:mod:`femast.cli_experiments`).  ``femast --help`` lists them, ``femast CMD --help``
-explains each argument with its default.  ``femast --quiet CMD`` shows no progress bars."""
+``examples`` (:mod:`femast.cli_experiments`); ``study`` (:mod:`femast.studies.cli`).  ``femast --help``
+lists them, ``femast CMD --help`` explains each argument with its default.  ``femast --quiet CMD`` shows no progress bars."""
 
 from __future__ import annotations
 
@@ -172,6 +172,9 @@ def build_parser() -> argparse.ArgumentParser:
         register = None
     if register is not None:
         register(sub, _Help)
+    from .studies.cli import register as register_study   # femast study (issue 20)
+
+    register_study(sub, _Help)
     for name, sp in sub.choices.items():  # --quiet also after the command (SUPPRESS: keeps the main one's value)
         if name != "run":
             sp.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS,

@@ -25,6 +25,7 @@ import numpy as np
 from .amplitudes import Amplitude
 from .elements.base import DOF_NAMES
 from .errors import ModelError
+from .model_arrays import ElementList, add_beams, add_nodes, add_trusses
 from .sections import Section
 from . import validation
 
@@ -182,15 +183,20 @@ Step.follow = _step_follow
 
 
 class Model:
-    """A structural model: nodes (6 DOF each), element families, fixed DOFs and steps."""
+    """A structural model: nodes (6 DOF each), element families, fixed DOFs and steps.
+
+    ``model.beams`` and ``model.trusses`` are the lists of beam and truss element specs; called,
+    they add many elements from arrays at once (``model.beams(pairs, section, up=...)``,
+    ``model.trusses(pairs, EA)``; see :meth:`add_beams`, :meth:`add_trusses`)."""
 
     def __init__(self, name: str = "model"):
         self.name = name
         self._node_labels: list[int] = []
         self._node_xyz: list[tuple] = []
         self._node_index: dict[int, int] = {}
-        self.beams: list[BeamSpec] = []
-        self.trusses: list[TrussSpec] = []
+        self._max_label = 0   # largest node label so far (auto-numbering without a max() per node)
+        self.beams: list[BeamSpec] = ElementList(self.add_beams)      # called: self.add_beams(...)
+        self.trusses: list[TrussSpec] = ElementList(self.add_trusses)  # called: self.add_trusses(...)
         self.families: list = []  # user / custom ElementFamily objects (built with node labels)
         self.fixed: dict[int, set] = {}
         self.rigid_bodies: list = []
@@ -208,18 +214,20 @@ class Model:
         xyz = tuple(_finite(v, f"node {label if label is not None else len(self._node_labels) + 1} coordinate {c}",
                             "m") for v, c in zip((x, y, z), "xyz"))
         if label is None:
-            label = (max(self._node_labels) + 1) if self._node_labels else 1
+            label = (self._max_label + 1) if self._node_labels else 1
         label = validation.whole(label, "node label")
         if label in self._node_index:
             raise ModelError(f"node {label} is defined twice; labels must be unique")
+        self._max_label = label if not self._node_labels else max(self._max_label, label)
         self._node_index[label] = len(self._node_labels)
         self._node_labels.append(label)
         self._node_xyz.append(xyz)
         return label
 
     def nodes(self, coords) -> list[int]:
-        """Add several nodes from an (n, 3) array of coordinates (m); returns their labels."""
-        return [self.node(*c) for c in validation.coordinates(coords, f"model '{self.name}': nodes()")]
+        """Add several nodes from an (n, 3) array of coordinates (m), labelled on from the largest
+        label so far (as repeated :meth:`node` calls, checked at once); returns their labels."""
+        return add_nodes(self, coords)
 
     @property
     def node_labels(self) -> np.ndarray:
@@ -292,6 +300,23 @@ class Model:
             self._next_element += 1
         self._error_sources(labels, length_error_m, alpha_per_K)
         return labels
+
+    def add_beams(self, nodes, section: Section, up=(0.0, 0.0, 1.0), family="beam", mass_per_length=None,
+                  length_error_m=0.0, alpha_per_K=0.0) -> np.ndarray:
+        """One beam per row of ``nodes`` ((n, 2) node labels), as :meth:`beam` with ``n=1`` for each
+        row but checked at once (no Python call per element); also ``model.beams(...)``.
+        ``section``, ``up`` (3,) or (n, 3), ``family``, ``mass_per_length`` (kg/m),
+        ``length_error_m`` (m), ``alpha_per_K`` (1/K): shared or one per element.  Returns the
+        element labels (see :mod:`femast.model_arrays`)."""
+        return add_beams(self, nodes, section, up, family, mass_per_length, length_error_m, alpha_per_K)
+
+    def add_trusses(self, nodes, EA, L0=None, pretension=None, tension_only=False, family=None,
+                    mass_per_length=0.0, length_error_m=0.0, alpha_per_K=0.0) -> np.ndarray:
+        """One truss (cable with ``tension_only``) per row of ``nodes`` ((n, 2) node labels), as
+        :meth:`truss` for each row but checked at once; also ``model.trusses(...)``.  ``EA`` (N),
+        ``L0`` (m), ``pretension`` (N) and the rest: shared or one per element.  Returns the labels."""
+        return add_trusses(self, nodes, EA, L0, pretension, tension_only, family, mass_per_length,
+                           length_error_m, alpha_per_K)
 
     def _error_sources(self, labels, length_error_m, alpha_per_K):
         if length_error_m != 0.0:

@@ -50,10 +50,22 @@ def _number(value, what, unit):
 
 
 def _element_table(model):
-    """{label: (kind, spec)} of the model's beam and truss elements."""
+    """{label: (kind, spec)} of the model's beam and truss elements, and of the elements of its cable
+    families (families with a ``length_factor``: cable/latch, cable-device): key ``(family name,
+    row)``, spec the node labels of the cable."""
     table = {b.label: ("beam", b) for b in model.beams}
     table.update({t.label: ("truss", t) for t in model.trusses})
+    for fam in model.families:
+        if hasattr(fam, "length_factor"):
+            for row, nodes in enumerate(np.asarray(fam.nodes).tolist()):
+                table[(fam.name, row)] = ("cable", nodes)
     return table
+
+
+
+def _midpoint(model, kind, spec):
+    nodes = spec.nodes if kind in ("beam", "truss") else spec
+    return np.mean([model.xyz(n) for n in nodes], axis=0)
 
 
 def select_elements(model, what, elements=None, family=None, where=None) -> list[int]:
@@ -65,30 +77,33 @@ def select_elements(model, what, elements=None, family=None, where=None) -> list
         labels = []
         for e in np.atleast_1d(np.asarray(elements, dtype=object)).tolist():
             try:
-                ok = float(e) == int(e) and int(e) in table
+                ok = float(e) == int(e) and int(e) in table and table[int(e)][0] != "cable"
             except (TypeError, ValueError):
                 ok = False
             if not ok:
                 raise ModelError(f"{what}: {e!r} is not a beam or truss element of model '{model.name}' "
                                  "(length errors and thermal strain apply to elements made with model.beam "
-                                 "or model.truss; use the labels they return)")
+                                 "or model.truss, or to whole cable families with family=; use the labels "
+                                 "model.beam and model.truss return)")
             labels.append(int(e))
     else:
-        labels = list(table)
+        labels = [e for e in table if table[e][0] != "cable"]
     if family is not None:
         fams = {family} if isinstance(family, str) else set(family)
-        known = {spec.family for _, spec in table.values()}
+        cable_fams = {e[0] for e in table if table[e][0] == "cable"}
+        known = {spec.family for kind, spec in table.values() if kind != "cable"} | cable_fams
         unknown = fams - known
         if unknown:
-            raise ModelError(f"{what}: no beam or truss family named {sorted(unknown)}; the model has "
+            raise ModelError(f"{what}: no beam or truss family named {sorted(unknown)} (nor a cable family); the model has "
                              f"{sorted(known)}")
-        labels = [e for e in labels if table[e][1].family in fams]
+        if elements is None:
+            labels += [e for e in table if table[e][0] == "cable" and e[0] in fams]
+        labels = [e for e in labels if (e[0] if table[e][0] == "cable" else table[e][1].family) in fams]
     if where is not None:
         if not callable(where):
             raise ModelError(f"{what}: where = {where!r} must be a function of an element midpoint (m) "
                              "returning True inside the region")
-        labels = [e for e in labels
-                  if bool(where(0.5 * (model.xyz(table[e][1].nodes[0]) + model.xyz(table[e][1].nodes[1]))))]
+        labels = [e for e in labels if bool(where(_midpoint(model, *table[e])))]
     if not labels:
         raise ModelError(f"{what}: the selection picks no element; check elements=, family= and where=")
     return labels
@@ -166,17 +181,27 @@ def has_fields(model) -> bool:
 
 
 class FieldLoads:
-    """The length factors of a model's beam and truss families over the analysis (module docstring).
+    """The length factors of a model's beam, truss and cable families over the analysis (module
+    docstring).
 
     families : the analysis' element families (``build_families``: the beam and truss families first,
-    carrying the element ``labels``)."""
+    carrying the element ``labels``, then copies of the model's own families; the cable families
+    among them get their own length-factor arrays here, so the model's families are not touched)."""
 
     def __init__(self, model, families):
         self.model = model
-        builtin = families[: len(families) - len(model.families)]
-        self.families = [f for f in builtin if hasattr(f, "length_factor")]
+        n_user = len(model.families)
+        builtin = families[: len(families) - n_user]
+        cables = [f for f in families[len(families) - n_user:] if hasattr(f, "length_factor")]
+        for f in cables:
+            f.length_factor = np.ones(f.nodes.shape[0])
+        self.families = [f for f in builtin if hasattr(f, "length_factor")] + cables
         where = {}
         for k, fam in enumerate(self.families):
+            if k >= len(self.families) - len(cables):
+                for row in range(fam.nodes.shape[0]):
+                    where[(fam.name, row)] = (k, row)
+                continue
             for row, lab in enumerate(np.asarray(fam.labels).tolist()):
                 where[int(lab)] = (k, row)
         self.where = where
@@ -233,7 +258,7 @@ class FieldLoads:
         return changed
 
     def thermal_strain(self, step_index, frac) -> dict:
-        """{element label: alpha (T - T_init)} at fraction ``frac`` of a step (dimensionless)."""
+        """{element label (a cable's: (family, row)): alpha (T - T_init)} at fraction ``frac`` of a step (dimensionless)."""
         T = self.temperatures(step_index, frac)
         return {lab: float(self.alpha[k][row] * (T[k][row] - self.T_init[k][row]))
                 for lab, (k, row) in self.where.items()}

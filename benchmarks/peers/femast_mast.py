@@ -17,9 +17,8 @@ from mast import E_AL, G_AL, SECTIONS
 def model(mast, n_inc):
     secs = {k: fm.Section(E=E_AL, G=G_AL, **v) for k, v in SECTIONS.items()}
     m = fm.Model(f"mast{mast.n_bays}")
-    labels = m.nodes(mast.X)
-    for e, (a, b) in enumerate(mast.conn):
-        m.beam(labels[a], labels[b], secs[mast.kind[e]], up=tuple(mast.up[e]))
+    labels = np.asarray(m.nodes(mast.X))
+    m.beams(labels[mast.conn], [secs[k] for k in mast.kind], up=mast.up)   # one call, checked at once
     for i in mast.fixed:
         m.fix(labels[i])
     step = m.step("load", initial_increment=1.0 / n_inc, max_increment=1.0 / n_inc)
