@@ -290,7 +290,7 @@ def _priority(req) -> int:
     """Element kernels and the assembly scatter first: interpreted, they cost the most per call
     (the beam kernel ~0.8 ms per element, 15 ms per call of a 20-beam model) against 0.5 ms or less
     for the configuration update and the convergence maxima."""
-    return 0 if req["module"].startswith(("femast.elements.", "femast.assembly")) else 1
+    return 0 if req["module"].startswith(("femast.elements.", "femast.analysis.assembly")) else 1
 
 
 def _remove(path: str) -> None:

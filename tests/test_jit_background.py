@@ -109,5 +109,5 @@ def test_off_in_the_worker_and_by_environment(monkeypatch):
 def test_worker_compiles_element_kernels_first():
     from femast import jit_background as jb
 
-    reqs = [{"module": "femast.configuration"}, {"module": "femast.elements.beam_corot"}]
+    reqs = [{"module": "femast.analysis.configuration"}, {"module": "femast.elements.beam_corot"}]
     assert sorted(range(2), key=lambda i: (jb._priority(reqs[i]), i)) == [1, 0]
