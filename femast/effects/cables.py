@@ -29,7 +29,7 @@ PROGRESSIVE_STIFFNESS = register_effect(Effect(
     title="progressive, tension-dependent shroud/cable stiffness",
     physics=(
         "Dyneema shrouds stiffen with tension: EA(tau) = k0 + k1 tau + k2 tau^2 (seed 000 Eq. 25, "
-        ":mod:`femast.guyed.shroud`).  The shroud that takes up a joint moment m gains tension in proportion "
+        ":mod:`femast.elements.shroud_law`).  The shroud that takes up a joint moment m gains tension in proportion "
         "to |m|, so to first order the joint's secant stiffness rises as k (1 + beta |m|), beta = k1 / "
         "(a EA(tau0)) with a the shroud lever arm (m) and tau0 the pretension.  The identified beta gives back "
         "the slope k1 of Eq. 25 for an assumed lever arm."),
