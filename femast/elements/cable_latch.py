@@ -71,6 +71,27 @@ def _per_element(value, n_el, what, name):
     return a
 
 
+def _hysteresis(hysteresis_force, hysteresis_length, latch, has, name):
+    """(n_el, 2) [force (N, 0 without a latch), length (m)] of the latch hysteresis option, checked."""
+    n_el = latch.shape[0]
+    Fh = _per_element(hysteresis_force, n_el, "hysteresis_force (N)", name)
+    ell = _per_element(hysteresis_length, n_el, "hysteresis_length (m)", name)
+    bad = np.flatnonzero(~(np.isfinite(Fh) & (Fh >= 0.0)))
+    if bad.size:
+        raise ModelError(f"{name} element {bad[0]}: hysteresis_force = {Fh[bad[0]]!r} N must be finite and >= 0 "
+                         "(0 switches the latch hysteresis off)")
+    bad = np.flatnonzero(~(np.isfinite(ell) & (ell > 0.0)))
+    if bad.size:
+        raise ModelError(f"{name} element {bad[0]}: hysteresis_length = {ell[bad[0]]!r} m must be finite and > 0")
+    xct = np.sqrt(np.clip((latch[:, 0] + latch[:, 5]) ** 2 - (latch[:, 4] + latch[:, 0]) ** 2,
+                          0.0, None))
+    bad = np.flatnonzero(has & (Fh > 0.0) & (latch[:, 1] >= xct))
+    if bad.size:
+        raise ModelError(f"{name} element {bad[0]}: the latch hysteresis option needs the backstop inside the "
+                         f"roller contact zone (x_backstop < x_contact = {xct[bad[0]]:.6g} m)")
+    return np.ascontiguousarray(np.column_stack([np.where(has, Fh, 0.0), ell]))
+
+
 class CableLatchFamily(ElementFamily):
     """A batch of cable/pulley/latch elements (seed 001, Eqs. 2-5 and 14), all with n sections.
 
@@ -175,22 +196,7 @@ class CableLatchFamily(ElementFamily):
         if not max_strain > 0:
             raise ModelError(f"{name}: max_strain = {max_strain!r} must be > 0")
         self.max_strain = float(max_strain)
-        Fh = _per_element(hysteresis_force, n_el, "hysteresis_force (N)", name)
-        ell = _per_element(hysteresis_length, n_el, "hysteresis_length (m)", name)
-        bad = np.flatnonzero(~(np.isfinite(Fh) & (Fh >= 0.0)))
-        if bad.size:
-            raise ModelError(f"{name} element {bad[0]}: hysteresis_force = {Fh[bad[0]]!r} N must be finite and >= 0 "
-                             "(0 switches the latch hysteresis off)")
-        bad = np.flatnonzero(~(np.isfinite(ell) & (ell > 0.0)))
-        if bad.size:
-            raise ModelError(f"{name} element {bad[0]}: hysteresis_length = {ell[bad[0]]!r} m must be finite and > 0")
-        xct = np.sqrt(np.clip((self.latch[:, 0] + self.latch[:, 5]) ** 2 - (self.latch[:, 4] + self.latch[:, 0]) ** 2,
-                              0.0, None))
-        bad = np.flatnonzero(has & (Fh > 0.0) & (self.latch[:, 1] >= xct))
-        if bad.size:
-            raise ModelError(f"{name} element {bad[0]}: the latch hysteresis option needs the backstop inside the "
-                             f"roller contact zone (x_backstop < x_contact = {xct[bad[0]]:.6g} m)")
-        self.hysteresis = np.ascontiguousarray(np.column_stack([np.where(has, Fh, 0.0), ell]))
+        self.hysteresis = _hysteresis(hysteresis_force, hysteresis_length, self.latch, has, name)
         self.length_factor = np.ones(n_el)
         self.set_length_errors(np.zeros((n_el, self.n_sections)) if length_error is None else length_error)
 

@@ -104,6 +104,40 @@ class TieSpec:
     dofs: tuple
 
 
+def rigid_body_spec(model, reference, nodes, name: str) -> RigidBodySpec:
+    """The :class:`RigidBodySpec` of :meth:`Model.rigid_body <femast.model.Model.rigid_body>`
+    after checking its nodes (known, the reference and at least one other, none twice)."""
+    model._check_node(reference, f"rigid body '{name}'")
+    nodes = [n for n in np.atleast_1d(nodes).tolist()]
+    for n in nodes:
+        model._check_node(n, f"rigid body '{name}'")
+    others = [n for n in nodes if int(n) != int(reference)]
+    if len(others) < 1:
+        raise ModelError(f"rigid body '{name}': needs the reference node and at least one other node "
+                         f"(got {len(others) + 1} node in all); a rigid body with fewer than two nodes ties nothing")
+    if len(set(int(n) for n in others)) != len(others):
+        raise ModelError(f"rigid body '{name}': a node is listed twice")
+    return RigidBodySpec(name, int(reference), tuple(int(n) for n in others))
+
+
+def tie_spec(model, master, slave, dofs) -> TieSpec:
+    """The :class:`TieSpec` of :meth:`Model.tie <femast.model.Model.tie>` after checking it
+    (default DOFs: the three translations; "all": the six)."""
+    from .model import dof_index
+
+    model._check_node(master, "tie")
+    model._check_node(slave, "tie")
+    if int(master) == int(slave):
+        raise ModelError(f"tie: node {master} tied to itself")
+    if not dofs:
+        idx = (0, 1, 2)
+    elif dofs == ("all",):
+        idx = tuple(range(6))
+    else:
+        idx = tuple(dof_index(d) for d in dofs)
+    return TieSpec(int(master), int(slave), idx)
+
+
 def _skew(v):
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 

@@ -49,6 +49,24 @@ def _finite(value, what, unit=""):
     return validation.number(value, what, unit)
 
 
+def _fixed_dofs(node, dofs) -> list[int]:
+    """DOF indices of ``Model.fix(node, *dofs)``: none or "all" -> six, names, "translations", "rotations"."""
+    if not dofs or dofs == ("all",):
+        idx = range(6)
+    else:
+        idx = []
+        for d in dofs:
+            if d == "translations":
+                idx += [0, 1, 2]
+            elif d == "rotations":
+                idx += [3, 4, 5]
+            else:
+                if str(d).lower() not in _DOF_INDEX:
+                    raise ModelError(f"fix node {node}: unknown DOF '{d}'; use {', '.join(DOF_NAMES)}")
+                idx.append(_DOF_INDEX[str(d).lower()])
+    return list(idx)
+
+
 @dataclass
 class BeamSpec:
     label: int
@@ -398,20 +416,7 @@ class Model:
         """Fix DOFs of ``node`` at zero for the whole analysis: ``fix(n)`` fixes all six,
         ``fix(n, "ux", "rz")`` some (names ux, uy, uz, rx, ry, rz; "translations", "rotations")."""
         self._check_node(node, "fix")
-        if not dofs or dofs == ("all",):
-            idx = range(6)
-        else:
-            idx = []
-            for d in dofs:
-                if d == "translations":
-                    idx += [0, 1, 2]
-                elif d == "rotations":
-                    idx += [3, 4, 5]
-                else:
-                    if str(d).lower() not in _DOF_INDEX:
-                        raise ModelError(f"fix node {node}: unknown DOF '{d}'; use {', '.join(DOF_NAMES)}")
-                    idx.append(_DOF_INDEX[str(d).lower()])
-        self.fixed.setdefault(int(node), set()).update(idx)
+        self.fixed.setdefault(int(node), set()).update(_fixed_dofs(node, dofs))
 
     # ------------------------------------------------------------ constraints
     def point_mass(self, node, mass: float = 0.0, inertia=None, offset=None, name: str = ""):
@@ -434,20 +439,10 @@ class Model:
         ``mass`` (kg) and ``inertia`` (kg m^2 about the centre of mass, see :meth:`point_mass`)
         of the body, its centre of mass at ``centre`` (m, global; default the reference node),
         are a point mass at the reference node."""
-        from .constraints import RigidBodySpec
+        from .constraints import rigid_body_spec
 
         name = name or f"rigid-{len(self.rigid_bodies) + 1}"
-        self._check_node(reference, f"rigid body '{name}'")
-        nodes = [n for n in np.atleast_1d(nodes).tolist()]
-        for n in nodes:
-            self._check_node(n, f"rigid body '{name}'")
-        others = [n for n in nodes if int(n) != int(reference)]
-        if len(others) < 1:
-            raise ModelError(f"rigid body '{name}': needs the reference node and at least one other node "
-                             f"(got {len(others) + 1} node in all); a rigid body with fewer than two nodes ties nothing")
-        if len(set(int(n) for n in others)) != len(others):
-            raise ModelError(f"rigid body '{name}': a node is listed twice")
-        spec = RigidBodySpec(name, int(reference), tuple(int(n) for n in others))
+        spec = rigid_body_spec(self, reference, nodes, name)
         if mass or inertia is not None:
             off = None if centre is None else np.asarray(centre, float) - self.xyz(reference)
             self.point_mass(reference, mass, inertia, off, name=f"rigid body '{name}'")
@@ -458,19 +453,9 @@ class Model:
         """Make ``dofs`` of node ``slave`` equal to those of ``master`` (default: the three
         translations, a pin between coincident nodes; "all" ties rotations too: exact for any
         rotation when all three rotations are tied)."""
-        from .constraints import TieSpec
+        from .constraints import tie_spec
 
-        self._check_node(master, "tie")
-        self._check_node(slave, "tie")
-        if int(master) == int(slave):
-            raise ModelError(f"tie: node {master} tied to itself")
-        if not dofs:
-            idx = (0, 1, 2)
-        elif dofs == ("all",):
-            idx = tuple(range(6))
-        else:
-            idx = tuple(dof_index(d) for d in dofs)
-        spec = TieSpec(int(master), int(slave), idx)
+        spec = tie_spec(self, master, slave, dofs)
         self.ties.append(spec)
         return spec
 
