@@ -6,7 +6,7 @@ Runs each model with every tangent update of :class:`femast.analysis.newton.Newt
 "full" (Newton-Raphson), "modified" (a tangent per increment, again when convergence slows or
 after ``refactor_every`` iterations), "quasi-newton" (the same with Broyden's update between
 factorisations) and "auto" (the default) -- and records, for each converged increment, its Newton
-iterations, its factorisations and its wall time.  Models:
+iterations, its factorisations and its wall and CPU time.  Models:
 
 * the corotational truss mast of benchmarks/peers (10 load increments);
 * the ADAM bay with ball-joint friction and latches along the bay-torsion example path (history:
@@ -15,7 +15,7 @@ iterations, its factorisations and its wall time.  Models:
 Prints per model and variant: increments, cutbacks, iterations, factorisations, wall and CPU
 time of the run, and the largest difference of the final displacements from full Newton
 (relative).  The machine's load is printed with the timings.  Writes a PNG with the
-factorisations and the wall time per increment of each variant.
+factorisations and the CPU time per increment of each variant.
 """
 
 from __future__ import annotations
@@ -48,16 +48,17 @@ class PerIncrement(Observer):
         self._f = 0
 
     def started(self, analysis):
-        self._t = time.perf_counter()
+        self._t = (time.perf_counter(), time.process_time())
         self._f = analysis.solver.factorizations
 
     def cutback(self, analysis, *args):
         self.cutbacks += 1
 
     def converged(self, analysis, step, increment, attempt, iterations, *args):
-        t = time.perf_counter()
+        t = (time.perf_counter(), time.process_time())
         f = analysis.solver.factorizations
-        self.rows.append((iterations, f - self._f, t - (self._t or t)))
+        t0 = self._t or t
+        self.rows.append((iterations, f - self._f, t[0] - t0[0], t[1] - t0[1]))
         self._t, self._f = t, f
 
 
@@ -111,22 +112,24 @@ def plot(all_runs, png):
     models = list(all_runs)
     fig, axes = plt.subplots(2, len(models), figsize=(4.2 * len(models), 6.4), squeeze=False)
     for j, model in enumerate(models):
-        for v, r in all_runs[model].items():
+        for (v, r), style in zip(all_runs[model].items(), ("o-", "s--", "^-.", "x:")):
             rows = np.array(r["obs"].rows)
             if rows.size == 0:
                 continue
             k = np.arange(1, len(rows) + 1)
-            axes[0, j].plot(k, rows[:, 1], "o-", ms=3, label=v)
-            axes[1, j].plot(k, rows[:, 2] * 1e3, "o-", ms=3, label=v)
+            label = f"{v} ({r['factorizations']} fact., {r['iterations']} it., {r['cpu']:.2f} s CPU)"
+            axes[0, j].plot(k, rows[:, 1], style, ms=3, label=label)
+            axes[1, j].plot(k, rows[:, 3] * 1e3, style, ms=3, label=v)
         axes[0, j].set_title(model, fontsize=9)
+        axes[0, j].legend(fontsize=7)
         axes[0, j].set_ylabel("factorisations per increment")
-        axes[1, j].set_ylabel("wall time per increment (ms)")
+        axes[1, j].set_ylabel("CPU time per increment (ms)")
         axes[1, j].set_xlabel("increment")
         axes[1, j].set_yscale("log")
         for ax in axes[:, j]:
             ax.grid(True, alpha=0.3)
-    axes[0, 0].legend(fontsize=8)
-    fig.suptitle(f"Newton variants (load {os.getloadavg()[0]:.1f} on 2 shared cores)", fontsize=10)
+    fig.suptitle(f"Newton variants, 'auto' = full (load {os.getloadavg()[0]:.1f} on 2 shared cores: CPU time "
+                 "of this process)", fontsize=10)
     plotstyle.save(fig, png)
     print(f"figure: {png}")
 
