@@ -4,7 +4,7 @@
 
 Each model is run once with SuperLU, every factorised tangent is kept, and the tangent of the
 middle iteration (a mid-increment, out-of-balance state) is factorised and solved ``--reps``
-times by each back-end (:mod:`femast.solvers.backends`):
+times by each back-end (:mod:`femast.analysis.solvers.backends`):
 
 * the corotational truss mast of benchmarks/peers (40, 400, 1000 bays: 960 to 24 000 DOFs);
 * the ADAM bay with ball-joint friction and latches, along the bay-torsion example path (a
@@ -38,8 +38,8 @@ sys.path.insert(0, str(ROOT / "benchmarks" / "peers"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from femast.errors import SingularModelError  # noqa: E402
-from femast.solvers import backends  # noqa: E402
-from femast.solvers import linear  # noqa: E402
+from femast.analysis.solvers import backends  # noqa: E402
+from femast.analysis.solvers import linear  # noqa: E402
 
 NAMES = ("superlu", "banded", "cholmod", "pardiso")
 

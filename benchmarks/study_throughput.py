@@ -26,7 +26,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import femast.studies as st  # noqa: E402
-from femast import plotstyle  # noqa: E402
+from femast.post import plotstyle  # noqa: E402
 from study_adam import adam_study  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "out" / "study_throughput"

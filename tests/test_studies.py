@@ -266,6 +266,8 @@ def test_input_matching_nothing_in_the_model(tmp_path):
     (st.NodeOutput("w", node=2, relative_to="pre"), ["no step 'pre'"]),
     (st.ElementOutput("n", family="cables", key="N"), ["'n'", "no element family 'cables'", "'beam'"]),
     (st.ElementOutput("n", family="beam", key="axial_force"), ["'n'", "no output 'axial_force'"]),
+    (st.ElementOutput("n", family="beam", key="section_forces", component=(0, 6)), ["'n'", "component (0, 6)",
+                                                                                     "outside"]),
 ])
 def test_output_that_does_not_exist(tmp_path, out, words):
     msg = _never_runs(tmp_path, _cantilever_study(outputs=[out]))
@@ -445,3 +447,23 @@ def test_more_samples_later_extend_the_same_study(tmp_path):
     st.run(_ishigami_study(sampler="lhs"), tmp_path / "lhs", samples=8)
     with pytest.raises(StudyError, match="Latin hypercube of 8 samples cannot be resumed with 16"):
         st.run(_ishigami_study(sampler="lhs"), tmp_path / "lhs", samples=16)
+
+
+def test_report_names_steps_and_components(tmp_path, capsys):
+    from femast.studies.report import report
+
+    st.run(_cantilever_study(outputs=[st.NodeOutput("tip", node=2, quantity="U", components=["x", "z"]),
+                                      st.ElementOutput("m_max", family="beam", key="section_forces",
+                                                       component=(slice(None), slice(4, 6)), reduce="absmax",
+                                                       at="load", unit="N m")]),
+           tmp_path / "r", samples=4)
+    res = st.load(tmp_path / "r")
+    assert res.component_label("tip", (0, 1)) == "tip[load, uz]" and res.component_label("tip", (1, 0)) == \
+        "tip[unload, ux]"
+    rep = report(tmp_path / "r", print_table=True, figures=False)
+    out = capsys.readouterr().out
+    assert "tip[load, uz]" in out and "m_max" in out
+    # the largest bending moment is at the root, F L (N m), sample by sample; the deflected tip's
+    # lever arm is shorter by O((w/L)^2) ~ 1e-6 of L (w/L ~ 1e-3 here)
+    assert np.allclose(res.output("m_max"), res.inputs("F") * L_M, rtol=1e-5)
+    assert len(rep["rows"]) == 5

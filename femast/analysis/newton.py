@@ -50,7 +50,7 @@ import numpy as np
 
 from ..elements.base import IncrementContext
 from ..errors import ModelError, SingularModelError
-from ..solvers.convergence import Convergence
+from .solvers.convergence import Convergence
 
 
 @dataclass
@@ -109,7 +109,7 @@ TANGENTS = ("auto", "full", "modified", "quasi-newton", "initial")
 class Newton:
     """Newton-Raphson iterations on one increment (see module docstring).
 
-    convergence : :class:`~femast.solvers.convergence.Convergence`.
+    convergence : :class:`~femast.analysis.solvers.convergence.Convergence`.
     line_search : secant line search when a step overshoots (fixed loads only): True, False, or
         "auto": only when retrying an increment that failed.
     tangent : "auto", "full", "modified", "quasi-newton" or "initial" (see module docstring).

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import plotstyle
+from ..post import plotstyle
 from .statistics import convergence, percentile
 
 MAX_PANELS = 6
@@ -20,7 +20,7 @@ def _label(name, idx):
 
 
 def _series(res, rep):
-    """[(label, values, unit)] of the scalar output components (first MAX_PANELS)."""
+    """[(label, values, unit)] of the scalar output components that vary (first MAX_PANELS)."""
     out = []
     shapes = res.store.shapes
     for name in res.output_names:
@@ -29,7 +29,9 @@ def _series(res, rep):
             continue
         shp = shapes.get(name, ())
         for idx in ([()] if not shp else list(np.ndindex(*shp))):
-            out.append((_label(name, idx), v[(slice(None),) + idx], res.units.get(name, "")))
+            if np.ptp(v[(slice(None),) + idx]) == 0.0:   # the same in every sample (e.g. a reference step)
+                continue
+            out.append((res.component_label(name, idx), v[(slice(None),) + idx], res.units.get(name, "")))
             if len(out) >= MAX_PANELS:
                 return out
     return out
@@ -104,7 +106,7 @@ def sensitivity_figure(sobol: dict, png):
         ax.set_xticks(x, s["names"], rotation=30 if k > 4 else 0)
         ax.axhline(0, color="0.3", lw=0.8)
         ax.set_ylabel("Sobol' index (1)")
-        ax.set_title(plotstyle.fit_title(ax, f"{_label(name, idx)}: {s['n']} base samples"))
+        ax.set_title(plotstyle.fit_title(ax, f"{s.get('label', _label(name, idx))}: {s['n']} base samples"))
         ax.legend(loc="best")
     for ax in axes.ravel()[n:]:
         ax.set_visible(False)

@@ -15,8 +15,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..errors import ModelError
-from ..model import dof_index
+from ...errors import ModelError
+from ...model import dof_index
 
 
 class LoadControl:

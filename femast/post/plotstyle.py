@@ -11,7 +11,7 @@ Rules: every axis says its quantity and the unit shown (:func:`axis_label`); dat
 shown by their quantity, never their raw CSV name (:func:`column_label`); numbers in legends and
 titles are rounded to what they mean (:func:`num`); a title wider than its axes is wrapped
 (:func:`fit_title`); shape views are orthographic with the undeformed shape labelled
-(:mod:`femast.render`, and :func:`equal_axes` for matplotlib shape plots).
+(:mod:`femast.post.render`, and :func:`equal_axes` for matplotlib shape plots).
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ At a converged state the small vibrations u(t) = phi sin(omega t) obey
 with K_T the analysis' own tangent at that state (elastic, geometric/stress stiffness of the
 prestress, and the cable/latch and joint contributions at their committed state: a slipping
 joint, a latched bead, a slack cable each give the tangent they give Newton) and M the mass
-(:mod:`femast.mass`), both on the free DOFs after the constraints (rigid bodies and ties:
+(:mod:`femast.modal.mass`), both on the free DOFs after the constraints (rigid bodies and ties:
 T^T K T + G and T^T M T).  The lowest ``n`` pairs come from ARPACK's shift-invert Lanczos
 (scipy ``eigsh``, mode 3, which allows DOFs without mass: their modes are at infinity).
 
@@ -29,10 +29,10 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from .elements.base import IncrementContext
-from .errors import ModelError, StateError
+from ..elements.base import IncrementContext
+from ..errors import ModelError, StateError
 from .mass import assemble_mass
-from .solvers.convergence import force_moment_abs_max
+from ..analysis.solvers.convergence import force_moment_abs_max
 
 #: Largest residual / reference force ratio accepted as a converged state (100x Newton's default
 #: force tolerance: a converged increment is well inside it, an unbalanced pretension is O(1)).
@@ -74,7 +74,7 @@ class Modes:
 
     def shape(self, mode: int, label, dof) -> float:
         """Component ``dof`` (name or 0..5) of mode ``mode`` (0-based) at node ``label``."""
-        from .model import dof_index
+        from ..model import dof_index
 
         rows = np.flatnonzero(self.node_labels == int(label))
         if rows.size == 0:

@@ -16,7 +16,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from .errors import StateError
+from ..errors import StateError
 
 
 def _cells(modes):
@@ -79,7 +79,7 @@ class ModesRecorder:
     out of balance has no modes (None; its frequencies NaN)."""
 
     def __init__(self, analysis, n_modes: int = 10, **options):
-        from .modal import modal_analysis
+        from .modes import modal_analysis
 
         self._modal = modal_analysis
         self.analysis = analysis

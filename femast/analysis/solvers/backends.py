@@ -1,6 +1,6 @@
 """Linear-solver back-ends for the tangent, and the rule that picks one per model.
 
-:class:`~femast.solvers.linear.SparseLU` computes the fill-reducing ordering and refills the
+:class:`~femast.analysis.solvers.linear.SparseLU` computes the fill-reducing ordering and refills the
 permuted matrix ``B`` every iteration; a back-end factorises ``B``:
 
 =========== ==================================================== ===============================
@@ -9,7 +9,7 @@ name        what                                                 needs
 "superlu"   scipy's SuperLU (threshold pivoting, symmetric mode)  scipy (always there)
 "banded"    LAPACK band Cholesky of the symmetric part, refined   scipy (always there)
             against B, or band LU with partial pivoting
-            (:mod:`femast.solvers.banded`)
+            (:mod:`femast.analysis.solvers.banded`)
 "cholmod"   CHOLMOD's supernodal Cholesky of the symmetric part,  ``pip install femast[cholmod]``
             refined against B; SuperLU when B is unsymmetric or   (scikit-sparse; Debian:
             not positive definite                                 ``apt-get install libsuitesparse-dev``)
@@ -17,7 +17,7 @@ name        what                                                 needs
 =========== ==================================================== ===============================
 
 **The automatic choice** (``backend="auto"``, :func:`choose`): the band back-end when the
-ordering is reverse Cuthill-McKee and its band is narrow (:func:`~femast.solvers.banded.band_rule`:
+ordering is reverse Cuthill-McKee and its band is narrow (:func:`~femast.analysis.solvers.banded.band_rule`:
 the band storage of one triangle, n (b + 1), at most 4x the entries of K's triangle), else
 SuperLU.  CHOLMOD and PARDISO are never chosen automatically: on every femast tangent measured
 (the 40-1000 bay masts, the ADAM bay and mast; ``python benchmarks/solver_backends.py``) one of

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .elements.base import DOF_NAMES
+from ..elements.base import DOF_NAMES
 
 
 @dataclass

@@ -1,6 +1,6 @@
 """The reduced tangent T^T K T + G of a constrained model, on a pattern computed once.
 
-With rigid bodies and ties the analysis eliminates the dependent DOFs (femast/constraints.py):
+With rigid bodies and ties the analysis eliminates the dependent DOFs (femast/model/constraints.py):
 the tangent on the independent DOFs is T^T K T + G.  K (all active DOFs) and T (active ->
 independent) keep their sparsity patterns for the whole analysis; only their values change.  The
 pattern of the product is therefore computed once, with every contribution

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from .rotations import apply_spins
+from ..rotations import apply_spins
 
 
 @njit(cache=True)

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import ModelError
+from ..errors import ModelError
 from .sections import Section
 from .validation import MAX_MAGNITUDE
 

@@ -26,7 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .errors import ModelError
+from ..errors import ModelError
 
 
 @njit(cache=True)

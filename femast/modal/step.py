@@ -15,8 +15,8 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from .errors import ModelError
-from .model import Step
+from ..errors import ModelError
+from ..model import Step
 
 
 @dataclass
@@ -62,8 +62,8 @@ def is_frequency_step(step) -> bool:
 def run_frequency_step(analysis, step):
     """Compute and store the modes of ``analysis``' current state for ``step`` (called by the
     analysis' step loop); returns the :class:`~femast.modal.Modes`."""
-    from .modal import modal_analysis
-    from .modal_output import export_modes_vtk
+    from .modes import modal_analysis
+    from .output import export_modes_vtk
 
     label = f"frequency step '{step.name}'"
     modes = modal_analysis(analysis, step.n_modes, shift_hz=step.shift_hz, label=label)

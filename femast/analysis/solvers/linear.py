@@ -46,7 +46,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-from ..errors import ModelError, SingularModelError
+from ...errors import ModelError, SingularModelError
 from . import backends
 
 try:  # scipy's SuperLU binding, called directly for the matrix refactorised every iteration
@@ -85,8 +85,8 @@ class SparseLU:
     pivot_check : "always": test every factorisation for a zero pivot (|u_kk| <= 1e-13 max |u_kk|);
         "auto" (default): test the first factorisation of each pattern, and later ones only when a
         solution is amplified enough (|x| max|u_kk| > 1e11 |b|) for such a pivot to be possible.
-    backend : who factorises the permuted matrix (:mod:`femast.solvers.backends`): "auto" (the
-        rule of :func:`~femast.solvers.backends.choose`), "superlu", "banded", "cholmod",
+    backend : who factorises the permuted matrix (:mod:`femast.analysis.solvers.backends`): "auto" (the
+        rule of :func:`~femast.analysis.solvers.backends.choose`), "superlu", "banded", "cholmod",
         "pardiso".  An optional back-end that is not installed falls back to SuperLU with a
         warning saying how to install it.
     """

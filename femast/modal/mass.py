@@ -34,8 +34,8 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .assembly import Assembler
-from .errors import ModelError
+from ..analysis.assembly import Assembler
+from ..errors import ModelError
 
 
 # ------------------------------------------------------------------------------ point masses
@@ -226,8 +226,8 @@ def _per_element(value, n, what):
 
 def family_mass_blocks(model, families, x, R, X0):
     """Mass blocks of every element family that carries mass, plus the point masses."""
-    from .elements.beam_corot import BeamFamily
-    from .elements.truss import TrussFamily
+    from ..elements.beam_corot import BeamFamily
+    from ..elements.truss import TrussFamily
 
     beams = {b.label: b for b in model.beams}
     trusses = {t.label: t for t in model.trusses}

@@ -1,17 +1,17 @@
 """Arc-length verification cases (issue 3, item 4), shared by tests and benchmarks/arc_length.py.
 
 Each returns the femast path (displacement of the loaded point along the load, load) and the
-independent reference from :mod:`femast.references`."""
+independent reference from :mod:`femast.verification.references`."""
 
 from __future__ import annotations
 
 import tempfile
 
 from . import references as ref
-from .analysis import Analysis
-from .model import Model
-from .sections import Section
-from .solvers.arclength import ArcLength
+from ..analysis import Analysis
+from ..model import Model
+from ..model.sections import Section
+from ..analysis.solvers.arclength import ArcLength
 
 
 def _planar(m):

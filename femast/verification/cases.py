@@ -3,7 +3,7 @@
 
 Each case builds a model, solves it and returns a list of :class:`Check` rows
 (quantity, reference, femast value, error) against the independent references in
-:mod:`femast.references`.  Units: the classic cases are dimensionless or in the units
+:mod:`femast.verification.references`.  Units: the classic cases are dimensionless or in the units
 of their source (Bathe-Bolourchi in consistent inch-pound units).
 """
 
@@ -16,10 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import references as ref
-from .analysis import Analysis
-from .model import Model
-from .sections import Section, square_tube
-from .solvers.control import DisplacementControl
+from ..analysis import Analysis
+from ..model import Model
+from ..model.sections import Section, square_tube
+from ..analysis.solvers.control import DisplacementControl
 
 
 @dataclass

@@ -32,7 +32,7 @@ import math
 import numpy as np
 
 from .amplitudes import Amplitude
-from .errors import ModelError
+from ..errors import ModelError
 
 # No structural material expands by more than ~1e-4 per K: a larger value is a units slip
 # (e.g. ppm/K given as 1/K would be 1e6 times too large, 1/degC as percent 100 times).

@@ -26,8 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ModelError
-from ..model import dof_index
+from ...errors import ModelError
+from ...model import dof_index
 
 
 @dataclass

@@ -23,9 +23,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .amplitudes import Amplitude
-from .elements.base import DOF_NAMES
-from .errors import ModelError
-from .model_arrays import ElementList, add_beams, add_nodes, add_trusses
+from ..elements.base import DOF_NAMES
+from ..errors import ModelError
+from .arrays import ElementList, add_beams, add_nodes, add_trusses
 from .sections import Section
 from . import validation
 
@@ -90,8 +90,8 @@ class Step:
     initial_increment, min_increment, max_increment : increments of step time, s.
     max_increments : most increments allowed in the step.
     control : None (load / prescribed-displacement control) or a control strategy such as
-        :class:`femast.solvers.control.DisplacementControl`.
-    stabilize : None, or a :class:`femast.solvers.stabilize.Stabilize` (issue 3).
+        :class:`femast.analysis.solvers.control.DisplacementControl`.
+    stabilize : None, or a :class:`femast.analysis.solvers.stabilize.Stabilize` (issue 3).
     hit_times : step times (s) at which an increment must end (amplitude table points
         are added automatically).
     output_frequency : write a frame (and call the analysis' ``on_frame``) every this many
@@ -151,7 +151,7 @@ def _step_temperature(self, T, elements=None, family=None, where=None, amplitude
     ``where`` (a function of the element midpoint, m: a region); none: all.  With a coefficient of
     thermal expansion (:meth:`Model.thermal_expansion`) it strains the elements by
     alpha (T - T_init).  It ramps from the step's start temperature linearly in step time, or as
-    ``T_start + a(t) (T - T_start)`` with an ``amplitude`` a(t); see :mod:`femast.thermal`."""
+    ``T_start + a(t) (T - T_start)`` with an ``amplitude`` a(t); see :mod:`femast.model.thermal`."""
     from .thermal import add_step_temperature
 
     return add_step_temperature(self, T, elements, family, where, amplitude)
@@ -202,7 +202,7 @@ class Model:
         self.rigid_bodies: list = []
         self.ties: list = []
         self.steps: list[Step] = []
-        self.point_masses: list = []   # femast.mass.PointMassSpec (modal analyses)
+        self.point_masses: list = []   # femast.modal.mass.PointMassSpec (modal analyses)
         self.length_errors: dict = {}         # element label -> m (lack of fit, issue 20)
         self.expansion: dict = {}             # element label -> 1/K
         self.initial_temperatures: dict = {}  # element label -> K or degC
@@ -307,7 +307,7 @@ class Model:
         row but checked at once (no Python call per element); also ``model.beams(...)``.
         ``section``, ``up`` (3,) or (n, 3), ``family``, ``mass_per_length`` (kg/m),
         ``length_error_m`` (m), ``alpha_per_K`` (1/K): shared or one per element.  Returns the
-        element labels (see :mod:`femast.model_arrays`)."""
+        element labels (see :mod:`femast.model.arrays`)."""
         return add_beams(self, nodes, section, up, family, mass_per_length, length_error_m, alpha_per_K)
 
     def add_trusses(self, nodes, EA, L0=None, pretension=None, tension_only=False, family=None,
@@ -418,8 +418,8 @@ class Model:
         """A mass ``mass`` (kg) with rotary ``inertia`` (kg m^2 about its centre of mass: a scalar,
         3 principal values along the global axes or a 3x3 matrix, initial global axes) at
         ``node``, its centre of mass ``offset`` (m) from the node (modal analyses, issue 18).
-        Returns the :class:`femast.mass.PointMassSpec`."""
-        from .mass import point_mass_spec
+        Returns the :class:`femast.modal.mass.PointMassSpec`."""
+        from ..modal.mass import point_mass_spec
 
         self._check_node(node, "point mass")
         spec = point_mass_spec(node, mass, inertia, offset, name)
@@ -497,8 +497,8 @@ class Model:
     def frequency_step(self, name: str | None = None, n_modes: int = 10, shift_hz: float | None = None,
                        vtk: bool = False):
         """Append a step that computes the lowest ``n_modes`` vibration modes of the state reached so
-        far (prestress and loads included; see :mod:`femast.frequency_step`); returns it."""
-        from .frequency_step import add_frequency_step
+        far (prestress and loads included; see :mod:`femast.modal.step`); returns it."""
+        from ..modal.step import add_frequency_step
 
         return add_frequency_step(self, name, n_modes, shift_hz, vtk)
 

@@ -13,8 +13,8 @@ import numbers
 
 import numpy as np
 
-from .elements.base import DOF_NAMES
-from .errors import EquilibriumError, ModelError
+from ..elements.base import DOF_NAMES
+from ..errors import EquilibriumError, ModelError
 
 #: largest accepted magnitude of any input number in its SI unit (m, N, Pa, m^4, s, ...)
 MAX_MAGNITUDE = 1e15

@@ -19,7 +19,7 @@ import math
 import numbers
 from dataclasses import dataclass, replace
 
-from .errors import ModelError
+from ..errors import ModelError
 from .validation import MAX_MAGNITUDE, number
 
 _UNITS = {"E": "Pa", "G": "Pa", "A": "m^2", "Iy": "m^4", "Iz": "m^4", "J": "m^4"}

@@ -15,8 +15,8 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from .elements.beam_corot import SECTION_FORCE_NAMES
-from .errors import FemastError
+from ..elements.beam_corot import SECTION_FORCE_NAMES
+from ..errors import FemastError
 from .results import Results
 
 
@@ -46,7 +46,7 @@ def _cell_fields(frame, families, sizes):
 
 def export_vtk(results, folder=None, every: int = 1) -> Path:
     """Write ``<folder>/frame_000001.vtu``... and ``<folder>/series.pvd`` from ``results``
-    (a :class:`~femast.results.Results` or a results folder).  Returns the .pvd path."""
+    (a :class:`~femast.post.results.Results` or a results folder).  Returns the .pvd path."""
     if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
         raise FemastError(f"every = {every!r}: give a whole number >= 1 (write every n-th frame)")
     res = results if isinstance(results, Results) else Results(results)

@@ -21,11 +21,11 @@ import math
 
 import numpy as np
 
-from .analysis import Analysis
-from .model import Model
-from .modal import modal_analysis
-from .sections import Section
-from .verification import Check
+from ..analysis import Analysis
+from ..model import Model
+from ..modal import modal_analysis
+from ..model.sections import Section
+from .cases import Check
 
 BETA_L = (1.8751040687, 4.6940911330, 7.8547574382)   # roots of cos x cosh x + 1 = 0
 

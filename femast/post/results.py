@@ -49,8 +49,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .elements.base import DOF_NAMES
-from .errors import FemastError
+from ..elements.base import DOF_NAMES
+from ..errors import FemastError
 
 _COMPONENTS = {
     "ux": ("U", 0), "uy": ("U", 1), "uz": ("U", 2),
