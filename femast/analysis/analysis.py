@@ -61,6 +61,9 @@ class Analysis:
         reading the results folder back (which costs about as much as the analysis of a small
         model).  Do not modify the arrays: the same ones are being written to disk.
     observers : more observers of the run (:class:`~femast.analysis.output.Observer`).
+    linear_solver : the back-end that factorises the tangent (:mod:`femast.solvers.backends`):
+        "auto" (default: LAPACK's band solver for a narrow reverse Cuthill-McKee band, as in a
+        mast, else SuperLU), or one forced by name: "superlu", "banded", "cholmod", "pardiso".
 
     After construction: ``state`` (:class:`State`: configuration, element states, loads...),
     ``system`` (:class:`System`: numbering, assembly, linear solver), ``algorithm``
@@ -70,7 +73,7 @@ class Analysis:
     def __init__(self, model, out="results", convergence: Convergence | None = None, progress: bool = True,
                  cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
                  extrapolate: bool = False, on_frame=None, tangent: str = "full", observers=(), restart=None,
-                 restart_every: int | None = None):
+                 restart_every: int | None = None, linear_solver: str = "auto"):
         self.model = model
         self.on_frame = on_frame
         self.out = out
@@ -96,7 +99,7 @@ class Analysis:
         # length errors and temperatures (issue 20): None when the model has neither
         self.fields = FieldLoads(model, self.families) if has_fields(model) else None
         self.summary = AnalysisSummary()
-        self.system = System(model, self.families, self.summary)
+        self.system = System(model, self.families, self.summary, linear_solver=linear_solver)
         self.state = State.initial(self.system.X0, self.families)
         self.output = ResultsOutput(out, [on_frame])
         self.observers = [self.output, *observers]

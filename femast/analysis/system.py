@@ -34,7 +34,7 @@ class System:
     summary : the :class:`AnalysisSummary` whose ``assembly_time`` / ``solve_time`` (s) it adds to.
     """
 
-    def __init__(self, model, families, summary):
+    def __init__(self, model, families, summary, linear_solver: str = "auto"):
         self.model = model
         self.families = families
         self.summary = summary
@@ -87,7 +87,7 @@ class System:
         self._Pa = None                # (loads array, its values on the active DOFs)
         self.length = float(np.ptp(self.X0, axis=0).max()) or 1.0
         self.symmetric = all(getattr(f, "symmetric", False) for f in self.families)
-        self.solver = SparseLU(symmetric=self.symmetric)
+        self.solver = SparseLU(symmetric=self.symmetric, backend=linear_solver)
         if not self._constrained:
             # symbolic analysis (the ordering) from the assembly pattern, once, at set-up; a
             # constrained model's reduced pattern T^T K T is only known at its first iteration

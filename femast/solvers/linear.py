@@ -46,7 +46,8 @@ import scipy.sparse.linalg as spla
 from numba import njit
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-from ..errors import SingularModelError
+from ..errors import ModelError, SingularModelError
+from . import backends
 
 try:  # scipy's SuperLU binding, called directly for the matrix refactorised every iteration
     from scipy.sparse.linalg._dsolve._superlu import gstrf as _gstrf
@@ -55,6 +56,7 @@ except ImportError:  # pragma: no cover - a scipy that moved it: splu is used in
 _DIRECT = {"gstrf": _gstrf}   # set to None if the binding's signature ever differs
 
 ORDERINGS = ("auto", "rcm", "mmd", "colamd")
+BACKENDS = backends.NAMES
 _FLOAT_MAX = float(np.finfo(float).max)
 
 
@@ -83,14 +85,25 @@ class SparseLU:
     pivot_check : "always": test every factorisation for a zero pivot (|u_kk| <= 1e-13 max |u_kk|);
         "auto" (default): test the first factorisation of each pattern, and later ones only when a
         solution is amplified enough (|x| max|u_kk| > 1e11 |b|) for such a pivot to be possible.
+    backend : who factorises the permuted matrix (:mod:`femast.solvers.backends`): "auto" (the
+        rule of :func:`~femast.solvers.backends.choose`), "superlu", "banded", "cholmod",
+        "pardiso".  An optional back-end that is not installed falls back to SuperLU with a
+        warning saying how to install it.
     """
 
     def __init__(self, symmetric: bool = False, ordering: str = "auto", pivot_threshold: float = 0.01,
-                 pivot_check: str = "auto"):
+                 pivot_check: str = "auto", backend: str = "auto"):
         if ordering not in ORDERINGS:
             raise ValueError(f"ordering must be one of {ORDERINGS}, not {ordering!r}")
         if pivot_check not in ("auto", "always"):
             raise ValueError(f"pivot_check must be 'auto' or 'always', not {pivot_check!r}")
+        if backend not in BACKENDS:
+            raise ModelError(f"linear solver back-end {backend!r} is not one of {BACKENDS}")
+        self.backend = backend
+        if backend == "banded" and ordering == "auto":
+            ordering = "rcm"   # the band comes from the RCM order
+        self._engine = None     # a non-SuperLU factor object working on self._B, or None
+        self.engine = "superlu"  # name of the back-end in use
         self.pivot_check = pivot_check
         self._dmax = None       # largest |pivot| at the last zero-pivot test
         self._checked = False   # zero-pivot test done for the current factorisation
@@ -163,7 +176,14 @@ class SparseLU:
         self.chosen = "rcm"
         self._perm = perm
         self._B, self._gather = self._permuted(K, perm)
+        self._choose_engine()
         return self.chosen
+
+    def _choose_engine(self):
+        """The back-end for the current permuted matrix (a new layout: a new choice)."""
+        self._engine = backends.make(self.backend, self._B, self.chosen, self.symmetric,
+                                     lambda B: self._factor_permuted(B, superlu=True))
+        self.engine = "superlu" if self._engine is None else self._engine.name
 
     def has_pattern(self, K) -> bool:
         """True if K has exactly the pattern the current ordering was analysed for."""
@@ -227,11 +247,13 @@ class SparseLU:
         B = sp.csc_matrix((K.data[gather], Bm.indices, Bm.indptr), shape=K.shape)
         return B, gather
 
-    def _factor_permuted(self, B):
+    def _factor_permuted(self, B, superlu=False):
         """LU of the permuted matrix B in its own (NATURAL) column order.  The matrix refactorised
         every iteration (:attr:`values`) goes straight to scipy's SuperLU binding with its index
         arrays converted once: ``splu`` checks and converts them on every call, ~30 us, 2 % of a
         40-bay iteration (issue 8).  The options are those ``splu`` passes."""
+        if self._engine is not None and B is self._B and not superlu:
+            return self._engine.factorize()
         if _DIRECT["gstrf"] is not None and B is self._B:
             if self._B_int is None or self._B_int[0] is not B.indices or self._B_int[1] is not B.indptr:
                 self._B_int = (B.indices, B.indptr, B.indices.astype(np.intc), B.indptr.astype(np.intc))
@@ -293,8 +315,12 @@ class SparseLU:
                 perm = np.arange(K.shape[0])
                 first = (kinds[0], perm) + self._permuted(K, perm)
             self.chosen, self._perm, self._B, self._gather = first
+            self._choose_engine()
             raise error
         self.chosen, self._perm, self._B, self._gather = best[1]
+        self._choose_engine()
+        if self._engine is not None:   # the trial was SuperLU's: factorise again with the back-end
+            return self._timed(self._factor_permuted, self._B)
         self.superlu_seconds += best[3]   # the kept factorisation; the trial of the other is overhead
         self.factorizations += 1
         return best[2]
@@ -372,7 +398,8 @@ class SparseLU:
     def _check_pivots(self):
         """Zero-pivot test on the diagonal of U (scipy builds L and U as CSC matrices for it:
         ~10 % of a factorisation)."""
-        d = np.abs(self._lu.U.diagonal())
+        pivots = getattr(self._lu, "pivot_magnitudes", None)
+        d = pivots() if pivots is not None else np.abs(self._lu.U.diagonal())
         if d.size and (not np.all(np.isfinite(d)) or np.min(d) <= 1e-13 * np.max(d)):
             self._lu = None
             raise SingularModelError("zero pivot in the LU factorisation")

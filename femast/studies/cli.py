@@ -40,7 +40,18 @@ def _study(args):
     study = load_script(args.script)
     out = args.out or str(Path("studies") / Path(args.script).stem)
     workers = args.workers if args.workers is not None else (os.cpu_count() or 1)
-    s = run(study, out, samples=args.samples, workers=workers, scheduler=args.scheduler, chunk_size=args.chunk_size)
+    try:
+        s = run(study, out, samples=args.samples, workers=workers, scheduler=args.scheduler,
+                chunk_size=args.chunk_size)
+    except KeyboardInterrupt:
+        import sys
+
+        from .. import progress
+
+        progress.close_all()
+        print(f"femast study: interrupted; the finished runs are in {out}: run the same command again to resume",
+              file=sys.stderr)
+        raise
     print(s)
     if s.complete and not args.no_report:
         report(out, print_table=True)

@@ -128,9 +128,17 @@ def _dask_warm(payload):
 
 
 def warm(study: Study) -> float:
-    """Run one nominal sample (loads the kernels from numba's cache); returns its wall time, s."""
+    """Run one nominal sample (loads the kernels from numba's cache; not recorded); returns its
+    wall time, s.  A :class:`StudyError` of the definition (a run function that does not return
+    its outputs, a factory that returns no Model) is raised here, before any sample runs; any
+    other failure of the nominal sample is left to the samples (which record it)."""
     t0 = time.perf_counter()
-    _sample(study, study.nominal_values())
+    try:
+        study.evaluate(study.nominal_values())
+    except StudyError as exc:
+        raise StudyError(f"the nominal sample (inputs at their medians): {exc}") from None
+    except Exception:
+        pass
     return time.perf_counter() - t0
 
 

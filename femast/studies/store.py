@@ -164,12 +164,12 @@ class Store:
             if pa.types.is_list(col.type):
                 shp = shapes.get(c) or ((sizes[c],) if sizes.get(c) else None)
                 width = int(np.prod(shp)) if shp else 0
-                rows = col.to_pylist()
-                arr = np.full((len(rows), width), np.nan)
-                for i, v in enumerate(rows):
-                    if v is not None:
-                        arr[i] = v
-                out[c] = arr.reshape((len(rows),) + tuple(shp or (0,)))[order]
+                col = col.combine_chunks()
+                valid = ~np.asarray(col.is_null().to_numpy(zero_copy_only=False), dtype=bool)
+                flat = np.asarray(col.flatten().to_numpy(zero_copy_only=False), dtype=float)   # non-null rows
+                arr = np.full((len(col), width), np.nan)
+                arr[valid] = flat.reshape(int(valid.sum()), width)
+                out[c] = arr.reshape((len(col),) + tuple(shp or (0,)))[order]
             elif pa.types.is_floating(col.type):
                 out[c] = np.asarray(col.to_numpy(zero_copy_only=False), dtype=float)[order]
             else:
