@@ -47,7 +47,7 @@ def _run(args):
 
 
 def _vtk(args):
-    from .vtk import export_vtk
+    from .post.vtk import export_vtk
 
     pvd = export_vtk(args.results, args.out, every=args.every)
     print(f"wrote {pvd} (open it in ParaView; apply 'Warp By Vector' with U to see the deformed shape)")
@@ -66,8 +66,8 @@ def _frame_arg(text: str):
 
 
 def _render(args):
-    from .render import largest_displacement_frame, render_png
-    from .results import Results
+    from .post.render import largest_displacement_frame, render_png
+    from .post.results import Results
 
     res = Results(args.results)
     if args.frame == "max":
@@ -95,7 +95,7 @@ def _warmup(args):
 
 
 def _info(args):
-    from .results import Results
+    from .post.results import Results
 
     res = Results(args.results)
     print(f"{res.folder}: {len(res)} frames, {len(res.node_labels)} nodes, families: {', '.join(res.families)}")

@@ -11,9 +11,9 @@ import scipy.sparse as sp
 import femast as fm
 from femast.analysis import Analysis
 from femast.errors import ModelError, SingularModelError
-from femast.solvers import backends
-from femast.solvers.banded import BandedFactor, band_of, band_rule
-from femast.solvers.linear import SparseLU
+from femast.analysis.solvers import backends
+from femast.analysis.solvers.banded import BandedFactor, band_of, band_rule
+from femast.analysis.solvers.linear import SparseLU
 
 
 def chain_matrix(n=300, b=7, asym=0.0, shift=0.0, seed=1):

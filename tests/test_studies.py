@@ -266,6 +266,8 @@ def test_input_matching_nothing_in_the_model(tmp_path):
     (st.NodeOutput("w", node=2, relative_to="pre"), ["no step 'pre'"]),
     (st.ElementOutput("n", family="cables", key="N"), ["'n'", "no element family 'cables'", "'beam'"]),
     (st.ElementOutput("n", family="beam", key="axial_force"), ["'n'", "no output 'axial_force'"]),
+    (st.ElementOutput("n", family="beam", key="section_forces", component=(0, 6)), ["'n'", "component (0, 6)",
+                                                                                     "outside"]),
 ])
 def test_output_that_does_not_exist(tmp_path, out, words):
     msg = _never_runs(tmp_path, _cantilever_study(outputs=[out]))
@@ -429,3 +431,96 @@ def test_ctrl_c_then_resume_equals_one_run(tmp_path):
 
 def _slow_local(a, b):
     return {"y": a * b + np.sin(a), "v": np.array([a, b, a - b])}
+
+
+def test_more_samples_later_extend_the_same_study(tmp_path):
+    # Sobol' points depend on the run index only: 16 samples then 32 equal 32 at once
+    st.run(_ishigami_study(sensitivity=True), tmp_path / "grow", samples=16)
+    s = st.run(_ishigami_study(sensitivity=True), tmp_path / "grow", samples=32)
+    assert s.resumed == 80 and s.ran == 80 and s.complete
+    st.run(_ishigami_study(sensitivity=True), tmp_path / "once", samples=32)
+    a, b = st.load(tmp_path / "grow").table(["y", "x3"]), st.load(tmp_path / "once").table(["y", "x3"])
+    for k in a:
+        assert np.array_equal(a[k], b[k]), k
+    with pytest.raises(StudyError, match="give --samples >= 32"):
+        st.run(_ishigami_study(sensitivity=True), tmp_path / "grow", samples=8)
+    st.run(_ishigami_study(sampler="lhs"), tmp_path / "lhs", samples=8)
+    with pytest.raises(StudyError, match="Latin hypercube of 8 samples cannot be resumed with 16"):
+        st.run(_ishigami_study(sampler="lhs"), tmp_path / "lhs", samples=16)
+
+
+def test_report_names_steps_and_components(tmp_path, capsys):
+    from femast.studies.report import report
+
+    st.run(_cantilever_study(outputs=[st.NodeOutput("tip", node=2, quantity="U", components=["x", "z"]),
+                                      st.ElementOutput("m_max", family="beam", key="section_forces",
+                                                       component=(slice(None), slice(4, 6)), reduce="absmax",
+                                                       at="load", unit="N m")]),
+           tmp_path / "r", samples=4)
+    res = st.load(tmp_path / "r")
+    assert res.component_label("tip", (0, 1)) == "tip[load, uz]" and res.component_label("tip", (1, 0)) == \
+        "tip[unload, ux]"
+    rep = report(tmp_path / "r", print_table=True, figures=False)
+    out = capsys.readouterr().out
+    assert "tip[load, uz]" in out and "m_max" in out
+    # the largest bending moment is at the root, F L (N m), sample by sample; the deflected tip's
+    # lever arm is shorter by O((w/L)^2) ~ 1e-6 of L (w/L ~ 1e-3 here)
+    assert np.allclose(res.output("m_max"), res.inputs("F") * L_M, rtol=1e-5)
+    assert len(rep["rows"]) == 5
+
+
+def _dies(x):
+    if x > 0.9:
+        import os
+
+        os._exit(3)   # a worker process dying (a crash in compiled code, the OOM killer)
+    return {"y": x}
+
+
+def test_a_dying_worker_process_is_a_clear_error_and_resumable(tmp_path):
+    study = st.Study(run=_dies, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], sampler="mc", seed=4)
+    with pytest.raises(StudyError, match="a worker process died"):
+        st.run(study, tmp_path / "d", samples=200, workers=2, chunk_size=5)
+    done = st.load(tmp_path / "d").counts()["runs"]
+    assert done < 200   # what finished is kept (and a rerun resumes from it)
+
+
+def test_sobol_convergence_approaches_the_ishigami_indices():
+    d = Design(_uniform_pi(), sampler="sobol", seed=3, sensitivity=True)
+    n = 2 ** 13
+    _, _, u = d.points(np.arange(n * 5), n)
+    y = ishigami(**d.values(u))["y"].reshape(n, 5)
+    c = st.sobol_convergence(y[:, 0], y[:, 1], y[:, 2:].T)
+    assert c["n"][0] == 8 and c["n"][-1] == n and c["ST"].shape == (len(c["n"]), 3)
+    err = np.max(np.abs(c["ST"] - ISHIGAMI_ST), axis=1)
+    # the last estimate equals sobol_indices' and the error falls by 10x from n = 64 to n = 8192
+    # (QMC: ~1/n; Monte Carlo would give sqrt(128) ~ 11x)
+    assert np.allclose(c["ST"][-1], st.sobol_indices(y[:, 0], y[:, 1], y[:, 2:].T, resamples=10)["ST"])
+    assert err[-1] < err[list(c["n"]).index(64)] / 10
+
+
+def test_statistics_refuse_what_they_cannot_estimate():
+    with pytest.raises(StudyError, match="q = 1.5"):
+        st.percentile([1.0, 2.0], 1.5)
+    with pytest.raises(StudyError, match="no values"):
+        st.percentile([], 0.5)
+    with pytest.raises(StudyError, match="not finite"):
+        st.percentile([1.0, np.nan], 0.5)
+    with pytest.raises(StudyError, match="variance 0"):
+        st.sobol_indices(np.ones(8), np.ones(8), np.ones((2, 8)))
+    with pytest.raises(StudyError, match=r"\(k, n\)"):
+        st.sobol_indices(np.arange(8.0), np.arange(8.0), np.ones((2, 7)))
+    p = st.percentile(np.arange(10.0), 0.99)   # 10 samples cannot bound the 99 % percentile from above
+    assert np.isnan(p["high"]) and p["low"] <= p["estimate"]
+
+
+def test_report_of_a_study_whose_samples_all_failed(tmp_path, capsys):
+    from femast.studies.report import report
+
+    study = st.Study(run=lambda x: _flaky(x, -1.0), inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y", "z"],
+                     units={"y": "m"})
+    # the nominal sample fails by non-convergence (not a definition error): the study runs, every sample fails
+    s = st.run(study, tmp_path / "f", samples=4)
+    assert s.failed == 4 and s.ok == 0
+    rep = report(tmp_path / "f", figures=True)
+    assert "(no successful sample)" in capsys.readouterr().out and rep["figures"] == []

@@ -28,7 +28,7 @@ cable_dL        (n, 4, 2)      m       length error of the latch cable of bay j,
                                        0 (through the backstop) and 1
 =============== ============== ======= =========================================================
 
-A length error dL makes the member stress free at its nominal length + dL (femast/thermal.py).
+A length error dL makes the member stress free at its nominal length + dL (femast/model/thermal.py).
 """
 
 from __future__ import annotations

@@ -21,10 +21,11 @@ from tqdm.auto import tqdm
 
 from ..elements.base import DOF_NAMES
 from ..errors import ConvergenceError, ModelError, SingularModelError
-from ..results import Results, run_outcome
-from ..solvers.convergence import Convergence
-from .. import validation
-from ..thermal import FieldLoads, check_controls, has_fields
+from ..jit import prepare as prepare_kernels
+from ..post.results import Results, run_outcome
+from .solvers.convergence import Convergence
+from ..model import validation
+from ..model.thermal import FieldLoads, check_controls, has_fields
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
@@ -42,7 +43,7 @@ class Analysis:
         frame then only goes to ``on_frame``, and :meth:`run` returns None.  For scripts and fits
         that keep what they need in memory (an FE experiment's many short runs).
 
-    convergence : :class:`~femast.solvers.convergence.Convergence` (tolerances, max iterations).
+    convergence : :class:`~femast.analysis.solvers.convergence.Convergence` (tolerances, max iterations).
     progress : show a tqdm progress bar per step.
     cutback : factor applied to a failed increment (Abaqus: 0.25).
     growth : factor applied after two easy increments (Abaqus: 1.5).
@@ -61,7 +62,7 @@ class Analysis:
         reading the results folder back (which costs about as much as the analysis of a small
         model).  Do not modify the arrays: the same ones are being written to disk.
     observers : more observers of the run (:class:`~femast.analysis.output.Observer`).
-    linear_solver : the back-end that factorises the tangent (:mod:`femast.solvers.backends`):
+    linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.solvers.backends`):
         "auto" (default: LAPACK's band solver for a narrow reverse Cuthill-McKee band, as in a
         mast, else SuperLU), or one forced by name: "superlu", "banded", "cholmod", "pardiso".
 
@@ -74,6 +75,7 @@ class Analysis:
                  cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
                  extrapolate: bool = False, on_frame=None, tangent: str = "full", observers=(), restart=None,
                  restart_every: int | None = None, linear_solver: str = "auto"):
+        prepare_kernels()   # first run: kernels compile in the background (femast.jit_background)
         self.model = model
         self.on_frame = on_frame
         self.out = out
@@ -223,7 +225,7 @@ class Analysis:
                     continue
                 self._state.step = k
                 if getattr(step, "kind", "static") == "frequency":   # modes of the state (issue 18)
-                    from ..frequency_step import run_frequency_step
+                    from ..modal.step import run_frequency_step
 
                     run_frequency_step(self, step)
                 else:

@@ -16,16 +16,16 @@ import time as _time
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import Assembler
-from ..configuration import update_configuration
-from ..constraints import Constraints, transpose_times
-from ..dofs import number_dofs
+from .assembly import Assembler
+from .configuration import update_configuration
+from ..model.constraints import Constraints, transpose_times
+from .dofs import number_dofs
 from ..elements.base import DOF_NAMES, IncrementContext
-from .. import validation
+from ..model import validation
 from ..errors import ModelError, SingularModelError
-from ..reduction import ReducedTangent
-from ..solvers.convergence import force_moment_abs_max
-from ..solvers.linear import SparseLU, mechanism_dofs
+from .reduction import ReducedTangent
+from .solvers.convergence import force_moment_abs_max
+from .solvers.linear import SparseLU, mechanism_dofs
 
 
 class System:
@@ -93,7 +93,7 @@ class System:
             # constrained model's reduced pattern T^T K T is only known at its first iteration
             self.solver.analyse(self.assembler.K_ff)
         self._direct = None   # (solver layout, positions): K_ff assembled into the solver's matrix
-        # constrained models: T^T K T + G on a pattern computed once (femast/reduction.py)
+        # constrained models: T^T K T + G on a pattern computed once (femast/analysis/reduction.py)
         self._reduced = (ReducedTangent(self.assembler.K_aa, self.constraints.transformation(self.X0),
                                         *self.constraints.geometric_entries(), self.dofmap.n_free)
                          if self._constrained else None)

@@ -204,7 +204,7 @@ class CableDeviceFamily(ElementFamily):
         sections before a device move the cable's material coordinate there (s0, a bead).
     name : label used in messages and results.
 
-    Thermal strain: ``length_factor`` (n_el,), set by the analysis (:mod:`femast.thermal`), scales
+    Thermal strain: ``length_factor`` (n_el,), set by the analysis (:mod:`femast.model.thermal`), scales
     every unstretched length of an element uniformly: the kernel sees ``L0 s``, beads at ``Lb s``
     and material coordinates ``S s`` (the state keeps them unscaled), so a free cable grows by
     ``alpha dT`` with no force; the strain is measured on the heated length (as

@@ -100,7 +100,7 @@ class CableLatchFamily(ElementFamily):
     name : label used in messages and results.
 
     Thermal strain: ``length_factor`` (n_el,), set by the analysis from the temperatures of a
-    step (:mod:`femast.thermal`, ``model.thermal_expansion(alpha, family=name)``), scales all
+    step (:mod:`femast.model.thermal`, ``model.thermal_expansion(alpha, family=name)``), scales all
     unstretched lengths of an element, bead coordinate included: the kernels see
     ``L0 s`` and ``Lb s`` with ``s = 1 + alpha (T - T_init)``, so a free cable grows by
     ``alpha dT`` with no force.  (The strain is then measured on the heated length, ``T = EA (L -

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import plotstyle
-from .statistics import convergence, percentile
+from ..post import plotstyle
+from .statistics import convergence, percentile, sobol_convergence
 
 MAX_PANELS = 6
 _Q = (0.05, 0.5, 0.95, 0.99)
@@ -20,7 +20,7 @@ def _label(name, idx):
 
 
 def _series(res, rep):
-    """[(label, values, unit)] of the scalar output components (first MAX_PANELS)."""
+    """[(label, values, unit)] of the scalar output components that vary (first MAX_PANELS)."""
     out = []
     shapes = res.store.shapes
     for name in res.output_names:
@@ -29,7 +29,9 @@ def _series(res, rep):
             continue
         shp = shapes.get(name, ())
         for idx in ([()] if not shp else list(np.ndindex(*shp))):
-            out.append((_label(name, idx), v[(slice(None),) + idx], res.units.get(name, "")))
+            if np.ptp(v[(slice(None),) + idx]) == 0.0:   # the same in every sample (e.g. a reference step)
+                continue
+            out.append((res.component_label(name, idx), v[(slice(None),) + idx], res.units.get(name, "")))
             if len(out) >= MAX_PANELS:
                 return out
     return out
@@ -104,10 +106,27 @@ def sensitivity_figure(sobol: dict, png):
         ax.set_xticks(x, s["names"], rotation=30 if k > 4 else 0)
         ax.axhline(0, color="0.3", lw=0.8)
         ax.set_ylabel("Sobol' index (1)")
-        ax.set_title(plotstyle.fit_title(ax, f"{_label(name, idx)}: {s['n']} base samples"))
+        ax.set_title(plotstyle.fit_title(ax, f"{s.get('label', _label(name, idx))}: {s['n']} base samples"))
         ax.legend(loc="best")
     for ax in axes.ravel()[n:]:
         ax.set_visible(False)
+    fig.tight_layout()
+    return plotstyle.save(fig, png)
+
+
+def sensitivity_convergence_figure(conv: dict, names, png, title=""):
+    """S1 (dashed) and ST (solid) of each input against the number of base samples."""
+    plt = plotstyle.pyplot()
+    fig, ax = plt.subplots(figsize=(5.2, 3.6))
+    for i, nm in enumerate(names):
+        ax.plot(conv["n"], conv["ST"][:, i], "o-", ms=3, color=f"C{i}", label=f"{nm}: ST")
+        ax.plot(conv["n"], conv["S1"][:, i], "s--", ms=3, color=f"C{i}", alpha=0.7, label=f"{nm}: S1")
+    ax.set_xscale("log", base=2)
+    ax.set_xlabel("base samples n")
+    ax.set_ylabel("Sobol' index (1)")
+    ax.axhline(0, color="0.3", lw=0.8)
+    ax.set_title(plotstyle.fit_title(ax, title or "convergence of the indices"))
+    ax.legend(loc="best", fontsize=7, ncol=2)
     fig.tight_layout()
     return plotstyle.save(fig, png)
 
@@ -122,4 +141,10 @@ def study_figures(res, rep=None) -> list:
         pngs.append(convergence_figure(series, folder / "convergence.png"))
     if rep and rep.get("sobol"):
         pngs.append(sensitivity_figure(rep["sobol"], folder / "sensitivity.png"))
+        (name, idx), s = next(iter(rep["sobol"].items()))
+        fA, fB, fAB, _ = res.saltelli(name)
+        sl = (slice(None),) + idx
+        conv = sobol_convergence(fA[sl], fB[sl], fAB[(slice(None),) + sl])
+        pngs.append(sensitivity_convergence_figure(conv, s["names"], folder / "sensitivity_convergence.png",
+                                                   f"{s.get('label', name)}: indices against n"))
     return pngs

@@ -51,6 +51,14 @@ class _StepOutput:
                                  f"{', '.join(repr(n) for n in names)} (and 'initial', the unloaded start)")
         return want
 
+    def labels(self, model) -> list:
+        """Names along each axis of the value (None: an axis without names)."""
+        lab = [] if isinstance(self.at, str) else [self.steps(model)]
+        return lab + self._component_labels()
+
+    def _component_labels(self) -> list:
+        return []
+
     def needed(self, model) -> list:
         return self.steps(model) + ([self.relative_to] if self.relative_to is not None else [])
 
@@ -104,6 +112,12 @@ class NodeOutput(_StepOutput):
         else:
             self.unit = "m" if quantity == "U" else "rad"
 
+    def _component_labels(self):
+        if np.ndim(self.components) == 0:
+            return []
+        names = list(_AXES.get(self.quantity, NODE_QUANTITIES[self.quantity]))
+        return [[names[i] for i in self.components]]
+
     def check(self, model, families=None):
         model._check_node(self.node, f"output '{self.name}'")   # ModelError names the node
         self.steps(model)
@@ -117,14 +131,18 @@ class ElementOutput(_StepOutput):
     the frames, e.g. 'N' of trusses) at the end of steps ``at``.
 
     elements : None (every element of the family) or positions in the family.
-    reduce : None (the array), or 'max', 'min', 'absmax', 'mean', 'sum' over the elements.
+    component : an index into the per-element axes, e.g. for beams' ``section_forces`` (n_el, 2 ends,
+        [N, Vy, Vz, T, My, Mz]) ``(0, 0)`` is N at end 1 and ``(slice(None), slice(4, 6))`` the
+        bending moments at both ends; None: all.
+    reduce : None (the array), or 'max', 'min', 'absmax', 'mean', 'sum' over what is selected.
     unit : the unit of the quantity, for tables and figures (e.g. 'N').
     """
 
     def __init__(self, name: str, family: str, key: str, elements=None, reduce: str | None = None, at=None,
-                 relative_to=None, unit: str = ""):
+                 relative_to=None, unit: str = "", component=None):
         super().__init__(name, at, relative_to)
         self.unit = str(unit)
+        self.component = None if component is None else (component if isinstance(component, tuple) else (component,))
         if reduce is not None and reduce not in REDUCTIONS:
             raise StudyError(f"output '{name}': reduce = {reduce!r} is unknown; use None or one of "
                              f"{', '.join(REDUCTIONS)}")
@@ -141,11 +159,27 @@ class ElementOutput(_StepOutput):
         if self.key not in keys:
             raise StudyError(f"output '{self.name}': family {self.family!r} has no output {self.key!r}; it has "
                              f"{', '.join(repr(k) for k in keys)}")
+        shape = keys[self.key]
+        if self.component is not None:
+            try:
+                np.empty(shape)[(slice(None),) + self.component]
+            except IndexError:
+                raise StudyError(f"output '{self.name}': component {self.component} is outside the per-element "
+                                 f"shape {shape[1:]} of {self.family}/{self.key}; index within it") from None
+
+    def _component_labels(self):
+        return [] if self.reduce is not None else [None]
 
     def extract(self, model, frame):
         v = np.asarray(frame[f"el/{self.family}/{self.key}"], dtype=float)
         if self.elements is not None:
             v = v[np.asarray(self.elements)]
+        if self.component is not None:
+            try:
+                v = v[(slice(None),) + self.component]
+            except IndexError:
+                raise StudyError(f"output '{self.name}': component {self.component} is outside the per-element "
+                                 f"shape {v.shape[1:]} of {self.family}/{self.key}") from None
         if self.reduce is None:
             return v.copy()
         if self.reduce == "absmax":
@@ -154,14 +188,14 @@ class ElementOutput(_StepOutput):
 
 
 def family_outputs(model, analysis_options: dict) -> dict:
-    """{family name: output keys} of ``model`` (its families evaluated once at the start)."""
+    """{family name: {output key: array shape}} of ``model`` (its families evaluated once at the start)."""
     from ..analysis import Analysis
 
     an = Analysis(model, None, progress=False, on_frame=lambda fr: None,
                   **{k: v for k, v in analysis_options.items() if k not in ("progress", "on_frame")})
     sys_ = an.system
     responses = sys_.evaluate(sys_.committed_context())
-    return {f.name: list(r.output) for f, r in zip(an.families, responses)}
+    return {f.name: {k: np.shape(v) for k, v in r.output.items()} for f, r in zip(an.families, responses)}
 
 
 class Recorder:

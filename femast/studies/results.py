@@ -26,7 +26,20 @@ class StudyResults:
         self.input_names = [x["name"] for x in self.spec["design"]["inputs"]]
         self.output_names = list(self.spec["outputs"])
         self.units = dict(self.spec.get("units", {}))
+        self.labels = dict(self.spec.get("labels", {}))
         self.sensitivity = bool(self.spec["design"]["sensitivity"])
+
+    def component_label(self, name: str, idx: tuple) -> str:
+        """'tip_u[M+F#1, ux]' for component ``idx`` of output ``name`` (indices where an axis has
+        no names)."""
+        if not idx:
+            return name
+        axes = self.labels.get(name, [])
+        parts = []
+        for k, i in enumerate(idx):
+            names = axes[k] if k < len(axes) else None
+            parts.append(str(names[i]) if names is not None and i < len(names) else str(i))
+        return f"{name}[{', '.join(parts)}]"
 
     @property
     def runs_per_sample(self) -> int:

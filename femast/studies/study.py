@@ -84,6 +84,7 @@ class Study:
             self.units[k] = str(u)
         self.analysis = dict(analysis or {})
         self.name = str(name)
+        self.labels = {}   # output name -> names along each axis (model= studies, set by check())
         self._checked = False
 
     # ------------------------------------------------------------ checks (before any sample)
@@ -126,6 +127,7 @@ class Study:
                 except FemastError as exc:
                     raise StudyError(str(exc) if isinstance(exc, StudyError) else
                                      f"output '{o.name}': {exc}") from None
+            self.labels = {o.name: o.labels(model) for o in self.outputs}
         self._checked = True
 
     def _build(self, values, nominal=False):
@@ -167,7 +169,8 @@ class Study:
 
     def spec(self) -> dict:
         """Plain description (the manifest of the store: a resumed study must have the same)."""
-        return {"name": self.name, "design": self.design.spec(), "outputs": self.output_names, "units": self.units}
+        return {"name": self.name, "design": self.design.spec(), "outputs": self.output_names, "units": self.units,
+                "labels": self.labels}
 
 
 def _as_values(name, v):
