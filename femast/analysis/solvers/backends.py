@@ -34,6 +34,8 @@ import numpy as np
 from .banded import SYMMETRY_TOL, BandedFactor, band_of, band_rule, refine
 
 NAMES = ("auto", "superlu", "banded", "cholmod", "pardiso")
+PARDISO_MIN_DOFS = 1000   # the automatic choice takes PARDISO (when installed) from this size on
+THREADS = 1               # MKL threads of PARDISO
 INSTALL = {"cholmod": "pip install 'femast[cholmod]' (scikit-sparse; on Debian first: apt-get install "
                       "libsuitesparse-dev)",
            "pardiso": "pip install 'femast[pardiso]' (pypardiso, Intel MKL)"}
@@ -57,6 +59,8 @@ def choose(backend: str, B, ordering: str) -> str:
         n = B.shape[0]
         if ordering == "rcm" and band_rule(n, band_of(B.indptr, B.indices), B.nnz):
             return "banded"
+        if n >= PARDISO_MIN_DOFS and available("pardiso")[0]:
+            return "pardiso"
         return "superlu"
     if backend in ("cholmod", "pardiso"):
         ok, why = available(backend)
@@ -192,6 +196,10 @@ class PardisoFactor:
         import pypardiso
 
         self._ps = ps = pypardiso.PyPardisoSolver(mtype=11)
+        try:   # one thread: reproducible bits from run to run, and no waiting on a shared core
+            ps.libmkl.MKL_Set_Num_Threads(ctypes.c_int(THREADS))
+        except AttributeError:  # pragma: no cover - an MKL without the symbol
+            pass
         self.B = B
         n = B.shape[0]
         ps.iparm[:] = 0
@@ -202,6 +210,7 @@ class PardisoFactor:
         ps.iparm[11] = 2      # transposed solve: the CSC arrays are B^T's CSR arrays
         ps.iparm[12] = 1      # weighted matching
         ps.iparm[34] = 1      # zero-based indices
+        ps.iparm[17] = -1     # report the entries of the factors
         self._ia = B.indptr.astype(np.int32)
         self._ja = B.indices.astype(np.int32)
         self._n = ctypes.c_int32(n)
