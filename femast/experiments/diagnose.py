@@ -250,8 +250,10 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         by = {e["effect"]: e for e in ranking}
         combos = [(x, y) for i, x in enumerate(top) for y in top[i + 1:]]
         # and the best with every other candidate: a second mechanism whose own gain the first one's
-        # larger error hides (forward selection)
-        combos += [(top[0], e["effect"]) for e in ranking if not e.get("failed") and e["effect"] not in top]
+        # larger error hides (forward selection); not for the FE experiments, where a refit costs
+        # a minute of FE runs (their few rows rarely show a second mechanism without its own gain)
+        if not exp.fit_options.get("expensive"):
+            combos += [(top[0], e["effect"]) for e in ranking if not e.get("failed") and e["effect"] not in top]
         pl = []
         for x, y in combos:
             st = dict(start)
