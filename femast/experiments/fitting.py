@@ -185,44 +185,94 @@ def _covariance(J, cost, n, scale):
     return stderr, cov, note
 
 
-def _forward_differences(fun, step: float, lo, hi):
-    """(fun, jac) for least_squares with forward differences of ``step x max(1, |u_i|)`` in the scaled
-    parameters u (the ``diff_step`` of ``Experiment.fit_options``).
+class _FEJacobian:
+    """(fun, jac) for least_squares on an expensive model (an FE run per evaluation): forward
+    differences of ``step x max(1, |u_i|)`` in the scaled parameters u (the ``diff_step`` of
+    ``Experiment.fit_options``), and between them Broyden's rank-one secant updates.
 
     scipy's own ``diff_step`` is relative to ``|u_i|`` and falls back to 1.5e-8 at ``u_i = 0``, the
     start of an effect whose default is "absent" (a pretension error dT0 = 0): an FE model resolves
     that step no better than its Newton tolerance, and the derivative comes out with the wrong sign.
     Here the step never drops below ``step``; it is taken backwards where it would leave the upper
     bound.  The value at the point itself is reused from the last call of ``fun`` (scipy evaluates
-    it just before asking for the Jacobian)."""
-    last = {}
+    it just before asking for the Jacobian).
 
-    def f(u):
+    ``secant``: after the first Jacobian, an accepted step s with residual change y updates it as
+    J + (y - J s) s^T / (s^T s) (Broyden 1965; Dennis & Schnabel 1996, Sec. 8.1) instead of p more
+    FE runs; a step the trust region rejected (the model did not follow the linearisation) makes
+    the next Jacobian a finite-difference one again.  ``J0``: columns known at the start (NaN where
+    not), e.g. the baseline's finite differences handed to a refit (issue 21, item 6).
+    ``runs`` counts the evaluations of ``fun`` (cache hits included); ``fd_at`` is the point of the
+    last finite-difference Jacobian and ``fd_J`` that Jacobian."""
+
+    def __init__(self, fun, step: float, lo, hi, secant: bool = True, J0=None):
+        self.fun, self.step, self.lo, self.hi, self.secant = fun, float(step), lo, hi, secant
+        self.last = {}
+        self.J = self.u = self.f = None
+        self.J0 = None if J0 is None else np.array(J0, float)
+        self.since = 0      # evaluations since the last Jacobian (> 1: a rejected step)
+        self.runs = 0
+        self.fd_at = self.fd_J = None
+
+    def value(self, u):
         key = np.asarray(u, float).tobytes()
-        if key not in last:
-            last.clear()
-            last[key] = fun(u)
-        return last[key]
+        if key not in self.last:
+            self.last.clear()
+            self.runs += 1
+            self.last[key] = self.fun(u)
+        self.since += 1
+        return self.last[key]
 
-    def jac(u, *args):
-        u = np.asarray(u, float)
-        f0 = f(u)
+    def differences(self, u, f0, known=None):
         J = np.empty((f0.size, u.size))
         for i in range(u.size):
-            h = step * max(1.0, abs(u[i]))
-            if u[i] + h > hi[i]:
+            if known is not None and np.all(np.isfinite(known[:, i])):
+                J[:, i] = known[:, i]
+                continue
+            h = self.step * max(1.0, abs(u[i]))
+            if u[i] + h > self.hi[i]:
                 h = -h
             up = u.copy()
             up[i] += h
-            J[:, i] = (fun(up) - f0) / h
+            self.runs += 1
+            J[:, i] = (self.fun(up) - f0) / h
+        if known is None or not np.all(np.isfinite(known)):
+            self.fd_at, self.fd_J = u.copy(), J.copy()
         return J
 
-    return f, jac
+    def jac(self, u, *args):
+        u = np.asarray(u, float)
+        f0 = self.value(u)
+        self.since -= 1     # scipy's value call before the Jacobian is not a trial step
+        if self.J is None:
+            known = self.J0 if self.J0 is not None and self.J0.shape == (f0.size, u.size) else None
+            J = self.differences(u, f0, known)
+        elif not self.secant or self.since > 1:
+            J = self.differences(u, f0)
+        else:
+            s = u - self.u
+            ss = float(s @ s)
+            J = self.J if ss == 0.0 else self.J + np.outer((f0 - self.f) - self.J @ s, s) / ss
+        self.J, self.u, self.f, self.since = J, u.copy(), f0, 0
+        return J
+
+    def at_solution(self, u):
+        """(J by finite differences at ``u``, whether it had to be computed)."""
+        u = np.asarray(u, float)
+        if self.fd_at is not None and np.array_equal(self.fd_at, u):
+            return self.fd_J, False
+        return self.differences(u, self.value(u)), True
+
+
+def _forward_differences(fun, step: float, lo, hi):
+    """(fun, jac) with forward differences at every Jacobian (no secant updates); see :class:`_FEJacobian`."""
+    j = _FEJacobian(fun, step, lo, hi, secant=False)
+    return j.value, j.jac
 
 
 def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, multistart: bool = True,
         max_nfev: int | None = None, given_start_clip: bool = False,
-        nfev_per_param: int | None = None) -> OptimizeResult:
+        nfev_per_param: int | None = None, start_sensitivity: dict | None = None) -> OptimizeResult:
     """Fit the baseline parameters and those of the switched-on ``effects`` to the data.
 
     effects : effect names (``femast.effects``) applicable to the experiment.
@@ -235,12 +285,23 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
         other fits) instead of raising ModelError naming the parameter.
     nfev_per_param : cap of the evaluations per start, ``x (p + 1)`` (the smaller of it and the
         experiment's ``max_nfev_per_param``); diagnose's refits use 25.
+    start_sensitivity : ``{name: d(predicted, channels concatenated)/d(parameter)}`` known at the
+        start (the ``sensitivity`` of an earlier fit, e.g. the baseline's for diagnose's refits): the
+        first Jacobian of an experiment fitted by finite differences (``diff_step``) takes these
+        columns instead of FE runs.  The Jacobian at the solution (covariance) is always computed.
 
     Returns an ``OptimizeResult`` with ``x``, ``names``, ``units``, ``stderr``, ``cov``,
     ``params`` (baseline ``{name: value}``), ``effect_params`` (``{effect: {name: value}}``),
     ``success``, ``message``, ``nfev``, ``cost``, ``fun`` (whitened residuals), ``predicted``,
     ``residuals`` (``{channel: array}``), ``noise``, ``rms`` (error unit), ``channel_rms``,
-    ``noise_rms``, ``ratio`` (rms / noise), ``bic``, ``n_obs``, ``n_params``, ``at_bound``.
+    ``noise_rms``, ``ratio`` (rms / noise), ``bic``, ``n_obs``, ``n_params``, ``at_bound``,
+    ``sensitivity`` (``{name: d predicted / d parameter}`` at the solution, channels concatenated)
+    and ``fe_runs`` (model evaluations, Jacobian columns included).
+
+    Experiments fitted by finite differences (``fit_options["diff_step"]``: the FE ones) take
+    Broyden secant updates of the Jacobian between finite-difference ones and a finite-difference
+    Jacobian at the solution, from which a Gauss-Newton check restarts the fit when it predicts a
+    further decrease beyond ``ftol`` (see :class:`_FEJacobian`, :func:`_polish`).
     """
     exp.require_model("a fit")
     if isinstance(effects, str):
@@ -301,34 +362,67 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     kw.update(fo)
     kw["max_nfev"] = max_nfev or kw.get("max_nfev") or per_param * (len(specs) + 1)
 
-    def solve(sigma, candidates):
+    n_res = data.n * len(exp.channels)
+
+    def sigma_rows(sigma):
+        return np.concatenate([np.broadcast_to(np.asarray(sigma[c], float), (data.n,)) for c in exp.channels])
+
+    def seed(sens, sigma):
+        """Whitened, scaled start Jacobian from known sensitivities d(predicted)/d(parameter) (NaN: unknown)."""
+        if not fd_step or not sens:
+            return None
+        J0 = np.full((n_res, len(specs)), np.nan)
+        rows = sigma_rows(sigma)
+        for i, (full, _, _) in enumerate(specs):
+            col = sens.get(full)
+            if col is not None and np.shape(col) == (n_res,):
+                J0[:, i] = -np.asarray(col, float) * scale[i] / rows
+        return J0 if np.isfinite(J0).any() else None
+
+    def solve(sigma, candidates, J0=None):
         best = None
-        fun = make_fun(sigma)
-        if fd_step:
-            fun, kw["jac"] = _forward_differences(fun, float(fd_step), lo, hi)
-        nfev = 0
-        for x in candidates:
-            u0 = np.clip(x / scale, lo, hi)
+        fun0 = make_fun(sigma)
+        nfev = runs = 0
+        for k, x in enumerate(candidates):
+            u0 = _exact_start(x, scale, lo, hi)
+            fj = None
+            fun = fun0
+            if fd_step:
+                fj = _FEJacobian(fun0, float(fd_step), lo, hi, secant=True, J0=J0 if k == 0 else None)
+                fun, kw["jac"] = fj.value, fj.jac
             with np.errstate(all="ignore"):
                 sol = least_squares(fun, u0, bounds=(lo, hi), **kw)
             nfev += sol.nfev
+            if fj is not None:
+                sol = _polish(sol, fj, fun, lo, hi, kw)
+                nfev += getattr(sol, "nfev_polish", 0)
+                runs += fj.runs
             if best is None or sol.cost < best.cost:
                 best = sol
         best.nfev_total = nfev
+        best.fe_runs = runs if fd_step else nfev
         return best
 
     if noise is None:
         base, eff = _split(specs, x0)
         sigma0 = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
-        sol = solve(sigma0, starts)
+        sol = solve(sigma0, starts, seed(start_sensitivity, sigma0))
         base, eff = _split(specs, sol.x * scale)
         sigma = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
-        sol2 = solve(sigma, [sol.x * scale])
-        sol2.nfev_total += sol.nfev_total
-        sol = sol2
+        if len(exp.channels) == 1:
+            # one channel, one noise level: the whitened residual only changes by a constant factor, so
+            # the minimiser and the covariance are the same; rescale instead of refitting
+            f = sigma0[exp.channels[0]] / sigma[exp.channels[0]]
+            sol.fun, sol.jac, sol.cost = sol.fun * f, sol.jac * f, sol.cost * f * f
+        else:
+            ratio = sigma_rows(sigma0) / sigma_rows(sigma)   # warm start: the last Jacobian, rows re-weighted
+            sol2 = solve(sigma, [sol.x * scale], sol.jac * ratio[:, None] if fd_step else None)
+            sol2.nfev_total += sol.nfev_total
+            sol2.fe_runs += sol.fe_runs
+            sol = sol2
     else:
         sigma = {c: _sigma_of(noise, c, data.n) for c in exp.channels}
-        sol = solve(sigma, starts)
+        sol = solve(sigma, starts, seed(start_sensitivity, sigma))
     x = sol.x * scale
     stderr, cov, note = _covariance(sol.jac, sol.cost, sol.fun.size, scale)
     if note:
@@ -337,8 +431,59 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     base, eff = _split(specs, x)
     predicted = predict(exp, data, base, eff)
     msg = sol.message.rstrip(".") + (f"; {note}" if note else "")
-    return _result(exp, data, specs, x, stderr, cov, sigma, predicted, True, bool(sol.success), msg,
-                   sol.nfev_total, [i[0] for i in impls])
+    out = _result(exp, data, specs, x, stderr, cov, sigma, predicted, True, bool(sol.success), msg,
+                  sol.nfev_total, [i[0] for i in impls])
+    rows = sigma_rows(sigma)
+    out.sensitivity = {full: -sol.jac[:, i] * rows / scale[i] for i, (full, _, _) in enumerate(specs)}
+    out.fe_runs = int(sol.fe_runs)
+    return out
+
+
+def _exact_start(x, scale, lo, hi):
+    """Scaled start ``u`` with ``u * scale == x`` bit for bit where one exists (a neighbour of
+    ``x / scale``): a refit started from another fit's values then asks the FE model for exactly
+    those values, which the run cache (fe_cache) already holds."""
+    x = np.asarray(x, float)
+    u = x / scale
+    for i in range(u.size):
+        for cand in (u[i], np.nextafter(u[i], np.inf), np.nextafter(u[i], -np.inf)):
+            if cand * scale[i] == x[i]:
+                u[i] = cand
+                break
+    return np.clip(u, lo, hi)
+
+
+POLISH_ROUNDS = 2
+
+
+def _polish(sol, fj, fun, lo, hi, kw):
+    """The Jacobian at the solution by finite differences (for the covariance), and a restart of the fit
+    from there, with that Jacobian, when its Gauss-Newton step (within the bounds) predicts a decrease
+    of the cost beyond ``ftol`` of it: a secant Jacobian may have stopped the fit early."""
+    extra = 0
+    ftol = float(kw.get("ftol", 1e-8))
+    for _ in range(POLISH_ROUNDS + 1):
+        J, _ = fj.at_solution(sol.x)
+        f = fj.value(sol.x)
+        step = np.linalg.lstsq(J, -f, rcond=None)[0]
+        u_new = np.clip(sol.x + step, lo, hi)
+        r = f + J @ (u_new - sol.x)
+        predicted = sol.cost - 0.5 * float(r @ r)
+        if _ == POLISH_ROUNDS or not predicted > ftol * sol.cost:
+            break
+        fj.J, fj.J0 = None, J
+        with np.errstate(all="ignore"):
+            again = least_squares(fun, sol.x, bounds=(lo, hi), **kw)
+        extra += again.nfev
+        if again.cost <= sol.cost:
+            sol = again
+        else:
+            break
+    J, _ = fj.at_solution(sol.x)
+    sol.jac = J
+    sol.fun = fj.value(sol.x)
+    sol.nfev_polish = extra
+    return sol
 
 
 def _sigma_of(noise: dict, channel: str, n: int):
