@@ -158,22 +158,28 @@ def main(argv=None):
     ratio_best = min(fw) / min(ow)
     ratio_med = statistics.median(fw) / statistics.median(ow)
     ratio_cpu = min(r["cpu"] for r in fr) / min(r["cpu"] for r in orr)
-    print(f"  ratio femast/OpenSees: best {ratio_best:.2f}, median {ratio_med:.2f}, CPU {ratio_cpu:.2f} "
-          f"(target <= 0.5): {'MET' if ratio_best <= 0.5 else 'NOT MET'}; load average {os.getloadavg()[0]:.2f}")
+    print(f"  ratio femast/OpenSees: wall best {ratio_best:.2f}, wall median {ratio_med:.2f}, CPU (best/best) "
+          f"{ratio_cpu:.2f}; target <= 0.5: wall {'MET' if ratio_best <= 0.5 else 'NOT MET'}, CPU "
+          f"{'MET' if ratio_cpu <= 0.5 else 'NOT MET'}; load average {os.getloadavg()[0]:.2f}\n"
+          "  (on a loaded machine OpenSees' wall time runs to several times its CPU time, femast's does not:\n"
+          "   the CPU ratio is the one contention does not distort)")
 
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
-    ax.plot(np.arange(len(fw)) + 1, np.array(fw) / K * 1e6, "o-", label="femast (frames written)")
-    ax.plot(np.arange(len(ow)) + 1, np.array(ow) / K * 1e6, "s-", label=f"OpenSees ({args.system})")
-    ax.set_xlabel("run (interleaved)")
-    ax.set_ylabel("wall time per increment (us)")
-    ax.set_ylim(bottom=0)
-    ax.set_title(f"{n_el}-element 45-degree bend, {K} increments: ratio best {ratio_best:.2f}")
-    ax.grid(alpha=0.3)
-    ax.legend()
+    fig, axes = plt.subplots(1, 2, figsize=(9.6, 3.8))
+    for ax, key, what in ((axes[0], "cpu", "CPU"), (axes[1], "wall", "wall")):
+        ax.plot(np.arange(len(fr)) + 1, [r[key] / K * 1e6 for r in fr], "o-", label="femast (frames written)")
+        ax.plot(np.arange(len(orr)) + 1, [r[key] / K * 1e6 for r in orr], "s-", label=f"OpenSees ({args.system})")
+        ax.set_xlabel("run (interleaved)")
+        ax.set_ylabel(f"{what} time per increment (us)")
+        ax.set_ylim(bottom=0)
+        ax.grid(alpha=0.3)
+    axes[0].legend()
+    axes[0].set_title(f"CPU: femast/OpenSees {ratio_cpu:.2f}")
+    axes[1].set_title(f"wall: best {ratio_best:.2f}, median {ratio_med:.2f} (load {os.getloadavg()[0]:.1f})")
+    fig.suptitle(f"{n_el}-element 45-degree bend, {K} increments (target <= 0.5)")
     fig.tight_layout()
     out = HERE.parent / "out"
     out.mkdir(exist_ok=True)
