@@ -28,7 +28,8 @@ def _experiment(secant=True):
                                      Parameter("b", "1/s", 0.8, 0.01, 10.0, "rate")),
         model=_model, hooks={"response": "y (n,)"},
         # the FE experiments' settings (bay-torsion, tip-cycle): loose tolerances, a 1e-3 step
-        fit_options={"diff_step": 1e-3, "xtol": 1e-4, "ftol": 1e-4, "gtol": 1e-8, "max_nfev_per_param": 30})
+        fit_options={"diff_step": 1e-3, "xtol": 1e-4, "ftol": 1e-4, "gtol": 1e-8, "max_nfev_per_param": 30,
+                     "expensive": True})
     return exp
 
 

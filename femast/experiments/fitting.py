@@ -287,7 +287,7 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
         experiment's ``max_nfev_per_param``); diagnose's refits use 25.
     start_sensitivity : ``{name: d(predicted, channels concatenated)/d(parameter)}`` known at the
         start (the ``sensitivity`` of an earlier fit, e.g. the baseline's for diagnose's refits): the
-        first Jacobian of an experiment fitted by finite differences (``diff_step``) takes these
+        first Jacobian of an expensive experiment fitted by finite differences takes these
         columns instead of FE runs.  The Jacobian at the solution (covariance) is always computed.
 
     Returns an ``OptimizeResult`` with ``x``, ``names``, ``units``, ``stderr``, ``cov``,
@@ -298,8 +298,8 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     ``sensitivity`` (``{name: d predicted / d parameter}`` at the solution, channels concatenated)
     and ``fe_runs`` (model evaluations, Jacobian columns included).
 
-    Experiments fitted by finite differences (``fit_options["diff_step"]``: the FE ones) take
-    Broyden secant updates of the Jacobian between finite-difference ones and a finite-difference
+    Experiments whose model evaluations are expensive and fitted by finite differences
+    (``fit_options`` with ``expensive`` and ``diff_step``: the FE ones) take Broyden secant updates of the Jacobian between finite-difference ones and a finite-difference
     Jacobian at the solution, from which a Gauss-Newton check restarts the fit when it predicts a
     further decrease beyond ``ftol`` (see :class:`_FEJacobian`, :func:`_polish`).
     """
@@ -356,7 +356,9 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     per_param = int(fo.pop("max_nfev_per_param", 100))
     if nfev_per_param:
         per_param = min(per_param, int(nfev_per_param))
-    fo.pop("expensive", None)  # a hint for diagnose, not a least_squares option
+    # a hint for diagnose, not a least_squares option; with finite differences it also turns on the
+    # run-saving Jacobians (secant updates, seeded starts, issue 21): every model evaluation is an FE run
+    secant = bool(fo.pop("expensive", None)) and bool(fo.get("diff_step"))
     fd_step = fo.pop("diff_step", None)
     kw = dict(method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10, x_scale=1.0)
     kw.update(fo)
@@ -369,7 +371,7 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
 
     def seed(sens, sigma):
         """Whitened, scaled start Jacobian from known sensitivities d(predicted)/d(parameter) (NaN: unknown)."""
-        if not fd_step or not sens:
+        if not secant or not sens:
             return None
         J0 = np.full((n_res, len(specs)), np.nan)
         rows = sigma_rows(sigma)
@@ -384,17 +386,18 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
         fun0 = make_fun(sigma)
         nfev = runs = 0
         for k, x in enumerate(candidates):
-            u0 = _exact_start(x, scale, lo, hi)
+            u0 = _exact_start(x, scale, lo, hi) if secant else np.clip(x / scale, lo, hi)
             fj = None
             fun = fun0
             if fd_step:
-                fj = _FEJacobian(fun0, float(fd_step), lo, hi, secant=True, J0=J0 if k == 0 else None)
+                fj = _FEJacobian(fun0, float(fd_step), lo, hi, secant=secant, J0=J0 if k == 0 and secant else None)
                 fun, kw["jac"] = fj.value, fj.jac
             with np.errstate(all="ignore"):
                 sol = least_squares(fun, u0, bounds=(lo, hi), **kw)
             nfev += sol.nfev
             if fj is not None:
-                sol = _polish(sol, fj, fun, lo, hi, kw)
+                if secant:
+                    sol = _polish(sol, fj, fun, lo, hi, kw)
                 nfev += getattr(sol, "nfev_polish", 0)
                 runs += fj.runs
             if best is None or sol.cost < best.cost:
@@ -409,14 +412,14 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
         sol = solve(sigma0, starts, seed(start_sensitivity, sigma0))
         base, eff = _split(specs, sol.x * scale)
         sigma = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
-        if len(exp.channels) == 1:
+        if secant and len(exp.channels) == 1:
             # one channel, one noise level: the whitened residual only changes by a constant factor, so
             # the minimiser and the covariance are the same; rescale instead of refitting
             f = sigma0[exp.channels[0]] / sigma[exp.channels[0]]
             sol.fun, sol.jac, sol.cost = sol.fun * f, sol.jac * f, sol.cost * f * f
         else:
             ratio = sigma_rows(sigma0) / sigma_rows(sigma)   # warm start: the last Jacobian, rows re-weighted
-            sol2 = solve(sigma, [sol.x * scale], sol.jac * ratio[:, None] if fd_step else None)
+            sol2 = solve(sigma, [sol.x * scale], sol.jac * ratio[:, None] if secant else None)
             sol2.nfev_total += sol.nfev_total
             sol2.fe_runs += sol.fe_runs
             sol = sol2
