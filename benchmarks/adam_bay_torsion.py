@@ -34,7 +34,7 @@ from femast.adam.post import bay_curve, plot_bay_torsion, relatch_angles, releas
 from femast.adam.steps import (CONVERGENCE, add_idealised_torsion, add_initial_steps, add_measured_torsion,
                                measured_style_path)
 from femast.latch import ZONE_LABELS
-from femast.vtk import export_vtk
+from femast.post.vtk import export_vtk
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs" / "figures"

@@ -163,8 +163,8 @@ def main(argv=None):
         print(format_table1(lab2, v2))
         summary["compare_mu"] = {"mu": args.compare_mu, "labels": lab2, "table_um_arcsec": v2.tolist()}
     if args.render:
-        from femast.render import render_png
-        from femast.vtk import export_vtk
+        from femast.post.render import render_png
+        from femast.post.vtk import export_vtk
 
         steps = res.steps
         i_load = max(i for i, s in enumerate(steps) if s == "M+F#1")

@@ -9,14 +9,14 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
 
 plotstyle.use()
 import matplotlib.pyplot as plt
 import numpy as np
 
-from femast import references as ref
-from femast import verification_arclength as va
+from femast.verification import references as ref
+from femast.verification import arclength as va
 
 
 def main(out="benchmarks/out"):

@@ -27,16 +27,16 @@ sys.path.insert(0, os.path.join(HERE, "peers"))
 PARTS = [  # (module, class, method, label)
     ("femast.elements.beam_corot", "BeamFamily", "evaluate", "beam kernel (element forces + tangents)"),
     ("femast.analysis", "Analysis", "_residual", "residual assembly"),
-    ("femast.assembly", "Assembler", "tangent", "tangent assembly into CSR"),
-    ("femast.assembly", "Assembler", "tangent_into", "tangent assembly into the solver's matrix"),
-    ("femast.solvers.linear", "SparseLU", "factorize", "SparseLU.factorize (CSR path, incl. SuperLU)"),
-    ("femast.solvers.linear", "SparseLU", "factorize_values", "SparseLU.factorize_values (incl. SuperLU)"),
-    ("femast.solvers.linear", "SparseLU", "solve", "SparseLU.solve (incl. SuperLU)"),
-    ("femast.solvers.linear", "SparseLU", "_factor_permuted", "  of which SuperLU factorisations (all)"),
+    ("femast.analysis.assembly", "Assembler", "tangent", "tangent assembly into CSR"),
+    ("femast.analysis.assembly", "Assembler", "tangent_into", "tangent assembly into the solver's matrix"),
+    ("femast.analysis.solvers.linear", "SparseLU", "factorize", "SparseLU.factorize (CSR path, incl. SuperLU)"),
+    ("femast.analysis.solvers.linear", "SparseLU", "factorize_values", "SparseLU.factorize_values (incl. SuperLU)"),
+    ("femast.analysis.solvers.linear", "SparseLU", "solve", "SparseLU.solve (incl. SuperLU)"),
+    ("femast.analysis.solvers.linear", "SparseLU", "_factor_permuted", "  of which SuperLU factorisations (all)"),
     ("femast.analysis", "Analysis", "_converged", "convergence test"),
     ("femast.analysis", "Analysis", "_update", "configuration update"),
     ("femast.analysis", "Analysis", "_write", "results frame (gather + hand-over)"),
-    ("femast.results", "ResultsWriter", "status", "status line (.sta)"),
+    ("femast.post.results", "ResultsWriter", "status", "status line (.sta)"),
 ]
 
 
@@ -97,7 +97,7 @@ def plot(results, path):
     import matplotlib
 
     matplotlib.use("Agg")
-    from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+    from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
 
     plotstyle.use()
     import matplotlib.pyplot as plt

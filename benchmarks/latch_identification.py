@@ -18,7 +18,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
 
 plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402

@@ -35,13 +35,13 @@ def minimal_run(mast, n_inc):
 
     import femast_mast
     from femast.analysis import Analysis
-    from femast.assembly import _scatter_matrix, _scatter_vector
-    from femast.configuration import update_configuration
+    from femast.analysis.assembly import _scatter_matrix, _scatter_vector
+    from femast.analysis.configuration import update_configuration
     from femast.elements.beam_corot import beam_family_kernel
-    from femast.results import ResultsWriter
+    from femast.post.results import ResultsWriter
     from femast.rotations import rotation_vectors
-    from femast.solvers.convergence import Convergence, force_moment_abs_max
-    from femast.solvers.linear import _unpermute
+    from femast.analysis.solvers.convergence import Convergence, force_moment_abs_max
+    from femast.analysis.solvers.linear import _unpermute
 
     m, _ = femast_mast.model(mast, n_inc)
     out = tempfile.mkdtemp(prefix="femast_floor_")

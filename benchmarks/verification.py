@@ -11,17 +11,17 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
 
 plotstyle.use()
 import matplotlib.pyplot as plt
 import numpy as np
 
 from femast import progress
-from femast import references as ref
+from femast.verification import references as ref
 from femast import verification as v
-from femast.render import render_png
-from femast.vtk import export_vtk
+from femast.post.render import render_png
+from femast.post.vtk import export_vtk
 
 
 def main():
@@ -147,7 +147,7 @@ def main():
 
 def modal_cases(out):
     """Issue 18: modal analysis against closed forms; figure modal_verification.png."""
-    from femast import verification_modal as vm
+    from femast.verification import modal as vm
 
     rows = []
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))

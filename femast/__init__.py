@@ -12,16 +12,20 @@ Quick start::
     print(res.node_history(b, "uz"))
 """
 
-from .amplitudes import Amplitude
+from . import _aliases
+
+_aliases.install()  # the import paths of before the package move (issue 15) keep working
+
+from .model.amplitudes import Amplitude
 from .analysis import Analysis, solve
 from .errors import ConvergenceError, DataFileError, EquilibriumError, FemastError, ModelError, SingularModelError
 from .model import Model
-from .results import Results
-from .sections import Section, circular_solid, circular_tube, shear_modulus, square_solid, square_tube
-from .solvers.control import DisplacementControl, LoadControl
-from .solvers.stabilize import Stabilize
-from .solvers.arclength import ArcLength
-from .solvers.convergence import Convergence
+from .post.results import Results
+from .model.sections import Section, circular_solid, circular_tube, shear_modulus, square_solid, square_tube
+from .analysis.solvers.control import DisplacementControl, LoadControl
+from .analysis.solvers.stabilize import Stabilize
+from .analysis.solvers.arclength import ArcLength
+from .analysis.solvers.convergence import Convergence
 
 __all__ = [
     "Amplitude", "Analysis", "solve", "Model", "Results", "Section", "circular_solid", "circular_tube",
@@ -29,6 +33,11 @@ __all__ = [
     "FemastError", "ModelError", "SingularModelError", "ConvergenceError", "DataFileError", "EquilibriumError",
 ]
 __version__ = "0.1.0"
+
+
+def __getattr__(name):  # fm.results, fm.sections...: the old top-level modules, imported on first use
+    return _aliases.attribute(name)
+
 
 from .jit import watch as _watch_compile
 

@@ -1,7 +1,7 @@
 """Command line: ``femast run SCRIPT``, ``femast vtk RESULTS``, ``femast render RESULTS [PNG]``,
 ``femast info RESULTS``, ``femast warmup``; ``compare``, ``diagnose``, ``experiments``, ``effects``,
-``examples`` (:mod:`femast.cli_experiments`).  ``femast --help`` lists them, ``femast CMD --help``
-explains each argument with its default.  ``femast --quiet CMD`` shows no progress bars."""
+``examples`` (:mod:`femast.cli_experiments`); ``study`` (:mod:`femast.studies.cli`).  ``femast --help``
+lists them, ``femast CMD --help`` explains each argument with its default.  ``femast --quiet CMD`` shows no progress bars."""
 
 from __future__ import annotations
 
@@ -47,7 +47,7 @@ def _run(args):
 
 
 def _vtk(args):
-    from .vtk import export_vtk
+    from .post.vtk import export_vtk
 
     pvd = export_vtk(args.results, args.out, every=args.every)
     print(f"wrote {pvd} (open it in ParaView; apply 'Warp By Vector' with U to see the deformed shape)")
@@ -66,8 +66,8 @@ def _frame_arg(text: str):
 
 
 def _render(args):
-    from .render import largest_displacement_frame, render_png
-    from .results import Results
+    from .post.render import largest_displacement_frame, render_png
+    from .post.results import Results
 
     res = Results(args.results)
     if args.frame == "max":
@@ -95,7 +95,7 @@ def _warmup(args):
 
 
 def _info(args):
-    from .results import Results
+    from .post.results import Results
 
     res = Results(args.results)
     print(f"{res.folder}: {len(res)} frames, {len(res.node_labels)} nodes, families: {', '.join(res.families)}")
@@ -172,6 +172,9 @@ def build_parser() -> argparse.ArgumentParser:
         register = None
     if register is not None:
         register(sub, _Help)
+    from .studies.cli import register as register_study   # femast study (issue 20)
+
+    register_study(sub, _Help)
     for name, sp in sub.choices.items():  # --quiet also after the command (SUPPRESS: keeps the main one's value)
         if name != "run":
             sp.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS,

@@ -32,3 +32,8 @@ class EquilibriumError(FemastError):
 class StateError(FemastError, ValueError):
     """An analysis state cannot be used as asked (e.g. a modal analysis of a state that is not in
     equilibrium)."""
+
+
+class StudyError(FemastError, ValueError):
+    """A study (femast.studies) is set up wrongly: an impossible distribution, an input or output
+    that matches nothing, a scheduler that cannot be reached.  Raised before any sample runs."""

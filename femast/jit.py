@@ -26,9 +26,9 @@ import time
 # recorded with numba's compile events; benchmarks/cold_start.py measures the whole first run).
 COMPILE_S = {
     "femast.elements.beam_corot.beam_family_kernel": 11.0,
-    "femast.configuration.update_configuration": 1.9,
+    "femast.analysis.configuration.update_configuration": 1.9,
     "femast.rotations.apply_spins": 1.0,
-    "femast.solvers.convergence.force_moment_abs_max": 0.9,
+    "femast.analysis.solvers.convergence.force_moment_abs_max": 0.9,
     "femast.rotations._rotation_vectors": 0.6,
 }
 

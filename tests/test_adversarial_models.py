@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import femast as fm
-from femast.amplitudes import Amplitude
+from femast.model.amplitudes import Amplitude
 from femast.elements.ball_joint import BallJointFamily
 
 
@@ -316,7 +316,7 @@ def test_battery_size():
 
 
 def test_equilibrium_check_catches_a_lost_load_and_passes_a_balanced_one():
-    from femast.validation import check_equilibrium
+    from femast.model.validation import check_equilibrium
 
     x = np.array([[0.0, 0, 0], [1.0, 0, 0]])
     P = np.zeros((2, 6))

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from femast import references as ref
-from femast import verification_arclength as va
+from femast.verification import references as ref
+from femast.verification import arclength as va
 
 
 def test_von_mises_truss_follows_the_analytic_snap_through():

@@ -4,11 +4,11 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import expm
 
-from femast.configuration import update_configuration
-from femast.constraints import transpose_times
+from femast.analysis.configuration import update_configuration
+from femast.model.constraints import transpose_times
 from femast.rotations import skew
-from femast.solvers.convergence import field_abs_max, force_moment_abs_max
-from femast.solvers.linear import _unpermute
+from femast.analysis.solvers.convergence import field_abs_max, force_moment_abs_max
+from femast.analysis.solvers.linear import _unpermute
 
 RNG = np.random.default_rng(11)
 

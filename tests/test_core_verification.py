@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from femast import references as ref
+from femast.verification import references as ref
 from femast import verification as v
 
 

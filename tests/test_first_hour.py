@@ -86,7 +86,7 @@ def test_compile_notice_once_per_process_and_only_for_femast(monkeypatch, capsys
     jit._on_compile(_fake_event("numpy_user_module"))
     assert capsys.readouterr().err == ""
     jit._on_compile(_fake_event("femast.rotations"))
-    jit._on_compile(_fake_event("femast.assembly"))
+    jit._on_compile(_fake_event("femast.analysis.assembly"))
     err = capsys.readouterr().err
     assert err.count("compiling femast kernels, first run only") == 1
     assert f"~{jit.COMPILE_S['femast.elements.beam_corot.beam_family_kernel']:.0f} s" in err
@@ -202,7 +202,7 @@ def _load_unload(folder):
 
 def test_render_defaults_to_the_largest_displacement(tmp_path, monkeypatch, capsys):
     pytest.importorskip("pyvista")
-    from femast.render import largest_displacement_frame
+    from femast.post.render import largest_displacement_frame
 
     res, tip = _load_unload(tmp_path / "lu")
     k, umax = largest_displacement_frame(res)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import femast as fm
-from femast.amplitudes import Amplitude
+from femast.model.amplitudes import Amplitude
 from femast.analysis import Analysis
 from femast.errors import ModelError
 from femast.testing import fd_tangent
@@ -262,7 +262,7 @@ def test_bad_inputs_name_the_item_and_the_unit():
 
 
 def test_thermal_step_under_arc_length_is_refused():
-    from femast.solvers.arclength import ArcLength
+    from femast.analysis.solvers.arclength import ArcLength
 
     m = fm.Model("arc")
     n1, n2 = m.node(0, 0, 0), m.node(1, 0, 0)
@@ -278,7 +278,7 @@ def test_bimetallic_strip_bends_with_timoshenkos_curvature():
     Euler-Bernoulli beam), heated by dT: Timoshenko (1925) curvature
     kappa = 6 (a2 - a1) dT (1 + m)^2 / (h (3 (1 + m)^2 + (1 + m n) (m^2 + 1 / (m n)))),
     m = t1 / t2, n = E1 / E2, h = t1 + t2; the free end turns by kappa L."""
-    import femast.sections as fs
+    import femast.model.sections as fs
 
     L, w, t1, t2, dT, n_el = 0.2, 0.01, 0.5e-3, 0.8e-3, 50.0, 8
     E1, a1, E2, a2 = 200e9, 12e-6, 70e9, 23e-6

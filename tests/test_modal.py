@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import femast as fm
-from femast import verification_modal as vm
+from femast.verification import modal as vm
 from femast.errors import ModelError, StateError
-from femast.mass import assemble_mass, total_mass
+from femast.modal.mass import assemble_mass, total_mass
 from femast.modal import modal_analysis
 
 
@@ -183,8 +183,8 @@ def test_modes_of_every_saved_increment_follow_the_axial_load(tmp_path):
     """ModesRecorder: the pin-ended beam's first frequency at each increment of a load ramp
     against f0^2 (1 + P/P_E) (tolerance 1e-3 f0^2, as in the verification case), written to the
     results folder; and the animated VTK series of the last frame's modes."""
-    from femast.modal_output import ModesRecorder, export_modes_vtk
-    from femast.verification_modal import pinned_beam_axial
+    from femast.modal.output import ModesRecorder, export_modes_vtk
+    from femast.verification.modal import pinned_beam_axial
 
     E, EI, EA, L = 1e4, 1.0, 1e6, 1.0
     sec = fm.Section(E=E, G=E / 2, A=EA / E, Iy=EI / E, Iz=EI / E, J=2 * EI / E, rho=E / EA)

@@ -1,4 +1,4 @@
-"""Each reference in femast.references checked against a published table or an
+"""Each reference in femast.verification.references checked against a published table or an
 independent computation (different equations or different numerics).  Every
 tolerance carries a one-line reason."""
 
@@ -9,7 +9,7 @@ import pytest
 from scipy.integrate import solve_bvp, solve_ivp
 from scipy.optimize import brentq
 
-from femast import references as ref
+from femast.verification import references as ref
 
 
 # ----------------------------------------------------------------------------- elastica

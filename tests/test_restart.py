@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import femast as fm
-from femast.results import Results
+from femast.post.results import Results
 
 MODEL = textwrap.dedent("""
     import femast as fm

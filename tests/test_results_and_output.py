@@ -9,8 +9,8 @@ import pytest
 
 import femast as fm
 from femast.cli import main
-from femast.render import render_png
-from femast.vtk import export_vtk
+from femast.post.render import render_png
+from femast.post.vtk import export_vtk
 
 
 @pytest.fixture(scope="module")

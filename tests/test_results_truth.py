@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import femast as fm
-from femast.results import Results, ResultsWarning
+from femast.post.results import Results, ResultsWarning
 
 
 def _cantilever(n_inc=4, load=-50.0):

@@ -16,8 +16,8 @@ import femast as fm
 from femast.analysis import Analysis
 from femast.elements.base import ElementFamily, ElementResponse
 from femast.errors import ConvergenceError
-from femast.results import ResultsWriter
-from femast.solvers.linear import SparseLU
+from femast.post.results import ResultsWriter
+from femast.analysis.solvers.linear import SparseLU
 
 
 def _frame_model(n_bays=3):
@@ -217,7 +217,7 @@ def test_a_nan_in_an_element_tangent_is_named(tmp_path):
 
 def test_reduced_tangent_matches_the_sparse_product():
     # T^T K T + G on the fixed pattern against scipy's product, random values on random patterns
-    from femast.reduction import ReducedTangent
+    from femast.analysis.reduction import ReducedTangent
 
     rng = np.random.default_rng(3)
     n_act, n_ind, nf = 40, 30, 24
@@ -271,7 +271,7 @@ def test_a_run_that_gives_up_writes_its_last_converged_increment(tmp_path):
 
 
 def test_output_frequency_in_an_arc_length_step_keeps_its_last_increment(monkeypatch):
-    import femast.verification_arclength as va
+    import femast.verification.arclength as va
 
     full = va.von_mises_truss()["results"]
     orig = va.Model.step

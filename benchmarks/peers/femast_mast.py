@@ -9,7 +9,7 @@ import numpy as np
 
 import femast as fm
 from femast.analysis import Analysis
-from femast.solvers.convergence import Convergence
+from femast.analysis.solvers.convergence import Convergence
 
 from mast import E_AL, G_AL, SECTIONS
 

@@ -49,6 +49,7 @@ from ..errors import ModelError
 from ..model import Model
 from .joint_spring import JointSprings
 from .parameters import BayParameters
+from .scatter import MastScatter, latch_array
 
 LATCH_FAMILY = "adam_latch"
 ARM_FAMILY = "adam_arm"
@@ -125,7 +126,7 @@ def build_bay(params: BayParameters | None = None, fold: int = 1, name: str = "A
 
 
 def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, alternate: bool = True,
-               name: str | None = None, cables: bool = True, **changes) -> AdamModel:
+               name: str | None = None, cables: bool = True, scatter=None, **changes) -> AdamModel:
     """A mast of ``n_bays`` identical ADAM bays (seed 001 Sec. VII: 40 bays, 6.84 m).
 
     params : :class:`BayParameters`; keyword ``changes`` override single parameters.
@@ -134,6 +135,9 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
         arranged to fold in alternate directions").
     The base frame is fixed (all DOFs of its nodes); the top frame is a rigid body whose reference
     is the control node at its centre.  ``cables=False`` leaves out the cable assemblies.
+    scatter : per-element values (:class:`~femast.adam.scatter.MastScatter` or a dict of its
+        fields): friction per ball joint, latch k and mu per latch, pretension per bay side, length
+        error per member (issue 20).  Default: every bay exactly ``params``.
     Returns an :class:`AdamModel`."""
     try:
         n_ok = int(n_bays) == n_bays and int(n_bays) >= 1 and not isinstance(n_bays, bool)
@@ -153,6 +157,7 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
             raise ModelError(f"build_mast: unknown bay parameter(s) {', '.join(unknown)}; see BayParameters")
         params = params.with_(**changes)
     p = params
+    sc = MastScatter.from_dict({} if scatter is None else scatter).resolve(n_bays, p)
     folds = np.array([fold * ((-1) ** j if alternate else 1) for j in range(n_bays)], dtype=int)
     m = Model(name or f"ADAM mast, {n_bays} bays")
     xy = corner_xy(p.b)
@@ -174,7 +179,7 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
     for i in range(n_frames):
         for k in range(4):
             m.beam(batten_ends[i, k, 0], batten_ends[i, (k + 1) % 4, 1], bsec, up=(0, 0, 1), n=p.n_batten,
-                   family=BATTEN_FAMILY)
+                   family=BATTEN_FAMILY, length_error_m=float(sc["batten_dL"][i, k]))
     # longerons and their ball joints
     longerons = np.zeros((n_bays, 4, 2), dtype=np.int64)
     pairs = []
@@ -184,10 +189,11 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
             a = m.node(*m.xyz(bot))
             c = m.node(*m.xyz(top))
             radial = (xy[k, 0], xy[k, 1], 0.0)
-            m.beam(a, c, lsec, up=radial, n=p.n_longeron, family=LONGERON_FAMILY)
+            m.beam(a, c, lsec, up=radial, n=p.n_longeron, family=LONGERON_FAMILY,
+                   length_error_m=float(sc["longeron_dL"][j, k]))
             longerons[j, k] = (a, c)
             pairs += [(a, bot), (c, top)]
-    add_ball_joints(m, pairs, mu=p.mu, B=p.B, penalty_factor=p.joint_penalty_factor,
+    add_ball_joints(m, pairs, mu=sc["mu"].ravel(), B=p.B, penalty_factor=p.joint_penalty_factor,
                     stick_factor=p.joint_stick_factor, name=JOINT_FAMILY)
     if p.joint_spring > 0:
         m.add_family(JointSprings(pairs, p.joint_spring, name=SPRING_FAMILY))
@@ -195,7 +201,7 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
     units = np.zeros((n_bays, 4 if cables else 0), dtype=np.int64)
     latch_nodes = []
     arm_labels = []
-    stretch = 1.0 + p.pretension / p.cable_EA
+    stretch = 1.0 + sc["pretension"].ravel() / p.cable_EA
     LA_list, LB_list = [], []
     for j in range(n_bays if cables else 0):
         for k in range(4):
@@ -215,15 +221,16 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
             latch_nodes.append(seq)
             LA_list.append(np.linalg.norm(m.xyz(seq[1]) - m.xyz(seq[0])))
             LB_list.append(np.linalg.norm(m.xyz(seq[2]) - m.xyz(seq[1])))
-            for t in tops:
-                arm_labels.append(m.truss(u, t, EA=p.cable_EA, pretension=p.pretension, tension_only=True,
-                                          family=ARM_FAMILY))
+            for a_, t in enumerate(tops):
+                arm_labels.append(m.truss(u, t, EA=p.cable_EA, pretension=float(sc["pretension"][j, k]),
+                                          tension_only=True, family=ARM_FAMILY,
+                                          length_error_m=float(sc["arm_dL"][j, k, a_])))
     LA, LB = np.array(LA_list), np.array(LB_list)
     x0 = -p.latch.x_backstop
     fam = None if not cables else CableLatchFamily(np.array(latch_nodes, dtype=np.int64), EA=p.cable_EA, L0=(LA + LB) / stretch,
-                           latch_node=1, bead=LA / stretch + x0, latch=p.latch, x0=x0,
+                           latch_node=1, bead=LA / stretch + x0, latch=latch_array(sc, p), x0=x0,
                            hysteresis_force=p.hysteresis_force, hysteresis_length=p.hysteresis_length,
-                           name=LATCH_FAMILY)
+                           length_error=sc["cable_dL"].reshape(-1, 2), name=LATCH_FAMILY)
     if fam is not None:
         m.add_family(fam)
     latch_labels = np.arange(1, 4 * n_bays + 1).reshape(n_bays, 4) if cables else np.zeros((n_bays, 0), int)

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, field, fields, replace
 
 from ..errors import ModelError
 from ..latch import LatchParameters, contact_half_width, validate_latch_array
-from ..sections import Section, circular_tube
+from ..model.sections import Section, circular_tube
 
 #: Bay height of seed 001, Sec. VII: 40 bays make a 6.84 m mast.
 SEED_BAY_HEIGHT = 6.84 / 40

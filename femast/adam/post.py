@@ -1,6 +1,6 @@
 """Post-processing of ADAM analyses: the bay's moment-rotation curve with the four latch-status
 bars (seed Figs. 16-17, zones of Fig. 6), CSV files, release angles, residual rotations, and the
-tip table of the 40-bay mast in the layout of seed Table 1.  Reads :class:`~femast.results.Results`
+tip table of the 40-bay mast in the layout of seed Table 1.  Reads :class:`~femast.post.results.Results`
 only (never the live solver)."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..latch import ZONE_BACKSTOP, ZONE_BEHIND_AXIS, ZONE_FREE, ZONE_IN_FRONT, ZONE_LABELS
-from ..results import Results
+from ..post.results import Results
 from .build import AdamModel
 
 ARCSEC = 180.0 / np.pi * 3600.0   # arcsec per rad
@@ -110,7 +110,7 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
     import matplotlib
 
     matplotlib.use("Agg")
-    from .. import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+    from ..post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
 
     plotstyle.use()
     import matplotlib.pyplot as plt

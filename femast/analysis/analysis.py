@@ -21,10 +21,10 @@ from tqdm.auto import tqdm
 
 from ..elements.base import DOF_NAMES
 from ..errors import ConvergenceError, ModelError, SingularModelError
-from ..results import Results, run_outcome
-from ..solvers.convergence import Convergence
-from .. import validation
-from ..thermal import FieldLoads, check_controls, has_fields
+from ..post.results import Results, run_outcome
+from .solvers.convergence import Convergence
+from ..model import validation
+from ..model.thermal import FieldLoads, check_controls, has_fields
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
@@ -42,7 +42,7 @@ class Analysis:
         frame then only goes to ``on_frame``, and :meth:`run` returns None.  For scripts and fits
         that keep what they need in memory (an FE experiment's many short runs).
 
-    convergence : :class:`~femast.solvers.convergence.Convergence` (tolerances, max iterations).
+    convergence : :class:`~femast.analysis.solvers.convergence.Convergence` (tolerances, max iterations).
     progress : show a tqdm progress bar per step.
     cutback : factor applied to a failed increment (Abaqus: 0.25).
     growth : factor applied after two easy increments (Abaqus: 1.5).
@@ -61,6 +61,9 @@ class Analysis:
         reading the results folder back (which costs about as much as the analysis of a small
         model).  Do not modify the arrays: the same ones are being written to disk.
     observers : more observers of the run (:class:`~femast.analysis.output.Observer`).
+    linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.solvers.backends`):
+        "auto" (default: LAPACK's band solver for a narrow reverse Cuthill-McKee band, as in a
+        mast, else SuperLU), or one forced by name: "superlu", "banded", "cholmod", "pardiso".
 
     After construction: ``state`` (:class:`State`: configuration, element states, loads...),
     ``system`` (:class:`System`: numbering, assembly, linear solver), ``algorithm``
@@ -70,7 +73,7 @@ class Analysis:
     def __init__(self, model, out="results", convergence: Convergence | None = None, progress: bool = True,
                  cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
                  extrapolate: bool = False, on_frame=None, tangent: str = "full", observers=(), restart=None,
-                 restart_every: int | None = None):
+                 restart_every: int | None = None, linear_solver: str = "auto"):
         self.model = model
         self.on_frame = on_frame
         self.out = out
@@ -96,7 +99,7 @@ class Analysis:
         # length errors and temperatures (issue 20): None when the model has neither
         self.fields = FieldLoads(model, self.families) if has_fields(model) else None
         self.summary = AnalysisSummary()
-        self.system = System(model, self.families, self.summary)
+        self.system = System(model, self.families, self.summary, linear_solver=linear_solver)
         self.state = State.initial(self.system.X0, self.families)
         self.output = ResultsOutput(out, [on_frame])
         self.observers = [self.output, *observers]
@@ -220,7 +223,7 @@ class Analysis:
                     continue
                 self._state.step = k
                 if getattr(step, "kind", "static") == "frequency":   # modes of the state (issue 18)
-                    from ..frequency_step import run_frequency_step
+                    from ..modal.step import run_frequency_step
 
                     run_frequency_step(self, step)
                 else:

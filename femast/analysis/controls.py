@@ -1,6 +1,6 @@
 """How each control strategy walks a step: the increment plans.
 
-A control strategy (femast/solvers/control.py, arclength.py: the user's parameters) gets a *plan*
+A control strategy (femast/analysis/solvers/control.py, arclength.py: the user's parameters) gets a *plan*
 for each step (:func:`plan_for`; a control of your own makes it with its ``plan(analysis, step)``
 method, see docs/architecture.md).  The plan is all that differs between
 strategies in the step loop (stepping.py): it proposes each increment (times, loads, predictor,
@@ -13,7 +13,7 @@ load-factor constraint: a :class:`~femast.analysis.newton.Increment`), shrinks i
   retried with ``cutback`` x its size (Abaqus: 0.25); after two easy increments the size grows by
   ``growth`` (1.5); the increment lands on the step's hit times and amplitude breakpoints.
 * :class:`ArcIncrements`: arc length.  The size is the arc length dl, adapted as
-  dl sqrt(I_d / I) (femast/solvers/arclength.py); the step ends at the load factor or monitor.
+  dl sqrt(I_d / I) (femast/analysis/solvers/arclength.py); the step ends at the load factor or monitor.
 
 A plan keeps what it carries from increment to increment in the analysis :class:`State`
 (``step_time``, ``size``, ``first_size``, ``easy``, ``last_increment``...), so a saved state holds it.
@@ -232,7 +232,7 @@ class TimeIncrements(Plan):
 
 
 class ArcIncrements(Plan):
-    """The increments of an arc-length step (:class:`~femast.solvers.arclength.ArcLength`)."""
+    """The increments of an arc-length step (:class:`~femast.analysis.solvers.arclength.ArcLength`)."""
 
     def __init__(self, analysis, step, control):
         super().__init__(analysis, step, control)

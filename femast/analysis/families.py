@@ -9,7 +9,7 @@ import numpy as np
 from ..elements.beam_corot import BeamFamily, element_frames
 from ..elements.truss import TrussFamily
 from ..errors import ModelError
-from ..model_arrays import node_rows
+from ..model.arrays import node_rows
 
 
 def build_families(model):

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..elements.base import IncrementContext
 from ..errors import ModelError, SingularModelError
-from ..solvers.convergence import Convergence
+from .solvers.convergence import Convergence
 
 
 @dataclass
@@ -84,7 +84,7 @@ class Outcome:
 class Newton:
     """Newton-Raphson iterations on one increment (see module docstring).
 
-    convergence : :class:`~femast.solvers.convergence.Convergence`.
+    convergence : :class:`~femast.analysis.solvers.convergence.Convergence`.
     line_search : secant line search when a step overshoots (fixed loads only): True, False, or
         "auto": only when retrying an increment that failed.
     tangent : "full", "modified" or "initial" (see module docstring).

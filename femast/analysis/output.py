@@ -12,7 +12,7 @@ The step loop (stepping.py) knows nothing of files.  It tells its observers what
 
 An observer implements the methods it needs (:class:`Observer` has them all, doing nothing).
 :class:`ResultsOutput` is the one every analysis has: it builds a frame (the arrays of
-``frames/NNNNNN.npz``, femast/results.py) at the step's output frequency and hands it to the
+``frames/NNNNNN.npz``, femast/post/results.py) at the step's output frequency and hands it to the
 results writer and to every ``on_frame`` recorder.
 """
 
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..results import NullWriter, ResultsWriter
+from ..post.results import NullWriter, ResultsWriter
 from ..rotations import rotation_vectors
 
 

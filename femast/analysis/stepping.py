@@ -8,7 +8,7 @@ increments, has the algorithm (newton.py) solve each one, retries failed attempt
 from __future__ import annotations
 
 from .. import progress as _progress
-from ..solvers.control import LoadControl
+from .solvers.control import LoadControl
 from .controls import plan_for
 
 

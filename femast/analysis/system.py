@@ -16,16 +16,16 @@ import time as _time
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import Assembler
-from ..configuration import update_configuration
-from ..constraints import Constraints, transpose_times
-from ..dofs import number_dofs
+from .assembly import Assembler
+from .configuration import update_configuration
+from ..model.constraints import Constraints, transpose_times
+from .dofs import number_dofs
 from ..elements.base import DOF_NAMES, IncrementContext
-from .. import validation
+from ..model import validation
 from ..errors import ModelError, SingularModelError
-from ..reduction import ReducedTangent
-from ..solvers.convergence import force_moment_abs_max
-from ..solvers.linear import SparseLU, mechanism_dofs
+from .reduction import ReducedTangent
+from .solvers.convergence import force_moment_abs_max
+from .solvers.linear import SparseLU, mechanism_dofs
 
 
 class System:
@@ -34,7 +34,7 @@ class System:
     summary : the :class:`AnalysisSummary` whose ``assembly_time`` / ``solve_time`` (s) it adds to.
     """
 
-    def __init__(self, model, families, summary):
+    def __init__(self, model, families, summary, linear_solver: str = "auto"):
         self.model = model
         self.families = families
         self.summary = summary
@@ -87,13 +87,13 @@ class System:
         self._Pa = None                # (loads array, its values on the active DOFs)
         self.length = float(np.ptp(self.X0, axis=0).max()) or 1.0
         self.symmetric = all(getattr(f, "symmetric", False) for f in self.families)
-        self.solver = SparseLU(symmetric=self.symmetric)
+        self.solver = SparseLU(symmetric=self.symmetric, backend=linear_solver)
         if not self._constrained:
             # symbolic analysis (the ordering) from the assembly pattern, once, at set-up; a
             # constrained model's reduced pattern T^T K T is only known at its first iteration
             self.solver.analyse(self.assembler.K_ff)
         self._direct = None   # (solver layout, positions): K_ff assembled into the solver's matrix
-        # constrained models: T^T K T + G on a pattern computed once (femast/reduction.py)
+        # constrained models: T^T K T + G on a pattern computed once (femast/analysis/reduction.py)
         self._reduced = (ReducedTangent(self.assembler.K_aa, self.constraints.transformation(self.X0),
                                         *self.constraints.geometric_entries(), self.dofmap.n_free)
                          if self._constrained else None)

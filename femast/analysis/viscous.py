@@ -1,6 +1,6 @@
 """The viscous term of a stabilised step (Abaqus *STABILIZE), as an option of the Newton loop.
 
-The parameters and the damping law are :class:`~femast.solvers.stabilize.Stabilize`'s; this is
+The parameters and the damping law are :class:`~femast.analysis.solvers.stabilize.Stabilize`'s; this is
 what the loop does with them: add C/dt to the tangent and -C Du/dt to the residual, and at each
 converged increment account the dissipated energy and the largest viscous force and moment, and
 adapt C.  The damping C (and its initial value) is kept in the analysis :class:`State`

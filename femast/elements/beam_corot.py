@@ -50,7 +50,7 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_facto
     (n, 2, 6) and strain energies ``energy`` (J) of all the corotational beams of a family.
 
     ``length_factor`` (dimensionless, per element): the axially stress-free length is
-    ``l0 * factor`` (a length error and a thermal strain, femast/thermal.py): ubar = l - l0 factor,
+    ``l0 * factor`` (a length error and a thermal strain, femast/model/thermal.py): ubar = l - l0 factor,
     N = EA ubar / l0 (strain on l0, so dN/dl = EA / l0 is unchanged); bending and torsion keep l0.
 
     One loop over the elements with the element's work written out in its body (not a call)
@@ -413,7 +413,7 @@ class BeamFamily(ElementFamily):
         self.GJ = np.ascontiguousarray(GJ, dtype=float)
         self.EIy = np.ascontiguousarray(EIy, dtype=float)
         self.EIz = np.ascontiguousarray(EIz, dtype=float)
-        self.length_factor = np.ones(len(self.nodes))   # stress-free length / l0 (femast/thermal.py)
+        self.length_factor = np.ones(len(self.nodes))   # stress-free length / l0 (femast/model/thermal.py)
         self.labels = np.arange(1, len(self.nodes) + 1) if labels is None else np.asarray(labels)
 
     def evaluate(self, x, R, state, ctx=None):

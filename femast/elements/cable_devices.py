@@ -29,7 +29,7 @@ from ..latch import LatchParameters, _as_param_array, validate_latch_array
 from ._cable_geometry import (GEO_ADJACENT_PULLEYS, GEO_INSIDE_PULLEY, GEO_NOT_FINITE, GEO_OK,
                               GEO_PLANE_UNDEFINED, GEO_ZERO_LENGTH, cable_geometry)
 from ._device_kernels import ERR_ACTIVE_SET, ERR_SHORT, SLIDE_FREE, STOP, device_kernel, kernel_for_law
-from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, N_PARAM, USER, builtin_law
+from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, LATCH_LB, N_PARAM, USER, builtin_law
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput, chain_nodes
 
 MODE_NAMES = {0: "stick", 1: "slide (out side pulls)", -1: "slide (in side pulls)", 2: "at stop", 3: "frictionless"}
@@ -195,13 +195,27 @@ class CableDeviceFamily(ElementFamily):
     s0 : (n_el, n-1) or (n-1,) initial material coordinates of the cable at the devices, m
         (needed where the cable is gripped: capstans, clamps, user devices; a latch's comes from
         its bead: s = Lb - x0).  Use :meth:`pretensioned` to get them from a geometry.
+    device_values : per-element device parameters (issue 20: scatter per latch or pulley), a dict
+        ``{device index: {parameter: value or (n_el,) values}}``; parameters of a Latch: r,
+        x_backstop, k, mu, h, R (SI, :class:`~femast.latch.LatchParameters`), hysteresis_force,
+        hysteresis_length; of a capstan Pulley (mu > 0): mu.  Each element's values are validated.
+    length_error : lack of fit per section, m, (n_el, n) or (n,) (default 0): the cable in section
+        i is that much longer than nominal.  The sum lengthens the cable (L0); the errors of the
+        sections before a device move the cable's material coordinate there (s0, a bead).
     name : label used in messages and results.
+
+    Thermal strain: ``length_factor`` (n_el,), set by the analysis (:mod:`femast.model.thermal`), scales
+    every unstretched length of an element uniformly: the kernel sees ``L0 s``, beads at ``Lb s``
+    and material coordinates ``S s`` (the state keeps them unscaled), so a free cable grows by
+    ``alpha dT`` with no force; the strain is measured on the heated length (as
+    :class:`~femast.elements.cable_latch.CableLatchFamily`).
     """
 
     active_dofs = (0, 1, 2)
     symmetric = False
 
-    def __init__(self, nodes, EA, L0, devices, *, s0=None, name: str = "cable_devices"):
+    def __init__(self, nodes, EA, L0, devices, *, s0=None, device_values=None, length_error=None,
+                 name: str = "cable_devices"):
         self.name = name
         self.nodes = chain_nodes(nodes, name)
         n_el, nn = self.nodes.shape
@@ -236,6 +250,22 @@ class CableDeviceFamily(ElementFamily):
         self.radius = radius
         self.P = P
         self._law = _combined_law(users.pop()) if users else None
+        if device_values:
+            self._set_device_values(device_values, devices)
+        dL = np.zeros((n_el, n))
+        if length_error is not None:
+            try:
+                dL[:] = np.broadcast_to(np.asarray(length_error, dtype=float), (n_el, n))
+            except (TypeError, ValueError):
+                raise ModelError(f"{name}: length_error must be one value per section, shape ({n_el}, {n}) or ({n},), "
+                                 f"in m; got {np.shape(length_error)}") from None
+            bad = np.argwhere(~np.isfinite(dL))
+            if bad.size:
+                raise ModelError(f"{name} element {bad[0][0]}: length_error of section {bad[0][1]} is not finite")
+        self.length_error = dL
+        self.L0 = self.L0 + dL.sum(axis=1)
+        before = np.cumsum(dL, axis=1)[:, :-1]          # (n_el, n-1): errors before device k
+        self.length_factor = np.ones(n_el)
         # initial material coordinates
         S0 = np.full((n_el, n - 1), np.nan)
         if s0 is not None:
@@ -245,20 +275,25 @@ class CableDeviceFamily(ElementFamily):
                 raise ModelError(f"{name}: s0 must have shape (n_el, n-1) = ({n_el}, {n - 1}) or ({n - 1},), in m")
         for k, dev in enumerate(devices):
             if isinstance(dev, Latch):
-                x0 = -P[0, k, 1] if dev.x0 is None else float(dev.x0)
+                x0 = -self.P[:, k, 1] if dev.x0 is None else np.full(n_el, float(dev.x0))
                 if dev.bead is None:
                     if s0 is None:
                         raise ModelError(f"{name} device {k} (Latch): give bead= (material coordinate of the bead, m) "
                                          "or build with CableDeviceFamily.pretensioned")
+                    S0[:, k] += before[:, k]
                     self.P[:, k, 6] = S0[:, k] + x0
                 else:
-                    self.P[:, k, 6] = dev.bead
-                    S0[:, k] = dev.bead - x0
-                if x0 < -P[0, k, 1] * (1 + 1e-12):
-                    raise ModelError(f"{name} device {k} (Latch): x0 = {x0!r} m is behind the backstop "
-                                     f"(x0 >= -x_backstop = {-P[0, k, 1]!r} m)")
+                    self.P[:, k, 6] = dev.bead + before[:, k]
+                    S0[:, k] = self.P[:, k, 6] - x0
+                behind = np.flatnonzero(x0 < -self.P[:, k, 1] * (1 + 1e-12))
+                if behind.size:
+                    el = behind[0]
+                    raise ModelError(f"{name} device {k} (Latch), element {el}: x0 = {x0[el]!r} m is behind the "
+                                     f"backstop (x0 >= -x_backstop = {-self.P[el, k, 1]!r} m)")
         need = [k for k, kd in enumerate(self.kinds) if kd != FREE]
         for k in need:
+            if not isinstance(devices[k], Latch):
+                S0[:, k] += before[:, k]
             if np.any(np.isnan(S0[:, k])):
                 raise ModelError(f"{name} device {k} ({type(devices[k]).__name__}) grips the cable: give s0 (the "
                                  "material coordinate of the cable at the device, m) or build with "
@@ -273,6 +308,44 @@ class CableDeviceFamily(ElementFamily):
             raise ModelError(f"{name} element {el}: the material coordinates s0 = {S0[el]} m must increase strictly "
                              f"from 0 to L0 = {self.L0[el]:.6g} m along the cable (section {i} has none)")
         self.S0 = S0
+
+    _LATCH_NAMES = ("r", "x_backstop", "k", "mu", "h", "R", None, "hysteresis_force", "hysteresis_length")
+
+    def _set_device_values(self, values, devices):
+        """Per-element device parameters (``device_values`` of the constructor), validated per element."""
+        n_el = self.nodes.shape[0]
+        if not isinstance(values, dict):
+            raise ModelError(f"{self.name}: device_values must be a dict {{device index: {{parameter: values}}}}")
+        for k, params in values.items():
+            if not (isinstance(k, (int, np.integer)) and 0 <= k < len(devices)):
+                raise ModelError(f"{self.name}: device_values has device {k!r}; the devices are 0..{len(devices) - 1}")
+            dev = devices[k]
+            if isinstance(dev, Latch):
+                cols = {nm: i for i, nm in enumerate(self._LATCH_NAMES) if nm}
+            elif isinstance(dev, Pulley) and self.kinds[k] == CAPSTAN:
+                cols = {"mu": 0}
+            else:
+                raise ModelError(f"{self.name} device {k} ({type(dev).__name__}): has no per-element parameters (a "
+                                 "Latch and a Pulley with mu > 0 have)")
+            for nm, v in dict(params).items():
+                if nm not in cols:
+                    raise ModelError(f"{self.name} device {k} ({type(dev).__name__}): unknown parameter {nm!r}; use "
+                                     f"{', '.join(cols)}")
+                try:
+                    arr = np.broadcast_to(np.asarray(v, dtype=float), (n_el,))
+                except (TypeError, ValueError):
+                    raise ModelError(f"{self.name} device {k}: {nm} must be a number or one per element ({n_el}), "
+                                     f"got shape {np.shape(v)}") from None
+                self.P[:, k, cols[nm]] = arr
+            for el in range(n_el):   # construction only, not a hot path
+                where = f"{self.name} device {k} ({type(dev).__name__}), element {el}"
+                if isinstance(dev, Latch):
+                    validate_latch_array(self.P[el, k, :6], where)
+                    if not (np.isfinite(self.P[el, k, 7]) and self.P[el, k, 7] >= 0.0 and np.isfinite(self.P[el, k, 8])
+                            and self.P[el, k, 8] > 0.0):
+                        raise ModelError(f"{where}: hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
+                elif not (np.isfinite(self.P[el, k, 0]) and self.P[el, k, 0] > 0.0):
+                    raise ModelError(f"{where}: capstan mu = {self.P[el, k, 0]!r} must be finite and > 0")
 
     def _per_element(self, value, what):
         a = np.asarray(value, dtype=float)
@@ -341,14 +414,25 @@ class CableDeviceFamily(ElementFamily):
         err = np.zeros(n_el, dtype=np.int64)
         where = np.zeros(n_el, dtype=np.int64)
         P = np.ascontiguousarray(self.P)
-        args = (X, self.radius, self.EA, self.L0, self.kinds, P, state, f, k, new, T, phi, energy, err, where)
+        L0 = self.L0
+        lf = getattr(self, "length_factor", None)
+        scaled = lf is not None and bool(np.any(lf != 1.0))
+        if scaled:   # thermal strain: every unstretched length and material coordinate times s
+            L0 = L0 * lf
+            P = P.copy()
+            P[:, :, LATCH_LB] *= lf[:, None]
+            state = state.copy()
+            state[:, :m] *= lf[:, None]
+        args = (X, self.radius, self.EA, L0, self.kinds, P, state, f, k, new, T, phi, energy, err, where)
         (device_kernel if self._law is None else kernel_for_law(self._law))(*args)
+        if scaled:
+            new[:, :m] /= lf[:, None]
         bad = np.flatnonzero(err)
         if bad.size:
             el = bad[0]
             self._raise(el, int(err[el]), int(where[el]), X[el])
         return ElementResponse(f=f, k=k, state=new, energy=energy,
-                               output=LazyOutput(lambda: self._output(T, new, phi[:, :m])))
+                               output=LazyOutput(lambda: self._output(T, new, phi[:, :m], lf if scaled else None)))
 
     def _raise(self, el, code, where, X):
         name = f"{self.name} element {el}"
@@ -362,10 +446,13 @@ class CableDeviceFamily(ElementFamily):
         raise ModelError(f"{name}: the device equations {what} (devices {[type(d).__name__ for d in self.devices]}); "
                          "take smaller load increments")
 
-    def _output(self, T, new, phi):
+    def _output(self, T, new, phi, lf=None):
         m = self.n_sections - 1
         S = np.column_stack([np.zeros(len(T)), new[:, :m], self.L0])
         latch = self.kinds == LATCH
         bead = np.where(latch[None, :], self.P[:, :m, 6] - new[:, :m], np.nan)
+        if lf is not None:   # physical (heated) lengths and bead positions
+            S = S * lf[:, None]
+            bead = bead * lf[:, None]
         return {"tension": T, "unstretched_length": np.diff(S, axis=1), "material_coordinate": new[:, :m].copy(),
                 "device_mode": new[:, m:].copy(), "wrap_angle": phi.copy(), "bead_position": bead}

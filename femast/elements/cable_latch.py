@@ -92,7 +92,20 @@ class CableLatchFamily(ElementFamily):
         widens to ``[dT_in - H, dT_out + H]`` and a sliding bead follows the widened branches,
         ``H = hysteresis_force * w(x)``, ``w = 1`` on the backstop fading to 0 at the roller axis
         over ``hysteresis_length`` (see :func:`femast.latch.hysteresis_force`).
+    length_error : lack of fit per section, m, shape (n_el, n) or (n,) (default 0): the cable
+        that runs in section i is ``length_error[:, i]`` longer than its nominal unstretched length
+        (issue 20).  Their sum lengthens the cable (L0); those of the sections before the latch
+        node move the bead along the cable (Lb).  A pretensioned cable over frictionless pulleys
+        with a section too short by d then gains ``EA d / L0`` of tension (on rigid anchors).
     name : label used in messages and results.
+
+    Thermal strain: ``length_factor`` (n_el,), set by the analysis from the temperatures of a
+    step (:mod:`femast.model.thermal`, ``model.thermal_expansion(alpha, family=name)``), scales all
+    unstretched lengths of an element, bead coordinate included: the kernels see
+    ``L0 s`` and ``Lb s`` with ``s = 1 + alpha (T - T_init)``, so a free cable grows by
+    ``alpha dT`` with no force.  (The strain is then measured on the heated length, ``T = EA (L -
+    L0 s) / (L0 s)``, unlike the trusses' ``EA (l - L0 s) / L0``: the two differ by a factor
+    ``s`` on EA, below 1e-3 for any real temperature change.)
     """
 
     active_dofs = (0, 1, 2)
@@ -100,7 +113,7 @@ class CableLatchFamily(ElementFamily):
 
     def __init__(self, nodes, EA, L0, *, latch_node=None, bead=None, latch=None, x0=None,
                  max_strain: float = 0.1, hysteresis_force=0.0, hysteresis_length=3e-4,
-                 name: str = "cable_latch"):
+                 length_error=None, name: str = "cable_latch"):
         self.name = name
         self.nodes = chain_nodes(nodes, name)
         n_el, nn = self.nodes.shape
@@ -178,6 +191,46 @@ class CableLatchFamily(ElementFamily):
             raise ModelError(f"{name} element {bad[0]}: the latch hysteresis option needs the backstop inside the "
                              f"roller contact zone (x_backstop < x_contact = {xct[bad[0]]:.6g} m)")
         self.hysteresis = np.ascontiguousarray(np.column_stack([np.where(has, Fh, 0.0), ell]))
+        self.length_factor = np.ones(n_el)
+        self.set_length_errors(np.zeros((n_el, self.n_sections)) if length_error is None else length_error)
+
+    def set_length_errors(self, length_error) -> None:
+        """Lack of fit per section, m ((n_el, n) or (n,); see the class docstring).  Replaces any
+        given before; raises :class:`ModelError` naming the element whose cable it would make
+        impossible (a non-positive length, or the bead off the cable)."""
+        n_el, n = self.nodes.shape[0], self.n_sections
+        try:
+            dL = np.broadcast_to(np.asarray(length_error, dtype=float), (n_el, n)).copy()
+        except (TypeError, ValueError):
+            raise ModelError(f"{self.name}: length_error must be one value per section, shape ({n_el}, {n}) or "
+                             f"({n},), in m; got {np.shape(length_error)}") from None
+        bad = np.argwhere(~np.isfinite(dL))
+        if bad.size:
+            el, i = bad[0]
+            raise ModelError(f"{self.name} element {el}: length_error of section {i} = {float(dL[el, i])!r} m is not finite")
+        before = np.where(np.arange(n)[None, :] < self.latch_node[:, None], dL, 0.0).sum(axis=1)
+        L0e = self.L0 + dL.sum(axis=1)
+        Lbe = self.bead + before
+        has = self.latch_node > 0
+        bad = np.flatnonzero(~(L0e > 0.0) | (has & ~((Lbe - self.x0 > 0.0) & (Lbe - self.x0 < L0e))))
+        if bad.size:
+            el = bad[0]
+            raise ModelError(f"{self.name} element {el}: length errors {dL[el].tolist()} m leave the cable "
+                             f"L0 = {L0e[el]:.6g} m with {Lbe[el] - self.x0[el]:.6g} m before the latch: not a cable "
+                             "(the errors must be small against the section lengths)")
+        self.length_error = dL
+        self._misfit = (dL.sum(axis=1), before) if np.any(dL) else None
+
+    def effective_lengths(self):
+        """(L0, Lb) the kernels use, m: nominal + length errors, times the length factor."""
+        L0, Lb = self.L0, self.bead
+        misfit = getattr(self, "_misfit", None)
+        if misfit is not None:
+            L0, Lb = L0 + misfit[0], Lb + misfit[1]
+        lf = getattr(self, "length_factor", None)
+        if lf is not None and np.any(lf != 1.0):
+            return L0 * lf, Lb * lf
+        return L0, Lb
 
     # ------------------------------------------------------------------ construction helpers
     @classmethod
@@ -212,33 +265,36 @@ class CableLatchFamily(ElementFamily):
         of the latch (a placeholder: the first evaluation replaces it from the geometry)."""
         n = self.n_sections
         j = self.latch_node[:, None]
-        s = np.where(self.latch_node > 0, self.bead - self.x0, 0.0)[:, None]
+        L0, Lb = self.effective_lengths()
+        s = np.where(self.latch_node > 0, Lb - self.x0, 0.0)[:, None]
         cols = np.arange(n)[None, :]
         with np.errstate(divide="ignore", invalid="ignore"):
-            L0i = np.where(cols < j, s / j, (self.L0[:, None] - s) / (n - j))
+            L0i = np.where(cols < j, s / j, (L0[:, None] - s) / (n - j))
         st = np.zeros((self.n_elements, self.n_state))
         st[:, 0] = self.x0
         st[:, 2:] = L0i
         return st
 
-    def _check_configuration(self, X):
+    def _check_configuration(self, X, L0=None, bead=None):
         """Raise ModelError if a (committed) configuration needs more than max_strain."""
+        L0 = self.L0 if L0 is None else L0
+        bead = self.bead if bead is None else bead
         Lsec = np.linalg.norm(np.diff(X, axis=1), axis=2)
         j = self.latch_node
         cols = np.arange(self.n_sections)[None, :]
         LA = np.where(cols < j[:, None], Lsec, 0.0).sum(axis=1)
         LB = Lsec.sum(axis=1) - LA
         # least strain over all bead positions the backstop allows (latch forces neglected)
-        s_free = self.L0 * LA / (LA + LB)
-        s = np.clip(np.minimum(s_free, self.bead + self.latch[:, 1]), 1e-12 * self.L0, (1 - 1e-12) * self.L0)
+        s_free = L0 * LA / (LA + LB)
+        s = np.clip(np.minimum(s_free, bead + self.latch[:, 1]), 1e-12 * L0, (1 - 1e-12) * L0)
         with np.errstate(divide="ignore", invalid="ignore"):
-            eps_latch = np.maximum(LA / s - 1.0, LB / (self.L0 - s) - 1.0)
-        eps = np.where(j > 0, eps_latch, (LA + LB) / self.L0 - 1.0)
+            eps_latch = np.maximum(LA / s - 1.0, LB / (L0 - s) - 1.0)
+        eps = np.where(j > 0, eps_latch, (LA + LB) / L0 - 1.0)
         bad = np.flatnonzero(~(eps <= self.max_strain))
         if bad.size:
             el = bad[0]
             raise ModelError(
-                f"{self.name} element {el}: total unstretched length L0 = {self.L0[el]:.6g} m is too short for "
+                f"{self.name} element {el}: total unstretched length L0 = {L0[el]:.6g} m is too short for "
                 f"any equilibrium within max_strain = {self.max_strain:g}: the anchors are "
                 f"{LA[el] + LB[el]:.6g} m of cable apart and the cable would need a strain of {eps[el]:.3g}. "
                 "Check the units of L0 and the node coordinates, or give the pretension instead "
@@ -260,13 +316,14 @@ class CableLatchFamily(ElementFamily):
         # every iteration (10 % of a bay run).  The analysis passes the same x_committed array to every
         # iteration of an increment (kept referenced here, so it cannot be another array at the same
         # address); a new one is compared by value with what the last check read
+        L0, Lb = self.effective_lengths()
         src = None if ctx is None else ctx.x_committed
         if src is None or src is not getattr(self, "_checked_src", None):
             Xc = X if src is None else np.asarray(src, float)[self.nodes]
-            key = (Xc, self.L0, self.bead, self.latch, self.latch_node, self.max_strain)
+            key = (Xc, L0, Lb, self.latch, self.latch_node, self.max_strain)
             last = getattr(self, "_checked", None)
             if last is None or not all(np.array_equal(a, b) for a, b in zip(last, key)):
-                self._check_configuration(Xc)
+                self._check_configuration(Xc, L0, Lb)
                 self._checked = tuple(np.array(a, copy=True) for a in key)
             self._checked_src = src
         state = np.asarray(state, dtype=float)
@@ -283,7 +340,7 @@ class CableLatchFamily(ElementFamily):
         if hy is None:  # families pickled or built before the option existed
             hy = np.zeros((n_el, 2))
             hy[:, 1] = 1.0
-        cable_latch_kernel(X, self.EA, self.L0, self.bead, self.latch_node, self.latch, hy,
+        cable_latch_kernel(X, self.EA, L0, Lb, self.latch_node, self.latch, hy,
                            np.ascontiguousarray(state), f, k, new, T, dT, energy, err)
         bad = np.flatnonzero(err)
         if bad.size:
@@ -298,7 +355,7 @@ class CableLatchFamily(ElementFamily):
                 msg = "nodal coordinates are not finite"
             elif code == ERR_BEAD_OFF_CABLE:
                 msg = (f"committed bead position x = {state[el, 0]!r} m puts the bead off the cable "
-                       f"(Lb - x must lie in (0, L0 = {self.L0[el]!r}) m)")
+                       f"(Lb - x must lie in (0, L0 = {L0[el]!r}) m)")
             else:  # pragma: no cover
                 msg = f"kernel error {code}"
             raise ModelError(f"{self.name} element {el}: {msg}")

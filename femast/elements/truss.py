@@ -25,7 +25,7 @@ def truss_family_kernel(nodes, x, L0, EA, tension_only, length_factor, f, K, N_o
     rows and columns stay as given: zero).  Scalars only, no allocation.
 
     ``length_factor`` (dimensionless, per element): the stress-free length is ``L0 * factor``
-    (a length error and a thermal strain, femast/thermal.py); the strain is measured on ``L0``:
+    (a length error and a thermal strain, femast/model/thermal.py); the strain is measured on ``L0``:
     N = EA (l - L0 factor) / L0, so dN/dl = EA / L0 is unchanged."""
     for el in range(nodes.shape[0]):
         a = nodes[el, 0]
@@ -62,7 +62,7 @@ def truss_family_kernel(nodes, x, L0, EA, tension_only, length_factor, f, K, N_o
 class TrussFamily(ElementFamily):
     """A batch of trusses / cables: ``L0`` unstretched lengths (m), ``EA`` (N),
     ``tension_only`` (bool per element).  ``length_factor`` (dimensionless, ones by default): the
-    stress-free length over ``L0`` (length errors and thermal strain, set by femast/thermal.py)."""
+    stress-free length over ``L0`` (length errors and thermal strain, set by femast/model/thermal.py)."""
 
     name = "truss"
     self_equilibrated = True   # equal and opposite forces along the chord (issue 16 check)

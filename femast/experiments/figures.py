@@ -1,5 +1,5 @@
 """Figures of ``compare`` and ``diagnose`` (matplotlib, Agg backend, PNG), in the style of
-:mod:`femast.plotstyle`."""
+:mod:`femast.post.plotstyle`."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import plotstyle
-from ..plotstyle import column_label, display_scale, fit_title, num  # noqa: F401  (display_scale: re-exported)
+from ..post import plotstyle
+from ..post.plotstyle import column_label, display_scale, fit_title, num  # noqa: F401  (display_scale: re-exported)
 
 
 def _plt():

@@ -47,8 +47,8 @@ def _label(rec: dict) -> str:
 
 def plot_history(folder, png=None):
     """Plot the RMS error (and the noise floor) against the model version; returns the PNG path."""
-    from .. import plotstyle
-    from ..plotstyle import display_scale, fit_title
+    from ..post import plotstyle
+    from ..post.plotstyle import display_scale, fit_title
 
     plt = plotstyle.pyplot()
 

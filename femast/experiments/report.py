@@ -10,7 +10,7 @@ import html
 import time
 from pathlib import Path
 
-from ..plotstyle import display_scale, num
+from ..post.plotstyle import display_scale, num
 
 _CSS = """
 body { font-family: -apple-system, "Segoe UI", Helvetica, Arial, sans-serif; margin: 2em auto; max-width: 70em;

@@ -11,7 +11,7 @@ Torsion constant (Eq. 10)
 Eq. 10 as printed, ``J = s_out L (s_out^2 + L^2)/12``, is the polar moment of a
 solid s_out x L rectangle: it grows with the beam length and is about 1.5e5 times
 Bredt's torsion constant of the 0.1 m x 3 mm tube.  The default here is
-:func:`femast.sections.square_tube` (Bredt, ``J = t (s_out - t)^3``);
+:func:`femast.model.sections.square_tube` (Bredt, ``J = t (s_out - t)^3``);
 ``torsion="seed_eq10"`` uses the printed value for comparison.
 
 Eq. 14 is printed ``C_bi = R_aug C_be bR_b^aug``; the last factor must be the
@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
-from ..sections import Section, seed000_eq10_torsion_constant, square_tube
+from ..model.sections import Section, seed000_eq10_torsion_constant, square_tube
 from ._common import check_positive, check_vectors
 
 #: Eq. 13: beam frame -> base frame for a vertical mast (x_be = z_b, y_be = y_b, z_be = -x_b).

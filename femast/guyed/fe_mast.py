@@ -43,7 +43,7 @@ from ..analysis import Analysis
 from ..elements.shroud_cable import ShroudCableFamily, unstretched_length
 from ..errors import ModelError
 from ..model import Model
-from ..solvers.convergence import Convergence
+from ..analysis.solvers.convergence import Convergence
 from .cantilever import cantilever_stiffness, mast_section
 from .complete_mast import ShroudSet, active_stiffness, passive_stiffness
 from .rocaspect import E_NO_SHROUD, L_BEAM, SHROUD_DROP, mast_bases, mast_tops, rocaspect_shrouds

@@ -1,0 +1,215 @@
+"""Banded factorisations through LAPACK for tangents whose reverse Cuthill-McKee band is narrow.
+
+A mast is a chain of identical bays: in RCM order every DOF couples only to DOFs of its own and
+the neighbouring frames, so the tangent is a band matrix of half-bandwidth ``b`` (41 for the
+four-longeron truss mast at every length).  LAPACK's blocked band kernels then factorise it with
+dense level-3 BLAS on (b + 1) x n storage, without the sparse bookkeeping of a general sparse LU.
+
+Two factorisations of the permuted matrix ``B`` (the CSC matrix :class:`~femast.analysis.solvers.linear.SparseLU`
+refills every iteration, already in RCM order):
+
+* **Cholesky of the symmetric part** (``dpbtrf``/``dpbtrs``) when ``B`` is numerically symmetric:
+  ``max |B - B^T| <= SYMMETRY_TOL * max |B|``.  The corotational beam tangent in spin variables is
+  symmetric at equilibrium and unsymmetric by terms of the order of the out-of-balance moments
+  away from it (docs/beam_element.md): 4e-9 relative on the 400-bay mast mid-iteration.  Every
+  solution is then refined against ``B`` itself (``x += C^-1 (b - B x)``) until its normwise
+  backward error is at most ``BACKWARD_TOL``, so the Newton step is the exact one, as from an LU
+  of ``B``.  A refinement that does not contract (``B`` farther from symmetric than it looked) makes
+  the solver fall back to the LU for this tangent.
+* **LU with partial pivoting** (``dgbtrf``/``dgbtrs``) otherwise: an unsymmetric tangent (joint
+  friction in slip, latches), and a symmetric one that is not positive definite (past a limit
+  point or a bifurcation: ``dpbtrf`` stops at the first non-positive pivot and the LU is used
+  for the next :data:`LU_AFTER_INDEFINITE` factorisations).
+
+Zero pivots: ``dgbtrf`` reports an exactly zero one (``info > 0``); like SuperLU's diagonal test,
+``|u_kk| <= 1e-13 max |u_kk|`` is a singular tangent (:meth:`BandedFactor.pivot_magnitudes`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from scipy.linalg import lapack
+
+SYMMETRY_TOL = 1e-6        # relative asymmetry below which the Cholesky of the symmetric part is tried
+BACKWARD_TOL = 1e-14       # normwise backward error a refined solution must reach (LU: ~1e-16 x growth)
+MAX_REFINE = 4             # refinement steps before falling back to the LU
+LU_AFTER_INDEFINITE = 8    # factorisations that go straight to the LU after a failed Cholesky
+
+
+def band_of(indptr, indices) -> int:
+    """Half-bandwidth max |i - j| of a CSC (or CSR) pattern."""
+    cols = np.repeat(np.arange(indptr.size - 1), np.diff(indptr))
+    return int(np.abs(indices - cols).max(initial=0))
+
+
+def band_rule(n: int, bandwidth: int, nnz: int) -> bool:
+    """The automatic choice of a banded factorisation: the band's storage n (b + 1) of one
+    triangle holds at most 4 times the entries of K's triangle (nnz + n) / 2, so a band solver
+    wastes at most that factor on zeros that a sparse factor would skip.  Holds for masts and
+    cantilevers (the 400-bay mast: 1.9), fails for compact 3D meshes, whose RCM band is wide."""
+    return n * (bandwidth + 1) <= 2.0 * (nnz + n)
+
+
+@njit(cache=True)
+def _fill(data, to_chol, to_lu, partner, chol, lu):
+    """Scatter B's values into the Cholesky band (the mean of (i, j) and (j, i), lower triangle)
+    and the LU band; returns (max |B_ij - B_ji|, max |B_ij|)."""
+    asym = 0.0
+    big = 0.0
+    for k in range(data.shape[0]):
+        v = data[k]
+        a = abs(v)
+        if a > big:
+            big = a
+        lu[to_lu[k]] = v
+        p = partner[k]
+        w = data[p] if p >= 0 else 0.0
+        d = abs(v - w)
+        if d > asym:
+            asym = d
+        if to_chol[k] >= 0:
+            chol[to_chol[k]] = 0.5 * (v + w)
+    return asym, big
+
+
+@njit(cache=True)
+def _residual(indptr, indices, data, x, b, r):
+    """r = b - B x for a CSC matrix B; returns (max |r|, max row sum of |B|, max |x|)."""
+    n = x.shape[0]
+    for i in range(n):
+        r[i] = b[i]
+    rows = np.zeros(n)
+    for j in range(n):
+        xj = x[j]
+        for k in range(indptr[j], indptr[j + 1]):
+            i = indices[k]
+            r[i] -= data[k] * xj
+            rows[i] += abs(data[k])
+    rmax = 0.0
+    amax = 0.0
+    xmax = 0.0
+    for i in range(n):
+        if abs(r[i]) > rmax:
+            rmax = abs(r[i])
+        if rows[i] > amax:
+            amax = rows[i]
+        if abs(x[i]) > xmax:
+            xmax = abs(x[i])
+    return rmax, amax, xmax
+
+
+class BandedFactor:
+    """Banded LAPACK factorisations of a CSC matrix with a fixed pattern (see module docstring).
+
+    B : the CSC matrix (its pattern is fixed; :meth:`factorize` reads its current values).
+    cholesky : try the Cholesky of the symmetric part when B is numerically symmetric (False: LU only).
+    """
+
+    name = "banded"
+
+    def __init__(self, B, cholesky: bool = True):
+        n = B.shape[0]
+        self.n = n
+        self.B = B
+        self.b = b = band_of(B.indptr, B.indices)
+        self.allow_cholesky = cholesky
+        cols = np.repeat(np.arange(n, dtype=np.int64), np.diff(B.indptr))
+        rows = B.indices.astype(np.int64)
+        # Fortran-ordered band storage, flat index i + j * ldab
+        self._ld_chol = b + 1
+        self._ld_lu = 3 * b + 1
+        self._to_chol = np.where(rows >= cols, (rows - cols) + cols * self._ld_chol, -1)
+        self._to_lu = (2 * b + rows - cols) + cols * self._ld_lu
+        keys = cols * n + rows                              # CSC entries are sorted by (col, row)
+        tkeys = rows * n + cols
+        pos = np.searchsorted(keys, tkeys)
+        pos[pos >= keys.size] = 0
+        self._partner = np.where(keys[pos] == tkeys, pos, -1)
+        self._chol = np.zeros((self._ld_chol, n), order="F")
+        self._lu = np.zeros((self._ld_lu, n), order="F")
+        self._r = np.zeros(n)
+        self.kind = None            # "cholesky" or "lu": the factorisation in use
+        self.asymmetry = np.nan     # max |B - B^T| / max |B| of the last factorisation
+        self.refinements = 0        # refinement steps taken (all solves)
+        self.fallbacks = 0          # Cholesky attempts that ended in the LU
+        self._lu_only = 0           # factorisations left that skip the Cholesky
+        self._ipiv = None
+        self._factor = None
+        self.nnz = 0
+
+    # ------------------------------------------------------------------ factorisations
+    def factorize(self):
+        """Factorise the current values of B; returns self (the factor object, with ``solve``).
+        Raises RuntimeError on an exactly zero pivot of the LU (a singular matrix)."""
+        self._chol.fill(0.0)
+        self._lu.fill(0.0)
+        asym, big = _fill(self.B.data, self._to_chol, self._to_lu, self._partner,
+                          self._chol.reshape(-1, order="F"), self._lu.reshape(-1, order="F"))
+        self.asymmetry = asym / big if big > 0 else 0.0
+        if self.allow_cholesky and self._lu_only == 0 and self.asymmetry <= SYMMETRY_TOL:
+            c, info = lapack.dpbtrf(self._chol, lower=1, overwrite_ab=1)
+            if info == 0:
+                self.kind, self._factor = "cholesky", c
+                self.nnz = self.n * (self.b + 1)
+                return self
+            self._lu_only = LU_AFTER_INDEFINITE   # not positive definite: the LU for a while
+        elif self._lu_only:
+            self._lu_only -= 1
+        self._factor_lu()
+        return self
+
+    def _factor_lu(self):
+        b = self.b
+        lu, ipiv, info = lapack.dgbtrf(self._lu, b, b, overwrite_ab=1)
+        if info > 0:
+            raise RuntimeError("Factor is exactly singular")
+        if info < 0:  # pragma: no cover - an argument error is a bug here
+            raise ValueError(f"dgbtrf: illegal argument {-info}")
+        self.kind, self._factor, self._ipiv = "lu", lu, ipiv
+        self.nnz = self.n * (2 * b + 1)
+
+    def pivot_magnitudes(self):
+        """|pivots| of the factorisation (diagonal of U, or the squared diagonal of the Cholesky
+        factor), for the zero-pivot test."""
+        if self.kind == "cholesky":
+            return self._factor[0] ** 2
+        return np.abs(self._factor[2 * self.b])
+
+    # ------------------------------------------------------------------ solves
+    def solve(self, rhs):
+        rhs = np.asarray(rhs, dtype=float)
+        if self.kind == "lu":
+            x, info = lapack.dgbtrs(self._factor, self.b, self.b, rhs, self._ipiv)
+            return x
+        x, steps = refine(lambda v: lapack.dpbtrs(self._factor, v, lower=1)[0], self.B, rhs, self._r)
+        self.refinements += steps
+        if x is not None:
+            return x
+        # the LU of B itself, kept for the other solves of this tangent
+        self.fallbacks += 1
+        self._lu.fill(0.0)
+        _fill(self.B.data, self._to_chol, self._to_lu, self._partner, self._chol.reshape(-1, order="F"),
+              self._lu.reshape(-1, order="F"))
+        self._factor_lu()
+        return self.solve(rhs)
+
+
+def refine(solve, B, rhs, r):
+    """Solve B x = rhs with ``solve`` (the factor of B's symmetric part) and iterative refinement
+    against B until the normwise backward error ||rhs - B x|| / (||B|| ||x|| + ||rhs||) (infinity
+    norms) is at most BACKWARD_TOL.  Returns (x, refinement steps), x None if a step did not
+    contract the error tenfold (B too far from symmetric: use an LU).  ``r``: scratch (n,)."""
+    x = solve(rhs)
+    last = np.inf
+    bmax = np.abs(rhs).max(initial=0.0)
+    for step in range(MAX_REFINE + 1):
+        rmax, amax, xmax = _residual(B.indptr, B.indices, B.data, x, rhs, r)
+        eta = rmax / (amax * xmax + bmax + 1e-300)
+        if eta <= BACKWARD_TOL or not np.isfinite(eta):
+            return x, step
+        if eta > 0.1 * last or step == MAX_REFINE:
+            return None, step
+        last = eta
+        x = x + solve(r)
+    return None, MAX_REFINE  # pragma: no cover - the loop returns

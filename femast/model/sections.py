@@ -1,0 +1,152 @@
+"""Beam cross-sections: elastic properties (SI units) and helpers for common shapes.
+
+A :class:`Section` holds E (Pa), G (Pa), A (m^2), Iy, Iz (m^4, second moments about
+the element's local y and z axes) and J (m^4, St Venant torsion constant).
+
+Note on seed 000, Eq. 10.  The seed gives ``J = s_out L (s_out^2 + L^2) / 12`` for
+the square-tube mast; that is the polar moment of a solid s_out x L plate, not a
+torsion constant of the tube cross-section (it grows with the beam length L).
+:func:`square_tube` uses Bredt's thin-walled formula for a closed section,
+``J = 4 A_m^2 t / p_m = t (s - t)^3`` with s the outer side and t the wall
+thickness (A_m, p_m area and perimeter enclosed by the wall mid-line), which is
+also the thick-walled approximation of Roark's formulas for a square tube.
+:func:`seed000_eq10_torsion_constant` keeps the printed formula for comparison.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass, replace
+
+from ..errors import ModelError
+from .validation import MAX_MAGNITUDE, number
+
+_UNITS = {"E": "Pa", "G": "Pa", "A": "m^2", "Iy": "m^4", "Iz": "m^4", "J": "m^4"}
+
+
+@dataclass(frozen=True)
+class Section:
+    """Elastic beam section.
+
+    Parameters
+    ----------
+    E : Young's modulus, Pa.
+    G : shear modulus, Pa.
+    A : area, m^2.
+    Iy, Iz : second moments of area about local y and z, m^4.
+    J : St Venant torsion constant, m^4.
+    name : optional label used in messages and output.
+    rho : density, kg/m^3 (default 0: massless; only modal analyses use it, issue 18).  Give it
+        with ``sec.with_(rho=2700.0)``.
+    """
+
+    E: float
+    G: float
+    A: float
+    Iy: float
+    Iz: float
+    J: float
+    name: str = "section"
+    rho: float = 0.0
+
+    def __post_init__(self):
+        for field in ("E", "G", "A", "Iy", "Iz", "J"):
+            value = getattr(self, field)
+            if value is None:
+                raise ModelError(f"section '{self.name}': property {field} is missing; give it in SI units")
+            if isinstance(value, (str, bytes, bool)) or not isinstance(value, numbers.Real):
+                raise ModelError(f"section '{self.name}': property {field}={value!r} is not a number; give it in "
+                                 f"SI units ({_UNITS[field]})")
+            value = float(value)
+            if not math.isfinite(value) or value <= 0.0:
+                raise ModelError(
+                    f"section '{self.name}': property {field}={value!r} must be a finite positive number (SI units)"
+                )
+            if value > MAX_MAGNITUDE:
+                raise ModelError(f"section '{self.name}': property {field}={value:g} {_UNITS[field]} is beyond "
+                                 f"{MAX_MAGNITUDE:g} (a typing error? it would overflow the stiffness); give it in "
+                                 "SI units")
+            object.__setattr__(self, field, value)
+        try:
+            rho = float(self.rho)
+        except (TypeError, ValueError):
+            raise ModelError(f"section '{self.name}': density rho={self.rho!r} is not a number (kg/m^3)") from None
+        if not math.isfinite(rho) or rho < 0.0:
+            raise ModelError(f"section '{self.name}': density rho={self.rho!r} kg/m^3 must be finite and >= 0")
+        object.__setattr__(self, "rho", rho)
+
+    @property
+    def EA(self) -> float:
+        """Axial stiffness, N."""
+        return self.E * self.A
+
+    def with_(self, **changes) -> "Section":
+        """A copy with some properties changed, e.g. ``sec.with_(E=70e9)``."""
+        return replace(self, **changes)
+
+
+def shear_modulus(E: float, nu: float, name: str = "section") -> float:
+    """Isotropic shear modulus G = E / (2 (1 + nu)), Pa.  Poisson's ratio ``nu`` must lie in
+    (-1, 0.5] (an isotropic solid's range; -1 would make G infinite)."""
+    E = number(E, f"section '{name}': Young's modulus E", "Pa", positive=True)
+    nu = number(nu, f"section '{name}': Poisson's ratio nu", "", lo=-1.0, hi=0.5)
+    return E / (2.0 * (1.0 + nu))
+
+
+def circular_solid(d: float, E: float, nu: float = 0.3, name: str = "circular solid") -> Section:
+    """Solid circular section of diameter ``d`` (m); E in Pa."""
+    return circular_tube(d, 0.0, E, nu, name=name)
+
+
+def circular_tube(d_out: float, d_in: float, E: float, nu: float = 0.3, name: str = "circular tube") -> Section:
+    """Circular tube of outer/inner diameters ``d_out``, ``d_in`` (m); E in Pa.
+
+    J is the polar moment pi (d_out^4 - d_in^4) / 32, exact for circular sections.
+    """
+    _check_dims(name, d_out, d_in)
+    A = math.pi * (d_out**2 - d_in**2) / 4.0
+    I = math.pi * (d_out**4 - d_in**4) / 64.0
+    return Section(E=E, G=shear_modulus(E, nu, name), A=A, Iy=I, Iz=I, J=2.0 * I, name=name)
+
+
+def square_solid(s: float, E: float, nu: float = 0.3, name: str = "square solid") -> Section:
+    """Solid square of side ``s`` (m); J = 0.1406 s^4 (St Venant, b/a = 1)."""
+    _check_dims(name, s, 0.0)
+    A = s * s
+    I = s**4 / 12.0
+    return Section(E=E, G=shear_modulus(E, nu, name), A=A, Iy=I, Iz=I, J=0.140577 * s**4, name=name)
+
+
+def square_tube(s_out: float, s_in: float, E: float, nu: float = 0.3, name: str = "square tube") -> Section:
+    """Square tube of outer side ``s_out`` and inner side ``s_in`` (m); E in Pa.
+
+    A = s_out^2 - s_in^2 and I = (s_out^4 - s_in^4)/12 (seed 000 Eqs. 11, 9).
+    J = t (s_out - t)^3 with t = (s_out - s_in)/2 (Bredt; see the module note on
+    seed 000 Eq. 10).
+    """
+    _check_dims(name, s_out, s_in)
+    t = 0.5 * (s_out - s_in)
+    A = s_out**2 - s_in**2
+    I = (s_out**4 - s_in**4) / 12.0
+    if s_in == 0.0:
+        J = 0.140577 * s_out**4
+    else:
+        J = t * (s_out - t) ** 3
+    return Section(E=E, G=shear_modulus(E, nu, name), A=A, Iy=I, Iz=I, J=J, name=name)
+
+
+def seed000_eq10_torsion_constant(s_out: float, L: float) -> float:
+    """Seed 000 Eq. 10 as printed, J = s_out L (s_out^2 + L^2) / 12 (m^4). Dimensionally
+    an area moment but not a torsion constant of the section; kept only for comparison."""
+    return s_out * L * (s_out**2 + L**2) / 12.0
+
+
+def _check_dims(name, outer, inner):
+    for label, v in (("outer size", outer), ("inner size", inner)):
+        if isinstance(v, (str, bytes, bool)) or not isinstance(v, numbers.Real) or not math.isfinite(v) or v < 0 \
+                or v > 1e3:
+            raise ModelError(f"section '{name}': {label}={v!r} must be a finite non-negative length in m "
+                             "(at most 1000 m)")
+    if outer <= 0 or inner >= outer:
+        raise ModelError(f"section '{name}': need 0 <= inner ({inner}) < outer ({outer}) size, in m")

@@ -1,0 +1,434 @@
+"""Results on disk, written increment by increment, readable without femast.
+
+Layout of a results folder::
+
+    mesh.npz              node labels, reference coordinates, element connectivity per family
+    frames/000001.npz     one file per converged increment (written atomically)
+    status.sta            one line per increment, like Abaqus' .sta file
+    summary.json          the run's status: written at the start as ``"status": "running"``
+                          (replacing any summary of an earlier run into the folder) and at the
+                          end as "completed" (every step done), "failed" (an error; ``message``
+                          says which) or "interrupted" (Ctrl-C or a stop)
+
+Every file is written to a temporary name and renamed into place (``os.replace``), so a run
+killed outright leaves at most a ``*.tmp`` file, which :class:`Results` ignores with a warning
+naming it.  A summary still saying "running" after its process has gone (a kill -9, a power cut)
+is reported by :attr:`Results.status` as "interrupted".
+
+Each frame holds: ``step`` (name), ``increment``, ``time`` (step time, s),
+``total_time`` (s), ``load_factor``, ``iterations``, ``U`` (n, 3) displacements (m),
+``R`` (n, 3, 3) nodal rotation matrices, ``UR`` (n, 3) rotation vectors (rad, |UR| <= pi),
+``URA`` (n, 3) accumulated spins (rad; the total rotation for rotations about a fixed
+axis, beyond 2 pi), ``RF`` (n, 6) reactions (N, N m), ``P`` (n, 6) applied loads, and
+element outputs as ``el/<family>/<name>``.  Read them with numpy.load, or with
+:class:`Results`.
+
+The mesh, the frames and the status lines are written by a background thread, so that the analysis
+goes on with the next increment while the last one is stored.  ``np.savez`` of a frame takes 1.5-3 ms
+and holds Python's GIL for most of it: in a large model the writer works while SuperLU factorises,
+but a small model's Newton loop is mostly Python, and there writing every frame can take longer
+than solving (an ADAM bay run: 0.08-0.14 s without files, 0.2-0.4 s with; see
+``Step.output_frequency`` and ``Analysis(out=None)``).  A frame is queued the moment its increment
+converges and the queue is drained by :meth:`ResultsWriter.close`, which the analysis calls however
+the run ends (normally, on a convergence failure, on Ctrl-C); only a process killed outright can
+lose the last queued frame or two.  A write error (a full disk) is raised in the analysis at the
+next frame or at the close.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import queue
+import re
+import socket
+import struct
+import threading
+import time as _time
+import warnings
+import zlib
+from pathlib import Path
+
+import numpy as np
+from numpy.lib import format as npformat
+
+from ..elements.base import DOF_NAMES
+from ..errors import FemastError
+
+_COMPONENTS = {
+    "ux": ("U", 0), "uy": ("U", 1), "uz": ("U", 2),
+    "urx": ("URA", 0), "ury": ("URA", 1), "urz": ("URA", 2),
+    "rx": ("URA", 0), "ry": ("URA", 1), "rz": ("URA", 2),
+    "rfx": ("RF", 0), "rfy": ("RF", 1), "rfz": ("RF", 2), "rmx": ("RF", 3), "rmy": ("RF", 4), "rmz": ("RF", 5),
+    "fx": ("P", 0), "fy": ("P", 1), "fz": ("P", 2), "mx": ("P", 3), "my": ("P", 4), "mz": ("P", 5),
+}
+
+
+TMP_SUFFIX = ".tmp"   # partial files: "<name>.tmp", never matched by the readers' patterns
+_FRAME_NAME = re.compile(r"^\d+\.npz$")
+
+
+def _npy_bytes(a: np.ndarray) -> bytes:
+    """``a`` in the .npy format, version 1.0 (what np.save writes for a plain array): magic, header
+    length, the header dict padded to a multiple of 64 bytes, the data in C order."""
+    head = "{'descr': %r, 'fortran_order': False, 'shape': %r, }" % (npformat.dtype_to_descr(a.dtype), a.shape)
+    head += " " * (-(10 + len(head) + 1) % 64) + "\n"
+    return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(head)) + head.encode("latin1") + a.tobytes()
+
+
+def _npz_bytes(arrays: dict) -> bytes | None:
+    """An uncompressed .npz (a zip of ``<name>.npy`` members, as np.savez writes it, readable by
+    np.load) built in memory: about a tenth of np.savez's time for a small frame, whose zipfile
+    bookkeeping costs more than its data (issue 21).  None if an array needs np.savez (objects,
+    members beyond 2 GB)."""
+    local, central, offset = [], [], 0
+    for name, value in arrays.items():
+        a = np.asanyarray(value)
+        if a.dtype.hasobject or a.nbytes > 2**31 - 2**20:
+            return None
+        body = _npy_bytes(np.ascontiguousarray(a) if a.ndim else a)
+        fname = (name + ".npy").encode("utf8")
+        crc = zlib.crc32(body)
+        head = struct.pack("<IHHHHHIIIHH", 0x04034B50, 20, 0x800, 0, 0, 0x21, crc, len(body), len(body), len(fname), 0)
+        central.append(struct.pack("<IHHHHHHIIIHHHHHII", 0x02014B50, 20, 20, 0x800, 0, 0, 0x21, crc, len(body),
+                                   len(body), len(fname), 0, 0, 0, 0, 0o600 << 16, offset) + fname)
+        local += (head, fname, body)
+        offset += len(head) + len(fname) + len(body)
+    cd = b"".join(central)
+    end = struct.pack("<IHHHHIIH", 0x06054B50, 0, 0, len(central), len(central), len(cd), offset, 0)
+    return b"".join(local) + cd + end
+
+
+def _atomic_savez(path: Path, **arrays):
+    """An .npz of ``arrays`` to ``path`` through a temporary file renamed into place (atomic on one
+    filesystem: a reader sees the whole file or none)."""
+    tmp = path.with_name(path.name + TMP_SUFFIX)
+    data = _npz_bytes(arrays)
+    with open(tmp, "wb") as fh:   # a file object: np.savez would append ".npz" to a name
+        if data is None:
+            np.savez(fh, **arrays)
+        else:
+            fh.write(data)
+    os.replace(tmp, path)
+
+
+def write_json_atomic(path: Path, data: dict) -> None:
+    """Write ``data`` as JSON to ``path`` through a temporary file renamed into place."""
+    path = Path(path)
+    tmp = path.with_name(path.name + TMP_SUFFIX)
+    with open(tmp, "w") as fh:
+        json.dump(data, fh, indent=2, default=_json_default)
+        fh.flush()
+        os.fsync(fh.fileno())   # the summary is the run's word on its own outcome: make it durable
+    os.replace(tmp, path)
+
+
+def _json_default(v):
+    if isinstance(v, (np.integer,)):
+        return int(v)
+    return float(v)
+
+
+def _process_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True   # exists but not ours, or cannot tell: assume alive
+    return True
+
+
+def prepare_folder(folder) -> Path:
+    """Create results folder ``folder`` (and its ``frames``) or raise a FemastError naming it."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise FemastError(f"results folder '{folder}' is an existing file, not a folder; give out= a folder "
+                          "name (or remove the file)")
+    try:
+        (folder / "frames").mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        raise FemastError(f"results folder '{folder}': a part of the path is an existing file; give out= a "
+                          "folder whose parents are folders") from None
+    except PermissionError as exc:
+        raise FemastError(f"results folder '{folder}': no permission to create it ({exc.strerror}); choose "
+                          "a folder you can write to") from None
+    except OSError as exc:
+        raise FemastError(f"results folder '{folder}' cannot be created ({exc.strerror or exc}); choose "
+                          "another folder") from None
+    return folder
+
+
+class ResultsWarning(UserWarning):
+    """A results folder holds partial files or an unreadable summary (ignored)."""
+
+
+class ResultsWriter:
+    """Writes a results folder as the analysis runs (see module docstring)."""
+
+    def __init__(self, folder, model, families, resume: int | None = None):
+        """``resume``: continue a restarted run whose first ``resume`` frames are on disk (kept;
+        later frames and partial files are removed; status lines are appended)."""
+        self.folder = prepare_folder(folder)
+        self._started = _time.time()
+        # the stale summary of an earlier run goes first: a kill from here on leaves "running"
+        write_json_atomic(self.folder / "summary.json", self._running())
+        for pattern in ("*.npz", "*" + TMP_SUFFIX):
+            for old in (self.folder / "frames").glob(pattern):
+                if resume is None or not _FRAME_NAME.match(old.name) or int(old.name[:-4]) > resume:
+                    old.unlink()
+        if resume is None:   # an earlier run's restart point does not belong to this run's frames
+            (self.folder / "restart" / "restart.json").unlink(missing_ok=True)
+        if resume is not None and len(list((self.folder / "frames").glob("*.npz"))) != resume:
+            raise FemastError(f"{self.folder}: the restart point names {resume} frames but fewer are on disk; "
+                              "run the analysis again from the start")
+        for old in (self.folder / "mesh.npz", self.folder / ("mesh.npz" + TMP_SUFFIX)):
+            old.unlink(missing_ok=True)
+        mesh = {"node_labels": model.node_labels, "X": model.coordinates,
+                "families": np.array([f.name for f in families])}
+        for f in families:
+            mesh[f"conn/{f.name}"] = model.node_labels[np.asarray(f.nodes)]
+            mesh[f"labels/{f.name}"] = np.asarray(getattr(f, "labels", np.arange(1, f.n_elements + 1)))
+        self.count = resume or 0
+        self._queue = queue.Queue(maxsize=16)   # bounded: a slow disk slows the analysis, not memory
+        self._error = None
+        self._queue.put(((self.folder / "mesh.npz",), mesh))   # written first, by the writer thread
+        self.sta = open(self.folder / "status.sta", "w" if resume is None else "a")
+        if resume is not None:
+            self.sta.write(f"{'':>12} restarted from frame {resume}\n")
+        else:
+            self.sta.write(f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} {'TOTAL TIME':>11} "
+                           f"{'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n")
+        self._thread = threading.Thread(target=self._drain, name="femast-results-writer", daemon=True)
+        self._thread.start()
+
+    def status(self, step, inc, attempt, iterations, time, total_time, dtime, lam, note=""):
+        """Queue one status line (written and flushed by the writer thread, in order with the
+        frames: a flush costs ~0.15 ms on a VM's disk, as much as a small model's iteration)."""
+        self._raise_error()
+        self._queue.put((f"{step:>12.12} {inc:5d} {attempt:3d} {iterations:4d} {time:11.4e} {total_time:11.4e} "
+                         f"{dtime:11.4e} {lam:12.5e}  {note}\n", None))
+
+    def flush(self):
+        """Wait until every queued frame and status line is on disk (a restart point names them)."""
+        self._queue.join()
+        self._raise_error()
+
+    def _drain(self):
+        while True:
+            item = self._queue.get()
+            try:
+                if item is None:
+                    return
+                if item[1] is None:   # a status line
+                    self.sta.write(item[0])
+                    self.sta.flush()
+                elif self._error is None:
+                    _atomic_savez(*item[0], **item[1])
+            except Exception as exc:  # reported in the analysis thread
+                self._error = exc
+            finally:
+                self._queue.task_done()
+
+    def _raise_error(self):
+        if self._error is not None:
+            exc, self._error = self._error, None
+            raise OSError(f"could not write results to '{self.folder}': {exc}") from exc
+
+    def frame(self, **data):
+        """Queue one frame (arrays must not be modified afterwards: pass copies)."""
+        self._raise_error()
+        self.count += 1
+        self._queue.put(((self.folder / "frames" / f"{self.count:06d}.npz",), data))
+
+    def _running(self) -> dict:
+        return {"status": "running", "completed": False, "pid": os.getpid(), "host": socket.gethostname(),
+                "started": self._started,
+                "message": "the analysis is running (or its process was killed before it could finish)"}
+
+    def close(self, summary: dict):
+        """Drain the queue and write the final summary (``summary["status"]`` says how the run ended)."""
+        try:
+            if self._thread.is_alive():
+                self._queue.put(None)
+                self._thread.join()
+        finally:
+            self.sta.close()
+            final = {**summary, "pid": os.getpid(), "host": socket.gethostname(), "started": self._started}
+            if self._error is not None and final.get("status") == "completed":
+                final.update(status="failed", completed=False,
+                             message=f"could not write results to '{self.folder}': {self._error}")
+            write_json_atomic(self.folder / "summary.json", final)
+        self._raise_error()
+
+
+class NullWriter:
+    """The writer of an analysis with ``out=None``: keeps nothing (frames go only to on_frame)."""
+
+    count = 0
+
+    def status(self, *args, **kwargs):
+        pass
+
+    def frame(self, **data):
+        self.count += 1
+
+    def flush(self):
+        pass
+
+    def close(self, summary: dict):
+        pass
+
+
+class Results:
+    """Read a results folder: ``Results("results/run")``.
+
+    ``len(results)`` frames (converged increments, frame 0 is the initial state);
+    ``results.frame(i)`` a dict of arrays; ``results.node_history(label, "uz")`` a time
+    history (components ux uy uz, rx ry rz (accumulated spins), rfx..rmz reactions,
+    fx..mz applied loads); ``results.element_history(family, label, name, column)``.
+    """
+
+    def __init__(self, folder):
+        self.folder = Path(folder)
+        mesh_file = self.folder / "mesh.npz"
+        if not mesh_file.exists():
+            raise FemastError(f"{self.folder}: not a femast results folder (no mesh.npz); run an analysis first")
+        self._mesh = None    # read on first use (an analysis returns its Results: ~1.5 ms per run saved)
+        frames = self.folder / "frames"
+        names = sorted(p.name for p in frames.iterdir()) if frames.is_dir() else []
+        self.files = [frames / n for n in names if _FRAME_NAME.match(n)]
+        self.partial = [frames / n for n in names if not _FRAME_NAME.match(n)]
+        if self.partial:
+            warnings.warn(f"{self.folder}: ignoring {len(self.partial)} partial or foreign file(s) in frames/ "
+                          f"({', '.join(p.name for p in self.partial[:5])}{', ...' if len(self.partial) > 5 else ''}"
+                          "): left by a run that was killed while writing", ResultsWarning, stacklevel=2)
+        self._cache = {}
+        sfile = self.folder / "summary.json"
+        self.summary = None
+        if sfile.exists():
+            try:
+                self.summary = json.loads(sfile.read_text())
+            except (ValueError, OSError) as exc:
+                warnings.warn(f"{sfile}: unreadable summary ({exc}); the run's outcome is unknown",
+                              ResultsWarning, stacklevel=2)
+            else:
+                if not isinstance(self.summary, dict):
+                    self.summary = None
+
+    @property
+    def status(self) -> str:
+        """How the run that wrote the folder ended: "completed", "failed", "interrupted",
+        "running" (its process is still alive) or "unknown" (no summary).  A summary saying
+        "running" whose process is gone (killed) reads "interrupted"."""
+        s = self.summary
+        if not s:
+            return "unknown"
+        status = s.get("status") or ("completed" if s.get("completed") else "failed")
+        if status == "running":
+            same_host = s.get("host") == socket.gethostname()
+            if same_host and isinstance(s.get("pid"), int) and not _process_alive(s["pid"]):
+                return "interrupted"
+        return status
+
+    def __len__(self):
+        return len(self.files)
+
+    @property
+    def mesh(self) -> dict:
+        """The arrays of mesh.npz: node_labels, X (m), families, conn/<family>, labels/<family>."""
+        if self._mesh is None:
+            try:
+                with np.load(self.folder / "mesh.npz", allow_pickle=False) as m:
+                    self._mesh = {k: m[k] for k in m.files}
+            except Exception as exc:
+                raise FemastError(f"{self.folder / 'mesh.npz'} is unreadable ({type(exc).__name__}: {exc}); "
+                                  "the folder is damaged: rerun the analysis") from None
+        return self._mesh
+
+    @property
+    def node_labels(self) -> np.ndarray:
+        return self.mesh["node_labels"]
+
+    @property
+    def X(self) -> np.ndarray:
+        """Reference nodal coordinates (m)."""
+        return self.mesh["X"]
+
+    @property
+    def families(self) -> list[str]:
+        return [str(f) for f in self.mesh["families"]]
+
+    def frame(self, i: int) -> dict:
+        """The arrays of frame ``i`` (0 = initial state; negative counts from the end)."""
+        try:
+            i = range(len(self.files))[int(i)]
+        except IndexError:
+            raise FemastError(f"{self.folder}: frame {i} does not exist; the folder has {len(self.files)} frames "
+                              f"(0..{len(self.files) - 1}, or -1 for the last)") from None
+        if i not in self._cache:
+            try:
+                with np.load(self.files[i], allow_pickle=False) as f:
+                    self._cache[i] = {k: f[k] for k in f.files}
+            except Exception as exc:   # zipfile.BadZipFile, EOFError, ValueError, OSError...
+                raise FemastError(f"{self.files[i]}: frame {i} is unreadable ({type(exc).__name__}: {exc}); "
+                                  "the file is damaged: rerun the analysis") from None
+        return self._cache[i]
+
+    def _node_row(self, label):
+        rows = np.flatnonzero(self.node_labels == int(label))
+        if rows.size == 0:
+            raise FemastError(f"node {label} is not in these results (labels {self.node_labels.min()}.."
+                              f"{self.node_labels.max()})")
+        return int(rows[0])
+
+    def scalar_history(self, name: str) -> np.ndarray:
+        """History of a frame scalar: time, total_time, load_factor, increment, iterations."""
+        return np.array([float(self.frame(i)[name]) for i in range(len(self))])
+
+    @property
+    def time(self):
+        return self.scalar_history("total_time")
+
+    @property
+    def steps(self):
+        return [str(self.frame(i)["step"]) for i in range(len(self))]
+
+    def node_history(self, label, component: str) -> np.ndarray:
+        """History of one nodal quantity (see class docstring) over all frames."""
+        key = component.lower()
+        if key not in _COMPONENTS:
+            raise FemastError(f"unknown nodal component '{component}'; use one of {', '.join(_COMPONENTS)}")
+        arr, col = _COMPONENTS[key]
+        row = self._node_row(label)
+        return np.array([self.frame(i)[arr][row, col] for i in range(len(self))])
+
+    def element_history(self, family: str, label: int, name: str) -> np.ndarray:
+        """History of element output ``name`` (e.g. 'section_forces', 'N') of element ``label``."""
+        if family not in self.families:
+            raise FemastError(f"no element family '{family}' in these results; families: {', '.join(self.families)}")
+        rows = np.flatnonzero(self.mesh[f"labels/{family}"] == int(label))
+        if rows.size == 0:
+            raise FemastError(f"element {label} is not in family '{family}'")
+        key = f"el/{family}/{name}"
+        if key not in self.frame(0):
+            names = [k.split("/")[-1] for k in self.frame(0) if k.startswith(f"el/{family}/")]
+            raise FemastError(f"family '{family}' has no output '{name}'; it has {', '.join(names)}")
+        return np.array([self.frame(i)[key][rows[0]] for i in range(len(self))])
+
+    def positions(self, i: int) -> np.ndarray:
+        """Current nodal positions (m) at frame i."""
+        return self.X + self.frame(i)["U"]
+
+
+DOF_COMPONENTS = DOF_NAMES
+
+
+def run_outcome(exc: BaseException) -> tuple[str, str]:
+    """(status, message) of a run ended by ``exc``: "interrupted" for Ctrl-C or a stop
+    (KeyboardInterrupt, SystemExit), else "failed" with the error as the reason."""
+    if isinstance(exc, (KeyboardInterrupt, SystemExit)):
+        return "interrupted", f"interrupted ({type(exc).__name__}) before the last increment"
+    if isinstance(exc, FemastError):
+        return "failed", f"{type(exc).__name__}: {exc}"
+    return "failed", f"unexpected {type(exc).__name__}: {exc}"

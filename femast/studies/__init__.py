@@ -1,0 +1,25 @@
+"""Studies of uncertain inputs (issue 20): run a model over the scatter of its inputs, store
+every run, and report percentiles, convergence and sensitivity indices.
+
+    import femast.studies as st
+    study = st.Study(model=factory, inputs=[st.Normal("dL_m", 0.0, 5e-5)],
+                     outputs=[st.NodeOutput("tip", node=tip, quantity="U")], sampler="sobol")
+    summary = st.run(study, "studies/tip", samples=256, workers=2)
+    res = st.load("studies/tip")
+
+Modules: ``distributions`` (inputs), ``sampling`` (points, copula, Saltelli layout), ``outputs``
+(what a femast run records), ``study`` (the definition), ``runners`` (serial / local processes /
+dask), ``store`` (Parquet chunks), ``results`` (reading back), ``statistics``, ``figures``.
+See docs/studies.md.
+"""
+
+from .distributions import Input, LogNormal, Normal, TruncatedNormal, Uniform
+from .outputs import ElementOutput, NodeOutput
+from .results import StudyResults, load
+from .runners import RunSummary, run
+from .statistics import bootstrap_ci, convergence, percentile, sobol_indices
+from .study import Study
+
+__all__ = ["Input", "Normal", "Uniform", "TruncatedNormal", "LogNormal", "NodeOutput", "ElementOutput", "Study",
+           "run", "RunSummary", "load", "StudyResults", "percentile", "bootstrap_ci", "convergence",
+           "sobol_indices"]
