@@ -6,7 +6,7 @@ import zipfile
 
 import numpy as np
 
-from femast.results import _atomic_savez, _npz_bytes
+from femast.post.results import _atomic_savez, _npz_bytes
 
 
 def _frame():
