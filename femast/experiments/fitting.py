@@ -328,12 +328,18 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
         x0.append(float(np.clip(v, p.lower, p.upper)))
     x0 = np.array(x0)
     scale = np.array([p.typical for _, p, _ in specs])
-    lo = np.array([p.lower for _, p, _ in specs]) / scale
-    hi = np.array([p.upper for _, p, _ in specs]) / scale
+    fo = dict(exp.fit_options)
+    # a hint for diagnose, not a least_squares option; with finite differences it also turns on the
+    # run-saving Jacobians (secant updates, seeded starts, log scaling, issue 21): every model
+    # evaluation is an FE run
+    secant = bool(fo.pop("expensive", None)) and bool(fo.get("diff_step"))
+    co = _Coords(scale, np.array([secant and p.lower > 0 and p.upper >= LOG_RANGE * p.lower for _, p, _ in specs]))
+    lo = co.to_u(np.array([p.lower for _, p, _ in specs]))
+    hi = co.to_u(np.array([p.upper for _, p, _ in specs]))
 
     def make_fun(sigma):
         def fun(u):
-            base, eff = _split(specs, u * scale)
+            base, eff = _split(specs, co.to_x(u))
             try:
                 pred = predict(exp, data, base, eff)
             except (FloatingPointError, ZeroDivisionError, ValueError):
@@ -352,13 +358,9 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
             for i, st in extra:
                 x[i] = np.clip(st[min(k, len(st) - 1)], specs[i][1].lower, specs[i][1].upper)
             starts.append(x)
-    fo = dict(exp.fit_options)
     per_param = int(fo.pop("max_nfev_per_param", 100))
     if nfev_per_param:
         per_param = min(per_param, int(nfev_per_param))
-    # a hint for diagnose, not a least_squares option; with finite differences it also turns on the
-    # run-saving Jacobians (secant updates, seeded starts, issue 21): every model evaluation is an FE run
-    secant = bool(fo.pop("expensive", None)) and bool(fo.get("diff_step"))
     fd_step = fo.pop("diff_step", None)
     kw = dict(method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10, x_scale=1.0)
     kw.update(fo)
@@ -369,16 +371,17 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     def sigma_rows(sigma):
         return np.concatenate([np.broadcast_to(np.asarray(sigma[c], float), (data.n,)) for c in exp.channels])
 
-    def seed(sens, sigma):
+    def seed(sens, sigma, x):
         """Whitened, scaled start Jacobian from known sensitivities d(predicted)/d(parameter) (NaN: unknown)."""
         if not secant or not sens:
             return None
         J0 = np.full((n_res, len(specs)), np.nan)
+        dxdu = co.dx_du(co.to_u(np.asarray(x, float)))
         rows = sigma_rows(sigma)
         for i, (full, _, _) in enumerate(specs):
             col = sens.get(full)
             if col is not None and np.shape(col) == (n_res,):
-                J0[:, i] = -np.asarray(col, float) * scale[i] / rows
+                J0[:, i] = -np.asarray(col, float) * dxdu[i] / rows
         return J0 if np.isfinite(J0).any() else None
 
     def solve(sigma, candidates, J0=None):
@@ -386,7 +389,7 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
         fun0 = make_fun(sigma)
         nfev = runs = 0
         for k, x in enumerate(candidates):
-            u0 = _exact_start(x, scale, lo, hi) if secant else np.clip(x / scale, lo, hi)
+            u0 = co.start(x, lo, hi) if secant else np.clip(x / scale, lo, hi)
             fj = None
             fun = fun0
             if fd_step:
@@ -409,8 +412,8 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     if noise is None:
         base, eff = _split(specs, x0)
         sigma0 = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
-        sol = solve(sigma0, starts, seed(start_sensitivity, sigma0))
-        base, eff = _split(specs, sol.x * scale)
+        sol = solve(sigma0, starts, seed(start_sensitivity, sigma0, x0))
+        base, eff = _split(specs, co.to_x(sol.x))
         sigma = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
         if secant and len(exp.channels) == 1:
             # one channel, one noise level: the whitened residual only changes by a constant factor, so
@@ -419,15 +422,16 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
             sol.fun, sol.jac, sol.cost = sol.fun * f, sol.jac * f, sol.cost * f * f
         else:
             ratio = sigma_rows(sigma0) / sigma_rows(sigma)   # warm start: the last Jacobian, rows re-weighted
-            sol2 = solve(sigma, [sol.x * scale], sol.jac * ratio[:, None] if secant else None)
+            sol2 = solve(sigma, [co.to_x(sol.x)], sol.jac * ratio[:, None] if secant else None)
             sol2.nfev_total += sol.nfev_total
             sol2.fe_runs += sol.fe_runs
             sol = sol2
     else:
         sigma = {c: _sigma_of(noise, c, data.n) for c in exp.channels}
-        sol = solve(sigma, starts, seed(start_sensitivity, sigma))
-    x = sol.x * scale
-    stderr, cov, note = _covariance(sol.jac, sol.cost, sol.fun.size, scale)
+        sol = solve(sigma, starts, seed(start_sensitivity, sigma, x0))
+    x = co.to_x(sol.x)
+    dxdu = co.dx_du(sol.x)
+    stderr, cov, note = _covariance(sol.jac, sol.cost, sol.fun.size, dxdu)
     if note:
         idx = [int(i) for i in note.split(": ")[1].split(", ")]
         note = "not identifiable from these data: " + ", ".join(specs[i][0] for i in idx)
@@ -437,23 +441,55 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     out = _result(exp, data, specs, x, stderr, cov, sigma, predicted, True, bool(sol.success), msg,
                   sol.nfev_total, [i[0] for i in impls])
     rows = sigma_rows(sigma)
-    out.sensitivity = {full: -sol.jac[:, i] * rows / scale[i] for i, (full, _, _) in enumerate(specs)}
+    out.sensitivity = {full: -sol.jac[:, i] * rows / dxdu[i] for i, (full, _, _) in enumerate(specs)}
     out.fe_runs = int(sol.fe_runs)
     return out
 
 
-def _exact_start(x, scale, lo, hi):
-    """Scaled start ``u`` with ``u * scale == x`` bit for bit where one exists (a neighbour of
-    ``x / scale``): a refit started from another fit's values then asks the FE model for exactly
-    those values, which the run cache (fe_cache) already holds."""
-    x = np.asarray(x, float)
-    u = x / scale
-    for i in range(u.size):
-        for cand in (u[i], np.nextafter(u[i], np.inf), np.nextafter(u[i], -np.inf)):
-            if cand * scale[i] == x[i]:
-                u[i] = cand
-                break
-    return np.clip(u, lo, hi)
+LOG_RANGE = 100.0   # a positive parameter whose bounds span this factor or more is fitted in log scale
+
+
+class _Coords:
+    """The fit's coordinates u of the parameters x: ``x / scale`` (linear), or ``ln(x / scale)`` for
+    the parameters flagged ``log`` (expensive fits of positive parameters spanning decades: a
+    stiffness or an axial rigidity, whose effect goes as 1/x: Gauss-Newton steps in ln x reach
+    the minimum in fewer FE runs than steps in x; issue 21).  ``start`` registers a start value so
+    that ``to_x`` gives it back bit for bit (the run cache then answers it)."""
+
+    def __init__(self, scale, log):
+        self.scale, self.log = np.asarray(scale, float), np.asarray(log, bool)
+        self.exact = {}
+
+    def to_u(self, x):
+        x = np.asarray(x, float)
+        u = x / self.scale
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u[self.log] = np.log(x[self.log] / self.scale[self.log])
+        return u
+
+    def to_x(self, u):
+        u = np.asarray(u, float)
+        hit = self.exact.get(u.tobytes())
+        if hit is not None:
+            return hit.copy()
+        x = u * self.scale
+        x[self.log] = self.scale[self.log] * np.exp(u[self.log])
+        return x
+
+    def dx_du(self, u):
+        """dx/du at ``u`` (the chain rule of the Jacobian and the covariance)."""
+        d = self.scale.copy()
+        d[self.log] = self.scale[self.log] * np.exp(np.asarray(u, float)[self.log])
+        return d
+
+    def start(self, x, lo, hi):
+        """The coordinates of start ``x`` (clipped into the bounds), remembered so that ``to_x`` returns
+        exactly ``x``: a refit started from another fit's values asks the FE model for those values."""
+        x = np.asarray(x, float)
+        u = np.clip(self.to_u(x), lo, hi)
+        if np.array_equal(np.clip(x, self.to_x(lo), self.to_x(hi)), x):
+            self.exact[u.tobytes()] = x.copy()
+        return u
 
 
 POLISH_ROUNDS = 2
