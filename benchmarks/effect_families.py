@@ -5,7 +5,9 @@
 Panels: joint friction on a load cycle (play: rigid stick; jenkins: finite stick stiffness; iwan:
 distributed micro-slip, smooth Masing loops), clearance (sharp against fitted closing scales),
 the fade of the latch hysteresis (gamma = 0 exponential, 1 linear, -1 hyperbolic, 2 abrupt), the
-progressive stiffness (linear / quadratic) and the pretension loss (linear / saturating).  The
+progressive stiffness (linear / quadratic), the pretension loss (linear / saturating) and the
+cable hysteresis (play: one proportional play; iwan: fibre groups with a distribution of friction
+coefficients, smooth returns, every loop closing at zero load).  The
 curves are the effect operators themselves (femast.effects), unit joint stiffness.
 """
 
@@ -20,7 +22,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from femast.effects.latch import fade  # noqa: E402
-from femast.effects.operators import iwan, jenkins, play  # noqa: E402
+from femast.effects.operators import iwan, jenkins, play, proportional_iwan, proportional_play  # noqa: E402
 
 OUT = Path(__file__).resolve().parents[1] / "docs" / "figures" / "effect_families.png"
 
@@ -28,7 +30,7 @@ OUT = Path(__file__).resolve().parents[1] / "docs" / "figures" / "effect_familie
 def main() -> Path:
     u = np.concatenate([np.linspace(0, 100, 201), np.linspace(100, -100, 401), np.linspace(-100, 100, 401),
                         np.linspace(100, 40, 121), np.linspace(40, 70, 61)])
-    fig, ax = plt.subplots(1, 4, figsize=(17, 4.2))
+    fig, ax = plt.subplots(1, 5, figsize=(21, 4.2))
     a = ax[0]
     a.plot(u, u, color="0.7", lw=1, label="elastic joint")
     a.plot(u, play(u, 15.0), label="play (M_f = 15): rigid stick")
@@ -75,6 +77,19 @@ def main() -> Path:
     a.set_ylabel("compliance / baseline compliance")
     a.legend(fontsize=7, loc="lower left")
     a2.legend(fontsize=7, loc="upper left")
+    a.grid(alpha=0.3)
+    a = ax[4]
+    c = np.concatenate([np.linspace(0, 100, 201), np.linspace(100, 0, 201), np.linspace(0, -60, 121),
+                        np.linspace(-60, 0, 121), np.linspace(0, 70, 141), np.linspace(70, 30, 81),
+                        np.linspace(30, 60, 61)])
+    a.plot(c, c, color="0.7", lw=1, label="no hysteresis")
+    a.plot(c, proportional_play(c, 0.2), label="play (eta = 0.2)")
+    a.plot(c, proportional_iwan(c, 0.5, 1.0, 0.0), label="iwan (eta = 0.5, beta = 1)")
+    a.plot(c, proportional_iwan(c, 0.9, 0.5, 0.2), label="iwan (eta = 0.9, beta = 0.5, alpha = 0.2)")
+    a.set_xlabel("load through the rope, joint moment m (N m)")
+    a.set_ylabel("load on the elastic part (N m)")
+    a.set_title("cable_hysteresis forms (close at 0)")
+    a.legend(fontsize=7)
     a.grid(alpha=0.3)
     fig.tight_layout()
     OUT.parent.mkdir(parents=True, exist_ok=True)

@@ -39,6 +39,7 @@ OLD_PATHS = {
     "femast.verification_arclength": "femast.verification.arclength",
     "femast.verification_modal": "femast.verification.modal",
     "femast.references": "femast.verification.references",
+    "femast.guyed.shroud": "femast.elements.shroud_law",   # the law of the shroud element (issue 15)
 }
 
 

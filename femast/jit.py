@@ -78,15 +78,10 @@ def estimate_s(names) -> float:
     return sum(COMPILE_S.get(n, 0.0) for n in names)
 
 
-def _on_compile(event):
+def _announce(background: bool = False) -> None:
+    """Print the compile notice once per process (unless quiet)."""
     global _announced
-    if _announced or not event.is_start:
-        return
-    try:
-        mod = event.data["dispatcher"].py_func.__module__
-    except (KeyError, AttributeError):
-        return
-    if not mod.startswith("femast"):
+    if _announced:
         return
     _announced = True
     from .progress import quiet
@@ -94,8 +89,33 @@ def _on_compile(event):
     if quiet():
         return
     est = max(estimate_s(uncached()), 1.0)
-    print(f"femast: compiling femast kernels, first run only, ~{est:.0f} s (`femast warmup` does it ahead)",
-          file=sys.stderr, flush=True)
+    if background:
+        print(f"femast: compiling femast kernels in a background process, first run only, ~{est:.0f} s; "
+              "small analyses run uncompiled meanwhile (`femast warmup` compiles ahead)", file=sys.stderr, flush=True)
+    else:
+        print(f"femast: compiling femast kernels, first run only, ~{est:.0f} s (`femast warmup` does it ahead)",
+              file=sys.stderr, flush=True)
+
+
+def _on_compile(event):
+    if _announced or not event.is_start:
+        return
+    try:
+        mod = event.data["dispatcher"].py_func.__module__
+    except (KeyError, AttributeError):
+        return
+    if mod.startswith("femast"):
+        _announce()
+
+
+def prepare() -> None:
+    """Before an analysis: the compile notice is armed and every loaded femast kernel compiles in a
+    background process on first use (:mod:`femast.jit_background`)."""
+    watch()
+    from . import jit_background
+
+    jit_background._announce = lambda: _announce(background=True)
+    jit_background.install()
 
 
 def watch() -> None:
@@ -174,10 +194,18 @@ PARTS = (("core: beams, trusses, solver", _warm_core), ("ADAM bay: cables, latch
 
 
 def warmup(report=print) -> float:
-    """Compile (or load from the cache) every femast kernel; returns the wall time, s."""
+    """Compile (or load from the cache) every femast kernel in this process; returns the wall time, s."""
     t_all = time.perf_counter()
-    for what, fn in PARTS:
-        t0 = time.perf_counter()
-        fn()
-        report(f"  {what}: {time.perf_counter() - t0:.1f} s")
+    before = os.environ.get("FEMAST_BACKGROUND_COMPILE")
+    os.environ["FEMAST_BACKGROUND_COMPILE"] = "0"     # compile here, not in a background worker
+    try:
+        for what, fn in PARTS:
+            t0 = time.perf_counter()
+            fn()
+            report(f"  {what}: {time.perf_counter() - t0:.1f} s")
+    finally:
+        if before is None:
+            del os.environ["FEMAST_BACKGROUND_COMPILE"]
+        else:
+            os.environ["FEMAST_BACKGROUND_COMPILE"] = before
     return time.perf_counter() - t_all

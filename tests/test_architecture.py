@@ -150,21 +150,36 @@ def test_observers_hear_every_converged_increment_and_the_end(tmp_path):
 
 
 def _sizes():
-    """(path, module lines, [(class, lines)]) of every module of the analysis package."""
+    """(path under femast/, module lines, [(class, lines)]) of every module of femast."""
     out = []
-    for p in sorted((PKG / "analysis").glob("*.py")):
+    for p in sorted(PKG.rglob("*.py")):
         src = p.read_text()
         tree = ast.parse(src)
         classes = [(n.name, n.end_lineno - n.lineno + 1) for n in ast.walk(tree) if isinstance(n, ast.ClassDef)]
-        out.append((p.name, len(src.splitlines()), classes))
+        out.append((p.relative_to(PKG).as_posix(), len(src.splitlines()), classes))
     return out
 
 
-def test_analysis_modules_and_classes_are_small():
+MODULE_LINES, CLASS_LINES = 500, 300
+# the few modules / classes allowed past the limits ("~500", "~300"), each with its ceiling and why
+SIZE_EXCEPTIONS = {
+    "model/model.py": (520, "the script API; 7 lines over after issue 21's array builders"),
+    "model/model.py:Model": (330, "one verb per method, each a few lines delegating to a module "
+                                  "(arrays, thermal, constraints, modal); mixins would scatter the API"),
+    "elements/cable_latch.py:CableLatchFamily": (310, "6 lines over: the family protocol methods of one element"),
+    "experiments/diagnose.py": (520, "being split by issue 14 this session"),
+    "analysis/solvers/linear.py:SparseLU": (360, "issue 21's back-ends landed into it this session; "
+                                                 "the pattern bookkeeping (analyse/master/positions) can move out"),
+}
+
+
+def test_modules_and_classes_are_small():
     for name, lines, classes in _sizes():
-        assert lines <= 500, f"femast/analysis/{name}: {lines} lines"
+        limit = SIZE_EXCEPTIONS.get(name, (MODULE_LINES,))[0]
+        assert lines <= limit, f"femast/{name}: {lines} lines (limit {limit}); split it by concept"
         for cls, n in classes:
-            assert n <= 300, f"femast/analysis/{name}: class {cls} has {n} lines"
+            limit = SIZE_EXCEPTIONS.get(f"{name}:{cls}", (CLASS_LINES,))[0]
+            assert n <= limit, f"femast/{name}: class {cls} has {n} lines (limit {limit})"
 
 
 def test_one_newton_loop():
@@ -201,7 +216,7 @@ def _femast_parts(path):
 
 
 # what each package of the layout may import (docs/architecture.md, "What may import what");
-# its own package, errors, rotations and progress always
+# its own package, errors, rotations, progress and jit always
 MAY_IMPORT = {
     "elements": {"latch"},
     "model": {"elements"},
@@ -216,9 +231,8 @@ EXCEPTIONS = {
     ("analysis/analysis.py", "modal"),  # a frequency step in the step sequence runs modal.step
     ("analysis/analysis.py", "post"),   # the results folder an Analysis returns (Results, run_outcome)
     ("analysis/output.py", "post"),     # output is the observer that owns the results writer
-    ("elements/shroud_cable.py", "guyed"),   # issue 15 item 3: being fixed
 }
-ALWAYS = {"errors", "rotations", "progress"}
+ALWAYS = {"errors", "rotations", "progress", "jit"}   # jit: the first-run compile (issue 17)
 
 
 @pytest.mark.parametrize("package", sorted(MAY_IMPORT))
@@ -229,6 +243,14 @@ def test_import_rules(package):
         bad = {m for m in _femast_parts(p) - allowed if (rel, m) not in EXCEPTIONS}
         assert not bad, (f"femast/{rel} imports femast.{sorted(bad)}: {package} may import only "
                          f"{sorted(allowed - {package})} (docs/architecture.md)")
+
+
+def test_the_core_never_imports_a_seed_package():
+    # adam/, guyed/ (and experiments, effects, studies) build on the core, never the other way
+    seed = {"adam", "guyed", "experiments", "effects", "studies", "verification"}
+    for package in ("elements", "model", "analysis", "modal", "post"):
+        for p in (PKG / package).rglob("*.py"):
+            assert not _femast_parts(p) & seed, f"{p.relative_to(PKG)} imports {_femast_parts(p) & seed}"
 
 
 def test_post_processing_and_elements_never_import_the_analysis():
@@ -257,6 +279,7 @@ OLD_TO_NEW = [("femast.results", "femast.post.results"), ("femast.vtk", "femast.
               ("femast.mass", "femast.modal.mass"), ("femast.modal_output", "femast.modal.output"),
               ("femast.frequency_step", "femast.modal.step"),
               ("femast.references", "femast.verification.references"),
+              ("femast.guyed.shroud", "femast.elements.shroud_law"),
               ("femast.verification_arclength", "femast.verification.arclength"),
               ("femast.verification_modal", "femast.verification.modal")]
 

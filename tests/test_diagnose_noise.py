@@ -97,3 +97,79 @@ def test_given_sigma_column_is_used_and_checked():
 def test_too_few_rows_for_the_noise_model_is_named():
     with pytest.raises(ModelError, match=r"channel dT_N: 5 rows are too few for the noise model .*sigma_dT_N"):
         channel_noise("dT_N", np.zeros(5), 5)
+
+
+def test_pinned_rows_are_left_out_of_the_level():
+    # a latch-pull residual is exactly zero where the measured force lies in an admissible band (the
+    # static band of a bead at rest, Eq. 9) and one constant along a hold on the backstop: 20 % of the
+    # rows pinned must not pull the level down (with them: ~0.7 of the true level)
+    rng = np.random.default_rng(11)
+    n, sigma = 500, 0.5
+    r = rng.normal(0, sigma, n)
+    r[100:150] = 0.0
+    r[300:350] = 0.012  # a hold: (x + x_backstop) x 5e4 N/m, the same on every row
+    lev = []
+    for _ in range(20):
+        rr = r.copy()
+        rr[~np.isin(np.arange(n), np.r_[100:150, 300:350])] = rng.normal(0, sigma, n - 100)
+        m = channel_noise("dT_N", rr, n)
+        assert "100 pinned rows" in m.reason
+        lev.append(m.sigma_rms)
+    # 400 noisy rows: the robust level scatters ~5 % per draw; the mean of 20 within 4 %
+    assert abs(np.mean(lev) / sigma - 1) < 0.04
+
+
+def test_variance_law_never_goes_below_its_floor():
+    # noise growing with the load's size from 0.4 to 2 of a level: unconstrained, a negative A once put
+    # the rows near zero load at a tenth of their noise.  A, D >= 0 and the floor (0.04 of the mean variance).
+    rng = np.random.default_rng(5)
+    n = 300
+    g = np.abs(np.sin(np.linspace(0, 12, n)))
+    true = 0.4 + 1.6 * g
+    for _ in range(20):
+        h = heteroscedastic_fit(rng.normal(0, 1, n) * true, g)
+        A, B, D = h["coef"]
+        assert A >= 0 and D >= 0
+        v = A + B * g + D * g * g
+        assert np.all(h["sigma"] ** 2 >= 0.04 * np.mean(v) * (1 - 1e-12))  # the floor, to round-off
+        assert np.all(h["sigma"] > 0.25 * true)  # not a tenth of the true noise again (these 20 draws: >= 0.51)
+
+
+def _passes(n_per, k):
+    """A path driven up and down k times over [0, 1] (n_per rows per pass, offset grids)."""
+    out = []
+    for i in range(k):
+        g = np.linspace(0, 1, n_per) + (0.37 * i % 1.0) / n_per  # another grid on each pass
+        out.append(g if i % 2 == 0 else g[::-1])
+    return np.concatenate(out)
+
+
+def test_repeated_passes_give_the_level_and_cancel_what_repeats():
+    from femast.experiments.noise import cycle_scatter, with_cycles
+
+    rng = np.random.default_rng(2)
+    coord = _passes(120, 6)
+    n = coord.size
+    # repeats with the coordinate: model error, not noise (12 rows a period: linear interpolation leaves
+    # (pi/12)^2/2 x 3 = 0.1 at most, 1 % of the level in variance; 6 rows a period would leave +8 %)
+    ripple = 3.0 * np.sin(2 * np.pi * coord / 0.1)
+    lev = []
+    for _ in range(20):
+        r = ripple + rng.normal(0, 0.5, n)
+        level, m = cycle_scatter(coord, r)
+        lev.append(level)
+    assert m > 200
+    # m ~ 300 compared rows: relative scatter 1 / sqrt(2 m) ~ 4 % per draw, the mean of 20 within 3 %
+    assert abs(np.mean(lev) / 0.5 - 1) < 0.03
+    # AR(1) noise: rows of different passes are independent, the level is the marginal one
+    lev = [cycle_scatter(coord, _ar1(0.6, n, 0.5, rng))[0] for _ in range(20)]
+    # (interpolating within a correlated pass adds variance: the estimate is high by ~9 % (measured),
+    # on the safe side: the check only ever lowers a noise model's level)
+    assert 0.97 < np.mean(lev) / 0.5 < 1.15
+    # a noise model that took the ripple for noise (level 2.2) is brought back to the passes' level
+    r = ripple + rng.normal(0, 0.5, n)
+    m = with_cycles(ChannelNoise("dT_N", "ar1", np.full(n, 2.2), 0.5, effective_n(n, 0.5)), coord, r)
+    assert m.kind == "white+cycles" and m.phi == 0.0 and abs(m.sigma_rms / 0.5 - 1) < 0.15  # 3 se of one draw
+    # one that is right is left alone
+    ok = ChannelNoise("dT_N", "white", np.full(n, 0.5), 0.0, float(n))
+    assert with_cycles(ok, coord, rng.normal(0, 0.5, n)).sigma_rms == 0.5

@@ -7,7 +7,7 @@ import pytest
 from femast.effects import get_effect, play, resolve
 from femast.effects.base import forms_of
 from femast.effects.latch import fade
-from femast.effects.operators import IWAN_ELEMENTS, iwan, iwan_strengths, jenkins
+from femast.effects.operators import IWAN_ELEMENTS, iwan, iwan_strengths, jenkins, proportional_iwan, proportional_play
 from femast.errors import ModelError
 from femast.experiments import Parameter, fit, get_experiment, predict
 from femast.experiments.synthetic import latch_pull_data, mast_top_data, mast_top_path
@@ -61,6 +61,30 @@ def test_iwan_special_cases():
     # columns are independent
     two = iwan(np.column_stack([u, -u]), 3.0, 1.5, 0.2)
     np.testing.assert_allclose(two[:, 1], iwan(-u, 3.0, 1.5, 0.2), atol=0)
+
+
+def test_proportional_iwan_limits_and_zero_closing_loops():
+    u = CYCLE
+    # beta -> inf: every coefficient at eta, the proportional play (eta (1 - q^1e-6) |u| < 1e-4 x 0.3 x 10)
+    np.testing.assert_allclose(proportional_iwan(u, 0.3, 1e6, 0.0), proportional_play(u, 0.3), atol=3e-4)
+    np.testing.assert_allclose(proportional_iwan(u, 0.3, 2.0, 1.0), u, atol=1e-14)  # no friction
+    zero = np.abs(u) < 1e-12
+    assert zero.sum() >= 2 and np.all(proportional_iwan(u, 0.5, 0.7, 0.2)[zero] == 0.0)  # loops close at zero
+
+
+def test_proportional_iwan_uniform_coefficients_follow_the_closed_form_return_branch():
+    # beta = 1: eta_j uniform on [0, H].  Loading 0 -> P: each group carries (1 - eta_j) u, mean (1 - H/2) u.
+    # Back down to 0 < u < P: group j carries min((1 - eta_j) P, (1 + eta_j) u); the groups with
+    # eta < e* = (P - u)/(P + u) have released.  Mean over [0, H] in closed form:
+    H, P, N = 0.6, 10.0, IWAN_ELEMENTS
+    up, down = np.linspace(0, P, 201), np.linspace(P, 0.0, 401)[1:]
+    y = proportional_iwan(np.concatenate([up, down]), H, 1.0, 0.0)
+    np.testing.assert_allclose(y[:201], (1 - H / 2) * up, rtol=1e-12)
+    e = np.minimum((P - down) / (P + down), H)
+    expect = (down * (e + e * e / 2) + P * ((H - H * H / 2) - (e - e * e / 2))) / H
+    # mid-quantile (midpoint) rule on an integrand with one slope kink of size u + P <= 2 P:
+    # error <= 2 P H / (8 N^2)
+    np.testing.assert_allclose(y[201:], expect, atol=2 * P * H / (8 * N**2))
 
 
 def test_forms_are_listed_and_selected_by_name():

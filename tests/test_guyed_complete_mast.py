@@ -10,7 +10,7 @@ from femast.guyed.complete_mast import (ShroudSet, active_stiffness, displacemen
                                         passive_stiffness, passive_stiffness_blocks, shroud_geometry,
                                         shroud_wrench_matrix)
 from femast.guyed.rocaspect import E_NO_SHROUD, L_BEAM, mast_tops, rocaspect_shrouds
-from femast.guyed.shroud import (SEED_X_S, DyneemaLaw, axial_rigidity_secant, axial_rigidity_tangent,
+from femast.elements.shroud_law import (SEED_X_S, DyneemaLaw, axial_rigidity_secant, axial_rigidity_tangent,
                                  shroud_stiffness, strain_from_tension, tension_from_strain)
 
 LAW = DyneemaLaw()

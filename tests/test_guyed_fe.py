@@ -12,7 +12,7 @@ from femast.guyed.fe_mast import (MastFE, beam_column_geometric_stiffness,
                                   compare_stiffness, relative_difference, rotation_scaling)
 from femast.guyed.cantilever import mast_section
 from femast.guyed.rocaspect import E_NO_SHROUD, L_BEAM, mast_tops
-from femast.guyed.shroud import DyneemaLaw, axial_rigidity_tangent, strain_from_tension, tension_from_strain
+from femast.elements.shroud_law import DyneemaLaw, axial_rigidity_tangent, strain_from_tension, tension_from_strain
 from femast.rotations import expm_so3
 from femast.testing import fd_tangent
 
@@ -61,7 +61,7 @@ def test_shroud_tangent_parts_add_up_and_material_part_is_the_law():
                                atol=1e-12 * np.abs(parts["full"].k).max())  # round-off of a sum
     assert np.all(parts["none"].k == 0.0)
     out = parts["full"].output
-    # tension and material tangent are Eq. 25 / Eq. 27 of femast.guyed.shroud (same formulas)
+    # tension and material tangent are Eq. 25 / Eq. 27 of femast.elements.shroud_law (same formulas)
     np.testing.assert_allclose(out["tension"], tension_from_strain(LAW, out["strain"]), rtol=1e-13)
     B = parts["full"].f / out["tension"][:, None]
     kt = np.einsum("ei,eij,ej->e", B, parts["material"].k, B) / np.einsum("ei,ei->e", B, B) ** 2

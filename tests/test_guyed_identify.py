@@ -10,7 +10,7 @@ from femast.guyed.identify import fit_3r, fit_beam_E, fit_shroud_law, seed_eq29_
 from femast.guyed.mast_3r import displacement_3r
 from femast.guyed.rocaspect import (E_1200N, L_BEAM, TABLE_III, fig5a_trajectory, mast_bases, mast_tops,
                                     rocaspect_geometry)
-from femast.guyed.shroud import SEED_X_S, DyneemaLaw, strain_from_tension
+from femast.elements.shroud_law import SEED_X_S, DyneemaLaw, strain_from_tension
 
 R_OC = mast_tops()[0] - mast_bases()[0]
 _, _WR = trajectory_loads(rocaspect_geometry(), fig5a_trajectory(12))

@@ -74,7 +74,8 @@ def test_inferred_side_gives_the_same_model(name):
     _, cols, with_side = _data(name, side=True)
     _, _, without = _data(name, side=False)
     s = infer_side(1e-3 * cols["x_mm"], cols["dT_N"])
-    loaded = np.abs(cols["dT_N"]) > 5 * NOISE_N
+    # a clear load: above 5 noise and 5 % of the peak (infer_side's rule; AR(1) noise passes 5 noise)
+    loaded = np.abs(cols["dT_N"]) > max(5 * NOISE_N, 0.05 * np.abs(cols["dT_N"]).max())
     # the two differ at most where the rig changes cables at a noise-size load (the change is placed
     # at one of those rows), and there by a noise-size force
     diff = np.abs(predict(EXP, with_side, TRUE)["dT_N"] - predict(EXP, without, TRUE)["dT_N"])
@@ -213,3 +214,21 @@ def test_partial_reversal_matches_an_fe_run_of_one_cable_latch_element():
     # the element solves the bead position to ~1e-12 m; times branch slopes up to 1.3e5 N/m that is
     # ~1e-7 N: 1e-6 N leaves a 10x margin and still fails any branch or state error (>= 0.1 N)
     np.testing.assert_allclose(pred, fe["dT"], rtol=0, atol=1e-6)
+
+
+def test_correlated_noise_out_of_contact_does_not_turn_the_side():
+    # AR(1) load-cell noise (phi = 0.6): its second differences see a third of its variance, so its
+    # excursions out of roller contact passed "5 noise" and turned the side in mid-pass (issue 14)
+    run, cols, _ = _data("full strokes")
+    rng = np.random.default_rng(3)
+    n = cols["dT_N"].size
+    e = np.zeros(n)
+    for i in range(1, n):
+        e[i] = 0.6 * e[i - 1] + 0.8 * NOISE_N * rng.standard_normal()
+    free = np.abs(run["dT"]) < 1e-9  # out of contact: the true force jump is zero
+    assert free.sum() > 50
+    e[np.flatnonzero(free)[free.sum() // 2]] = -3.5 * NOISE_N  # one excursion of 3.5 sigma
+    dT = run["dT"] + e
+    s = infer_side(1e-3 * cols["x_mm"], dT)
+    loaded = np.abs(dT) > max(5 * NOISE_N, 0.05 * np.abs(dT).max())
+    np.testing.assert_array_equal(s[loaded], cols["side"][loaded])

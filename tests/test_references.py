@@ -71,7 +71,7 @@ def test_elastica_small_load_and_symmetry():
 
 def test_elastica_branches_agree_at_k_half():
     # quadrature branch (k < 0.5) and elliptic closed form: both exact, agree to roundoff
-    a = ref._elastica_small_load(0.5)
+    a = ref.cantilever._elastica_small_load(0.5)
     b = ref.elastica_tip_load(0.5)
     assert np.allclose(a, tuple(b), rtol=1e-13, atol=1e-15)
 
@@ -303,7 +303,7 @@ def test_planar_chain_reproduces_exact_cantilever_elastica():
     P = k * EI / L**2
     tip = ref.elastica_tip_load(k)
     x_tip = L * (1 - tip.u_over_L)
-    chain = ref._PlanarChain([(0.0, 0.0), (L, 0.0)], EI, 1e30, "clamp", "clamp", load_node=1,
+    chain = ref.planar._PlanarChain([(0.0, 0.0), (L, 0.0)], EI, 1e30, "clamp", "clamp", load_node=1,
                              load_dir=(0.0, -1.0), h=L / 400)
     # reactions (0, P) and root bending moment M(0) = -P x_tip (hogging, clockwise on [0, s])
     (x, y, th, M), _ = chain.integrate(np.array([0.0, P, -P * x_tip]), 0.0)
@@ -363,7 +363,7 @@ def lee_path():
 def test_lee_frame_small_load_is_linear_frame_solution():
     d = ref.LEE_FRAME
     L, EI, EA = d["L"], d["E"] * d["I"], d["E"] * d["A"]
-    chain = ref._lee_chain(L, d["E"], d["A"], d["I"], d["load_offset"], 2.0)
+    chain = ref.planar._lee_chain(L, d["E"], d["A"], d["I"], d["load_offset"], 2.0)
     P = 1e-3  # P/P_limit ~ 5e-8: second-order (v^2/L) terms are ~1e-6 of the linear u
     q = _shoot(chain, P, L)
     disp, _ = chain.monitor(q, P)
@@ -408,7 +408,7 @@ def toggle_path():
 def test_williams_toggle_small_load_is_linear_frame_solution():
     d = ref.WILLIAMS_TOGGLE
     A, I = d["b"] * d["d"], d["b"] * d["d"] ** 3 / 12
-    chain = ref._toggle_chain(d["half_span"], d["rise"], d["E"], d["b"], d["d"], 0.5)
+    chain = ref.planar._toggle_chain(d["half_span"], d["rise"], d["E"], d["b"], d["d"], 0.5)
     P = 1e-3  # P / P_limit ~ 3e-5
     q = _shoot(chain, P, 1.0)
     disp, _ = chain.monitor(q, P)

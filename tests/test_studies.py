@@ -467,3 +467,60 @@ def test_report_names_steps_and_components(tmp_path, capsys):
     # lever arm is shorter by O((w/L)^2) ~ 1e-6 of L (w/L ~ 1e-3 here)
     assert np.allclose(res.output("m_max"), res.inputs("F") * L_M, rtol=1e-5)
     assert len(rep["rows"]) == 5
+
+
+def _dies(x):
+    if x > 0.9:
+        import os
+
+        os._exit(3)   # a worker process dying (a crash in compiled code, the OOM killer)
+    return {"y": x}
+
+
+def test_a_dying_worker_process_is_a_clear_error_and_resumable(tmp_path):
+    study = st.Study(run=_dies, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], sampler="mc", seed=4)
+    with pytest.raises(StudyError, match="a worker process died"):
+        st.run(study, tmp_path / "d", samples=200, workers=2, chunk_size=5)
+    done = st.load(tmp_path / "d").counts()["runs"]
+    assert done < 200   # what finished is kept (and a rerun resumes from it)
+
+
+def test_sobol_convergence_approaches_the_ishigami_indices():
+    d = Design(_uniform_pi(), sampler="sobol", seed=3, sensitivity=True)
+    n = 2 ** 13
+    _, _, u = d.points(np.arange(n * 5), n)
+    y = ishigami(**d.values(u))["y"].reshape(n, 5)
+    c = st.sobol_convergence(y[:, 0], y[:, 1], y[:, 2:].T)
+    assert c["n"][0] == 8 and c["n"][-1] == n and c["ST"].shape == (len(c["n"]), 3)
+    err = np.max(np.abs(c["ST"] - ISHIGAMI_ST), axis=1)
+    # the last estimate equals sobol_indices' and the error falls by 10x from n = 64 to n = 8192
+    # (QMC: ~1/n; Monte Carlo would give sqrt(128) ~ 11x)
+    assert np.allclose(c["ST"][-1], st.sobol_indices(y[:, 0], y[:, 1], y[:, 2:].T, resamples=10)["ST"])
+    assert err[-1] < err[list(c["n"]).index(64)] / 10
+
+
+def test_statistics_refuse_what_they_cannot_estimate():
+    with pytest.raises(StudyError, match="q = 1.5"):
+        st.percentile([1.0, 2.0], 1.5)
+    with pytest.raises(StudyError, match="no values"):
+        st.percentile([], 0.5)
+    with pytest.raises(StudyError, match="not finite"):
+        st.percentile([1.0, np.nan], 0.5)
+    with pytest.raises(StudyError, match="variance 0"):
+        st.sobol_indices(np.ones(8), np.ones(8), np.ones((2, 8)))
+    with pytest.raises(StudyError, match=r"\(k, n\)"):
+        st.sobol_indices(np.arange(8.0), np.arange(8.0), np.ones((2, 7)))
+    p = st.percentile(np.arange(10.0), 0.99)   # 10 samples cannot bound the 99 % percentile from above
+    assert np.isnan(p["high"]) and p["low"] <= p["estimate"]
+
+
+def test_report_of_a_study_whose_samples_all_failed(tmp_path, capsys):
+    from femast.studies.report import report
+
+    study = st.Study(run=lambda x: _flaky(x, -1.0), inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y", "z"],
+                     units={"y": "m"})
+    # the nominal sample fails by non-convergence (not a definition error): the study runs, every sample fails
+    s = st.run(study, tmp_path / "f", samples=4)
+    assert s.failed == 4 and s.ok == 0
+    rep = report(tmp_path / "f", figures=True)
+    assert "(no successful sample)" in capsys.readouterr().out and rep["figures"] == []

@@ -21,6 +21,7 @@ from tqdm.auto import tqdm
 
 from ..elements.base import DOF_NAMES
 from ..errors import ConvergenceError, ModelError, SingularModelError
+from ..jit import prepare as prepare_kernels
 from ..post.results import Results, run_outcome
 from .solvers.convergence import Convergence
 from ..model import validation
@@ -74,6 +75,7 @@ class Analysis:
                  cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
                  extrapolate: bool = False, on_frame=None, tangent: str = "full", observers=(), restart=None,
                  restart_every: int | None = None, linear_solver: str = "auto"):
+        prepare_kernels()   # first run: kernels compile in the background (femast.jit_background)
         self.model = model
         self.on_frame = on_frame
         self.out = out

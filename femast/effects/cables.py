@@ -10,7 +10,7 @@ import numpy as np
 
 from ..experiments.core import Parameter
 from .base import Effect, Implementation, register_effect
-from .operators import proportional_play
+from .operators import proportional_iwan, proportional_play
 
 FE = ("bay-torsion", "tip-cycle")
 
@@ -29,7 +29,7 @@ PROGRESSIVE_STIFFNESS = register_effect(Effect(
     title="progressive, tension-dependent shroud/cable stiffness",
     physics=(
         "Dyneema shrouds stiffen with tension: EA(tau) = k0 + k1 tau + k2 tau^2 (seed 000 Eq. 25, "
-        ":mod:`femast.guyed.shroud`).  The shroud that takes up a joint moment m gains tension in proportion "
+        ":mod:`femast.elements.shroud_law`).  The shroud that takes up a joint moment m gains tension in proportion "
         "to |m|, so to first order the joint's secant stiffness rises as k (1 + beta |m|), beta = k1 / "
         "(a EA(tau0)) with a the shroud lever arm (m) and tau0 the pretension.  The identified beta gives back "
         "the slope k1 of Eq. 25 for an assumed lever arm."),
@@ -64,10 +64,23 @@ def _cable_hysteresis_mast_top(m, p, ctx):
     return m
 
 
+def _cable_hysteresis_mast_top_iwan(m, p, ctx):
+    m = m.copy()
+    m[:, :2] = proportional_iwan(m[:, :2], p["eta"], p["beta"], p["alpha"])
+    return m
+
+
 def _cable_hysteresis_latch_pull(x, p, ctx):
     dT = ctx["prep"]["dT"]
     T = np.abs(dT)
     lag = T - proportional_play(T, p["eta"])
+    return x + np.sign(dT) * ctx["options"]["cable_compliance_m_per_N"] * lag
+
+
+def _cable_hysteresis_latch_pull_iwan(x, p, ctx):
+    dT = ctx["prep"]["dT"]
+    T = np.abs(dT)
+    lag = p["kappa"] * T - p["gain"] * proportional_iwan(T, p["eta"], p["beta"])
     return x + np.sign(dT) * ctx["options"]["cable_compliance_m_per_N"] * lag
 
 
@@ -89,17 +102,44 @@ CABLE_HYSTERESIS = register_effect(Effect(
             hook="joint_moment", order=45,
             parameters=(Parameter("eta", "-", 0.05, 0.0, 0.6, "loop half-width relative to the load", scale=0.05,
                                   starts=(0.01, 0.2)),),
-            apply=_cable_hysteresis_mast_top,
+            apply=_cable_hysteresis_mast_top, form="play",
             doc="m_k -> play(m_k; eta |m_k|), k = 1, 2: the shroud-supported joint is (1 - eta) / k compliant on "
-                "loading and (1 + eta) / k on unloading."),
+                "loading and (1 + eta) / k on unloading.",
+            forms={"iwan": Implementation(
+                hook="joint_moment", order=45,
+                parameters=(Parameter("eta", "-", 0.3, 0.0, 0.99, "largest friction threshold of the fibre groups "
+                                      "relative to the load", scale=0.1, starts=(0.6, 0.95, 0.3)),
+                            Parameter("beta", "-", 1.0, 0.05, 50.0, "shape of the threshold distribution "
+                                      "P(e <= s) = (s / eta)^beta", scale=1.0, starts=(1.0, 3.0, 0.5)),
+                            Parameter("alpha", "-", 0.1, 0.0, 0.95, "share of the load without friction",
+                                      scale=0.1, starts=(0.2, 0.0, 0.1))),
+                apply=_cable_hysteresis_mast_top_iwan,
+                doc="m_k -> alpha m_k + (1 - alpha) mean_j play(m_k; eta_j |m_k|), eta_j = eta q_j^(1/beta): the "
+                    "rope's fibre groups with a distribution of friction coefficients (24 groups); smooth loops "
+                    "closing at zero load, return branches curved (beta -> inf, alpha = 0: the play form).")}),
         "latch-pull": Implementation(
             hook="bead_position", order=45,
             parameters=(Parameter("eta", "-", 0.1, 0.0, 0.6, "loop half-width of the test cable's stretch",
                                   scale=0.1, starts=(0.02, 0.3)),),
-            apply=_cable_hysteresis_latch_pull,
+            apply=_cable_hysteresis_latch_pull, form="play",
             doc="x_bead = x + sign(dT) c_cable (|dT| - play(|dT|; eta |dT|)): Eq. 15 removed the mean stretch "
                 "c_cable |dT| (c_cable = L_cable / EA, option cable_compliance_m_per_N), the cable's own "
-                "stretch lags it."),
+                "stretch lags it.",
+            forms={"iwan": Implementation(
+                hook="bead_position", order=45,
+                parameters=(Parameter("eta", "-", 0.5, 0.0, 0.99, "largest friction threshold of the fibre groups "
+                                      "relative to the tension", scale=0.1, starts=(0.9, 0.3, 0.6)),
+                            Parameter("beta", "-", 1.0, 0.05, 50.0, "shape of the threshold distribution "
+                                      "P(e <= s) = (s / eta)^beta", scale=1.0, starts=(1.0, 4.0, 0.5)),
+                            Parameter("gain", "-", 1.0, 0.0, 20.0, "hysteretic stretch compliance relative to "
+                                      "c_cable", scale=1.0, starts=(3.0, 1.0, 6.0)),
+                            Parameter("kappa", "-", 1.0, -20.0, 20.0, "compliance Eq. 15 removed, relative to "
+                                      "c_cable", scale=1.0, starts=(2.0, 1.0, 4.0))),
+                apply=_cable_hysteresis_latch_pull_iwan,
+                doc="x_bead = x + sign(dT) c_cable (kappa |dT| - gain P(|dT|)), P(T) = mean_j play(T; eta_j T), "
+                    "eta_j = eta q_j^(1/beta): the test cable's stretch c_cable gain P(T) follows the tension "
+                    "through fibre groups with a distribution of friction coefficients (smooth loops closing at "
+                    "zero), Eq. 15 removed c_cable kappa T.  kappa = gain = 1, beta -> inf: the play form.")}),
     },
 ))
 

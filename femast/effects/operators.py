@@ -6,6 +6,8 @@
 * :func:`proportional_play` -- the same with a threshold ``eta |u|`` proportional to the current
   input: the loop width grows with the load and closes at zero load (inter-fibre friction of a
   rope whose normal force grows with its tension).
+* :func:`proportional_iwan` -- many proportional plays with a distribution of coefficients (a rope's
+  fibre groups): smooth zero-closing loops; one coefficient is :func:`proportional_play`.
 * :func:`jenkins` -- an elastic joint in parallel with a Jenkins element (a spring in series with
   a Coulomb slider) driven by its load: ``alpha u + play((1 - alpha) u; r)``.  ``alpha = 0`` is the
   play operator (rigid stick), ``alpha = 1`` the elastic joint alone.
@@ -71,6 +73,33 @@ def _play_sum(u, radii, weights):
     return out
 
 
+@njit(cache=True)
+def _prop_play_sum(u, etas, weights):
+    """sum_k weights[k] play(u; etas[k] |u|) on each column of u (n, m), every play from state 0."""
+    n, m = u.shape
+    out = np.zeros_like(u)
+    nk = etas.size
+    state = np.zeros(nk)
+    for j in range(m):
+        for k in range(nk):
+            state[k] = 0.0
+        for i in range(n):
+            acc = 0.0
+            x = u[i, j]
+            a = abs(x)
+            for k in range(nk):
+                p = state[k]
+                r = etas[k] * a
+                if p < x - r:
+                    p = x - r
+                elif p > x + r:
+                    p = x + r
+                state[k] = p
+                acc += weights[k] * p
+            out[i, j] = acc
+    return out
+
+
 def _as2d(u):
     u = np.asarray(u, dtype=float)
     return u, np.ascontiguousarray(u.reshape(u.shape[0], -1))
@@ -121,3 +150,22 @@ def iwan(u, R: float, beta: float, alpha: float = 0.0, n: int = IWAN_ELEMENTS) -
     u, u2 = _as2d(u)
     w = np.full(radii.size, (1.0 - a) / radii.size)
     return (a * u2 + _play_sum(u2, radii, w)).reshape(u.shape)
+
+
+def proportional_iwan(u, eta: float, beta: float, alpha: float = 0.0, n: int = IWAN_ELEMENTS) -> np.ndarray:
+    """Distributed inter-fibre friction of a rope driven by its load ``u`` (n,) or (n, k): the load
+    carried by the elastic part, ``alpha u + (1 - alpha) / n sum_j play(u; eta_j |u|)``.
+
+    A parallel bundle of fibre groups whose friction thresholds grow with the tension, each in
+    proportion to its own coefficient ``eta_j = eta q_j^(1/beta)`` (mid quantiles ``q_j`` of the
+    power-law distribution ``P(e <= s) = (s / eta)^beta`` on ``[0, eta]``, as :func:`iwan_strengths`).
+    Every loop closes at zero load; the groups with small ``eta_j`` release first on a return, so
+    the return branch is curved (smooth) where :func:`proportional_play` gives a flat part and a
+    straight line.  eta : largest relative threshold (in [0, 1)); beta : shape (> 0; large: all at
+    eta, the :func:`proportional_play` limit); alpha : share without friction, in [0, 1].
+    """
+    a = min(max(float(alpha), 0.0), 1.0)
+    etas = iwan_strengths(eta, beta, n)
+    u, u2 = _as2d(u)
+    w = np.full(etas.size, (1.0 - a) / etas.size)
+    return (a * u2 + _prop_play_sum(u2, etas, w)).reshape(u.shape)

@@ -163,3 +163,19 @@ def chain_nodes(nodes, name: str) -> np.ndarray:
     if nodes.ndim != 2 or nodes.shape[1] < 2 or not np.issubdtype(nodes.dtype, np.integer):
         raise ModelError(f"{name}: nodes must be an (n_el, n+1) integer array with n+1 >= 2, got {nodes.shape}")
     return np.ascontiguousarray(nodes, dtype=np.int64)
+
+
+def check_positive(name: str, value, unit: str, allow_inf: bool = False) -> np.ndarray:
+    """Return ``value`` as a float array after checking every entry is finite and > 0.
+
+    Raises :class:`~femast.errors.ModelError` naming ``name`` and the unit otherwise.
+    """
+    from ..errors import ModelError
+
+    arr = np.asarray(value, dtype=float)
+    bad = ~(arr > 0.0) | (np.isinf(arr) if not allow_inf else np.isnan(arr))
+    if np.any(bad):
+        where = "" if arr.ndim == 0 else f" (entry {int(np.flatnonzero(bad.ravel())[0])})"
+        what = "a positive number" + (" or inf (rigid)" if allow_inf else "")
+        raise ModelError(f"{name}={value!r}{where} must be {what} in {unit}; give a physical value")
+    return arr

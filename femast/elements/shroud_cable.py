@@ -9,7 +9,7 @@ shroud attachment points C_ir are rigidly attached to the mast top C_i3):
 with R_a the node's total rotation.  Without offsets the element is a plain cable with
 translational DOFs only.
 
-Axial law (seed 000, Eqs. 25, 27, as corrected in :mod:`femast.guyed.shroud`).  The strain is
+Axial law (seed 000, Eqs. 25, 27, as corrected in :mod:`femast.elements.shroud_law`).  The strain is
 measured from the unstretched length L0, ``eps = l / L0 - 1``, and the tension is the root of
 ``tau = g(tau) eps`` with ``g = k0 + k1 tau + k2 tau^2`` (k0 in N, k1 dimensionless, k2 in 1/N):
 
@@ -17,7 +17,7 @@ measured from the unstretched length L0, ``eps = l / L0 - 1``, and the tension i
     tau = 0                                                                       (eps < 0, slack)
 
 and the material tangent ``d tau / d l = EA_t(tau) / L0`` with ``EA_t = g^2 / (k0 - k2 tau^2)``
-(:func:`femast.guyed.shroud.axial_rigidity_tangent`).  At exactly ``eps = 0`` the rope counts as
+(:func:`femast.elements.shroud_law.axial_rigidity_tangent`).  At exactly ``eps = 0`` the rope counts as
 taut (tangent ``k0 / L0``, the one-sided derivative from the taut side): a shroud installed
 exactly taut with zero pretension then has the seed's passive stiffness at tau = 0.
 
@@ -52,6 +52,7 @@ from numba import njit
 
 from ..errors import ModelError
 from .base import ElementFamily, ElementResponse
+from .shroud_law import DyneemaLaw, strain_from_tension
 
 PARTS = {"none": 0, "material": 1, "geometric": 2, "full": 3}
 
@@ -183,7 +184,6 @@ def shroud_family_kernel(nodes, x, R, offsets, L0, law, parts, gx, gw, f, K, tau
 
 def _law_array(law, n_el, name):
     """(n_el, 3) array [k0, k1, k2] from a DyneemaLaw, a sequence of them, or an array."""
-    from ..guyed.shroud import DyneemaLaw  # local import: guyed imports the FE core, not vice versa
 
     if law is None:
         law = DyneemaLaw()
@@ -224,7 +224,7 @@ class ShroudCableFamily(ElementFamily):
     ----------
     nodes : (n_el, 2) int, end nodes (labels when added with ``Model.add_family``).
     L0 : unstretched lengths, m (> 0), scalar or per element.
-    law : :class:`~femast.guyed.shroud.DyneemaLaw` (default: the seed's coefficients), a list of
+    law : :class:`~femast.elements.shroud_law.DyneemaLaw` (default: the seed's coefficients), a list of
         them, or an (n_el, 3) array ``[k0 (N), k1 (-), k2 (1/N)]``; k0 must be > 0.
     offsets : optional (n_el, 2, 3) rigid offsets of the end points from nodes a and b in the
         initial configuration, m (global axes).  With any nonzero offset the family also acts on
@@ -315,8 +315,7 @@ class ShroudCableFamily(ElementFamily):
 
 def unstretched_length(law, tension, length):
     """Unstretched length L0 (m) at which a rope of the law carries ``tension`` (N) at ``length`` (m):
-    ``L0 = length / (1 + eps(tension))`` with eps from :func:`femast.guyed.shroud.strain_from_tension`."""
-    from ..guyed.shroud import DyneemaLaw, strain_from_tension
+    ``L0 = length / (1 + eps(tension))`` with eps from :func:`femast.elements.shroud_law.strain_from_tension`."""
 
     return np.asarray(length, float) / (1.0 + strain_from_tension(law or DyneemaLaw(), tension))
 
@@ -329,7 +328,6 @@ def add_shrouds(model, pairs, law=None, tension=None, L0=None, offsets=None, nam
     ``offsets`` (n, 2, 3) as in :class:`ShroudCableFamily`.  Raises ModelError for coincident
     attachment points, non-positive lengths or stiffness, and tensions outside the law's range.
     """
-    from ..guyed.shroud import DyneemaLaw
 
     pairs = np.atleast_2d(np.asarray(pairs, dtype=np.int64))
     if pairs.ndim != 2 or pairs.shape[1] != 2:

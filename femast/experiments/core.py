@@ -190,6 +190,10 @@ class Experiment:
         (n,) array}}`` of quantities the noise level of a channel may grow with, because of how
         the data are measured (latch-pull: the slope of the law, seed 001 Eq. 15); the noise model
         of ``diagnose`` (:mod:`femast.experiments.noise`) tests them.
+    path_coordinate : optional ``path_coordinate(data, options) -> (n,)`` the quantity the test
+        drives along its passes (latch-pull: the bead position), whose repeated passes give the
+        noise model a model-free level (:func:`~femast.experiments.noise.cycle_scatter`); default:
+        the load measure.
 
     Every channel ``c`` also accepts an optional column ``sigma_c`` (same unit) with the standard
     uncertainty of each row; ``diagnose`` then uses it as the noise of that channel.
@@ -217,6 +221,7 @@ class Experiment:
     fit_options: dict = field(default_factory=dict)
     source: str = ""
     noise_covariates: Callable | None = None
+    path_coordinate: Callable | None = None
 
     def __post_init__(self):
         names = [c.name for c in self.columns]

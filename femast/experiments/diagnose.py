@@ -3,9 +3,9 @@
 The baseline (the experiment's model, plus any effects already switched on) is fitted and the
 noise floor of every channel is estimated from its residual.  Then the model is refitted once
 per candidate effect -- every applicable effect not yet in the model -- with the same noise
-weights.  The refits are independent and run in parallel: local processes by default
-(:class:`concurrent.futures.ProcessPoolExecutor`), a dask.distributed cluster when a scheduler
-address (or a ``distributed.Client``) is given.  With the default number of workers a
+weights.  The refits are independent and run in parallel (:mod:`femast.experiments.refits`): local
+processes by default (:class:`concurrent.futures.ProcessPoolExecutor`), a dask.distributed cluster
+when a scheduler address (or a ``distributed.Client``) is given.  With the default number of workers a
 diagnosis whose refits are estimated to take under a second in all runs in the calling process:
 starting worker processes would cost more than it saves (the FE experiments are the ones that
 need the workers).
@@ -16,161 +16,45 @@ Candidates are ranked by ``delta_bic = BIC(candidate) - BIC(baseline)`` (see
 :func:`~femast.experiments.fitting.bic`), which rewards explained error and penalises each added
 parameter by ``ln n``.  A candidate is *significant* when ``delta_bic < -10`` ("very strong"
 evidence on the Kass-Raftery scale; for one added parameter and n = 1500 residuals this needs a
-chi-square drop of 17, i.e. p < 4e-5 under the null).  A model is *at the noise floor* when its
-RMS error is at most ``AT_NOISE = 1.2`` times the noise: the white-noise estimate scatters by a
+chi-square drop of 17, i.e. p < 4e-5 under the null), also without the 2 % of rows that gain most,
+and it explains at least 10 % of the excess error (:mod:`femast.experiments.verdict`).  A model
+is *at the noise floor* when its RMS error is at most ``AT_NOISE = 1.2`` times the noise: the white-noise estimate scatters by a
 few % for a few hundred samples, and 1.2 leaves room for that; a structured error whose RMS is
 0.66 of the noise lifts the total to 1.2x, so structure smaller than that is not claimed.  For
 short data sets the estimate scatters more (the FE experiments have 40-80 rows: +-15-20 %), and
 the threshold is raised to the 95th percentile of what a perfect model gives on pure noise of that
 size (:func:`~femast.experiments.residuals.at_noise_threshold`: 1.38 for 45 rows of one channel;
 1.2 from about 120 rows, or fewer with several channels); it is ``at_noise`` in the result and
-the JSON report.
+the JSON report (with serially correlated noise it is computed for the effective sample size).
 
-* no significant candidate and the baseline at the noise floor -> "nothing is missing"
-  (``missing_effect`` null, ``explained`` true);
-* the best candidate significant and at the noise floor -> it is the missing effect
-  (``explained`` true);
-* otherwise -> "none of the candidates explains this" (``missing_effect`` null, ``explained``
-  false; ``best_candidate`` names the one that helps most, if any is significant).
+The noise model of every channel (white, heteroscedastic, AR(1), given, checked against repeated
+passes) is :mod:`femast.experiments.noise`; the significance rule and the verdict kinds
+(``missing_effect``, ``missing_pair``, ``form_imperfect``, ``better_form``, ``nothing_missing``,
+``not_explained``) are :mod:`femast.experiments.verdict`.
 """
 
 from __future__ import annotations
 
 import json
-import multiprocessing
-import os
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
 from scipy.optimize import OptimizeResult
 
 from .. import progress
-from ..effects.base import applicable_effects, forms_of, get_effect, load_script, loaded_scripts, resolve, split_form
-from ..errors import FemastError, ModelError
+from ..effects.base import applicable_effects, forms_of, get_effect, loaded_scripts, resolve, split_form
+from ..errors import ModelError
 from .compare import analyse
 from .core import Experiment, Measured
 from .figures import diagnose_figure, display_scale
 from .fitting import fit, params_table
-from .noise import noise_model
+from .noise import noise_model, pinned_rows
 from .residuals import AT_NOISE, at_noise_threshold
+# the refits' executor (re-exported: diagnose.REFIT_NFEV, diagnose._mp_context, ... keep working)
+from .refits import (_START_METHOD, REFIT_NFEV, SERIAL_BELOW_S, _dispatch, _mp_context, _refit_task,  # noqa: F401
+                     _run_tasks, _safe_fit, _serial_refits)
 from .verdict import MIN_SHARE, SIGNIFICANT_DBIC, conclude, flags, pair_candidates, robust_delta, score, share
-_START_METHOD = None  # multiprocessing start method of the local pool (None: the platform's default)
-REFIT_NFEV = 25  # evaluations per parameter and start of a refit (a converging refit needs 5-20; a direction the
-# data do not determine -- beam flexibility against the joint stiffness under top forces -- would use 100)
-SERIAL_BELOW_S = 1.0  # default workers: refit in this process when the refits should take less than this (s)
-
-
-# --------------------------------------------------------------------------- refit tasks
-def _refit_task(payload: dict) -> OptimizeResult:
-    """One refit (runs in a worker process or on a dask worker)."""
-    from .registry import experiment_from_source
-
-    for script in payload["scripts"]:
-        load_script(script)
-    exp = experiment_from_source(payload["source"], payload["options"])
-    data = Measured(payload["data_experiment"], payload["columns"], payload["path"], payload["lines"])
-    res = _safe_fit(exp, data, payload["effects"], start=payload["start"], noise=payload["noise"],
-                    sensitivity=payload.get("sensitivity"))
-    res.pid = os.getpid()
-    return res
-
-
-def _safe_fit(exp, data, effects, start, noise, sensitivity=None) -> OptimizeResult:
-    """:func:`fit`, or a result with ``failed = True`` and the error as ``message`` when the model
-    cannot be evaluated even at the start of the refit (an FE run that does not converge with the
-    effect's default parameters): one failed candidate must not end the whole diagnosis."""
-    try:
-        return fit(exp, data, effects, start=start, noise=noise, given_start_clip=True, nfev_per_param=REFIT_NFEV,
-                   start_sensitivity=sensitivity)   # the baseline's derivatives seed the refit's (issue 21)
-    except (ValueError, FemastError, FloatingPointError, ZeroDivisionError) as e:
-        return OptimizeResult(failed=True, success=False, message=f"{type(e).__name__}: {e}", effects=tuple(effects))
-
-
-def _rebuildable(exp: Experiment) -> bool:
-    """True if a worker can rebuild ``exp`` from its source name/script and options."""
-    if not exp.source:
-        return False
-    try:
-        from .registry import experiment_from_source
-
-        other = experiment_from_source(exp.source, exp.options)
-    except Exception:
-        return False
-    return other.name == exp.name and other.model is exp.model
-
-
-def _mp_context():
-    """Start method of the local pool: ``_START_METHOD`` if set; else 'forkserver' once numba has
-    started GNU OpenMP threads in this process (the FE experiments' ``kernel_threads`` does, and so
-    would a parallel user kernel; forking after that aborts the child: "fork() called from a process
-    already using GNU OpenMP"); else the platform's default (fork on Linux: the fastest start)."""
-    if _START_METHOD:
-        return multiprocessing.get_context(_START_METHOD)
-    try:
-        import numba
-
-        layer = numba.threading_layer()  # ValueError while no parallel kernel has run
-    except Exception:
-        layer = None
-    if layer == "omp" and "forkserver" in multiprocessing.get_all_start_methods():
-        return multiprocessing.get_context("forkserver")
-    return None
-
-
-def _run_tasks(payloads, workers, scheduler):
-    """Run the refits; returns (results, how) with ``how`` describing the executor used."""
-    if scheduler is not None:
-        try:
-            from distributed import Client
-        except ImportError:
-            raise ModelError("--scheduler needs dask.distributed: pip install 'dask[distributed]' "
-                             "(the femast extra 'dist')") from None
-        own = not isinstance(scheduler, Client)
-        client = Client(scheduler) if own else scheduler
-        try:
-            address = client.scheduler.address if client.scheduler is not None else str(scheduler)
-            from distributed import as_completed as dask_completed
-
-            futures = client.map(_refit_task, payloads, pure=False)
-            names = {f.key: _candidate(p) for f, p in zip(futures, payloads)}
-            with progress.counter(len(futures), "diagnose: refits on the cluster", unit="refits") as bar:
-                for fut in dask_completed(futures):
-                    bar.set_postfix_str(f"done: {names[fut.key]}", refresh=False)
-                    bar.update(1)
-            results = client.gather(futures)
-        finally:
-            if own:
-                client.close()
-        return list(results), f"dask.distributed at {address}"
-    n = (os.cpu_count() or 1) if workers is None else int(workers)
-    if n < 1:
-        raise ModelError(f"--workers must be >= 1, got {workers}")
-    n = min(n, len(payloads))
-    if n <= 1:
-        return _serial_refits(payloads), "serial (1 process)"
-    with ProcessPoolExecutor(max_workers=n, mp_context=_mp_context()) as pool:
-        futures = [pool.submit(_refit_task, p) for p in payloads]
-        with progress.counter(len(futures), f"diagnose: refits on {n} processes", unit="refits") as bar:
-            for fut in as_completed(futures):
-                bar.set_postfix_str(f"done: {_candidate(payloads[futures.index(fut)])}", refresh=False)
-                bar.update(1)
-        results = [fut.result() for fut in futures]
-    return results, f"{n} local processes"
-
-
-def _candidate(payload) -> str:
-    return payload["effects"][-1]
-
-
-def _serial_refits(payloads):
-    """The refits one after the other in this process, a progress bar per refit naming its candidate."""
-    results = []
-    for i, p in enumerate(payloads):
-        with progress.task(f"diagnose: refit {i + 1}/{len(payloads)} with {_candidate(p)}"):
-            results.append(_refit_task(p))
-    return results
 
 
 # --------------------------------------------------------------------------- readings
@@ -209,20 +93,6 @@ def _remaining_where(masks, z, nch, thr, min_rows=3):
     out = [(r, k) for k, m in masks.items() if m.sum() >= min_rows and (r := _kind_ratio(m, z, nch)) > thr]
     return [f"{k} ({r:.1f}x)" for r, k in sorted(out, reverse=True)]
 
-
-def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base):
-    """Run refit payloads: in this process when cheap or not rebuildable, else on the executor."""
-    if not payloads:
-        return [], "no candidates"
-    if not _rebuildable(exp):
-        return ([_safe_fit(exp, data, p["effects"], start=p["start"], noise=sigma, sensitivity=p.get("sensitivity"))
-                 for p in payloads],
-                "serial (experiment defined in memory: worker processes cannot rebuild it)")
-    est = 6.0 * t_base * len(payloads)
-    if workers is None and scheduler is None and not exp.fit_options.get("expensive") and est < SERIAL_BELOW_S:
-        return _serial_refits(payloads), f"serial (refits estimated at {est:.2f} s: cheaper than starting " \
-                                                   "processes)"
-    return _run_tasks(payloads, workers, scheduler)
 
 
 # --------------------------------------------------------------------------- diagnose
@@ -278,7 +148,7 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     payload0 = {"source": exp.source, "options": exp.options, "scripts": list(loaded_scripts()),
                 "data_experiment": data.experiment, "columns": data.columns, "path": data.path,
                 "lines": data.lines, "start": start, "noise": sigma,
-                "sensitivity": getattr(baseline, "sensitivity", None)}
+                "sensitivity": getattr(baseline, "sensitivity", None)}   # seeds the refits' Jacobians (issue 21)
     # stage 1: the forms of the added effects (shape mismatch) and the default form of each candidate;
     # stage 2: the generalised forms of the candidates whose default form has an information-criterion
     # gain (under the null nothing does, and the generalised forms cannot gain where it did not),
@@ -365,6 +235,8 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         sc = score(res, models, chans, data.n)
         d, frac = sc["ic"] - ic0, share(r0, sc["ratio"])
         dr = robust_delta(s0["z"], sc["z"], data.n, models, int(baseline.n_params), int(res.n_params))
+        order = list(by)
+        x, y = sorted((x, y), key=order.index)  # the better-ranked member first
         return {"effects": [x, y], "forms": [by[x]["form"], by[y]["form"]], "ratio": sc["ratio"],
                 "rms": float(res.rms), "delta_bic": float(d), "explained_fraction": frac, **flags(d, frac, dr),
                 "gain_over_best_single": float(d - min(by[x]["delta_bic"], by[y]["delta_bic"])),
@@ -375,9 +247,12 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     # pairs of the top candidates with an information-criterion gain, fitted jointly
     pair_fits = []
     top = pair_candidates(ranking)
-    if pairs and len(top) >= 2 and r0 > thr:
+    if pairs and top and r0 > thr:
         by = {e["effect"]: e for e in ranking}
         combos = [(x, y) for i, x in enumerate(top) for y in top[i + 1:]]
+        # and the best with every other candidate: a second mechanism whose own gain the first one's
+        # larger error hides (forward selection)
+        combos += [(top[0], e["effect"]) for e in ranking if not e.get("failed") and e["effect"] not in top]
         pl = []
         for x, y in combos:
             st = dict(start)
@@ -389,7 +264,7 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     # final noise model from the residual of the best model (femast.experiments.noise), everything rescored
     cands = [baseline, *ok, *(res for *_, res in pair_fits)]
     best_res = min(cands, key=lambda f: score(f, models, chans, data.n)["rss"])
-    models = noise_model(exp, data, best_res)
+    models = noise_model(exp, data, best_res, pinned=pinned_rows(baseline, chans))
     sigma = {c: models[c].sigma for c in chans}
     s0 = score(baseline, models, chans, data.n)
     r0, ic0 = s0["ratio"], s0["ic"]

@@ -103,6 +103,18 @@ def load_measure(data: Measured, options: dict) -> np.ndarray:
     return s if s[np.argmax(np.abs(s))] > 0 else -s
 
 
+def noise_covariates(data: Measured, params: dict, options: dict, fit=None) -> dict:
+    """What the displacement noise may vary with (issue 14): the size of the load, the bending moment
+    at the base ``|(m1, m2)|`` (N m).  The wrench is measured too (load cells, whose error is
+    commonly a share of the reading) and its error enters the displacement residual through the
+    compliance; a loaded mast top also vibrates more.  Tested by ``diagnose``'s noise model
+    (femast.experiments.noise) against a constant level; a component of the top displacement is not
+    the load's size when the load turns (biaxial paths)."""
+    prep = prepared(data, _prepare, options)
+    g = np.hypot(prep["m"][:, 0], prep["m"][:, 1])
+    return {c: {"size of the load (base bending moment)": g} for c in DISPLACEMENT}
+
+
 def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: dict) -> None:
     """Top view of the top's path, measured against model (seed 000 Fig. 6 style), mm."""
     ax.plot(1e3 * data["dx_m"], 1e3 * data["dy_m"], ".", ms=2.5, color="0.35", label="measured")
@@ -149,6 +161,7 @@ _EXPERIMENT = Experiment(
     load_measure=load_measure,
     load_label="base bending moment (N m)",
     plot_measured=plot_measured,
+    noise_covariates=noise_covariates,
     error_unit="m",
     min_rows=10,
     source="mast-top",

@@ -24,7 +24,12 @@ changes little from one row to the next, the noise does; see
   quadratic in s; for every experiment the size of the reading).  ``A, B, D`` are the Gaussian
   maximum-likelihood fit (Fisher scoring) of the second differences, whose variance is
   ``(1 - phi)(3 - phi) / 3 x (v_{i-1} + 4 v_i + v_{i+1})`` (exact for independent noise), with
-  rows beyond 6 standard deviations left out (jumps of the model error).  The model is kept when
+  rows beyond 6 standard deviations left out (jumps of the model error), ``A >= 0`` and ``D >= 0``
+  (the variance at zero covariate and its growth far out cannot be negative; unconstrained, a
+  negative ``A`` put the noise of the rows near zero load at a tenth of its true value and a
+  3-sigma row at 20 "sigma"), and no row's variance below ``VAR_FLOOR`` = 0.04 of the mean (sigma
+  at least 0.2 of its RMS: a few second differences near the end of the covariate's range cannot
+  establish a noise 5x below the typical; seed 001 Eq. 15's range on the seed's latch is 0.45).  The model is kept when
   its likelihood-ratio statistic against one level exceeds ``HETERO_LR`` = 18.5, the 99th
   percentile of that statistic on white noise (Monte Carlo, 2000 draws of 100-1500 rows along
   signed and unsigned covariates: 16.0-19.8; the second differences are correlated, so it exceeds
@@ -32,6 +37,14 @@ changes little from one row to the next, the noise does; see
   least ``HETERO_MIN_RANGE`` = 1.3 over the data (smaller variations change no verdict).
 * **given** -- a ``sigma_<channel>`` column (same unit as the channel) gives the standard
   uncertainty of every row; it is used as it is.
+
+* **pinned rows** -- a model that admits an interval at some rows (latch-pull: the static band of a
+  bead at rest, Eq. 9 third case; the backstop; a slack cable) predicts the measured value itself
+  there, so those residuals are exactly zero (or one constant along a hold): they carry no noise.
+  Left in, they pull every difference-based estimate down (15 % of the rows of a latch-pull test
+  with its holds: the level by up to 25 %, the verdict "not explained" on pure noise).  Rows whose
+  residual is zero or repeats its neighbour's exactly (:func:`informative_rows`) are left out of
+  the estimates, which use the remaining rows in path order; the level then applies to every row.
 
 Fewer than ``MIN_ROWS`` = 8 rows (without ``sigma_`` columns) leave too few differences for any
 estimate: a :class:`~femast.errors.ModelError`.  Correlation and heteroscedasticity are only tested
@@ -45,6 +58,7 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
+from scipy.optimize import lsq_linear
 
 from ..errors import DataFileError, ModelError
 
@@ -52,6 +66,8 @@ MIN_ROWS = 8
 MIN_ROWS_STRUCTURE = 60
 HETERO_MIN_RANGE = 1.3
 HETERO_LR = 18.5
+CYCLE_MIN_PAIRS = 30  # fewest rows compared across repeated passes for a level (its scatter then <= 13 %)
+VAR_FLOOR = 0.04  # smallest variance of a row / the mean variance: sigma >= 0.2 of its RMS (module docstring)
 QUANTILE = 0.99
 _MAD = 1.482602218505602  # 1 / Phi^-1(3/4): MAD -> standard deviation of a normal variable
 _SEED = 20241124
@@ -79,6 +95,21 @@ class ChannelNoise:
                 "sigma_max": float(np.max(self.sigma)), "phi": float(self.phi), "n_eff": float(self.n_eff),
                 "covariate": self.covariate, "reason": self.reason,
                 **{k: v for k, v in self.extra.items() if k != "level_reason"}}
+
+
+def informative_rows(r) -> np.ndarray:
+    """(n,) bool: rows of a residual r (n,) that carry noise -- not zero and not repeating a neighbour
+    exactly (to 1e-12 of the largest |r|): a noisy measurement never does, a model that admits an
+    interval and predicts the measured value inside it (a pinned row) does.  All True when fewer than
+    ``MIN_ROWS`` rows would be left."""
+    r = np.asarray(r, float)
+    tol = 1e-12 * float(np.max(np.abs(r), initial=0.0))
+    pinned = np.abs(r) <= tol
+    tie = np.abs(np.diff(r)) <= tol
+    pinned[1:] |= tie
+    pinned[:-1] |= tie
+    keep = ~pinned
+    return keep if keep.sum() >= MIN_ROWS else np.ones(r.size, bool)
 
 
 def _mad(x) -> float:
@@ -134,17 +165,23 @@ def _g3(g2):
 def _fit_variance(d2sq, X, iters: int = 10):
     """Maximum-likelihood ``beta`` of ``d2^2 ~ v chi^2_1``, ``v = X beta`` (design X (m, k)), batched over
     the leading axis of ``d2sq`` (draws, m), by Fisher scoring (weighted least squares of d2^2 on X,
-    weights 1 / v^2); v is kept above 1e-3 of the mean d2^2 and rows beyond 36 v are left out.
+    weights 1 / v^2) with ``A, D >= 0`` (a variance at zero covariate, a growth far out); v is kept
+    above ``VAR_FLOOR`` of the mean d2^2 and rows beyond 36 v are left out.
     Returns (beta (draws, k), v (draws, m), keep, log-likelihood (draws,))."""
-    floor = 1e-3 * np.mean(d2sq, axis=-1, keepdims=True)
+    floor = VAR_FLOOR * np.mean(d2sq, axis=-1, keepdims=True)
     v = np.broadcast_to(np.median(d2sq, axis=-1, keepdims=True) / 0.4549, d2sq.shape)  # median of chi^2_1
     beta = None
+    lo = np.array([0.0, -np.inf, 0.0])[: X.shape[1]]
     for _ in range(iters):
         keep = d2sq < 36.0 * v
         w = keep / v**2
         XtW = X.T[None, :, :] * w[:, None, :]
         M = XtW @ X + 1e-12 * np.eye(X.shape[1])
         beta = np.linalg.solve(M, (XtW @ d2sq[..., None]))[..., 0]
+        for j in np.flatnonzero(np.any(beta < lo, axis=-1)):  # A, D >= 0: bounded weighted least squares
+            sw = np.sqrt(w[j])
+            sc = np.sqrt(np.sum((X * sw[:, None]) ** 2, axis=0)) + 1e-300
+            beta[j] = lsq_linear(X * sw[:, None] / sc, d2sq[j] * sw, bounds=(lo * sc, np.inf)).x / sc
         v = np.maximum(beta @ X.T, floor)
     keep = d2sq < 36.0 * v
     ll = -0.5 * np.sum(keep * (d2sq / v + np.log(v)), axis=-1)
@@ -182,7 +219,7 @@ def heteroscedastic_fit(r, g, phi: float = 0.0) -> dict:
     lr, beta, _ = _lr((d2**2)[None, :], _design(u))
     A, B, D = (float(x) / (6.0 * c) for x in beta[0])
     v = A + B * u + D * u * u
-    v = np.maximum(v, 1e-3 * max(float(np.mean(v)), 1e-300))
+    v = np.maximum(v, VAR_FLOOR * max(float(np.mean(v)), 1e-300))
     sigma = np.sqrt(v)
     return {"coef": (A, B / gs, D / gs**2), "lr": float(lr[0]), "threshold": HETERO_LR, "sigma": sigma,
             "range": float(sigma.max() / sigma.min())}
@@ -205,12 +242,14 @@ def given_sigma(data, channel: str) -> np.ndarray | None:
 
 
 def channel_noise(channel: str, r, n_channel_rows: int, covariates=None, given=None,
-                  correlate: bool = True) -> ChannelNoise:
+                  correlate: bool = True, pinned=None) -> ChannelNoise:
     """Noise model of one channel from its residual r (n,) (module docstring).
 
     correlate : also test r for serial correlation (:func:`with_correlation`).
     covariates : ``{name: (n,) array}`` heteroscedasticity candidates (>= 0, any unit).
     given : (n,) per-row standard uncertainty (``sigma_`` column), or None.
+    pinned : (n,) bool, rows to leave out besides those :func:`informative_rows` finds (diagnose
+        passes the baseline's pinned rows when it estimates from a variant whose effect unpins them).
     """
     r = np.asarray(r, float)
     n = r.size
@@ -226,29 +265,42 @@ def channel_noise(channel: str, r, n_channel_rows: int, covariates=None, given=N
         return ChannelNoise(channel, "white", np.full(n, max(noise_floor(r), 1e-300)), 0.0, float(n), None,
                             f"white: {n} rows are too few (< {MIN_ROWS_STRUCTURE}) to test for serial correlation "
                             "or a varying noise level")
+    keep = _keep(r, pinned)
+    rk = r[keep]
+    pinned = int(n - keep.sum())
+    note = f"; {pinned} pinned rows (residual exactly zero or repeated: no noise) left out" if pinned else ""
     best = None
     for name, g in (covariates or {}).items():
         g = np.asarray(g, float)
-        if g.shape != (n,) or not np.all(np.isfinite(g)) or np.ptp(g) <= 0.0:
+        if g.shape != (n,) or not np.all(np.isfinite(g)) or np.ptp(g[keep]) <= 0.0:
             continue
-        h = heteroscedastic_fit(r, g)
-        if h["lr"] > h["threshold"] and h["range"] >= HETERO_MIN_RANGE and (best is None or h["lr"] > best[1]["lr"]):
-            best = (name, h)
+        h = heteroscedastic_fit(rk, g[keep])
+        if h["lr"] > h["threshold"] and h["range"] >= HETERO_MIN_RANGE and (best is None or h["lr"] > best[2]["lr"]):
+            best = (name, g, h)
     if best is None:
-        model = ChannelNoise(channel, "white", np.full(n, max(noise_floor(r), 1e-300)), 0.0, float(n), None,
-                             "constant level (no covariate explains a varying level)")
+        model = ChannelNoise(channel, "white", np.full(n, max(noise_floor(rk), 1e-300)), 0.0, float(n), None,
+                             "constant level (no covariate explains a varying level)" + note)
     else:
-        name, h = best
+        name, g, h = best
         A, B, D = h["coef"]
+        v = A + B * g + D * g * g
+        sigma = np.sqrt(np.maximum(v, VAR_FLOOR * max(float(np.mean(v[keep])), 1e-300)))
         model = ChannelNoise(
-            channel, "heteroscedastic", np.maximum(h["sigma"], 1e-300), 0.0, float(n), name,
+            channel, "heteroscedastic", np.maximum(sigma, 1e-300), 0.0, float(n), name,
             f"level varies with {name}: sigma^2 = A + B g + D g^2, A = {A:.3g}, B = {B:.3g}, D = {D:.3g} "
             f"(likelihood ratio {h['lr']:.0f} > {h['threshold']:.0f}, the 99th percentile on white noise; sigma "
-            f"from {h['sigma'].min():.3g} to {h['sigma'].max():.3g})", {"variance_coefficients": [A, B, D]})
-    return with_correlation(model, r) if correlate else model
+            f"from {h['sigma'].min():.3g} to {h['sigma'].max():.3g}){note}", {"variance_coefficients": [A, B, D]})
+    return with_correlation(model, r, pinned) if correlate else model
 
 
-def with_correlation(model: ChannelNoise, r) -> ChannelNoise:
+def _keep(r, pinned=None) -> np.ndarray:
+    keep = informative_rows(r)
+    if pinned is not None and (both := keep & ~np.asarray(pinned, bool)).sum() >= MIN_ROWS:
+        keep = both
+    return keep
+
+
+def with_correlation(model: ChannelNoise, r, pinned=None) -> ChannelNoise:
     """``model`` with its AR(1) coefficient from the residual r (n,) of a (better) model: phi, n_eff,
     kind and reason updated, the level corrected from the white-noise estimate (module docstring)."""
     r = np.asarray(r, float)
@@ -257,9 +309,12 @@ def with_correlation(model: ChannelNoise, r) -> ChannelNoise:
     base_kind = model.kind.replace("+ar1", "").replace("ar1", "white")
     phi0 = model.phi
     reason = model.extra.get("level_reason", model.reason)
-    phi_hat = lag1(r / model.sigma)
-    thr = ar1_threshold(r.size)
-    cap = difference_phi(r / model.sigma) + 2.0 * 1.9 / math.sqrt(r.size)
+    keep = _keep(r, pinned)
+    u = (r / model.sigma)[keep]
+    m = u.size
+    phi_hat = lag1(u)
+    thr = ar1_threshold(m)
+    cap = difference_phi(u) + 2.0 * 1.9 / math.sqrt(m)
     if phi_hat > thr and cap > thr:
         phi = min(phi_hat, cap, 0.95)
         why = (f"serially correlated: AR(1) phi = {phi:.2f} (lag-1 autocorrelation {phi_hat:.2f} > {thr:.2f}, the 99th "
@@ -275,11 +330,13 @@ def with_correlation(model: ChannelNoise, r) -> ChannelNoise:
                         f"{why}; {reason}", {**model.extra, "level_reason": reason})
 
 
-def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = True) -> dict:
+def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = True, pinned=None) -> dict:
     """``{channel: ChannelNoise}`` from a fit's residuals (``diagnose``: first the baseline's without the
     correlation test and with the experiment's own covariates only -- a structured residual would pass
     for noise growing with the reading --, for the weights of the refits; then the best model's, for
-    the verdict).  generic : also test the size of the reading as a covariate."""
+    the verdict).  generic : also test the size of the reading as a covariate.  pinned :
+    ``{channel: (n,) bool}`` rows to leave out besides the fit's own pinned rows (:func:`pinned_rows`
+    of another fit)."""
     covs = {}
     pred = fit_result.predicted
     for c in exp.channels:
@@ -288,10 +345,119 @@ def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = T
         extra = exp.noise_covariates(data, dict(fit_result.params), exp.options, fit_result) or {}
         for c, d in extra.items():
             covs.setdefault(c, {}).update(d)
+    coord = path_coordinate(exp, data) if correlate else None
     out = {}
     for c in exp.channels:
-        out[c] = channel_noise(c, fit_result.residuals[c], data.n, covs.get(c), given_sigma(data, c), correlate)
+        out[c] = channel_noise(c, fit_result.residuals[c], data.n, covs.get(c), given_sigma(data, c), correlate,
+                               (pinned or {}).get(c))
+        if coord is not None:
+            out[c] = with_cycles(out[c], coord, fit_result.residuals[c], (pinned or {}).get(c))
     return out
+
+
+def path_coordinate(exp, data) -> np.ndarray | None:
+    """The quantity the test drives along its passes (``Experiment.path_coordinate``, else the load
+    measure of the segmentation), for :func:`cycle_scatter`; None if it cannot be evaluated."""
+    try:
+        if getattr(exp, "path_coordinate", None) is not None:
+            return np.asarray(exp.path_coordinate(data, exp.options), float)
+        from .compare import load_path
+
+        return np.asarray(load_path(exp, data), float)
+    except Exception:  # a coordinate is optional: no repeated-pass check rather than a failed diagnosis
+        return None
+
+
+def pinned_rows(fit_result, channels) -> dict:
+    """``{channel: (n,) bool}`` rows of a fit's residual that carry no noise (:func:`informative_rows`)."""
+    return {c: ~informative_rows(fit_result.residuals[c]) for c in channels}
+
+
+def cycle_scatter(coord, r, keep=None, sigma=None, min_pairs: int = CYCLE_MIN_PAIRS):
+    """Noise level from repeated passes along a path coordinate (module docstring, "repeated cycles").
+
+    coord : (n,) the quantity the test drives (latch-pull: the bead position; mast-top: the load),
+    r : (n,) residual (or measurement), keep : (n,) bool rows that carry noise, sigma : (n,) a noise
+    model's per-row level (default 1: the level itself is returned).  Passes are the
+    monotone runs of coord (turning points confirmed by 5 % of its range); each row of a pass is
+    compared with the later passes in the same direction that cover its coordinate: ``d = r_a -
+    interp(r_b)`` has variance ``sigma^2 (1 + w^2 + (1 - w)^2)`` for independent noise (w the
+    interpolation weight), while anything that repeats with the coordinate -- the model's error,
+    a ripple -- cancels.  Rows where the other pass is not sampled (its neighbours further apart
+    than 3 of its median steps, or equal) are left out.  Returns ``(level, pairs)`` -- the robust RMS
+    of ``d`` whitened by the variance sigma gives it (so the level relative to sigma) -- or ``None``
+    with fewer than ``min_pairs`` compared rows."""
+    from .residuals import turning_points
+
+    coord, r = np.asarray(coord, float), np.asarray(r, float)
+    n = coord.size
+    keep = np.ones(n, bool) if keep is None else np.asarray(keep, bool)
+    sg = np.ones(n) if sigma is None else np.broadcast_to(np.asarray(sigma, float), (n,))
+    span = float(np.ptp(coord)) if n else 0.0
+    if n < MIN_ROWS_STRUCTURE or span <= 0.0:
+        return None
+    tps, direction = turning_points(coord, 0.05 * span)
+    bounds = [0, *(int(t) + 1 for t in tps), n]
+    runs = [(np.arange(a, b), float(direction[a])) for a, b in zip(bounds[:-1], bounds[1:]) if b - a >= 3]
+    out = []
+    for i, (ra, da) in enumerate(runs):
+        for rb, db in runs[i + 1:]:
+            if db != da:
+                continue
+            rb = rb[keep[rb]]
+            if rb.size < 3:
+                continue
+            order = np.argsort(coord[rb], kind="stable")
+            cb, vb, sb = coord[rb][order], r[rb][order], sg[rb][order]
+            step = np.diff(cb)
+            med = float(np.median(step[step > 0])) if np.any(step > 0) else 0.0
+            if med <= 0.0:
+                continue
+            rows = ra[keep[ra] & (coord[ra] > cb[0]) & (coord[ra] < cb[-1])]
+            j = np.clip(np.searchsorted(cb, coord[rows]) - 1, 0, cb.size - 2)
+            h = step[j]
+            ok = (h > 0) & (h <= 3.0 * med)
+            rows, j, h = rows[ok], j[ok], h[ok]
+            w = (coord[rows] - cb[j]) / h
+            d = r[rows] - ((1.0 - w) * vb[j] + w * vb[j + 1])
+            out.append(d / np.sqrt(sg[rows] ** 2 + (w * sb[j + 1]) ** 2 + ((1.0 - w) * sb[j]) ** 2))
+    d = np.concatenate(out) if out else np.zeros(0)
+    if d.size < min_pairs:
+        return None
+    return math.sqrt(_trimmed_ms(d)), int(d.size)
+
+
+def with_cycles(model: ChannelNoise, coord, r, pinned=None) -> ChannelNoise:
+    """``model`` checked against the level of the repeated passes (:func:`cycle_scatter`): where its
+    RMS level exceeds that level beyond the estimate's scatter (``1 + 3 / sqrt(2 m)`` for m compared
+    rows), the excess is structure that repeats with the path (a ripple with the position, a model
+    error taken for correlated or growing noise), not noise: the level is scaled down to it and an
+    AR(1) coefficient dropped (kind ``+cycles``).  A lower estimate than the repeated passes' is kept:
+    passes differ also by model errors that do not repeat (hysteresis of other amplitudes, drift)."""
+    if model.kind == "given":
+        return model
+    r = np.asarray(r, float)
+    keep = _keep(r, pinned)
+    cyc = cycle_scatter(coord, r, keep, model.sigma)
+    if cyc is None:
+        return model
+    rho, m = cyc
+    # scatter of the two estimates: 1 / (2 m) for the passes' RMS, ~2 / n for the difference estimate
+    # (the MAD's relative variance 1.36 / n on n - 2 correlated second differences)
+    limit = 1.0 + 3.0 * math.sqrt(1.0 / (2.0 * m) + 2.0 / max(int(keep.sum()), 1))
+    extra = {**model.extra, "cycle_ratio": rho, "cycle_pairs": m}
+    if rho * limit >= 1.0:
+        return ChannelNoise(model.channel, model.kind, model.sigma, model.phi, model.n_eff, model.covariate,
+                            model.reason + f"; repeated passes agree ({rho:.2f}x this level from {m} compared rows)",
+                            extra)
+    n = r.size
+    kind = model.kind.replace("+ar1", "").replace("ar1", "white") + "+cycles"
+    return ChannelNoise(model.channel, kind, model.sigma * rho, 0.0, float(n), model.covariate,
+                        f"level from repeated passes: {rho:.2f}x the difference estimate ({m} rows compared at the "
+                        f"same path position in passes of the same direction; below it beyond the scatter of the "
+                        f"two, 1/{limit:.2f}): what that estimate took for noise"
+                        f"{' (serial correlation)' if model.phi > 0 else ''} repeats with the path; "
+                        f"{model.extra.get('level_reason', model.reason)}", extra)
 
 
 def information_criterion(fun, n_rows: int, models: dict, n_params: int) -> float:

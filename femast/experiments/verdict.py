@@ -29,7 +29,9 @@ Conclusions (``verdict["kind"]``)
   mismatch of the added effect, not a new mechanism;
 * ``missing_effect`` -- the best significant candidate brings the model to the noise floor (and no
   pair does significantly better);
-* ``missing_pair`` -- the best pair of the top four candidates, fitted jointly, brings the model
+* ``missing_pair`` -- the best pair, fitted jointly, of the top four candidates with an
+  information-criterion gain or of the best candidate with any other (forward selection: a
+  second mechanism whose own gain the first one's larger error hides), brings the model
   to the noise floor and is significantly better than its best member alone (information
   criterion -10 and another 10 % of the excess), also when that member alone reaches the floor
   (a small second effect);

@@ -20,5 +20,5 @@ from .complete_mast import (MastStiffness, ShroudSet, active_stiffness, displace
                             passive_stiffness, shroud_wrench_matrix)
 from .identify import FitResult, fit_3r, fit_beam_E, fit_shroud_law
 from .mast_3r import compliance_3r, displacement_3r, jacobian_3r
-from .shroud import (SEED_X_S, DyneemaLaw, axial_rigidity_secant, axial_rigidity_tangent, shroud_stiffness,
+from ..elements.shroud_law import (SEED_X_S, DyneemaLaw, axial_rigidity_secant, axial_rigidity_tangent, shroud_stiffness,
                      strain_from_tension, tension_from_strain)

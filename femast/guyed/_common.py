@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from ..elements.base import check_positive  # noqa: F401  (one copy, shared with the shroud law)
 from ..errors import ModelError
 
 
@@ -23,20 +24,6 @@ def skew(v) -> np.ndarray:
     S[..., 2, 0] = -v[..., 1]
     S[..., 2, 1] = v[..., 0]
     return S
-
-
-def check_positive(name: str, value, unit: str, allow_inf: bool = False) -> np.ndarray:
-    """Return ``value`` as a float array after checking every entry is finite and > 0.
-
-    Raises :class:`~femast.errors.ModelError` naming ``name`` and the unit otherwise.
-    """
-    arr = np.asarray(value, dtype=float)
-    bad = ~(arr > 0.0) | (np.isinf(arr) if not allow_inf else np.isnan(arr))
-    if np.any(bad):
-        where = "" if arr.ndim == 0 else f" (entry {int(np.flatnonzero(bad.ravel())[0])})"
-        what = "a positive number" + (" or inf (rigid)" if allow_inf else "")
-        raise ModelError(f"{name}={value!r}{where} must be {what} in {unit}; give a physical value")
-    return arr
 
 
 def check_vectors(name: str, value, shape_tail=(3,)) -> np.ndarray:

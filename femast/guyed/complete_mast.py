@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ._common import check_positive, check_vectors, skew, unit_vectors
-from .shroud import DyneemaLaw, shroud_stiffness
+from ..elements.shroud_law import DyneemaLaw, shroud_stiffness
 
 
 @dataclass(frozen=True)

@@ -47,7 +47,7 @@ from ..analysis.solvers.convergence import Convergence
 from .cantilever import cantilever_stiffness, mast_section
 from .complete_mast import ShroudSet, active_stiffness, passive_stiffness
 from .rocaspect import E_NO_SHROUD, L_BEAM, SHROUD_DROP, mast_bases, mast_tops, rocaspect_shrouds
-from .shroud import DyneemaLaw
+from ..elements.shroud_law import DyneemaLaw
 
 SHROUD_FAMILY = "shroud"
 BEAM_FAMILY = "mast_beam"
@@ -192,7 +192,7 @@ class MastFE:
         k_r = EA_t / L0 and c_r = d tau / d L0 at fixed length = -EA_t l / L0^2):
         ``d tau / d L0 = diag(c) - diag(k) B^T K^-1 B diag(c)``.  (The plain fixed point
         ``L0 <- l_eq / (1 + eps(target))`` contracts only by ~0.6 per iteration here.)"""
-        from .shroud import axial_rigidity_tangent
+        from ..elements.shroud_law import axial_rigidity_tangent
 
         if self.shrouds_nominal is None or self.pretension == 0.0:
             return self.solve()

@@ -36,7 +36,7 @@ import numpy as np
 
 from .cdpr import CdprGeometry
 from .complete_mast import ShroudSet
-from .shroud import DyneemaLaw
+from ..elements.shroud_law import DyneemaLaw
 
 FRAME = (8.3, 6.8, 4.0)
 """Frame size x, y, z, m."""

@@ -17,9 +17,9 @@ from .distributions import Input, LogNormal, Normal, TruncatedNormal, Uniform
 from .outputs import ElementOutput, NodeOutput
 from .results import StudyResults, load
 from .runners import RunSummary, run
-from .statistics import bootstrap_ci, convergence, percentile, sobol_indices
+from .statistics import bootstrap_ci, convergence, percentile, sobol_convergence, sobol_indices
 from .study import Study
 
 __all__ = ["Input", "Normal", "Uniform", "TruncatedNormal", "LogNormal", "NodeOutput", "ElementOutput", "Study",
            "run", "RunSummary", "load", "StudyResults", "percentile", "bootstrap_ci", "convergence",
-           "sobol_indices"]
+           "sobol_indices", "sobol_convergence"]

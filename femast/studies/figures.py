@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..post import plotstyle
-from .statistics import convergence, percentile
+from .statistics import convergence, percentile, sobol_convergence
 
 MAX_PANELS = 6
 _Q = (0.05, 0.5, 0.95, 0.99)
@@ -114,6 +114,23 @@ def sensitivity_figure(sobol: dict, png):
     return plotstyle.save(fig, png)
 
 
+def sensitivity_convergence_figure(conv: dict, names, png, title=""):
+    """S1 (dashed) and ST (solid) of each input against the number of base samples."""
+    plt = plotstyle.pyplot()
+    fig, ax = plt.subplots(figsize=(5.2, 3.6))
+    for i, nm in enumerate(names):
+        ax.plot(conv["n"], conv["ST"][:, i], "o-", ms=3, color=f"C{i}", label=f"{nm}: ST")
+        ax.plot(conv["n"], conv["S1"][:, i], "s--", ms=3, color=f"C{i}", alpha=0.7, label=f"{nm}: S1")
+    ax.set_xscale("log", base=2)
+    ax.set_xlabel("base samples n")
+    ax.set_ylabel("Sobol' index (1)")
+    ax.axhline(0, color="0.3", lw=0.8)
+    ax.set_title(plotstyle.fit_title(ax, title or "convergence of the indices"))
+    ax.legend(loc="best", fontsize=7, ncol=2)
+    fig.tight_layout()
+    return plotstyle.save(fig, png)
+
+
 def study_figures(res, rep=None) -> list:
     """Write the study's figures into ``<folder>/figures``; returns their paths."""
     folder = Path(res.folder) / "figures"
@@ -124,4 +141,10 @@ def study_figures(res, rep=None) -> list:
         pngs.append(convergence_figure(series, folder / "convergence.png"))
     if rep and rep.get("sobol"):
         pngs.append(sensitivity_figure(rep["sobol"], folder / "sensitivity.png"))
+        (name, idx), s = next(iter(rep["sobol"].items()))
+        fA, fB, fAB, _ = res.saltelli(name)
+        sl = (slice(None),) + idx
+        conv = sobol_convergence(fA[sl], fB[sl], fAB[(slice(None),) + sl])
+        pngs.append(sensitivity_convergence_figure(conv, s["names"], folder / "sensitivity_convergence.png",
+                                                   f"{s.get('label', name)}: indices against n"))
     return pngs

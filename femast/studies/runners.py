@@ -24,6 +24,7 @@ import pickle
 import socket
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -288,8 +289,13 @@ def _run_local(study, chunks, make, record, workers, s):
     s.warmup_time = time.perf_counter() - tw
     ex = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_local, initargs=(arg,))
     try:
-        _pipeline(chunks, make, record, lambda *a: ex.submit(_local_chunk, *a),
-                  lambda p: wait(p, return_when=FIRST_COMPLETED), 2 * workers)
+        try:
+            _pipeline(chunks, make, record, lambda *a: ex.submit(_local_chunk, *a),
+                      lambda p: wait(p, return_when=FIRST_COMPLETED), 2 * workers)
+        except BrokenProcessPool:
+            raise StudyError(f"a worker process died (killed, out of memory, or a crash in compiled code) after "
+                             f"{s.ran} runs of this call; the finished runs are stored: run again to resume, "
+                             "with --workers 1 to see which sample crashes") from None
     except BaseException:
         # interrupted (or a worker died): the chunks in flight are lost, nothing half-written
         # (only this process writes); stop the workers now rather than after their chunks
@@ -320,5 +326,11 @@ def _run_dask(study, chunks, make, record, client, s):
         r = dwait(p, return_when="FIRST_COMPLETED")
         return r.done, r.not_done
 
-    _pipeline(chunks, make, record, lambda *a: client.submit(_dask_chunk, fut, *a, pure=False), wait_one,
-              2 * s.workers)
+    try:
+        _pipeline(chunks, make, record, lambda *a: client.submit(_dask_chunk, fut, *a, pure=False), wait_one,
+                  2 * s.workers)
+    except Exception as exc:
+        if type(exc).__name__ != "KilledWorker":
+            raise
+        raise StudyError(f"dask workers died running a chunk ({exc}); the finished runs ({s.ran} of this call) are "
+                         "stored: run again to resume; check the workers' memory and logs") from None

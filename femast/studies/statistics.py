@@ -130,6 +130,22 @@ def sobol_indices(fA, fB, fAB, names=None, confidence: float = 0.95, resamples: 
             "ST_high": np.nanquantile(bt, 1 - a, axis=0), "variance": float(V), "n": n}
 
 
+def sobol_convergence(fA, fB, fAB, ns=None) -> dict:
+    """First-order and total indices from the first n base samples, n doubling from 8 (default):
+    {'n': (m,), 'S1': (m, k), 'ST': (m, k)} (for the convergence of the indices with N)."""
+    fA, fB, fAB = np.asarray(fA, float), np.asarray(fB, float), np.asarray(fAB, float)
+    n = len(fA)
+    if ns is None:
+        ns = [m for m in (8 * 2 ** j for j in range(40)) if m < n] + [n]
+    ns = np.array(sorted(set(int(m) for m in ns if 2 <= m <= n)))
+    S1, ST = [], []
+    for m in ns:
+        a, b, _ = _jansen(fA[:m], fB[:m], fAB[:, :m])
+        S1.append(a)
+        ST.append(b)
+    return {"n": ns, "S1": np.array(S1), "ST": np.array(ST)}
+
+
 def component(values, index=None, name="output") -> np.ndarray:
     """A scalar series from an array output: ``values[:, *index]`` ((n,) when the output is scalar
     and index None)."""

@@ -1,5 +1,9 @@
 """Tension-dependent stiffness of the Dyneema shrouds (seed 000, Eqs. 23, 25, 27).
 
+The constitutive law of the shroud element (:mod:`femast.elements.shroud_cable`), used also by the
+analytic guyed-mast models of :mod:`femast.guyed` (it was ``femast/guyed/shroud.py``; the old path
+still imports).
+
 The seed writes the shroud spring coefficient as (Eq. 25)
 
     k(tau) = (k0 + k1 tau + k2 tau^2) / l
@@ -33,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
-from ._common import check_positive
+from .base import check_positive
 
 #: Seed 000 shroud coefficients [k0 (N), k1 (-), k2 (1/N)], Section IV-A.
 SEED_X_S = (935353.664, 144.320, -0.000465)

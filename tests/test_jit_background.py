@@ -1,0 +1,113 @@
+"""Kernels compiled in a background process while the first run interprets them (issue 17,
+femast/jit_background.py): the interpreted kernels give bit for bit the compiled results, and the
+worker fills numba's cache so that the next call loads it instead of compiling."""
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# A beam cantilever with a truss brace, bent and twisted through large rotations, then unloaded:
+# every kernel of the core path (beam and truss families, configuration update, assembly,
+# convergence maxima, rotation vectors for the output).
+MODEL = textwrap.dedent("""
+    import numpy as np
+    import femast as fm
+
+    def run():
+        m = fm.Model("bg")
+        a = m.node(0.0, 0.0, 0.0)
+        b = m.node(1.0, 0.0, 0.0)
+        c = m.node(1.0, 0.5, 0.0)
+        m.beam(a, b, fm.circular_tube(0.03, 0.026, E=70e9), up=(0, 0, 1), n=6)
+        m.truss(b, c, EA=1e5)
+        m.fix(a)
+        m.fix(c)
+        m.step("load", initial_increment=0.25).load(b, fz=-300.0, mx=20.0)
+        frames = []
+        an = fm.Analysis(m, None, progress=False, on_frame=lambda fr: frames.append(fr))
+        an.run()
+        return np.concatenate([np.ravel(an.x), np.ravel(an.R)]), an.summary.iterations
+""")
+
+
+def _child(code, env_extra, cwd):
+    env = dict(os.environ, PYTHONPATH=str(ROOT), FEMAST_QUIET="1", **env_extra)
+    p = subprocess.run([sys.executable, "-c", code], env=env, cwd=cwd, capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr[-3000:]
+    return p.stdout
+
+
+def test_interpreted_kernels_give_the_compiled_results_bit_for_bit(tmp_path):
+    """Same arithmetic in the same order on IEEE doubles: the final state of a large-rotation run
+    is identical to the last bit, and so is the number of Newton iterations."""
+    (tmp_path / "model_bg.py").write_text(MODEL)
+    code = ("import sys, json, numpy as np; sys.path.insert(0, '.'); from model_bg import run; "
+            "import femast.jit_background as jb; v, it = run(); "
+            "print(json.dumps({'v': v.tolist(), 'it': it, 'n_hooked': len(jb._hooked)}))")
+    compiled = json.loads(_child(code, {"FEMAST_BACKGROUND_COMPILE": "0"}, tmp_path))
+    interp = json.loads(_child(code, {"FEMAST_BACKGROUND_COMPILE": "interpret"}, tmp_path))
+    assert compiled["n_hooked"] == 0 and interp["n_hooked"] > 5
+    assert interp["it"] == compiled["it"]
+    assert np.array_equal(np.array(interp["v"]), np.array(compiled["v"]))   # bit for bit, no tolerance
+
+
+def test_worker_fills_the_cache_and_the_next_call_loads_it(tmp_path):
+    """With an empty cache the first call runs interpreted (nothing compiled in this process), a
+    worker compiles the kernel into the cache and drops its claim, and the next call loads the
+    compiled code from the cache (a cache hit, still no compile here)."""
+    code = textwrap.dedent("""
+        import json, time, glob, numpy as np
+        from numba.core import event
+        import femast
+        from femast import jit, rotations
+        compiled_here = []
+        class L(event.Listener):
+            def on_start(self, ev): compiled_here.append(ev.data["dispatcher"].py_func.__name__)
+            def on_end(self, ev): pass
+        event.register("numba:compile", L())
+        jit.prepare()
+        R = rotations.expm_so3.py_func(np.array([0.3, -0.2, 0.5]))
+        first = rotations.logm_so3(R)
+        d = rotations.logm_so3
+        hook = d._compile_for_args
+        claims = glob.glob(hook.index + ".*.femast-compiling")
+        t0 = time.time()
+        while glob.glob(hook.index + ".*.femast-compiling") and time.time() - t0 < 300:
+            time.sleep(0.1)
+        second = rotations.logm_so3(R)
+        print(json.dumps({"first": first.tolist(), "second": second.tolist(), "claims": len(claims),
+                          "compiled_here": compiled_here, "signatures": len(d.signatures),
+                          "hits": sum(d.stats.cache_hits.values())}))
+    """)
+    out = json.loads(_child(code, {"NUMBA_CACHE_DIR": str(tmp_path / "cache"), "FEMAST_BACKGROUND_COMPILE": "1"},
+                            tmp_path))
+    assert out["claims"] == 1                 # the worker was asked, the call did not wait
+    assert out["compiled_here"] == []         # nothing compiled in this process
+    assert out["signatures"] == 1 and out["hits"] == 1   # the second call loaded the worker's code
+    assert out["first"] == out["second"]      # interpreted and compiled: the same bits
+    assert list((tmp_path / "cache").rglob("*logm_so3*.nbi"))
+
+
+def test_off_in_the_worker_and_by_environment(monkeypatch):
+    from femast import jit_background as jb
+
+    monkeypatch.setenv("FEMAST_BACKGROUND_COMPILE", "0")
+    assert jb.mode() == "off" and not jb.enabled()
+    monkeypatch.setenv("FEMAST_BACKGROUND_COMPILE", "interpret")
+    assert jb.mode() == "interpret"
+    monkeypatch.setenv("FEMAST_BACKGROUND_COMPILE", "1")
+    assert jb.mode() == "on"
+
+
+def test_worker_compiles_element_kernels_first():
+    from femast import jit_background as jb
+
+    reqs = [{"module": "femast.analysis.configuration"}, {"module": "femast.elements.beam_corot"}]
+    assert sorted(range(2), key=lambda i: (jb._priority(reqs[i]), i)) == [1, 0]
