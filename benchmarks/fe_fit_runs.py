@@ -127,9 +127,10 @@ def main(argv=None) -> int:
     import numpy as np
 
     names = list(results)
-    fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.8))
+    fig, axes = plt.subplots(1, 3, figsize=(12.0, 3.8))
     x = np.arange(len(names))
-    for ax, key, label in ((axes[0], "fe_runs", "FE runs"), (axes[1], "wall_s", "wall time (s)")):
+    for ax, key, label in ((axes[0], "fe_runs", "FE runs"), (axes[1], "cpu_s", "CPU time, all processes (s)"),
+                           (axes[2], "wall_s", "wall time (s)")):
         if before:
             ax.bar(x - 0.2, [before.get(n, {}).get(key, np.nan) for n in names], 0.4, label="before", color="0.6")
         ax.bar(x + (0.2 if before else 0.0), [results[n][key] for n in names], 0.4, label="now", color="C0")
@@ -138,10 +139,12 @@ def main(argv=None) -> int:
         ax.grid(axis="y", alpha=0.3)
     for n, i in zip(names, x):
         if n in TARGET_S:
-            axes[1].plot([i - 0.45, i + 0.45], [TARGET_S[n]] * 2, "C3--", lw=1)
+            axes[2].plot([i - 0.45, i + 0.45], [TARGET_S[n]] * 2, "C3--", lw=1)
     axes[0].legend()
     axes[1].set_yscale("log")
-    fig.suptitle(f"FE fits: runs and wall time (--workers {args.workers}; target dashed)")
+    axes[2].set_yscale("log")
+    fig.suptitle(f"FE fits: runs, CPU and wall time (--workers {args.workers}; wall target dashed; load "
+                 f"{os.getloadavg()[0]:.1f} on 2 cores)")
     fig.tight_layout()
     out = ROOT / "benchmarks" / "out"
     out.mkdir(exist_ok=True)
