@@ -167,9 +167,6 @@ SIZE_EXCEPTIONS = {
     "model/model.py:Model": (330, "one verb per method, each a few lines delegating to a module "
                                   "(arrays, thermal, constraints, modal); mixins would scatter the API"),
     "elements/cable_latch.py:CableLatchFamily": (310, "6 lines over: the family protocol methods of one element"),
-    "experiments/diagnose.py": (520, "being split by issue 14 this session"),
-    "analysis/solvers/linear.py:SparseLU": (360, "issue 21's back-ends landed into it this session; "
-                                                 "the pattern bookkeeping (analyse/master/positions) can move out"),
 }
 
 

@@ -44,10 +44,10 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit
-from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ...errors import ModelError, SingularModelError
 from . import backends
+from .ordering import entry_keys, permuted, permuted_positions, rcm, same_pattern, try_orderings
 
 try:  # scipy's SuperLU binding, called directly for the matrix refactorised every iteration
     from scipy.sparse.linalg._dsolve._superlu import gstrf as _gstrf
@@ -129,37 +129,16 @@ class SparseLU:
         self.layout = 0         # bumped whenever the permuted matrix (its pattern or ordering) changes
 
     # ------------------------------------------------------------------ symbolic part
-    @staticmethod
-    def _same(pattern, K):
-        return (pattern is not None and pattern[0] == K.shape and np.array_equal(pattern[1], K.indptr)
-                and np.array_equal(pattern[2], K.indices))
-
     def _is_master(self, K):
         """K has the master pattern.  The assembler refills the same CSR arrays every iteration, so
         arrays once found equal are recognised by identity (same objects, same lengths)."""
         v = self._validated
         if v is not None and v[0] is K.indptr and v[1] is K.indices and v[2] == K.indices.size:
             return True
-        if self._same(self._pattern, K):
+        if same_pattern(self._pattern, K):
             self._validated = (K.indptr, K.indices, K.indices.size)
             return True
         return False
-
-    @staticmethod
-    def _rcm(K):
-        """RCM permutation of K's pattern and whether its envelope bounds the LU fill to at most
-        twice nnz(K) (then no other ordering is worth a trial factorisation)."""
-        perm = np.asarray(reverse_cuthill_mckee(K, symmetric_mode=True), dtype=np.int64)
-        n = K.shape[0]
-        inv = np.empty(n, dtype=np.int64)
-        inv[perm] = np.arange(n)
-        rows = np.repeat(inv, np.diff(K.indptr))
-        cols = inv[K.indices]
-        lo = np.full(n, n, dtype=np.int64)   # leftmost column of each permuted row (symmetric pattern)
-        np.minimum.at(lo, rows, cols)
-        np.minimum.at(lo, cols, rows)
-        envelope = int(np.sum(np.arange(n) - np.minimum(lo, np.arange(n))))
-        return perm, 2 * envelope + n <= 2 * K.nnz
 
     def analyse(self, K):
         """Symbolic analysis from the pattern of K alone (values unused), if RCM is the ordering to
@@ -168,14 +147,14 @@ class SparseLU:
         if self.ordering not in ("auto", "rcm"):
             return None
         K = K if K.format == "csr" else K.tocsr()
-        perm, enough = self._rcm(K)
+        perm, enough = rcm(K)
         if self.ordering == "auto" and not enough:
             return None
         self.analyses += 1
         self._set_master(K)
         self.chosen = "rcm"
         self._perm = perm
-        self._B, self._gather = self._permuted(K, perm)
+        self._B, self._gather = permuted(K, perm)
         self._choose_engine()
         return self.chosen
 
@@ -195,10 +174,7 @@ class SparseLU:
         permuted matrix directly (no gather per factorisation; see :meth:`factorize_values`)."""
         if self._gather is None:
             raise RuntimeError("SparseLU.permuted_positions: no pattern analysed yet")
-        inv = np.empty(self._gather.size, dtype=np.int64)
-        inv[self._gather] = np.arange(self._gather.size)
-        pos = np.asarray(pos)
-        return np.where(pos >= 0, inv[np.maximum(pos, 0)], -1)
+        return permuted_positions(self._gather, pos)
 
     @property
     def values(self):
@@ -219,33 +195,19 @@ class SparseLU:
     def _set_master(self, K):
         self.layout += 1
         self._pattern = (K.shape, K.indptr.copy(), K.indices.copy())
-        self._master_keys = self._keys(K.shape, K.indptr, K.indices)
+        self._master_keys = entry_keys(K.shape, K.indptr, K.indices)
         self._sub = None
         self._sub_ids = None
         self._validated = None
 
-    @staticmethod
-    def _keys(shape, indptr, indices):
-        rows = np.repeat(np.arange(shape[0], dtype=np.int64), np.diff(indptr))
-        return rows * shape[1] + indices
-
     def _positions(self, K):
         """Positions of K's entries in the master pattern, or None if one is outside it."""
-        keys = self._keys(K.shape, K.indptr, K.indices)
+        keys = entry_keys(K.shape, K.indptr, K.indices)
         pos = np.searchsorted(self._master_keys, keys)
         pos[pos >= self._master_keys.size] = 0
         if not np.array_equal(self._master_keys[pos], keys):
             return None
         return pos
-
-    def _permuted(self, K, perm):
-        """(B, gather): the CSC matrix K[perm][:, perm] and the index with B.data = K.data[gather]."""
-        marker = sp.csr_matrix((np.arange(1, K.nnz + 1, dtype=np.float64), K.indices, K.indptr), shape=K.shape)
-        Bm = marker[perm][:, perm].tocsc()
-        Bm.sort_indices()
-        gather = Bm.data.astype(np.int64) - 1
-        B = sp.csc_matrix((K.data[gather], Bm.indices, Bm.indptr), shape=K.shape)
-        return B, gather
 
     def _factor_permuted(self, B, superlu=False):
         """LU of the permuted matrix B in its own (NATURAL) column order.  The matrix refactorised
@@ -281,39 +243,12 @@ class SparseLU:
         (the union of the master and a tangent with entries outside it) reuses the kind chosen."""
         self.analyses += 1
         kinds = [self.chosen] if self.chosen else (["rcm", "mmd"] if self.ordering == "auto" else [self.ordering])
-        best = None
-        first = None
-        error = RuntimeError("Factor is exactly singular")
-        for kind in kinds:
-            enough = False
-            if kind == "rcm":
-                perm, enough = self._rcm(K)  # enough: its fill is within 2x of any ordering's
-            else:
-                try:
-                    lu = spla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=self.pivot_threshold,
-                                   options=dict(SymmetricMode=True))
-                except RuntimeError as exc:
-                    error = exc
-                    continue
-                perm = np.argsort(lu.perm_c).astype(np.int64)
-            B, gather = self._permuted(K, perm)
-            first = first or (kind, perm, B, gather)
-            try:
-                t0 = perf_counter()
-                lu = self._factor_permuted(B)
-                dt = perf_counter() - t0
-            except RuntimeError as exc:
-                error = exc
-                continue
-            if best is None or lu.nnz < best[0]:
-                best = (lu.nnz, (kind, perm, B, gather), lu, dt)
-            if enough:
-                break
+        best, first, error = try_orderings(K, kinds, self._factor_permuted, self.pivot_threshold)
         self._set_master(K)
         if best is None:  # singular: keep an ordering so that the pattern is not analysed again
             if first is None:
                 perm = np.arange(K.shape[0])
-                first = (kinds[0], perm) + self._permuted(K, perm)
+                first = (kinds[0], perm) + permuted(K, perm)
             self.chosen, self._perm, self._B, self._gather = first
             self._choose_engine()
             raise error
@@ -337,7 +272,7 @@ class SparseLU:
             return K.data, self._gather
         ids = self._sub_ids
         if not (ids is not None and ids[0] is K.indptr and ids[1] is K.indices and ids[2] == K.indices.size):
-            if not self._same(self._sub, K):
+            if not same_pattern(self._sub, K):
                 pos = self._positions(K)
                 if pos is None:  # entries outside the master pattern: analyse the union once
                     ones = sp.csr_matrix((np.ones(K.nnz), K.indices, K.indptr), shape=K.shape)
@@ -346,7 +281,7 @@ class SparseLU:
                     union = (ones + master).tocsr()
                     union.sort_indices()
                     union.data[:] = 0.0
-                    self._master_keys = self._keys(union.shape, union.indptr, union.indices)
+                    self._master_keys = entry_keys(union.shape, union.indptr, union.indices)
                     union.data[self._positions(K)] = K.data
                     self._lu = self._analyse(union)
                     return None
