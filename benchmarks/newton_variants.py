@@ -148,6 +148,7 @@ def main(argv=None):
         models["ADAM bay, friction + latches"] = run_adam_bay
     all_runs = {}
     for model, run in models.items():
+        run("full")   # warm-up, discarded: the numba caches of the model's families load here
         runs = {v: run(v) for v in VARIANTS}
         all_runs[model] = runs
         ref = runs["full"]["u"]

@@ -66,7 +66,8 @@ class Analysis:
     observers : more observers of the run (:class:`~femast.analysis.output.Observer`).
     linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.solvers.backends`):
         "auto" (default: LAPACK's band solver for a narrow reverse Cuthill-McKee band, as in a
-        mast, else SuperLU), or one forced by name: "superlu", "banded", "cholmod", "pardiso".
+        mast; PARDISO, if installed, for other models of 1000 DOFs or more; else SuperLU), or one
+        forced by name: "superlu", "banded", "cholmod", "pardiso".
 
     After construction: ``state`` (:class:`State`: configuration, element states, loads...),
     ``system`` (:class:`System`: numbering, assembly, linear solver), ``algorithm``

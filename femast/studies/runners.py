@@ -65,7 +65,8 @@ class RunSummary:
             else ", 0 failed"
         res = f" ({self.resumed} already on disk)" if self.resumed else ""
         return (f"study {state}: {self.samples} samples, {self.runs} runs{res}; this call ran {self.ran}: {self.ok} ok"
-                f"{fail}; wall time {self.wall_time:.1f} s, CPU {self.cpu_time:.1f} s, {self.workers} "
+                f"{fail}; wall time {self.wall_time:.1f} s, CPU {self.cpu_time:.1f} s"
+                f"{' (this process; not the dask workers)' if self.engine == 'dask' else ''}, {self.workers} "
                 f"{self.engine} worker(s) (warm-up {self.warmup_time:.1f} s); results in {self.folder}")
 
 

@@ -18,11 +18,12 @@ name        what                                                 needs
 
 **The automatic choice** (``backend="auto"``, :func:`choose`): the band back-end when the
 ordering is reverse Cuthill-McKee and its band is narrow (:func:`~femast.analysis.solvers.banded.band_rule`:
-the band storage of one triangle, n (b + 1), at most 4x the entries of K's triangle), else
-SuperLU.  CHOLMOD and PARDISO are never chosen automatically: on every femast tangent measured
-(the 40-1000 bay masts, the ADAM bay and mast; ``python benchmarks/solver_backends.py``) one of
-the two built-in back-ends was the faster; they stay available by name.  A back-end named but not
-installed falls back to SuperLU with a warning that says how to install it.
+the band storage of one triangle, n (b + 1), at most 4x the entries of K's triangle: the masts);
+otherwise PARDISO when it is installed and the model has at least :data:`PARDISO_MIN_DOFS` DOFs
+(the ADAM mast: 1.0-2.0x faster than SuperLU); otherwise SuperLU.  CHOLMOD is never chosen
+automatically (slower than the band on the masts, and most tangents of the unbanded models are
+unsymmetric).  Measurements: ``python benchmarks/solver_backends.py``, docs/performance.md.  A
+back-end named but not installed falls back to SuperLU with a warning that says how to install it.
 """
 
 from __future__ import annotations
