@@ -9,12 +9,10 @@ were held in memory the 100 000-sample peak would grow by the size of the result
 """
 
 import os
-import resource
 import shutil
 import subprocess
 import sys
 import tempfile
-import time
 
 CHILD = r'''
 import resource, sys, time

@@ -37,3 +37,7 @@ class StateError(FemastError, ValueError):
 class StudyError(FemastError, ValueError):
     """A study (femast.studies) is set up wrongly: an impossible distribution, an input or output
     that matches nothing, a scheduler that cannot be reached.  Raised before any sample runs."""
+
+
+class SampleTimeout(FemastError):
+    """A sample of a study ran longer than the study's ``timeout_s`` (it is recorded as failed)."""

@@ -106,3 +106,35 @@ def test_short_latch_cable_section_raises_its_tension_by_EA_d_over_2L():
 def test_bad_scatter_names_the_item(sc, words):
     with pytest.raises(ModelError, match=words):
         build_mast(1, scatter=sc)
+
+
+def test_stated_scatter_samples_lie_in_their_bounds_and_midpoints_are_nominal():
+    from femast.adam.shape_study import GROUPS, n_uniforms, sample_scatter, stated_inputs
+
+    n = 3
+    p = BayParameters()
+    need = n_uniforms(n)
+    mid = sample_scatter({g: np.full(need[g], 0.5) for g in GROUPS}, n)
+    sc = MastScatter(**mid).resolve(n, p)
+    assert np.all(sc["mu"] == p.mu) and np.all(sc["pretension"] == p.pretension)
+    assert not np.any(sc["longeron_dL"]) and not np.any(sc["cable_dL"])
+    rng = np.random.default_rng(0)
+    vals = sample_scatter({g: rng.random(need[g]) for g in GROUPS}, n)
+    for g, field, lo, hi, size, unit in stated_inputs(n):
+        a = np.asarray(vals[field])
+        assert a.size == size and np.all((a >= lo) & (a <= hi)), field
+    pre = [(lo, hi) for _, f, lo, hi, _, _ in stated_inputs(n) if f == "pretension"]
+    np.testing.assert_allclose(pre, [(153.0, 187.0)], rtol=1e-15)   # 170 N +- 10 %, round-off of 170 x 1.1
+    with pytest.raises(ModelError, match="group 'latch' needs 24 uniform numbers"):
+        sample_scatter({g: rng.random(need[g] - (g == "latch")) for g in GROUPS}, n)
+
+
+def test_tip_history_reports_every_load_level_and_the_nominal_mast_deploys_straight():
+    from femast.adam.shape_study import tip_history
+
+    h = tip_history(2, None, cycles=1)
+    assert h["labels"] == ["pretension", "M+F#1", "0a#1", "-M-F#1", "0b#1"]
+    # the nominal mast shortens under its pretension, with no sideways motion or rotation
+    # (round-off and the 1e-9 force tolerance: far below 1 nm and 1e-8 rad)
+    assert h["u"][0, 2] < 0 and np.abs(h["u"][0, :2]).max() < 1e-9 and np.abs(h["theta"][0]).max() < 1e-8
+    assert h["theta"][1, 2] > 0 > h["theta"][3, 2]      # M twists the tip one way, -M the other

@@ -118,8 +118,19 @@ def test_band_rule_mast_yes_compact_mesh_no():
     lu = SparseLU(ordering="rcm")
     L3 = (L3 + 10 * sp.identity(g ** 3)).tocsr()
     lu.factorize(L3)
-    assert lu.chosen == "rcm" and lu.engine == "superlu"
     assert not band_rule(L3.shape[0], band_of(lu._B.indptr, lu._B.indices), L3.nnz)
+    # not banded, >= 1000 DOFs: PARDISO where installed, else SuperLU
+    assert lu.chosen == "rcm" and lu.engine == ("pardiso" if backends.available("pardiso")[0] else "superlu")
+    b = np.ones(L3.shape[0])
+    assert backward_error(L3, lu.solve(b), b) <= 1e-14   # either LU is backward stable
+
+
+def test_small_unbanded_model_stays_on_superlu():
+    A = chain_matrix(n=300, b=7)
+    P = sp.csr_matrix(np.random.default_rng(7).permutation(np.eye(300)))
+    lu = SparseLU(ordering="mmd")           # not RCM: no band
+    lu.factorize((P @ A @ P.T).tocsr())
+    assert lu.engine == "superlu"           # 300 DOFs < PARDISO_MIN_DOFS
 
 
 def test_unknown_backend_is_a_model_error():

@@ -524,3 +524,28 @@ def test_report_of_a_study_whose_samples_all_failed(tmp_path, capsys):
     assert s.failed == 4 and s.ok == 0
     rep = report(tmp_path / "f", figures=True)
     assert "(no successful sample)" in capsys.readouterr().out and rep["figures"] == []
+
+
+def _sometimes_slow(x):
+    if x > 0.8:
+        import time
+
+        time.sleep(5.0)   # a sample that struggles (cutbacks, a hang)
+    return {"y": x}
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_samples_over_the_timeout_are_recorded_failed(tmp_path, workers):
+    import time
+
+    study = st.Study(run=_sometimes_slow, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], sampler="mc", seed=2,
+                     timeout_s=0.3)
+    t0 = time.perf_counter()
+    s = st.run(study, tmp_path / "t", samples=20, workers=workers)
+    res = st.load(tmp_path / "t")
+    n_slow = int(np.sum(res.table(["x"])["x"] > 0.8))
+    assert n_slow > 0 and s.failed == n_slow and s.ok == 20 - n_slow
+    assert all("SampleTimeout: the sample ran over timeout_s = 0.3 s" in r for _, r in res.failures())
+    assert time.perf_counter() - t0 < 5.0 * n_slow / workers   # the slow samples were cut short
+    with pytest.raises(StudyError, match="timeout_s"):
+        st.Study(run=_sometimes_slow, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], timeout_s=0)

@@ -9,7 +9,6 @@ import numpy as np
 
 import femast as fm
 from femast.analysis import Analysis
-from femast.analysis.solvers.convergence import Convergence
 
 from mast import E_AL, G_AL, SECTIONS
 
@@ -33,7 +32,7 @@ def solve(mast, n_inc, tol=1e-6, out=None):
     out = out or tempfile.mkdtemp(prefix="femast_peer_")
     t0 = time.perf_counter()
     m, labels = model(mast, n_inc)
-    an = Analysis(m, out, progress=False, convergence=Convergence(force_tol=tol, disp_tol=tol))
+    an = Analysis(m, out, progress=False, convergence=fm.Convergence(force_tol=tol, disp_tol=tol))
     t1 = time.perf_counter()
     c1 = time.process_time()
     an.run()

@@ -50,8 +50,10 @@ class Analysis:
     line_search : secant line search when a Newton step overshoots (load control): True, False, or
         "auto" (default): only when retrying an increment that failed, where plain Newton
         already went astray (a line search slows the easy increments down).
-    tangent : "full" (default: a new tangent every iteration), "modified" (one per increment) or
-        "initial" (one per step): see :class:`~femast.analysis.newton.Newton`.
+    tangent : "auto" (default: full Newton, see the measurements in docs/performance.md), "full" (a
+        new tangent every iteration), "modified" (one per increment, again when convergence slows), "quasi-newton"
+        (modified with Broyden's update) or "initial" (one per step): see
+        :class:`~femast.analysis.newton.Newton`.
     extrapolate : start each increment from the previous increment's solution scaled to the new
         increment (Abaqus' default linear extrapolation); off after a step change.
     easy_iterations : an increment converged in at most this many iterations is easy (Abaqus'
@@ -64,7 +66,8 @@ class Analysis:
     observers : more observers of the run (:class:`~femast.analysis.output.Observer`).
     linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.solvers.backends`):
         "auto" (default: LAPACK's band solver for a narrow reverse Cuthill-McKee band, as in a
-        mast, else SuperLU), or one forced by name: "superlu", "banded", "cholmod", "pardiso".
+        mast; PARDISO, if installed, for other models of 1000 DOFs or more; else SuperLU), or one
+        forced by name: "superlu", "banded", "cholmod", "pardiso".
 
     After construction: ``state`` (:class:`State`: configuration, element states, loads...),
     ``system`` (:class:`System`: numbering, assembly, linear solver), ``algorithm``
@@ -73,7 +76,7 @@ class Analysis:
 
     def __init__(self, model, out="results", convergence: Convergence | None = None, progress: bool = True,
                  cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
-                 extrapolate: bool = False, on_frame=None, tangent: str = "full", observers=(), restart=None,
+                 extrapolate: bool = False, on_frame=None, tangent: str = "auto", observers=(), restart=None,
                  restart_every: int | None = None, linear_solver: str = "auto"):
         prepare_kernels()   # first run: kernels compile in the background (femast.jit_background)
         self.model = model

@@ -12,11 +12,33 @@
 * the prescribed-value increment ``dpres`` and the viscous term of a stabilised step.
 
 Options of the algorithm: a secant line search (``line_search``) and the tangent update
-(``tangent``): ``"full"`` (a new tangent every iteration, the default), ``"modified"`` (one per
-increment attempt) or ``"initial"`` (one per step, formed again only where an increment needs its
-own: prescribed values or a viscous term).  Every Newton iteration: tangent (if due), solve,
-correct the load factor, update the configuration, evaluate the residual, test convergence.
-On convergence the state is committed, on failure rolled back (both one call).
+(``tangent``):
+
+* ``"full"``: a new tangent every iteration (Newton-Raphson);
+* ``"modified"``: a tangent at the start of each increment attempt, formed again after
+  ``refactor_every`` iterations on it or as soon as convergence slows (the residual ratio falls
+  by less than the factor ``slow`` in an iteration);
+* ``"quasi-newton"``: as ``"modified"``, and between two factorisations Broyden's update of the
+  inverse (the "good" Broyden method in product form, Kelley 1995 sec. 7.3; Engelman, Strang &
+  Bathe 1981 for finite elements): after a step s that changed the residual by y, the inverse H
+  becomes H + (s - H y) s^T H / (s^T H y), stored as vector pairs, so each iteration costs one
+  triangular solve and one dot product per pair.  Unsymmetric tangents (friction) are handled:
+  Broyden's update, unlike BFGS, does not assume symmetry.  Under a control whose load factor is
+  an unknown (displacement control, arc length) it acts as ``"modified"``.
+* ``"initial"``: one per step, formed again only where an increment needs its own (prescribed
+  values or a viscous term);
+* ``"auto"`` (the default): ``"full"``.  ``"modified"`` and ``"quasi-newton"`` are not chosen
+  automatically: on the peer masts (40-1000 bays) and the ADAM bay they need more iterations
+  than they save factorisations, and they do not beat full Newton's time
+  (``python benchmarks/newton_variants.py``, docs/performance.md).  Full Newton converges where
+  they do and more (friction, latches, limit points).  A shortcut that was measured and not kept:
+  reusing the previous increment's last factorisation for the first iteration of the next one
+  (a quarter fewer factorisations on the masts, the same iterations) breaks the bit-for-bit
+  equality of a restarted run with the uninterrupted one (tests/test_restart.py).
+
+Every Newton iteration: tangent (if due), solve, correct the load factor, update the
+configuration, evaluate the residual, test convergence.  On convergence the state is committed,
+on failure rolled back (both one call).
 """
 
 from __future__ import annotations
@@ -81,33 +103,63 @@ class Outcome:
     dlam: float = 0.0
 
 
+TANGENTS = ("auto", "full", "modified", "quasi-newton", "initial")
+
+
 class Newton:
     """Newton-Raphson iterations on one increment (see module docstring).
 
     convergence : :class:`~femast.analysis.solvers.convergence.Convergence`.
     line_search : secant line search when a step overshoots (fixed loads only): True, False, or
         "auto": only when retrying an increment that failed.
-    tangent : "full", "modified" or "initial" (see module docstring).
+    tangent : "auto", "full", "modified", "quasi-newton" or "initial" (see module docstring).
+    refactor_every : "modified" / "quasi-newton": iterations on one factorisation before a new one.
+    slow : "modified" / "quasi-newton": a new factorisation when an iteration reduces the residual
+        ratio by less than this factor (dimensionless, 0 < slow < 1).
     """
 
-    def __init__(self, convergence: Convergence | None = None, line_search="auto", tangent="full"):
-        if tangent not in ("full", "modified", "initial"):
-            raise ModelError(f"Newton: tangent='{tangent}' is not one of 'full', 'modified', 'initial'")
+    def __init__(self, convergence: Convergence | None = None, line_search="auto", tangent="auto",
+                 refactor_every: int = 6, slow: float = 0.25):
+        if tangent not in TANGENTS:
+            raise ModelError(f"Newton: tangent='{tangent}' is not one of {', '.join(repr(t) for t in TANGENTS)}")
+        if not (isinstance(refactor_every, int) and refactor_every >= 1):
+            raise ModelError(f"Newton: refactor_every={refactor_every!r} must be a whole number >= 1")
+        if not 0.0 < float(slow) < 1.0:
+            raise ModelError(f"Newton: slow={slow!r} must be between 0 and 1 (e.g. 0.25)")
         self.convergence = convergence or Convergence()
         self.line_search = line_search
         self.tangent = tangent
+        self.refactor_every = refactor_every
+        self.slow = float(slow)
         self.factorized = False   # a usable factorisation exists (modified / initial Newton)
 
     def new_step(self):
         """Called at the start of every step (the initial-stiffness tangent is formed again)."""
         self.factorized = False
 
-    def _refactor(self, it, inc, has_dpres):
-        if self.tangent == "full" or not self.factorized:
+    def method(self):
+        """The tangent update used ("auto" resolved)."""
+        return "full" if self.tangent == "auto" else self.tangent
+
+    def _refactor(self, method, it, inc, has_dpres, since, ratios, steps):
+        """A new factorisation due?  ``ratios``: the residual ratios of this attempt, the first one
+        before any iteration; ``steps``: the largest |correction| of each iteration (modified and
+        quasi-Newton only).  Slow: either fell by less than the factor ``slow`` in the last
+        iteration (the residual only while above round-off, 1e-2 of its tolerance)."""
+        if not self.factorized:
             return True
-        if self.tangent == "modified":
-            return it == 0
-        return it == 0 and (has_dpres or inc.viscous is not None)
+        if method == "full":
+            return True
+        if method == "initial":
+            return it == 0 and (has_dpres or inc.viscous is not None)
+        # modified / quasi-Newton: each attempt starts on its own tangent; a new one when the last
+        # iteration reduced the residual ratio by less than the factor `slow` (unless the residual
+        # already meets its tolerance: the iterations left are for the displacement test)
+        if it == 0 or since >= self.refactor_every:
+            return True
+        slow_r = ratios[-1] > 1e-2 * self.convergence.force_tol and ratios[-1] > self.slow * ratios[-2]
+        slow_d = len(steps) >= 2 and steps[-1] > self.slow * steps[-2]
+        return slow_r or slow_d
 
     def solve(self, system, state, inc: Increment, attempt: int = 1) -> Outcome:
         """Solve increment ``inc`` from the committed ``state``: commit it and return
@@ -129,6 +181,11 @@ class Newton:
         dt = inc.dtime
         line_search = self.line_search is True or (self.line_search == "auto" and attempt > 1)
         conv = self.convergence
+        method = self.method()
+        broyden = Broyden() if method == "quasi-newton" and not uses_lam else None
+        since = 0   # iterations on the current factorisation
+        ratios = []  # residual ratios, the first before any iteration (modified / quasi-Newton)
+        steps = []   # largest |correction| of each iteration (modified / quasi-Newton)
 
         def fail(why):
             state.rollback()
@@ -165,6 +222,7 @@ class Newton:
                 if it > 0:
                     ok, ratio = system.converged(conv, r, du, Du, responses, P, iters)
                     rnorm_hist.append(ratio)
+                    ratios.append(ratio)
                     if ok:
                         if visc is not None:
                             visc.converged(state, Du, dt, responses)
@@ -179,7 +237,10 @@ class Newton:
                 # the tangent only when another iteration is needed
                 K = Kfc = None
                 with_fc = it == 0 and has_dpres
-                if self._refactor(it, inc, has_dpres):
+                if self._refactor(method, it, inc, has_dpres, since, ratios, steps):
+                    since = 0
+                    if broyden is not None:
+                        broyden.reset()
                     try:
                         if visc is not None:
                             K, Kfc = system.factorize_csr(responses, with_fc, adjust=lambda K_: visc.tangent(K_, dt))
@@ -199,12 +260,16 @@ class Newton:
                         return fail("singular tangent (bifurcation or mechanism)")
                 elif with_fc:
                     Kfc = system.assembler.coupling([q.k for q in responses])
+                if it == 0 and method in ("modified", "quasi-newton"):   # (after the first tangent's floors)
+                    ratios.append(system.converged(conv, r, None, Du, responses, P, 0)[1])
                 ts = _time.perf_counter()
                 if it == 0 and inc.predict is not None:
                     du_p = system.solver.solve(system.reduce_load(inc.P_ref))
                     dlam = inc.predict(du_p)
                     du = dlam * du_p
                     lam += dlam
+                elif broyden is not None and not with_fc:
+                    du = broyden.direction(system.solver.solve, r)
                 else:
                     rhs = r if Kfc is None else r - Kfc @ dpres
                     du = system.solver.solve(rhs)
@@ -218,6 +283,9 @@ class Newton:
                         lam += dlam
                 summary.solve_time += _time.perf_counter() - ts
                 iters += 1
+                since += 1
+                if method in ("modified", "quasi-newton"):
+                    steps.append(float(np.abs(du).max(initial=0.0)))
                 search = line_search and not uses_lam and not (it == 0 and has_dpres)
                 before = (state.x.copy(), state.R.copy(), state.spin.copy()) if search else None
                 system.update(du, dpres if it == 0 else None)
@@ -230,6 +298,8 @@ class Newton:
                     du, responses, F, r_new = line_search_step(system, state, du, r, r_new, responses, F, before,
                                                                evaluate, P, Du_before)
                     Du = Du_before + du
+                if broyden is not None:   # the secant pair of this step (none across prescribed motion)
+                    broyden.step(du, None if with_fc else r_new)
                 r = r_new
         except (FloatingPointError, SingularModelError, ValueError) as exc:
             bad = system.bad_tangent(exc, responses)
@@ -272,3 +342,48 @@ def line_search_step(system, state, du, r0, r1, responses, F, before, evaluate, 
         system.update(s_best * du)
     system.summary.line_searches += 1
     return s_best * du, resp, F_, r_
+
+
+class Broyden:
+    """The inverse of the factorised tangent with Broyden's ("good") rank-one updates, in product
+    form (Kelley 1995, Iterative Methods for Linear and Nonlinear Equations, alg. 7.3.1 brsol):
+    H_(k+1) = (I + w_k s_k^T) H_k with w_k = (s_k - H_k y_k) / (s_k^T H_k y_k), y_k = r_k - r_(k+1)
+    (the residual r = P - F falls by K s along a step s).  ``direction(solve, r)`` returns H r
+    (one solve with the factorisation, one dot product per stored pair); the pending pair of the
+    last step is completed there from the same solve: H_k y_k = h_k - H_k r_(k+1), with h_k the
+    direction that gave the step."""
+
+    def __init__(self):
+        self.reset()
+
+    def reset(self):
+        """A new factorisation: H = K^-1, no pairs."""
+        self.w, self.s = [], []
+        self._h = None        # H_k r_k, the last direction
+        self._pending = None  # (s_k, h_k) waiting for r_(k+1)
+
+    def _apply(self, solve, v):
+        x = solve(v)
+        for w, s in zip(self.w, self.s):
+            x += w * (s @ x)
+        return x
+
+    def direction(self, solve, r):
+        q = self._apply(solve, r)   # H_k r_(k+1)
+        if self._pending is not None:
+            s, h = self._pending
+            self._pending = None
+            z = h - q               # H_k y_k
+            sz = float(s @ z)
+            if abs(sz) > 1e-12 * float(np.linalg.norm(s) * np.linalg.norm(z)) and np.isfinite(sz):
+                w = (s - z) / sz
+                self.w.append(w)
+                self.s.append(s)
+                q += w * (s @ q)    # H_(k+1) r_(k+1)
+        self._h = q
+        return q
+
+    def step(self, s, r_new):
+        """The step s taken along the last direction (scaled by a line search or not); r_new None:
+        no secant pair from this step (it also moved prescribed values)."""
+        self._pending = (s.copy(), self._h) if (r_new is not None and self._h is not None) else None

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import progress
-from ..errors import StudyError
+from ..errors import SampleTimeout, StudyError
 from .store import Store
 from .study import Study
 
@@ -65,15 +65,46 @@ class RunSummary:
             else ", 0 failed"
         res = f" ({self.resumed} already on disk)" if self.resumed else ""
         return (f"study {state}: {self.samples} samples, {self.runs} runs{res}; this call ran {self.ran}: {self.ok} ok"
-                f"{fail}; wall time {self.wall_time:.1f} s, CPU {self.cpu_time:.1f} s, {self.workers} "
+                f"{fail}; wall time {self.wall_time:.1f} s, CPU {self.cpu_time:.1f} s"
+                f"{' (this process; not the dask workers)' if self.engine == 'dask' else ''}, {self.workers} "
                 f"{self.engine} worker(s) (warm-up {self.warmup_time:.1f} s); results in {self.folder}")
 
 
 # ---------------------------------------------------------------- one chunk (any process)
+class _Timer:
+    """A SIGALRM timer raising SampleTimeout after ``seconds`` (only in a main thread, Unix)."""
+
+    def __init__(self, seconds):
+        import signal
+        import threading
+
+        self.seconds = seconds
+        self.on = (seconds is not None and hasattr(signal, "setitimer")
+                   and threading.current_thread() is threading.main_thread())
+
+    def _alarm(self, signum, frame):
+        raise SampleTimeout(f"the sample ran over timeout_s = {self.seconds:g} s (wall clock); it is stopped")
+
+    def __enter__(self):
+        if self.on:
+            import signal
+
+            self.old = signal.signal(signal.SIGALRM, self._alarm)
+            signal.setitimer(signal.ITIMER_REAL, self.seconds)
+
+    def __exit__(self, *exc):
+        if self.on:
+            import signal
+
+            signal.setitimer(signal.ITIMER_REAL, 0.0)
+            signal.signal(signal.SIGALRM, self.old)
+
+
 def _sample(study: Study, values: dict):
     t0 = time.perf_counter()
     try:
-        out = study.evaluate(values)
+        with _Timer(study.timeout_s):
+            out = study.evaluate(values)
         for k, v in out.items():
             if not np.all(np.isfinite(v)):
                 raise StudyError(f"output '{k}' is not finite ({v}); the sample is counted as failed")
@@ -135,7 +166,8 @@ def warm(study: Study) -> float:
     other failure of the nominal sample is left to the samples (which record it)."""
     t0 = time.perf_counter()
     try:
-        study.evaluate(study.nominal_values())
+        with _Timer(study.timeout_s):
+            study.evaluate(study.nominal_values())
     except StudyError as exc:
         raise StudyError(f"the nominal sample (inputs at their medians): {exc}") from None
     except Exception:

@@ -37,12 +37,15 @@ class Study:
     sampler, seed, sensitivity, correlation : the design (:class:`~femast.studies.sampling.Design`).
     analysis : options of :class:`~femast.Analysis` for ``model=`` studies (e.g. convergence).
     units : {output name: unit} for tables and figures (``run=`` studies; node outputs know theirs).
+    timeout_s : wall-clock seconds after which a sample is stopped and recorded as failed
+        (SampleTimeout); None: no limit.  Enforced in this process and in local workers (a
+        SIGALRM timer, Unix), not on dask workers (their samples run in threads).
     name : a label for summaries and figures.
     """
 
     def __init__(self, model=None, *, run=None, inputs, outputs, sampler: str = "sobol", seed: int = 1,
                  sensitivity: bool = False, correlation: dict | None = None, analysis: dict | None = None,
-                 units: dict | None = None, name: str = "study"):
+                 units: dict | None = None, timeout_s: float | None = None, name: str = "study"):
         if (model is None) == (run is None):
             raise StudyError("give a study either model=FACTORY (returns a femast Model; femast runs it) or "
                              "run=FUNCTION (runs a sample, returns a dict of outputs), not both / neither")
@@ -84,6 +87,14 @@ class Study:
             self.units[k] = str(u)
         self.analysis = dict(analysis or {})
         self.name = str(name)
+        if timeout_s is not None:
+            try:
+                timeout_s = float(timeout_s)
+            except (TypeError, ValueError):
+                timeout_s = -1.0
+            if not timeout_s > 0.0 or timeout_s != timeout_s:
+                raise StudyError("timeout_s must be a number of seconds > 0 (or None: no limit)")
+        self.timeout_s = timeout_s
         self.labels = {}   # output name -> names along each axis (model= studies, set by check())
         self._checked = False
 

@@ -18,11 +18,12 @@ name        what                                                 needs
 
 **The automatic choice** (``backend="auto"``, :func:`choose`): the band back-end when the
 ordering is reverse Cuthill-McKee and its band is narrow (:func:`~femast.analysis.solvers.banded.band_rule`:
-the band storage of one triangle, n (b + 1), at most 4x the entries of K's triangle), else
-SuperLU.  CHOLMOD and PARDISO are never chosen automatically: on every femast tangent measured
-(the 40-1000 bay masts, the ADAM bay and mast; ``python benchmarks/solver_backends.py``) one of
-the two built-in back-ends was the faster; they stay available by name.  A back-end named but not
-installed falls back to SuperLU with a warning that says how to install it.
+the band storage of one triangle, n (b + 1), at most 4x the entries of K's triangle: the masts);
+otherwise PARDISO when it is installed and the model has at least :data:`PARDISO_MIN_DOFS` DOFs
+(the ADAM mast: 1.0-2.0x faster than SuperLU); otherwise SuperLU.  CHOLMOD is never chosen
+automatically (slower than the band on the masts, and most tangents of the unbanded models are
+unsymmetric).  Measurements: ``python benchmarks/solver_backends.py``, docs/performance.md.  A
+back-end named but not installed falls back to SuperLU with a warning that says how to install it.
 """
 
 from __future__ import annotations
@@ -34,6 +35,8 @@ import numpy as np
 from .banded import SYMMETRY_TOL, BandedFactor, band_of, band_rule, refine
 
 NAMES = ("auto", "superlu", "banded", "cholmod", "pardiso")
+PARDISO_MIN_DOFS = 1000   # the automatic choice takes PARDISO (when installed) from this size on
+THREADS = 1               # MKL threads of PARDISO
 INSTALL = {"cholmod": "pip install 'femast[cholmod]' (scikit-sparse; on Debian first: apt-get install "
                       "libsuitesparse-dev)",
            "pardiso": "pip install 'femast[pardiso]' (pypardiso, Intel MKL)"}
@@ -57,6 +60,8 @@ def choose(backend: str, B, ordering: str) -> str:
         n = B.shape[0]
         if ordering == "rcm" and band_rule(n, band_of(B.indptr, B.indices), B.nnz):
             return "banded"
+        if n >= PARDISO_MIN_DOFS and available("pardiso")[0]:
+            return "pardiso"
         return "superlu"
     if backend in ("cholmod", "pardiso"):
         ok, why = available(backend)
@@ -192,6 +197,10 @@ class PardisoFactor:
         import pypardiso
 
         self._ps = ps = pypardiso.PyPardisoSolver(mtype=11)
+        try:   # one thread: reproducible bits from run to run, and no waiting on a shared core
+            ps.libmkl.MKL_Set_Num_Threads(ctypes.c_int(THREADS))
+        except AttributeError:  # pragma: no cover - an MKL without the symbol
+            pass
         self.B = B
         n = B.shape[0]
         ps.iparm[:] = 0
@@ -202,6 +211,7 @@ class PardisoFactor:
         ps.iparm[11] = 2      # transposed solve: the CSC arrays are B^T's CSR arrays
         ps.iparm[12] = 1      # weighted matching
         ps.iparm[34] = 1      # zero-based indices
+        ps.iparm[17] = -1     # report the entries of the factors
         self._ia = B.indptr.astype(np.int32)
         self._ja = B.indices.astype(np.int32)
         self._n = ctypes.c_int32(n)

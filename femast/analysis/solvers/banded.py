@@ -52,9 +52,9 @@ def band_rule(n: int, bandwidth: int, nnz: int) -> bool:
 
 
 @njit(cache=True)
-def _fill(data, to_chol, to_lu, partner, chol, lu):
-    """Scatter B's values into the Cholesky band (the mean of (i, j) and (j, i), lower triangle)
-    and the LU band; returns (max |B_ij - B_ji|, max |B_ij|)."""
+def _fill(data, to_chol, partner, chol):
+    """Scatter the symmetric part of B (the mean of (i, j) and (j, i)) into the lower Cholesky
+    band; returns (max |B_ij - B_ji|, max |B_ij|)."""
     asym = 0.0
     big = 0.0
     for k in range(data.shape[0]):
@@ -62,7 +62,6 @@ def _fill(data, to_chol, to_lu, partner, chol, lu):
         a = abs(v)
         if a > big:
             big = a
-        lu[to_lu[k]] = v
         p = partner[k]
         w = data[p] if p >= 0 else 0.0
         d = abs(v - w)
@@ -71,6 +70,12 @@ def _fill(data, to_chol, to_lu, partner, chol, lu):
         if to_chol[k] >= 0:
             chol[to_chol[k]] = 0.5 * (v + w)
     return asym, big
+
+
+@njit(cache=True)
+def _scatter(data, to, out):
+    for k in range(data.shape[0]):
+        out[to[k]] = data[k]
 
 
 @njit(cache=True)
@@ -143,9 +148,7 @@ class BandedFactor:
         """Factorise the current values of B; returns self (the factor object, with ``solve``).
         Raises RuntimeError on an exactly zero pivot of the LU (a singular matrix)."""
         self._chol.fill(0.0)
-        self._lu.fill(0.0)
-        asym, big = _fill(self.B.data, self._to_chol, self._to_lu, self._partner,
-                          self._chol.reshape(-1, order="F"), self._lu.reshape(-1, order="F"))
+        asym, big = _fill(self.B.data, self._to_chol, self._partner, self._chol.reshape(-1, order="F"))
         self.asymmetry = asym / big if big > 0 else 0.0
         if self.allow_cholesky and self._lu_only == 0 and self.asymmetry <= SYMMETRY_TOL:
             c, info = lapack.dpbtrf(self._chol, lower=1, overwrite_ab=1)
@@ -160,7 +163,10 @@ class BandedFactor:
         return self
 
     def _factor_lu(self):
+        """The band LU of B's current values (the band filled only here: 3b + 1 rows)."""
         b = self.b
+        self._lu.fill(0.0)
+        _scatter(self.B.data, self._to_lu, self._lu.reshape(-1, order="F"))
         lu, ipiv, info = lapack.dgbtrf(self._lu, b, b, overwrite_ab=1)
         if info > 0:
             raise RuntimeError("Factor is exactly singular")
@@ -188,9 +194,6 @@ class BandedFactor:
             return x
         # the LU of B itself, kept for the other solves of this tangent
         self.fallbacks += 1
-        self._lu.fill(0.0)
-        _fill(self.B.data, self._to_chol, self._to_lu, self._partner, self._chol.reshape(-1, order="F"),
-              self._lu.reshape(-1, order="F"))
         self._factor_lu()
         return self.solve(rhs)
 
