@@ -147,7 +147,8 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     start = dict(zip(baseline.names, baseline.x))
     payload0 = {"source": exp.source, "options": exp.options, "scripts": list(loaded_scripts()),
                 "data_experiment": data.experiment, "columns": data.columns, "path": data.path,
-                "lines": data.lines, "start": start, "noise": sigma}
+                "lines": data.lines, "start": start, "noise": sigma,
+                "sensitivity": getattr(baseline, "sensitivity", None)}   # seeds the refits' Jacobians (issue 21)
     # stage 1: the forms of the added effects (shape mismatch) and the default form of each candidate;
     # stage 2: the generalised forms of the candidates whose default form has an information-criterion
     # gain (under the null nothing does, and the generalised forms cannot gain where it did not),
