@@ -139,13 +139,12 @@ def main(argv=None):
     axs[2].plot(sw[:, 0], sw[:, 1], "o-", color="#c0392b", label="residual rotation (deg)")
     axs[2].plot(sw[:, 0], sw[:, 2] * 0.1, "s--", color="0.4", label="bead travel from backstop (mm) / 10")
     axs[2].set_xlabel("largest twist of the cycle (degrees)")
+    axs[2].set_ylabel("residual rotation (degrees); bead travel (mm) / 10")
     axs[2].set_title("hysteresis needs a bead to leave its backstop")
     axs[2].grid(alpha=0.3)
     axs[2].legend(fontsize=8)
     png = out / "hysteresis.png"
-    fig.tight_layout()
     plotstyle.save(fig, png, dpi=120)
-    plt.close(fig)
     if args.docs:
         shutil.copy(png, DOCS / "adam_hysteresis.png")
     if not args.skip_mast:

@@ -27,7 +27,7 @@ def main(out="benchmarks/out"):
     w = np.linspace(0, vm["w"].max(), 400)
     ax[0].plot(w / vm["h"], ref.von_mises_truss_load(w, 1.0, 0.1, 1e6) / vm["P_limit"], "k-", label="analytic")
     ax[0].plot(vm["w"] / vm["h"], vm["P"] / vm["P_limit"], "o", ms=4, label="femast, arc length")
-    ax[0].set(xlabel="apex deflection / rise", ylabel="P / P_limit", title="von Mises truss (a = 1, h = 0.1)")
+    ax[0].set(xlabel="apex deflection / rise (-)", ylabel="P / P_limit (-)", title="von Mises truss (a = 1, h = 0.1)")
     err_vm = np.abs(vm["P"] - vm["P_exact"]).max() / vm["P_limit"]
 
     lee = va.lee_frame()
@@ -36,8 +36,9 @@ def main(out="benchmarks/out"):
     for k, comp in ((1, "v"), (2, "u")):
         ax[k].plot(getattr(path, comp), path.load, "k-", label="elastica (reference)")
         ax[k].plot(lee[comp], lee["P"], "o", ms=3, label="femast, 10 el./member")
-        ax[k].set(xlabel=f"load point {'vertical (down)' if comp == 'v' else 'horizontal'} displacement",
-                  ylabel="P", title=f"Lee's frame: P - {comp}")
+        ax[k].set(xlabel=f"load point {'vertical (down)' if comp == 'v' else 'horizontal'} displacement "
+                         "(length unit of L = 120)",
+                  ylabel="P (force unit of E = 7.2e6)", title=f"Lee's frame: P - {comp}")
     inside = lee["v"] <= path.v.max()
     err_lee = max(path.distance(lee["P"][inside], lee[c][inside], P_lim, 90.0, c).max() for c in "vu")
 

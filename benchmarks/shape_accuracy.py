@@ -2,22 +2,25 @@
 seed 001): how far is the tip from where it should be, after deployment and after the Table 1
 load cycles, which inputs drive it, and how does it grow with the number of bays?
 
-    femast run benchmarks/shape_accuracy.py [--bays 10 20 40] [--samples 32 32 16] [--big 350]
-                                            [--big-samples 4] [--workers 2] [--out DIR] [--docs]
+    femast run benchmarks/shape_accuracy.py [--bays 10 20] [--samples 32 32] [--plain-bays 40]
+                                            [--plain-samples 64] [--big 350] [--big-samples 4]
+                                            [--workers 2] [--out DIR] [--report-only] [--docs]
 
 For each mast (n bays of seed 001's bay, femast.adam defaults) a study of ``femast.studies`` draws
-``--samples`` base samples of the stated scatter (femast/adam/shape_study.py SCATTER, every value
-independent per element, uniform):
+samples of the stated scatter (femast/adam/shape_study.py SCATTER, every value independent per
+element, uniform):
 
 * ball-joint friction coefficient 0.5 +- 20 % per joint,
 * latch roller stiffness 100 N/mm and friction 0.07, +- 20 % per latch,
 * cable pretension 170 N +- 10 % per bay side,
 * member length errors +- 0.05 mm per longeron, batten, arm cable and latch-cable section,
 
-with Saltelli's layout (``--samples`` x 10 runs: the A and B blocks are plain samples, the AB
-blocks give first-order and total Sobol' indices of each input group).  Each run deploys the mast
-(pretension step, seed Sec. II.C) and applies ``--cycles`` Table 1 cycles (M = 6.8 N m, F = 14 N).
-The ``--big`` mast (default 350 bays ~ 60 m, ATK's length) runs ``--big-samples`` plain samples.
+the ``--bays`` masts with Saltelli's layout (``--samples`` base samples x 10 runs: the A and B
+blocks are plain samples, the AB blocks give first-order and total Sobol' indices of each input),
+the ``--plain-bays`` masts with ``--plain-samples`` Latin-hypercube samples (distributions only),
+the ``--big`` mast (default 350 bays ~ 60 m, ATK's length) with ``--big-samples`` plain samples.
+Each run deploys the mast (pretension step, seed Sec. II.C) and applies ``--cycles`` Table 1
+cycles (M = 6.8 N m, F = 14 N).  A study resumes what is on disk; ``--report-only`` runs nothing.
 
 Errors: the tip (control node) of each sample minus the tip of the nominal mast (no scatter) at
 the same stage: after deployment and at the end of the cycles; and the *load-cycle residual* of a
@@ -48,6 +51,7 @@ DOCS = ROOT / "docs" / "figures"
 ARCSEC = 180.0 / np.pi * 3600.0
 ATK_LENGTH_M = 1.3e-3          # seed 001 Sec. I: ATK's length accuracy and repeatability, +- m over 60 m
 ATK_ROT_RAD = np.radians(0.02)  # +- 0.02 deg of rotational misalignment over 60 m
+ATK_BAYS = 350                  # 350 bays of 0.171 m: 59.9 m, ATK's 60 m
 SEED_BAY_RESIDUAL_RAD = np.radians(0.10)   # seed Sec. VIII: residual rotation of one bay at zero moment
 FIELDS = [f for _, f, *_ in SCATTER]
 GROUP_OF = {f: g for g, f, *_ in SCATTER}
@@ -104,18 +108,22 @@ def p95_abs(x):
     return st.percentile(np.abs(x), 0.95)
 
 
-def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=False):
+def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=False, big=False):
     t0 = time.perf_counter()
+    folder = out / (f"bays{n_bays}" if sensitivity else f"bays{n_bays}_plain")
     nominal = tip_history(n_bays, None, cycles=cycles)
     if report_only:   # the runs are on disk (an earlier call): statistics and figures only
         summary = "results read from disk (--report-only)"
     else:
         study = make_study(n_bays, cycles, sensitivity)
-        summary = st.run(study, out / f"bays{n_bays}", samples=samples, workers=workers)
-    res = st.load(out / f"bays{n_bays}")
+        summary = st.run(study, folder, samples=samples, workers=workers)
+    res = st.load(folder)
     blocks = ("A", "B") if sensitivity else ("A",)
     u, th = res.output("tip_u", blocks=blocks), res.output("tip_rot", blocks=blocks)
-    m = metrics(u, th, nominal["u"], nominal["theta"])
+    if len(u) == 0 or np.ndim(u) != 3:     # nothing finished yet
+        m = {name: np.array([]) for name, *_ in METRICS}
+    else:
+        m = metrics(u, th, nominal["u"], nominal["theta"])
     cpu = res.table(["seconds"])["seconds"]
     sob = {}
     if sensitivity:
@@ -131,7 +139,7 @@ def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=Fal
             except Exception as exc:   # a constant output (e.g. no residual at all) has no indices
                 print(f"  no Sobol' indices for {name}: {exc}")
         sob["_dropped"] = dropped
-    return {"n_bays": n_bays, "nominal": nominal, "metrics": m, "summary": str(summary), "sobol": sob,
+    return {"n_bays": n_bays, "big": big, "nominal": nominal, "metrics": m, "summary": str(summary), "sobol": sob,
             "failures": res.failures(), "counts": res.counts(), "run_seconds": cpu,
             "wall_s": time.perf_counter() - t0}
 
@@ -161,7 +169,7 @@ def fig_distributions(r, png):
 def growth_fit(results, name, unit):
     """Exponent b and prefactor of 95th pct |metric| = a n^b fitted (log-log least squares) on the
     sampled masts with Sobol' layout (the big mast, few runs, is the check)."""
-    rs = [r for r in results if r["sobol"]]
+    rs = [r for r in results if not r["big"]]
     n = np.array([r["n_bays"] for r in rs], float)
     p = np.array([p95_abs(r["metrics"][name] * SCALE[unit])["estimate"] for r in rs])
     if len(rs) < 2 or not np.all(p > 0):
@@ -173,8 +181,8 @@ def growth_fit(results, name, unit):
 def fig_growth(results, png):
     plt = plotstyle.pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(12.5, 4.8))
-    sampled = [r for r in results if r["sobol"]]
-    big = [r for r in results if not r["sobol"]]
+    sampled = [r for r in results if not r["big"]]
+    big = [r for r in results if r["big"]]
     lb = BayParameters().l
     for ax, unit in zip(axes, ("um", "arcsec")):
         for k, (name, u, what) in enumerate(METRICS):
@@ -188,20 +196,26 @@ def fig_growth(results, png):
             b, a = growth_fit(results, name, u)
             ax.errorbar(n * lb, est, yerr=[lo, hi], marker="o", capsize=3, color=f"C{k}",
                         label=f"{what} (~ n^{b:.2f})")
-            if big and np.isfinite(b):
-                nn = np.array([n.min(), big[0]["n_bays"]], float)
+            if np.isfinite(b):
+                nn = np.array([n.min(), big[0]["n_bays"] if big else ATK_BAYS], float)
                 ax.plot(nn * lb, a * nn ** b, ls=":", color=f"C{k}", lw=1)
+            if big:
                 v = np.abs(big[0]["metrics"][name] * SCALE[u])
                 ax.plot(np.full(len(v), big[0]["n_bays"] * lb), v, ls="none", marker="x", color=f"C{k}")
         atk = ATK_LENGTH_M * 1e6 if unit == "um" else ATK_ROT_RAD * ARCSEC
         ax.axhline(atk, color="k", ls="--", lw=1, label=f"ATK +-{'1.3 mm' if unit == 'um' else '0.02 deg'} over 60 m")
         ax.set_xscale("log")
         ax.set_yscale("log")
+        from matplotlib.ticker import FuncFormatter, NullFormatter
+
+        ax.set_xticks([1, 2, 5, 10, 20, 60])
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel(plotstyle.axis_label("mast length", "m"))
         ax.set_ylabel(plotstyle.axis_label("95th percentile of |error|", unit))
         ax.legend(loc="best", fontsize=7.5)
-    fig.suptitle("Growth with the number of bays: o 95th percentile (bars: its 95 % interval), dotted: power-law "
-                 "fit extrapolated, x: single runs of the long mast")
+    fig.suptitle("Growth with the number of bays: o 95th percentile (bars: its 95 % interval; no upper bound below "
+                 "72 samples), dotted: power-law fit extrapolated to 60 m, x: single runs of the long mast")
     fig.tight_layout()
     return plotstyle.save(fig, png)
 
@@ -232,16 +246,19 @@ def fig_sensitivity(r, png):
     return plotstyle.save(fig, png)
 
 
-def fig_residual_scaling(results, png):
+def fig_residual_scaling(results, png, nominal_only=()):
     plt = plotstyle.pyplot()
     fig, ax = plt.subplots(figsize=(7.0, 4.6))
+    every = sorted(list(results) + list(nominal_only), key=lambda r: r["n_bays"])
+    nn_nom = np.array([r["n_bays"] for r in every])
+    nom = np.array([abs(r["nominal"]["theta"][-1, 2] - r["nominal"]["theta"][0, 2]) for r in every])
     n = np.array([r["n_bays"] for r in results])
-    nom = np.array([abs(r["nominal"]["theta"][-1, 2] - r["nominal"]["theta"][0, 2]) for r in results])
-    med = np.array([np.median(np.abs(r["metrics"]["cycle_twist"])) for r in results])
+    # a median of exactly 0 (no residual) is drawn at 1e-6 deg on the log axis
+    med = np.maximum(np.array([np.median(np.abs(r["metrics"]["cycle_twist"])) for r in results]), np.radians(1e-6))
     p95 = np.array([p95_abs(r["metrics"]["cycle_twist"])["estimate"] for r in results])
-    nn = np.linspace(1, n.max(), 50)
+    nn = np.linspace(1, nn_nom.max(), 50)
     ax.plot(nn, np.degrees(nn / 2 * SEED_BAY_RESIDUAL_RAD), "k--", label="seed's estimate: n/2 bays x 0.10 deg")
-    ax.plot(n, np.degrees(nom), "o-", color="C0", label="full model, nominal mast")
+    ax.plot(nn_nom, np.degrees(nom), "o-", color="C0", label="full model, nominal mast")
     ax.plot(n, np.degrees(med), "s-", color="C1", label="full model, scatter: median")
     ax.plot(n, np.degrees(p95), "^-", color="C3", label="full model, scatter: 95th percentile")
     ax.axhline(np.degrees(ATK_ROT_RAD), color="C2", lw=1, label="ATK 0.02 deg over 60 m")
@@ -262,10 +279,13 @@ def _fmt(p, unit):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--bays", type=int, nargs="+", default=[10, 20, 40])
-    ap.add_argument("--samples", type=int, nargs="+", default=[32, 32, 16],
-                    help="base samples per mast (x 10 runs: Saltelli layout; one number or one per --bays)")
-    ap.add_argument("--big", type=int, default=350, help="bays of the long mast (0: none)")
+    ap.add_argument("--bays", type=int, nargs="+", default=[10, 20],
+                    help="masts with Sobol' indices (Saltelli layout)")
+    ap.add_argument("--samples", type=int, nargs="+", default=[32, 32],
+                    help="base samples per --bays mast (x 10 runs; one number or one per mast)")
+    ap.add_argument("--plain-bays", type=int, nargs="*", default=[40], help="masts with plain (LHS) samples only")
+    ap.add_argument("--plain-samples", type=int, default=64)
+    ap.add_argument("--big", type=int, default=350, help="bays of the long mast, a few plain samples (0: none)")
     ap.add_argument("--big-samples", type=int, default=4)
     ap.add_argument("--cycles", type=int, default=1, help="Table 1 cycles after deployment")
     ap.add_argument("--workers", type=int, default=2)
@@ -284,10 +304,19 @@ def main(argv=None):
         print(f"\n== {n} bays ({n * BayParameters().l:.2f} m): {ns} base samples x {len(FIELDS) + 2} runs")
         results.append(run_mast(n, ns, args.cycles, args.workers, out, sensitivity=True,
                                 report_only=args.report_only))
+    for n in args.plain_bays:
+        print(f"\n== {n} bays ({n * BayParameters().l:.2f} m): {args.plain_samples} plain (LHS) samples")
+        results.append(run_mast(n, args.plain_samples, args.cycles, args.workers, out, sensitivity=False,
+                                report_only=args.report_only))
     if args.big:
         print(f"\n== {args.big} bays ({args.big * BayParameters().l:.2f} m): {args.big_samples} plain samples")
         results.append(run_mast(args.big, args.big_samples, args.cycles, args.workers, out, sensitivity=False,
-                                report_only=args.report_only))
+                                report_only=args.report_only, big=True))
+    nominal_only = []
+    for r in [r for r in results if len(r["metrics"]["deploy_axial"]) == 0]:
+        print(f"\n{r['n_bays']} bays: no finished run on disk; only the nominal mast is shown")
+        results.remove(r)
+        nominal_only.append(r)
     summary = {"scatter": [list(r) for r in stated_inputs(1)], "cycles": args.cycles, "masts": []}
     for r in results:
         n = r["n_bays"]
@@ -313,20 +342,22 @@ def main(argv=None):
                                                         for i in top))
             row["sobol"][name] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in s.items()}
         summary["masts"].append(row)
-    pngs = [fig_distributions(next(r for r in results if r["n_bays"] == max(args.bays)),
-                              out / "shape_accuracy_distributions.png"),
+    main_mast = max((r for r in results if not r["big"]), key=lambda r: r["n_bays"])
+    pngs = [fig_distributions(main_mast, out / "shape_accuracy_distributions.png"),
             fig_growth(results, out / "shape_accuracy_growth.png"),
-            fig_sensitivity(next(r for r in results if r["n_bays"] == max(args.bays)),
+            fig_sensitivity(max((r for r in results if r["sobol"]),     # the one with most complete base samples
+                                key=lambda r: max([v["n"] for k, v in r["sobol"].items() if not k.startswith("_")]
+                                                  + [0])),
                             out / "shape_accuracy_sensitivity.png"),
-            fig_residual_scaling(results, out / "shape_accuracy_residual_scaling.png")]
-    nb = args.big or max(args.bays)
-    big = next((r for r in results if r["n_bays"] == nb), None)
+            fig_residual_scaling(results, out / "shape_accuracy_residual_scaling.png", nominal_only)]
+    nb = args.big or ATK_BAYS
+    big = next((r for r in results if r["n_bays"] == nb and r["big"]), None)
     print(f"\n{nb} bays ({nb * BayParameters().l:.1f} m) against ATK's requirement (over 60 m):")
     for name, unit, what in METRICS:
         lim = ATK_LENGTH_M * 1e6 if unit == "um" else ATK_ROT_RAD * ARCSEC
         b, a = growth_fit(results, name, unit)
         line = f"  {what:40s} fit 95th pct ~ n^{b:.2f}: {a * nb ** b:.4g} {unit} = {a * nb ** b / lim:.3g} x ATK"
-        if big is not None and not big["sobol"]:
+        if big is not None and big["big"]:
             v = np.abs(big["metrics"][name] * SCALE[unit])
             line += f"; {len(v)} runs: max {v.max():.4g} {unit} = {v.max() / lim:.3g} x ATK"
         print(line)

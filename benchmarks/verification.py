@@ -159,40 +159,41 @@ def modal_cases(out):
     for k in (0, 2, 4):
         yz = modes.shapes[k, order, 1:3]      # a mode of a degenerate (y, z) pair: w(x) along one direction
         w = yz @ np.linalg.svd(yz, full_matrices=False)[2][0]
-        ax.plot(modes.x[order, 0], w * np.sign(w[len(w) // 4 or 1]),
-                label=f"f = {modes.frequencies[k]:.4f} Hz (exact {25 * (k // 2 + 1):.0f})")
+        ax.plot(modes.x[order, 0], w * np.sign(w[len(w) // 4 or 1]),   # errors: the table, not the legend
+                label=f"f = {plotstyle.num(modes.frequencies[k], 4)} Hz (exact {25 * (k // 2 + 1):.0f} Hz)")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("transverse mode shape (mass-normalised, m/sqrt(kg))")
     ax.set_title("Taut string, T = 100 N, m' = 0.01 kg/m, 100 cables")
     ax.legend(fontsize=8)
     r, modes = vm.cantilever()
     rows += r
+    f_exact = [row.reference for row in r]   # the closed forms of the table (Euler-Bernoulli cantilever)
     ax = axes[1]
     order = np.argsort(modes.x[:, 0])
     for k in (0, 2, 4):
         yz = modes.shapes[k, order, 1:3]
         w = yz @ np.linalg.svd(yz, full_matrices=False)[2][0]
-        ax.plot(modes.x[order, 0], w / w[np.argmax(np.abs(w))], label=f"f = {modes.frequencies[k]:.5f} Hz")
-    ax.set_xlabel("x / L")
+        ax.plot(modes.x[order, 0], w / w[np.argmax(np.abs(w))],
+                label=f"f = {plotstyle.num(modes.frequencies[k], 4)} Hz (exact {plotstyle.num(f_exact[k // 2], 4)} Hz)")
+    ax.set_xlabel("x / L (-)")
+    ax.set_ylabel("transverse mode shape, 1 at its largest (-)")
     ax.set_title("Cantilever, EI = m = L = 1, 20 beams")
     ax.legend(fontsize=8)
     r, (ratios, f2, exact) = vm.pinned_beam_axial()
     rows += r
     ax = axes[2]
     pp = np.linspace(-1.3, 1.0, 50)
-    ax.plot(pp, exact[ratios == 0][0] * (1 + pp), "k-", lw=1, label="f0^2 (1 + P/P_E)")
+    ax.plot(pp, exact[ratios == 0][0] * (1 + pp), "k-", lw=1, label="exact: f0^2 (1 + P/P_E)")
     ax.plot(ratios, f2, "o", label="femast, 48 beams (sign(f) f^2)")
     ax.axhline(0, color="0.6", lw=0.8)
     ax.axvline(-1, color="0.6", lw=0.8, ls="--")
-    ax.set_xlabel("axial force P / P_E (tension > 0)")
+    ax.set_xlabel("axial force P / P_E (-, tension > 0)")
     ax.set_ylabel("f_1^2 (Hz^2)")
     ax.set_title("Pin-ended beam under axial force")
     ax.legend(fontsize=8)
     rows += vm.rigid_body_springs()[0]
     rows += vm.pendulum()[0]
-    fig.tight_layout()
-    fig.savefig(out / "modal_verification.png", dpi=110)
-    plt.close(fig)
+    plotstyle.save(fig, out / "modal_verification.png", dpi=110)
     return rows
 
 

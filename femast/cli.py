@@ -49,7 +49,8 @@ def _run(args):
 def _vtk(args):
     from .post.vtk import export_vtk
 
-    pvd = export_vtk(args.results, args.out, every=args.every)
+    out = Path(args.out) / Path(args.results).resolve().name   # ./vtk/NAME: beside render's ./render (issue 17)
+    pvd = export_vtk(args.results, out, every=args.every)
     print(f"wrote {pvd} (open it in ParaView; apply 'Warp By Vector' with U to see the deformed shape)")
 
 
@@ -140,7 +141,8 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Write one .vtu file per frame and a .pvd series for ParaView (open the .pvd, "
                                    "apply 'Warp By Vector' with U).")
     p.add_argument("results", help="results folder written by an analysis (fm.solve(model, FOLDER))")
-    p.add_argument("--out", default=None, help="output folder (default: RESULTS/vtk)")
+    p.add_argument("--out", default="vtk", help="folder in which a subfolder named after RESULTS gets the "
+                                                 "series (default: vtk, in the working directory)")
     p.add_argument("--every", type=int, default=1, help="write every n-th frame")
     p.set_defaults(func=_vtk)
     p = sub.add_parser("render", help="render the deformed shape to PNG off-screen", formatter_class=_Help,

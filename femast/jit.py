@@ -2,18 +2,21 @@
 
 numba compiles each kernel the first time it is called and keeps it in its on-disk cache (beside
 the installed package, or in ``NUMBA_CACHE_DIR``); only kernels a model calls are compiled.  On a
-fresh install the first analysis therefore waits for the compiler.  :func:`watch` (installed by
-:class:`femast.Analysis` and the experiments) prints, once per process and only if something is
-actually being compiled, ::
+fresh install the first analysis therefore meets the compiler.  :func:`prepare` (called by every
+:class:`femast.Analysis`) hands that compile to a background worker process while small analyses
+run the kernels uncompiled (:mod:`femast.jit_background`), and prints once per process, only if
+something is actually being compiled, ::
 
-    femast: compiling femast kernels, first run only, ~12 s (`femast warmup` does it ahead)
+    femast: compiling femast kernels in a background process, first run only, ~12 s; small analyses
+    run uncompiled meanwhile (`femast warmup` compiles ahead)
 
-to stderr; ``femast --quiet`` or ``FEMAST_QUIET=1`` silences it.  The estimate is the sum of
-the measured cold-compile CPU times (:data:`COMPILE_S`) of the kernels of the loaded femast modules
-whose cache is missing.
+to stderr (or "compiling femast kernels, first run only, ~12 s" when numba compiles in the
+process: ``FEMAST_BACKGROUND_COMPILE=0``, kernels called outside an analysis); ``femast --quiet``
+or ``FEMAST_QUIET=1`` silences it.  The estimate is the sum of the measured cold-compile CPU times
+(:data:`COMPILE_S`) of the kernels of the loaded femast modules whose cache is missing.
 
-:func:`warmup` compiles every kernel ahead by running small models of each element family (for
-CI images and cluster workers, whose first job should not pay for it).
+:func:`warmup` compiles every kernel ahead, in this process, by running small models of each
+element family (for CI images and cluster workers, whose first job should not pay for it).
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ import time
 # cold compile CPU time of the main kernels, s (numba 0.68, one core of the development machine,
 # recorded with numba's compile events; benchmarks/cold_start.py measures the whole first run).
 COMPILE_S = {
-    "femast.elements.beam_corot.beam_family_kernel": 11.0,
+    "femast.elements.beam_corot.beam_family_kernel": 8.5,   # 11-12 s before the end loops (issue 17)
     "femast.analysis.configuration.update_configuration": 1.9,
     "femast.rotations.apply_spins": 1.0,
     "femast.analysis.solvers.convergence.force_moment_abs_max": 0.9,

@@ -34,6 +34,7 @@ analyses would start one worker each) and in ``femast warmup``.
 
 from __future__ import annotations
 
+import atexit
 import base64
 import hashlib
 import json
@@ -170,7 +171,19 @@ def _start_worker() -> subprocess.Popen:
     env["PYTHONPATH"] = os.pathsep.join([root] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p])
     _worker = subprocess.Popen([sys.executable, "-m", "femast.jit_background"], stdin=subprocess.PIPE,
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, text=True)
+    atexit.register(_let_worker_finish, _worker)
     return _worker
+
+
+def _let_worker_finish(worker: subprocess.Popen) -> None:
+    """At exit: close the request pipe (the worker compiles what is queued, then ends by itself)
+    and do not wait for it; ``returncode`` set so that Popen does not warn that it still runs."""
+    try:
+        worker.stdin.close()
+    except OSError:
+        pass
+    if worker.poll() is None:
+        worker.returncode = 0
 
 
 def _request(dispatcher, sig, claim: str) -> bool:

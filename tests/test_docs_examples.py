@@ -5,7 +5,8 @@ import re
 import pytest
 from doc_examples import run_python_blocks, printed_in
 PAGES = ["getting_started.md", "model.md", "solver.md", "results.md", "stabilize.md", "arc_length.md",
-         "constraints.md", "robustness.md", "restart.md", "misfit_and_thermal.md", "studies.md"]
+         "constraints.md", "robustness.md", "restart.md", "misfit_and_thermal.md", "studies.md",
+         "shape_accuracy.md"]
 
 
 @pytest.mark.parametrize("page", PAGES)

@@ -185,7 +185,7 @@ def test_examples_command_copies(tmp_path, capsys):
 
 def test_gitignore_covers_what_the_docs_commands_write():
     ignored = (ROOT / ".gitignore").read_text().split()
-    for folder in ("results/", "compare/", "diagnose/", "render/", "tutorial/", "out/"):
+    for folder in ("results/", "compare/", "diagnose/", "render/", "vtk/", "tutorial/", "out/"):
         assert folder in ignored
 
 
@@ -216,6 +216,18 @@ def test_render_defaults_to_the_largest_displacement(tmp_path, monkeypatch, caps
     assert (tmp_path / "render" / f"lu_frame{k}.png").is_file()
     assert main(["render", str(tmp_path / "lu"), "--frame", "last"]) == 0
     assert f"frame {len(res) - 1} of {len(res)}" in capsys.readouterr().out
+
+
+def test_vtk_writes_into_the_working_directory_by_default(tmp_path, monkeypatch, capsys):
+    """Like render (./render/), vtk writes ./vtk/NAME/series.pvd, not into the results folder."""
+    _load_unload(tmp_path / "lu")
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    assert main(["vtk", str(tmp_path / "lu")]) == 0
+    pvd = work / "vtk" / "lu" / "series.pvd"
+    assert pvd.is_file() and str(Path("vtk") / "lu" / "series.pvd") in capsys.readouterr().out
+    assert not (tmp_path / "lu" / "vtk").exists()
 
 
 # ------------------------------------------------------------------ docs index

@@ -184,7 +184,9 @@ class Experiment:
         ``typical`` size, never smaller, so also at an effect's zero default) larger than the
         convergence noise of its solver, and a lower ``max_nfev_per_param`` (``max_nfev = that x
         (p + 1)``).  ``expensive: True`` makes ``diagnose`` refit in parallel by default even when
-        the baseline fit was fast (its runs came from a cache).
+        the baseline fit was fast (its runs came from a cache); with ``diff_step`` it also makes the
+        fit save runs (secant Jacobians, seeded refits, positive parameters spanning two decades in
+        log scale: :func:`~femast.experiments.fitting.fit`, issue 21).
     source : where it came from (a built-in name or a script path), set by the registry.
     noise_covariates : optional ``noise_covariates(data, params, options, fit) -> {channel: {name:
         (n,) array}}`` of quantities the noise level of a channel may grow with, because of how

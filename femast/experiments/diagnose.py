@@ -147,7 +147,8 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     start = dict(zip(baseline.names, baseline.x))
     payload0 = {"source": exp.source, "options": exp.options, "scripts": list(loaded_scripts()),
                 "data_experiment": data.experiment, "columns": data.columns, "path": data.path,
-                "lines": data.lines, "start": start, "noise": sigma}
+                "lines": data.lines, "start": start, "noise": sigma,
+                "sensitivity": getattr(baseline, "sensitivity", None)}   # seeds the refits' Jacobians (issue 21)
     # stage 1: the forms of the added effects (shape mismatch) and the default form of each candidate;
     # stage 2: the generalised forms of the candidates whose default form has an information-criterion
     # gain (under the null nothing does, and the generalised forms cannot gain where it did not),
@@ -250,8 +251,10 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         by = {e["effect"]: e for e in ranking}
         combos = [(x, y) for i, x in enumerate(top) for y in top[i + 1:]]
         # and the best with every other candidate: a second mechanism whose own gain the first one's
-        # larger error hides (forward selection)
-        combos += [(top[0], e["effect"]) for e in ranking if not e.get("failed") and e["effect"] not in top]
+        # larger error hides (forward selection); not for the FE experiments, where a refit costs
+        # a minute of FE runs (their few rows rarely show a second mechanism without its own gain)
+        if not exp.fit_options.get("expensive"):
+            combos += [(top[0], e["effect"]) for e in ranking if not e.get("failed") and e["effect"] not in top]
         pl = []
         for x, y in combos:
             st = dict(start)

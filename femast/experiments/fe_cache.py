@@ -33,6 +33,7 @@ import io
 import json
 import numbers
 import os
+import time
 from collections import OrderedDict
 from pathlib import Path
 
@@ -40,6 +41,7 @@ import numpy as np
 
 MEMORY_ENTRIES = 256
 ENV = "FEMAST_FE_CACHE"
+RUN_LOG = "FEMAST_FE_RUN_LOG"
 _MEM: OrderedDict = OrderedDict()
 STATS = {"hits": 0, "disk_hits": 0, "misses": 0}
 
@@ -96,11 +98,22 @@ def cached(kind: str, key_parts, compute, options: dict | None = None):
             _remember(key, value)
             return copy.deepcopy(value)
     STATS["misses"] += 1
+    t0 = time.perf_counter()
     value = compute()
+    _log_run(kind, key, time.perf_counter() - t0)
     _remember(key, value)
     if path is not None:
         write_entry(path, key, value)
     return copy.deepcopy(value)
+
+
+def _log_run(kind: str, key: str, seconds: float) -> None:
+    """One line per computed run to ``$FEMAST_FE_RUN_LOG`` when set (benchmarks count the FE runs of a
+    fit or a diagnosis across its worker processes: ``benchmarks/diagnose_speed.py``)."""
+    log = os.environ.get(RUN_LOG)
+    if log:
+        with open(log, "a") as fh:
+            fh.write(f"{os.getpid()} {kind} {key[-12:]} {seconds:.4f}\n")
 
 
 FORMAT = "femast-fe-cache 1"

@@ -32,6 +32,7 @@ from ..effects.base import resolve
 from .. import progress
 from ..errors import ModelError
 from .core import EffectStack, Experiment, Measured
+from .fe_jacobian import LOG_RANGE, _Coords, _FEJacobian, _forward_differences, _polish  # noqa: F401
 from .residuals import noise_floor
 
 _BAD = 1e6  # whitened residual given to a non-finite prediction (a parameter set the model rejects)
@@ -185,44 +186,9 @@ def _covariance(J, cost, n, scale):
     return stderr, cov, note
 
 
-def _forward_differences(fun, step: float, lo, hi):
-    """(fun, jac) for least_squares with forward differences of ``step x max(1, |u_i|)`` in the scaled
-    parameters u (the ``diff_step`` of ``Experiment.fit_options``).
-
-    scipy's own ``diff_step`` is relative to ``|u_i|`` and falls back to 1.5e-8 at ``u_i = 0``, the
-    start of an effect whose default is "absent" (a pretension error dT0 = 0): an FE model resolves
-    that step no better than its Newton tolerance, and the derivative comes out with the wrong sign.
-    Here the step never drops below ``step``; it is taken backwards where it would leave the upper
-    bound.  The value at the point itself is reused from the last call of ``fun`` (scipy evaluates
-    it just before asking for the Jacobian)."""
-    last = {}
-
-    def f(u):
-        key = np.asarray(u, float).tobytes()
-        if key not in last:
-            last.clear()
-            last[key] = fun(u)
-        return last[key]
-
-    def jac(u, *args):
-        u = np.asarray(u, float)
-        f0 = f(u)
-        J = np.empty((f0.size, u.size))
-        for i in range(u.size):
-            h = step * max(1.0, abs(u[i]))
-            if u[i] + h > hi[i]:
-                h = -h
-            up = u.copy()
-            up[i] += h
-            J[:, i] = (fun(up) - f0) / h
-        return J
-
-    return f, jac
-
-
 def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, multistart: bool = True,
         max_nfev: int | None = None, given_start_clip: bool = False,
-        nfev_per_param: int | None = None) -> OptimizeResult:
+        nfev_per_param: int | None = None, start_sensitivity: dict | None = None) -> OptimizeResult:
     """Fit the baseline parameters and those of the switched-on ``effects`` to the data.
 
     effects : effect names (``femast.effects``) applicable to the experiment.
@@ -235,12 +201,23 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
         other fits) instead of raising ModelError naming the parameter.
     nfev_per_param : cap of the evaluations per start, ``x (p + 1)`` (the smaller of it and the
         experiment's ``max_nfev_per_param``); diagnose's refits use 25.
+    start_sensitivity : ``{name: d(predicted, channels concatenated)/d(parameter)}`` known at the
+        start (the ``sensitivity`` of an earlier fit, e.g. the baseline's for diagnose's refits): the
+        first Jacobian of an expensive experiment fitted by finite differences takes these
+        columns instead of FE runs.  The Jacobian at the solution (covariance) is always computed.
 
     Returns an ``OptimizeResult`` with ``x``, ``names``, ``units``, ``stderr``, ``cov``,
     ``params`` (baseline ``{name: value}``), ``effect_params`` (``{effect: {name: value}}``),
     ``success``, ``message``, ``nfev``, ``cost``, ``fun`` (whitened residuals), ``predicted``,
     ``residuals`` (``{channel: array}``), ``noise``, ``rms`` (error unit), ``channel_rms``,
-    ``noise_rms``, ``ratio`` (rms / noise), ``bic``, ``n_obs``, ``n_params``, ``at_bound``.
+    ``noise_rms``, ``ratio`` (rms / noise), ``bic``, ``n_obs``, ``n_params``, ``at_bound``,
+    ``sensitivity`` (``{name: d predicted / d parameter}`` at the solution, channels concatenated)
+    and ``fe_runs`` (model evaluations, Jacobian columns included).
+
+    Experiments whose model evaluations are expensive and fitted by finite differences
+    (``fit_options`` with ``expensive`` and ``diff_step``: the FE ones) take Broyden secant updates of the Jacobian between finite-difference ones and a finite-difference
+    Jacobian at the solution, from which a Gauss-Newton check restarts the fit when it predicts a
+    further decrease beyond ``ftol`` (see :class:`_FEJacobian`, :func:`_polish`).
     """
     exp.require_model("a fit")
     if isinstance(effects, str):
@@ -267,12 +244,18 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
         x0.append(float(np.clip(v, p.lower, p.upper)))
     x0 = np.array(x0)
     scale = np.array([p.typical for _, p, _ in specs])
-    lo = np.array([p.lower for _, p, _ in specs]) / scale
-    hi = np.array([p.upper for _, p, _ in specs]) / scale
+    fo = dict(exp.fit_options)
+    # a hint for diagnose, not a least_squares option; with finite differences it also turns on the
+    # run-saving Jacobians (secant updates, seeded starts, log scaling, issue 21): every model
+    # evaluation is an FE run
+    secant = bool(fo.pop("expensive", None)) and bool(fo.get("diff_step"))
+    co = _Coords(scale, np.array([secant and p.lower > 0 and p.upper >= LOG_RANGE * p.lower for _, p, _ in specs]))
+    lo = co.to_u(np.array([p.lower for _, p, _ in specs]))
+    hi = co.to_u(np.array([p.upper for _, p, _ in specs]))
 
     def make_fun(sigma):
         def fun(u):
-            base, eff = _split(specs, u * scale)
+            base, eff = _split(specs, co.to_x(u))
             try:
                 pred = predict(exp, data, base, eff)
             except (FloatingPointError, ZeroDivisionError, ValueError):
@@ -291,54 +274,92 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
             for i, st in extra:
                 x[i] = np.clip(st[min(k, len(st) - 1)], specs[i][1].lower, specs[i][1].upper)
             starts.append(x)
-    fo = dict(exp.fit_options)
     per_param = int(fo.pop("max_nfev_per_param", 100))
     if nfev_per_param:
         per_param = min(per_param, int(nfev_per_param))
-    fo.pop("expensive", None)  # a hint for diagnose, not a least_squares option
     fd_step = fo.pop("diff_step", None)
     kw = dict(method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10, x_scale=1.0)
     kw.update(fo)
     kw["max_nfev"] = max_nfev or kw.get("max_nfev") or per_param * (len(specs) + 1)
 
-    def solve(sigma, candidates):
+    n_res = data.n * len(exp.channels)
+
+    def sigma_rows(sigma):
+        return np.concatenate([np.broadcast_to(np.asarray(sigma[c], float), (data.n,)) for c in exp.channels])
+
+    def seed(sens, sigma, x):
+        """Whitened, scaled start Jacobian from known sensitivities d(predicted)/d(parameter) (NaN: unknown)."""
+        if not secant or not sens:
+            return None
+        J0 = np.full((n_res, len(specs)), np.nan)
+        dxdu = co.dx_du(co.to_u(np.asarray(x, float)))
+        rows = sigma_rows(sigma)
+        for i, (full, _, _) in enumerate(specs):
+            col = sens.get(full)
+            if col is not None and np.shape(col) == (n_res,):
+                J0[:, i] = -np.asarray(col, float) * dxdu[i] / rows
+        return J0 if np.isfinite(J0).any() else None
+
+    def solve(sigma, candidates, J0=None):
         best = None
-        fun = make_fun(sigma)
-        if fd_step:
-            fun, kw["jac"] = _forward_differences(fun, float(fd_step), lo, hi)
-        nfev = 0
-        for x in candidates:
-            u0 = np.clip(x / scale, lo, hi)
+        fun0 = make_fun(sigma)
+        nfev = runs = 0
+        for k, x in enumerate(candidates):
+            u0 = co.start(x, lo, hi) if secant else np.clip(x / scale, lo, hi)
+            fj = None
+            fun = fun0
+            if fd_step:
+                fj = _FEJacobian(fun0, float(fd_step), lo, hi, secant=secant, J0=J0 if k == 0 and secant else None)
+                fun, kw["jac"] = fj.value, fj.jac
             with np.errstate(all="ignore"):
                 sol = least_squares(fun, u0, bounds=(lo, hi), **kw)
             nfev += sol.nfev
+            if fj is not None:
+                if secant:
+                    sol = _polish(sol, fj, fun, lo, hi, kw)
+                nfev += getattr(sol, "nfev_polish", 0)
+                runs += fj.runs
             if best is None or sol.cost < best.cost:
                 best = sol
         best.nfev_total = nfev
+        best.fe_runs = runs if fd_step else nfev
         return best
 
     if noise is None:
         base, eff = _split(specs, x0)
         sigma0 = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
-        sol = solve(sigma0, starts)
-        base, eff = _split(specs, sol.x * scale)
+        sol = solve(sigma0, starts, seed(start_sensitivity, sigma0, x0))
+        base, eff = _split(specs, co.to_x(sol.x))
         sigma = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
-        sol2 = solve(sigma, [sol.x * scale])
-        sol2.nfev_total += sol.nfev_total
-        sol = sol2
+        if secant and len(exp.channels) == 1:
+            # one channel, one noise level: the whitened residual only changes by a constant factor, so
+            # the minimiser and the covariance are the same; rescale instead of refitting
+            f = sigma0[exp.channels[0]] / sigma[exp.channels[0]]
+            sol.fun, sol.jac, sol.cost = sol.fun * f, sol.jac * f, sol.cost * f * f
+        else:
+            ratio = sigma_rows(sigma0) / sigma_rows(sigma)   # warm start: the last Jacobian, rows re-weighted
+            sol2 = solve(sigma, [co.to_x(sol.x)], sol.jac * ratio[:, None] if secant else None)
+            sol2.nfev_total += sol.nfev_total
+            sol2.fe_runs += sol.fe_runs
+            sol = sol2
     else:
         sigma = {c: _sigma_of(noise, c, data.n) for c in exp.channels}
-        sol = solve(sigma, starts)
-    x = sol.x * scale
-    stderr, cov, note = _covariance(sol.jac, sol.cost, sol.fun.size, scale)
+        sol = solve(sigma, starts, seed(start_sensitivity, sigma, x0))
+    x = co.to_x(sol.x)
+    dxdu = co.dx_du(sol.x)
+    stderr, cov, note = _covariance(sol.jac, sol.cost, sol.fun.size, dxdu)
     if note:
         idx = [int(i) for i in note.split(": ")[1].split(", ")]
         note = "not identifiable from these data: " + ", ".join(specs[i][0] for i in idx)
     base, eff = _split(specs, x)
     predicted = predict(exp, data, base, eff)
     msg = sol.message.rstrip(".") + (f"; {note}" if note else "")
-    return _result(exp, data, specs, x, stderr, cov, sigma, predicted, True, bool(sol.success), msg,
-                   sol.nfev_total, [i[0] for i in impls])
+    out = _result(exp, data, specs, x, stderr, cov, sigma, predicted, True, bool(sol.success), msg,
+                  sol.nfev_total, [i[0] for i in impls])
+    rows = sigma_rows(sigma)
+    out.sensitivity = {full: -sol.jac[:, i] * rows / dxdu[i] for i, (full, _, _) in enumerate(specs)}
+    out.fe_runs = int(sol.fe_runs)
+    return out
 
 
 def _sigma_of(noise: dict, channel: str, n: int):

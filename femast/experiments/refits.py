@@ -35,17 +35,19 @@ def _refit_task(payload: dict) -> OptimizeResult:
         load_script(script)
     exp = experiment_from_source(payload["source"], payload["options"])
     data = Measured(payload["data_experiment"], payload["columns"], payload["path"], payload["lines"])
-    res = _safe_fit(exp, data, payload["effects"], start=payload["start"], noise=payload["noise"])
+    res = _safe_fit(exp, data, payload["effects"], start=payload["start"], noise=payload["noise"],
+                    sensitivity=payload.get("sensitivity"))
     res.pid = os.getpid()
     return res
 
 
-def _safe_fit(exp, data, effects, start, noise) -> OptimizeResult:
+def _safe_fit(exp, data, effects, start, noise, sensitivity=None) -> OptimizeResult:
     """:func:`fit`, or a result with ``failed = True`` and the error as ``message`` when the model
     cannot be evaluated even at the start of the refit (an FE run that does not converge with the
     effect's default parameters): one failed candidate must not end the whole diagnosis."""
     try:
-        return fit(exp, data, effects, start=start, noise=noise, given_start_clip=True, nfev_per_param=REFIT_NFEV)
+        return fit(exp, data, effects, start=start, noise=noise, given_start_clip=True, nfev_per_param=REFIT_NFEV,
+                   start_sensitivity=sensitivity)   # the baseline's derivatives seed the refit's (issue 21)
     except (ValueError, FemastError, FloatingPointError, ZeroDivisionError) as e:
         return OptimizeResult(failed=True, success=False, message=f"{type(e).__name__}: {e}", effects=tuple(effects))
 
@@ -140,7 +142,8 @@ def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base):
     if not payloads:
         return [], "no candidates"
     if not _rebuildable(exp):
-        return ([_safe_fit(exp, data, p["effects"], start=p["start"], noise=sigma) for p in payloads],
+        return ([_safe_fit(exp, data, p["effects"], start=p["start"], noise=sigma, sensitivity=p.get("sensitivity"))
+                 for p in payloads],
                 "serial (experiment defined in memory: worker processes cannot rebuild it)")
     est = 6.0 * t_base * len(payloads)
     if workers is None and scheduler is None and not exp.fit_options.get("expensive") and est < SERIAL_BELOW_S:

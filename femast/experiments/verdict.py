@@ -31,7 +31,8 @@ Conclusions (``verdict["kind"]``)
   pair does significantly better);
 * ``missing_pair`` -- the best pair, fitted jointly, of the top four candidates with an
   information-criterion gain or of the best candidate with any other (forward selection: a
-  second mechanism whose own gain the first one's larger error hides), brings the model
+  second mechanism whose own gain the first one's larger error hides; not on the expensive FE
+  experiments), brings the model
   to the noise floor and is significantly better than its best member alone (information
   criterion -10 and another 10 % of the excess), also when that member alone reaches the floor
   (a small second effect);

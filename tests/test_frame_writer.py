@@ -1,0 +1,41 @@
+"""Frames written as a zip built in memory (issue 21, item 3): the same members, dtypes, shapes and
+values as np.savez, a valid zip, and np.savez's own path for what it cannot write."""
+
+import io
+import zipfile
+
+import numpy as np
+
+from femast.post.results import _atomic_savez, _npz_bytes
+
+
+def _frame():
+    rng = np.random.default_rng(0)
+    return {"step": "bend", "increment": 7, "time": 0.35, "load_factor": np.float64(0.35), "iterations": 4,
+            "U": rng.normal(size=(9, 3)), "R": rng.normal(size=(9, 3, 3)),
+            "F": np.asfortranarray(rng.normal(size=(4, 3))), "S": rng.normal(size=(6, 4))[:, ::2],
+            "empty": np.zeros((0, 6)), "flags": np.array([True, False]), "zone": np.arange(8, dtype=np.int32),
+            "big_endian": np.arange(3, dtype=">f8"), "el/beam/section_forces": rng.normal(size=(8, 2, 6))}
+
+
+def test_frame_bytes_load_like_np_savez(tmp_path):
+    frame = _frame()
+    _atomic_savez(tmp_path / "f.npz", **frame)
+    ref = io.BytesIO()
+    np.savez(ref, **frame)
+    with np.load(tmp_path / "f.npz", allow_pickle=False) as got, np.load(io.BytesIO(ref.getvalue())) as want:
+        assert sorted(got.files) == sorted(want.files)
+        for k in want.files:
+            assert got[k].dtype == want[k].dtype and got[k].shape == want[k].shape, k
+            assert np.array_equal(got[k], want[k]), k
+    with zipfile.ZipFile(tmp_path / "f.npz") as z:
+        assert z.testzip() is None                      # every member's CRC checks
+    assert not list(tmp_path.glob("*.tmp"))             # written through a temporary name, renamed
+
+
+def test_object_arrays_fall_back_to_np_savez(tmp_path):
+    assert _npz_bytes({"a": np.array([1, "x"], dtype=object)}) is None
+    # the writer then uses np.savez, which refuses nothing here; np.load needs allow_pickle to read it
+    _atomic_savez(tmp_path / "o.npz", a=np.array([1, "x"], dtype=object))
+    with np.load(tmp_path / "o.npz", allow_pickle=True) as z:
+        assert z["a"].tolist() == [1, "x"]
