@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 import femast.studies as st
-from femast import plotstyle
+from femast.post import plotstyle
 from femast.adam import BayParameters
 from femast.adam.shape_study import GROUPS, SCATTER, stated_inputs, tip_history
 

@@ -36,7 +36,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import femast as fm  # noqa: E402
 from femast.analysis import Analysis  # noqa: E402
-from femast.solvers.convergence import Convergence  # noqa: E402
+from femast.analysis.solvers.convergence import Convergence  # noqa: E402
 
 import opensees_mast  # noqa: E402  (its optional import of openseespy)
 
