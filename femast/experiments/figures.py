@@ -62,7 +62,8 @@ def compare_figure(exp, data, result, png) -> Path:
     lab = exp.load_label
     ax2.set_ylabel(lab.replace(" (", "\n(", 1) if len(lab) > 24 else lab)  # a long label on two lines
     ax2.set_title("load along the path: near-zero load, reversals and peaks marked")
-    ax2.legend(ncol=3, loc="upper right")
+    if ax2.get_legend_handles_labels()[0]:  # a path with no marked rows has no legend
+        ax2.legend(ncol=3, loc="upper right")
     for i, c in enumerate(exp.channels):
         f, ul = display_scale(exp.unit_of(c))
         ax3.plot(rows, f * result.residuals[c], "-", lw=0.8, color=f"C{i}", label=column_label(c, ul))

@@ -127,10 +127,14 @@ def save(fig, png, dpi=None) -> Path:
 
     png = Path(png)
     png.parent.mkdir(parents=True, exist_ok=True)
-    try:
-        fig.tight_layout()
-    except Exception:  # a layout that cannot be tightened is saved as it is
-        pass
+    import warnings
+
+    with warnings.catch_warnings():  # axes tight_layout cannot handle (colour bars, insets) keep their place
+        warnings.simplefilter("ignore", UserWarning)
+        try:
+            fig.tight_layout()
+        except Exception:  # a layout that cannot be tightened is saved as it is
+            pass
     fig.savefig(png, dpi=dpi or STYLE["savefig.dpi"], bbox_inches="tight")
     plt.close(fig)
     return png
