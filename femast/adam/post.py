@@ -145,10 +145,9 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right", fontsize=9)
     if title:
-        ax.set_title(title, fontsize=11)
-    if seed_note:
-        ax.text(0.01, 0.98, seed_note, transform=ax.transAxes, va="top", fontsize=8.5,
-                bbox=dict(boxstyle="round", fc="white", ec="0.7"))
+        fig.suptitle(title, fontsize=11)
+    if seed_note:  # above the axes, never over the curve
+        ax.set_title(seed_note, loc="left", fontsize=8.5, color="0.25")
     bx = fig.add_subplot(gs[1])
     for k in range(4):
         z = zones[:, k]
