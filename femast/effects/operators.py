@@ -48,8 +48,10 @@ def _play(u, r, p0):
 
 
 @njit(cache=True)
-def _play_sum(u, radii, weights):
-    """sum_k weights[k] play(u; radii[k]) on each column of u (n, m), every play from state 0."""
+def _play_sum(u, radii, etas, weights):
+    """sum_k weights[k] play(u; radii[k] + etas[k] |u|) on each column of u (n, m), every play from
+    state 0: fixed half-widths (etas = 0, the Iwan model) or half-widths proportional to the input
+    (radii = 0, the proportional Iwan model); an exact zero term leaves the other bit for bit."""
     n, m = u.shape
     out = np.zeros_like(u)
     nk = radii.size
@@ -60,36 +62,10 @@ def _play_sum(u, radii, weights):
         for i in range(n):
             acc = 0.0
             x = u[i, j]
-            for k in range(nk):
-                p = state[k]
-                r = radii[k]
-                if p < x - r:
-                    p = x - r
-                elif p > x + r:
-                    p = x + r
-                state[k] = p
-                acc += weights[k] * p
-            out[i, j] = acc
-    return out
-
-
-@njit(cache=True)
-def _prop_play_sum(u, etas, weights):
-    """sum_k weights[k] play(u; etas[k] |u|) on each column of u (n, m), every play from state 0."""
-    n, m = u.shape
-    out = np.zeros_like(u)
-    nk = etas.size
-    state = np.zeros(nk)
-    for j in range(m):
-        for k in range(nk):
-            state[k] = 0.0
-        for i in range(n):
-            acc = 0.0
-            x = u[i, j]
             a = abs(x)
             for k in range(nk):
                 p = state[k]
-                r = etas[k] * a
+                r = radii[k] + etas[k] * a
                 if p < x - r:
                     p = x - r
                 elif p > x + r:
@@ -149,7 +125,7 @@ def iwan(u, R: float, beta: float, alpha: float = 0.0, n: int = IWAN_ELEMENTS) -
     radii = iwan_strengths(R, beta, n)
     u, u2 = _as2d(u)
     w = np.full(radii.size, (1.0 - a) / radii.size)
-    return (a * u2 + _play_sum(u2, radii, w)).reshape(u.shape)
+    return (a * u2 + _play_sum(u2, radii, np.zeros_like(radii), w)).reshape(u.shape)
 
 
 def proportional_iwan(u, eta: float, beta: float, alpha: float = 0.0, n: int = IWAN_ELEMENTS) -> np.ndarray:
@@ -168,4 +144,4 @@ def proportional_iwan(u, eta: float, beta: float, alpha: float = 0.0, n: int = I
     etas = iwan_strengths(eta, beta, n)
     u, u2 = _as2d(u)
     w = np.full(etas.size, (1.0 - a) / etas.size)
-    return (a * u2 + _prop_play_sum(u2, etas, w)).reshape(u.shape)
+    return (a * u2 + _play_sum(u2, np.zeros_like(etas), etas, w)).reshape(u.shape)
