@@ -109,11 +109,12 @@ def cached(kind: str, key_parts, compute, options: dict | None = None):
 
 def _log_run(kind: str, key: str, seconds: float) -> None:
     """One line per computed run to ``$FEMAST_FE_RUN_LOG`` when set (benchmarks count the FE runs of a
-    fit or a diagnosis across its worker processes: ``benchmarks/diagnose_speed.py``)."""
+    fit or a diagnosis across its worker processes: ``benchmarks/diagnose_speed.py``): pid, kind, key,
+    seconds, the run's end (Unix time, s) and the CPU seconds of this process so far."""
     log = os.environ.get(RUN_LOG)
     if log:
         with open(log, "a") as fh:
-            fh.write(f"{os.getpid()} {kind} {key[-12:]} {seconds:.4f}\n")
+            fh.write(f"{os.getpid()} {kind} {key[-12:]} {seconds:.4f} {time.time():.4f} {time.process_time():.3f}\n")
 
 
 FORMAT = "femast-fe-cache 1"
