@@ -82,16 +82,23 @@ def cache_dir(options: dict | None = None) -> Path | None:
     return Path(d) if d else None
 
 
-def cached(kind: str, key_parts, compute, options: dict | None = None):
-    """``compute()`` once per distinct ``key_parts`` (see the module docstring); returns a copy."""
-    key = f"{kind}-{key_of(kind, key_parts)}"
-    if key in _MEM:
+def run_key(kind: str, key_parts) -> str:
+    """The cache key of run ``key_parts`` of ``kind``."""
+    return f"{kind}-{key_of(kind, key_parts)}"
+
+
+def cached(kind: str, key_parts, compute, options: dict | None = None, refresh: bool = False):
+    """``compute()`` once per distinct ``key_parts`` (see the module docstring); returns a copy.
+    refresh : compute even if cached (a run whose side products are needed: a reference path) and
+    store the new value."""
+    key = run_key(kind, key_parts)
+    if key in _MEM and not refresh:
         _MEM.move_to_end(key)
         STATS["hits"] += 1
         return copy.deepcopy(_MEM[key])
     folder = cache_dir(options)
     path = folder / f"{key}.npz" if folder else None
-    if path is not None and path.is_file():
+    if path is not None and path.is_file() and not refresh:
         value = read_entry(path, key)
         if value is not None:
             STATS["disk_hits"] += 1
