@@ -367,6 +367,35 @@ def test_cli_study_runs_reports_and_resumes(tmp_path, capsys):
     assert "160 already on disk" in capsys.readouterr().out
 
 
+FAILING_SCRIPT = """
+import femast.studies as st
+
+def half_fail(x):
+    if x > 0.5:
+        raise RuntimeError(f"no convergence at x = {x:.3f}")
+    return {"y": x}
+
+study = st.Study(run=half_fail, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], name="half")
+"""
+
+
+def test_cli_study_exits_3_when_runs_failed_also_after_a_resume(tmp_path, capsys):
+    from femast.cli import main
+
+    script = tmp_path / "half.py"
+    script.write_text(FAILING_SCRIPT)
+    out = tmp_path / "res"
+    assert main(["--quiet", "study", str(script), "--samples", "16", "--workers", "1", "--out", str(out),
+                 "--no-report"]) == 3
+    cap = capsys.readouterr()
+    n_failed = st.load(out).counts()["failed"]
+    assert 0 < n_failed < 16       # x > 0.5 in about half of 16 Sobol' points
+    assert f"{n_failed} FAILED" in cap.out and f"{n_failed} run(s) FAILED; exit code 3" in cap.err
+    # resuming a complete study runs nothing new, and still says the study holds failures
+    assert main(["--quiet", "study", str(script), "--samples", "16", "--out", str(out), "--no-report"]) == 3
+    # the Ishigami study has no failure: exit 0 (test_cli_study_runs_reports_and_resumes)
+
+
 def test_cli_study_errors_are_one_line(tmp_path, capsys):
     from femast.cli import main
 
