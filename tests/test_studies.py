@@ -367,6 +367,35 @@ def test_cli_study_runs_reports_and_resumes(tmp_path, capsys):
     assert "160 already on disk" in capsys.readouterr().out
 
 
+FAILING_SCRIPT = """
+import femast.studies as st
+
+def half_fail(x):
+    if x > 0.5:
+        raise RuntimeError(f"no convergence at x = {x:.3f}")
+    return {"y": x}
+
+study = st.Study(run=half_fail, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], name="half")
+"""
+
+
+def test_cli_study_exits_3_when_runs_failed_also_after_a_resume(tmp_path, capsys):
+    from femast.cli import main
+
+    script = tmp_path / "half.py"
+    script.write_text(FAILING_SCRIPT)
+    out = tmp_path / "res"
+    assert main(["--quiet", "study", str(script), "--samples", "16", "--workers", "1", "--out", str(out),
+                 "--no-report"]) == 3
+    cap = capsys.readouterr()
+    n_failed = st.load(out).counts()["failed"]
+    assert 0 < n_failed < 16       # x > 0.5 in about half of 16 Sobol' points
+    assert f"{n_failed} FAILED" in cap.out and f"{n_failed} run(s) FAILED; exit code 3" in cap.err
+    # resuming a complete study runs nothing new, and still says the study holds failures
+    assert main(["--quiet", "study", str(script), "--samples", "16", "--out", str(out), "--no-report"]) == 3
+    # the Ishigami study has no failure: exit 0 (test_cli_study_runs_reports_and_resumes)
+
+
 def test_cli_study_errors_are_one_line(tmp_path, capsys):
     from femast.cli import main
 
@@ -549,3 +578,75 @@ def test_samples_over_the_timeout_are_recorded_failed(tmp_path, workers):
     assert time.perf_counter() - t0 < 5.0 * n_slow / workers   # the slow samples were cut short
     with pytest.raises(StudyError, match="timeout_s"):
         st.Study(run=_sometimes_slow, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], timeout_s=0)
+
+
+# ------------------------------------------------------------------ timeout_s in threads (the analysis' deadline)
+def _slow_cantilever(F):
+    """A cantilever loaded in 1e-4 steps when F > 1.3: 10 000 increments (several seconds)."""
+    m = fm.Model("slow cantilever")
+    a, b = m.node(0, 0, 0), m.node(L_M, 0, 0)
+    m.beam(a, b, fm.circular_tube(D_M, D_M - 2 * T_M, E=70e9), n=2)
+    m.fix(a)
+    inc = 1e-4 if F > 1.3 else 0.5
+    m.step("load", initial_increment=inc, max_increment=inc, max_increments=20000, output_frequency=20000).load(
+        b, fz=-F)
+    return m
+
+
+def test_deadline_stops_an_analysis_in_a_thread_and_costs_nothing_without_one():
+    import threading
+    import time
+
+    from femast.analysis.deadline import check, deadline, remaining
+    from femast.errors import SampleTimeout
+
+    out = {}
+
+    def job():
+        t0 = time.perf_counter()
+        try:
+            with deadline(0.3, "stopped: over 0.3 s"):
+                fm.Analysis(_slow_cantilever(1.5), None, progress=False, on_frame=lambda fr: None).run()
+        except SampleTimeout as exc:
+            out["err"] = str(exc)
+        out["t"] = time.perf_counter() - t0
+        out["after"] = remaining()
+
+    th = threading.Thread(target=job)   # not the main thread: no SIGALRM could reach it
+    th.start()
+    th.join(60)
+    assert out["err"] == "stopped: over 0.3 s"
+    assert out["t"] < 3.0           # stopped at an iteration after 0.3 s; unstopped: 10 000 increments, 6 s
+    assert out["after"] is None     # the deadline ends with its block
+    # nested: the earlier deadline holds
+    with deadline(10.0):
+        with deadline(100.0):
+            assert remaining() < 10.0
+    with pytest.raises(fm.ModelError, match="must be > 0"):
+        with deadline(0.0):
+            pass
+    check()   # no deadline: nothing
+    n = 200_000
+    t0 = time.perf_counter()
+    for _ in range(n):
+        check()
+    per_call = (time.perf_counter() - t0) / n
+    assert per_call < 5e-6    # 0.1-0.2 us measured; an iteration of this 2-beam model takes ~300 us
+
+
+def test_timeout_on_dask_thread_workers_records_the_slow_samples_failed(tmp_path):
+    import time
+
+    distributed = pytest.importorskip("distributed")
+    study = st.Study(model=_slow_cantilever, inputs=[st.Uniform("F", 0.5, 1.5)],
+                     outputs=[st.NodeOutput("tip_w", node=2, quantity="U", components="z")],
+                     sampler="mc", seed=3, timeout_s=0.5)
+    t0 = time.perf_counter()
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cl, distributed.Client(cl) as client:
+        s = st.run(study, tmp_path / "d", samples=12, scheduler=client)
+    res = st.load(tmp_path / "d")
+    n_slow = int(np.sum(res.table(["F"])["F"] > 1.3))
+    assert s.engine == "dask" and n_slow > 0 and s.failed == n_slow and s.ok == 12 - n_slow
+    assert all("SampleTimeout: the sample ran over timeout_s = 0.5 s" in r for _, r in res.failures())
+    assert time.perf_counter() - t0 < 60.0   # unstopped, each slow sample runs 10 000 increments

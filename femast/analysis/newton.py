@@ -50,6 +50,7 @@ import numpy as np
 
 from ..elements.base import IncrementContext
 from ..errors import ModelError, SingularModelError
+from .deadline import check as check_deadline
 from .solvers.convergence import Convergence
 
 
@@ -225,6 +226,7 @@ class Newton:
             P = inc.loads(lam)
             responses, F, r = evaluate(P, reuse=True)
             for it in range(conv.max_iterations + 1):
+                check_deadline()   # Study(timeout_s=) in threads (femast/analysis/deadline.py)
                 if (it == 0 and not uses_lam and not has_dpres and not whole and not np.any(Du) and visc is None
                         and state.at_equilibrium and np.array_equal(P, state.loads)):
                     # nothing changes (e.g. a step that repeats the previous loads): the committed
