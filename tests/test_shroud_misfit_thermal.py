@@ -329,3 +329,21 @@ def test_guyed_study_script_runs_its_samples(tmp_path):
     dT = res.inputs("dT", blocks=("A", "B"))
     # the vertical error is the temperature's (1.55 mm at 20 K; shroud errors move z by < 0.01 mm)
     assert np.all(np.sign(uz - np.median(uz)) == np.sign(dT - np.median(dT)))
+
+
+def test_platform_study_calibration_removes_the_static_lean_of_erroneous_shrouds():
+    """benchmarks/study_guyed_platform.py: exit points calibrated with the masts as they stand, so
+    shroud errors that lean the tops by millimetres give no platform error at the calibration pose;
+    a temperature change after calibration does."""
+    import runpy
+    from pathlib import Path
+
+    ns = runpy.run_path(str(Path(__file__).resolve().parents[1] / "benchmarks" / "study_guyed_platform.py"),
+                        run_name="__femast_study__")
+    rng = np.random.default_rng(0)
+    dL, pre = rng.normal(0.0, 0.5e-3, 12), rng.normal(T0, 60.0, 12)
+    cold = ns["platform"](dL, pre, 0.0)
+    assert np.abs(cold["error_cal"]).max() < 1e-9       # solve_pose's Newton tolerance (1e-11) on metres
+    assert cold["error_max"] > 1e-3                      # the cable wrenches along the path still bend the masts
+    warm = ns["platform"](dL, pre, 20.0)
+    assert np.abs(warm["error_cal"][2]) > 1e-3           # masts 1.5 mm taller: millimetres at the platform
