@@ -190,6 +190,39 @@ def test_fe_mast_heated_shrouds_equal_the_same_length_error():
     assert [fr[0] for fr in hot._frames][-1] == "thermal"
 
 
+def test_fe_mast_heated_top_rises_as_the_hand_calculation_of_tube_and_shrouds():
+    """Tube (+23e-6 /K) and Dyneema shrouds (-12e-6 /K) warmed by 20 K.  Hand model: the top rises by
+    delta, the tube (EA / H) grows freely by alpha_t dT H less its extra compression, each rope
+    (vertical cosine c_r, length l_r) stretches by c_r delta from its heated stress-free length
+    L0_r (1 + alpha_s dT), with the Eq. 27 law: k_t (alpha_t dT H - delta) = sum c_r (tau_r(delta) - tau_r0).
+    Neglected: the top's lateral drift (0.27 mm; the ropes are not placed symmetrically), which
+    changes the rope lengths by ~0.04 mm of their ~2.4 mm: ~1 % on the tensions, less on delta."""
+    from femast.guyed.cantilever import mast_section
+    from femast.guyed.rocaspect import E_NO_SHROUD, L_BEAM
+
+    at, as_, dT = 23e-6, -12e-6, 20.0
+    nom = MastFE(1200.0)
+    nom.solve()
+    s0 = nom.state()
+    hot = MastFE(1200.0, temperature_change_K=dT, shroud_alpha_per_K=as_, beam_alpha_per_K=at)
+    hot.solve()
+    s1 = hot.state()
+    sec = mast_section(E_NO_SHROUD)
+    kt = sec.E * sec.A / L_BEAM
+    d = s0.upper - s0.lower
+    length = np.linalg.norm(d, axis=1)
+    c = d[:, 2] / length
+
+    def taus(delta):
+        return np.array([tension((length[r] + c[r] * delta) / (nom.L0[r] * (1 + as_ * dT)) - 1.0) for r in range(3)])
+
+    delta = brentq(lambda z: kt * (at * dT * L_BEAM - z) - np.sum(c * (taus(z) - s0.tension)), 0.0, at * dT * L_BEAM)
+    rise = s1.displacement[2] - s0.displacement[2]
+    assert rise == pytest.approx(delta, rel=1e-3)           # measured 4e-5
+    np.testing.assert_allclose(s1.tension, taus(delta), rtol=0.02)   # measured 1.1 %
+    assert rise < 0.95 * at * dT * L_BEAM                   # the tightening ropes hold the tube back
+
+
 def test_fe_mast_one_shroud_short_moves_the_top_as_its_linearised_stiffness_says():
     """Shroud 0 cut 0.1 mm short: the top moves by K^-1 B_0 dtau (K the condensed top stiffness at
     the pretension, B_0 shroud 0's direction and arm, dtau = EA_t d / L0 the tension it would gain on
@@ -278,3 +311,39 @@ def test_bad_thermal_and_mast_input_is_named():
         MastFE(None, length_error=1e-3)
     with pytest.raises(ModelError, match=r"shroud: length_error must be a scalar or one value per rope, shape \(3,\)"):
         MastFE(1200.0, length_error=[1e-3, 0.0]).build()
+
+
+def test_guyed_study_script_runs_its_samples(tmp_path):
+    """benchmarks/study_guyed.py (docs/studies.md): the study loads, runs 2 base samples with
+    sensitivity (10 runs) without failure, and a warm mast's top rises (dT > 0) or sinks (dT < 0)."""
+    from pathlib import Path
+
+    import femast.studies as st
+    from femast.studies.cli import load_script
+
+    study = load_script(Path(__file__).resolve().parents[1] / "benchmarks" / "study_guyed.py")
+    s = st.run(study, tmp_path / "g", samples=2)
+    assert s.complete and s.failed == 0 and s.ok == 10
+    res = st.load(tmp_path / "g")
+    uz = res.output("top_u", blocks=("A", "B"))[:, 0, 2]      # after 'thermal'
+    dT = res.inputs("dT", blocks=("A", "B"))
+    # the vertical error is the temperature's (1.55 mm at 20 K; shroud errors move z by < 0.01 mm)
+    assert np.all(np.sign(uz - np.median(uz)) == np.sign(dT - np.median(dT)))
+
+
+def test_platform_study_calibration_removes_the_static_lean_of_erroneous_shrouds():
+    """benchmarks/study_guyed_platform.py: exit points calibrated with the masts as they stand, so
+    shroud errors that lean the tops by millimetres give no platform error at the calibration pose;
+    a temperature change after calibration does."""
+    import runpy
+    from pathlib import Path
+
+    ns = runpy.run_path(str(Path(__file__).resolve().parents[1] / "benchmarks" / "study_guyed_platform.py"),
+                        run_name="__femast_study__")
+    rng = np.random.default_rng(0)
+    dL, pre = rng.normal(0.0, 0.5e-3, 12), rng.normal(T0, 60.0, 12)
+    cold = ns["platform"](dL, pre, 0.0)
+    assert np.abs(cold["error_cal"]).max() < 1e-9       # solve_pose's Newton tolerance (1e-11) on metres
+    assert cold["error_max"] > 1e-3                      # the cable wrenches along the path still bend the masts
+    warm = ns["platform"](dL, pre, 20.0)
+    assert np.abs(warm["error_cal"][2]) > 1e-3           # masts 1.5 mm taller: millimetres at the platform
