@@ -71,6 +71,9 @@ class Increment:
     ``P_start + lam * P_ref`` with P_ref the reference pattern (n, 6).  dpres : increment of the
     constrained DOFs' values (prescribed displacements, rad for rotations), or None.
     predictor : (du, dlam) added before the first iteration (linear extrapolation), or None.
+    whole : the predictor is the whole increment of the free DOFs (a reference run's, see
+    :mod:`femast.analysis.reference`; fixed loads or prescribed motion only): the prescribed motion
+    is applied with it, and the first iteration is not taken as a linear solve.
     predict : ``predict(du_p) -> dlam``, the tangent predictor of the load factor from
     K du_p = P_ref (arc length), or None.  dlambda : ``dlambda(du_r, du_p, Du) -> dlam or None``,
     the load-factor correction of an iteration (None: the constraint has no solution).
@@ -93,6 +96,7 @@ class Increment:
     dlambda: object = None
     viscous: object = None
     direct: bool = True
+    whole: bool = False
 
     def loads(self, lam):
         return self.P if self.P_ref is None else self.P_start + lam * self.P_ref
@@ -245,10 +249,18 @@ class Newton:
                 r_ = r_ - visc.C / dt * (Du if Dtrial is None else Dtrial)
             return resp, res_, r_
 
+        whole = 1 if inc.whole and inc.predictor is not None and not uses_lam else 0
         if inc.predictor is not None:
             pdu, pdlam = inc.predictor
             Du += pdu
-            system.update(pdu)
+            if whole:
+                # a predictor of the whole increment (a reference run's converged increment, issue 21):
+                # the prescribed motion goes in with it, not again in the first iteration, and the
+                # first iteration is no linear solve from the committed state (no linear-increment rule)
+                system.update(pdu, dpres if has_dpres else None)
+                dpres, has_dpres = None, False
+            else:
+                system.update(pdu)
             lam += pdlam if uses_lam else 0.0
         lam_start = state.lam
         try:
@@ -256,14 +268,14 @@ class Newton:
             responses, F, r = evaluate(P, reuse=True)
             for it in range(conv.max_iterations + 1):
                 check_deadline()   # Study(timeout_s=) in threads (femast/analysis/deadline.py)
-                if (it == 0 and not uses_lam and not has_dpres and not np.any(Du) and visc is None
+                if (it == 0 and not uses_lam and not has_dpres and not whole and not np.any(Du) and visc is None
                         and state.at_equilibrium and np.array_equal(P, state.loads)):
                     # nothing changes (e.g. a step that repeats the previous loads): the committed
                     # state is the converged solution
                     system.commit(responses, P, F, lam)
                     return Outcome(True, 0, "", responses, Du, 0.0)
                 if it > 0:
-                    ok, ratio = system.converged(conv, r, du, Du, responses, P, iters)
+                    ok, ratio = system.converged(conv, r, du, Du, responses, P, iters + whole)
                     rnorm_hist.append(ratio)
                     ratios.append(ratio)
                     if ok:
