@@ -223,3 +223,18 @@ def test_band_storage_input_factorises_bit_for_bit_as_the_csc_input(asym, shift)
     assert direct.kind == ("lu" if asym == 1e-2 or shift else "cholesky")
     if asym == 1e-10:
         assert direct.refinements > 0   # the refinement against B (from the band storage) ran
+
+
+def test_band_positions_through_the_permutation_compose_the_two_maps():
+    """Positions of a matrix K's entries in the band storage of B = P K P^T (given B.data =
+    K.data[gather]) are those of B's entries at the permuted positions."""
+    from femast.analysis.solvers.ordering import permuted, permuted_positions
+
+    K = chain_matrix(n=120, b=5, asym=1e-3)
+    perm = np.random.default_rng(8).permutation(K.shape[0])
+    B, gather = permuted(K, perm)
+    f = BandedFactor(B)
+    pos = np.random.default_rng(9).integers(-1, K.nnz, size=(30, 4, 4))
+    np.testing.assert_array_equal(f.band_positions(pos, gather), f.band_positions(permuted_positions(gather, pos)))
+    direct = f.band_positions(np.arange(B.nnz))
+    assert np.unique(direct).size == B.nnz   # one slot per entry of B

@@ -27,14 +27,21 @@ Options of the algorithm: a secant line search (``line_search``) and the tangent
   an unknown (displacement control, arc length) it acts as ``"modified"``.
 * ``"initial"``: one per step, formed again only where an increment needs its own (prescribed
   values or a viscous term);
-* ``"auto"`` (the default): ``"full"``.  ``"modified"`` and ``"quasi-newton"`` are not chosen
+* ``"auto"`` (the default): ``"full"``, except that the first iteration of an increment reuses
+  the factorisation of the previous increment's last iteration (the tangent one correction away
+  from the converged configuration, of the order of the tolerance), when nothing else may have
+  changed the tangent: the same step, load control without a predictor, no prescribed values, no
+  viscous term, every element family path-independent (its response a function of the
+  configuration alone) and the previous increment converged in at least one iteration.  On the
+  peer masts that saves one factorisation in four or five with the same iterations
+  (docs/performance.md).  A restart point keeps the configuration that factorisation was formed at
+  (:meth:`Newton.reuse_configuration`), and a restarted run forms it again there, so that it
+  continues bit for bit as the uninterrupted run (tests/test_restart.py).
+  ``"modified"`` and ``"quasi-newton"`` are not chosen
   automatically: on the peer masts (40-1000 bays) and the ADAM bay they need more iterations
   than they save factorisations, and they do not beat full Newton's time
   (``python benchmarks/newton_variants.py``, docs/performance.md).  Full Newton converges where
-  they do and more (friction, latches, limit points).  A shortcut that was measured and not kept:
-  reusing the previous increment's last factorisation for the first iteration of the next one
-  (a quarter fewer factorisations on the masts, the same iterations) breaks the bit-for-bit
-  equality of a restarted run with the uninterrupted one (tests/test_restart.py).
+  they do and more (friction, latches, limit points).
 
 Every Newton iteration: tangent (if due), solve, correct the load factor, update the
 configuration, evaluate the residual, test convergence.  On convergence the state is committed,
@@ -137,10 +144,42 @@ class Newton:
         self.refactor_every = refactor_every
         self.slow = float(slow)
         self.factorized = False   # a usable factorisation exists (modified / initial Newton)
+        # "auto": [state version, x, R, formed] of the factorisation kept for the next increment's
+        # first iteration (x, R: the configuration it was formed at; formed False after a restart)
+        self._reuse = None
 
     def new_step(self):
-        """Called at the start of every step (the initial-stiffness tangent is formed again)."""
+        """Called at the start of every step (the initial-stiffness tangent is formed again; "auto"
+        reuses no factorisation across steps)."""
         self.factorized = False
+        self._reuse = None
+
+    def reuse_configuration(self):
+        """(x, R) at which the factorisation that the next increment's first iteration reuses was
+        formed, or None: what a restart point keeps so that a restarted run can form it again."""
+        return None if self._reuse is None else (self._reuse[1], self._reuse[2])
+
+    def resume_reuse(self, version, x, R):
+        """A restarted run at configuration ``version``: the factorisation to reuse is to be formed
+        again at configuration (x, R) (the restart point's :meth:`reuse_configuration`)."""
+        self._reuse = [version, x, R, False]
+
+    def _reusable(self, system, state, inc, has_dpres, uses_lam, it):
+        """The kept factorisation serves this increment's first iteration ("auto" only)."""
+        r = self._reuse
+        return (self.tangent == "auto" and it == 0 and r is not None and r[0] == state.version and not has_dpres
+                and not uses_lam and inc.predictor is None and inc.viscous is None and inc.direct
+                and all(f.path_independent for f in system.families))
+
+    def _form_again(self, system, state, ctx):
+        """Form the kept factorisation again at the configuration it was formed at (a restarted run)."""
+        keep = state.x, state.R
+        state.x, state.R = self._reuse[1].copy(), self._reuse[2].copy()
+        try:
+            system.factorize_tangent(system.evaluate(ctx), False)
+        finally:
+            state.x, state.R = keep
+        self._reuse[3] = True
 
     def method(self):
         """The tangent update used ("auto" resolved)."""
@@ -191,6 +230,8 @@ class Newton:
         since = 0   # iterations on the current factorisation
         ratios = []  # residual ratios, the first before any iteration (modified / quasi-Newton)
         steps = []   # largest |correction| of each iteration (modified / quasi-Newton)
+        keep = self.tangent == "auto" and all(f.path_independent for f in system.families)
+        formed_at = None   # (x, R) of this attempt's last factorisation ("auto", path-independent)
 
         def fail(why):
             state.rollback()
@@ -242,6 +283,8 @@ class Newton:
                             visc.converged(state, Du, dt, responses)
                         state.last_increment, state.last_size, state.last_dlam = Du.copy(), dt, lam - lam_start
                         system.commit(responses, P, F, lam, equilibrium=visc is None)
+                        if formed_at is not None:   # kept for the next increment's first iteration
+                            self._reuse = [state.version, formed_at[0], formed_at[1], True]
                         return Outcome(True, iters, "", responses, Du, lam - lam_start)
                     if it == conv.max_iterations:
                         return fail(f"no convergence in {iters} iterations "
@@ -251,8 +294,15 @@ class Newton:
                 # the tangent only when another iteration is needed
                 K = Kfc = None
                 with_fc = it == 0 and has_dpres
-                if self._refactor(method, it, inc, has_dpres, since, ratios, steps):
+                if self._reusable(system, state, inc, has_dpres, uses_lam, it):
+                    if not self._reuse[3]:
+                        self._form_again(system, state, ctx)
+                    self._reuse = None
+                    self.factorized = True
+                elif self._refactor(method, it, inc, has_dpres, since, ratios, steps):
                     since = 0
+                    self._reuse = None
+                    formed_at = (state.x.copy(), state.R.copy()) if keep else None
                     if broyden is not None:
                         broyden.reset()
                     try:

@@ -135,6 +135,37 @@ def _residual_split(L, U, x, rhs, r):
 
 
 @njit(cache=True)
+def _split_positions(indptr, indices, b, gather, pos):
+    """Positions in split band storage (:meth:`BandedFactor.band_positions`) of the entries at
+    positions ``pos`` (any shape, -1: none) of the data of the matrix B was permuted from
+    (``B.data = K.data[gather]``; ``gather`` empty: of B's data itself)."""
+    n = indptr.shape[0] - 1
+    nnz = indices.shape[0]
+    to_split = np.empty(nnz, dtype=np.int64)
+    for j in range(n):
+        for k in range(indptr[j], indptr[j + 1]):
+            i = indices[k]
+            if i >= j:
+                to_split[k] = (i - j) + j * (b + 1)
+            else:
+                to_split[k] = (b + 1) * n + (j - i) + i * (b + 1)
+    if gather.shape[0] > 0:
+        inv = np.empty(nnz, dtype=np.int64)
+        for k in range(nnz):
+            inv[gather[k]] = k
+        comp = np.empty(nnz, dtype=np.int64)
+        for k in range(nnz):
+            comp[k] = to_split[inv[k]]
+        to_split = comp
+    flat = pos.ravel()
+    out = np.empty(flat.shape[0], dtype=np.int64)
+    for k in range(flat.shape[0]):
+        p = flat[k]
+        out[k] = to_split[p] if p >= 0 else -1
+    return out.reshape(pos.shape)
+
+
+@njit(cache=True)
 def _split_to_lu(L, U, lu):
     """B from split band storage into LAPACK's LU band storage (B_ij at row 2b + i - j)."""
     ldc = L.shape[0]
@@ -216,10 +247,11 @@ class BandedFactor:
         self.nnz = 0
 
     # ------------------------------------------------------------------ band storage input
-    def band_positions(self, pos):
+    def band_positions(self, pos, gather=None):
         """Positions in :attr:`band_values` of the entries at positions ``pos`` (-1: none) of B's
-        data array: an assembler then writes the element matrices straight into band storage (no
-        CSC values, no scatter into the band per factorisation; :meth:`factorize_band`).
+        data array (or, given ``gather``, of the data of the matrix K that B permutes:
+        ``B.data = K.data[gather]``): an assembler then writes the element matrices straight into
+        band storage (no CSC values, no scatter into the band per factorisation; :meth:`factorize_band`).
 
         The storage is split: the lower triangle as LAPACK's lower band (B_ij at (i - j) + j (b + 1),
         i >= j), then the upper one transposed (B_ij at (b + 1) n + (j - i) + i (b + 1), i < j), so
@@ -229,11 +261,8 @@ class BandedFactor:
             m = (self.b + 1) * self.n
             self._L = self._split[:m].reshape((self.b + 1, self.n), order="F")
             self._U = self._split[m:].reshape((self.b + 1, self.n), order="F")
-        cols, rows = self._entries()
-        to_split = np.where(rows >= cols, (rows - cols) + cols * (self.b + 1),
-                            (self.b + 1) * self.n + (cols - rows) + rows * (self.b + 1))
-        pos = np.asarray(pos)
-        return np.where(pos >= 0, to_split[np.maximum(pos, 0)], -1)
+        g = np.zeros(0, np.int64) if gather is None else np.asarray(gather, dtype=np.int64)
+        return _split_positions(self.B.indptr, self.B.indices, self.b, g, np.ascontiguousarray(pos, dtype=np.int64))
 
     def _entries(self):
         """(column, row) of every entry of B's data array."""

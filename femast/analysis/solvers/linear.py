@@ -174,10 +174,9 @@ class SparseLU:
         permuted matrix directly (no gather per factorisation; see :meth:`factorize_values`)."""
         if self._gather is None:
             raise RuntimeError("SparseLU.permuted_positions: no pattern analysed yet")
-        p = permuted_positions(self._gather, pos)
         if self._band_input():   # the band back-end: straight into its band storage
-            return self._engine.band_positions(p)
-        return p
+            return self._engine.band_positions(pos, self._gather)
+        return permuted_positions(self._gather, pos)
 
     def _band_input(self):
         """The back-end takes the permuted matrix in its own band storage (the banded one)."""
