@@ -218,15 +218,16 @@ class BandedFactor:
 
     B : the CSC matrix (its pattern is fixed; :meth:`factorize` reads its current values).
     cholesky : try the Cholesky of the symmetric part when B is numerically symmetric (False: LU only).
+    bandwidth : B's half-bandwidth, if known (computed otherwise).
     """
 
     name = "banded"
 
-    def __init__(self, B, cholesky: bool = True):
+    def __init__(self, B, cholesky: bool = True, bandwidth: int | None = None):
         n = B.shape[0]
         self.n = n
         self.B = B
-        self.b = b = band_of(B.indptr, B.indices)
+        self.b = b = band_of(B.indptr, B.indices) if bandwidth is None else int(bandwidth)
         self.allow_cholesky = cholesky
         # Fortran-ordered band storage, flat index i + j * ldab
         self._ld_chol = b + 1
