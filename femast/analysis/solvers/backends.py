@@ -33,8 +33,9 @@ import warnings
 import numpy as np
 
 from .banded import SYMMETRY_TOL, BandedFactor, band_of, band_rule, refine
+from .dense import DENSE_MAX_DOFS, DenseFactor
 
-NAMES = ("auto", "superlu", "banded", "cholmod", "pardiso")
+NAMES = ("auto", "superlu", "banded", "dense", "cholmod", "pardiso")
 PARDISO_MIN_DOFS = 1000   # the automatic choice takes PARDISO (when installed) from this size on
 THREADS = 1               # MKL threads of PARDISO
 INSTALL = {"cholmod": "pip install 'femast[cholmod]' (scikit-sparse; on Debian first: apt-get install "
@@ -80,6 +81,8 @@ def make(backend: str, B, ordering: str, symmetric: bool, superlu_factor):
     name = choose(backend, B, ordering)
     if name == "banded":
         return BandedFactor(B)
+    if name == "dense":
+        return DenseFactor(B)
     if name == "cholmod":
         return CholmodFactor(B, superlu_factor)
     if name == "pardiso":
