@@ -19,7 +19,8 @@ from scipy.linalg import lapack
 
 from .banded import _scatter
 
-DENSE_MAX_DOFS = 64   # the automatic choice takes the dense LU up to this many DOFs (see backends.choose)
+DENSE_MAX_DOFS = 64      # the automatic choice takes the dense LU up to this many DOFs (see backends.choose)
+DENSE_FORCED_MAX = 4000  # a forced dense LU beyond this many DOFs (128 MB) falls back to SuperLU
 
 
 class DenseFactor:
