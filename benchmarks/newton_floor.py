@@ -42,6 +42,7 @@ def minimal_run(mast, n_inc):
     from femast.rotations import rotation_vectors
     from femast.analysis.solvers.convergence import Convergence, force_moment_abs_max
     from femast.analysis.solvers.linear import _unpermute
+    from femast.analysis.solvers.ordering import permuted_positions
 
     m, _ = femast_mast.model(mast, n_inc)
     out = tempfile.mkdtemp(prefix="femast_floor_")
@@ -49,7 +50,7 @@ def minimal_run(mast, n_inc):
     an = Analysis(m, out, progress=False, convergence=Convergence(force_tol=tol, disp_tol=tol))
     fam, solver, nf = an.families[0], an.solver, an.dofmap.n_free
     eqs = an.assembler.eqs[0]
-    pos = solver.permuted_positions(an.assembler.pos_ff[0])
+    pos = permuted_positions(solver._gather, an.assembler.pos_ff[0])   # into the permuted CSC matrix B
     B, perm = solver._B, solver._perm
     ind, ptr = B.indices.astype(np.intc), B.indptr.astype(np.intc)
     opts = dict(DiagPivotThresh=solver.pivot_threshold, ColPerm="NATURAL", PanelSize=None, Relax=None,

@@ -200,11 +200,11 @@ def main(argv=None):
 
 def _guarded(func, args, debug=False) -> int:
     """Run a command: every error becomes one line on stderr and exit code 2 (``--debug``: the
-    traceback); a closed output pipe (``femast info R | head -1``) ends the command silently."""
+    traceback); a command returning an int exits with it; a closed output pipe (``femast info R | head -1``) ends the command silently."""
     from . import progress
 
     try:
-        func(args)
+        code = func(args)
     except BrokenPipeError:
         _silence_stdout()
         return 1
@@ -230,7 +230,7 @@ def _guarded(func, args, debug=False) -> int:
     except BrokenPipeError:
         _silence_stdout()
         return 1
-    return 0
+    return code if isinstance(code, int) else 0   # a command may return its own exit code (femast study: 3)
 
 
 def _silence_stdout():

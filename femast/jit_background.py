@@ -273,13 +273,23 @@ def _notice():
         _announce()
 
 
+_installed_for = None   # the loaded femast modules at the last install (nothing new: no scan)
+
+
 def install() -> int:
     """Hook every cacheable femast kernel of the loaded modules (idempotent); returns how many are
-    hooked."""
+    hooked.  The scan of the modules' globals (~10 ms) runs again only when femast modules were
+    loaded (or reloaded) since the last one: every Analysis calls this."""
+    global _installed_for
     if not enabled():
         return 0
+    loaded = frozenset((name, id(mod)) for name, mod in list(sys.modules.items())
+                       if name.startswith("femast") and mod is not None)
+    if loaded == _installed_for:
+        return len(_hooked)
     from .jit import _dispatchers
 
+    _installed_for = loaded
     for _, d in _dispatchers():
         if id(d) not in _hooked and _index_path(d) is not None:
             hook = _Hook(d)
@@ -290,6 +300,8 @@ def install() -> int:
 
 def uninstall() -> None:
     """Give every hooked kernel numba's own ``_compile_for_args`` back."""
+    global _installed_for
+    _installed_for = None
     for hook in _hooked.values():
         try:
             del hook.dispatcher._compile_for_args

@@ -193,3 +193,48 @@ def test_mast_auto_picks_banded_and_matches_superlu():
     # both solve each Newton step to a backward error ~1e-15; the converged states then differ
     # by round-off times the conditioning of the slender structure
     assert np.abs(u["auto"] - u["superlu"]).max() <= 1e-10 * np.abs(u["superlu"]).max()
+
+
+@pytest.mark.parametrize("asym, shift", [(0.0, 0.0), (1e-10, 0.0), (1e-2, 0.0), (0.0, "indefinite")])
+def test_band_storage_input_factorises_bit_for_bit_as_the_csc_input(asym, shift):
+    """The matrix written straight into the band back-end's split band storage (as the assembler
+    does for a mast) gives the very factorisation and solutions of the same values in B's CSC data:
+    Cholesky (symmetric), Cholesky refined against B (1e-10 unsymmetric), LU (1e-2 unsymmetric),
+    LU after a failed Cholesky (indefinite)."""
+    A = chain_matrix(asym=asym)
+    if shift == "indefinite":
+        w = np.linalg.eigvalsh(A.toarray())
+        A = (A - 0.5 * (w[3] + w[4]) * sp.identity(A.shape[0])).tocsr()
+        A.sort_indices()
+    B = A.tocsc()
+    B.sort_indices()
+    rhs = np.random.default_rng(5).normal(size=(3, A.shape[0]))
+    csc = BandedFactor(B.copy())
+    csc.factorize()
+    direct = BandedFactor(B.copy())
+    pos = direct.band_positions(np.arange(B.nnz))
+    direct.band_values[:] = 0.0
+    direct.band_values[pos] = B.data
+    direct.factorize_band()
+    assert csc.kind == direct.kind and csc.asymmetry == direct.asymmetry
+    for b in rhs:
+        assert np.array_equal(csc.solve(b), direct.solve(b))
+    assert csc.refinements == direct.refinements and csc.fallbacks == direct.fallbacks
+    assert direct.kind == ("lu" if asym == 1e-2 or shift else "cholesky")
+    if asym == 1e-10:
+        assert direct.refinements > 0   # the refinement against B (from the band storage) ran
+
+
+def test_band_positions_through_the_permutation_compose_the_two_maps():
+    """Positions of a matrix K's entries in the band storage of B = P K P^T (given B.data =
+    K.data[gather]) are those of B's entries at the permuted positions."""
+    from femast.analysis.solvers.ordering import permuted, permuted_positions
+
+    K = chain_matrix(n=120, b=5, asym=1e-3)
+    perm = np.random.default_rng(8).permutation(K.shape[0])
+    B, gather = permuted(K, perm)
+    f = BandedFactor(B)
+    pos = np.random.default_rng(9).integers(-1, K.nnz, size=(30, 4, 4))
+    np.testing.assert_array_equal(f.band_positions(pos, gather), f.band_positions(permuted_positions(gather, pos)))
+    direct = f.band_positions(np.arange(B.nnz))
+    assert np.unique(direct).size == B.nnz   # one slot per entry of B

@@ -59,11 +59,41 @@ def test_modified_and_quasi_newton_reach_the_full_newton_solution(tangent):
     np.testing.assert_allclose(u, u_full, rtol=0, atol=1e-7 * np.abs(u_full).max())
 
 
-def test_auto_is_full_newton():
+def _run(m, **kw):
+    an = Analysis(m, None, progress=False, on_frame=lambda fr: None, **kw)
+    an.run()
+    return an
+
+
+def test_auto_is_full_newton_reusing_the_last_factorisation_at_the_next_increment():
+    m, tip = _bent_cantilever()
+    auto = _run(m)
+    assert auto.algorithm.method() == "full"
+    s = auto.summary
+    # every increment after the first starts on the previous one's last factorisation
+    assert s.increments == 4 and auto.solver.factorizations == s.iterations - (s.increments - 1)
+    m, _ = _bent_cantilever()
+    full = _run(m, tangent="full")
+    assert full.solver.factorizations == full.summary.iterations   # "full": a new tangent every iteration
+    # the reused tangent is one converged correction away from the exact one: the same solution to
+    # far below the 1e-6 tolerances (quadratic convergence from there)
+    i = m.index(tip)
+    u_auto, u_full = auto.x[i] - auto.X0[i], full.x[i] - full.X0[i]
+    np.testing.assert_allclose(u_auto, u_full, rtol=0, atol=1e-9 * np.abs(u_full).max())
+
+
+def test_auto_reuses_no_factorisation_across_steps_or_with_path_dependent_families():
+    m, tip = _bent_cantilever()
+    m.step("more", initial_increment=0.5, max_increment=0.5).load(tip, fz=-500.0, my=30.0)
+    an = _run(m)
+    s = an.summary
+    assert [st["increments"] for st in s.steps] == [4, 2]
+    assert an.solver.factorizations == s.iterations - (4 - 1) - (2 - 1)   # none at each step's start
     m, _ = _bent_cantilever()
     an = Analysis(m, None, progress=False, on_frame=lambda fr: None)
+    for f in an.families:
+        f.path_independent = False   # a response that may depend on more than the configuration
     an.run()
-    assert an.algorithm.method() == "full"
     assert an.solver.factorizations == an.summary.iterations
 
 

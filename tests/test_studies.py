@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy import stats
+from scipy import special, stats
 
 import femast as fm
 import femast.studies as st
@@ -367,6 +367,35 @@ def test_cli_study_runs_reports_and_resumes(tmp_path, capsys):
     assert "160 already on disk" in capsys.readouterr().out
 
 
+FAILING_SCRIPT = """
+import femast.studies as st
+
+def half_fail(x):
+    if x > 0.5:
+        raise RuntimeError(f"no convergence at x = {x:.3f}")
+    return {"y": x}
+
+study = st.Study(run=half_fail, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], name="half")
+"""
+
+
+def test_cli_study_exits_3_when_runs_failed_also_after_a_resume(tmp_path, capsys):
+    from femast.cli import main
+
+    script = tmp_path / "half.py"
+    script.write_text(FAILING_SCRIPT)
+    out = tmp_path / "res"
+    assert main(["--quiet", "study", str(script), "--samples", "16", "--workers", "1", "--out", str(out),
+                 "--no-report"]) == 3
+    cap = capsys.readouterr()
+    n_failed = st.load(out).counts()["failed"]
+    assert 0 < n_failed < 16       # x > 0.5 in about half of 16 Sobol' points
+    assert f"{n_failed} FAILED" in cap.out and f"{n_failed} run(s) FAILED; exit code 3" in cap.err
+    # resuming a complete study runs nothing new, and still says the study holds failures
+    assert main(["--quiet", "study", str(script), "--samples", "16", "--out", str(out), "--no-report"]) == 3
+    # the Ishigami study has no failure: exit 0 (test_cli_study_runs_reports_and_resumes)
+
+
 def test_cli_study_errors_are_one_line(tmp_path, capsys):
     from femast.cli import main
 
@@ -549,3 +578,175 @@ def test_samples_over_the_timeout_are_recorded_failed(tmp_path, workers):
     assert time.perf_counter() - t0 < 5.0 * n_slow / workers   # the slow samples were cut short
     with pytest.raises(StudyError, match="timeout_s"):
         st.Study(run=_sometimes_slow, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], timeout_s=0)
+
+
+# ------------------------------------------------------------------ timeout_s in threads (the analysis' deadline)
+def _slow_cantilever(F):
+    """A cantilever loaded in 1e-4 steps when F > 1.3: 10 000 increments (several seconds)."""
+    m = fm.Model("slow cantilever")
+    a, b = m.node(0, 0, 0), m.node(L_M, 0, 0)
+    m.beam(a, b, fm.circular_tube(D_M, D_M - 2 * T_M, E=70e9), n=2)
+    m.fix(a)
+    inc = 1e-4 if F > 1.3 else 0.5
+    m.step("load", initial_increment=inc, max_increment=inc, max_increments=20000, output_frequency=20000).load(
+        b, fz=-F)
+    return m
+
+
+def test_deadline_stops_an_analysis_in_a_thread_and_costs_nothing_without_one():
+    import threading
+    import time
+
+    from femast.analysis.deadline import check, deadline, remaining
+    from femast.errors import SampleTimeout
+
+    out = {}
+
+    def job():
+        t0 = time.perf_counter()
+        try:
+            with deadline(0.3, "stopped: over 0.3 s"):
+                fm.Analysis(_slow_cantilever(1.5), None, progress=False, on_frame=lambda fr: None).run()
+        except SampleTimeout as exc:
+            out["err"] = str(exc)
+        out["t"] = time.perf_counter() - t0
+        out["after"] = remaining()
+
+    th = threading.Thread(target=job)   # not the main thread: no SIGALRM could reach it
+    th.start()
+    th.join(60)
+    assert out["err"] == "stopped: over 0.3 s"
+    assert out["t"] < 3.0           # stopped at an iteration after 0.3 s; unstopped: 10 000 increments, 6 s
+    assert out["after"] is None     # the deadline ends with its block
+    # nested: the earlier deadline holds
+    with deadline(10.0):
+        with deadline(100.0):
+            assert remaining() < 10.0
+    with pytest.raises(fm.ModelError, match="must be > 0"):
+        with deadline(0.0):
+            pass
+    check()   # no deadline: nothing
+    n = 200_000
+    t0 = time.perf_counter()
+    for _ in range(n):
+        check()
+    per_call = (time.perf_counter() - t0) / n
+    assert per_call < 5e-6    # 0.1-0.2 us measured; an iteration of this 2-beam model takes ~300 us
+
+
+def test_timeout_on_dask_thread_workers_records_the_slow_samples_failed(tmp_path):
+    import time
+
+    distributed = pytest.importorskip("distributed")
+    study = st.Study(model=_slow_cantilever, inputs=[st.Uniform("F", 0.5, 1.5)],
+                     outputs=[st.NodeOutput("tip_w", node=2, quantity="U", components="z")],
+                     sampler="mc", seed=3, timeout_s=0.5)
+    t0 = time.perf_counter()
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cl, distributed.Client(cl) as client:
+        s = st.run(study, tmp_path / "d", samples=12, scheduler=client)
+    res = st.load(tmp_path / "d")
+    n_slow = int(np.sum(res.table(["F"])["F"] > 1.3))
+    assert s.engine == "dask" and n_slow > 0 and s.failed == n_slow and s.ok == 12 - n_slow
+    assert all("SampleTimeout: the sample ran over timeout_s = 0.5 s" in r for _, r in res.failures())
+    assert time.perf_counter() - t0 < 60.0   # unstopped, each slow sample runs 10 000 increments
+
+
+# ------------------------------------------------------------------ correlation between the members of one input
+def test_member_equicorrelation_and_exponential_correlation_are_sampled():
+    """Normal scores of the members carry the stated correlation; marginals unchanged.  n = 2^14
+    points: the standard error of a sample correlation is (1 - rho^2) / sqrt(n) <= 0.008, so 0.03
+    is ~4 standard errors (0.02 for the KS distance, ~1.4 / sqrt(n) = 0.011 at 95 %)."""
+    n = 2 ** 14
+    rho = 0.6
+    x = st.Normal("dL", 0.0, 2.0, size=5, member_correlation=rho)
+    d = Design([x, st.Uniform("mu", 0.0, 1.0)], sampler="sobol", seed=4)
+    _, _, u = d.points(np.arange(n), n)
+    v = d.values(u)["dL"]
+    C = np.corrcoef(v.T)
+    off = C[~np.eye(5, dtype=bool)]
+    assert np.abs(off - rho).max() < 0.03
+    for j in range(5):
+        assert stats.kstest(v[:, j], "norm", args=(0.0, 2.0)).statistic < 0.02
+    # the scalar input stays independent of the members
+    assert np.abs(np.corrcoef(v[:, 0], d.values(u)["mu"])[0, 1]) < 0.03
+    # exponential correlation of members 0, 1, 2, 4 m apart with length 2 m; uniform marginals:
+    # the normal scores carry exp(-|dx| / 2)
+    z = np.array([0.0, 1.0, 2.0, 4.0])
+    R = st.exponential_correlation(z, 2.0)
+    assert R[0, 3] == pytest.approx(np.exp(-2.0)) and R[1, 2] == pytest.approx(np.exp(-0.5))
+    y = st.Uniform("g", -1.0, 1.0, size=4, member_correlation=R)
+    dm = Design([y], sampler="mc", seed=5)
+    _, _, u = dm.points(np.arange(n), n)
+    g = dm.values(u)["g"]
+    scores = special.ndtri((g + 1.0) / 2.0)
+    assert np.abs(np.corrcoef(scores.T) - R).max() < 0.03
+    assert g.min() >= -1.0 and g.max() <= 1.0 and stats.kstest(g[:, 3], "uniform", args=(-1.0, 2.0)).statistic < 0.02
+
+
+def test_member_correlation_holds_in_every_saltelli_block_and_keeps_indices_defined():
+    """With sensitivity the group's columns are swapped together (A, B, AB:x), so every block has the
+    correlation; the Sobol' indices of the groups stay those of independent groups."""
+    n = 2 ** 12
+    x = st.Normal("a", 0.0, 1.0, size=3, member_correlation=0.5)
+    d = Design([x, st.Normal("b", 0.0, 1.0)], sampler="sobol", seed=2, sensitivity=True)
+    runs = np.arange(n * d.runs_per_sample)
+    _, block, u = d.points(runs, n)
+    v = d.values(u)["a"]
+    for j in range(d.runs_per_sample):
+        C = np.corrcoef(v[block == j].T)
+        assert np.abs(C[~np.eye(3, dtype=bool)] - 0.5).max() < 0.05    # n = 4096: 4 standard errors
+    # Y = sum of the members + b: Var(sum) = 3 + 6 * 0.5 = 6, Var(b) = 1 -> S_a = 6/7, S_b = 1/7
+    vals = d.values(u)
+    y = vals["a"].sum(axis=1) + vals["b"]
+    fA, fB = y[block == 0], y[block == 1]
+    fAB = np.stack([y[block == 2], y[block == 3]])
+    idx = st.sobol_indices(fA, fB, fAB, ["a", "b"])
+    np.testing.assert_allclose(idx["S1"], [6 / 7, 1 / 7], atol=0.03)   # 4096 Sobol' samples: bootstrap se ~0.008
+    np.testing.assert_allclose(idx["ST"], [6 / 7, 1 / 7], atol=0.03)
+
+
+@pytest.mark.parametrize("make, words", [
+    (lambda: st.Normal("a", 0, 1, member_correlation=0.5), ["'a'", "per-member input"]),
+    (lambda: st.Normal("a", 0, 1, size=4, member_correlation=-0.5), ["'a'", "(-0.3333, 1)", "4 members"]),
+    (lambda: st.Normal("a", 0, 1, size=4, member_correlation=1.0), ["'a'", "must lie in"]),
+    (lambda: st.Normal("a", 0, 1, size=3, member_correlation=float("nan")), ["'a'", "not finite"]),
+    (lambda: st.Normal("a", 0, 1, size=3, member_correlation=np.eye(2)), ["'a'", "(3, 3)", "(2, 2)"]),
+    (lambda: st.Uniform("a", 0, 1, size=2, member_correlation=[[1, 0.5], [0.4, 1]]), ["symmetric"]),
+    (lambda: st.Uniform("a", 0, 1, size=3, member_correlation=[[1, .9, -.9], [.9, 1, .9], [-.9, .9, 1]]),
+     ["not positive definite"]),
+    (lambda: st.exponential_correlation([0.0, 1.0], 0.0), ["length", "> 0"]),
+])
+def test_bad_member_correlation_is_named(make, words):
+    with pytest.raises(StudyError) as e:
+        make()
+    for w in words:
+        assert w in str(e.value), (w, str(e.value))
+
+
+def test_member_correlation_is_part_of_the_stored_study(tmp_path):
+    def run_fn(a):
+        return {"y": float(np.sum(a))}
+
+    s1 = st.Study(run=run_fn, inputs=[st.Normal("a", 0, 1, size=3, member_correlation=0.3)], outputs=["y"])
+    st.run(s1, tmp_path / "s", samples=4)
+    s2 = st.Study(run=run_fn, inputs=[st.Normal("a", 0, 1, size=3, member_correlation=0.4)], outputs=["y"])
+    with pytest.raises(StudyError, match="holds another study"):
+        st.run(s2, tmp_path / "s", samples=4)
+
+
+def test_first_order_indices_do_not_depend_on_the_output_mean():
+    """Y = c + a + 0.5 b (a, b standard normal): S1 = (0.8, 0.2) whatever the offset c.  The
+    estimator centres f_B (same expectation); uncentred, a mean 1000 times the spread adds a
+    variance ~c^2 / n to S1 (errors ~1 at n = 512 Monte Carlo samples)."""
+    n = 512
+    d = Design([st.Normal("a", 0, 1), st.Normal("b", 0, 1)], sampler="mc", seed=3, sensitivity=True)
+    _, block, u = d.points(np.arange(n * 4), n)
+    v = d.values(u)
+    out = []
+    for c in (0.0, 1000.0):
+        y = c + v["a"] + 0.5 * v["b"]
+        out.append(st.sobol_indices(y[block == 0], y[block == 1], np.stack([y[block == 2], y[block == 3]])))
+    np.testing.assert_allclose(out[1]["S1"], out[0]["S1"], rtol=0, atol=1e-9)   # round-off of the offset
+    np.testing.assert_allclose(out[1]["S1"], [0.8, 0.2], atol=0.1)   # 512 MC samples: ~3 standard errors
+    assert np.all(out[1]["S1_high"] - out[1]["S1_low"] < 0.5)

@@ -34,39 +34,113 @@ def _scatter_vector(f, eqs, out):
                 out[q] += f[e, i]
 
 
+@njit(cache=True)
+def _scatter_diagonal(k, eqs, n, out):
+    """Add the element matrices' entries on the diagonal of the assembled matrix (equations
+    below ``n``) to ``out``, in the order :func:`_scatter_matrix` adds them."""
+    n_el, m, _ = k.shape
+    for e in range(n_el):
+        for i in range(m):
+            q = eqs[e, i]
+            if q < 0 or q >= n:
+                continue
+            for j in range(m):
+                if eqs[e, j] == q:
+                    out[q] += k[e, i, j]
+
+
+@njit(cache=True)
+def _pattern_kernel(el_ptr, el_eq, ent_ptr, row_lo, row_hi, col_lo, col_hi):
+    """CSR pattern (indptr, indices) of the block [row_lo:row_hi, col_lo:col_hi] of the matrix
+    assembled from elements whose equations are ``el_eq[el_ptr[e]:el_ptr[e + 1]]`` (-1: none), and
+    the position in its data array of every element-matrix entry (e, i, j), stored at
+    ``ent_ptr[e] + i m_e + j`` (-1: outside the block).  Row by row: the elements incident to a row
+    (a row -> (element, local index) incidence built first), their columns marked once, sorted."""
+    nr = row_hi - row_lo
+    nc = col_hi - col_lo
+    n_el = el_ptr.shape[0] - 1
+    inc_ptr = np.zeros(nr + 1, dtype=np.int64)
+    for k in range(el_eq.shape[0]):
+        r = el_eq[k]
+        if r >= row_lo and r < row_hi:
+            inc_ptr[r - row_lo + 1] += 1
+    for r in range(nr):
+        inc_ptr[r + 1] += inc_ptr[r]
+    inc_el = np.empty(inc_ptr[nr], dtype=np.int64)   # element and flat index k of each incidence
+    inc_k = np.empty(inc_ptr[nr], dtype=np.int64)
+    fill = inc_ptr[:nr].copy()
+    for e in range(n_el):
+        for k in range(el_ptr[e], el_ptr[e + 1]):
+            r = el_eq[k]
+            if r >= row_lo and r < row_hi:
+                inc_el[fill[r - row_lo]] = e
+                inc_k[fill[r - row_lo]] = k
+                fill[r - row_lo] += 1
+    # pass 1: distinct columns per row (marker stamped with the row)
+    marker = np.full(nc, -1, dtype=np.int64)
+    indptr = np.zeros(nr + 1, dtype=np.int64)
+    for r in range(nr):
+        count = 0
+        for t in range(inc_ptr[r], inc_ptr[r + 1]):
+            e = inc_el[t]
+            for kk in range(el_ptr[e], el_ptr[e + 1]):
+                c = el_eq[kk] - col_lo
+                if c >= 0 and c < nc and marker[c] != r:
+                    marker[c] = r
+                    count += 1
+        indptr[r + 1] = indptr[r] + count
+    # pass 2: the sorted columns of each row, and the positions of the entries in it
+    indices = np.empty(indptr[nr], dtype=np.int64)
+    pos = np.full(ent_ptr[n_el], -1, dtype=np.int64)
+    marker[:] = -1
+    where = np.empty(nc, dtype=np.int64)
+    for r in range(nr):
+        q = indptr[r]
+        for t in range(inc_ptr[r], inc_ptr[r + 1]):
+            e = inc_el[t]
+            for kk in range(el_ptr[e], el_ptr[e + 1]):
+                c = el_eq[kk] - col_lo
+                if c >= 0 and c < nc and marker[c] != r:
+                    marker[c] = r
+                    indices[q] = c
+                    q += 1
+        indices[indptr[r]:q] = np.sort(indices[indptr[r]:q])
+        for q2 in range(indptr[r], q):
+            where[indices[q2]] = q2
+        for t in range(inc_ptr[r], inc_ptr[r + 1]):
+            e = inc_el[t]
+            k0 = el_ptr[e]
+            m = el_ptr[e + 1] - k0
+            i = inc_k[t] - k0
+            base = ent_ptr[e] + i * m
+            for j in range(m):
+                c = el_eq[k0 + j] - col_lo
+                if c >= 0 and c < nc:
+                    pos[base + j] = where[c]
+    return indptr, indices, pos
+
+
 def _block_pattern(eq_list, row_lo, row_hi, col_lo, col_hi):
     """CSR pattern of the block [row_lo:row_hi, col_lo:col_hi] of the assembled matrix and, per
-    family, the position in its data array of every element-matrix entry (-1: outside)."""
+    family, the position in its data array of every element-matrix entry (-1: outside).
+    ``eq_list``: one (n_el, m) array of element equations per family (-1: not an equation)."""
     shape = (row_hi - row_lo, col_hi - col_lo)
-    keys = []
-    for eqs in eq_list:
-        m = eqs.shape[1]
-        r = np.repeat(eqs, m, axis=1).reshape(eqs.shape[0], m, m)
-        c = np.tile(eqs, (1, m)).reshape(eqs.shape[0], m, m)
-        keep = (r >= row_lo) & (r < row_hi) & (c >= col_lo) & (c < col_hi)
-        keys.append(np.where(keep, (r - row_lo).astype(np.int64) * shape[1] + (c - col_lo), -1))
-    flat = np.concatenate([k.ravel() for k in keys]) if keys else np.zeros(0, np.int64)
-    valid = np.flatnonzero(flat >= 0)
-    if valid.size == 0:
-        return sp.csr_matrix(shape), []
-    # unique keys and the inverse map by one stable argsort (np.unique's hash path was 10x slower)
-    kv = flat[valid]
-    order = np.argsort(kv, kind="stable")
-    s = kv[order]
-    first = np.empty(s.size, dtype=bool)
-    first[0] = True
-    np.not_equal(s[1:], s[:-1], out=first[1:])
-    key = s[first]
-    pos = np.full(flat.size, -1, dtype=np.int64)
-    pos[valid[order]] = np.cumsum(first) - 1
-    indptr = np.zeros(shape[0] + 1, dtype=np.int64)
-    indptr[1:] = np.cumsum(np.bincount(key // shape[1], minlength=shape[0]))
-    mat = sp.csr_matrix((np.zeros(key.size), key % shape[1], indptr), shape=shape)
+    sizes = [int(eqs.size) for eqs in eq_list]
+    ms = [int(eqs.shape[1]) for eqs in eq_list]
+    el_ptr = np.concatenate([[0]] + [np.full(eqs.shape[0], m, dtype=np.int64) for eqs, m in zip(eq_list, ms)])
+    el_ptr = np.cumsum(el_ptr)
+    ent_ptr = np.cumsum(np.concatenate([[0]] + [np.full(eqs.shape[0], m * m, dtype=np.int64)
+                                                for eqs, m in zip(eq_list, ms)]))
+    el_eq = (np.concatenate([np.ravel(eqs) for eqs in eq_list]).astype(np.int64) if sum(sizes)
+             else np.zeros(0, np.int64))
+    indptr, indices, pos = _pattern_kernel(el_ptr, el_eq, ent_ptr, row_lo, row_hi, col_lo, col_hi)
+    mat = sp.csr_matrix((np.zeros(indices.size), indices, indptr), shape=shape)
     positions = []
     offset = 0
-    for k in keys:
-        positions.append(pos[offset:offset + k.size].reshape(k.shape))
-        offset += k.size
+    for eqs, m in zip(eq_list, ms):
+        n = eqs.shape[0] * m * m
+        positions.append(pos[offset:offset + n].reshape(eqs.shape[0], m, m))
+        offset += n
     return mat, positions
 
 
@@ -82,7 +156,22 @@ class Assembler:
             self.K_aa, self.pos_aa = _block_pattern(self.eqs, 0, na, 0, na)
         else:
             self.K_ff, self.pos_ff = _block_pattern(self.eqs, 0, nf, 0, nf)
-            self.K_fc, self.pos_fc = _block_pattern(self.eqs, 0, nf, nf, na)
+        self._fc = None   # (K_fc, pos_fc), built when first needed (prescribed-value increments)
+
+    @property
+    def K_fc(self):
+        """The free-constrained block (CSR pattern built on first use)."""
+        return self._fc_block()[0]
+
+    @property
+    def pos_fc(self):
+        return self._fc_block()[1]
+
+    def _fc_block(self):
+        if self._fc is None:
+            nf, na = self.dofmap.n_free, self.dofmap.n_active
+            self._fc = _block_pattern(self.eqs, 0, nf, nf, na)
+        return self._fc
 
     def full_tangent(self, k_list):
         """K over all active DOFs (only with ``full=True``)."""
@@ -104,6 +193,13 @@ class Assembler:
         data[:] = 0.0
         for k, pos in zip(k_list, positions):
             _scatter_matrix(k, pos, data)
+
+    def diagonal(self, k_list):
+        """The diagonal of K_ff (the same sums as in the assembled K_ff)."""
+        out = np.zeros(self.dofmap.n_free)
+        for k, eqs in zip(k_list, self.eqs):
+            _scatter_diagonal(k, eqs, self.dofmap.n_free, out)
+        return out
 
     def coupling(self, k_list):
         """K_fc alone (the free-constrained block)."""

@@ -167,7 +167,11 @@ class TimeIncrements(Plan):
         dpres = pres[cn, cd] - st.prescribed[cn, cd]
         dpres[sys_.fixed[cn, cd]] = 0.0
         inc.dpres = dpres
-        if an.extrapolate and st.last_increment is not None and not np.any(dpres):
+        ref = getattr(an, "reference", None)
+        pdu = None if ref is None or self.uses_lam else ref.predictor(st.step, st.total_time, st.total_time + dt)
+        if pdu is not None and pdu.shape == (sys_.n_free,):   # a reference run's converged increment (femast.analysis.reference)
+            inc.predictor, inc.whole = (pdu, 0.0), True
+        elif an.extrapolate and st.last_increment is not None and not np.any(dpres):
             # Abaqus' linear extrapolation: start from the previous increment's solution, scaled
             scale = dt / st.last_size
             inc.predictor = (scale * st.last_increment, scale * st.last_dlam)

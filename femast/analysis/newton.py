@@ -27,14 +27,21 @@ Options of the algorithm: a secant line search (``line_search``) and the tangent
   an unknown (displacement control, arc length) it acts as ``"modified"``.
 * ``"initial"``: one per step, formed again only where an increment needs its own (prescribed
   values or a viscous term);
-* ``"auto"`` (the default): ``"full"``.  ``"modified"`` and ``"quasi-newton"`` are not chosen
+* ``"auto"`` (the default): ``"full"``, except that the first iteration of an increment reuses
+  the factorisation of the previous increment's last iteration (the tangent one correction away
+  from the converged configuration, of the order of the tolerance), when nothing else may have
+  changed the tangent: the same step, load control without a predictor, no prescribed values, no
+  viscous term, every element family path-independent (its response a function of the
+  configuration alone) and the previous increment converged in at least one iteration.  On the
+  peer masts that saves one factorisation in four or five with the same iterations
+  (docs/performance.md).  A restart point keeps the configuration that factorisation was formed at
+  (:meth:`Newton.reuse_configuration`), and a restarted run forms it again there, so that it
+  continues bit for bit as the uninterrupted run (tests/test_restart.py).
+  ``"modified"`` and ``"quasi-newton"`` are not chosen
   automatically: on the peer masts (40-1000 bays) and the ADAM bay they need more iterations
   than they save factorisations, and they do not beat full Newton's time
   (``python benchmarks/newton_variants.py``, docs/performance.md).  Full Newton converges where
-  they do and more (friction, latches, limit points).  A shortcut that was measured and not kept:
-  reusing the previous increment's last factorisation for the first iteration of the next one
-  (a quarter fewer factorisations on the masts, the same iterations) breaks the bit-for-bit
-  equality of a restarted run with the uninterrupted one (tests/test_restart.py).
+  they do and more (friction, latches, limit points).
 
 Every Newton iteration: tangent (if due), solve, correct the load factor, update the
 configuration, evaluate the residual, test convergence.  On convergence the state is committed,
@@ -50,6 +57,7 @@ import numpy as np
 
 from ..elements.base import IncrementContext
 from ..errors import ModelError, SingularModelError
+from .deadline import check as check_deadline
 from .solvers.convergence import Convergence
 
 
@@ -63,6 +71,9 @@ class Increment:
     ``P_start + lam * P_ref`` with P_ref the reference pattern (n, 6).  dpres : increment of the
     constrained DOFs' values (prescribed displacements, rad for rotations), or None.
     predictor : (du, dlam) added before the first iteration (linear extrapolation), or None.
+    whole : the predictor is the whole increment of the free DOFs (a reference run's, see
+    :mod:`femast.analysis.reference`; fixed loads or prescribed motion only): the prescribed motion
+    is applied with it, and the first iteration is not taken as a linear solve.
     predict : ``predict(du_p) -> dlam``, the tangent predictor of the load factor from
     K du_p = P_ref (arc length), or None.  dlambda : ``dlambda(du_r, du_p, Du) -> dlam or None``,
     the load-factor correction of an iteration (None: the constraint has no solution).
@@ -85,6 +96,7 @@ class Increment:
     dlambda: object = None
     viscous: object = None
     direct: bool = True
+    whole: bool = False
 
     def loads(self, lam):
         return self.P if self.P_ref is None else self.P_start + lam * self.P_ref
@@ -132,10 +144,42 @@ class Newton:
         self.refactor_every = refactor_every
         self.slow = float(slow)
         self.factorized = False   # a usable factorisation exists (modified / initial Newton)
+        # "auto": [state version, x, R, formed] of the factorisation kept for the next increment's
+        # first iteration (x, R: the configuration it was formed at; formed False after a restart)
+        self._reuse = None
 
     def new_step(self):
-        """Called at the start of every step (the initial-stiffness tangent is formed again)."""
+        """Called at the start of every step (the initial-stiffness tangent is formed again; "auto"
+        reuses no factorisation across steps)."""
         self.factorized = False
+        self._reuse = None
+
+    def reuse_configuration(self):
+        """(x, R) at which the factorisation that the next increment's first iteration reuses was
+        formed, or None: what a restart point keeps so that a restarted run can form it again."""
+        return None if self._reuse is None else (self._reuse[1], self._reuse[2])
+
+    def resume_reuse(self, version, x, R):
+        """A restarted run at configuration ``version``: the factorisation to reuse is to be formed
+        again at configuration (x, R) (the restart point's :meth:`reuse_configuration`)."""
+        self._reuse = [version, x, R, False]
+
+    def _reusable(self, system, state, inc, has_dpres, uses_lam, it):
+        """The kept factorisation serves this increment's first iteration ("auto" only)."""
+        r = self._reuse
+        return (self.tangent == "auto" and it == 0 and r is not None and r[0] == state.version and not has_dpres
+                and not uses_lam and inc.predictor is None and inc.viscous is None and inc.direct
+                and all(f.path_independent for f in system.families))
+
+    def _form_again(self, system, state, ctx):
+        """Form the kept factorisation again at the configuration it was formed at (a restarted run)."""
+        keep = state.x, state.R
+        state.x, state.R = self._reuse[1].copy(), self._reuse[2].copy()
+        try:
+            system.factorize_tangent(system.evaluate(ctx), False)
+        finally:
+            state.x, state.R = keep
+        self._reuse[3] = True
 
     def method(self):
         """The tangent update used ("auto" resolved)."""
@@ -186,6 +230,8 @@ class Newton:
         since = 0   # iterations on the current factorisation
         ratios = []  # residual ratios, the first before any iteration (modified / quasi-Newton)
         steps = []   # largest |correction| of each iteration (modified / quasi-Newton)
+        keep = self.tangent == "auto" and all(f.path_independent for f in system.families)
+        formed_at = None   # (x, R) of this attempt's last factorisation ("auto", path-independent)
 
         def fail(why):
             state.rollback()
@@ -203,24 +249,33 @@ class Newton:
                 r_ = r_ - visc.C / dt * (Du if Dtrial is None else Dtrial)
             return resp, res_, r_
 
+        whole = 1 if inc.whole and inc.predictor is not None and not uses_lam else 0
         if inc.predictor is not None:
             pdu, pdlam = inc.predictor
             Du += pdu
-            system.update(pdu)
+            if whole:
+                # a predictor of the whole increment (a reference run's converged increment, issue 21):
+                # the prescribed motion goes in with it, not again in the first iteration, and the
+                # first iteration is no linear solve from the committed state (no linear-increment rule)
+                system.update(pdu, dpres if has_dpres else None)
+                dpres, has_dpres = None, False
+            else:
+                system.update(pdu)
             lam += pdlam if uses_lam else 0.0
         lam_start = state.lam
         try:
             P = inc.loads(lam)
             responses, F, r = evaluate(P, reuse=True)
             for it in range(conv.max_iterations + 1):
-                if (it == 0 and not uses_lam and not has_dpres and not np.any(Du) and visc is None
+                check_deadline()   # Study(timeout_s=) in threads (femast/analysis/deadline.py)
+                if (it == 0 and not uses_lam and not has_dpres and not whole and not np.any(Du) and visc is None
                         and state.at_equilibrium and np.array_equal(P, state.loads)):
                     # nothing changes (e.g. a step that repeats the previous loads): the committed
                     # state is the converged solution
                     system.commit(responses, P, F, lam)
                     return Outcome(True, 0, "", responses, Du, 0.0)
                 if it > 0:
-                    ok, ratio = system.converged(conv, r, du, Du, responses, P, iters)
+                    ok, ratio = system.converged(conv, r, du, Du, responses, P, iters + whole)
                     rnorm_hist.append(ratio)
                     ratios.append(ratio)
                     if ok:
@@ -228,6 +283,8 @@ class Newton:
                             visc.converged(state, Du, dt, responses)
                         state.last_increment, state.last_size, state.last_dlam = Du.copy(), dt, lam - lam_start
                         system.commit(responses, P, F, lam, equilibrium=visc is None)
+                        if formed_at is not None:   # kept for the next increment's first iteration
+                            self._reuse = [state.version, formed_at[0], formed_at[1], True]
                         return Outcome(True, iters, "", responses, Du, lam - lam_start)
                     if it == conv.max_iterations:
                         return fail(f"no convergence in {iters} iterations "
@@ -237,8 +294,15 @@ class Newton:
                 # the tangent only when another iteration is needed
                 K = Kfc = None
                 with_fc = it == 0 and has_dpres
-                if self._refactor(method, it, inc, has_dpres, since, ratios, steps):
+                if self._reusable(system, state, inc, has_dpres, uses_lam, it):
+                    if not self._reuse[3]:
+                        self._form_again(system, state, ctx)
+                    self._reuse = None
+                    self.factorized = True
+                elif self._refactor(method, it, inc, has_dpres, since, ratios, steps):
                     since = 0
+                    self._reuse = None
+                    formed_at = (state.x.copy(), state.R.copy()) if keep else None
                     if broyden is not None:
                         broyden.reset()
                     try:

@@ -7,7 +7,8 @@ increment of every step, everything the run needs to go on into ``<out>/restart/
 * ``state-<k>.npz``: the :class:`~femast.analysis.state.State` (configuration, element states,
   loads, prescribed values, load factor, times, increment sizes, damping...), bit for bit;
 * ``extra-<k>.npz``: the loads and prescribed values at the start of the step in progress (the
-  step's loads ramp from them);
+  step's loads ramp from them), and the configuration at which the factorisation that the next
+  increment's first iteration reuses was formed (newton.py, ``tangent="auto"``), if any;
 * ``restart.json``: which step and increment, how many frames are on disk, the run's counts so far,
   the convergence floor of the run (its first tangent's), and the names of the two files.  It is
   written last (atomically), so a run killed while saving keeps the previous restart point.
@@ -113,8 +114,10 @@ class RestartOutput(Observer):
         st.save(tmp)
         os.replace(tmp, self.folder / state_file)
         tmp = self.folder / (extra_file + ".tmp")
+        reuse = an.algorithm.reuse_configuration()   # the factorisation the next increment reuses
+        extra = {} if reuse is None else {"reuse_x": reuse[0], "reuse_R": reuse[1]}
         with open(tmp, "wb") as fh:
-            np.savez(fh, load_start=self.step_start[0], pres_start=self.step_start[1])
+            np.savez(fh, load_start=self.step_start[0], pres_start=self.step_start[1], **extra)
         os.replace(tmp, self.folder / extra_file)
         done_iters = sum(s["iterations"] for s in summary.steps)
         zf = an.system.zero_force
@@ -156,6 +159,7 @@ def load_restart(folder, analysis) -> dict | None:
             state = State.load(rdir / info["state_file"])
             with np.load(rdir / info["extra_file"], allow_pickle=False) as z:
                 step_start = (z["load_start"], z["pres_start"])
+                reuse = (z["reuse_x"], z["reuse_R"]) if "reuse_x" in z.files else None
     except FemastError:
         raise
     except Exception as exc:
@@ -171,7 +175,7 @@ def load_restart(folder, analysis) -> dict | None:
                           "with the model that wrote it")
     if state is None:
         return None
-    info.update(state=state, step_start=step_start, folder=folder)
+    info.update(state=state, step_start=step_start, folder=folder, reuse=reuse)
     return info
 
 
@@ -185,6 +189,8 @@ def restore(analysis, info) -> None:
             setattr(st, f.name, getattr(saved, f.name))
     if info["zero_force"] is not None:
         analysis.system.zero_force = float.fromhex(info["zero_force"])
+    if info.get("reuse") is not None:   # the factorisation the next increment reuses: formed again there
+        analysis.algorithm.resume_reuse(st.version, *info["reuse"])
     s = info["summary"]
     summ = analysis.summary
     summ.increments, summ.iterations = s["increments"], s["iterations"]

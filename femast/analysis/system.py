@@ -186,9 +186,9 @@ class System:
 
         An unconstrained model's element matrices go straight into the linear solver's permuted
         matrix (positions composed once: no CSR fill and no gather per iteration), and K_ff is
-        then not formed (None).  Constrained models, and the first tangent (whose diagonal sets
-        the zero-force floors), go through :meth:`tangent`."""
-        if self._constrained or self.zero_force is None or self.solver.chosen is None:
+        then not formed (None); the first tangent's diagonal, which sets the zero-force floors, is
+        summed from the element matrices.  Constrained models go through :meth:`tangent`."""
+        if self._constrained or self.solver.chosen is None:
             return self.factorize_csr(responses, with_fc)
         if self._direct is None or self._direct[0] != self.solver.layout:
             # a stabilised step may have widened the solver's pattern (a diagonal entry K_ff lacks):
@@ -200,6 +200,8 @@ class System:
             return self.factorize_csr(responses, with_fc)
         ta = _time.perf_counter()
         k_list = [q.k for q in responses]
+        if self.zero_force is None:
+            self._set_floors(self.assembler.diagonal(k_list))
         Kfc = self.assembler.coupling(k_list) if with_fc else None
         self.assembler.tangent_into(k_list, self.solver.values, self._direct[1])
         self.summary.assembly_time += _time.perf_counter() - ta
@@ -232,13 +234,15 @@ class System:
                                         self.constraints.geometric_values(self.state.x, self._net))
             Kfc = Kfc if with_fc else None
         if self.zero_force is None:
-            dk = np.abs(K.diagonal())
-            kt, kr = (float(np.median(v[v > 0])) if np.any(v > 0) else 0.0
-                      for v in (dk[~self.is_rot], dk[self.is_rot]))
-            # 'zero flux' floors: forces of a 1e-6 L (1e-6 rad) motion of a typical DOF (the median
-            # stiffness, so that penalty ties do not inflate it)
-            self.zero_force = 1e-6 * max(kt * self.length, kr / self.length)
+            self._set_floors(K.diagonal())
         return K, Kfc
+
+    def _set_floors(self, diagonal):
+        """The 'zero flux' floors from the first tangent's diagonal: forces of a 1e-6 L (1e-6 rad)
+        motion of a typical DOF (the median stiffness, so that penalty ties do not inflate it)."""
+        dk = np.abs(diagonal)
+        kt, kr = (float(np.median(v[v > 0])) if np.any(v > 0) else 0.0 for v in (dk[~self.is_rot], dk[self.is_rot]))
+        self.zero_force = 1e-6 * max(kt * self.length, kr / self.length)
 
     def plus_diagonal(self, K, c):
         """K + diag(c) on K's own pattern, explicit zeros kept (the viscous term of a stabilised step).

@@ -41,6 +41,15 @@ the arm term is not (``[e]x[r]x`` is symmetric only for r parallel to e).
 Construction: :class:`ShroudCableFamily` takes the unstretched lengths; :func:`add_shrouds`
 adds shrouds to a :class:`~femast.model.Model` given either the unstretched length or the
 tension that each carries in the model's initial geometry.
+
+Sources of error (issue 20, as the cable families of :mod:`femast.model.thermal`): a *length error*
+dL per rope (lack of fit, m; ``length_error=``, :meth:`ShroudCableFamily.set_length_errors`) makes it
+stress free at ``L0 + dL``; a thermal strain scales that by the ``length_factor``
+``s = 1 + alpha (T - T_init)`` the analysis writes from a step's temperatures
+(``model.thermal_expansion(alpha, family=name)``, ``step.temperature(T, family=name)``).  The law
+then sees the strain from the stress-free length ``L_f = (L0 + dL) s``: ``eps = l / L_f - 1``, the
+strain of the tensile test (Eq. 27) on the rope as it is.  (Measured on L0 as the trusses do, the
+strain would differ by a factor ~ s on EA, below 1e-3 for any real error or temperature change.)
 """
 
 from __future__ import annotations
@@ -230,16 +239,21 @@ class ShroudCableFamily(ElementFamily):
         initial configuration, m (global axes).  With any nonzero offset the family also acts on
         the rotations of its nodes: every node of the family then needs rotational support
         (a beam, a fix) -- keep offset-free ropes on translational-only nodes in another family.
+    length_error : lack of fit per rope, m (scalar or per element; default 0): the rope is stress free
+        at ``L0 + length_error`` (negative: cut short, so it pulls harder).
     name : label used in messages and results.
 
-    Output per element: ``tension`` (N), ``strain`` (from L0), ``length`` (m, between the end
-    points), ``slack`` (1.0 when the rope carries nothing).
+    Thermal strain: ``length_factor`` (n_el,), written by the analysis from the temperatures of a
+    step (:mod:`femast.model.thermal`), scales the stress-free lengths (module docstring).
+
+    Output per element: ``tension`` (N), ``strain`` (from the stress-free length ``(L0 + dL) s``),
+    ``length`` (m, between the end points), ``slack`` (1.0 when the rope carries nothing).
     """
 
     n_state = 0
     path_independent = True
 
-    def __init__(self, nodes, L0, law=None, offsets=None, labels=None, name: str = "shroud"):
+    def __init__(self, nodes, L0, law=None, offsets=None, labels=None, name: str = "shroud", length_error=None):
         self.name = name
         nodes = np.asarray(nodes)
         if nodes.ndim == 1:
@@ -270,6 +284,37 @@ class ShroudCableFamily(ElementFamily):
         self.symmetric = not has_off
         self.labels = np.arange(1, n_el + 1) if labels is None else np.asarray(labels)
         self.tangent_parts = "full"
+        self.length_factor = np.ones(n_el)
+        self.set_length_errors(0.0 if length_error is None else length_error)
+
+    def set_length_errors(self, length_error) -> None:
+        """Lack of fit per rope, m (scalar or one per element; replaces any given before): rope e is stress
+        free at ``L0[e] + length_error[e]``.  Raises :class:`ModelError` naming the rope for a wrong shape,
+        a non-finite value or a stress-free length that is not positive."""
+        n_el = self.nodes.shape[0]
+        try:
+            dL = np.asarray(length_error, dtype=float)
+        except (TypeError, ValueError):
+            raise ModelError(f"{self.name}: length_error must be numbers in m (one or one per rope); "
+                             f"got {length_error!r}") from None
+        if dL.ndim > 1 or (dL.ndim == 1 and dL.size != n_el):
+            raise ModelError(f"{self.name}: length_error must be a scalar or one value per rope, shape ({n_el},), "
+                             f"in m; got shape {dL.shape}")
+        dL = np.ascontiguousarray(np.broadcast_to(dL, (n_el,)), dtype=float).copy()
+        for el in np.flatnonzero(~np.isfinite(dL) | ~(self.L0 + dL > 0.0)):
+            label = self.labels[el]
+            if not np.isfinite(dL[el]):
+                raise ModelError(f"{self.name} element {label}: length_error = {float(dL[el])!r} m is not finite")
+            raise ModelError(f"{self.name} element {label}: length_error = {float(dL[el])!r} m leaves the rope a stress-free "
+                             f"length {self.L0[el] + dL[el]:.6g} m (L0 = {self.L0[el]:.6g} m); it must stay > 0 "
+                             "(give the error in m)")
+        self.length_error = dL
+
+    def stress_free_lengths(self) -> np.ndarray:
+        """(n_el,) stress-free lengths the law sees, m: ``(L0 + length_error) * length_factor``."""
+        L = self.L0 + self.length_error if np.any(self.length_error) else self.L0
+        lf = self.length_factor
+        return L * lf if np.any(lf != 1.0) else L
 
     def end_points(self, x, R) -> np.ndarray:
         """(n_el, 2, 3) current end points p = x + R o, m (x, R for all model nodes)."""
@@ -290,7 +335,8 @@ class ShroudCableFamily(ElementFamily):
         length = np.zeros(n)
         energy = np.zeros(n)
         err = np.zeros(n, dtype=np.int64)
-        shroud_family_kernel(self.nodes, x, R, self.offsets, self.L0, self.law, PARTS[self.tangent_parts],
+        L0 = np.ascontiguousarray(self.stress_free_lengths())
+        shroud_family_kernel(self.nodes, x, R, self.offsets, L0, self.law, PARTS[self.tangent_parts],
                              _GX, _GW, f, K, tau, eps, length, energy, err)
         bad = np.flatnonzero(err)
         if bad.size:
@@ -303,9 +349,10 @@ class ShroudCableFamily(ElementFamily):
                        "attachment points")
             elif code == ERR_BEYOND_LAW:
                 l = float(np.linalg.norm(p[1] - p[0]))
-                msg = (f"strain {l / self.L0[el] - 1.0:.4g} is beyond the range of the rope law "
+                msg = (f"strain {l / L0[el] - 1.0:.4g} is beyond the range of the rope law "
                        f"{self.law[el].tolist()} (no finite increasing tension there); check L0 = {self.L0[el]:.6g} m "
-                       "and the node coordinates (units m)")
+                       f"(stress free at {L0[el]:.6g} m with its length error and thermal strain) and the node "
+                       "coordinates (units m)")
             else:
                 msg = "nodal coordinates are not finite"
             raise ModelError(f"{self.name} element {self.labels[el]}: {msg}")
@@ -320,12 +367,15 @@ def unstretched_length(law, tension, length):
     return np.asarray(length, float) / (1.0 + strain_from_tension(law or DyneemaLaw(), tension))
 
 
-def add_shrouds(model, pairs, law=None, tension=None, L0=None, offsets=None, name: str = "shroud") -> ShroudCableFamily:
+def add_shrouds(model, pairs, law=None, tension=None, L0=None, offsets=None, name: str = "shroud",
+                length_error=None) -> ShroudCableFamily:
     """Add Dyneema shrouds between node-label pairs ``pairs`` ((n, 2)) to ``model``; returns the family.
 
     Give either ``L0`` (unstretched lengths, m) or ``tension`` (N, >= 0: the tension each rope carries
     in the model's *initial* geometry, including the offsets); neither means taut at zero tension.
-    ``offsets`` (n, 2, 3) as in :class:`ShroudCableFamily`.  Raises ModelError for coincident
+    ``offsets`` (n, 2, 3) as in :class:`ShroudCableFamily`.  ``length_error`` (m, scalar or per rope): lack
+    of fit added to the unstretched lengths so found (a rope meant to carry ``tension`` but cut
+    ``length_error`` too long).  Raises ModelError for coincident
     attachment points, non-positive lengths or stiffness, and tensions outside the law's range.
     """
 
@@ -356,5 +406,6 @@ def add_shrouds(model, pairs, law=None, tension=None, L0=None, offsets=None, nam
         L0v = _per_element(L0, n, name, "L0 (m)")
     else:
         L0v = length.copy()
-    fam = ShroudCableFamily(pairs, L0v, laws, offsets=None if offsets is None else off, name=name)
+    fam = ShroudCableFamily(pairs, L0v, laws, offsets=None if offsets is None else off, name=name,
+                            length_error=length_error)
     return model.add_family(fam)

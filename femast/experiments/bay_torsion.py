@@ -57,7 +57,9 @@ friction), ``ball_B_m`` (4e-3, ball end radius used by ``ball_joint_friction``),
 bay folds under a positive twist), ``off_axis_side`` (0: ``off_axis_motion`` moves the axis
 towards the centre of this side), ``bay`` (dict of further :class:`~femast.adam.BayParameters`
 changes, e.g. ``{"b": 0.3}``), ``max_fe_rows`` (80), ``cache_dir`` (None), ``threads`` (1: numba
-threads of parallel kernels during a run, see :class:`~femast.experiments.fe_cache.kernel_threads`).
+threads of parallel kernels during a run, see :class:`~femast.experiments.fe_cache.kernel_threads`),
+``fe_reference`` (None: ``{latch_k, latch_mu}`` of a reference run whose converged increments start
+every run's, :mod:`femast.experiments.fe_reference`; a fit sets it to its start).
 
 Hooks (where effects act)
 -------------------------
@@ -83,7 +85,8 @@ import numpy as np
 from .. import progress
 from ..errors import ConvergenceError, FemastError, ModelError
 from .core import Column, Experiment, Measured, Parameter, prepared
-from .fe_cache import cached, kernel_threads
+from .fe_cache import kernel_threads
+from .fe_reference import cached_run
 from .residuals import turning_points
 
 ZONE_KINDS = ("zone (a) at backstop", "zone (b) behind roller axis", "zone (c) in front of roller axis",
@@ -159,11 +162,15 @@ def bay_parameters(inputs: dict):
     return BayParameters(latch=latch, **rest)
 
 
-def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None = 1) -> dict:
+def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None = 1, reference=None,
+            record_path=None) -> dict:
     """One FE run of the bay along ``drive`` (m, 3) = [theta (rad), ux, uy (m)] (uncached).
 
     threads : numba threads of the parallel kernels (:class:`~femast.experiments.fe_cache.kernel_threads`;
         None leaves numba's setting).
+    reference : a :class:`~femast.analysis.reference.ReferencePath` of another run of the bay whose
+        converged increments start this run's, or None.  record_path : a ReferencePath that records
+        this run's converged increments, or None.
     Returns ``Mz`` (m,) N m (seed sign), ``zone``, ``bead`` (m), ``dT`` (N) (m, 4) of the four
     latches, ``uz`` (m,), ``increments``, ``iterations``, ``wall_time``."""
     from ..adam import build_bay
@@ -198,7 +205,9 @@ def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None 
                     fr["U"][row, 2], fr[f"el/{fam}/bead_position"], fr[f"el/{fam}/latch_dT"],
                     fr[f"el/{fam}/latch_zone"]))
 
-    an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=record)   # no files
+    an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=record,
+                  observers=[record_path] if record_path is not None else ())   # no files
+    an.reference = reference
     with kernel_threads(threads):
         an.run()
     steps = [r[0] for r in rec]
@@ -216,20 +225,30 @@ def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None 
     return out
 
 
-def solve(inputs: dict, drive: np.ndarray, options: dict) -> dict:
+def solve(inputs: dict, drive: np.ndarray, options: dict, reference=None) -> dict:
     """:func:`run_bay`, cached (:mod:`femast.experiments.fe_cache`).  An FE run that fails (no
     convergence, parameters that describe no bay) raises ModelError (a ValueError), which a fit
-    treats as a rejected parameter set."""
-    fold = int(options["fold"])
+    treats as a rejected parameter set.
 
-    def compute():
+    reference : ``(inputs, drive)`` of a reference run whose converged increments start this run's
+        (:mod:`femast.experiments.fe_reference`; part of the cache key), or None."""
+    fold = int(options["fold"])
+    threads = options.get("threads", 1)
+    key = (inputs, np.asarray(drive, float), fold)
+    ref_key = None
+    if reference is not None and np.array_equal(np.asarray(reference[1], float), key[1]):
+        # (another drive path -- an effect moving the axis -- runs without: the reference's increments
+        # predict it worse than the tangent)
+        ref_key = (dict(reference[0]), np.asarray(reference[1], float), fold)
+
+    def run(parts, reference=None, record=None):
         progress.tick("FE runs")
         try:
-            return run_bay(inputs, drive, fold, options.get("threads", 1))
+            return run_bay(parts[0], parts[1], fold, threads, reference=reference, record_path=record)
         except (ConvergenceError, FemastError) as e:  # includes ModelError from invalid inputs
             return {"error": f"bay-torsion FE run failed: {e}"}
 
-    out = cached("bay-torsion", (inputs, np.asarray(drive, float), fold), compute, options)
+    out = cached_run("bay-torsion", key, ref_key, run, options)
     if "error" in out:
         raise ModelError(out["error"])
     return out
@@ -242,10 +261,11 @@ def _run(params: dict, data: Measured, effects, options: dict):
     if effects:
         inputs = effects.apply("bay_parameters", inputs, **ctx)
     rows = prep["rows"]
-    drive = np.column_stack([prep["theta"][rows], prep["ux"][rows], prep["uy"][rows]])
+    drive0 = drive = np.column_stack([prep["theta"][rows], prep["ux"][rows], prep["uy"][rows]])
     if effects:
         drive = effects.apply("control_path", drive, bay=inputs, **ctx)
-    fe = solve(inputs, drive, options)
+    ref = options.get("fe_reference")
+    fe = solve(inputs, drive, options, None if ref is None else (bay_inputs(dict(ref), options), drive0))
     return prep, ctx, inputs, drive, fe
 
 
@@ -332,7 +352,7 @@ EXPERIMENT = Experiment(
     model=model,
     options={"pretension_N": 170.0, "cable_EA_N": _default_EA(), "ball_mu": 0.0, "ball_B_m": 4e-3,
              "latch_hysteresis_length_m": 3e-4, "fold": 1, "off_axis_side": 0, "bay": {}, "max_fe_rows": 80,
-             "cache_dir": None, "threads": 1},
+             "cache_dir": None, "threads": 1, "fe_reference": None},
     hooks={
         "bay_parameters": "dict of the FE bay's inputs (BayParameters fields, latch_* for the latch law), SI",
         "control_path": "(m, 3) [theta rad, ux m, uy m] of the control node at the driven rows",

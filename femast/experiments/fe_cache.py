@@ -82,16 +82,23 @@ def cache_dir(options: dict | None = None) -> Path | None:
     return Path(d) if d else None
 
 
-def cached(kind: str, key_parts, compute, options: dict | None = None):
-    """``compute()`` once per distinct ``key_parts`` (see the module docstring); returns a copy."""
-    key = f"{kind}-{key_of(kind, key_parts)}"
-    if key in _MEM:
+def run_key(kind: str, key_parts) -> str:
+    """The cache key of run ``key_parts`` of ``kind``."""
+    return f"{kind}-{key_of(kind, key_parts)}"
+
+
+def cached(kind: str, key_parts, compute, options: dict | None = None, refresh: bool = False):
+    """``compute()`` once per distinct ``key_parts`` (see the module docstring); returns a copy.
+    refresh : compute even if cached (a run whose side products are needed: a reference path) and
+    store the new value."""
+    key = run_key(kind, key_parts)
+    if key in _MEM and not refresh:
         _MEM.move_to_end(key)
         STATS["hits"] += 1
         return copy.deepcopy(_MEM[key])
     folder = cache_dir(options)
     path = folder / f"{key}.npz" if folder else None
-    if path is not None and path.is_file():
+    if path is not None and path.is_file() and not refresh:
         value = read_entry(path, key)
         if value is not None:
             STATS["disk_hits"] += 1
@@ -109,11 +116,12 @@ def cached(kind: str, key_parts, compute, options: dict | None = None):
 
 def _log_run(kind: str, key: str, seconds: float) -> None:
     """One line per computed run to ``$FEMAST_FE_RUN_LOG`` when set (benchmarks count the FE runs of a
-    fit or a diagnosis across its worker processes: ``benchmarks/diagnose_speed.py``)."""
+    fit or a diagnosis across its worker processes: ``benchmarks/diagnose_speed.py``): pid, kind, key,
+    seconds, the run's end (Unix time, s) and the CPU seconds of this process so far."""
     log = os.environ.get(RUN_LOG)
     if log:
         with open(log, "a") as fh:
-            fh.write(f"{os.getpid()} {kind} {key[-12:]} {seconds:.4f}\n")
+            fh.write(f"{os.getpid()} {kind} {key[-12:]} {seconds:.4f} {time.time():.4f} {time.process_time():.3f}\n")
 
 
 FORMAT = "femast-fe-cache 1"

@@ -12,6 +12,11 @@ Model (SI units)
     ``e_r = C_ir - C_i3`` of the top node, so the top is the rigid body the seed's model assumes.
   - ``attach="wall"``: shrouds 1 and 2 are tied to a beam node 0.25 m below the top through a 0.05 m
     rigid offset to the tube wall (the physical mast); the top segment of the tube is then flexible.
+* Sources of error (issue 20): ``length_error`` (m, per shroud) cuts the shrouds that much longer
+  than the pretension asks (lack of fit; negative: shorter, tighter); ``temperature_change_K`` heats
+  the shrouds and the tube by dT in a step ``"thermal"`` after the pretension, with the expansion
+  coefficients ``shroud_alpha_per_K`` and ``beam_alpha_per_K`` (1/K; the seed gives none: Dyneema
+  is about -12e-6 /K along the fibre, aluminium +23e-6 /K).
 * Pretension: the shroud tensions *at the pretensioned equilibrium* equal ``pretension`` (the seed
   measures them there).  :meth:`MastFE.equilibrate` adjusts the unstretched lengths until they do
   (the beam shortens and bends under the shroud loads, which relaxes the shrouds by a few percent).
@@ -94,11 +99,16 @@ class MastFE:
     n_beam : number of beam elements (the beam's geometric stiffness converges as 1/n_beam^2).
     law : Dyneema law (default the seed's x_s).
     attach : "top" (shroud points rigidly on the top, the analytic convention) or "wall".
+    length_error : lack of fit per shroud, m (scalar or 3 values; module note).
+    temperature_change_K : uniform temperature change of shrouds and tube in a step ``"thermal"``
+        after the pretension, K (0: no such step); ``shroud_alpha_per_K``, ``beam_alpha_per_K``:
+        their coefficients of thermal expansion, 1/K.
     """
 
     def __init__(self, pretension: float | None = 1200.0, *, mast: int = 0, E: float = E_NO_SHROUD,
                  n_beam: int = 16, law: DyneemaLaw | None = None, attach: str = "top",
-                 convergence: Convergence | None = None):
+                 convergence: Convergence | None = None, length_error=None, temperature_change_K: float = 0.0,
+                 shroud_alpha_per_K: float = 0.0, beam_alpha_per_K: float = 0.0):
         if pretension is not None and not (np.isfinite(pretension) and pretension >= 0.0):
             raise ModelError(f"shroud pretension {pretension!r} N must be finite and >= 0 (None: no shrouds)")
         if attach not in ("top", "wall"):
@@ -121,13 +131,23 @@ class MastFE:
             sh = self.shrouds_nominal
             length = np.linalg.norm(sh.lower - sh.upper, axis=1)
             self.L0 = np.asarray(unstretched_length(self.law, sh.tension, length), dtype=float)
+        if length_error is not None and self.shrouds_nominal is None:
+            raise ModelError("length_error is given but the mast has no shrouds (pretension=None)")
+        self.length_error = length_error
+        for what, v in (("temperature_change_K", temperature_change_K), ("shroud_alpha_per_K", shroud_alpha_per_K),
+                        ("beam_alpha_per_K", beam_alpha_per_K)):
+            if not np.isfinite(v):
+                raise ModelError(f"MastFE {what} = {v!r} is not finite")
+        self.temperature_change_K = float(temperature_change_K)
+        self.alpha = {SHROUD_FAMILY: float(shroud_alpha_per_K), BEAM_FAMILY: float(beam_alpha_per_K)}
         self.analysis: Analysis | None = None
         self._frames = []   # per converged increment of the last solve: (step, top [u, spins], tensions)
 
     # ----------------------------------------------------------------- model
     def build(self, wrenches=(), step_names=None) -> Model:
-        """The FE model: a pretension step, then one step per top wrench ``[fx, fy, fz, mx, my, mz]``
-        (N, N m about the top; dead loads at the top node, reached linearly within the step)."""
+        """The FE model: a pretension step (then ``"thermal"`` with a temperature change), then one step
+        per top wrench ``[fx, fy, fz, mx, my, mz]`` (N, N m about the top; dead loads at the top node,
+        reached linearly within the step)."""
         m = Model(f"Rocaspect mast {self.mast + 1}")
         base = m.node(*self.base_point)
         top_z = self.top_point[2]
@@ -157,9 +177,17 @@ class MastFE:
                 a = top if at_top else tie
                 pairs.append((a, d))
                 offsets.append([sh.upper[r] - m.xyz(a), np.zeros(3)])
-            fam = ShroudCableFamily(np.array(pairs), self.L0, self.law, offsets=np.array(offsets), name=SHROUD_FAMILY)
+            fam = ShroudCableFamily(np.array(pairs), self.L0, self.law, offsets=np.array(offsets), name=SHROUD_FAMILY,
+                                    length_error=self.length_error)
             m.add_family(fam)
         m.step("pretension")
+        if self.temperature_change_K != 0.0:
+            heated = [f for f, a in self.alpha.items() if a != 0.0 and (f == BEAM_FAMILY or self.anchors)]
+            for f in heated:
+                m.thermal_expansion(self.alpha[f], family=f)
+            st = m.step("thermal")
+            if heated:
+                st.temperature(self.temperature_change_K, family=heated)
         names = step_names or [f"load{k + 1:04d}" for k in range(len(wrenches))]
         for name, w in zip(names, np.asarray(wrenches, dtype=float).reshape(-1, 6)):
             m.step(name).load(top, **dict(zip(("fx", "fy", "fz", "mx", "my", "mz"), w)))
@@ -185,7 +213,9 @@ class MastFE:
 
     def equilibrate(self, tol: float = 1e-9, max_iter: int = 30) -> Analysis:
         """Solve the pretension step with unstretched lengths adjusted so that every shroud carries
-        ``pretension`` (relative ``tol``) at the equilibrium.
+        ``pretension`` (relative ``tol``) at the equilibrium (after the ``"thermal"`` step if there is
+        one).  With length errors the nominal lengths are tuned so that the erroneous ropes carry the
+        target: tensioning to a measured force in the field removes the lack of fit.
 
         Newton on L0 with the exact sensitivity of the equilibrium tensions (the shrouds load only
         the top, so with K the condensed top stiffness, B_r the top part of shroud r's B vector,
@@ -208,8 +238,11 @@ class MastFE:
             e = d / length[:, None]
             B = -np.vstack([e.T, np.cross(st.upper - st.top, e).T])  # (6, q): dl_r = B_r . du_top
             EAt = axial_rigidity_tangent(self.law, st.tension)
-            k = EAt / self.L0
-            c = -EAt * length / self.L0**2
+            fam = self._family(SHROUD_FAMILY)
+            Lf = fam.stress_free_lengths()     # (L0 + dL) s: with length errors and heat
+            s = Lf / (self.L0 + fam.length_error)
+            k = EAt / Lf
+            c = -EAt * length / Lf**2 * s
             K = self.top_stiffness("full")
             J = np.diag(c) - (k[:, None] * (B.T @ np.linalg.solve(K, B))) * c[None, :]
             self.L0 = self.L0 - np.linalg.solve(J, st.tension - target)
@@ -218,8 +251,8 @@ class MastFE:
 
     def run_wrenches(self, wrenches) -> dict:
         """Nonlinear response to a sequence of top wrenches (k, 6) (N, N m about the top, dead loads),
-        applied one step each after the pretension step (keep :meth:`equilibrate`'s unstretched lengths:
-        call it first).  Returns a dict with, at the end of the pretension step (``"u0"``) and of each
+        applied one step each after the pretension (and thermal) step (keep :meth:`equilibrate`'s unstretched lengths:
+        call it first).  Returns a dict with, at the end of the pretension (or thermal) step (``"u0"``) and of each
         load step (``"u"``, (k, 6)): the top displacement [ux, uy, uz] (m) and accumulated spins (rad)
         from the initial geometry, and the shroud tensions ``"tension0"``, ``"tension"`` (k, q) in N."""
         wrenches = np.asarray(wrenches, dtype=float).reshape(-1, 6)
@@ -242,7 +275,7 @@ class MastFE:
         def pick(i):
             return self._frames[i][1], self._frames[i][2]
 
-        u0, t0 = pick(last["pretension"])
+        u0, t0 = pick(last.get("thermal", last["pretension"]))
         picked = [pick(last[f"load{k + 1:04d}"]) for k in range(len(unique))]
         picked.insert(0, (u0, t0))  # step_of = -1: no load yet
         sel = [picked[j + 1] for j in step_of]

@@ -13,13 +13,14 @@ dask), ``store`` (Parquet chunks), ``results`` (reading back), ``statistics``, `
 See docs/studies.md.
 """
 
-from .distributions import Input, LogNormal, Normal, TruncatedNormal, Uniform
+from .distributions import Input, LogNormal, Normal, TruncatedNormal, Uniform, exponential_correlation
 from .outputs import ElementOutput, NodeOutput
 from .results import StudyResults, load
 from .runners import RunSummary, run
 from .statistics import bootstrap_ci, convergence, percentile, sobol_convergence, sobol_indices
 from .study import Study
 
-__all__ = ["Input", "Normal", "Uniform", "TruncatedNormal", "LogNormal", "NodeOutput", "ElementOutput", "Study",
+__all__ = ["Input", "Normal", "Uniform", "TruncatedNormal", "LogNormal", "exponential_correlation", "NodeOutput",
+           "ElementOutput", "Study",
            "run", "RunSummary", "load", "StudyResults", "percentile", "bootstrap_ci", "convergence",
            "sobol_indices", "sobol_convergence"]

@@ -14,6 +14,8 @@ from pathlib import Path
 
 from ..errors import StudyError
 
+EXIT_FAILED_SAMPLES = 3
+
 
 def load_script(path) -> "Study":  # noqa: F821
     """The ``study`` defined by the script at ``path``."""
@@ -55,6 +57,16 @@ def _study(args):
     print(s)
     if s.complete and not args.no_report:
         report(out, print_table=True)
+    from .results import load
+
+    failed = load(out).counts()["failed"]     # this call's and any stored before a resume
+    if failed:
+        import sys
+
+        print(f"femast study: {failed} run(s) FAILED; exit code {EXIT_FAILED_SAMPLES} "
+              f"(reasons: femast.studies.load('{out}').failures())", file=sys.stderr)
+        return EXIT_FAILED_SAMPLES
+    return 0
 
 
 def register(sub, help_formatter):
@@ -62,7 +74,9 @@ def register(sub, help_formatter):
                        formatter_class=help_formatter,
                        description="Run the femast.studies.Study named 'study' in SCRIPT for N samples, in local "
                                    "processes or on a dask cluster; the results are stored as they come (run the "
-                                   "same command again to resume) and summarised with figures.")
+                                   "same command again to resume) and summarised with figures.  Exit code 0: "
+                                   "every run succeeded; 3: some runs failed (listed by femast.studies.load(OUT)"
+                                   ".failures()); 2: the study could not run; 130: interrupted.")
     p.add_argument("script", help="Python file defining study = femast.studies.Study(...)")
     p.add_argument("--samples", type=int, required=True, help="number of base samples N (with sensitivity, N x (k+2) "
                                                               "runs; a power of 2 keeps Sobol' points balanced)")

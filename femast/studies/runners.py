@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import progress
+from ..analysis.deadline import deadline
 from ..errors import SampleTimeout, StudyError
 from .store import Store
 from .study import Study
@@ -71,8 +72,20 @@ class RunSummary:
 
 
 # ---------------------------------------------------------------- one chunk (any process)
+def _over(seconds):
+    return f"the sample ran over timeout_s = {seconds:g} s (wall clock); it is stopped"
+
+
+def _limits(study):
+    """The SIGALRM timer and the analyses' deadline of one sample."""
+    t = study.timeout_s
+    return _Timer(t), deadline(t, None if t is None else _over(t))
+
+
 class _Timer:
-    """A SIGALRM timer raising SampleTimeout after ``seconds`` (only in a main thread, Unix)."""
+    """A SIGALRM timer raising SampleTimeout after ``seconds`` (only in a main thread, Unix): it stops
+    any code, the analysis' own deadline (femast/analysis/deadline.py, any thread: dask workers) only
+    the analyses."""
 
     def __init__(self, seconds):
         import signal
@@ -83,7 +96,7 @@ class _Timer:
                    and threading.current_thread() is threading.main_thread())
 
     def _alarm(self, signum, frame):
-        raise SampleTimeout(f"the sample ran over timeout_s = {self.seconds:g} s (wall clock); it is stopped")
+        raise SampleTimeout(_over(self.seconds))
 
     def __enter__(self):
         if self.on:
@@ -103,7 +116,8 @@ class _Timer:
 def _sample(study: Study, values: dict):
     t0 = time.perf_counter()
     try:
-        with _Timer(study.timeout_s):
+        timer, limit = _limits(study)
+        with timer, limit:
             out = study.evaluate(values)
         for k, v in out.items():
             if not np.all(np.isfinite(v)):
@@ -166,7 +180,8 @@ def warm(study: Study) -> float:
     other failure of the nominal sample is left to the samples (which record it)."""
     t0 = time.perf_counter()
     try:
-        with _Timer(study.timeout_s):
+        timer, limit = _limits(study)
+        with timer, limit:
             study.evaluate(study.nominal_values())
     except StudyError as exc:
         raise StudyError(f"the nominal sample (inputs at their medians): {exc}") from None

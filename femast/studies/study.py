@@ -38,8 +38,10 @@ class Study:
     analysis : options of :class:`~femast.Analysis` for ``model=`` studies (e.g. convergence).
     units : {output name: unit} for tables and figures (``run=`` studies; node outputs know theirs).
     timeout_s : wall-clock seconds after which a sample is stopped and recorded as failed
-        (SampleTimeout); None: no limit.  Enforced in this process and in local workers (a
-        SIGALRM timer, Unix), not on dask workers (their samples run in threads).
+        (SampleTimeout); None: no limit.  Everywhere the analyses check it at each Newton
+        iteration (a thread's deadline: dask workers too); in this process and in local workers a
+        SIGALRM timer (Unix) also stops other code (a ``run=`` function's own loops).  On dask
+        workers a ``run=`` function that runs no femast analysis is not stopped.
     name : a label for summaries and figures.
     """
 

@@ -66,7 +66,7 @@ def choose(backend: str, B, ordering: str) -> str:
     if backend == "auto":
         if n <= DENSE_MAX_DOFS:
             return "dense"
-        if ordering == "rcm" and band_rule(n, band_of(B.indptr, B.indices), B.nnz):
+        if ordering == "rcm" and band_rule(n, _band(B), B.nnz):
             return "banded"
         if n >= PARDISO_MIN_DOFS and available("pardiso")[0]:
             return "pardiso"
@@ -87,12 +87,22 @@ def choose(backend: str, B, ordering: str) -> str:
     return backend
 
 
+def _band(B) -> int:
+    """The half-bandwidth of B, computed once per matrix object (the rule and the band back-end
+    both need it)."""
+    cached = getattr(B, "_femast_band", None)
+    if cached is None or cached[0] is not B.indices:
+        cached = (B.indices, band_of(B.indptr, B.indices))
+        B._femast_band = cached
+    return cached[1]
+
+
 def make(backend: str, B, ordering: str, symmetric: bool, superlu_factor):
     """A factor object for B (``factorize()`` -> object with ``solve``, ``nnz``, ``pivot_magnitudes``),
     or None for SuperLU.  ``superlu_factor(B)``: SuperLU's LU of B (the fall-back of CHOLMOD)."""
     name = choose(backend, B, ordering)
     if name == "banded":
-        return BandedFactor(B)
+        return BandedFactor(B, bandwidth=_band(B))
     if name == "dense":
         return DenseFactor(B)
     if name == "cholmod":

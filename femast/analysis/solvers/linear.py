@@ -174,20 +174,30 @@ class SparseLU:
         permuted matrix directly (no gather per factorisation; see :meth:`factorize_values`)."""
         if self._gather is None:
             raise RuntimeError("SparseLU.permuted_positions: no pattern analysed yet")
+        if self._band_input():   # the band back-end: straight into its band storage
+            return self._engine.band_positions(pos, self._gather)
         return permuted_positions(self._gather, pos)
+
+    def _band_input(self):
+        """The back-end takes the permuted matrix in its own band storage (the banded one)."""
+        return self._engine is not None and hasattr(self._engine, "band_positions")
 
     @property
     def values(self):
         """The values of the permuted matrix that :meth:`factorize_values` factorises (write them
-        in place, at the positions given by :meth:`permuted_positions`)."""
-        return self._B.data
+        in place, at the positions given by :meth:`permuted_positions`): the permuted CSC matrix's
+        data, or the band back-end's band storage."""
+        return self._engine.band_values if self._band_input() else self._B.data
 
     def factorize_values(self):
         """Factorise the matrix whose values were written into :attr:`values` (same checks and
         errors as :meth:`factorize`)."""
 
         def step():
-            self._lu = self._timed(self._factor_permuted, self._B)
+            if self._band_input():
+                self._lu = self._timed(self._engine.factorize_band)
+            else:
+                self._lu = self._timed(self._factor_permuted, self._B)
             return False
 
         self._guarded(step)

@@ -9,6 +9,7 @@ from time import perf_counter
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from numba import njit
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 
@@ -40,13 +41,42 @@ def rcm(K):
     return perm, 2 * envelope + n <= 2 * K.nnz
 
 
+@njit(cache=True)
+def _permuted_csc(indptr, indices, inv, n_cols):
+    """CSC pattern (indptr, indices) of P K P^T for a square CSR pattern of K (``inv``: the new
+    index of each old one) and the gather index of its entries into K's data; rows sorted in each
+    column (a counting sort by column, the rows visited in their new order)."""
+    n = indptr.shape[0] - 1
+    nnz = indices.shape[0]
+    out_ptr = np.zeros(n_cols + 1, dtype=np.int64)
+    for k in range(nnz):
+        out_ptr[inv[indices[k]] + 1] += 1
+    for j in range(n_cols):
+        out_ptr[j + 1] += out_ptr[j]
+    fill = out_ptr[:n_cols].copy()
+    rows = np.empty(nnz, dtype=np.int64)
+    gather = np.empty(nnz, dtype=np.int64)
+    perm = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        perm[inv[i]] = i
+    for r in range(n):      # the new rows in order: each column receives its rows sorted
+        i = perm[r]
+        for k in range(indptr[i], indptr[i + 1]):
+            j = inv[indices[k]]
+            rows[fill[j]] = r
+            gather[fill[j]] = k
+            fill[j] += 1
+    return out_ptr, rows, gather
+
+
 def permuted(K, perm):
-    """(B, gather): the CSC matrix K[perm][:, perm] and the index with B.data = K.data[gather]."""
-    marker = sp.csr_matrix((np.arange(1, K.nnz + 1, dtype=np.float64), K.indices, K.indptr), shape=K.shape)
-    Bm = marker[perm][:, perm].tocsc()
-    Bm.sort_indices()
-    gather = Bm.data.astype(np.int64) - 1
-    B = sp.csc_matrix((K.data[gather], Bm.indices, Bm.indptr), shape=K.shape)
+    """(B, gather): the CSC matrix K[perm][:, perm] (K square CSR, without duplicate entries) and
+    the index with B.data = K.data[gather]."""
+    n = K.shape[0]
+    inv = np.empty(n, dtype=np.int64)
+    inv[np.asarray(perm, dtype=np.int64)] = np.arange(n)
+    indptr, indices, gather = _permuted_csc(K.indptr.astype(np.int64), K.indices.astype(np.int64), inv, n)
+    B = sp.csc_matrix((K.data[gather], indices, indptr), shape=K.shape)
     return B, gather
 
 
