@@ -85,8 +85,8 @@ import numpy as np
 from .. import progress
 from ..errors import ConvergenceError, FemastError, ModelError
 from .core import Column, Experiment, Measured, Parameter, prepared
-from .fe_cache import cached, kernel_threads, run_key
-from .fe_reference import reference_path, remember
+from .fe_cache import kernel_threads
+from .fe_reference import cached_run
 from .residuals import turning_points
 
 ZONE_KINDS = ("zone (a) at backstop", "zone (b) behind roller axis", "zone (c) in front of roller axis",
@@ -236,32 +236,19 @@ def solve(inputs: dict, drive: np.ndarray, options: dict, reference=None) -> dic
     threads = options.get("threads", 1)
     key = (inputs, np.asarray(drive, float), fold)
     ref_key = None
-    if reference is not None:
+    if reference is not None and np.array_equal(np.asarray(reference[1], float), key[1]):
+        # (another drive path -- an effect moving the axis -- runs without: the reference's increments
+        # predict it worse than the tangent)
         ref_key = (dict(reference[0]), np.asarray(reference[1], float), fold)
-        if not np.array_equal(ref_key[1], key[1]) or run_key("bay-torsion", ref_key) == run_key("bay-torsion", key):
-            ref_key = None   # another drive path (the reference predicts it worse than the tangent), or the
-            # reference itself
 
-    def run(inp, drv, path=None, rec=None):
+    def run(parts, reference=None, record=None):
+        progress.tick("FE runs")
         try:
-            return run_bay(inp, drv, fold, threads, reference=path, record_path=rec)
+            return run_bay(parts[0], parts[1], fold, threads, reference=reference, record_path=record)
         except (ConvergenceError, FemastError) as e:  # includes ModelError from invalid inputs
             return {"error": f"bay-torsion FE run failed: {e}"}
 
-    def compute():
-        progress.tick("FE runs")
-        if ref_key is None:   # a run without a reference keeps its path: it may become one
-            from ..analysis.reference import ReferencePath
-
-            rec = ReferencePath()
-            out = run(inputs, drive, rec=rec)
-            if "error" not in out and len(rec):
-                remember(run_key("bay-torsion", key), rec)
-            return out
-        path = reference_path("bay-torsion", ref_key, lambda rec: run(*ref_key[:2], rec=rec), options)
-        return run(inputs, drive, path=path)
-
-    out = cached("bay-torsion", key if ref_key is None else (*key, "reference", ref_key), compute, options)
+    out = cached_run("bay-torsion", key, ref_key, run, options)
     if "error" in out:
         raise ModelError(out["error"])
     return out

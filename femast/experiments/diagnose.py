@@ -48,7 +48,7 @@ from ..errors import ModelError
 from .compare import analyse
 from .core import Experiment, Measured
 from .figures import diagnose_figure, display_scale
-from .fitting import fit, params_table
+from .fitting import fit, params_table, predict
 from .noise import noise_model, pinned_rows
 from .residuals import AT_NOISE, at_noise_threshold
 # the refits' executor (re-exported: diagnose.REFIT_NFEV, diagnose._mp_context, ... keep working)
@@ -145,6 +145,10 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
         baseline = fit(exp, data, base_effects, start=dict(zip(baseline.names, baseline.x)), noise=sigma,
                        given_start_clip=True)
     start = dict(zip(baseline.names, baseline.x))
+    if exp.fit_options.get("expensive") and exp.options.get("fe_reference", False) is None:
+        # the refits' reference run (the baseline model at its solution, femast.experiments.fe_reference),
+        # here once: forked workers inherit it (and its converged path) instead of each running it
+        predict(exp, data, baseline.params)
     payload0 = {"source": exp.source, "options": exp.options, "scripts": list(loaded_scripts()),
                 "data_experiment": data.experiment, "columns": data.columns, "path": data.path,
                 "lines": data.lines, "start": start, "noise": sigma,
@@ -163,7 +167,9 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     for c in candidates:
         jobs.append(("candidate", c, c, base_effects + [c], start))
     payloads = [{**payload0, "effects": effs, "start": st} for *_, effs, st in jobs]
-    fits_list, how = _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base)
+    # the report's matplotlib is imported while the worker processes refit (issue 21)
+    fits_list, how = _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base,
+                               while_waiting=_import_pyplot if out is not None else None)
     s_pre = score(baseline, models, chans, data.n)
     jobs2 = []
     for (stage, c, spec, _, _), res in zip(jobs, fits_list):
@@ -332,6 +338,12 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
 
         diagnose_report(exp, data, result, out)
     return result
+
+
+def _import_pyplot():
+    from ..post.plotstyle import pyplot
+
+    pyplot()
 
 
 def _form(spec: str, effect: str, key: str) -> str:

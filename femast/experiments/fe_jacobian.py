@@ -146,12 +146,16 @@ class _Coords:
 
 
 POLISH_ROUNDS = 2
+POLISH_MIN_DECREASE = 0.01   # half chi-square: a restart must promise more (0.14 standard errors of a parameter)
 
 
-def _polish(sol, fj, fun, lo, hi, kw):
+def _polish(sol, fj, fun, lo, hi, kw, min_decrease: float = 0.0):
     """The Jacobian at the solution by finite differences (for the covariance), and a restart of the fit
     from there, with that Jacobian, when its Gauss-Newton step (within the bounds) predicts a decrease
-    of the cost beyond ``ftol`` of it: a secant Jacobian may have stopped the fit early."""
+    of the cost beyond ``ftol`` of it and beyond ``min_decrease``: a secant Jacobian may have stopped
+    the fit early.  With residuals whitened by the noise (a given noise model), the cost is half the
+    chi-square, and a decrease d moves the parameters by about sqrt(2 d) standard errors
+    (``POLISH_MIN_DECREASE`` = 0.01: 0.14 of one); a smaller predicted gain is not worth a restart."""
     extra = 0
     ftol = float(kw.get("ftol", 1e-8))
     for _ in range(POLISH_ROUNDS + 1):
@@ -161,7 +165,7 @@ def _polish(sol, fj, fun, lo, hi, kw):
         u_new = np.clip(sol.x + step, lo, hi)
         r = f + J @ (u_new - sol.x)
         predicted = sol.cost - 0.5 * float(r @ r)
-        if _ == POLISH_ROUNDS or not predicted > ftol * sol.cost:
+        if _ == POLISH_ROUNDS or not predicted > max(ftol * sol.cost, min_decrease):
             break
         fj.J, fj.J0 = None, J
         with np.errstate(all="ignore"):

@@ -54,6 +54,34 @@ def reference_path(kind: str, key_parts, run, options: dict | None = None):
     return rec
 
 
+def cached_run(kind: str, key_parts, ref_parts, run, options: dict | None = None) -> dict:
+    """A run of ``kind``, cached (:func:`~femast.experiments.fe_cache.cached`), started from the
+    reference run ``ref_parts`` (None: no reference; the run itself: none either).
+
+    run : ``run(parts, reference=None, record=None) -> output dict`` computes the run described by
+        the key parts ``parts`` (catching its own failures as ``{"error": ...}``), starting from the
+        ReferencePath ``reference`` and recording its own path with ``record`` when given.
+    A run without a reference keeps its path (it may become a reference); a run with one is cached
+    under its key and the reference's."""
+    from ..analysis.reference import ReferencePath
+
+    key = run_key(kind, key_parts)
+    if ref_parts is not None and run_key(kind, ref_parts) == key:
+        ref_parts = None
+
+    def compute():
+        if ref_parts is None:
+            rec = ReferencePath()
+            out = run(key_parts, record=rec)
+            if "error" not in out and len(rec):
+                remember(key, rec)
+            return out
+        path = reference_path(kind, ref_parts, lambda rec: run(ref_parts, record=rec), options)
+        return run(key_parts, reference=path)
+
+    return cached(kind, key_parts if ref_parts is None else (*key_parts, "reference", ref_parts), compute, options)
+
+
 def remember(key: str, path) -> None:
     """Keep ``path`` as the reference path of run ``key`` (the last PATH_ENTRIES of them)."""
     _PATHS[key] = path

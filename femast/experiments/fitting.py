@@ -32,7 +32,7 @@ from ..effects.base import resolve
 from .. import progress
 from ..errors import ModelError
 from .core import EffectStack, Experiment, Measured
-from .fe_jacobian import LOG_RANGE, _Coords, _FEJacobian, _forward_differences, _polish  # noqa: F401
+from .fe_jacobian import LOG_RANGE, POLISH_MIN_DECREASE, _Coords, _FEJacobian, _forward_differences, _polish  # noqa: F401
 from .residuals import noise_floor
 
 _BAD = 1e6  # whitened residual given to a non-finite prediction (a parameter set the model rejects)
@@ -315,12 +315,20 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
             if fd_step:
                 fj = _FEJacobian(fun0, float(fd_step), lo, hi, secant=secant, J0=J0 if k == 0 and secant else None)
                 fun, kw["jac"] = fj.value, fj.jac
+            kw_k = kw
+            min_dec = POLISH_MIN_DECREASE if secant and noise is not None else 0.0
+            if min_dec:
+                # a noise model given: the cost is half the chi-square, and a decrease below min_dec is no
+                # reason for more FE runs (see _polish); scipy's ftol is relative to the current cost,
+                # bounded here by the start's (the start's run is the fit's first evaluation anyway)
+                f0 = fun(u0)
+                kw_k = {**kw, "ftol": max(float(kw.get("ftol", 1e-8)), min_dec / max(0.5 * float(f0 @ f0), 1e-300))}
             with np.errstate(all="ignore"):
-                sol = least_squares(fun, u0, bounds=(lo, hi), **kw)
+                sol = least_squares(fun, u0, bounds=(lo, hi), **kw_k)
             nfev += sol.nfev
             if fj is not None:
                 if secant:
-                    sol = _polish(sol, fj, fun, lo, hi, kw)
+                    sol = _polish(sol, fj, fun, lo, hi, kw, min_dec)
                 nfev += getattr(sol, "nfev_polish", 0)
                 runs += fj.runs
             if best is None or sol.cost < best.cost:

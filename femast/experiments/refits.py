@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import threading
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
 from scipy.optimize import OptimizeResult
@@ -23,6 +24,7 @@ from .fitting import fit
 _START_METHOD = None  # multiprocessing start method of the local pool (None: the platform's default)
 REFIT_NFEV = 25  # evaluations per parameter and start of a refit (a converging refit needs 5-20; a direction the
 # data do not determine -- beam flexibility against the joint stiffness under top forces -- would use 100)
+OVERSUBSCRIBE = 3  # default workers of the expensive (FE) experiments: up to this many processes per CPU
 SERIAL_BELOW_S = 1.0  # default workers: refit in this process when the refits should take less than this (s)
 
 
@@ -83,8 +85,10 @@ def _mp_context():
     return None
 
 
-def _run_tasks(payloads, workers, scheduler):
-    """Run the refits; returns (results, how) with ``how`` describing the executor used."""
+def _run_tasks(payloads, workers, scheduler, while_waiting=None):
+    """Run the refits; returns (results, how) with ``how`` describing the executor used.
+    while_waiting : a callable run in a thread of this process while local worker processes refit
+    (started after they are forked, joined before the pool closes), e.g. an import the report needs."""
     if scheduler is not None:
         try:
             from distributed import Client
@@ -116,12 +120,25 @@ def _run_tasks(payloads, workers, scheduler):
         return _serial_refits(payloads), "serial (1 process)"
     with ProcessPoolExecutor(max_workers=n, mp_context=_mp_context()) as pool:
         futures = [pool.submit(_refit_task, p) for p in payloads]
+        helper = None
+        if while_waiting is not None:
+            helper = threading.Thread(target=_quietly, args=(while_waiting,), daemon=True)
+            helper.start()
         with progress.counter(len(futures), f"diagnose: refits on {n} processes", unit="refits") as bar:
             for fut in as_completed(futures):
                 bar.set_postfix_str(f"done: {_candidate(payloads[futures.index(fut)])}", refresh=False)
                 bar.update(1)
         results = [fut.result() for fut in futures]
+        if helper is not None:
+            helper.join()   # (before any later fork: a thread holding the import lock must not be forked)
     return results, f"{n} local processes"
+
+
+def _quietly(fn):
+    try:
+        fn()
+    except Exception:   # a helper's failure shows later, where its work is needed
+        pass
 
 
 def _candidate(payload) -> str:
@@ -137,7 +154,7 @@ def _serial_refits(payloads):
     return results
 
 
-def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base):
+def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base, while_waiting=None):
     """Run refit payloads: in this process when cheap or not rebuildable, else on the executor."""
     if not payloads:
         return [], "no candidates"
@@ -149,4 +166,9 @@ def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base):
     if workers is None and scheduler is None and not exp.fit_options.get("expensive") and est < SERIAL_BELOW_S:
         return _serial_refits(payloads), f"serial (refits estimated at {est:.2f} s: cheaper than starting " \
                                                    "processes)"
-    return _run_tasks(payloads, workers, scheduler)
+    if workers is None and scheduler is None and exp.fit_options.get("expensive"):
+        # a process per refit (up to OVERSUBSCRIBE x the CPUs): the refits of the FE experiments take
+        # 6-15 FE runs each, and a pool of one process per CPU ends with one CPU idle while the
+        # longest refits finish; more processes than CPUs share them to the end (issue 21)
+        workers = max(1, min(len(payloads), OVERSUBSCRIBE * (os.cpu_count() or 1)))
+    return _run_tasks(payloads, workers, scheduler, while_waiting)
