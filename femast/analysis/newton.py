@@ -276,6 +276,8 @@ class Newton:
                     return Outcome(True, 0, "", responses, Du, 0.0)
                 if it > 0:
                     ok, ratio = system.converged(conv, r, du, Du, responses, P, iters + whole)
+                    if ok and any(q.provisional for q in responses):
+                        ok = False   # an element answered with a predictor, not its law (ElementResponse)
                     rnorm_hist.append(ratio)
                     ratios.append(ratio)
                     if ok:
@@ -350,6 +352,8 @@ class Newton:
                 since += 1
                 if method in ("modified", "quasi-newton"):
                     steps.append(float(np.abs(du).max(initial=0.0)))
+                # the trial states of this iterate, for elements that look at their last iteration
+                ctx.previous = {id(f_): q.state for f_, q in zip(system.families, responses)}
                 search = line_search and not uses_lam and not (it == 0 and has_dpres)
                 before = (state.x.copy(), state.R.copy(), state.spin.copy()) if search else None
                 system.update(du, dpres if it == 0 else None)

@@ -9,6 +9,9 @@ State row (``N_STATE`` = 15)::
     4     gamma  accumulated slip (relative rotation by sliding), rad
     5     D      dissipated energy, J
     6:15  Q      committed relative rotation Q = R_a^T R_b, row-major
+
+In a trial state, slip = -1.0 marks a joint taken as stuck for one Newton iteration because its
+slip direction reversed since the previous iteration (:func:`ball_joint_element`).
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ I_SLIP = 3
 I_GAMMA = 4
 I_DISS = 5
 I_Q = 6
+REVERSED = -1.0   # slip flag of a trial state: slip reversed, taken as stuck for this iteration
 
 # error codes of the kernel
 OK = 0
@@ -37,9 +41,18 @@ MAX_INCREMENT = 3.0  # rad
 
 
 @njit(cache=True)
-def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out):
+def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out, prev, has_prev):
     """Forces ``f`` (12), tangent ``K`` (12x12), trial state ``new`` (15) and output ``out``
     (11: M (3, global), F (3, global), |F|, limit, slip, gamma, D) of one joint.
+
+    ``prev`` (15): the joint's trial state at the previous Newton iteration (``has_prev``).  A
+    joint that slipped there and would now slip the opposite way (trial moment against the
+    previous moment) is answered as stuck (m = m_tr, tangent k_s) for this one iteration, and its
+    trial state is marked ``slip = REVERSED``: Newton's step then puts it back at its stuck
+    equilibrium.  Without this the iterates of a joint whose equilibrium lies in the narrow stick
+    band |m_tr| <= Y (width Y / k_s in rotation) jump across the band from one slip direction to
+    the other for ever when the mode is soft (a longeron spinning between two slipping joints,
+    held only by the joint springs: Newton's step is ~Y / k_spring, 1e3 times the band).
     Returns (strain energy in J, error code)."""
     # tie: node b sits at the point x_a + R_a d0 of node a (d0: initial offset, below the tolerance)
     c = Ra @ d0
@@ -68,9 +81,13 @@ def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out
     C = np.zeros((3, 3))
     G = np.zeros((3, 3))  # dm/dd (slip only): n (mu B dFn/dd)^T
     m = np.empty(3)
+    # slip reversed since the previous iteration: stuck for this iteration (see docstring)
+    reversed_ = False
+    if has_prev and prev[I_SLIP] == 1.0 and nm > Y * (1.0 + 1e-12):
+        reversed_ = mtr[0] * prev[I_M] + mtr[1] * prev[I_M + 1] + mtr[2] * prev[I_M + 2] < 0.0
     # relative tolerance: a point on the slip surface (|m_tr| = Y to round-off) sticks
-    if nm <= Y * (1.0 + 1e-12):
-        slip = 0.0
+    if nm <= Y * (1.0 + 1e-12) or reversed_:
+        slip = REVERSED if reversed_ else 0.0
         dgam = 0.0
         for i in range(3):
             m[i] = mtr[i]
@@ -144,7 +161,7 @@ def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out
         out[3 + i] = F[i]
     out[6] = Fn
     out[7] = Y
-    out[8] = slip
+    out[8] = max(slip, 0.0)
     out[9] = new[I_GAMMA]
     out[10] = new[I_DISS]
     mm = m[0] ** 2 + m[1] ** 2 + m[2] ** 2
@@ -152,12 +169,14 @@ def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out
 
 
 @njit(cache=True)
-def ball_joint_family_kernel(nodes, x, R, d0, k_pen, k_s, mu, B, state, f, K, new, out, energy, err):
-    """All joints of a family at once (see :func:`ball_joint_element`)."""
+def ball_joint_family_kernel(nodes, x, R, d0, k_pen, k_s, mu, B, state, f, K, new, out, energy, err, prev,
+                             has_prev):
+    """All joints of a family at once (see :func:`ball_joint_element`); ``prev`` (n_el, 15):
+    the previous iteration's trial states (read only if ``has_prev``)."""
     for e in range(nodes.shape[0]):
         a = nodes[e, 0]
         b = nodes[e, 1]
         en, code = ball_joint_element(x[a], x[b], R[a], R[b], d0[e], k_pen[e], k_s[e], mu[e], B[e],
-                                      state[e], f[e], K[e], new[e], out[e])
+                                      state[e], f[e], K[e], new[e], out[e], prev[e if has_prev else 0], has_prev)
         energy[e] = en
         err[e] = code

@@ -56,6 +56,7 @@ from ._ball_joint_kernels import (
     I_SLIP,
     MAX_INCREMENT,
     N_STATE,
+    REVERSED,
     ball_joint_family_kernel,
 )
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput
@@ -73,6 +74,9 @@ PENALTY_FACTOR = 1e4
 STICK_FACTOR = 1e3
 # Default coincidence tolerance, as a fraction of the model's size.
 TOL_FACTOR = 1e-6
+
+
+_NO_PREV = np.zeros((1, N_STATE))
 
 
 def _per_joint(value, n, what, name):
@@ -175,8 +179,9 @@ class BallJointFamily(ElementFamily):
         """Forces, tangent, trial state and output of all joints (see module docstring).
 
         x : (n_nodes, 3) positions, m.  R : (n_nodes, 3, 3) nodal rotations.
-        state : (n_el, 15) committed state (not modified).  ctx : unused (the committed
-        relative rotation is part of the state).
+        state : (n_el, 15) committed state (not modified).  ctx : its ``previous_state`` (the
+        previous Newton iteration's trial states) is used to see slip reversals; the committed
+        relative rotation is part of the state.
         """
         n = self.n_elements
         f = np.empty((n, 12))
@@ -185,10 +190,13 @@ class BallJointFamily(ElementFamily):
         out = np.empty((n, 11))
         energy = np.empty(n)
         err = np.zeros(n, dtype=np.int64)
+        prev = ctx.previous_state(self) if hasattr(ctx, "previous_state") else None
+        has_prev = prev is not None and prev.shape == (n, N_STATE)
         ball_joint_family_kernel(self.nodes, np.ascontiguousarray(x, dtype=float),
                                  np.ascontiguousarray(R, dtype=float), self.d0, self.k_pen, self.k_stick,
                                  self.mu, self.B, np.ascontiguousarray(state, dtype=float), f, K, new, out,
-                                 energy, err)
+                                 energy, err, np.ascontiguousarray(prev, dtype=float) if has_prev else _NO_PREV,
+                                 has_prev)
         bad = np.flatnonzero(err)
         if bad.size:
             el = bad[0]
@@ -208,7 +216,8 @@ class BallJointFamily(ElementFamily):
             "dissipated": out[:, 10].copy(),
             "moment_norm": np.linalg.norm(out[:, 0:3], axis=1),
         })
-        return ElementResponse(f=f, k=K, state=new, output=output, energy=energy)
+        return ElementResponse(f=f, k=K, state=new, output=output, energy=energy,
+                               provisional=bool(has_prev and np.any(new[:, I_SLIP] == REVERSED)))
 
     # ------------------------------------------------------------------ helpers
     @staticmethod

@@ -54,6 +54,11 @@ class IncrementContext:
     x_committed : (n_nodes, 3) nodal positions at the start of the increment, m.
     R_committed : (n_nodes, 3, 3) nodal rotation matrices at the start of the increment.
     step_name : name of the current step.
+    previous : the trial states of the previous Newton iteration of this attempt, one (n_el,
+        n_state) array per family in the analysis' family order (None in the first iteration and
+        outside Newton iterations); read with :meth:`previous_state`.  A family with a
+        non-smooth law may use it to see that an element jumped from one branch of its law to
+        the opposite one (see :attr:`ElementResponse.provisional`).
     """
 
     time: float = 0.0
@@ -62,6 +67,11 @@ class IncrementContext:
     x_committed: np.ndarray | None = None
     R_committed: np.ndarray | None = None
     step_name: str = ""
+    previous: dict | None = None
+
+    def previous_state(self, family):
+        """The previous iteration's trial state of ``family`` (None if there is none)."""
+        return None if self.previous is None else self.previous.get(id(family))
 
 
 class LazyOutput(Mapping):
@@ -104,6 +114,11 @@ class ElementResponse:
     output: Mapping = field(default_factory=dict)
     # Strain energy per element, J (used for stabilisation energy ratios and reports).
     energy: np.ndarray | None = None
+    # True when some element answered with a predictor of its law instead of the law itself (e.g.
+    # a friction joint that reversed its slip direction between two iterations is taken as stuck
+    # for one iteration): the forces are not the law's, so the analysis never accepts this
+    # iteration as converged.
+    provisional: bool = False
 
 
 class ElementFamily:
