@@ -39,3 +39,20 @@ def test_object_arrays_fall_back_to_np_savez(tmp_path):
     _atomic_savez(tmp_path / "o.npz", a=np.array([1, "x"], dtype=object))
     with np.load(tmp_path / "o.npz", allow_pickle=True) as z:
         assert z["a"].tolist() == [1, "x"]
+
+
+def test_repeated_layout_new_values(tmp_path):
+    """Frames of one signature (names, dtypes, shapes) share a cached zip layout: every frame must
+    still carry its own values and CRCs (np.load checks each member's CRC-32)."""
+    rng = np.random.default_rng(1)
+    for k in range(3):
+        frame = _frame()
+        frame["U"] = rng.normal(size=(9, 3))
+        frame["increment"] = k
+        frame["step"] = "b" + "x" * k            # a str of another length: another dtype, another layout
+        _atomic_savez(tmp_path / f"{k}.npz", **frame)
+        with np.load(tmp_path / f"{k}.npz", allow_pickle=False) as got:
+            assert np.array_equal(got["U"], frame["U"]) and int(got["increment"]) == k
+            assert str(got["step"]) == frame["step"]
+        with zipfile.ZipFile(tmp_path / f"{k}.npz") as z:
+            assert z.testzip() is None

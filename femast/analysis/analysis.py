@@ -65,9 +65,9 @@ class Analysis:
         model).  Do not modify the arrays: the same ones are being written to disk.
     observers : more observers of the run (:class:`~femast.analysis.output.Observer`).
     linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.solvers.backends`):
-        "auto" (default: LAPACK's band solver for a narrow reverse Cuthill-McKee band, as in a
-        mast; PARDISO, if installed, for other models of 1000 DOFs or more; else SuperLU), or one
-        forced by name: "superlu", "banded", "cholmod", "pardiso".
+        "auto" (default: LAPACK's dense LU up to 64 DOFs; LAPACK's band solver for a narrow reverse
+        Cuthill-McKee band, as in a mast; PARDISO, if installed, for other models of 1000 DOFs or
+        more; else SuperLU), or one forced by name: "superlu", "banded", "dense", "cholmod", "pardiso".
 
     After construction: ``state`` (:class:`State`: configuration, element states, loads...),
     ``system`` (:class:`System`: numbering, assembly, linear solver), ``algorithm``

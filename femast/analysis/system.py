@@ -15,6 +15,7 @@ import time as _time
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
 from .assembly import Assembler
 from .configuration import update_configuration
@@ -26,6 +27,26 @@ from ..errors import ModelError, SingularModelError
 from .reduction import ReducedTangent
 from .solvers.convergence import force_moment_abs_max
 from .solvers.linear import SparseLU, mechanism_dofs
+
+
+@njit(cache=True)
+def _reached(x, X0, spin, cons_node, cons_dof, reactions, prescribed, RF):
+    """The values reached at the constrained DOFs into ``prescribed`` (displacement x - X0, m, or
+    the accumulated spin, rad) and their ``reactions`` into the nodal array ``RF`` (zeros)."""
+    for i in range(cons_node.shape[0]):
+        n = cons_node[i]
+        d = cons_dof[i]
+        prescribed[n, d] = x[n, d] - X0[n, d] if d < 3 else spin[n, d - 3]
+        RF[n, d] = reactions[i]
+
+
+@njit(cache=True)
+def _abs_sum(a):
+    """Sum of |a| over every entry of ``a``."""
+    s = 0.0
+    for v in a.flat:
+        s += abs(v)
+    return s
 
 
 class System:
@@ -80,6 +101,7 @@ class System:
         self.n_free = nf
         self.free_node, self.free_dof = self.dofmap.slots(np.arange(nf))
         self.cons_node, self.cons_dof = self.dofmap.slots(np.arange(nf, ni))
+        self._labels = model.node_labels
         self.act_node, self.act_dof = self.dofmap.slots(np.arange(self.dofmap.n_active))
         self.is_rot = self.free_dof >= 3
         self._W = np.zeros((n, 3))     # scratch spins of the configuration update
@@ -276,19 +298,17 @@ class System:
         """Commit a converged increment into the state (one call: see :meth:`State.commit`)."""
         st = self.state
         self.last_converged = (st.version, responses)
-        cn, cd = self.cons_node, self.cons_dof
-        t = cd < 3   # the values reached: displacements x - X0, rotations the accumulated spins
-        st.prescribed[cn[t], cd[t]] = st.x[cn[t], cd[t]] - self.X0[cn[t], cd[t]]
-        st.prescribed[cn[~t], cd[~t]] = st.spin[cn[~t], cd[~t] - 3]
-        st.commit([r.state for r in responses], P, lam, -res[self.dofmap.n_free:],
+        reactions = -res[self.dofmap.n_free:]
+        RF = np.zeros(P.shape)
+        # the values reached (displacements x - X0, rotations the accumulated spins) and the reactions
+        _reached(st.x, self.X0, st.spin, self.cons_node, self.cons_dof, reactions, st.prescribed, RF)
+        st.commit([r.state for r in responses], P, lam, reactions,
                   float(sum(np.sum(r.energy) for r in responses if r.energy is not None)), equilibrium)
         if equilibrium and self.check_balance:   # issue 16: the reactions balance the loads
-            RF = np.zeros_like(P)
-            RF[cn, cd] = st.reactions
             validation.check_equilibrium(st.x, P, RF, res[:self.dofmap.n_free], self.free_dof,
                                          f"increment {self.summary.increments + 1}",
-                                         internal=float(sum(np.abs(q.f).sum() for q in responses)),
-                                         labels=self.model.node_labels)
+                                         internal=float(sum(_abs_sum(q.f) for q in responses)),
+                                         labels=self._labels)
 
     # ------------------------------------------------------------ messages
     def worst(self, r):

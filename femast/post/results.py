@@ -42,18 +42,16 @@ import os
 import queue
 import re
 import socket
-import struct
 import threading
 import time as _time
 import warnings
-import zlib
 from pathlib import Path
 
 import numpy as np
-from numpy.lib import format as npformat
 
 from ..elements.base import DOF_NAMES
 from ..errors import FemastError
+from .npz import TMP_SUFFIX, atomic_savez as _atomic_savez, npz_bytes as _npz_bytes  # noqa: F401
 
 _COMPONENTS = {
     "ux": ("U", 0), "uy": ("U", 1), "uz": ("U", 2),
@@ -64,52 +62,7 @@ _COMPONENTS = {
 }
 
 
-TMP_SUFFIX = ".tmp"   # partial files: "<name>.tmp", never matched by the readers' patterns
 _FRAME_NAME = re.compile(r"^\d+\.npz$")
-
-
-def _npy_bytes(a: np.ndarray) -> bytes:
-    """``a`` in the .npy format, version 1.0 (what np.save writes for a plain array): magic, header
-    length, the header dict padded to a multiple of 64 bytes, the data in C order."""
-    head = "{'descr': %r, 'fortran_order': False, 'shape': %r, }" % (npformat.dtype_to_descr(a.dtype), a.shape)
-    head += " " * (-(10 + len(head) + 1) % 64) + "\n"
-    return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(head)) + head.encode("latin1") + a.tobytes()
-
-
-def _npz_bytes(arrays: dict) -> bytes | None:
-    """An uncompressed .npz (a zip of ``<name>.npy`` members, as np.savez writes it, readable by
-    np.load) built in memory: about a tenth of np.savez's time for a small frame, whose zipfile
-    bookkeeping costs more than its data (issue 21).  None if an array needs np.savez (objects,
-    members beyond 2 GB)."""
-    local, central, offset = [], [], 0
-    for name, value in arrays.items():
-        a = np.asanyarray(value)
-        if a.dtype.hasobject or a.nbytes > 2**31 - 2**20:
-            return None
-        body = _npy_bytes(np.ascontiguousarray(a) if a.ndim else a)
-        fname = (name + ".npy").encode("utf8")
-        crc = zlib.crc32(body)
-        head = struct.pack("<IHHHHHIIIHH", 0x04034B50, 20, 0x800, 0, 0, 0x21, crc, len(body), len(body), len(fname), 0)
-        central.append(struct.pack("<IHHHHHHIIIHHHHHII", 0x02014B50, 20, 20, 0x800, 0, 0, 0x21, crc, len(body),
-                                   len(body), len(fname), 0, 0, 0, 0, 0o600 << 16, offset) + fname)
-        local += (head, fname, body)
-        offset += len(head) + len(fname) + len(body)
-    cd = b"".join(central)
-    end = struct.pack("<IHHHHIIH", 0x06054B50, 0, 0, len(central), len(central), len(cd), offset, 0)
-    return b"".join(local) + cd + end
-
-
-def _atomic_savez(path: Path, **arrays):
-    """An .npz of ``arrays`` to ``path`` through a temporary file renamed into place (atomic on one
-    filesystem: a reader sees the whole file or none)."""
-    tmp = path.with_name(path.name + TMP_SUFFIX)
-    data = _npz_bytes(arrays)
-    with open(tmp, "wb") as fh:   # a file object: np.savez would append ".npz" to a name
-        if data is None:
-            np.savez(fh, **arrays)
-        else:
-            fh.write(data)
-    os.replace(tmp, path)
 
 
 def write_json_atomic(path: Path, data: dict) -> None:
@@ -190,6 +143,7 @@ class ResultsWriter:
             mesh[f"conn/{f.name}"] = model.node_labels[np.asarray(f.nodes)]
             mesh[f"labels/{f.name}"] = np.asarray(getattr(f, "labels", np.arange(1, f.n_elements + 1)))
         self.count = resume or 0
+        self._frames = os.path.join(os.fspath(self.folder), "frames", "")   # (a str: no Path per frame)
         self._queue = queue.Queue(maxsize=16)   # bounded: a slow disk slows the analysis, not memory
         self._error = None
         self._queue.put(((self.folder / "mesh.npz",), mesh))   # written first, by the writer thread
@@ -239,7 +193,7 @@ class ResultsWriter:
         """Queue one frame (arrays must not be modified afterwards: pass copies)."""
         self._raise_error()
         self.count += 1
-        self._queue.put(((self.folder / "frames" / f"{self.count:06d}.npz",), data))
+        self._queue.put(((f"{self._frames}{self.count:06d}.npz",), data))
 
     def _running(self) -> dict:
         return {"status": "running", "completed": False, "pid": os.getpid(), "host": socket.gethostname(),
