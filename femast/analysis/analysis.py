@@ -50,7 +50,8 @@ class Analysis:
     line_search : secant line search when a Newton step overshoots (load control): True, False, or
         "auto" (default): only when retrying an increment that failed, where plain Newton
         already went astray (a line search slows the easy increments down).
-    tangent : "auto" (default: full Newton, see the measurements in docs/performance.md), "full" (a
+    tangent : "auto" (default: full Newton, the first iteration of an increment on the previous
+        increment's last factorisation where that is safe; see docs/performance.md), "full" (a
         new tangent every iteration), "modified" (one per increment, again when convergence slows), "quasi-newton"
         (modified with Broyden's update) or "initial" (one per step): see
         :class:`~femast.analysis.newton.Newton`.

@@ -17,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .assembly import Assembler
+from .assembly import Assembler, assigning_positions
 from .configuration import update_configuration
 from ..model.constraints import Constraints, transpose_times
 from .dofs import number_dofs
@@ -194,8 +194,10 @@ class System:
             # a stabilised step may have widened the solver's pattern (a diagonal entry K_ff lacks):
             # the direct path needs the solver's pattern to be K_ff's own
             same = self.solver.has_pattern(self.assembler.K_ff)
-            self._direct = (self.solver.layout, [self.solver.permuted_positions(p) for p in self.assembler.pos_ff]
-                            if same else None)
+            positions = [self.solver.permuted_positions(p) for p in self.assembler.pos_ff] if same else None
+            if positions is not None:   # the first entry of each position assigns it: no zeroing
+                positions = assigning_positions(positions, self.solver.values.size)
+            self._direct = (self.solver.layout, positions)
         if self._direct[1] is None:
             return self.factorize_csr(responses, with_fc)
         ta = _time.perf_counter()
@@ -203,7 +205,7 @@ class System:
         if self.zero_force is None:
             self._set_floors(self.assembler.diagonal(k_list))
         Kfc = self.assembler.coupling(k_list) if with_fc else None
-        self.assembler.tangent_into(k_list, self.solver.values, self._direct[1])
+        self.assembler.tangent_into(k_list, self.solver.values, self._direct[1], assigning=True)
         self.summary.assembly_time += _time.perf_counter() - ta
         ts = _time.perf_counter()
         self.solver.factorize_values()
