@@ -1,7 +1,7 @@
 """How many FE runs (and how much time) the FE experiments' fits take (issue 21, item 6).
 
-    python benchmarks/fe_fit_runs.py [--cases bay-compare bay-diagnose tip-diagnose] [--workers 2]
-                                     [--save FILE.json] [--before FILE.json]
+    python benchmarks/fe_fit_runs.py [--cases bay-compare bay-diagnose tip-diagnose] [--workers N]
+                                     [--save FILE.json] [--before FILE.json] [--other CHECKOUT --repeat K]
 
 Each case runs in a fresh process (``femast ... --json`` through ``femast.cli.main``: imports, numba
 cache loads and worker start-up included, no disk cache of FE runs) with ``$FEMAST_FE_RUN_LOG``
@@ -16,7 +16,9 @@ Printed per case: FE runs, the seconds spent in them (summed over the processes)
 time of the child and its workers (``resource.getrusage``; contention on the shared machine
 stretches wall time, CPU time much less), the load average, the verdict and the fitted baseline
 parameters with their standard errors.  ``--before`` prints the change against an earlier
-``--save`` and checks the targets: bay-torsion diagnose under 5 s, tip-cycle diagnose under 60 s
+``--save`` (``--other CHECKOUT``: against the same cases run alternately with the femast of another
+checkout, e.g. ``git archive`` of an older commit unpacked in /tmp) and checks the targets:
+bay-torsion diagnose under 5 s, tip-cycle diagnose under 60 s
 (2 cores), same verdicts, parameters within their standard errors.  Writes
 ``benchmarks/out/fe_fit_runs.png`` (``--docs``: docs/figures/performance_fe_fits.png).
 """
@@ -48,13 +50,17 @@ def _cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def run_case(name: str, workers: int, tmp: Path) -> dict:
+def run_case(name: str, workers: int, tmp: Path, code: Path | None = None) -> dict:
+    """One case in a fresh process; ``workers`` 0: the command's default; ``code``: run the femast of
+    that checkout (PYTHONPATH) instead of this one."""
     args = list(CASES[name]) + ["--out", str(tmp / name), "--json", "--quiet"]
-    if args[0] == "diagnose":
+    if args[0] == "diagnose" and workers:
         args += ["--workers", str(workers)]
     log = tmp / f"{name}.log"
+    log.unlink(missing_ok=True)
     env = {k: v for k, v in os.environ.items() if k != "FEMAST_FE_CACHE"}   # cold: no disk cache
     env["FEMAST_FE_RUN_LOG"] = str(log)
+    env["PYTHONPATH"] = str(code or ROOT)
     cmd = [sys.executable, "-c", "import sys; from femast.cli import main; sys.exit(main(sys.argv[1:]))", *args]
     load0 = os.getloadavg()[0]
     c0, t0 = _cpu(), time.perf_counter()
@@ -90,7 +96,10 @@ def _param_text(params: dict) -> str:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
-    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--workers", type=int, default=0, help="diagnose --workers (0: the command's default)")
+    ap.add_argument("--other", help="another femast checkout (e.g. `git worktree add /tmp/old COMMIT`): each case "
+                                    "runs alternately there and here, --repeat times (interleaved A/B)")
+    ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--save", help="write the figures of this run to a JSON file")
     ap.add_argument("--before", help="a JSON file of an earlier --save to compare with")
     ap.add_argument("--docs", action="store_true")
@@ -99,7 +108,17 @@ def main(argv=None) -> int:
     results = {}
     with tempfile.TemporaryDirectory() as t:
         for name in args.cases:
-            r = run_case(name, args.workers, Path(t))
+            for k in range(args.repeat):
+                if args.other:
+                    o = run_case(name, args.workers, Path(t), Path(args.other))
+                    print(f"{name} [other {args.other}]: {o['fe_runs']} FE runs, wall {o['wall_s']:.1f} s, CPU "
+                          f"{o['cpu_s']:.1f} s; load {o['load'][0]:.1f}; verdict {o['verdict']}; "
+                          f"{_param_text(o['params'])}")
+                    before.setdefault(name, o)
+                r = run_case(name, args.workers, Path(t))
+                if k + 1 < args.repeat:
+                    print(f"{name}: {r['fe_runs']} FE runs, wall {r['wall_s']:.1f} s, CPU {r['cpu_s']:.1f} s; load "
+                          f"{r['load'][0]:.1f}")
             results[name] = r
             print(f"{name}: {r['fe_runs']} FE runs ({r['fe_seconds']:.1f} s in them, {r['processes']} processes), "
                   f"wall {r['wall_s']:.1f} s, CPU {r['cpu_s']:.1f} s; load {r['load'][0]:.1f} -> {r['load'][1]:.1f}"
@@ -143,7 +162,7 @@ def main(argv=None) -> int:
     axes[0].legend()
     axes[1].set_yscale("log")
     axes[2].set_yscale("log")
-    fig.suptitle(f"FE fits: runs, CPU and wall time (--workers {args.workers}; wall target dashed; load "
+    fig.suptitle(f"FE fits: runs, CPU and wall time (--workers {args.workers or 'default'}; wall target dashed; load "
                  f"{os.getloadavg()[0]:.1f} on 2 cores)")
     fig.tight_layout()
     out = ROOT / "benchmarks" / "out"

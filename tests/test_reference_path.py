@@ -116,3 +116,27 @@ def test_bay_runs_with_a_reference_are_cached_under_their_own_key_and_agree():
     ref0 = bt.model(p0, data, None, opts)["Mz_Nm"]  # the reference itself: its plain run, cached
     assert fe_cache.stats()["misses"] == m1
     np.testing.assert_array_equal(ref0, bt.model(p0, data, None, exp.options)["Mz_Nm"])
+
+
+def test_a_lazy_frame_has_the_keys_and_values_of_a_written_frame_and_a_kept_one_is_completed(tmp_path):
+    """Without a results folder the recorders get a LazyFrame (femast/analysis/output.py): the same
+    keys and the same values as the frames written to disk; a recorder that keeps
+    the frame gets it completed with the state of its own increment."""
+    from femast.post.results import Results
+
+    kept, read = [], []
+    m, tip = _cantilever(drive="uz")
+    Analysis(m, tmp_path / "r", progress=False, convergence=CONV).run()
+    m2, _ = _cantilever(drive="uz")
+    Analysis(m2, None, progress=False, convergence=CONV, on_frame=kept.append).run()
+    m3, _ = _cantilever(drive="uz")
+    Analysis(m3, None, progress=False, convergence=CONV, on_frame=lambda fr: read.append(fr["U"])).run()
+    res = Results(tmp_path / "r")
+    assert len(kept) == len(res) == len(read)
+    for i, fr in enumerate(kept):
+        disk = res.frame(i)
+        assert set(fr) == set(disk)
+        for k in ("U", "UR", "URA", "RF", "P"):
+            np.testing.assert_array_equal(fr[k], disk[k])   # bit for bit: the same computation
+        np.testing.assert_array_equal(read[i], disk["U"])
+    assert "el/nope/x" not in kept[0] and "U" in kept[0]

@@ -50,7 +50,8 @@ class Analysis:
     line_search : secant line search when a Newton step overshoots (load control): True, False, or
         "auto" (default): only when retrying an increment that failed, where plain Newton
         already went astray (a line search slows the easy increments down).
-    tangent : "auto" (default: full Newton, see the measurements in docs/performance.md), "full" (a
+    tangent : "auto" (default: full Newton, the first iteration of an increment on the previous
+        increment's last factorisation where that is safe; see docs/performance.md), "full" (a
         new tangent every iteration), "modified" (one per increment, again when convergence slows), "quasi-newton"
         (modified with Broyden's update) or "initial" (one per step): see
         :class:`~femast.analysis.newton.Newton`.
@@ -59,15 +60,15 @@ class Analysis:
     easy_iterations : an increment converged in at most this many iterations is easy (Abaqus'
         I_G = 4 with looser tolerances; 6 with femast's tighter defaults).
     on_frame : a recorder, called with each frame's dict (the arrays written to
-        ``frames/NNNNNN.npz``; the first call is the initial state) as soon as its increment has
+        ``frames/frames.npzs``; the first call is the initial state) as soon as its increment has
         converged.  A script that needs a few quantities keeps them in memory this way instead of
         reading the results folder back (which costs about as much as the analysis of a small
         model).  Do not modify the arrays: the same ones are being written to disk.
     observers : more observers of the run (:class:`~femast.analysis.output.Observer`).
     linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.solvers.backends`):
-        "auto" (default: LAPACK's band solver for a narrow reverse Cuthill-McKee band, as in a
-        mast; PARDISO, if installed, for other models of 1000 DOFs or more; else SuperLU), or one
-        forced by name: "superlu", "banded", "cholmod", "pardiso".
+        "auto" (default: LAPACK's dense LU up to 64 DOFs; LAPACK's band solver for a narrow reverse
+        Cuthill-McKee band, as in a mast; PARDISO, if installed, for other models of 1000 DOFs or
+        more; else SuperLU), or one forced by name: "superlu", "banded", "dense", "cholmod", "pardiso".
 
     After construction: ``state`` (:class:`State`: configuration, element states, loads...),
     ``system`` (:class:`System`: numbering, assembly, linear solver), ``algorithm``

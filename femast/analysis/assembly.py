@@ -25,6 +25,54 @@ def _scatter_matrix(k, pos, data):
 
 
 @njit(cache=True)
+def _assign_first_positions(pos, seen, out):
+    """``out``: ``pos`` (int32) with each position's first entry in scatter order (families, then
+    element, i, j) encoded as -2 - p (it assigns instead of adding), -1 kept (outside).
+    ``seen``: bool flags per position of the target array, shared across the families."""
+    flat = pos.ravel()
+    o = out.ravel()
+    for k in range(flat.shape[0]):
+        p = flat[k]
+        if p < 0:
+            o[k] = -1
+        elif seen[p]:
+            o[k] = p
+        else:
+            seen[p] = True
+            o[k] = -2 - p
+
+
+@njit(cache=True)
+def _scatter_matrix_assigning(k, pos, data):
+    """:func:`_scatter_matrix` with positions from :func:`_assign_first_positions`: the first
+    entry of each position assigns, the others add, so ``data`` needs no zeroing (the same sums:
+    0 + a = a)."""
+    n_el, m, _ = k.shape
+    for e in range(n_el):
+        for i in range(m):
+            for j in range(m):
+                p = pos[e, i, j]
+                if p >= 0:
+                    data[p] += k[e, i, j]
+                elif p <= -2:
+                    data[-2 - p] = k[e, i, j]
+
+
+def assigning_positions(positions, size):
+    """Positions (one array per family, -1 outside) re-encoded for :meth:`Assembler.tangent_into`
+    without zeroing: the first entry of each position of a ``size``-long target assigns it (int32
+    when the target is below 2**31 - 2 entries, half the memory traffic of the scatter)."""
+    dtype = np.int32 if size < 2 ** 31 - 2 else np.int64
+    seen = np.zeros(size, dtype=np.bool_)
+    out = []
+    for pos in positions:
+        o = np.empty(pos.shape, dtype=dtype)
+        _assign_first_positions(np.ascontiguousarray(pos), seen, o)
+        out.append(o)
+    return out
+
+
+@njit(cache=True)
 def _scatter_vector(f, eqs, out):
     n_el, m = f.shape
     for e in range(n_el):
@@ -186,10 +234,16 @@ class Assembler:
             _scatter_vector(f, eqs, out)
         return out
 
-    def tangent_into(self, k_list, data, positions):
+    def tangent_into(self, k_list, data, positions, assigning=False):
         """Zero ``data`` and add the element matrices at ``positions`` (one (n_el, m, m) array per
         family, -1 outside): K_ff assembled straight into another layout of its entries, such
-        as the linear solver's permuted matrix."""
+        as the linear solver's permuted matrix.  ``assigning``: the positions come from
+        :func:`assigning_positions` (the first entry of each position assigns it: no zeroing;
+        entries of ``data`` that no element writes keep their value, zero in a fresh array)."""
+        if assigning:
+            for k, pos in zip(k_list, positions):
+                _scatter_matrix_assigning(k, pos, data)
+            return
         data[:] = 0.0
         for k, pos in zip(k_list, positions):
             _scatter_matrix(k, pos, data)

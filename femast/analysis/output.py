@@ -11,12 +11,15 @@ The step loop (stepping.py) knows nothing of files.  It tells its observers what
 * ``finished(analysis)``: the run is over, however it ended (the summary is final).
 
 An observer implements the methods it needs (:class:`Observer` has them all, doing nothing).
-:class:`ResultsOutput` is the one every analysis has: it builds a frame (the arrays of
-``frames/NNNNNN.npz``, femast/post/results.py) at the step's output frequency and hands it to the
-results writer and to every ``on_frame`` recorder.
+:class:`ResultsOutput` is the one every analysis has: it builds a frame (the arrays of a record
+of ``frames/frames.npzs``, femast/post/results.py) at the step's output frequency and hands it to
+the results writer and to every ``on_frame`` recorder.
 """
 
 from __future__ import annotations
+
+import sys
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -108,18 +111,91 @@ class ResultsOutput(Observer):
             return
         st, sys_ = analysis.state, analysis.system
         n = len(sys_.X0)
-        RF = np.zeros((n, 6))
-        if responses is not None:
-            RF[sys_.cons_node, sys_.cons_dof] = st.reactions
+        converged = responses is not None   # (the initial frame has no reactions)
+
+        def reactions():
+            RF = np.zeros((n, 6))
+            if converged:
+                RF[sys_.cons_node, sys_.cons_dof] = st.reactions
+            return RF
+
+        state = {"U": lambda: st.x - sys_.X0, "R": lambda: st.R.copy(), "UR": lambda: rotation_vectors(st.R),
+                 "URA": lambda: st.spin.copy(), "RF": reactions, "P": lambda: st.loads.copy()}
         data = {"step": step_name, "increment": inc, "time": time, "total_time": st.total_time,
-                "load_factor": st.lam, "iterations": iterations, "U": st.x - sys_.X0, "R": st.R.copy(),
-                "UR": rotation_vectors(st.R), "URA": st.spin.copy(), "RF": RF, "P": st.loads.copy(),
+                "load_factor": st.lam, "iterations": iterations,
                 "strain_energy": st.strain_energy, "stabilization_energy": st.stabilization_energy}
         if responses is None:
             responses = sys_.evaluate(sys_.committed_context())
-        for f, r in zip(analysis.families, responses):
-            for key, val in r.output.items():
-                data[f"el/{f.name}/{key}"] = val
+        outputs = {f.name: r.output for f, r in zip(analysis.families, responses)}
+        if isinstance(self.writer, NullWriter):
+            # recorders only (out=None): a frame that computes what a recorder reads (issue 21: an FE
+            # experiment reads a few arrays of each increment); one kept by a recorder is completed
+            frame = LazyFrame(data, state, outputs)
+            self.writer.frame()
+            for record in self.recorders:
+                record(frame)
+            if sys.getrefcount(frame) > 2:   # (this name and getrefcount's argument)
+                frame.complete()
+            return
+        data.update({k: make() for k, make in state.items()})
+        for name, out in outputs.items():
+            for key, val in out.items():
+                data[f"el/{name}/{key}"] = val
         self.writer.frame(**data)
         for record in self.recorders:
             record(data)
+
+
+class LazyFrame(Mapping):
+    """The frame dict of a run without a results folder (only ``on_frame`` recorders), built on
+    reading: the state arrays (U, R, UR, URA, RF, P) and each family's element outputs
+    (``el/FAMILY/NAME``) are computed when first read; iterating it (``dict(frame)``,
+    ``frame.items()``) computes everything.  A recorder that keeps the frame itself (not only arrays
+    read from it) gets it completed before the analysis moves on (:meth:`complete`).  Keys, values
+    and their order are those of the dict written to a results folder."""
+
+    def __init__(self, data: dict, state: dict, outputs: dict):
+        self._data, self._state, self._outputs = data, state, outputs
+        self._done = False
+
+    def __getitem__(self, key):
+        d = self._data
+        if key in d:
+            return d[key]
+        make = self._state.get(key)
+        if make is not None:
+            d[key] = v = make()
+            return v
+        if isinstance(key, str) and key.startswith("el/"):
+            fam, _, name = key[3:].partition("/")
+            out = self._outputs.get(fam)
+            if out is not None and name in out:
+                d[key] = v = out[name]
+                return v
+        raise KeyError(key)
+
+    def complete(self) -> dict:
+        """Compute every entry (in the order of a written frame); returns the plain dict."""
+        if not self._done:
+            d = self._data
+            full = {k: d[k] for k in ("step", "increment", "time", "total_time", "load_factor", "iterations")}
+            full.update({k: d[k] if k in d else make() for k, make in self._state.items()})
+            full.update({k: d[k] for k in ("strain_energy", "stabilization_energy")})
+            for fam, out in self._outputs.items():
+                for name, val in out.items():
+                    full[f"el/{fam}/{name}"] = val
+            self._data, self._done = full, True
+        return self._data
+
+    def __iter__(self):
+        return iter(self.complete())
+
+    def __len__(self):
+        return len(self.complete())
+
+    def __contains__(self, key):
+        try:
+            self[key]
+        except KeyError:
+            return False
+        return True

@@ -15,8 +15,9 @@ import time as _time
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
-from .assembly import Assembler
+from .assembly import Assembler, assigning_positions
 from .configuration import update_configuration
 from ..model.constraints import Constraints, transpose_times
 from .dofs import number_dofs
@@ -24,8 +25,28 @@ from ..elements.base import DOF_NAMES, IncrementContext
 from ..model import validation
 from ..errors import ModelError, SingularModelError
 from .reduction import ReducedTangent
-from .solvers.convergence import force_moment_abs_max
+from .solvers.convergence import all_finite, force_moment_abs_max
 from .solvers.linear import SparseLU, mechanism_dofs
+
+
+@njit(cache=True)
+def _reached(x, X0, spin, cons_node, cons_dof, reactions, prescribed, RF):
+    """The values reached at the constrained DOFs into ``prescribed`` (displacement x - X0, m, or
+    the accumulated spin, rad) and their ``reactions`` into the nodal array ``RF`` (zeros)."""
+    for i in range(cons_node.shape[0]):
+        n = cons_node[i]
+        d = cons_dof[i]
+        prescribed[n, d] = x[n, d] - X0[n, d] if d < 3 else spin[n, d - 3]
+        RF[n, d] = reactions[i]
+
+
+@njit(cache=True)
+def _abs_sum(a):
+    """Sum of |a| over every entry of ``a``."""
+    s = 0.0
+    for v in a.flat:
+        s += abs(v)
+    return s
 
 
 class System:
@@ -80,6 +101,7 @@ class System:
         self.n_free = nf
         self.free_node, self.free_dof = self.dofmap.slots(np.arange(nf))
         self.cons_node, self.cons_dof = self.dofmap.slots(np.arange(nf, ni))
+        self._labels = model.node_labels
         self.act_node, self.act_dof = self.dofmap.slots(np.arange(self.dofmap.n_active))
         self.is_rot = self.free_dof >= 3
         self._W = np.zeros((n, 3))     # scratch spins of the configuration update
@@ -123,7 +145,7 @@ class System:
                 responses.append(cached[i])
                 continue
             r = f.evaluate(x, R, s, ctx)
-            if not np.isfinite(r.f).all():   # (the method: np.all's dispatch costs ~2 us a call)
+            if not all_finite(r.f):   # (compiled: numpy's isfinite + all cost ~2 us a call)
                 raise FloatingPointError(f"non-finite internal forces in element family '{f.name}'")
             responses.append(r)
         return responses
@@ -172,8 +194,10 @@ class System:
             # a stabilised step may have widened the solver's pattern (a diagonal entry K_ff lacks):
             # the direct path needs the solver's pattern to be K_ff's own
             same = self.solver.has_pattern(self.assembler.K_ff)
-            self._direct = (self.solver.layout, [self.solver.permuted_positions(p) for p in self.assembler.pos_ff]
-                            if same else None)
+            positions = [self.solver.permuted_positions(p) for p in self.assembler.pos_ff] if same else None
+            if positions is not None:   # the first entry of each position assigns it: no zeroing
+                positions = assigning_positions(positions, self.solver.values.size)
+            self._direct = (self.solver.layout, positions)
         if self._direct[1] is None:
             return self.factorize_csr(responses, with_fc)
         ta = _time.perf_counter()
@@ -181,7 +205,7 @@ class System:
         if self.zero_force is None:
             self._set_floors(self.assembler.diagonal(k_list))
         Kfc = self.assembler.coupling(k_list) if with_fc else None
-        self.assembler.tangent_into(k_list, self.solver.values, self._direct[1])
+        self.assembler.tangent_into(k_list, self.solver.values, self._direct[1], assigning=True)
         self.summary.assembly_time += _time.perf_counter() - ta
         ts = _time.perf_counter()
         self.solver.factorize_values()
@@ -276,19 +300,17 @@ class System:
         """Commit a converged increment into the state (one call: see :meth:`State.commit`)."""
         st = self.state
         self.last_converged = (st.version, responses)
-        cn, cd = self.cons_node, self.cons_dof
-        t = cd < 3   # the values reached: displacements x - X0, rotations the accumulated spins
-        st.prescribed[cn[t], cd[t]] = st.x[cn[t], cd[t]] - self.X0[cn[t], cd[t]]
-        st.prescribed[cn[~t], cd[~t]] = st.spin[cn[~t], cd[~t] - 3]
-        st.commit([r.state for r in responses], P, lam, -res[self.dofmap.n_free:],
+        reactions = -res[self.dofmap.n_free:]
+        RF = np.zeros(P.shape)
+        # the values reached (displacements x - X0, rotations the accumulated spins) and the reactions
+        _reached(st.x, self.X0, st.spin, self.cons_node, self.cons_dof, reactions, st.prescribed, RF)
+        st.commit([r.state for r in responses], P, lam, reactions,
                   float(sum(np.sum(r.energy) for r in responses if r.energy is not None)), equilibrium)
         if equilibrium and self.check_balance:   # issue 16: the reactions balance the loads
-            RF = np.zeros_like(P)
-            RF[cn, cd] = st.reactions
             validation.check_equilibrium(st.x, P, RF, res[:self.dofmap.n_free], self.free_dof,
                                          f"increment {self.summary.increments + 1}",
-                                         internal=float(sum(np.abs(q.f).sum() for q in responses)),
-                                         labels=self.model.node_labels)
+                                         internal=float(sum(_abs_sum(q.f) for q in responses)),
+                                         labels=self._labels)
 
     # ------------------------------------------------------------ messages
     def worst(self, r):

@@ -33,7 +33,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import special, stats
+from scipy import special   # (scipy.stats where needed: 0.45 s to import, and every femast command pays
+# the import of this package: issue 21)
 
 from ..errors import StudyError
 
@@ -209,12 +210,16 @@ class TruncatedNormal(Input):
         b = np.inf if self.high is None else (self.high - self.mean) / self.std
         if not a < b:
             raise StudyError(f"input '{name}': low = {low!r} must be below high = {high!r}")
+        from scipy import stats
+
         if stats.norm.cdf(b) - stats.norm.cdf(a) < 1e-12:
             raise StudyError(f"input '{name}': [low, high] = [{low}, {high}] holds no probability of "
                              f"Normal({mean}, {std}) (more than 7 std from the mean); move the bounds or the mean")
         self._ab = (a, b)
 
     def ppf(self, u):
+        from scipy import stats
+
         a, b = self._ab
         return self.mean + self.std * stats.truncnorm.ppf(u, a, b)
 

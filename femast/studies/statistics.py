@@ -18,7 +18,6 @@ of the estimates with the number of samples, first-order and total Sobol' indice
 from __future__ import annotations
 
 import numpy as np
-from scipy import stats
 
 from ..errors import StudyError
 
@@ -36,6 +35,8 @@ def order_statistic_ranks(n: int, q: float, confidence: float = 0.95) -> tuple:
     """1-based ranks (l, u) with P(x_(l) <= xi_q <= x_(u)) >= confidence; 0 or n + 1 when n is too
     small for that side (no bound)."""
     alpha = 1.0 - confidence
+    from scipy import stats   # (here: importing scipy.stats costs every femast command 0.45 s, issue 21)
+
     l = int(stats.binom.ppf(alpha / 2, n, q))                 # P(B <= l - 1) <= alpha / 2
     if l >= 1 and stats.binom.cdf(l - 1, n, q) > alpha / 2:
         l -= 1
@@ -54,6 +55,8 @@ def percentile(x, q: float, confidence: float = 0.95) -> dict:
     l, u = order_statistic_ranks(n, q, confidence)
     lo = x[l - 1] if l >= 1 else np.nan
     hi = x[u - 1] if u <= n else np.nan
+    from scipy import stats
+
     cover = stats.binom.cdf(u - 1, n, q) - (stats.binom.cdf(l - 1, n, q) if l >= 1 else 0.0)
     return {"q": q, "estimate": float(np.quantile(x, q)), "low": float(lo), "high": float(hi), "n": n,
             "coverage": float(cover)}
@@ -78,6 +81,8 @@ def convergence(x, q=(0.5, 0.95, 0.99), ns=None, confidence: float = 0.95) -> di
     if ns is None:
         ns = [n for n in (8 * 2 ** k for k in range(40)) if n < len(x)] + [len(x)]
     ns = np.array(sorted(set(int(n) for n in ns if 1 <= n <= len(x))))
+    from scipy import stats
+
     z = stats.norm.ppf(0.5 + confidence / 2)
     out = {"n": ns, "mean": np.zeros((len(ns), 3))}
     for qq in q:

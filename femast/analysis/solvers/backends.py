@@ -10,13 +10,18 @@ name        what                                                 needs
 "banded"    LAPACK band Cholesky of the symmetric part, refined   scipy (always there)
             against B, or band LU with partial pivoting
             (:mod:`femast.analysis.solvers.banded`)
+"dense"     LAPACK dense LU with partial pivoting (``dgetrf``)     scipy (always there)
+            (:mod:`femast.analysis.solvers.dense`)
 "cholmod"   CHOLMOD's supernodal Cholesky of the symmetric part,  ``pip install femast[cholmod]``
             refined against B; SuperLU when B is unsymmetric or   (scikit-sparse; Debian:
             not positive definite                                 ``apt-get install libsuitesparse-dev``)
 "pardiso"   MKL PARDISO, unsymmetric LU with the analysis once    ``pip install femast[pardiso]``
 =========== ==================================================== ===============================
 
-**The automatic choice** (``backend="auto"``, :func:`choose`): the band back-end when the
+**The automatic choice** (``backend="auto"``, :func:`choose`): the dense LU for a system of at most
+:data:`~femast.analysis.solvers.dense.DENSE_MAX_DOFS` (64) DOFs (below that a factorisation's
+arithmetic is a few microseconds and the dense LU needs the fewest calls: no symbolic structures, no
+refinement; ``python benchmarks/small_systems.py``); otherwise the band back-end when the
 ordering is reverse Cuthill-McKee and its band is narrow (:func:`~femast.analysis.solvers.banded.band_rule`:
 the band storage of one triangle, n (b + 1), at most 4x the entries of K's triangle: the masts);
 otherwise PARDISO when it is installed and the model has at least :data:`PARDISO_MIN_DOFS` DOFs
@@ -33,8 +38,9 @@ import warnings
 import numpy as np
 
 from .banded import SYMMETRY_TOL, BandedFactor, band_of, band_rule, refine
+from .dense import DENSE_FORCED_MAX, DENSE_MAX_DOFS, DenseFactor
 
-NAMES = ("auto", "superlu", "banded", "cholmod", "pardiso")
+NAMES = ("auto", "superlu", "banded", "dense", "cholmod", "pardiso")
 PARDISO_MIN_DOFS = 1000   # the automatic choice takes PARDISO (when installed) from this size on
 THREADS = 1               # MKL threads of PARDISO
 INSTALL = {"cholmod": "pip install 'femast[cholmod]' (scikit-sparse; on Debian first: apt-get install "
@@ -56,8 +62,10 @@ def available(name: str) -> tuple[bool, str]:
 
 def choose(backend: str, B, ordering: str) -> str:
     """The back-end to use for the permuted matrix B (CSC, in the order ``ordering``)."""
+    n = B.shape[0]
     if backend == "auto":
-        n = B.shape[0]
+        if n <= DENSE_MAX_DOFS:
+            return "dense"
         if ordering == "rcm" and band_rule(n, _band(B), B.nnz):
             return "banded"
         if n >= PARDISO_MIN_DOFS and available("pardiso")[0]:
@@ -69,6 +77,11 @@ def choose(backend: str, B, ordering: str) -> str:
             warnings.warn(f"linear solver back-end '{backend}' is not installed ({why}); using SuperLU. "
                           f"Install it with: {INSTALL[backend]}", stacklevel=4)
             return "superlu"
+    if backend == "dense" and n > DENSE_FORCED_MAX:
+        warnings.warn(f"linear solver back-end 'dense' for {n} DOFs (an {n} x {n} matrix, "
+                      f"{8 * n * n / 1e9:.2g} GB) is beyond its limit of {DENSE_FORCED_MAX} DOFs; using SuperLU",
+                      stacklevel=4)
+        return "superlu"
     if backend == "banded" and ordering != "rcm":
         return "superlu"   # a band needs the RCM order (forced by SparseLU(backend="banded"))
     return backend
@@ -90,6 +103,8 @@ def make(backend: str, B, ordering: str, symmetric: bool, superlu_factor):
     name = choose(backend, B, ordering)
     if name == "banded":
         return BandedFactor(B, bandwidth=_band(B))
+    if name == "dense":
+        return DenseFactor(B)
     if name == "cholmod":
         return CholmodFactor(B, superlu_factor)
     if name == "pardiso":

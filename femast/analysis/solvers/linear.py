@@ -86,7 +86,7 @@ class SparseLU:
         "auto" (default): test the first factorisation of each pattern, and later ones only when a
         solution is amplified enough (|x| max|u_kk| > 1e11 |b|) for such a pivot to be possible.
     backend : who factorises the permuted matrix (:mod:`femast.analysis.solvers.backends`): "auto" (the
-        rule of :func:`~femast.analysis.solvers.backends.choose`), "superlu", "banded", "cholmod",
+        rule of :func:`~femast.analysis.solvers.backends.choose`), "superlu", "banded", "dense", "cholmod",
         "pardiso".  An optional back-end that is not installed falls back to SuperLU with a
         warning saying how to install it.
     """
