@@ -42,7 +42,8 @@ after release: EA (``cable_EA_N``, identified from Table 1 in issue 5) and the p
 (``pretension_N``, measured by vibration, seed Eq. 16) are options, and a pretension error is a
 candidate effect.
 
-Speed: one run is about 0.7 s for 40 driven rows on one core (warm).  A file with more than
+Speed: one run is about 0.1 s for 49 driven rows on one core (warm; 0.07 s started from a reference
+run, option ``fe_reference``).  A file with more than
 ``max_fe_rows`` rows is driven through a subset (the first and last row, every turning point of
 theta and rows evenly spread along the path) and the moment at the other rows is interpolated
 linearly along the path; keep files short (40-80 rows) for fits.  Runs are cached
