@@ -71,6 +71,8 @@ def compare(exp: Experiment, data: Measured, effects=(), *, fit: bool = False, p
     if fit:
         with progress.task(f"fitting {variant}"):
             run = _fit(exp, data, effects, noise=noise)
+        if getattr(run, "fe_reference", None) is not None:   # the fit's FE runs answer the zones and figures
+            exp = exp.with_options(fe_reference=run.fe_reference)
     else:
         params = dict(params or {})
         base = {k: v for k, v in params.items() if "." not in k}

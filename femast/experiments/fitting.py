@@ -371,6 +371,7 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     rows = sigma_rows(sigma)
     out.sensitivity = {full: -sol.jac[:, i] * rows / dxdu[i] for i, (full, _, _) in enumerate(specs)}
     out.fe_runs = int(sol.fe_runs)
+    out.fe_reference = exp.options.get("fe_reference")   # the reference run of the fit's FE runs, or None
     return out
 
 
