@@ -346,9 +346,7 @@ def main(argv=None):
     main_mast = max((r for r in results if not r["big"]), key=lambda r: r["n_bays"])
     pngs = [fig_distributions(main_mast, out / "shape_accuracy_distributions.png"),
             fig_growth(results, out / "shape_accuracy_growth.png"),
-            fig_sensitivity(max((r for r in results if r["sobol"]),     # the one with most complete base samples
-                                key=lambda r: max([v["n"] for k, v in r["sobol"].items() if not k.startswith("_")]
-                                                  + [0])),
+            fig_sensitivity(max((r for r in results if r["sobol"]), key=lambda r: r["n_bays"]),   # the longest
                             out / "shape_accuracy_sensitivity.png"),
             fig_residual_scaling(results, out / "shape_accuracy_residual_scaling.png", nominal_only)]
     nb = args.big or ATK_BAYS
