@@ -38,6 +38,21 @@ COMPILE_S = {
 _announced = False
 _installed = False
 
+# Set-up kernels (run once per analysis: assembly pattern, orderings, position maps) run as plain
+# Python on inputs up to this many items: a small model then never compiles them (nor queues them
+# for the background compile, which would delay the element kernels' compile), at a few ms of
+# Python; larger inputs call the compiled kernel.
+SETUP_PYTHON_MAX = 20_000   # inner-loop iterations (~10 ms of Python)
+
+
+def setup_call(kernel, n_items: int, *args):
+    """``kernel(*args)`` for a set-up kernel: its plain-Python function when ``n_items`` (about the
+    number of its inner-loop iterations) is at most :data:`SETUP_PYTHON_MAX` (integer results, or
+    sums in the same order: the same bits)."""
+    if n_items <= SETUP_PYTHON_MAX:
+        return kernel.py_func(*args)
+    return kernel(*args)
+
 
 def _dispatchers():
     """(qualified name, dispatcher) of every cacheable, non-inlined numba kernel of the loaded

@@ -67,3 +67,23 @@ def test_assigning_scatter_needs_no_zeroing_and_gives_the_same_sums():
     data = rng.normal(size=mat.nnz) * 1e6   # what a previous assembly left there
     Assembler.tangent_into(None, k_list, data, enc, assigning=True)
     assert np.array_equal(data, ref)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_setup_kernels_give_the_same_results_as_plain_python(seed, monkeypatch):
+    """Small models run the set-up kernels as plain Python (femast.jit.setup_call), large ones
+    compiled: the same pattern, positions and diagonal either way."""
+    from femast import jit
+
+    rng = np.random.default_rng(20 + seed)
+    eq_list = [rng.integers(-1, 30, size=(25, 12))]
+    k = rng.normal(size=(25, 12, 12))
+    results = []
+    for limit in (10 ** 9, -1):   # everything in Python, then everything compiled
+        monkeypatch.setattr(jit, "SETUP_PYTHON_MAX", limit)
+        mat, (pos,) = _block_pattern(eq_list, 0, 20, 0, 20)
+        diag = np.zeros(20)
+        jit.setup_call(_scatter_diagonal, k.size, k, eq_list[0], 20, diag)
+        results.append((mat.indptr, mat.indices, pos, diag))
+    for a, b in zip(*results):
+        assert np.array_equal(a, b)

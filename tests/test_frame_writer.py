@@ -2,6 +2,7 @@
 values as np.savez, a valid zip, and np.savez's own path for what it cannot write."""
 
 import io
+import os
 import zipfile
 
 import numpy as np
@@ -56,3 +57,30 @@ def test_repeated_layout_new_values(tmp_path):
             assert str(got["step"]) == frame["step"]
         with zipfile.ZipFile(tmp_path / f"{k}.npz") as z:
             assert z.testzip() is None
+
+
+def test_frame_log_records_truncation_and_old_folders(tmp_path):
+    """The frame log: records read back as written; a restart cuts it after its frames (and a
+    partial record); a folder of one file per frame becomes a log of the same frames."""
+    from femast.post.npz import append_record, read_log, record_bytes, scan_log, truncate_log
+    from femast.post.results import _log_from_files
+
+    frames = [dict(_frame(), increment=k) for k in range(4)]
+    log = tmp_path / "frames.npzs"
+    fd = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_APPEND)
+    for fr in frames:
+        append_record(fd, record_bytes(fr))
+    os.write(fd, record_bytes(frames[0])[:50])     # a record cut short
+    os.close(fd)
+    got = list(read_log(log))
+    assert [int(g["increment"]) for g in got] == [0, 1, 2, 3]
+    assert all(np.array_equal(g["U"], f["U"]) for g, f in zip(got, frames))
+    assert scan_log(log)[1] == 50
+    assert truncate_log(log, 2) == 4
+    assert [int(g["increment"]) for g in read_log(log)] == [0, 1] and scan_log(log)[1] == 0
+    old = tmp_path / "old"
+    old.mkdir()
+    for k, fr in enumerate(frames):
+        np.savez(old / f"{k + 1:06d}.npz", **fr)
+    _log_from_files(old, old / "frames.npzs")
+    assert [int(g["increment"]) for g in read_log(old / "frames.npzs")] == [0, 1, 2, 3]

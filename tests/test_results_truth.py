@@ -4,6 +4,7 @@ warning, a summary that says "completed" only after the last increment), and a k
 import json
 import os
 import signal
+import struct
 import subprocess
 import sys
 import textwrap
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 
 import femast as fm
+from femast.post.npz import LOG_NAME, RECORD_MAGIC, read_log, scan_log
 from femast.post.results import Results, ResultsWarning
 
 
@@ -26,6 +28,11 @@ def _cantilever(n_inc=4, load=-50.0):
     return m, b
 
 
+def _frames_on_disk(out):
+    log = out / "frames" / LOG_NAME
+    return len(scan_log(log)[0]) if log.exists() else 0
+
+
 def _summary(folder):
     return json.loads((folder / "summary.json").read_text())
 
@@ -36,7 +43,7 @@ def test_completed_run_says_completed(tmp_path):
     s = _summary(tmp_path / "r")
     assert s["status"] == "completed" and s["completed"] is True and res.status == "completed"
     assert not list((tmp_path / "r" / "frames").glob("*.tmp"))
-    assert len(res) == 5
+    assert len(res) == 5 and len(list(read_log(tmp_path / "r" / "frames" / LOG_NAME))) == 5
 
 
 def test_summary_is_running_during_the_run_and_replaces_a_stale_one(tmp_path):
@@ -94,10 +101,46 @@ def test_raw_exception_is_failed(tmp_path):
 
 
 def test_partial_and_corrupt_frames(tmp_path):
+    """The frame log (frames/frames.npzs): a record cut short by a kill is ignored with a warning,
+    a damaged record is an error naming the frame."""
+    m, b = _cantilever()
+    res = fm.solve(m, tmp_path / "r", progress=False)
+    log = tmp_path / "r" / "frames" / LOG_NAME
+    last = res.frame(-1)["U"].copy()
+    whole = log.read_bytes()
+    with open(log, "ab") as fh:            # a sixth frame, killed half-way through its write
+        fh.write(RECORD_MAGIC + struct.pack("<Q", 4000) + b"PK\x03\x04 half a zip")
+    with pytest.warns(ResultsWarning, match=r"frames\.npzs \(a partial last frame"):
+        r2 = Results(tmp_path / "r")
+    assert len(r2) == 5 and np.array_equal(r2.frame(-1)["U"], last)
+    assert r2.node_history(b, "uz").shape == (5,)
+    # frame 3's .npz starts 16 bytes after the end of frame 2's record: overwrite its zip signature
+    offsets = []
+    pos = 0
+    while pos < len(whole):
+        n = struct.unpack("<Q", whole[pos + 8:pos + 16])[0]
+        offsets.append(pos + 16)
+        pos += 16 + n
+    damaged = bytearray(whole)
+    damaged[offsets[3]:offsets[3] + 4] = b"XXXX"
+    log.write_bytes(bytes(damaged))
+    r3 = Results(tmp_path / "r")
+    with pytest.raises(fm.FemastError, match=r"frames\.npzs: frame 3 is unreadable"):
+        r3.frame(3)
+    with pytest.raises(fm.FemastError, match=r"frame 99 does not exist; the folder has 5 frames"):
+        r2.frame(99)
+
+
+def test_folder_of_one_file_per_frame_still_reads(tmp_path):
+    """Folders written before the frame log (frames/000001.npz, ...): read as before, partial
+    files ignored with a warning naming them, a damaged file an error naming it."""
     m, b = _cantilever()
     res = fm.solve(m, tmp_path / "r", progress=False)
     frames = tmp_path / "r" / "frames"
     last = res.frame(-1)["U"].copy()
+    for k, fr in enumerate(read_log(frames / LOG_NAME)):
+        np.savez(frames / f"{k + 1:06d}.npz", **fr)
+    (frames / LOG_NAME).unlink()
     (frames / "000006.npz.tmp").write_bytes(b"PK\x03\x04 half a zip")
     (frames / "000007.tmp.npz").write_bytes(b"PK\x03\x04 half a zip (older femast's name)")
     with pytest.warns(ResultsWarning, match=r"000006\.npz\.tmp"):
@@ -109,8 +152,6 @@ def test_partial_and_corrupt_frames(tmp_path):
         r3 = Results(tmp_path / "r")
     with pytest.raises(fm.FemastError, match=r"000004\.npz: frame 3 is unreadable"):
         r3.frame(3)
-    with pytest.raises(fm.FemastError, match=r"frame 99 does not exist; the folder has 5 frames"):
-        r2.frame(99)
 
 
 def test_out_is_an_existing_file(tmp_path):
@@ -146,7 +187,7 @@ def test_kill_9_and_read(tmp_path):
     p = subprocess.Popen([sys.executable, str(script), str(out)], env=env)
     try:
         deadline = time.time() + 120
-        while time.time() < deadline and len(list((out / "frames").glob("*.npz"))) < 15:
+        while time.time() < deadline and _frames_on_disk(out) < 15:
             time.sleep(0.05)
         assert p.poll() is None, "the run ended before it could be killed"
     finally:

@@ -60,7 +60,7 @@ class Analysis:
     easy_iterations : an increment converged in at most this many iterations is easy (Abaqus'
         I_G = 4 with looser tolerances; 6 with femast's tighter defaults).
     on_frame : a recorder, called with each frame's dict (the arrays written to
-        ``frames/NNNNNN.npz``; the first call is the initial state) as soon as its increment has
+        ``frames/frames.npzs``; the first call is the initial state) as soon as its increment has
         converged.  A script that needs a few quantities keeps them in memory this way instead of
         reading the results folder back (which costs about as much as the analysis of a small
         model).  Do not modify the arrays: the same ones are being written to disk.

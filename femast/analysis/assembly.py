@@ -12,6 +12,8 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
+from ..jit import setup_call
+
 
 @njit(cache=True)
 def _scatter_matrix(k, pos, data):
@@ -67,7 +69,7 @@ def assigning_positions(positions, size):
     out = []
     for pos in positions:
         o = np.empty(pos.shape, dtype=dtype)
-        _assign_first_positions(np.ascontiguousarray(pos), seen, o)
+        setup_call(_assign_first_positions, pos.size, np.ascontiguousarray(pos), seen, o)
         out.append(o)
     return out
 
@@ -181,7 +183,7 @@ def _block_pattern(eq_list, row_lo, row_hi, col_lo, col_hi):
                                                 for eqs, m in zip(eq_list, ms)]))
     el_eq = (np.concatenate([np.ravel(eqs) for eqs in eq_list]).astype(np.int64) if sum(sizes)
              else np.zeros(0, np.int64))
-    indptr, indices, pos = _pattern_kernel(el_ptr, el_eq, ent_ptr, row_lo, row_hi, col_lo, col_hi)
+    indptr, indices, pos = setup_call(_pattern_kernel, el_eq.size * 36, el_ptr, el_eq, ent_ptr, row_lo, row_hi, col_lo, col_hi)
     mat = sp.csr_matrix((np.zeros(indices.size), indices, indptr), shape=shape)
     positions = []
     offset = 0
@@ -252,7 +254,7 @@ class Assembler:
         """The diagonal of K_ff (the same sums as in the assembled K_ff)."""
         out = np.zeros(self.dofmap.n_free)
         for k, eqs in zip(k_list, self.eqs):
-            _scatter_diagonal(k, eqs, self.dofmap.n_free, out)
+            setup_call(_scatter_diagonal, k.size, k, eqs, self.dofmap.n_free, out)
         return out
 
     def coupling(self, k_list):

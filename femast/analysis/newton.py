@@ -58,7 +58,7 @@ import numpy as np
 from ..elements.base import IncrementContext
 from ..errors import ModelError, SingularModelError
 from .deadline import check as check_deadline
-from .solvers.convergence import Convergence
+from .solvers.convergence import Convergence, all_finite
 
 
 @dataclass
@@ -242,7 +242,7 @@ class Newton:
             resp = system.evaluate(ctx, reuse=reuse)
             res_ = system.residual(resp, P)
             summary.assembly_time += _time.perf_counter() - ta
-            if not np.isfinite(res_).all():
+            if not all_finite(res_):
                 raise FloatingPointError("non-finite residual")
             r_ = res_[:nf]
             if visc is not None and visc.C is not None:

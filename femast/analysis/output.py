@@ -11,9 +11,9 @@ The step loop (stepping.py) knows nothing of files.  It tells its observers what
 * ``finished(analysis)``: the run is over, however it ended (the summary is final).
 
 An observer implements the methods it needs (:class:`Observer` has them all, doing nothing).
-:class:`ResultsOutput` is the one every analysis has: it builds a frame (the arrays of
-``frames/NNNNNN.npz``, femast/post/results.py) at the step's output frequency and hands it to the
-results writer and to every ``on_frame`` recorder.
+:class:`ResultsOutput` is the one every analysis has: it builds a frame (the arrays of a record
+of ``frames/frames.npzs``, femast/post/results.py) at the step's output frequency and hands it to
+the results writer and to every ``on_frame`` recorder.
 """
 
 from __future__ import annotations

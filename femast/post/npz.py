@@ -8,10 +8,17 @@ of a run repeat their names, dtypes and shapes from one increment to the next, s
 (local headers, ``.npy`` headers, central directory) is laid out once per such signature and
 kept: a frame then costs one copy of the layout, one copy of each array's bytes and one CRC-32
 per member.
+
+The frames of a run go into one file, the frame log (``frames/frames.npzs``), one record appended
+per frame as its increment converges (:func:`record_bytes`, :func:`append_record`): a file created
+and renamed per frame cost a small model's frame ~0.1-0.3 ms of system time, more than its
+increment.  A record is ``b"FEMASTFR"``, the length n of its .npz as a little-endian uint64, and the
+n bytes of the .npz; :func:`read_log` reads the frames back with numpy alone.
 """
 
 from __future__ import annotations
 
+import io
 import os
 import struct
 import zlib
@@ -128,3 +135,66 @@ def atomic_savez(path, **arrays):
         finally:
             os.close(fd)
     os.replace(tmp, path)
+
+
+# --------------------------------------------------------------------------- the frame log
+LOG_NAME = "frames.npzs"      # frames/frames.npzs: every frame of a run, appended as it converges
+RECORD_MAGIC = b"FEMASTFR"
+_RECORD = struct.Struct("<8sQ")   # magic, length of the .npz that follows (bytes)
+
+
+def record_bytes(arrays: dict) -> bytes:
+    """One record of the frame log: the 16-byte record header (``b"FEMASTFR"``, the length as a
+    little-endian uint64) and the frame as an .npz (np.savez's bytes where :func:`npz_bytes` cannot)."""
+    data = npz_bytes(arrays)
+    if data is None:
+        buf = io.BytesIO()
+        np.savez(buf, **arrays)
+        data = buf.getvalue()
+    return _RECORD.pack(RECORD_MAGIC, len(data)) + data
+
+
+def append_record(fd: int, record: bytes) -> None:
+    """Append ``record`` to the log open as ``fd`` (O_APPEND) in one write (looped if it is short)."""
+    view = memoryview(record)
+    while view:
+        view = view[os.write(fd, view):]
+
+
+def scan_log(path) -> tuple[list, int]:
+    """The records of a frame log: ([(offset of the .npz, its length), ...], bytes left over at the end
+    -- a record cut short by a run killed while writing it, or anything that is not a record)."""
+    records = []
+    with open(path, "rb") as fh:
+        size = os.fstat(fh.fileno()).st_size
+        at = 0
+        while at + _RECORD.size <= size:
+            fh.seek(at)
+            magic, length = _RECORD.unpack(fh.read(_RECORD.size))
+            if magic != RECORD_MAGIC or at + _RECORD.size + length > size:
+                break
+            records.append((at + _RECORD.size, length))
+            at += _RECORD.size + length
+    return records, size - at
+
+
+def read_log(path):
+    """Iterate over the frames of a frame log as dicts of arrays (what :func:`numpy.load` gives for
+    each record's .npz); a partial last record is skipped.  Needs only numpy: the layout is a
+    sequence of records, each ``b"FEMASTFR"``, a little-endian uint64 n, then n bytes of .npz."""
+    records, _ = scan_log(path)
+    with open(path, "rb") as fh:
+        for offset, length in records:
+            fh.seek(offset)
+            with np.load(io.BytesIO(fh.read(length)), allow_pickle=False) as z:
+                yield {k: z[k] for k in z.files}
+
+
+def truncate_log(path, keep: int) -> int:
+    """Cut the frame log at ``path`` after its first ``keep`` records (a restarted run goes on from
+    there); returns the number of whole records it had."""
+    records, rest = scan_log(path)
+    if len(records) >= keep and (len(records) > keep or rest):
+        end = records[keep - 1][0] + records[keep - 1][1] if keep else 0
+        os.truncate(path, end)
+    return len(records)

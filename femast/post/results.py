@@ -3,16 +3,18 @@
 Layout of a results folder::
 
     mesh.npz              node labels, reference coordinates, element connectivity per family
-    frames/000001.npz     one file per converged increment (written atomically)
+    frames/frames.npzs    the frames: a record appended per converged increment (the record:
+                          b"FEMASTFR", a little-endian uint64 n, n bytes of .npz; femast/post/npz.py)
     status.sta            one line per increment, like Abaqus' .sta file
     summary.json          the run's status: written at the start as ``"status": "running"``
                           (replacing any summary of an earlier run into the folder) and at the
                           end as "completed" (every step done), "failed" (an error; ``message``
                           says which) or "interrupted" (Ctrl-C or a stop)
 
-Every file is written to a temporary name and renamed into place (``os.replace``), so a run
-killed outright leaves at most a ``*.tmp`` file, which :class:`Results` ignores with a warning
-naming it.  A summary still saying "running" after its process has gone (a kill -9, a power cut)
+The mesh and the summary are written to a temporary name and renamed into place (``os.replace``);
+frames are appended to the frame log, so a run killed outright leaves at most a partial last
+record, which :class:`Results` ignores with a warning.  Folders of one ``frames/NNNNNN.npz`` per
+frame (femast before issue 21) are read as before, and a restart from one converts them to a log.  A summary still saying "running" after its process has gone (a kill -9, a power cut)
 is reported by :attr:`Results.status` as "interrupted".
 
 Each frame holds: ``step`` (name), ``increment``, ``time`` (step time, s),
@@ -20,15 +22,12 @@ Each frame holds: ``step`` (name), ``increment``, ``time`` (step time, s),
 ``R`` (n, 3, 3) nodal rotation matrices, ``UR`` (n, 3) rotation vectors (rad, |UR| <= pi),
 ``URA`` (n, 3) accumulated spins (rad; the total rotation for rotations about a fixed
 axis, beyond 2 pi), ``RF`` (n, 6) reactions (N, N m), ``P`` (n, 6) applied loads, and
-element outputs as ``el/<family>/<name>``.  Read them with numpy.load, or with
-:class:`Results`.
+element outputs as ``el/<family>/<name>``.  Read them with :class:`Results`, or with
+numpy alone (:func:`femast.post.npz.read_log`).
 
 The mesh, the frames and the status lines are written by a background thread, so that the analysis
-goes on with the next increment while the last one is stored.  ``np.savez`` of a frame takes 1.5-3 ms
-and holds Python's GIL for most of it: in a large model the writer works while SuperLU factorises,
-but a small model's Newton loop is mostly Python, and there writing every frame can take longer
-than solving (an ADAM bay run: 0.08-0.14 s without files, 0.2-0.4 s with; see
-``Step.output_frequency`` and ``Analysis(out=None)``).  A frame is queued the moment its increment
+goes on with the next increment while the last one is stored (a frame of a small model costs
+~0.05 ms to encode and one append; see ``Step.output_frequency`` and ``Analysis(out=None)``).  A frame is queued the moment its increment
 converges and the queue is drained by :meth:`ResultsWriter.close`, which the analysis calls however
 the run ends (normally, on a convergence failure, on Ctrl-C); only a process killed outright can
 lose the last queued frame or two.  A write error (a full disk) is raised in the analysis at the
@@ -37,11 +36,13 @@ next frame or at the close.
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import queue
 import re
 import socket
+import struct
 import threading
 import time as _time
 import warnings
@@ -51,7 +52,8 @@ import numpy as np
 
 from ..elements.base import DOF_NAMES
 from ..errors import FemastError
-from .npz import TMP_SUFFIX, atomic_savez as _atomic_savez, npz_bytes as _npz_bytes  # noqa: F401
+from .npz import (LOG_NAME, RECORD_MAGIC, TMP_SUFFIX, append_record, atomic_savez as _atomic_savez,  # noqa: F401
+                  npz_bytes as _npz_bytes, record_bytes, scan_log, truncate_log)
 
 _COMPONENTS = {
     "ux": ("U", 0), "uy": ("U", 1), "uz": ("U", 2),
@@ -112,6 +114,16 @@ def prepare_folder(folder) -> Path:
     return folder
 
 
+def _log_from_files(frames: Path, log: Path) -> None:
+    """The frame log of a folder written with one file per frame (an earlier femast): the whole
+    frames in order, as records (a restarted run appends to it)."""
+    names = sorted(p.name for p in frames.glob("*.npz") if _FRAME_NAME.match(p.name))
+    with open(log, "wb") as fh:
+        for n in names:
+            data = (frames / n).read_bytes()
+            fh.write(struct.pack("<8sQ", RECORD_MAGIC, len(data)) + data)
+
+
 class ResultsWarning(UserWarning):
     """A results folder holds partial files or an unreadable summary (ignored)."""
 
@@ -126,13 +138,17 @@ class ResultsWriter:
         self._started = _time.time()
         # the stale summary of an earlier run goes first: a kill from here on leaves "running"
         write_json_atomic(self.folder / "summary.json", self._running())
-        for pattern in ("*.npz", "*" + TMP_SUFFIX):
-            for old in (self.folder / "frames").glob(pattern):
-                if resume is None or not _FRAME_NAME.match(old.name) or int(old.name[:-4]) > resume:
-                    old.unlink()
+        frames = self.folder / "frames"
+        log = frames / LOG_NAME
+        if resume is not None and not log.exists():   # a folder of one file per frame (femast < 0.x)
+            _log_from_files(frames, log)
+        for pattern in ("*.npz", "*" + TMP_SUFFIX):   # one-file-per-frame frames of an earlier run
+            for old in frames.glob(pattern):
+                old.unlink()
         if resume is None:   # an earlier run's restart point does not belong to this run's frames
+            log.unlink(missing_ok=True)
             (self.folder / "restart" / "restart.json").unlink(missing_ok=True)
-        if resume is not None and len(list((self.folder / "frames").glob("*.npz"))) != resume:
+        elif truncate_log(log, resume) < resume:
             raise FemastError(f"{self.folder}: the restart point names {resume} frames but fewer are on disk; "
                               "run the analysis again from the start")
         for old in (self.folder / "mesh.npz", self.folder / ("mesh.npz" + TMP_SUFFIX)):
@@ -143,7 +159,7 @@ class ResultsWriter:
             mesh[f"conn/{f.name}"] = model.node_labels[np.asarray(f.nodes)]
             mesh[f"labels/{f.name}"] = np.asarray(getattr(f, "labels", np.arange(1, f.n_elements + 1)))
         self.count = resume or 0
-        self._frames = os.path.join(os.fspath(self.folder), "frames", "")   # (a str: no Path per frame)
+        self._log = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_APPEND | getattr(os, "O_BINARY", 0), 0o666)
         self._queue = queue.Queue(maxsize=16)   # bounded: a slow disk slows the analysis, not memory
         self._error = None
         self._queue.put(((self.folder / "mesh.npz",), mesh))   # written first, by the writer thread
@@ -178,7 +194,10 @@ class ResultsWriter:
                     self.sta.write(item[0])
                     self.sta.flush()
                 elif self._error is None:
-                    _atomic_savez(*item[0], **item[1])
+                    if item[0] is None:   # a frame: appended to the log
+                        append_record(self._log, record_bytes(item[1]))
+                    else:
+                        _atomic_savez(*item[0], **item[1])
             except Exception as exc:  # reported in the analysis thread
                 self._error = exc
             finally:
@@ -193,7 +212,7 @@ class ResultsWriter:
         """Queue one frame (arrays must not be modified afterwards: pass copies)."""
         self._raise_error()
         self.count += 1
-        self._queue.put(((f"{self._frames}{self.count:06d}.npz",), data))
+        self._queue.put((None, data))
 
     def _running(self) -> dict:
         return {"status": "running", "completed": False, "pid": os.getpid(), "host": socket.gethostname(),
@@ -208,6 +227,7 @@ class ResultsWriter:
                 self._thread.join()
         finally:
             self.sta.close()
+            os.close(self._log)
             final = {**summary, "pid": os.getpid(), "host": socket.gethostname(), "started": self._started}
             if self._error is not None and final.get("status") == "completed":
                 final.update(status="failed", completed=False,
@@ -251,11 +271,17 @@ class Results:
         self._mesh = None    # read on first use (an analysis returns its Results: ~1.5 ms per run saved)
         frames = self.folder / "frames"
         names = sorted(p.name for p in frames.iterdir()) if frames.is_dir() else []
-        self.files = [frames / n for n in names if _FRAME_NAME.match(n)]
-        self.partial = [frames / n for n in names if not _FRAME_NAME.match(n)]
+        log = frames / LOG_NAME
+        if LOG_NAME in names:   # the frame log: a record per frame
+            records, rest = scan_log(log)
+            self.files = [(log, offset, length) for offset, length in records]
+            self.partial = [f"{LOG_NAME} (a partial last frame, {rest} bytes)"] if rest else []
+        else:                   # one file per frame (folders written before the log)
+            self.files = [frames / n for n in names if _FRAME_NAME.match(n)]
+            self.partial = [n for n in names if not _FRAME_NAME.match(n)]
         if self.partial:
             warnings.warn(f"{self.folder}: ignoring {len(self.partial)} partial or foreign file(s) in frames/ "
-                          f"({', '.join(p.name for p in self.partial[:5])}{', ...' if len(self.partial) > 5 else ''}"
+                          f"({', '.join(self.partial[:5])}{', ...' if len(self.partial) > 5 else ''}"
                           "): left by a run that was killed while writing", ResultsWarning, stacklevel=2)
         self._cache = {}
         sfile = self.folder / "summary.json"
@@ -321,11 +347,17 @@ class Results:
             raise FemastError(f"{self.folder}: frame {i} does not exist; the folder has {len(self.files)} frames "
                               f"(0..{len(self.files) - 1}, or -1 for the last)") from None
         if i not in self._cache:
+            src = self.files[i]
             try:
-                with np.load(self.files[i], allow_pickle=False) as f:
+                if isinstance(src, tuple):   # a record of the frame log
+                    with open(src[0], "rb") as fh:
+                        fh.seek(src[1])
+                        src = io.BytesIO(fh.read(src[2]))
+                with np.load(src, allow_pickle=False) as f:
                     self._cache[i] = {k: f[k] for k in f.files}
             except Exception as exc:   # zipfile.BadZipFile, EOFError, ValueError, OSError...
-                raise FemastError(f"{self.files[i]}: frame {i} is unreadable ({type(exc).__name__}: {exc}); "
+                where = self.files[i] if not isinstance(self.files[i], tuple) else self.files[i][0]
+                raise FemastError(f"{where}: frame {i} is unreadable ({type(exc).__name__}: {exc}); "
                                   "the file is damaged: rerun the analysis") from None
         return self._cache[i]
 

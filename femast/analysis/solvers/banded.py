@@ -32,6 +32,8 @@ import numpy as np
 from numba import njit
 from scipy.linalg import lapack
 
+from ...jit import setup_call
+
 SYMMETRY_TOL = 1e-6        # relative asymmetry below which the Cholesky of the symmetric part is tried
 BACKWARD_TOL = 1e-14       # normwise backward error a refined solution must reach (LU: ~1e-16 x growth)
 MAX_REFINE = 4             # refinement steps before falling back to the LU
@@ -263,7 +265,8 @@ class BandedFactor:
             self._L = self._split[:m].reshape((self.b + 1, self.n), order="F")
             self._U = self._split[m:].reshape((self.b + 1, self.n), order="F")
         g = np.zeros(0, np.int64) if gather is None else np.asarray(gather, dtype=np.int64)
-        return _split_positions(self.B.indptr, self.B.indices, self.b, g, np.ascontiguousarray(pos, dtype=np.int64))
+        return setup_call(_split_positions, self.B.nnz + np.size(pos), self.B.indptr, self.B.indices, self.b, g,
+                          np.ascontiguousarray(pos, dtype=np.int64))
 
     def _entries(self):
         """(column, row) of every entry of B's data array."""

@@ -12,6 +12,8 @@ import scipy.sparse.linalg as spla
 from numba import njit
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
+from ...jit import setup_call
+
 
 def same_pattern(pattern, K) -> bool:
     """K (CSR) has the pattern ``(shape, indptr, indices)`` (None: no pattern)."""
@@ -75,7 +77,7 @@ def permuted(K, perm):
     n = K.shape[0]
     inv = np.empty(n, dtype=np.int64)
     inv[np.asarray(perm, dtype=np.int64)] = np.arange(n)
-    indptr, indices, gather = _permuted_csc(K.indptr.astype(np.int64), K.indices.astype(np.int64), inv, n)
+    indptr, indices, gather = setup_call(_permuted_csc, K.nnz, K.indptr.astype(np.int64), K.indices.astype(np.int64), inv, n)
     B = sp.csc_matrix((K.data[gather], indices, indptr), shape=K.shape)
     return B, gather
 
