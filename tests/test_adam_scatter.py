@@ -133,7 +133,7 @@ def test_tip_history_reports_every_load_level_and_the_nominal_mast_deploys_strai
     from femast.adam.shape_study import tip_history
 
     h = tip_history(2, None, cycles=1)
-    assert h["labels"] == ["pretension", "M+F#1", "0a#1", "-M-F#1", "0b#1"]
+    assert h["labels"] == ["equilibrium", "M+F#1", "0a#1", "-M-F#1", "0b#1"]
     # the nominal mast shortens under its pretension, with no sideways motion or rotation
     # (round-off and the 1e-9 force tolerance: far below 1 nm and 1e-8 rad)
     assert h["u"][0, 2] < 0 and np.abs(h["u"][0, :2]).max() < 1e-9 and np.abs(h["theta"][0]).max() < 1e-8
