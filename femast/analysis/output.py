@@ -88,13 +88,16 @@ class ResultsOutput(Observer):
         """Write the frame of increment ``increment`` if the step's output frequency asks for it or
         it is the step's ``last``; else keep it pending.  Then the status line."""
         frame = (step.name, increment, time, iterations, responses)
+        st = analysis.state
+        line = (step.name, increment, attempt, iterations, time, st.total_time, dtime, st.lam, note)
         if last or increment % step.output_frequency == 0:
+            # the status line travels with the frame to the writer thread (one hand-over, not two)
+            self.writer.status(*line, with_next_frame=True)
             self.frame(analysis, *frame)
             self.pending = None
         else:
             self.pending = frame
-        st = analysis.state
-        self.writer.status(step.name, increment, attempt, iterations, time, st.total_time, dtime, st.lam, note)
+            self.writer.status(*line)
 
     def stopped(self, analysis):
         if self.pending is not None:   # the state is that of the last converged increment

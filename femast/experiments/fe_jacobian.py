@@ -158,14 +158,14 @@ def _polish(sol, fj, fun, lo, hi, kw, min_decrease: float = 0.0):
     (``POLISH_MIN_DECREASE`` = 0.01: 0.14 of one); a smaller predicted gain is not worth a restart."""
     extra = 0
     ftol = float(kw.get("ftol", 1e-8))
-    for _ in range(POLISH_ROUNDS + 1):
+    for rnd in range(POLISH_ROUNDS + 1):
         J, _ = fj.at_solution(sol.x)
         f = fj.value(sol.x)
         step = np.linalg.lstsq(J, -f, rcond=None)[0]
         u_new = np.clip(sol.x + step, lo, hi)
         r = f + J @ (u_new - sol.x)
         predicted = sol.cost - 0.5 * float(r @ r)
-        if _ == POLISH_ROUNDS or not predicted > max(ftol * sol.cost, min_decrease):
+        if rnd == POLISH_ROUNDS or not predicted > max(ftol * sol.cost, min_decrease):
             break
         fj.J, fj.J0 = None, J
         with np.errstate(all="ignore"):

@@ -162,6 +162,7 @@ class ResultsWriter:
         self._log = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_APPEND | getattr(os, "O_BINARY", 0), 0o666)
         self._queue = queue.Queue(maxsize=16)   # bounded: a slow disk slows the analysis, not memory
         self._error = None
+        self._lines = []   # status lines waiting for the next frame (status(with_next_frame=True))
         self._queue.put(((self.folder / "mesh.npz",), mesh))   # written first, by the writer thread
         self.sta = open(self.folder / "status.sta", "w" if resume is None else "a")
         if resume is not None:
@@ -172,15 +173,29 @@ class ResultsWriter:
         self._thread = threading.Thread(target=self._drain, name="femast-results-writer", daemon=True)
         self._thread.start()
 
-    def status(self, step, inc, attempt, iterations, time, total_time, dtime, lam, note=""):
+    def status(self, step, inc, attempt, iterations, time, total_time, dtime, lam, note="",
+               with_next_frame=False):
         """Queue one status line (written and flushed by the writer thread, in order with the
-        frames: a flush costs ~0.15 ms on a VM's disk, as much as a small model's iteration)."""
+        frames: a flush costs ~0.15 ms on a VM's disk, as much as a small model's iteration).
+        ``with_next_frame``: the line goes to the writer with the frame queued next (written after
+        it), one hand-over to the writer thread instead of two."""
         self._raise_error()
-        self._queue.put((f"{step:>12.12} {inc:5d} {attempt:3d} {iterations:4d} {time:11.4e} {total_time:11.4e} "
-                         f"{dtime:11.4e} {lam:12.5e}  {note}\n", None))
+        line = (f"{step:>12.12} {inc:5d} {attempt:3d} {iterations:4d} {time:11.4e} {total_time:11.4e} "
+                f"{dtime:11.4e} {lam:12.5e}  {note}\n")
+        if with_next_frame:
+            self._lines.append(line)
+        else:
+            self._put_lines()
+            self._queue.put((line, None))
+
+    def _put_lines(self):
+        if self._lines:
+            self._queue.put(("".join(self._lines), None))
+            self._lines = []
 
     def flush(self):
         """Wait until every queued frame and status line is on disk (a restart point names them)."""
+        self._put_lines()
         self._queue.join()
         self._raise_error()
 
@@ -194,8 +209,11 @@ class ResultsWriter:
                     self.sta.write(item[0])
                     self.sta.flush()
                 elif self._error is None:
-                    if item[0] is None:   # a frame: appended to the log
+                    if item[0] is None:   # a frame: appended to the log, then its status lines
                         append_record(self._log, record_bytes(item[1]))
+                        if item[2]:
+                            self.sta.write(item[2])
+                            self.sta.flush()
                     else:
                         _atomic_savez(*item[0], **item[1])
             except Exception as exc:  # reported in the analysis thread
@@ -212,7 +230,8 @@ class ResultsWriter:
         """Queue one frame (arrays must not be modified afterwards: pass copies)."""
         self._raise_error()
         self.count += 1
-        self._queue.put((None, data))
+        lines, self._lines = "".join(self._lines), []
+        self._queue.put((None, data, lines))
 
     def _running(self) -> dict:
         return {"status": "running", "completed": False, "pid": os.getpid(), "host": socket.gethostname(),
@@ -223,6 +242,7 @@ class ResultsWriter:
         """Drain the queue and write the final summary (``summary["status"]`` says how the run ended)."""
         try:
             if self._thread.is_alive():
+                self._put_lines()
                 self._queue.put(None)
                 self._thread.join()
         finally:
