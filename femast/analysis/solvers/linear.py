@@ -61,6 +61,19 @@ _FLOAT_MAX = float(np.finfo(float).max)
 
 
 @njit(cache=True)
+def _permute(rhs, perm, b):
+    """b = rhs[perm] in one pass; returns max |rhs| (the amplification test's scale)."""
+    m = 0.0
+    for i in range(perm.shape[0]):
+        v = rhs[perm[i]]
+        b[i] = v
+        a = abs(v)
+        if a > m:
+            m = a
+    return m
+
+
+@njit(cache=True)
 def _unpermute(y, perm, x):
     """x[perm] = y in one pass; returns max |x|, or NaN as soon as an entry is not finite."""
     m = 0.0
@@ -192,6 +205,21 @@ class SparseLU:
     def factorize_values(self):
         """Factorise the matrix whose values were written into :attr:`values` (same checks and
         errors as :meth:`factorize`)."""
+        eng = self._engine
+        if (eng is not None and self._dmax is not None and self.pivot_check != "always"
+                and not hasattr(eng, "band_positions")):
+            # the usual case, inline (a small model's iteration is a few tens of microseconds): a
+            # back-end refactorising the permuted CSC matrix, no zero-pivot test due
+            t0 = perf_counter()
+            try:
+                self._lu = eng.factorize()
+            except RuntimeError as exc:
+                self._lu = None
+                raise SingularModelError(str(exc)) from None
+            self.superlu_seconds += perf_counter() - t0
+            self.factorizations += 1
+            self._checked = False
+            return
 
         def step():
             if self._band_input():
@@ -359,7 +387,8 @@ class SparseLU:
             self.superlu_seconds += perf_counter() - t0
             xmax = float(np.abs(x).max(initial=0.0)) if np.isfinite(x).all() else math.nan
         else:
-            b = rhs[self._perm]
+            b = np.empty(rhs.shape[0])
+            rmax = _permute(rhs, self._perm, b)
             t0 = perf_counter()
             y = self._lu.solve(b)
             self.superlu_seconds += perf_counter() - t0
@@ -367,7 +396,8 @@ class SparseLU:
             xmax = _unpermute(y, self._perm, x)
         if not xmax <= _FLOAT_MAX:
             raise SingularModelError("non-finite solution of the linear system")
-        if not self._checked and xmax * self._dmax > 1e11 * np.abs(rhs).max(initial=0.0):
+        if not self._checked and xmax * self._dmax > 1e11 * (np.abs(rhs).max(initial=0.0) if self._perm is None
+                                                            else rmax):
             # an amplification this large means a pivot within ~1e-11 of the largest: test them
             self._check_pivots()
         return x
