@@ -205,21 +205,6 @@ class SparseLU:
     def factorize_values(self):
         """Factorise the matrix whose values were written into :attr:`values` (same checks and
         errors as :meth:`factorize`)."""
-        eng = self._engine
-        if (eng is not None and self._dmax is not None and self.pivot_check != "always"
-                and not hasattr(eng, "band_positions")):
-            # the usual case, inline (a small model's iteration is a few tens of microseconds): a
-            # back-end refactorising the permuted CSC matrix, no zero-pivot test due
-            t0 = perf_counter()
-            try:
-                self._lu = eng.factorize()
-            except RuntimeError as exc:
-                self._lu = None
-                raise SingularModelError(str(exc)) from None
-            self.superlu_seconds += perf_counter() - t0
-            self.factorizations += 1
-            self._checked = False
-            return
 
         def step():
             if self._band_input():
