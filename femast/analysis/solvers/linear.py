@@ -61,6 +61,19 @@ _FLOAT_MAX = float(np.finfo(float).max)
 
 
 @njit(cache=True)
+def _permute(rhs, perm, b):
+    """b = rhs[perm] in one pass; returns max |rhs| (the amplification test's scale)."""
+    m = 0.0
+    for i in range(perm.shape[0]):
+        v = rhs[perm[i]]
+        b[i] = v
+        a = abs(v)
+        if a > m:
+            m = a
+    return m
+
+
+@njit(cache=True)
 def _unpermute(y, perm, x):
     """x[perm] = y in one pass; returns max |x|, or NaN as soon as an entry is not finite."""
     m = 0.0
@@ -359,7 +372,8 @@ class SparseLU:
             self.superlu_seconds += perf_counter() - t0
             xmax = float(np.abs(x).max(initial=0.0)) if np.isfinite(x).all() else math.nan
         else:
-            b = rhs[self._perm]
+            b = np.empty(rhs.shape[0])
+            rmax = _permute(rhs, self._perm, b)
             t0 = perf_counter()
             y = self._lu.solve(b)
             self.superlu_seconds += perf_counter() - t0
@@ -367,7 +381,8 @@ class SparseLU:
             xmax = _unpermute(y, self._perm, x)
         if not xmax <= _FLOAT_MAX:
             raise SingularModelError("non-finite solution of the linear system")
-        if not self._checked and xmax * self._dmax > 1e11 * np.abs(rhs).max(initial=0.0):
+        if not self._checked and xmax * self._dmax > 1e11 * (np.abs(rhs).max(initial=0.0) if self._perm is None
+                                                            else rmax):
             # an amplification this large means a pivot within ~1e-11 of the largest: test them
             self._check_pivots()
         return x
