@@ -138,7 +138,11 @@ class ResultsOutput(Observer):
             if sys.getrefcount(frame) > 2:   # (this name and getrefcount's argument)
                 frame.complete()
             return
-        data.update({k: make() for k, make in state.items()})
+        if self.recorders:   # a recorder may keep the arrays: the state's own are copied
+            data.update({k: make() for k, make in state.items()})
+        else:                # written at once (ResultsWriter.frame): the state's arrays as they are
+            data.update(U=st.x - sys_.X0, R=st.R, UR=rotation_vectors(st.R), URA=st.spin, RF=reactions(),
+                        P=st.loads)
         for name, out in outputs.items():
             for key, val in out.items():
                 data[f"el/{name}/{key}"] = val
