@@ -14,13 +14,20 @@ pytestmark = pytest.mark.skipif(not hasattr(os, "fork") or (os.cpu_count() or 1)
                                 reason="needs fork and two CPUs")
 
 
+@pytest.fixture
+def forking(monkeypatch):
+    """Forking allowed although earlier tests may have left threads behind (the functions forked here
+    take no locks); the thread rule itself is tested below."""
+    monkeypatch.setattr(fj, "_only_thread", lambda: True)
+
+
 def _fun(u):
     # a smooth vector function with values whose bits a round trip through text would change
     x = np.linspace(0.0, 1.0, 7)
     return np.sin(u[0] * x) / 3.0 + np.exp(-u[1] * x) + np.pi * u[0] * u[1]
 
 
-def test_forked_columns_equal_serial_ones_bit_for_bit():
+def test_forked_columns_equal_serial_ones_bit_for_bit(forking):
     pts = [np.array([0.1 * k, 1.0 + 0.3 * k]) for k in range(5)]
     assert fj._fork_ok(len(pts))
     got = fj.evaluate_many(_fun, pts, 7)
@@ -30,7 +37,7 @@ def test_forked_columns_equal_serial_ones_bit_for_bit():
         assert g.dtype == np.float64 and np.array_equal(g, w)
 
 
-def test_the_child_runs_the_second_half():
+def test_the_child_runs_the_second_half(forking):
     parent = os.getpid()
     pids = {}
 
@@ -44,7 +51,7 @@ def test_the_child_runs_the_second_half():
     assert set(pids) == {1.0, 2.0}
 
 
-def test_a_failing_child_is_replaced_by_this_process():
+def test_a_failing_child_is_replaced_by_this_process(forking):
     parent = os.getpid()
 
     def fun(u):
@@ -56,7 +63,7 @@ def test_a_failing_child_is_replaced_by_this_process():
     assert np.array_equal(got[1], np.full(4, 2.0))
 
 
-def test_serial_outside_the_main_thread_and_when_switched_off(monkeypatch):
+def test_serial_outside_the_main_thread_and_when_switched_off(forking, monkeypatch):
     out = {}
 
     def run():
@@ -71,7 +78,7 @@ def test_serial_outside_the_main_thread_and_when_switched_off(monkeypatch):
     assert fj._fork_ok(4) is False
 
 
-def test_jacobian_with_forked_columns_equals_the_serial_one(monkeypatch):
+def test_jacobian_with_forked_columns_equals_the_serial_one(forking, monkeypatch):
     lo, hi = np.full(2, -10.0), np.full(2, 10.0)
     u = np.array([0.4, 0.7])
     jac = {}
@@ -88,8 +95,7 @@ def test_serial_while_another_thread_runs():
     t = threading.Thread(target=stop.wait, daemon=True)
     t.start()
     try:
-        assert fj._fork_ok(4) is False
+        assert fj._only_thread() is False and fj._fork_ok(4) is False
     finally:
         stop.set()
         t.join()
-    assert fj._fork_ok(4) is True

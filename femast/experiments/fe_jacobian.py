@@ -114,9 +114,7 @@ def _fork_ok(n_points: int) -> bool:
 
     if multiprocessing.parent_process() is not None or threading.current_thread() is not threading.main_thread():
         return False
-    # no other thread that might hold a lock the child needs (a Jupyter kernel's, a results writer's);
-    # tqdm's monitor only wakes every 10 s to check the bars, which the child does not draw
-    if any(t is not threading.current_thread() and type(t).__name__ != "TMonitor" for t in threading.enumerate()):
+    if not _only_thread():
         return False
     try:
         import numba
@@ -126,6 +124,15 @@ def _fork_ok(n_points: int) -> bool:
     except Exception:   # (ValueError while no parallel kernel has run: no threads)
         pass
     return True
+
+
+def _only_thread() -> bool:
+    """No other thread that might hold a lock the child needs (a Jupyter kernel's, a results writer's);
+    tqdm's monitor only wakes every 10 s to check the bars, which the child does not draw."""
+    import threading
+
+    me = threading.current_thread()
+    return all(t is me or type(t).__name__ == "TMonitor" for t in threading.enumerate())
 
 
 def evaluate_many(fun, points, size: int) -> list:
