@@ -45,7 +45,9 @@ Options of the algorithm: a secant line search (``line_search``) and the tangent
 
 Every Newton iteration: tangent (if due), solve, correct the load factor, update the
 configuration, evaluate the residual, test convergence.  On convergence the state is committed,
-on failure rolled back (both one call).
+on failure rolled back (both one call).  Under full Newton and fixed loads an iteration whose force
+test passes may also be accepted on its predicted next correction, one more solve with the
+factorisation in hand (``Convergence(predicted=True)``, :mod:`~femast.analysis.solvers.convergence`).
 """
 
 from __future__ import annotations
