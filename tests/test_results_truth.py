@@ -203,3 +203,69 @@ def test_kill_9_and_read(tmp_path):
     inc = res.scalar_history("increment")
     assert np.array_equal(inc, np.arange(len(res)))   # consecutive: nothing lost before the last
 
+
+
+_REPORT_SCRIPT = textwrap.dedent("""
+    import sys, time, femast as fm
+    import femast.post.results as results
+    from femast.analysis.output import Observer
+
+    write = results.append_record
+    def slow_disk(fd, record):   # a disk slower than the analysis: writes must not fall behind
+        time.sleep(0.002)
+        write(fd, record)
+    results.append_record = slow_disk
+
+    class Report(Observer):   # told after the results writer: the run's word that an increment converged
+        def converged(self, an, step, increment, *args):
+            sys.stdout.write(f"{increment} {float(an.x[-1, 2] - an.X0[-1, 2]).hex()}\\n")
+            sys.stdout.flush()
+
+    m = fm.Model("kill")
+    a = m.node(0, 0, 0)
+    b = m.node(1, 0, 0)
+    m.beam(a, b, fm.circular_tube(0.02, 0.016, E=70e9), n=4)
+    m.fix(a)
+    m.step("s", initial_increment=1e-4, max_increment=1e-4, max_increments=100000).load(b, fz=-50.0)
+    fm.Analysis(m, sys.argv[1], progress=False, observers=[Report()]).run()
+""")
+
+
+@pytest.mark.parametrize("reports, delay_s", [(3, 0.0), (40, 0.0137)])
+def test_kill_9_loses_no_increment_the_run_reported_converged(tmp_path, reports, delay_s):
+    """The durability rule: a frame is the operating system's before anyone hears that its increment
+    converged (no fsync: a process kill, unlike a power cut, loses nothing written).  A child run
+    on a slow disk (2 ms per write) reports each converged increment (number and tip deflection) on
+    a pipe; it is killed with SIGKILL at an arbitrary moment; every increment it reported is then in
+    the frame log with the reported deflection, bit for bit, and so is every increment named in
+    status.sta.  (femast before session 8 queued frames to a writer thread and fails this.)"""
+    out = tmp_path / "r"
+    script = tmp_path / "run.py"
+    script.write_text(_REPORT_SCRIPT)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([os.getcwd(), os.environ.get("PYTHONPATH", "")])}
+    p = subprocess.Popen([sys.executable, str(script), str(out)], env=env, stdout=subprocess.PIPE)
+    lines = []
+    try:
+        while len(lines) < reports:
+            line = p.stdout.readline()
+            assert line, "the run ended before it could be killed"
+            lines.append(line)
+        time.sleep(delay_s)   # (the kill lands anywhere in an increment, not just after a report)
+    finally:
+        p.send_signal(signal.SIGKILL)
+        p.wait()
+    lines += p.stdout.read().splitlines(keepends=True)   # what it reported before it died
+    p.stdout.close()
+    reported = [line.split() for line in lines if line.endswith(b"\n")]
+    assert len(reported) >= reports
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ResultsWarning)   # a record cut short by the kill may be left
+        res = Results(out)
+    assert len(res) >= len(reported) + 1   # the initial frame and every reported increment
+    for inc, uz in reported:
+        fr = res.frame(int(inc))
+        assert int(fr["increment"]) == int(inc)
+        assert fr["U"][-1, 2] == float.fromhex(uz.decode())   # the converged state, not a later one
+    sta = [line.split() for line in (out / "status.sta").read_text().splitlines()[1:]]
+    named = [int(row[1]) for row in sta if len(row) >= 8]
+    assert named and max(named) <= len(res) - 1   # a status line never runs ahead of its frame

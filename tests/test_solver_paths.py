@@ -7,6 +7,7 @@
 * a NaN in an element tangent named in the error, although element matrices are not scanned.
 """
 
+import json
 import os
 
 import numpy as np
@@ -161,7 +162,7 @@ def test_out_none_writes_nothing_and_passes_the_same_frames_to_the_recorder(tmp_
     np.testing.assert_array_equal(an.x - an.X0, recorded[-1]["U"])   # the final state is kept
 
 
-def test_background_writer_keeps_every_frame_and_reports_a_write_error(tmp_path):
+def test_writer_keeps_every_frame_and_reports_a_write_error_at_once(tmp_path):
     m, rows = _frame_model()
     recorded = []
     res = fm.Analysis(m, tmp_path / "r", progress=False, on_frame=recorded.append).run()
@@ -185,9 +186,12 @@ def test_background_writer_keeps_every_frame_and_reports_a_write_error(tmp_path)
     w = ResultsWriter(tmp_path / "w", Frozen(), [])
     os.close(w._log)
     w._log = os.open("/dev/full", os.O_WRONLY)   # the frame log's disk is full (ENOSPC)
-    w.frame(U=np.zeros((1, 3)))
-    with pytest.raises(OSError, match="could not write results"):
-        w.close({})
+    with pytest.raises(OSError, match="could not write results"):   # at the frame, not later
+        w.frame(U=np.zeros((1, 3)))
+    assert w.count == 0
+    w.close({"status": "completed", "completed": True})   # a run that went on would not be "completed"
+    s = json.loads((tmp_path / "w" / "summary.json").read_text())
+    assert s["status"] == "failed" and "No space left" in s["message"]
 
 
 class _NaNTangent(ElementFamily):

@@ -35,13 +35,22 @@ from .viscous import ViscousTerm
 
 def step_values(model, conds, start, frac_time, period):
     """Loads or prescribed values (n, 6) at step time ``frac_time * period`` (s), from ``start``."""
+    return _values(_rows(model, conds), start, frac_time, period)
+
+
+def _rows(model, conds):
+    """(node row, dof, amplitude, magnitude) of each condition (looked up once per step)."""
+    return [(model.index(c.node), c.dof, c.amplitude, c.magnitude) for c in conds]
+
+
+def _values(rows, start, frac_time, period):
+    """:func:`step_values` of conditions given by :func:`_rows`."""
     out = start.copy()
-    for c in conds:
-        i = model.index(c.node)
-        if c.amplitude is not None:
-            out[i, c.dof] = c.amplitude(frac_time * period) * c.magnitude
+    for i, dof, amplitude, magnitude in rows:
+        if amplitude is not None:
+            out[i, dof] = amplitude(frac_time * period) * magnitude
         else:
-            out[i, c.dof] = start[i, c.dof] + frac_time * (c.magnitude - start[i, c.dof])
+            out[i, dof] = start[i, dof] + frac_time * (magnitude - start[i, dof])
     return out
 
 
@@ -107,12 +116,17 @@ class TimeIncrements(Plan):
                           {float(t) for _, _, amp in getattr(step, "temperatures", ()) if amp is not None
                            for t in amp.times if 0 < t < period})   # temperature amplitudes (issue 20)
         self.load_start, self.pres_start = st.loads.copy(), st.prescribed.copy()
+        self.load_rows, self.pres_rows = _rows(analysis.model, step.loads), _rows(analysis.model, step.prescribed)
+        sys_ = analysis.system
+        # the constrained DOFs that are not fixed (prescribed in some step); none: every increment's
+        # dpres is zero, and passed as None (nothing to apply, no coupling term)
+        self.moving = ~sys_.fixed[sys_.cons_node, sys_.cons_dof]
+        self.any_moving = bool(self.moving.any())
         st.size = st.first_size = step.initial_increment or min(period, step.max_increment or period)
         st.step_time, st.easy, st.lam = 0.0, 0, 0.0
         st.last_increment = None
         st.damping = None
         st.stabilization_energy = 0.0
-        sys_ = analysis.system
         self.viscous = (ViscousTerm(step.stabilize, st, sys_.is_rot, st.first_size, sys_.plus_diagonal)
                         if step.stabilize is not None else None)
 
@@ -155,23 +169,25 @@ class TimeIncrements(Plan):
                         viscous=self.viscous)
         if self.uses_lam:
             inc.lam = st.lam
-            P_end = step_values(an.model, step.loads, self.load_start, 1.0, period)
+            P_end = _values(self.load_rows, self.load_start, 1.0, period)
             inc.P_start, inc.P_ref = self.load_start, P_end - self.load_start
             eq, control = self.control.eq, self.control
             node, dof = sys_.free_node[eq], sys_.free_dof[eq]
             inc.dlambda = lambda du_r, du_p, Du: control.dlambda(du_r, du_p, sys_.dof_value(node, dof), frac)
         else:
-            inc.P = step_values(an.model, step.loads, self.load_start, frac, period)
-        pres = step_values(an.model, step.prescribed, self.pres_start, frac, period)
-        cn, cd = sys_.cons_node, sys_.cons_dof
-        dpres = pres[cn, cd] - st.prescribed[cn, cd]
-        dpres[sys_.fixed[cn, cd]] = 0.0
+            inc.P = _values(self.load_rows, self.load_start, frac, period)
+        dpres = None
+        if self.any_moving:
+            pres = _values(self.pres_rows, self.pres_start, frac, period)
+            cn, cd = sys_.cons_node, sys_.cons_dof
+            dpres = pres[cn, cd] - st.prescribed[cn, cd]
+            dpres[~self.moving] = 0.0
         inc.dpres = dpres
         ref = getattr(an, "reference", None)
         pdu = None if ref is None or self.uses_lam else ref.predictor(st.step, st.total_time, st.total_time + dt)
         if pdu is not None and pdu.shape == (sys_.n_free,):   # a reference run's converged increment (femast.analysis.reference)
             inc.predictor, inc.whole = (pdu, 0.0), True
-        elif an.extrapolate and st.last_increment is not None and not np.any(dpres):
+        elif an.extrapolate and st.last_increment is not None and (dpres is None or not dpres.any()):
             # Abaqus' linear extrapolation: start from the previous increment's solution, scaled
             scale = dt / st.last_size
             inc.predictor = (scale * st.last_increment, scale * st.last_dlam)

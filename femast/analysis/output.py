@@ -91,13 +91,11 @@ class ResultsOutput(Observer):
         st = analysis.state
         line = (step.name, increment, attempt, iterations, time, st.total_time, dtime, st.lam, note)
         if last or increment % step.output_frequency == 0:
-            # the status line travels with the frame to the writer thread (one hand-over, not two)
-            self.writer.status(*line, with_next_frame=True)
-            self.frame(analysis, *frame)
+            self.frame(analysis, *frame)   # on the OS before the status line says it converged
             self.pending = None
         else:
             self.pending = frame
-            self.writer.status(*line)
+        self.writer.status(*line)
 
     def stopped(self, analysis):
         if self.pending is not None:   # the state is that of the last converged increment
@@ -140,7 +138,11 @@ class ResultsOutput(Observer):
             if sys.getrefcount(frame) > 2:   # (this name and getrefcount's argument)
                 frame.complete()
             return
-        data.update({k: make() for k, make in state.items()})
+        if self.recorders:   # a recorder may keep the arrays: the state's own are copied
+            data.update({k: make() for k, make in state.items()})
+        else:                # written at once (ResultsWriter.frame): the state's arrays as they are
+            data.update(U=st.x - sys_.X0, R=st.R, UR=rotation_vectors(st.R), URA=st.spin, RF=reactions(),
+                        P=st.loads)
         for name, out in outputs.items():
             for key, val in out.items():
                 data[f"el/{name}/{key}"] = val

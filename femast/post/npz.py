@@ -19,6 +19,7 @@ n bytes of the .npz; :func:`read_log` reads the frames back with numpy alone.
 from __future__ import annotations
 
 import io
+import mmap
 import os
 import struct
 import zlib
@@ -163,18 +164,23 @@ def append_record(fd: int, record: bytes) -> None:
 
 def scan_log(path) -> tuple[list, int]:
     """The records of a frame log: ([(offset of the .npz, its length), ...], bytes left over at the end
-    -- a record cut short by a run killed while writing it, or anything that is not a record)."""
+    -- a record cut short by a run killed while writing it, or anything that is not a record).
+    The headers are read through a memory map (no system call per record)."""
     records = []
     with open(path, "rb") as fh:
         size = os.fstat(fh.fileno()).st_size
-        at = 0
-        while at + _RECORD.size <= size:
-            fh.seek(at)
-            magic, length = _RECORD.unpack(fh.read(_RECORD.size))
-            if magic != RECORD_MAGIC or at + _RECORD.size + length > size:
-                break
-            records.append((at + _RECORD.size, length))
-            at += _RECORD.size + length
+        if size < _RECORD.size:
+            return records, size
+        with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mm:
+            size = len(mm)   # (the map's length: a writer may have appended since the fstat)
+            unpack, head = _RECORD.unpack_from, _RECORD.size
+            at = 0
+            while at + head <= size:
+                magic, length = unpack(mm, at)
+                if magic != RECORD_MAGIC or at + head + length > size:
+                    break
+                records.append((at + head, length))
+                at += head + length
     return records, size - at
 
 

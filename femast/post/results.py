@@ -25,13 +25,17 @@ axis, beyond 2 pi), ``RF`` (n, 6) reactions (N, N m), ``P`` (n, 6) applied loads
 element outputs as ``el/<family>/<name>``.  Read them with :class:`Results`, or with
 numpy alone (:func:`femast.post.npz.read_log`).
 
-The mesh, the frames and the status lines are written by a background thread, so that the analysis
-goes on with the next increment while the last one is stored (a frame of a small model costs
-~0.05 ms to encode and one append; see ``Step.output_frequency`` and ``Analysis(out=None)``).  A frame is queued the moment its increment
-converges and the queue is drained by :meth:`ResultsWriter.close`, which the analysis calls however
-the run ends (normally, on a convergence failure, on Ctrl-C); only a process killed outright can
-lose the last queued frame or two.  A write error (a full disk) is raised in the analysis at the
-next frame or at the close.
+Durability: a frame is appended to the frame log, and its status line to ``status.sta``, in the
+analysis' own thread the moment its increment converges, before the analysis tells anyone else
+(``on_frame`` recorders, other observers) or starts the next increment.  Once written, the bytes
+belong to the operating system: a process killed outright (kill -9, the OOM killer) loses no
+increment it finished, and at most the record it was writing is cut short (ignored on reading).
+Nothing is fsync'd: the OS writes its cache to disk within seconds (Linux: ~30 s), and only a
+power cut or an OS crash in that window can lose the last increments; call :func:`os.sync` after
+a run that must survive one.  fsync of a small model's frame (1-10 ms on a VM's disk) would cost
+more than its increment.  A frame of a small model costs ~0.03 ms to encode and append (see
+``Step.output_frequency`` and ``Analysis(out=None)``).  A write error (a full disk) is raised in
+the analysis at the frame that could not be written, and the summary says "failed".
 """
 
 from __future__ import annotations
@@ -39,11 +43,9 @@ from __future__ import annotations
 import io
 import json
 import os
-import queue
 import re
 import socket
 import struct
-import threading
 import time as _time
 import warnings
 from pathlib import Path
@@ -73,8 +75,8 @@ def write_json_atomic(path: Path, data: dict) -> None:
     tmp = path.with_name(path.name + TMP_SUFFIX)
     with open(tmp, "w") as fh:
         json.dump(data, fh, indent=2, default=_json_default)
-        fh.flush()
-        os.fsync(fh.fileno())   # the summary is the run's word on its own outcome: make it durable
+    # not fsync'd: the rename publishes a whole file to any reader, and a process kill loses nothing
+    # written; the summary's durability against a power cut is that of the frames (module docstring)
     os.replace(tmp, path)
 
 
@@ -129,7 +131,8 @@ class ResultsWarning(UserWarning):
 
 
 class ResultsWriter:
-    """Writes a results folder as the analysis runs (see module docstring)."""
+    """Writes a results folder as the analysis runs (see module docstring): every frame and status
+    line goes to the operating system (one ``write``) before :meth:`frame` / :meth:`status` return."""
 
     def __init__(self, folder, model, families, resume: int | None = None):
         """``resume``: continue a restarted run whose first ``resume`` frames are on disk (kept;
@@ -151,109 +154,80 @@ class ResultsWriter:
         elif truncate_log(log, resume) < resume:
             raise FemastError(f"{self.folder}: the restart point names {resume} frames but fewer are on disk; "
                               "run the analysis again from the start")
-        for old in (self.folder / "mesh.npz", self.folder / ("mesh.npz" + TMP_SUFFIX)):
-            old.unlink(missing_ok=True)
+        (self.folder / ("mesh.npz" + TMP_SUFFIX)).unlink(missing_ok=True)
         mesh = {"node_labels": model.node_labels, "X": model.coordinates,
                 "families": np.array([f.name for f in families])}
         for f in families:
             mesh[f"conn/{f.name}"] = model.node_labels[np.asarray(f.nodes)]
             mesh[f"labels/{f.name}"] = np.asarray(getattr(f, "labels", np.arange(1, f.n_elements + 1)))
         self.count = resume or 0
-        self._log = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_APPEND | getattr(os, "O_BINARY", 0), 0o666)
-        self._queue = queue.Queue(maxsize=16)   # bounded: a slow disk slows the analysis, not memory
         self._error = None
-        self._lines = []   # status lines waiting for the next frame (status(with_next_frame=True))
-        self._queue.put(((self.folder / "mesh.npz",), mesh))   # written first, by the writer thread
-        self.sta = open(self.folder / "status.sta", "w" if resume is None else "a")
-        if resume is not None:
-            self.sta.write(f"{'':>12} restarted from frame {resume}\n")
-        else:
-            self.sta.write(f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} {'TOTAL TIME':>11} "
-                           f"{'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n")
-        self._thread = threading.Thread(target=self._drain, name="femast-results-writer", daemon=True)
-        self._thread.start()
+        self._log = self._sta = None
+        try:
+            _atomic_savez(self.folder / "mesh.npz", **mesh)   # (replaces an earlier run's)
+            self._log = os.open(log, _APPEND, 0o666)
+            self._sta = os.open(self.folder / "status.sta", _APPEND | (0 if resume is not None else os.O_TRUNC),
+                                0o666)
+            if resume is not None:
+                self._write_line(f"{'':>12} restarted from frame {resume}\n")
+            else:
+                self._write_line(f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} "
+                                 f"{'TOTAL TIME':>11} {'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n")
+        except BaseException:
+            self._close_files()
+            raise
 
-    def status(self, step, inc, attempt, iterations, time, total_time, dtime, lam, note="",
-               with_next_frame=False):
-        """Queue one status line (written and flushed by the writer thread, in order with the
-        frames: a flush costs ~0.15 ms on a VM's disk, as much as a small model's iteration).
-        ``with_next_frame``: the line goes to the writer with the frame queued next (written after
-        it), one hand-over to the writer thread instead of two."""
-        self._raise_error()
-        line = (f"{step:>12.12} {inc:5d} {attempt:3d} {iterations:4d} {time:11.4e} {total_time:11.4e} "
-                f"{dtime:11.4e} {lam:12.5e}  {note}\n")
-        if with_next_frame:
-            self._lines.append(line)
-        else:
-            self._put_lines()
-            self._queue.put((line, None))
+    def status(self, step, inc, attempt, iterations, time, total_time, dtime, lam, note=""):
+        """Write one status line to ``status.sta`` (one unbuffered append)."""
+        self._write_line(f"{step:>12.12} {inc:5d} {attempt:3d} {iterations:4d} {time:11.4e} {total_time:11.4e} "
+                         f"{dtime:11.4e} {lam:12.5e}  {note}\n")
 
-    def _put_lines(self):
-        if self._lines:
-            self._queue.put(("".join(self._lines), None))
-            self._lines = []
-
-    def flush(self):
-        """Wait until every queued frame and status line is on disk (a restart point names them)."""
-        self._put_lines()
-        self._queue.join()
-        self._raise_error()
-
-    def _drain(self):
-        while True:
-            item = self._queue.get()
-            try:
-                if item is None:
-                    return
-                if item[1] is None:   # a status line
-                    self.sta.write(item[0])
-                    self.sta.flush()
-                elif self._error is None:
-                    if item[0] is None:   # a frame: appended to the log, then its status lines
-                        append_record(self._log, record_bytes(item[1]))
-                        if item[2]:
-                            self.sta.write(item[2])
-                            self.sta.flush()
-                    else:
-                        _atomic_savez(*item[0], **item[1])
-            except Exception as exc:  # reported in the analysis thread
-                self._error = exc
-            finally:
-                self._queue.task_done()
-
-    def _raise_error(self):
-        if self._error is not None:
-            exc, self._error = self._error, None
-            raise OSError(f"could not write results to '{self.folder}': {exc}") from exc
+    def _write_line(self, line: str):
+        try:
+            append_record(self._sta, line.encode())
+        except OSError as exc:
+            self._failed(exc)
 
     def frame(self, **data):
-        """Queue one frame (arrays must not be modified afterwards: pass copies)."""
-        self._raise_error()
+        """Append one frame to the frame log: on return its bytes are the operating system's (a
+        process killed from then on loses nothing of it).  Arrays may be modified afterwards."""
+        try:
+            append_record(self._log, record_bytes(data))
+        except OSError as exc:
+            self._failed(exc)
         self.count += 1
-        lines, self._lines = "".join(self._lines), []
-        self._queue.put((None, data, lines))
+
+    def _failed(self, exc):
+        self._error = exc
+        raise OSError(f"could not write results to '{self.folder}': {exc}") from exc
+
+    def flush(self):
+        """Nothing to wait for: frames and status lines are written as they come (kept for callers
+        that name the frames on disk, such as a restart point)."""
 
     def _running(self) -> dict:
         return {"status": "running", "completed": False, "pid": os.getpid(), "host": socket.gethostname(),
                 "started": self._started,
                 "message": "the analysis is running (or its process was killed before it could finish)"}
 
+    def _close_files(self):
+        for fd in (self._log, self._sta):
+            if fd is not None:
+                os.close(fd)
+        self._log = self._sta = None
+
     def close(self, summary: dict):
-        """Drain the queue and write the final summary (``summary["status"]`` says how the run ended)."""
-        try:
-            if self._thread.is_alive():
-                self._put_lines()
-                self._queue.put(None)
-                self._thread.join()
-        finally:
-            self.sta.close()
-            os.close(self._log)
-            final = {**summary, "pid": os.getpid(), "host": socket.gethostname(), "started": self._started}
-            if self._error is not None and final.get("status") == "completed":
-                final.update(status="failed", completed=False,
-                             message=f"could not write results to '{self.folder}': {self._error}")
-            write_json_atomic(self.folder / "summary.json", final)
-        self._raise_error()
+        """Close the frame log and the status file and write the final summary (``summary["status"]``
+        says how the run ended; "failed" if a frame could not be written)."""
+        self._close_files()
+        final = {**summary, "pid": os.getpid(), "host": socket.gethostname(), "started": self._started}
+        if self._error is not None and final.get("status") == "completed":
+            final.update(status="failed", completed=False,
+                         message=f"could not write results to '{self.folder}': {self._error}")
+        write_json_atomic(self.folder / "summary.json", final)
+
+
+_APPEND = os.O_WRONLY | os.O_CREAT | os.O_APPEND | getattr(os, "O_BINARY", 0)
 
 
 class NullWriter:
