@@ -1,7 +1,7 @@
 """The Bathe-Bolourchi 45-degree bend, a small model with many increments, in femast and OpenSeesPy
 (issue 21, item 3: the fixed cost per increment).
 
-    python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--profile]
+    python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--profile] [--strict]
 
 A cantilever bent to 45 degrees in the x-y plane, radius R = 100, unit square section (E = 1e7,
 G = E/2, J = 0.140577), clamped at one end and loaded at the other by a dead force P along +z up to
@@ -50,7 +50,7 @@ def geometry(n_el):
     return np.column_stack([R * (1 - np.cos(ang)), R * np.sin(ang), np.zeros_like(ang)])
 
 
-def femast_run(n_el, n_inc, tol, out):
+def femast_run(n_el, n_inc, tol, out, predicted=True):
     """Build and solve in femast, results written to ``out``; dict(wall, cpu, iterations, tips)."""
     t0, c0 = time.perf_counter(), time.process_time()
     m = fm.Model("bend45")
@@ -58,7 +58,7 @@ def femast_run(n_el, n_inc, tol, out):
     m.beams(np.column_stack([n[:-1], n[1:]]), fm.Section(E=E, G=G, A=A, Iy=I, Iz=I, J=J), up=(0.0, 0.0, 1.0))
     m.fix(n[0])
     m.step("load", initial_increment=1.0 / n_inc, max_increment=1.0 / n_inc).load(n[-1], fz=P_END)
-    an = Analysis(m, out, progress=False, convergence=Convergence(force_tol=tol, disp_tol=tol))
+    an = Analysis(m, out, progress=False, convergence=Convergence(force_tol=tol, disp_tol=tol, predicted=predicted))
     res = an.run()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     U = np.array([res.frame(i)["U"][-1] for i in range(len(res))])   # read back after the clock stopped
@@ -112,6 +112,8 @@ def main(argv=None):
     ap.add_argument("--tol", type=float, default=1e-6)
     ap.add_argument("--system", default="BandGeneral", help="OpenSees linear system")
     ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--strict", action="store_true", help="femast's strict correction test only "
+                    "(Convergence(predicted=False), the rule before issue 21's predicted correction)")
     ap.add_argument("--docs", action="store_true")
     args = ap.parse_args(argv)
     ok_os, info = opensees_mast.available()
@@ -123,14 +125,14 @@ def main(argv=None):
     if args.profile:
         pr = cProfile.Profile()
         pr.enable()
-        femast_run(n_el, K, args.tol, tmp / "profile")
+        femast_run(n_el, K, args.tol, tmp / "profile", predicted=not args.strict)
         pr.disable()
         s = io.StringIO()
         pstats.Stats(pr, stream=s).sort_stats("tottime").print_stats(25)
         print(s.getvalue())
     fr, orr = [], []
     for r in range(args.repeat):                    # interleaved
-        fr.append(femast_run(n_el, K, args.tol, tmp / f"run{r}"))
+        fr.append(femast_run(n_el, K, args.tol, tmp / f"run{r}", predicted=not args.strict))
         if ok_os:
             orr.append(opensees_run(n_el, K, args.tol, args.system))
     shutil.rmtree(tmp, ignore_errors=True)
