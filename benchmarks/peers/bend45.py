@@ -1,14 +1,15 @@
 """The Bathe-Bolourchi 45-degree bend, a small model with many increments, in femast and OpenSeesPy
 (issue 21, item 3: the fixed cost per increment).
 
-    python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--profile]
+    python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--no-folder] [--profile] [--docs]
 
 A cantilever bent to 45 degrees in the x-y plane, radius R = 100, unit square section (E = 1e7,
 G = E/2, J = 0.140577), clamped at one end and loaded at the other by a dead force P along +z up to
 600, in K equal load increments with full Newton.  femast writes a results folder with a frame per
 increment (its default); OpenSees records the tip displacement after each increment in memory
-(``nodeDisp``), the usual script.  Both run --repeat times, interleaved; the script prints best
-and median wall time, CPU time of this process, Newton iterations, the femast/OpenSees ratio of the
+(``nodeDisp``), the usual script (``--no-folder``: femast too keeps the tip in memory, with
+``out=None`` and an ``on_frame`` recorder).  Both run --repeat times, interleaved; the script
+prints best and median wall time, CPU time of this process, Newton iterations, the femast/OpenSees ratio of the
 best and of the median runs (target <= 0.5), and the tip positions at P = 300, 450, 600 against
 the Kirchhoff-rod solution (femast.references.bend45_tip_position) and against each other.
 ``--profile`` prints femast's cProfile of one run.  Writes ``benchmarks/out/bend45_peer.png``
@@ -51,17 +52,22 @@ def geometry(n_el):
 
 
 def femast_run(n_el, n_inc, tol, out):
-    """Build and solve in femast, results written to ``out``; dict(wall, cpu, iterations, tips)."""
+    """Build and solve in femast, results written to ``out`` (None: no results folder, the tip
+    recorded in memory by an ``on_frame`` recorder, as OpenSees' ``nodeDisp``); dict(wall, cpu,
+    iterations, tips)."""
+    tips = []
     t0, c0 = time.perf_counter(), time.process_time()
     m = fm.Model("bend45")
     n = np.asarray(m.nodes(geometry(n_el)))
     m.beams(np.column_stack([n[:-1], n[1:]]), fm.Section(E=E, G=G, A=A, Iy=I, Iz=I, J=J), up=(0.0, 0.0, 1.0))
     m.fix(n[0])
     m.step("load", initial_increment=1.0 / n_inc, max_increment=1.0 / n_inc).load(n[-1], fz=P_END)
-    an = Analysis(m, out, progress=False, convergence=Convergence(force_tol=tol, disp_tol=tol))
+    an = Analysis(m, out, progress=False, convergence=Convergence(force_tol=tol, disp_tol=tol),
+                  on_frame=None if out is not None else (lambda f: tips.append(f["U"][-1].copy())))
     res = an.run()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    U = np.array([res.frame(i)["U"][-1] for i in range(len(res))])   # read back after the clock stopped
+    U = (np.array([res.frame(i)["U"][-1] for i in range(len(res))]) if out is not None   # read back after
+         else np.array(tips))                                                              # the clock stopped
     return dict(wall=wall, cpu=cpu, iterations=an.summary.iterations, increments=an.summary.increments,
                 tips=geometry(n_el)[-1] + U[1:])
 
@@ -111,6 +117,8 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--tol", type=float, default=1e-6)
     ap.add_argument("--system", default="BandGeneral", help="OpenSees linear system")
+    ap.add_argument("--no-folder", action="store_true",
+                    help="femast writes no results folder (out=None; the tip kept by an on_frame recorder)")
     ap.add_argument("--profile", action="store_true")
     ap.add_argument("--docs", action="store_true")
     args = ap.parse_args(argv)
@@ -118,19 +126,20 @@ def main(argv=None):
     n_el, K = args.elements, args.increments
     tmp = Path(tempfile.mkdtemp(prefix="femast_bend45_"))
     femast_run(n_el, 2, args.tol, tmp / "warm")     # numba cache load, not timed
-    print(f"{n_el}-element 45-degree bend, {K} load increments, a frame per increment; load average "
+    print(f"{n_el}-element 45-degree bend, {K} load increments, "
+          f"{'no results folder (tip recorded in memory)' if args.no_folder else 'a frame per increment'}; load average "
           f"{os.getloadavg()[0]:.2f} (2 shared cores)")
     if args.profile:
         pr = cProfile.Profile()
         pr.enable()
-        femast_run(n_el, K, args.tol, tmp / "profile")
+        femast_run(n_el, K, args.tol, None if args.no_folder else tmp / "profile")
         pr.disable()
         s = io.StringIO()
         pstats.Stats(pr, stream=s).sort_stats("tottime").print_stats(25)
         print(s.getvalue())
     fr, orr = [], []
     for r in range(args.repeat):                    # interleaved
-        fr.append(femast_run(n_el, K, args.tol, tmp / f"run{r}"))
+        fr.append(femast_run(n_el, K, args.tol, None if args.no_folder else tmp / f"run{r}"))
         if ok_os:
             orr.append(opensees_run(n_el, K, args.tol, args.system))
     shutil.rmtree(tmp, ignore_errors=True)
@@ -170,7 +179,7 @@ def main(argv=None):
 
     fig, axes = plt.subplots(1, 2, figsize=(9.6, 3.8))
     for ax, key, what in ((axes[0], "cpu", "CPU"), (axes[1], "wall", "wall")):
-        ax.plot(np.arange(len(fr)) + 1, [r[key] / K * 1e6 for r in fr], "o-", label="femast (frames written)")
+        ax.plot(np.arange(len(fr)) + 1, [r[key] / K * 1e6 for r in fr], "o-", label="femast (" + ("no folder" if args.no_folder else "frames written") + ")")
         ax.plot(np.arange(len(orr)) + 1, [r[key] / K * 1e6 for r in orr], "s-", label=f"OpenSees ({args.system})")
         ax.set_xlabel("run (interleaved)")
         ax.set_ylabel(f"{what} time per increment (us)")
@@ -179,14 +188,16 @@ def main(argv=None):
     axes[0].legend()
     axes[0].set_title(f"CPU: femast/OpenSees {ratio_cpu:.2f}")
     axes[1].set_title(f"wall: best {ratio_best:.2f}, median {ratio_med:.2f} (load {os.getloadavg()[0]:.1f})")
-    fig.suptitle(f"{n_el}-element 45-degree bend, {K} increments (target <= 0.5)")
+    fig.suptitle(f"{n_el}-element 45-degree bend, {K} increments (target <= 0.5)"
+                 + (", femast without a results folder" if args.no_folder else ""))
     fig.tight_layout()
     out = HERE.parent / "out"
     out.mkdir(exist_ok=True)
-    fig.savefig(out / "bend45_peer.png", dpi=120)
-    print(f"figure: {out / 'bend45_peer.png'}")
+    name = "bend45_peer_nofolder.png" if args.no_folder else "bend45_peer.png"
+    fig.savefig(out / name, dpi=120)
+    print(f"figure: {out / name}")
     if args.docs:
-        shutil.copy(out / "bend45_peer.png", HERE.parent.parent / "docs" / "figures" / "performance_bend45.png")
+        shutil.copy(out / name, HERE.parent.parent / "docs" / "figures" / ("performance_" + name.replace("_peer", "")))
     return 0
 
 
