@@ -182,6 +182,7 @@ def main(argv=None):
         ax.plot(np.arange(len(fr)) + 1, [r[key] / K * 1e6 for r in fr], "o-", label="femast (" + ("no folder" if args.no_folder else "frames written") + ")")
         ax.plot(np.arange(len(orr)) + 1, [r[key] / K * 1e6 for r in orr], "s-", label=f"OpenSees ({args.system})")
         ax.set_xlabel("run (interleaved)")
+        ax.set_xticks(np.arange(len(fr)) + 1)
         ax.set_ylabel(f"{what} time per increment (us)")
         ax.set_ylim(bottom=0)
         ax.grid(alpha=0.3)
