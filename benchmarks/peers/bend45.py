@@ -1,7 +1,7 @@
 """The Bathe-Bolourchi 45-degree bend, a small model with many increments, in femast and OpenSeesPy
 (issue 21, item 3: the fixed cost per increment).
 
-    python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--no-folder] [--profile] [--docs]
+    python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--no-folder] [--profile] [--parts] [--docs]
 
 A cantilever bent to 45 degrees in the x-y plane, radius R = 100, unit square section (E = 1e7,
 G = E/2, J = 0.140577), clamped at one end and loaded at the other by a dead force P along +z up to
@@ -12,7 +12,8 @@ increment (its default); OpenSees records the tip displacement after each increm
 prints best and median wall time, CPU time of this process, Newton iterations, the femast/OpenSees ratio of the
 best and of the median runs (target <= 0.5), and the tip positions at P = 300, 450, 600 against
 the Kirchhoff-rod solution (femast.references.bend45_tip_position) and against each other.
-``--profile`` prints femast's cProfile of one run.  Writes ``benchmarks/out/bend45_peer.png``
+``--profile`` prints femast's cProfile of one run; ``--parts`` femast's CPU time per increment
+by part (set-up, Newton, increment plan, frames, ...) instead of the comparison.  Writes ``benchmarks/out/bend45_peer.png``
 (``--docs``: docs/figures/performance_bend45.png): the time per increment of each run.
 """
 
@@ -51,10 +52,10 @@ def geometry(n_el):
     return np.column_stack([R * (1 - np.cos(ang)), R * np.sin(ang), np.zeros_like(ang)])
 
 
-def femast_run(n_el, n_inc, tol, out):
+def femast_run(n_el, n_inc, tol, out, clock=None):
     """Build and solve in femast, results written to ``out`` (None: no results folder, the tip
     recorded in memory by an ``on_frame`` recorder, as OpenSees' ``nodeDisp``); dict(wall, cpu,
-    iterations, tips)."""
+    iterations, tips).  ``clock(cpu)`` is called when the clock stops (before the read-back)."""
     tips = []
     t0, c0 = time.perf_counter(), time.process_time()
     m = fm.Model("bend45")
@@ -66,10 +67,70 @@ def femast_run(n_el, n_inc, tol, out):
                   on_frame=None if out is not None else (lambda f: tips.append(f["U"][-1].copy())))
     res = an.run()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    if clock is not None:
+        clock(cpu)
     U = (np.array([res.frame(i)["U"][-1] for i in range(len(res))]) if out is not None   # read back after
          else np.array(tips))                                                              # the clock stopped
     return dict(wall=wall, cpu=cpu, iterations=an.summary.iterations, increments=an.summary.increments,
                 tips=geometry(n_el)[-1] + U[1:])
+
+
+PARTS = (   # (module, attribute path, label) timed by --parts
+    ("femast.analysis.analysis", "Analysis.__init__", "analysis set-up (Analysis())"),
+    ("femast.analysis.output", "ResultsOutput.started", "results folder set-up + initial frame"),
+    ("femast.analysis.newton", "Newton.solve", "Newton iterations (Newton.solve)"),
+    ("femast.analysis.controls", "TimeIncrements.propose", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.controls", "TimeIncrements.accept", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.controls", "TimeIncrements.grow", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.controls", "TimeIncrements.next_increment", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.controls", "TimeIncrements.done", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.output", "ResultsOutput.converged", "frame + status line (analysis thread)"),
+    ("femast.analysis.output", "ResultsOutput.finished", "close + final summary"),
+    ("femast.analysis.analysis", "Results", "Results(out) returned by run()"),
+)
+
+
+def parts(n_el, n_inc, tol, out_dir, repeat):
+    """CPU time of femast's parts per increment (thread CPU time of the analysis thread; any other
+    thread's CPU -- a results writer thread of femast before session 8 -- is the process' CPU time
+    less the analysis thread's), in the run of least process CPU of ``repeat``; printed.  The
+    parts are wrapped by name, so the same script times an older checkout put first on PYTHONPATH."""
+    import collections
+    import importlib
+
+    spent = collections.defaultdict(float)
+    for mod_name, path, label in PARTS:
+        owner = importlib.import_module(mod_name)
+        *outer, name = path.split(".")
+        for o in outer:
+            owner = getattr(owner, o)
+        f = getattr(owner, name)
+
+        def timed(*a, _f=f, _label=label, **k):
+            t = time.thread_time()
+            try:
+                return _f(*a, **k)
+            finally:
+                spent[_label] += time.thread_time() - t
+        setattr(owner, name, timed)
+    runs = []
+    for r in range(repeat):
+        spent.clear()
+        stop = []
+        t0 = time.thread_time()
+        femast_run(n_el, n_inc, tol, None if out_dir is None else out_dir / f"parts{r}",
+                   clock=lambda cpu: stop.append((cpu, time.thread_time() - t0)))
+        proc, thread = stop[0]
+        d = dict(spent)
+        d["rest: model, step loop (analysis thread)"] = thread - sum(spent.values())
+        d["other threads (process - analysis thread)"] = max(proc - thread, 0.0)   # (read ~us apart)
+        runs.append((proc, d))
+    proc, d = min(runs, key=lambda r: r[0])
+    print(f"  femast by part ({'no folder' if out_dir is None else 'frames written'}), run of least CPU of "
+          f"{repeat}: {proc * 1e3:.1f} ms CPU = {proc / n_inc * 1e6:.0f} us per increment; load "
+          f"{os.getloadavg()[0]:.2f}")
+    for label, v in d.items():
+        print(f"    {label:48s} {v * 1e3:7.2f} ms  {v / n_inc * 1e6:6.1f} us per increment")
 
 
 def opensees_run(n_el, n_inc, tol, system="BandGeneral"):
@@ -120,6 +181,8 @@ def main(argv=None):
     ap.add_argument("--no-folder", action="store_true",
                     help="femast writes no results folder (out=None; the tip kept by an on_frame recorder)")
     ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--parts", action="store_true", help="print femast's CPU time by part per increment "
+                    "(--repeat runs, no OpenSees) and stop")
     ap.add_argument("--docs", action="store_true")
     args = ap.parse_args(argv)
     ok_os, info = opensees_mast.available()
@@ -129,6 +192,10 @@ def main(argv=None):
     print(f"{n_el}-element 45-degree bend, {K} load increments, "
           f"{'no results folder (tip recorded in memory)' if args.no_folder else 'a frame per increment'}; load average "
           f"{os.getloadavg()[0]:.2f} (2 shared cores)")
+    if args.parts:
+        parts(n_el, K, args.tol, None if args.no_folder else tmp, args.repeat)
+        shutil.rmtree(tmp, ignore_errors=True)
+        return 0
     if args.profile:
         pr = cProfile.Profile()
         pr.enable()
