@@ -43,9 +43,10 @@ def test_a_round_off_load_change_converges_with_friction_joints():
         an = Analysis(am.model, d, progress=False, convergence=CONVERGENCE)
         res = an.run()
         assert an.summary.steps[-1]["increments"] == 1 and an.summary.steps[-1]["iterations"] <= 1
-        u = [res.node_history(am.control, c) for c in ("ux", "rz")]
-    # the state does not move: the load changed by 1e-14 relative; 1e-9 is the force tolerance of
-    # the ADAM runs, which bounds how far either state is from exact equilibrium, so the two differ
-    # by at most twice that
-    for h in u:
-        assert abs(h[-1] - h[-2]) <= 2e-9 * max(abs(h[-2]), 1e-12)
+        U = [res.frame(i)["U"] for i in (len(res) - 3, len(res) - 2, len(res) - 1)]
+    # the state does not move: the load changed by 1e-14 relative, and step b's one iteration (the
+    # linear-increment rule) is one Newton correction from step a's end, i.e. the error left there.
+    # The correction test (strict or predicted, issue 21) bounds that error by disp_tol times the
+    # largest displacement of step a's last increment (the test's own measure; the strict rule
+    # leaves ~4e-10 of it here, the predicted one ~7e-10)
+    assert np.abs(U[2] - U[1]).max() <= CONVERGENCE.disp_tol * np.abs(U[1] - U[0]).max()

@@ -131,3 +131,57 @@ def test_worker_compiles_element_kernels_first():
 
     reqs = [{"module": "femast.analysis.configuration"}, {"module": "femast.elements.beam_corot"}]
     assert sorted(range(2), key=lambda i: (jb._priority(reqs[i]), i)) == [1, 0]
+
+
+def test_helpers_of_interpreted_kernels_are_interpreted_not_compiled(tmp_path):
+    """The band solver's residual kernels share an inlined helper (their maxima), and the two
+    scatter encodings one kernel: run interpreted (an empty cache), they compile nothing in the
+    foreground, the helper included, and give the direct sums' results."""
+    code = textwrap.dedent("""
+        import json, numpy as np, scipy.sparse as sp
+        from numba.core import event
+        compiled_here = []
+        class L(event.Listener):
+            def on_start(self, ev): compiled_here.append(ev.data["dispatcher"].py_func.__name__)
+            def on_end(self, ev): pass
+        event.register("numba:compile", L())
+        from femast import jit_background
+        from femast.analysis import assembly
+        from femast.analysis.solvers import banded
+        jit_background.install()
+        rng = np.random.default_rng(1)
+        n, b = 12, 2
+        B = sp.diags([rng.normal(size=n - abs(d)) for d in range(-b, b + 1)], range(-b, b + 1)).tocsc()
+        B.sort_indices()
+        x, rhs, r = rng.normal(size=n), rng.normal(size=n), np.empty(n)
+        csc = banded._residual(B.indptr, B.indices, B.data, x, rhs, r)
+        r_csc = r.copy()
+        L, U = np.zeros((b + 1, n)), np.zeros((b + 1, n))
+        D = B.toarray()
+        for d in range(b + 1):
+            L[d, :n - d] = np.diagonal(D, -d)
+            U[d, :n - d] = np.diagonal(D, d)
+        split = banded._residual_split(L, U, x, rhs, r)
+        k = rng.normal(size=(3, 2, 2))
+        pos = np.array([[[0, 1], [-1, 2]], [[0, 1], [2, -1]], [[3, 3], [-1, 0]]])
+        plain = np.zeros(4)
+        assembly._scatter_matrix(k, pos, plain)
+        data = np.full(4, 7.0)    # the first entry of each position assigns: no zeroing needed
+        assembly._scatter_matrix(k, assembly.assigning_positions([pos], 4)[0], data)
+        print(json.dumps({"compiled_here": compiled_here, "csc": list(csc), "split": list(split),
+                          "r_csc": r_csc.tolist(), "r": r.tolist(), "ref": (rhs - D @ x).tolist(),
+                          "rows": float(np.abs(D).sum(axis=1).max()), "data": data.tolist(), "plain": plain.tolist(),
+                          "k": k.tolist()}))
+    """)
+    out = json.loads(_child(code, {"NUMBA_CACHE_DIR": str(tmp_path / "cache"), "FEMAST_BACKGROUND_COMPILE": "interpret"},
+                            tmp_path))
+    assert out["compiled_here"] == []
+    assert out["csc"] == out["split"] and out["r"] == out["r_csc"]   # the same sums in the same order
+    ref = np.array(out["ref"])
+    assert np.allclose(out["r"], ref, rtol=0, atol=1e-14 * np.abs(ref).max())   # r = rhs - B x to round-off
+    assert out["csc"][0] == np.abs(out["r"]).max() and np.isclose(out["csc"][1], out["rows"], rtol=1e-15)
+    k = np.array(out["k"])
+    # -1 is outside; the sums of the entries at each position, in scatter order
+    expected = [k[0, 0, 0] + k[1, 0, 0] + k[2, 1, 1], k[0, 0, 1] + k[1, 0, 1], k[0, 1, 1] + k[1, 1, 0],
+                k[2, 0, 0] + k[2, 0, 1]]
+    assert out["plain"] == expected and out["data"] == expected   # same order: the same bits

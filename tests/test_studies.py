@@ -218,7 +218,10 @@ def test_model_outputs_match_the_cantilever_closed_form(tmp_path):
     # geometric nonlinearity, O((w/L)^2) ~ 1e-6 relative at these loads, and shear (d/L)^2 ~ 4e-4
     assert np.allclose(-w[:, 0], F * L_M ** 3 / (3 * E * I), rtol=2e-3)
     assert np.allclose(rot, F * L_M ** 2 / (2 * E * I), rtol=2e-3)
-    assert np.max(np.abs(w[:, 1])) < 1e-12         # unloaded: back to zero (elastic)
+    # unloaded: back to zero (elastic), to the correction tolerance (disp_tol 1e-6 of the unload
+    # increment, the loaded deflection: since issue 21 an increment may be accepted on its predicted
+    # next correction, ~1e-7 of it here, without the extra iteration that went to round-off)
+    assert np.all(np.abs(w[:, 1]) <= 1e-6 * np.abs(w[:, 0]))
 
 
 # ------------------------------------------------------------------ bad input, before any sample

@@ -1,7 +1,7 @@
 """The Bathe-Bolourchi 45-degree bend, a small model with many increments, in femast and OpenSeesPy
 (issue 21, item 3: the fixed cost per increment).
 
-    python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--no-folder] [--profile] [--parts] [--docs]
+    python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--no-folder] [--strict] [--profile] [--parts] [--docs]
 
 A cantilever bent to 45 degrees in the x-y plane, radius R = 100, unit square section (E = 1e7,
 G = E/2, J = 0.140577), clamped at one end and loaded at the other by a dead force P along +z up to
@@ -9,12 +9,13 @@ G = E/2, J = 0.140577), clamped at one end and loaded at the other by a dead for
 increment (its default); OpenSees records the tip displacement after each increment in memory
 (``nodeDisp``), the usual script (``--no-folder``: femast too keeps the tip in memory, with
 ``out=None`` and an ``on_frame`` recorder).  Both run --repeat times, interleaved; the script
-prints best and median wall time, CPU time of this process, Newton iterations, the femast/OpenSees ratio of the
-best and of the median runs (target <= 0.5), and the tip positions at P = 300, 450, 600 against
-the Kirchhoff-rod solution (femast.references.bend45_tip_position) and against each other.
-``--profile`` prints femast's cProfile of one run; ``--parts`` femast's CPU time per increment
-by part (set-up, Newton, increment plan, frames, ...) instead of the comparison.  Writes ``benchmarks/out/bend45_peer.png``
-(``--docs``: docs/figures/performance_bend45.png): the time per increment of each run.
+prints best and median wall time, CPU time of this process, Newton iterations, the femast/OpenSees
+ratio of the best and of the median runs (target <= 0.5), and the tip positions at P = 300, 450,
+600 against the Kirchhoff-rod solution (femast.references.bend45_tip_position) and against each other.
+``--profile`` prints femast's cProfile of one run; ``--parts`` femast's CPU time per increment by
+part (set-up, Newton, increment plan, frames, ...) instead of the comparison.  Writes
+``benchmarks/out/bend45_peer.png`` (``--no-folder``: ``bend45_peer_nofolder.png``; ``--docs``: also
+to docs/figures/performance_bend45*.png): the time per increment of each run.
 """
 
 from __future__ import annotations
@@ -52,10 +53,11 @@ def geometry(n_el):
     return np.column_stack([R * (1 - np.cos(ang)), R * np.sin(ang), np.zeros_like(ang)])
 
 
-def femast_run(n_el, n_inc, tol, out, clock=None):
+def femast_run(n_el, n_inc, tol, out, clock=None, predicted=True):
     """Build and solve in femast, results written to ``out`` (None: no results folder, the tip
     recorded in memory by an ``on_frame`` recorder, as OpenSees' ``nodeDisp``); dict(wall, cpu,
-    iterations, tips).  ``clock(cpu)`` is called when the clock stops (before the read-back)."""
+    iterations, tips).  ``clock(cpu)`` is called when the clock stops (before the read-back);
+    ``predicted``: femast's predicted-correction acceptance (Convergence(predicted=))."""
     tips = []
     t0, c0 = time.perf_counter(), time.process_time()
     m = fm.Model("bend45")
@@ -63,7 +65,8 @@ def femast_run(n_el, n_inc, tol, out, clock=None):
     m.beams(np.column_stack([n[:-1], n[1:]]), fm.Section(E=E, G=G, A=A, Iy=I, Iz=I, J=J), up=(0.0, 0.0, 1.0))
     m.fix(n[0])
     m.step("load", initial_increment=1.0 / n_inc, max_increment=1.0 / n_inc).load(n[-1], fz=P_END)
-    an = Analysis(m, out, progress=False, convergence=Convergence(force_tol=tol, disp_tol=tol),
+    strict = {} if predicted else {"predicted": False}   # (the default: an older checkout can be timed too)
+    an = Analysis(m, out, progress=False, convergence=Convergence(force_tol=tol, disp_tol=tol, **strict),
                   on_frame=None if out is not None else (lambda f: tips.append(f["U"][-1].copy())))
     res = an.run()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
@@ -90,7 +93,7 @@ PARTS = (   # (module, attribute path, label) timed by --parts
 )
 
 
-def parts(n_el, n_inc, tol, out_dir, repeat):
+def parts(n_el, n_inc, tol, out_dir, repeat, predicted=True):
     """CPU time of femast's parts per increment (thread CPU time of the analysis thread; any other
     thread's CPU -- a results writer thread of femast before session 8 -- is the process' CPU time
     less the analysis thread's), in the run of least process CPU of ``repeat``; printed.  The
@@ -119,7 +122,7 @@ def parts(n_el, n_inc, tol, out_dir, repeat):
         stop = []
         t0 = time.thread_time()
         femast_run(n_el, n_inc, tol, None if out_dir is None else out_dir / f"parts{r}",
-                   clock=lambda cpu: stop.append((cpu, time.thread_time() - t0)))
+                   clock=lambda cpu: stop.append((cpu, time.thread_time() - t0)), predicted=predicted)
         proc, thread = stop[0]
         d = dict(spent)
         d["rest: model, step loop (analysis thread)"] = thread - sum(spent.values())
@@ -183,6 +186,8 @@ def main(argv=None):
     ap.add_argument("--profile", action="store_true")
     ap.add_argument("--parts", action="store_true", help="print femast's CPU time by part per increment "
                     "(--repeat runs, no OpenSees) and stop")
+    ap.add_argument("--strict", action="store_true", help="femast's strict correction test only "
+                    "(Convergence(predicted=False), the rule before issue 21's predicted correction)")
     ap.add_argument("--docs", action="store_true")
     args = ap.parse_args(argv)
     ok_os, info = opensees_mast.available()
@@ -193,20 +198,20 @@ def main(argv=None):
           f"{'no results folder (tip recorded in memory)' if args.no_folder else 'a frame per increment'}; load average "
           f"{os.getloadavg()[0]:.2f} (2 shared cores)")
     if args.parts:
-        parts(n_el, K, args.tol, None if args.no_folder else tmp, args.repeat)
+        parts(n_el, K, args.tol, None if args.no_folder else tmp, args.repeat, predicted=not args.strict)
         shutil.rmtree(tmp, ignore_errors=True)
         return 0
     if args.profile:
         pr = cProfile.Profile()
         pr.enable()
-        femast_run(n_el, K, args.tol, None if args.no_folder else tmp / "profile")
+        femast_run(n_el, K, args.tol, None if args.no_folder else tmp / "profile", predicted=not args.strict)
         pr.disable()
         s = io.StringIO()
         pstats.Stats(pr, stream=s).sort_stats("tottime").print_stats(25)
         print(s.getvalue())
     fr, orr = [], []
     for r in range(args.repeat):                    # interleaved
-        fr.append(femast_run(n_el, K, args.tol, None if args.no_folder else tmp / f"run{r}"))
+        fr.append(femast_run(n_el, K, args.tol, None if args.no_folder else tmp / f"run{r}", predicted=not args.strict))
         if ok_os:
             orr.append(opensees_run(n_el, K, args.tol, args.system))
     shutil.rmtree(tmp, ignore_errors=True)

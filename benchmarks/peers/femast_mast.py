@@ -26,15 +26,17 @@ def model(mast, n_inc):
     return m, labels
 
 
-def solve(mast, n_inc, tol=1e-6, out=None, disp_tol=None):
+def solve(mast, n_inc, tol=1e-6, out=None, disp_tol=None, predicted=True):
     """Build and solve; returns dict(wall, build, analyze, cpu_analyze, iterations, tip_u, analysis)
     (seconds: wall clock, except cpu_analyze: CPU time of this process during the solve).
     ``tol``: relative force tolerance; ``disp_tol``: relative correction tolerance (default ``tol``;
-    ``inf``: no correction test, as OpenSees' NormUnbalance)."""
+    ``inf``: no correction test, as OpenSees' NormUnbalance); ``predicted``: accept on the predicted next
+    correction (``Convergence(predicted=)``)."""
     out = out or tempfile.mkdtemp(prefix="femast_peer_")
     t0 = time.perf_counter()
     m, labels = model(mast, n_inc)
-    an = Analysis(m, out, progress=False, convergence=fm.Convergence(force_tol=tol, disp_tol=tol if disp_tol is None else disp_tol))
+    an = Analysis(m, out, progress=False, convergence=fm.Convergence(
+        force_tol=tol, disp_tol=tol if disp_tol is None else disp_tol, predicted=predicted))
     t1 = time.perf_counter()
     c1 = time.process_time()
     an.run()

@@ -17,6 +17,10 @@ from ..jit import setup_call
 
 @njit(cache=True)
 def _scatter_matrix(k, pos, data):
+    """Add the element matrices ``k`` (n_el, m, m) into ``data`` at positions ``pos`` (n_el, m, m):
+    ``p >= 0`` adds at p, -1 is outside; ``p <= -2`` (from :func:`_assign_first_positions`) assigns
+    at -2 - p, so that ``data`` needs no zeroing (the same sums: 0 + a = a).  The assignment test
+    is reached only for negative positions: plain positions cost no extra branch per entry."""
     n_el, m, _ = k.shape
     for e in range(n_el):
         for i in range(m):
@@ -24,12 +28,15 @@ def _scatter_matrix(k, pos, data):
                 p = pos[e, i, j]
                 if p >= 0:
                     data[p] += k[e, i, j]
+                elif p <= -2:
+                    data[-2 - p] = k[e, i, j]
 
 
 @njit(cache=True)
 def _assign_first_positions(pos, seen, out):
     """``out``: ``pos`` (int32) with each position's first entry in scatter order (families, then
-    element, i, j) encoded as -2 - p (it assigns instead of adding), -1 kept (outside).
+    element, i, j) encoded as -2 - p (:func:`_scatter_matrix` assigns it instead of adding), -1 kept
+    (outside).
     ``seen``: bool flags per position of the target array, shared across the families."""
     flat = pos.ravel()
     o = out.ravel()
@@ -42,22 +49,6 @@ def _assign_first_positions(pos, seen, out):
         else:
             seen[p] = True
             o[k] = -2 - p
-
-
-@njit(cache=True)
-def _scatter_matrix_assigning(k, pos, data):
-    """:func:`_scatter_matrix` with positions from :func:`_assign_first_positions`: the first
-    entry of each position assigns, the others add, so ``data`` needs no zeroing (the same sums:
-    0 + a = a)."""
-    n_el, m, _ = k.shape
-    for e in range(n_el):
-        for i in range(m):
-            for j in range(m):
-                p = pos[e, i, j]
-                if p >= 0:
-                    data[p] += k[e, i, j]
-                elif p <= -2:
-                    data[-2 - p] = k[e, i, j]
 
 
 def assigning_positions(positions, size):
@@ -242,11 +233,8 @@ class Assembler:
         as the linear solver's permuted matrix.  ``assigning``: the positions come from
         :func:`assigning_positions` (the first entry of each position assigns it: no zeroing;
         entries of ``data`` that no element writes keep their value, zero in a fresh array)."""
-        if assigning:
-            for k, pos in zip(k_list, positions):
-                _scatter_matrix_assigning(k, pos, data)
-            return
-        data[:] = 0.0
+        if not assigning:
+            data[:] = 0.0
         for k, pos in zip(k_list, positions):
             _scatter_matrix(k, pos, data)
 

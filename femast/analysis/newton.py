@@ -45,7 +45,9 @@ Options of the algorithm: a secant line search (``line_search``) and the tangent
 
 Every Newton iteration: tangent (if due), solve, correct the load factor, update the
 configuration, evaluate the residual, test convergence.  On convergence the state is committed,
-on failure rolled back (both one call).
+on failure rolled back (both one call).  Under full Newton and fixed loads an iteration whose force
+test passes may also be accepted on its predicted next correction, one more solve with the
+factorisation in hand (``Convergence(predicted=True)``, :mod:`~femast.analysis.solvers.convergence`).
 """
 
 from __future__ import annotations
@@ -205,6 +207,21 @@ class Newton:
         slow_d = len(steps) >= 2 and steps[-1] > self.slow * steps[-2]
         return slow_r or slow_d
 
+    def _predicted(self, system, conv, r, Du, sizes):
+        """Accept the current iterate on its predicted next correction: the simplified Newton
+        correction K^-1 r with the factorisation in hand (formed at the previous iterate), one solve
+        (:meth:`Convergence.accept_predicted`); no solve unless the last correction contracted."""
+        if not sizes[-1] <= conv.max_contraction * sizes[-2]:
+            return False
+        ts = _time.perf_counter()
+        try:
+            c = system.solver.solve(r)
+        except SingularModelError:
+            return False
+        finally:
+            system.summary.solve_time += _time.perf_counter() - ts
+        return conv.accept_predicted(sizes[-2], sizes[-1], system.scaled_size(c, Du))
+
     def solve(self, system, state, inc: Increment, attempt: int = 1) -> Outcome:
         """Solve increment ``inc`` from the committed ``state``: commit it and return
         ``Outcome(ok=True, ...)``, or roll back and return why it failed."""
@@ -231,6 +248,10 @@ class Newton:
         ratios = []  # residual ratios, the first before any iteration (modified / quasi-Newton)
         steps = []   # largest |correction| of each iteration (modified / quasi-Newton)
         keep = self.tangent == "auto" and all(f.path_independent for f in system.families)
+        # the predicted-correction acceptance: full Newton (the factorisation in hand formed at the
+        # previous iterate), fixed loads, no line search (its steps are not Newton's corrections)
+        predict = conv.predicted and method == "full" and not uses_lam and not line_search
+        sizes = []   # scaled size of each correction of this attempt (Convergence.measure)
         formed_at = None   # (x, R) of this attempt's last factorisation ("auto", path-independent)
 
         def fail(why):
@@ -275,9 +296,13 @@ class Newton:
                     system.commit(responses, P, F, lam)
                     return Outcome(True, 0, "", responses, Du, 0.0)
                 if it > 0:
-                    ok, ratio = system.converged(conv, r, du, Du, responses, P, iters + whole)
-                    if ok and any(q.provisional for q in responses):
-                        ok = False   # an element answered with a predictor, not its law (ElementResponse)
+                    ok, ratio, forces_ok, size = system.converged(conv, r, du, Du, responses, P, iters + whole)
+                    sizes.append(size)
+                    early = not ok and forces_ok and predict and iters >= 2
+                    if (ok or early) and any(q.provisional for q in responses):
+                        ok = early = False   # an element answered with a predictor, not its law (ElementResponse)
+                    if early:   # the predicted next correction (convergence.py)
+                        ok = self._predicted(system, conv, r, Du, sizes)
                     rnorm_hist.append(ratio)
                     ratios.append(ratio)
                     if ok:

@@ -25,7 +25,7 @@ from ..elements.base import DOF_NAMES, IncrementContext
 from ..model import validation
 from ..errors import ModelError, SingularModelError
 from .reduction import ReducedTangent
-from .solvers.convergence import all_finite, force_moment_abs_max
+from .solvers.convergence import all_finite, force_moment_abs_max, scaled_size
 from .solvers.linear import SparseLU, mechanism_dofs
 
 
@@ -285,7 +285,9 @@ class System:
 
     def converged(self, convergence, r, du, Du, responses, P, iteration=0):
         """Force/moment residual against the largest element nodal force/moment or applied load
-        (Abaqus' 'flux' magnitude), displacement correction against the increment."""
+        (Abaqus' 'flux' magnitude), displacement correction against the increment:
+        (converged, residual ratio, force test passed, scaled correction), see
+        :meth:`~femast.analysis.solvers.convergence.Convergence.measure`."""
         fmax, mmax = force_moment_abs_max(P)
         for resp in responses:
             ff, mm = force_moment_abs_max(resp.f)
@@ -294,7 +296,12 @@ class System:
         L = self.length
         ref_f = max(fmax, 1e-2 * mmax / L, self.zero_force)
         ref_m = max(mmax, 1e-2 * fmax * L, self.zero_force * L)
-        return convergence.check(r, du, Du, self.is_rot, ref_f, ref_m, L, iteration)
+        return convergence.measure(r, du, Du, self.is_rot, ref_f, ref_m, L, iteration)
+
+    def scaled_size(self, v, Du):
+        """The correction test's measure of a correction ``v`` given the increment so far ``Du``
+        (:func:`~femast.analysis.solvers.convergence.scaled_size`)."""
+        return scaled_size(v, Du, self.is_rot, self.length)
 
     def commit(self, responses, P, res, lam, equilibrium=True):
         """Commit a converged increment into the state (one call: see :meth:`State.commit`)."""

@@ -40,7 +40,12 @@ SECTION_FORCE_NAMES = ("N", "Vy", "Vz", "T", "My", "Mz")
 # The kernel.  Every quantity of the element depends on the nodal translations only through the
 # chord d = x2 - x1, so its Jacobians are taken with respect to the 9 independent variations
 # [dd, dw1, dw2] (columns 0:3, 3:6, 6:9) and expanded to the 12 element DOFs at the end
-# (d/dx1 = -d/dd, d/dx2 = d/dd).  Plain loops with fixed trip counts over scratch arrays on the
+# (d/dx1 = -d/dd, d/dx2 = d/dd).  The tangent is assembled from 3x3 blocks in the global frame
+# (docs/beam_element.md, "The tangent in 3x3 blocks"): the spin of the corotated frame is a full
+# 3x3 block in the dd columns and of rank one (about e1) in the spin columns, and the chain
+# Ti^T (local stiffness) Ti + K_h Ti of the local rotations is collapsed into four 3x3 matrices
+# before it meets the frame's Jacobian (issue 21: ~1000 instead of ~1800 multiply-adds per element,
+# the tangent 1.5x faster, equal to the chain rule on 3x9 Jacobians to 2e-17 of max |K|).  Plain loops with fixed trip counts over scratch arrays on the
 # stack: no allocation per element.  What is the same for both ends is written once, in a loop
 # over the end a = 0, 1 with the end's arrays stacked (T[a], th[a], ...): numba's compile time
 # grows with the size of the kernel's body (issue 17: 23 % fewer IR statements and about 25 % less
@@ -54,7 +59,7 @@ _C_OTHER = np.array([-1.0, 1.0, 1.0])
 _END_SIGN = np.array([-1.0, 1.0])   # section moment at end a = sign * m_a (acting on the section)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_factor, fs, Ks, sfs, energy):
     """Internal forces ``fs`` (n, 12), tangents ``Ks`` (n, 12, 12), section forces ``sfs``
     (n, 2, 6) and strain energies ``energy`` (J) of all the corotational beams of a family.
@@ -77,18 +82,23 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_facto
     qe = carray(stack_buffer(6), (2, 3))        # q_a x e3
     q = carray(stack_buffer(3), (3,))
     kr = carray(stack_buffer(3), (3,))          # GJ / l0, 2 EIy / l0, 2 EIz / l0
-    # 3x9 Jacobians with respect to [dd, dw1, dw2] and 9-vectors (rows of scalars)
-    G = carray(stack_buffer(27), (3, 9))
-    Wr = carray(stack_buffer(27), (3, 9))
-    Je = carray(stack_buffer(81), (3, 3, 9))    # J_e1, J_e2, J_e3
-    Jth = carray(stack_buffer(54), (2, 3, 9))
-    Jm = carray(stack_buffer(54), (2, 3, 9))
-    Jmt = carray(stack_buffer(54), (2, 3, 9))
+    Wd = carray(stack_buffer(9), (3, 3))        # frame spin per dd
+    ga = carray(stack_buffer(6), (2, 3))        # frame spin about e1 per dw_a
+    V = carray(stack_buffer(18), (2, 3, 3))     # Ti_a Rr^T
+    P = carray(stack_buffer(9), (3, 3))
+    Gm = carray(stack_buffer(36), (2, 2, 3, 3))
+    Sg = carray(stack_buffer(18), (2, 3, 3))
+    Lm = carray(stack_buffer(9), (3, 3))
+    Y = carray(stack_buffer(9), (3, 3))
+    JM = carray(stack_buffer(27), (3, 9))
+    Jq = carray(stack_buffer(18), (2, 9))
     Jfx2 = carray(stack_buffer(27), (3, 9))
-    Jfw = carray(stack_buffer(27), (3, 9))
-    Jq = carray(stack_buffer(18), (2, 9))       # J_q1c, J_q2c
     Jal = carray(stack_buffer(9), (9,))
     Jc = carray(stack_buffer(9), (9,))
+    fx = carray(stack_buffer(3), (3,))
+    fl = carray(stack_buffer(3), (3,))
+    fa = carray(stack_buffer(3), (3,))
+    fb = carray(stack_buffer(3), (3,))
     for e in range(nodes.shape[0]):
         E0 = E0s[e]
         l0 = l0s[e]
@@ -166,78 +176,112 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_facto
             for a in range(2):
                 f[3 + 6 * a + i] = Rr[i, 0] * mt[a, 0] + Rr[i, 1] * mt[a, 1] + Rr[i, 2] * mt[a, 2] - c * qe[a, i]
 
-        # ---- consistent tangent: chain rule with 3x9 Jacobians ----
-        # spin of the corotated frame w_r = Rr G dd
+        # ---- consistent tangent, in 3x3 blocks of the global frame; columns [dd, dw1, dw2] ----
+        # spin of the corotated frame Wr dv (Wr = Rr G): the 3x3 Wd in the dd columns, the rank-one
+        # e1 g_a^T in those of w_a (g_a = qe_a / (2 q2c))
+        il = 1.0 / l            # reciprocals: a division costs several multiplications' throughput
+        iq = 1.0 / q2c
+        r12 = q1c * iq
         for k in range(3):
-            G[1, k] = -Rr[k, 2] / l
-            G[2, k] = Rr[k, 1] / l
-            G[0, k] = q1c * G[1, k] / q2c
-            G[0, 3 + k] = 0.5 * qe[0, k] / q2c
-            G[0, 6 + k] = 0.5 * qe[1, k] / q2c
-        # G[1:3] vanish in the spin columns, so there Wr[:, j] = e1 G[0, j]
+            g1k = -Rr[k, 2] * il
+            g2k = Rr[k, 1] * il
+            g0k = r12 * g1k
+            for i in range(3):
+                Wd[i, k] = Rr[i, 0] * g0k + Rr[i, 1] * g1k + Rr[i, 2] * g2k
+            for a in range(2):
+                ga[a, k] = 0.5 * iq * qe[a, k]
+        # local rotations: d theta_a = V_a (dw_a - Wr dv), V_a = Ti_a Rr^T
+        for a in range(2):
+            for i in range(3):
+                for j in range(3):
+                    V[a, i, j] = Ti[a, i, 0] * Rr[j, 0] + Ti[a, i, 1] * Rr[j, 1] + Ti[a, i, 2] * Rr[j, 2]
+        # Rr d mt_a = Gm[a, a] (dw_a - Wr dv) + Gm[a, b] (dw_b - Wr dv), b the other end, with
+        # Gm[a, a] = (V_a^T Ds + Rr K_h(theta_a, m_a)) V_a and Gm[a, b] = V_a^T Do V_b (Ds, Do: the
+        # diagonal matrices kr C_SELF, kr C_OTHER of the local stiffness); Gm[b, a] = Gm[a, b]^T
+        for a in range(2):
+            ts_inv_T_times_derivative_into(th[a], m[a], Kh)
+            for i in range(3):
+                for k in range(3):
+                    P[i, k] = (V[a, k, i] * kr[k] * _C_SELF[k]
+                               + Rr[i, 0] * Kh[0, k] + Rr[i, 1] * Kh[1, k] + Rr[i, 2] * Kh[2, k])
+            for i in range(3):
+                for j in range(3):
+                    Gm[a, a, i, j] = P[i, 0] * V[a, 0, j] + P[i, 1] * V[a, 1, j] + P[i, 2] * V[a, 2, j]
         for i in range(3):
             for j in range(3):
-                Wr[i, j] = Rr[i, 0] * G[0, j] + Rr[i, 1] * G[1, j] + Rr[i, 2] * G[2, j]
-            for j in range(3, 9):
-                Wr[i, j] = Rr[i, 0] * G[0, j]
-        # J_ea = -skew(e_a) Wr: columns Wr[:, j] x e_a; in the spin columns G[0, j] (e1 x e_a)
-        for a in range(3):
-            for j in range(3):
-                Je[a, 0, j] = Wr[1, j] * Rr[2, a] - Wr[2, j] * Rr[1, a]
-                Je[a, 1, j] = Wr[2, j] * Rr[0, a] - Wr[0, j] * Rr[2, a]
-                Je[a, 2, j] = Wr[0, j] * Rr[1, a] - Wr[1, j] * Rr[0, a]
-        for j in range(3, 9):
+                s = 0.0
+                for k in range(3):
+                    s += V[0, k, i] * kr[k] * _C_OTHER[k] * V[1, k, j]
+                Gm[0, 1, i, j] = s
+                Gm[1, 0, j, i] = s
+        # Sg_a = Gm[a, 0] + Gm[a, 1]: Rr d mt_a = -Sg_a Wr dv + Gm[a, 0] dw_1 + Gm[a, 1] dw_2
+        for a in range(2):
             for i in range(3):
-                Je[0, i, j] = 0.0
-                Je[1, i, j] = G[0, j] * Rr[i, 2]
-                Je[2, i, j] = -G[0, j] * Rr[i, 1]
-        # J_q = (J_q1 + J_q2)/2, J_qa = -skew(q_a) in the columns of w_a;
-        # J_q1c = e1^T J_q + q^T J_e1, J_q2c = e2^T J_q + q^T J_e2 (q . e3 = 0 in the spin columns)
-        for b in range(2):
+                for j in range(3):
+                    Sg[a, i, j] = Gm[a, 0, i, j] + Gm[a, 1, i, j]
+        # JM = d(mt_1 + mt_2) in local components (rows M0, M1, M2): Rr^T (Rr d mt_1 + Rr d mt_2)
+        for r in range(3):
             for j in range(3):
-                Jq[b, j] = q[0] * Je[b, 0, j] + q[1] * Je[b, 1, j] + q[2] * Je[b, 2, j]
-            # e^T (-skew(q_a)) / 2 = (q_a x e) / 2
+                Lm[r, j] = (Rr[0, r] * (Sg[0, 0, j] + Sg[1, 0, j]) + Rr[1, r] * (Sg[0, 1, j] + Sg[1, 1, j])
+                            + Rr[2, r] * (Sg[0, 2, j] + Sg[1, 2, j]))
+        for r in range(3):
+            for k in range(3):
+                JM[r, k] = -(Lm[r, 0] * Wd[0, k] + Lm[r, 1] * Wd[1, k] + Lm[r, 2] * Wd[2, k])
+            l0r = Lm[r, 0] * Rr[0, 0] + Lm[r, 1] * Rr[1, 0] + Lm[r, 2] * Rr[2, 0]   # (Rr^T Sg e1)_r
+            for b in range(2):
+                for k in range(3):
+                    JM[r, 3 + 3 * b + k] = (-l0r * ga[b, k]
+                                            + Rr[0, r] * (Gm[0, b, 0, k] + Gm[1, b, 0, k])
+                                            + Rr[1, r] * (Gm[0, b, 1, k] + Gm[1, b, 1, k])
+                                            + Rr[2, r] * (Gm[0, b, 2, k] + Gm[1, b, 2, k]))
+        # J_q1c, J_q2c: q . (Wr_j x e_b) = (e_b x q) . Wr_j in the dd columns, (q_a x e_b) / 2 in those of w_a
+        for b in range(2):
+            u0 = Rr[1, b] * q[2] - Rr[2, b] * q[1]
+            u1 = Rr[2, b] * q[0] - Rr[0, b] * q[2]
+            u2 = Rr[0, b] * q[1] - Rr[1, b] * q[0]
+            for k in range(3):
+                Jq[b, k] = u0 * Wd[0, k] + u1 * Wd[1, k] + u2 * Wd[2, k]
             for a in range(2):
                 o = 3 + 3 * a
                 Jq[b, o + 0] = 0.5 * (T[a, 1, 1] * Rr[2, b] - T[a, 2, 1] * Rr[1, b])
                 Jq[b, o + 1] = 0.5 * (T[a, 2, 1] * Rr[0, b] - T[a, 0, 1] * Rr[2, b])
                 Jq[b, o + 2] = 0.5 * (T[a, 0, 1] * Rr[1, b] - T[a, 1, 1] * Rr[0, b])
-        # local rotations: J_tha = Ti_a (-G + [Rr^T in the columns of w_a])
-        for a in range(2):
-            for i in range(3):
-                for j in range(3):
-                    Jth[a, i, j] = -(Ti[a, i, 0] * G[0, j] + Ti[a, i, 1] * G[1, j] + Ti[a, i, 2] * G[2, j])
-                for j in range(3, 9):
-                    Jth[a, i, j] = -Ti[a, i, 0] * G[0, j]
-                for k in range(3):
-                    Jth[a, i, 3 + 3 * a + k] += Ti[a, i, 0] * Rr[k, 0] + Ti[a, i, 1] * Rr[k, 1] + Ti[a, i, 2] * Rr[k, 2]
-        for a in range(2):
-            for r in range(3):
-                for j in range(9):
-                    Jm[a, r, j] = kr[r] * (_C_SELF[r] * Jth[a, r, j] + _C_OTHER[r] * Jth[1 - a, r, j])
-        # J_mta = Ti_a^T J_ma + K_h(theta_a, m_a) J_tha
-        for a in range(2):
-            ts_inv_T_times_derivative_into(th[a], m[a], Kh)
-            for i in range(3):
-                for j in range(9):
-                    Jmt[a, i, j] = (Ti[a, 0, i] * Jm[a, 0, j] + Ti[a, 1, i] * Jm[a, 1, j] + Ti[a, 2, i] * Jm[a, 2, j]
-                                    + Kh[i, 0] * Jth[a, 0, j] + Kh[i, 1] * Jth[a, 1, j] + Kh[i, 2] * Jth[a, 2, j])
-        r12 = q1c / q2c
+        a0 = M0 * iq
+        a1 = a0 * r12
+        h = 0.5 * iq
+        h1 = h * a0
         for j in range(9):
-            JM0 = Jmt[0, 0, j] + Jmt[1, 0, j]
-            Jal[j] = Jmt[0, 1, j] + Jmt[1, 1, j] + r12 * JM0 + (M0 / q2c) * Jq[0, j] - (M0 * r12 / q2c) * Jq[1, j]
-            Jc[j] = JM0 / (2.0 * q2c) - (M0 / (2.0 * q2c * q2c)) * Jq[1, j]
-        # forces at node 2: fx2 = N e1 - FD, FD = (-alpha e3 + M2 e2) / l
+            Jal[j] = JM[1, j] + r12 * JM[0, j] + a0 * Jq[0, j] - a1 * Jq[1, j]
+            Jc[j] = h * JM[0, j] - h1 * Jq[1, j]
+        # forces at node 2: fx2 = N e1 - FD, FD = (-alpha e3 + M2 e2) / l;
+        # d fx2 = Wr dv x fx2 + (e3 dalpha - e2 dM2) / l + (kN e1 + FD / l) e1^T dd
         kN = EA / l0
         for i in range(3):
-            FDi = (-alpha * Rr[i, 2] + M2 * Rr[i, 1]) / l
-            for j in range(9):
-                JFD = (-Rr[i, 2] * Jal[j] - alpha * Je[2, i, j] + Rr[i, 1] * (Jmt[0, 2, j] + Jmt[1, 2, j])
-                       + M2 * Je[1, i, j]) / l
-                Jfx2[i, j] = N * Je[0, i, j] - JFD
-            for k in range(3):  # J_l = [e1, 0, 0]
-                Jfx2[i, k] += (Rr[i, 0] * kN + FDi / l) * Rr[k, 0]
-        # expand to the 12 DOFs: rows [-fx2, ., fx2, .], columns [-dd, dw1, dd, dw2]
+            FDi = (-alpha * Rr[i, 2] + M2 * Rr[i, 1]) * il
+            fx[i] = N * Rr[i, 0] - FDi
+            fl[i] = Rr[i, 0] * kN + FDi * il
+            fa[i] = Rr[i, 2] * il      # e3 / l and e2 / l
+            fb[i] = Rr[i, 1] * il
+        # e1 x fx2 (the spin columns' Wr_j x fx2 = g_j e1 x fx2)
+        c0 = Rr[1, 0] * fx[2] - Rr[2, 0] * fx[1]
+        c1 = Rr[2, 0] * fx[0] - Rr[0, 0] * fx[2]
+        c2 = Rr[0, 0] * fx[1] - Rr[1, 0] * fx[0]
+        for k in range(3):
+            w0 = Wd[0, k]
+            w1 = Wd[1, k]
+            w2 = Wd[2, k]
+            x0 = w1 * fx[2] - w2 * fx[1]
+            x1_ = w2 * fx[0] - w0 * fx[2]
+            x2_ = w0 * fx[1] - w1 * fx[0]
+            Jfx2[0, k] = x0 + (fa[0] * Jal[k] - fb[0] * JM[2, k]) + fl[0] * Rr[k, 0]
+            Jfx2[1, k] = x1_ + (fa[1] * Jal[k] - fb[1] * JM[2, k]) + fl[1] * Rr[k, 0]
+            Jfx2[2, k] = x2_ + (fa[2] * Jal[k] - fb[2] * JM[2, k]) + fl[2] * Rr[k, 0]
+            for a in range(2):
+                j = 3 + 3 * a + k
+                g = ga[a, k]
+                Jfx2[0, j] = c0 * g + (fa[0] * Jal[j] - fb[0] * JM[2, j])
+                Jfx2[1, j] = c1 * g + (fa[1] * Jal[j] - fb[1] * JM[2, j])
+                Jfx2[2, j] = c2 * g + (fa[2] * Jal[j] - fb[2] * JM[2, j])
         for i in range(3):
             for k in range(3):
                 a_ = Jfx2[i, k]
@@ -251,39 +295,43 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_facto
                 K[6 + i, 3 + k] = b_
                 K[6 + i, 6 + k] = a_
                 K[6 + i, 9 + k] = g_
-        # moments: fw_a = Rr mt_a - c (q_a x e3): rows 3 + 6 a of K
+        # moments: fw_a = Rr mt_a - c (q_a x e3):
+        # d fw_a = Y_a Wr dv + Gm[a, 0] dw_1 + Gm[a, 1] dw_2 - qe_a dc - c (q_a e3^T - (e3 . q_a) I) dw_a,
+        # Y_a = -skew(Rr mt_a) - c (q_a . e3) I + c e3 q_a^T - Sg_a (from d(Rr) mt_a = Wr dv x Rr mt_a
+        # and c q_a x (Wr dv x e3), expanded)
         for a in range(2):
-            qa0 = T[a, 0, 1]
-            qa1 = T[a, 1, 1]
-            qa2 = T[a, 2, 1]
-            for j in range(9):
-                # - c q_a x J_e3[:, j]
-                x0 = qa1 * Je[2, 2, j] - qa2 * Je[2, 1, j]
-                x1_ = qa2 * Je[2, 0, j] - qa0 * Je[2, 2, j]
-                x2_ = qa0 * Je[2, 1, j] - qa1 * Je[2, 0, j]
-                for i in range(3):
-                    Jfw[i, j] = (Rr[i, 0] * Jmt[a, 0, j] + Rr[i, 1] * Jmt[a, 1, j] + Rr[i, 2] * Jmt[a, 2, j]
-                                 + mt[a, 0] * Je[0, i, j] + mt[a, 1] * Je[1, i, j] + mt[a, 2] * Je[2, i, j]
-                                 - qe[a, i] * Jc[j])
-                Jfw[0, j] -= c * x0
-                Jfw[1, j] -= c * x1_
-                Jfw[2, j] -= c * x2_
-            # + c skew(e3) J_qa, J_qa = -skew(q_a) in the columns of w_a:
-            # -c skew(e3) skew(q_a) = -c (q_a e3^T - (e3 . q_a) I)
-            o = 3 + 3 * a
+            v0 = Rr[0, 0] * mt[a, 0] + Rr[0, 1] * mt[a, 1] + Rr[0, 2] * mt[a, 2]
+            v1 = Rr[1, 0] * mt[a, 0] + Rr[1, 1] * mt[a, 1] + Rr[1, 2] * mt[a, 2]
+            v2 = Rr[2, 0] * mt[a, 0] + Rr[2, 1] * mt[a, 1] + Rr[2, 2] * mt[a, 2]
             e3q = T[a, 0, 1] * Rr[0, 2] + T[a, 1, 1] * Rr[1, 2] + T[a, 2, 1] * Rr[2, 2]
             for i in range(3):
-                qai = T[a, i, 1]
-                for k in range(3):
-                    Jfw[i, o + k] -= c * qai * Rr[k, 2]
-                Jfw[i, o + i] += c * e3q
+                for j in range(3):
+                    Y[i, j] = c * Rr[i, 2] * T[a, j, 1] - Sg[a, i, j]
+                Y[i, i] -= c * e3q
+            Y[0, 1] += v2
+            Y[0, 2] -= v1
+            Y[1, 0] -= v2
+            Y[1, 2] += v0
+            Y[2, 0] += v1
+            Y[2, 1] -= v0
             row = 3 + 6 * a
             for i in range(3):
+                y0 = Y[i, 0]
+                y1 = Y[i, 1]
+                y2 = Y[i, 2]
+                # Y_a e1: the spin columns' Y_a Wr_j = g_j Y_a e1
+                ye = y0 * Rr[0, 0] + y1 * Rr[1, 0] + y2 * Rr[2, 0]
+                qi = qe[a, i]
                 for k in range(3):
-                    K[row + i, k] = -Jfw[i, k]
-                    K[row + i, 3 + k] = Jfw[i, 3 + k]
-                    K[row + i, 6 + k] = Jfw[i, k]
-                    K[row + i, 9 + k] = Jfw[i, 6 + k]
+                    v = y0 * Wd[0, k] + y1 * Wd[1, k] + y2 * Wd[2, k] - qi * Jc[k]
+                    K[row + i, k] = -v
+                    K[row + i, 6 + k] = v
+                    for b in range(2):
+                        j = 3 + 3 * b + k
+                        K[row + i, j + 3 * b] = ye * ga[b, k] + Gm[a, b, i, k] - qi * Jc[j]
+                K[row + i, 3 + 6 * a + i] += c * e3q
+                for k in range(3):
+                    K[row + i, 3 + 6 * a + k] -= c * T[a, i, 1] * Rr[k, 2]
 
         # section forces, local axes: N (tension +), shear from end-moment equilibrium,
         # torsion and bending moments as acting on the beam section at each end

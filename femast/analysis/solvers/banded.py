@@ -99,6 +99,23 @@ def _fill_split(L, U, chol):
     return asym, big
 
 
+@njit(cache=True, inline="always")
+def _residual_maxima(r, rows, x):
+    """(max |r_i|, max rows_i, max |x_i|): the backward-error terms of :func:`refine` (inlined into
+    the residual kernels; the kernels' plain-Python fallback calls its Python function)."""
+    rmax = 0.0
+    amax = 0.0
+    xmax = 0.0
+    for i in range(x.shape[0]):
+        if abs(r[i]) > rmax:
+            rmax = abs(r[i])
+        if rows[i] > amax:
+            amax = rows[i]
+        if abs(x[i]) > xmax:
+            xmax = abs(x[i])
+    return rmax, amax, xmax
+
+
 @njit(cache=True)
 def _residual_split(L, U, x, rhs, r):
     """:func:`_residual` for B in split band storage (:func:`_fill_split`): the same sums in the
@@ -123,17 +140,7 @@ def _residual_split(L, U, x, rhs, r):
             sj += abs(v)
         r[j] = rj
         rows[j] = sj
-    rmax = 0.0
-    amax = 0.0
-    xmax = 0.0
-    for i in range(n):
-        if abs(r[i]) > rmax:
-            rmax = abs(r[i])
-        if rows[i] > amax:
-            amax = rows[i]
-        if abs(x[i]) > xmax:
-            xmax = abs(x[i])
-    return rmax, amax, xmax
+    return _residual_maxima(r, rows, x)
 
 
 @njit(cache=True)
@@ -202,17 +209,7 @@ def _residual(indptr, indices, data, x, b, r):
             i = indices[k]
             r[i] -= data[k] * xj
             rows[i] += abs(data[k])
-    rmax = 0.0
-    amax = 0.0
-    xmax = 0.0
-    for i in range(n):
-        if abs(r[i]) > rmax:
-            rmax = abs(r[i])
-        if rows[i] > amax:
-            amax = rows[i]
-        if abs(x[i]) > xmax:
-            xmax = abs(x[i])
-    return rmax, amax, xmax
+    return _residual_maxima(r, rows, x)
 
 
 class BandedFactor:

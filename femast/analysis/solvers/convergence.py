@@ -15,6 +15,33 @@ A *linear* increment is accepted after its first iteration when every residual i
 ``min(linear_tol, force_tol)`` times its reference, whatever the correction (Abaqus' R_l = 1e-8).
 Without this rule an increment that changes the loads by round-off never converges: its whole
 increment is round-off, so the correction test compares round-off with round-off.
+
+**The predicted correction** (``predicted=True``, the default).  The correction test above bounds
+the error of the *previous* iterate: when it passes, Newton has already spent an iteration whose
+only purpose was to measure that the iterate before it was converged.  Abaqus/Standard therefore
+also accepts an iteration whose residual passes when the *estimated* next correction passes the
+correction test (Abaqus Analysis User's Guide, "Convergence criteria for nonlinear problems").
+femast does not extrapolate that estimate from the residuals (on a mast's soft modes a residual
+at round-off still carries a large displacement); it computes it: the simplified Newton correction
+c~ = K_(k-1)^-1 r_k, one more solve with the factorisation already in hand (Deuflhard 2004,
+*Newton Methods for Nonlinear Problems*, sec. 2.1.2: the natural monotonicity test and the error
+estimate of the accepted iterate).  Iteration k (of full Newton, under fixed loads) is accepted
+without iteration k + 1 when, with every correction measured as in the correction test (largest
+entry over the field's increment, the larger of the two fields):
+
+* the force test passes and no element answered provisionally;
+* at least two corrections were taken in this attempt and the last one contracted:
+  rho = |du_k| / |du_(k-1)| <= ``max_contraction`` (never on one iteration's rate, never on a
+  non-contracting sequence: on the 1000-bay mast's soft mode |du_3| = 0.995 |du_2| while c~ still
+  looks small, and the true |du_4| is 15 times c~);
+* c~ contracts too: theta = |c~| / |du_k| <= ``max_contraction``;
+* the error left in iterate k, estimated as the geometric series c~ / (1 - theta), is at most
+  half the correction tolerance: 2 |c~| / (1 - theta) <= ``disp_tol`` |Du|.  The factor 2 covers the
+  estimate's own error: c~ differs from the Newton correction by a factor up to 1 + omega |du_k|,
+  where omega |du_k| ~ 2 rho^2 <= 1/2 from Newton's quadratic contraction (Deuflhard's
+  affine-covariant Lipschitz constant omega).
+
+The strict rule stays selectable: ``Convergence(predicted=False)``.
 """
 
 from __future__ import annotations
@@ -24,6 +51,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+
+from ...errors import ModelError
 
 
 @njit(cache=True)
@@ -72,22 +101,69 @@ def force_moment_abs_max(f):
     return fm, mm
 
 
+@njit(cache=True)
+def scaled_size(v, Dv, is_rot, length):
+    """The correction test's measure of a correction ``v``: over translations and rotations, the
+    larger of (largest |v_i| / largest |Dv_i|), with ``Dv`` the increment so far and its floors
+    (1e-9 ``length`` (m), 1e-9 rad) for round-off increments; 0 without DOFs; NaN if v holds one.
+    The correction test is ``scaled_size(du, Du) <= disp_tol``."""
+    vt, vr = field_abs_max(v, is_rot)
+    dt, dr = field_abs_max(Dv, is_rot)
+    if math.isnan(vt) or math.isnan(vr):
+        return math.nan
+    s = 0.0
+    if vt >= 0.0:
+        s = vt / max(dt, 1e-9 * length)
+    if vr >= 0.0:
+        s = max(s, vr / max(dr, 1e-9))
+    return s
+
+
 @dataclass
 class Convergence:
     """force_tol, disp_tol : relative tolerances (dimensionless); max_iterations per attempt;
     linear_tol : residual ratio below which an increment is accepted as linear after its first
-    iteration (dimensionless; the tighter of it and force_tol is used)."""
+    iteration (dimensionless; the tighter of it and force_tol is used).
+    predicted : also accept an iteration on its predicted next correction (module docstring);
+    False: the strict correction test only.  max_contraction : the largest ratio of successive
+    corrections (dimensionless, 0 < max_contraction < 1) for which the prediction is trusted."""
 
     force_tol: float = 1e-6
     disp_tol: float = 1e-6
     max_iterations: int = 25
     linear_tol: float = 1e-8
+    predicted: bool = True
+    max_contraction: float = 0.5
+
+    def __post_init__(self):
+        if not 0.0 < float(self.max_contraction) < 1.0:
+            raise ModelError(f"Convergence: max_contraction={self.max_contraction!r} must be between 0 and 1 "
+                             "(e.g. 0.5)")
 
     def check(self, r, du, Du, is_rot, ref_force, ref_moment, length, iteration=0):
         """Return (converged, residual_ratio) given the free residual ``r``, the last
         correction ``du``, the increment so far ``Du``, the bool mask ``is_rot`` and the number
         of Newton iterations done in this attempt (1: the linear-increment rule applies)."""
+        return self.measure(r, du, Du, is_rot, ref_force, ref_moment, length, iteration)[:2]
+
+    def accept_predicted(self, previous, last, predicted):
+        """Accept an iteration whose force test passed on its predicted next correction?
+        ``previous``, ``last``: the scaled sizes (:func:`scaled_size`) of the attempt's last two
+        corrections; ``predicted``: that of the simplified Newton correction c~ (module docstring)."""
+        if not self.predicted:
+            return False
+        rate = self.max_contraction
+        if not (previous > 0.0 and last <= rate * previous):   # a contracting sequence (NaN: no)
+            return False
+        theta = predicted / last if last > 0.0 else math.inf
+        return theta <= rate and 2.0 * predicted <= (1.0 - theta) * self.disp_tol
+
+    def measure(self, r, du, Du, is_rot, ref_force, ref_moment, length, iteration=0):
+        """(converged, residual_ratio, forces_ok, correction): :meth:`check`'s answer, whether the
+        force (moment) test alone passed, and the scaled size of the correction ``du``
+        (:func:`scaled_size`; NaN without one)."""
         ok = True
+        forces = True
         linear = iteration == 1
         linear_tol = min(self.linear_tol, self.force_tol)
         worst = 0.0
@@ -102,9 +178,15 @@ class Convergence:
             ratio = rmax[k] / ref if ref > 0 else (0.0 if rmax[k] == 0 else np.inf)
             worst = max(worst, ratio)
             if not ratio <= self.force_tol:   # NaN never converges
-                ok = False
+                ok = forces = False
             if not ratio <= linear_tol:
                 linear = False
             if du is not None and not dmax[k] <= self.disp_tol * max(Dmax[k], 1e-9 * dref):
                 ok = False     # floor 1e-9 dref: round-off-sized increments
-        return ok or linear, worst
+        size = math.nan   # the correction's scaled size, as scaled_size(du, Du) from the maxima above
+        if du is not None and not math.isnan(dmax[0]):
+            size = 0.0
+            for k, dref in ((0, length), (1, 1.0)):
+                if dmax[k] >= 0.0:
+                    size = max(size, dmax[k] / max(Dmax[k], 1e-9 * dref))
+        return ok or linear, worst, forces, size
