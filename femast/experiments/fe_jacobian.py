@@ -10,6 +10,8 @@ and gives registered starts back bit for bit (so the run cache answers them).  U
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 from scipy.optimize import least_squares
 
@@ -54,6 +56,7 @@ class _FEJacobian:
 
     def differences(self, u, f0, known=None):
         J = np.empty((f0.size, u.size))
+        todo, points, steps = [], [], []
         for i in range(u.size):
             if known is not None and np.all(np.isfinite(known[:, i])):
                 J[:, i] = known[:, i]
@@ -63,8 +66,12 @@ class _FEJacobian:
                 h = -h
             up = u.copy()
             up[i] += h
-            self.runs += 1
-            J[:, i] = (self.fun(up) - f0) / h
+            todo.append(i)
+            points.append(up)
+            steps.append(h)
+        self.runs += len(points)
+        for i, h, f in zip(todo, steps, evaluate_many(self.fun, points, f0.size)):
+            J[:, i] = (f - f0) / h
         if known is None or not np.all(np.isfinite(known)):
             self.fd_at, self.fd_J = u.copy(), J.copy()
         return J
@@ -91,6 +98,88 @@ class _FEJacobian:
         if self.fd_at is not None and np.array_equal(self.fd_at, u):
             return self.fd_J, False
         return self.differences(u, self.value(u)), True
+
+
+FORK_COLUMNS = True   # evaluate a Jacobian's finite-difference columns in this process and a forked one
+
+
+def _fork_ok(n_points: int) -> bool:
+    """Columns may be split with a forked child: several to compute, a second CPU, fork available, this
+    the main and only thread of a process that is not itself a worker of a pool (whose cores are taken:
+    the refits of diagnose), and numba not running GNU OpenMP threads (a forked child of those aborts)."""
+    if not FORK_COLUMNS or n_points < 2 or not hasattr(os, "fork") or (os.cpu_count() or 1) < 2:
+        return False
+    import multiprocessing
+    import threading
+
+    if multiprocessing.parent_process() is not None or threading.current_thread() is not threading.main_thread():
+        return False
+    if not _only_thread():
+        return False
+    try:
+        import numba
+
+        if numba.threading_layer() == "omp":
+            return False
+    except Exception:   # (ValueError while no parallel kernel has run: no threads)
+        pass
+    return True
+
+
+def _only_thread() -> bool:
+    """No other thread that might hold a lock the child needs (a Jupyter kernel's, a results writer's);
+    tqdm's monitor only wakes every 10 s to check the bars, which the child does not draw."""
+    import threading
+
+    me = threading.current_thread()
+    return all(t is me or type(t).__name__ == "TMonitor" for t in threading.enumerate())
+
+
+def evaluate_many(fun, points, size: int) -> list:
+    """``[fun(p) for p in points]`` (each a (size,) float array), the second half of the points in a
+    forked child process while this one computes the first (issue 21: a fit's finite-difference
+    columns are independent FE runs, and during a fit in the main process the second CPU is idle; a
+    forked child inherits the loaded kernels, the reference path and the model).  The child sends the
+    values back as raw float64 bytes through a pipe and ends with ``os._exit``; if it fails, this process
+    computes its points itself.  Serial when :func:`_fork_ok` says no."""
+    if not _fork_ok(len(points)):
+        return [fun(p) for p in points]
+    k = (len(points) + 1) // 2
+    rd, wr = os.pipe()
+    try:
+        pid = os.fork()
+    except OSError:
+        os.close(rd)
+        os.close(wr)
+        return [fun(p) for p in points]
+    if pid == 0:   # the child: its points, then exit without running any of the parent's exit handlers
+        code = 1
+        try:
+            os.close(rd)
+            os.environ["FEMAST_BACKGROUND_COMPILE"] = "0"   # (no requests to the parent's compile worker)
+            from .. import progress
+
+            progress.set_quiet(True)
+            vals = [np.asarray(fun(p), dtype=np.float64).reshape(size) for p in points[k:]]
+            data = np.concatenate(vals).tobytes()
+            with os.fdopen(wr, "wb") as fh:
+                fh.write(data)
+            code = 0
+        finally:
+            os._exit(code)
+    os.close(wr)
+    try:
+        mine = [fun(p) for p in points[:k]]
+    finally:
+        with os.fdopen(rd, "rb") as fh:
+            data = fh.read()
+        _, status = os.waitpid(pid, 0)
+    n = len(points) - k
+    if status == 0 and len(data) == 8 * size * n:
+        theirs = list(np.frombuffer(data, dtype=np.float64).reshape(n, size).copy())
+    else:
+        theirs = [fun(p) for p in points[k:]]
+    return mine + theirs
 
 
 def _forward_differences(fun, step: float, lo, hi):

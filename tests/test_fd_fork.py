@@ -1,0 +1,101 @@
+"""Finite-difference columns of the expensive fits split with a forked child
+(femast.experiments.fe_jacobian.evaluate_many, issue 21): the same values as computing them here,
+bit for bit; a child that fails is replaced by this process; serial where forking is unsafe."""
+
+import os
+import threading
+
+import numpy as np
+import pytest
+
+from femast.experiments import fe_jacobian as fj
+
+pytestmark = pytest.mark.skipif(not hasattr(os, "fork") or (os.cpu_count() or 1) < 2,
+                                reason="needs fork and two CPUs")
+
+
+@pytest.fixture
+def forking(monkeypatch):
+    """Forking allowed although earlier tests may have left threads behind (the functions forked here
+    take no locks); the thread rule itself is tested below."""
+    monkeypatch.setattr(fj, "_only_thread", lambda: True)
+
+
+def _fun(u):
+    # a smooth vector function with values whose bits a round trip through text would change
+    x = np.linspace(0.0, 1.0, 7)
+    return np.sin(u[0] * x) / 3.0 + np.exp(-u[1] * x) + np.pi * u[0] * u[1]
+
+
+def test_forked_columns_equal_serial_ones_bit_for_bit(forking):
+    pts = [np.array([0.1 * k, 1.0 + 0.3 * k]) for k in range(5)]
+    assert fj._fork_ok(len(pts))
+    got = fj.evaluate_many(_fun, pts, 7)
+    want = [_fun(p) for p in pts]
+    assert len(got) == 5
+    for g, w in zip(got, want):
+        assert g.dtype == np.float64 and np.array_equal(g, w)
+
+
+def test_the_child_runs_the_second_half(forking):
+    parent = os.getpid()
+    pids = {}
+
+    def fun(u):
+        pids[float(u[0])] = os.getpid()
+        return np.full(3, float(os.getpid() == parent))
+
+    got = fj.evaluate_many(fun, [np.array([1.0]), np.array([2.0]), np.array([3.0])], 3)
+    # ceil(3 / 2) = 2 points here (seen in this process's dict), the last one in the child (1.0 -> 0)
+    assert [g[0] for g in got] == [1.0, 1.0, 0.0]
+    assert set(pids) == {1.0, 2.0}
+
+
+def test_a_failing_child_is_replaced_by_this_process(forking):
+    parent = os.getpid()
+
+    def fun(u):
+        if os.getpid() != parent:
+            raise RuntimeError("child fails")
+        return np.full(4, u[0])
+
+    got = fj.evaluate_many(fun, [np.array([1.0]), np.array([2.0])], 4)
+    assert np.array_equal(got[1], np.full(4, 2.0))
+
+
+def test_serial_outside_the_main_thread_and_when_switched_off(forking, monkeypatch):
+    out = {}
+
+    def run():
+        out["ok"] = fj._fork_ok(4)
+
+    t = threading.Thread(target=run)
+    t.start()
+    t.join()
+    assert out["ok"] is False
+    assert fj._fork_ok(1) is False   # one point: nothing to split
+    monkeypatch.setattr(fj, "FORK_COLUMNS", False)
+    assert fj._fork_ok(4) is False
+
+
+def test_jacobian_with_forked_columns_equals_the_serial_one(forking, monkeypatch):
+    lo, hi = np.full(2, -10.0), np.full(2, 10.0)
+    u = np.array([0.4, 0.7])
+    jac = {}
+    for fork in (True, False):
+        monkeypatch.setattr(fj, "FORK_COLUMNS", fork)
+        j = fj._FEJacobian(_fun, 1e-3, lo, hi)
+        jac[fork] = j.jac(u)
+        assert j.runs == 3   # the point itself and two columns
+    assert np.array_equal(jac[True], jac[False])
+
+
+def test_serial_while_another_thread_runs():
+    stop = threading.Event()
+    t = threading.Thread(target=stop.wait, daemon=True)
+    t.start()
+    try:
+        assert fj._only_thread() is False and fj._fork_ok(4) is False
+    finally:
+        stop.set()
+        t.join()
