@@ -3,7 +3,7 @@
 * converged responses of path-independent families reused at the next increment's start;
 * the symbolic analysis (ordering) done from the assembly pattern at set-up;
 * K_ff assembled straight into the linear solver's permuted matrix;
-* frames written by a background thread;
+* frames written as increments converge (every one on disk, a write error raised at once);
 * a NaN in an element tangent named in the error, although element matrices are not scanned.
 """
 

@@ -1,18 +1,21 @@
 """The Bathe-Bolourchi 45-degree bend, a small model with many increments, in femast and OpenSeesPy
 (issue 21, item 3: the fixed cost per increment).
 
-    python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--profile] [--strict]
+    python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--no-folder] [--strict] [--profile] [--parts] [--docs]
 
 A cantilever bent to 45 degrees in the x-y plane, radius R = 100, unit square section (E = 1e7,
 G = E/2, J = 0.140577), clamped at one end and loaded at the other by a dead force P along +z up to
 600, in K equal load increments with full Newton.  femast writes a results folder with a frame per
 increment (its default); OpenSees records the tip displacement after each increment in memory
-(``nodeDisp``), the usual script.  Both run --repeat times, interleaved; the script prints best
-and median wall time, CPU time of this process, Newton iterations, the femast/OpenSees ratio of the
-best and of the median runs (target <= 0.5), and the tip positions at P = 300, 450, 600 against
-the Kirchhoff-rod solution (femast.references.bend45_tip_position) and against each other.
-``--profile`` prints femast's cProfile of one run.  Writes ``benchmarks/out/bend45_peer.png``
-(``--docs``: docs/figures/performance_bend45.png): the time per increment of each run.
+(``nodeDisp``), the usual script (``--no-folder``: femast too keeps the tip in memory, with
+``out=None`` and an ``on_frame`` recorder).  Both run --repeat times, interleaved; the script
+prints best and median wall time, CPU time of this process, Newton iterations, the femast/OpenSees
+ratio of the best and of the median runs (target <= 0.5), and the tip positions at P = 300, 450,
+600 against the Kirchhoff-rod solution (femast.references.bend45_tip_position) and against each other.
+``--profile`` prints femast's cProfile of one run; ``--parts`` femast's CPU time per increment by
+part (set-up, Newton, increment plan, frames, ...) instead of the comparison.  Writes
+``benchmarks/out/bend45_peer.png`` (``--no-folder``: ``bend45_peer_nofolder.png``; ``--docs``: also
+to docs/figures/performance_bend45*.png): the time per increment of each run.
 """
 
 from __future__ import annotations
@@ -50,20 +53,87 @@ def geometry(n_el):
     return np.column_stack([R * (1 - np.cos(ang)), R * np.sin(ang), np.zeros_like(ang)])
 
 
-def femast_run(n_el, n_inc, tol, out, predicted=True):
-    """Build and solve in femast, results written to ``out``; dict(wall, cpu, iterations, tips)."""
+def femast_run(n_el, n_inc, tol, out, clock=None, predicted=True):
+    """Build and solve in femast, results written to ``out`` (None: no results folder, the tip
+    recorded in memory by an ``on_frame`` recorder, as OpenSees' ``nodeDisp``); dict(wall, cpu,
+    iterations, tips).  ``clock(cpu)`` is called when the clock stops (before the read-back);
+    ``predicted``: femast's predicted-correction acceptance (Convergence(predicted=))."""
+    tips = []
     t0, c0 = time.perf_counter(), time.process_time()
     m = fm.Model("bend45")
     n = np.asarray(m.nodes(geometry(n_el)))
     m.beams(np.column_stack([n[:-1], n[1:]]), fm.Section(E=E, G=G, A=A, Iy=I, Iz=I, J=J), up=(0.0, 0.0, 1.0))
     m.fix(n[0])
     m.step("load", initial_increment=1.0 / n_inc, max_increment=1.0 / n_inc).load(n[-1], fz=P_END)
-    an = Analysis(m, out, progress=False, convergence=Convergence(force_tol=tol, disp_tol=tol, predicted=predicted))
+    strict = {} if predicted else {"predicted": False}   # (the default: an older checkout can be timed too)
+    an = Analysis(m, out, progress=False, convergence=Convergence(force_tol=tol, disp_tol=tol, **strict),
+                  on_frame=None if out is not None else (lambda f: tips.append(f["U"][-1].copy())))
     res = an.run()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    U = np.array([res.frame(i)["U"][-1] for i in range(len(res))])   # read back after the clock stopped
+    if clock is not None:
+        clock(cpu)
+    U = (np.array([res.frame(i)["U"][-1] for i in range(len(res))]) if out is not None   # read back after
+         else np.array(tips))                                                              # the clock stopped
     return dict(wall=wall, cpu=cpu, iterations=an.summary.iterations, increments=an.summary.increments,
                 tips=geometry(n_el)[-1] + U[1:])
+
+
+PARTS = (   # (module, attribute path, label) timed by --parts
+    ("femast.analysis.analysis", "Analysis.__init__", "analysis set-up (Analysis())"),
+    ("femast.analysis.output", "ResultsOutput.started", "results folder set-up + initial frame"),
+    ("femast.analysis.newton", "Newton.solve", "Newton iterations (Newton.solve)"),
+    ("femast.analysis.controls", "TimeIncrements.propose", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.controls", "TimeIncrements.accept", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.controls", "TimeIncrements.grow", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.controls", "TimeIncrements.next_increment", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.controls", "TimeIncrements.done", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.output", "ResultsOutput.converged", "frame + status line (analysis thread)"),
+    ("femast.analysis.output", "ResultsOutput.finished", "close + final summary"),
+    ("femast.analysis.analysis", "Results", "Results(out) returned by run()"),
+)
+
+
+def parts(n_el, n_inc, tol, out_dir, repeat, predicted=True):
+    """CPU time of femast's parts per increment (thread CPU time of the analysis thread; any other
+    thread's CPU -- a results writer thread of femast before session 8 -- is the process' CPU time
+    less the analysis thread's), in the run of least process CPU of ``repeat``; printed.  The
+    parts are wrapped by name, so the same script times an older checkout put first on PYTHONPATH."""
+    import collections
+    import importlib
+
+    spent = collections.defaultdict(float)
+    for mod_name, path, label in PARTS:
+        owner = importlib.import_module(mod_name)
+        *outer, name = path.split(".")
+        for o in outer:
+            owner = getattr(owner, o)
+        f = getattr(owner, name)
+
+        def timed(*a, _f=f, _label=label, **k):
+            t = time.thread_time()
+            try:
+                return _f(*a, **k)
+            finally:
+                spent[_label] += time.thread_time() - t
+        setattr(owner, name, timed)
+    runs = []
+    for r in range(repeat):
+        spent.clear()
+        stop = []
+        t0 = time.thread_time()
+        femast_run(n_el, n_inc, tol, None if out_dir is None else out_dir / f"parts{r}",
+                   clock=lambda cpu: stop.append((cpu, time.thread_time() - t0)), predicted=predicted)
+        proc, thread = stop[0]
+        d = dict(spent)
+        d["rest: model, step loop (analysis thread)"] = thread - sum(spent.values())
+        d["other threads (process - analysis thread)"] = max(proc - thread, 0.0)   # (read ~us apart)
+        runs.append((proc, d))
+    proc, d = min(runs, key=lambda r: r[0])
+    print(f"  femast by part ({'no folder' if out_dir is None else 'frames written'}), run of least CPU of "
+          f"{repeat}: {proc * 1e3:.1f} ms CPU = {proc / n_inc * 1e6:.0f} us per increment; load "
+          f"{os.getloadavg()[0]:.2f}")
+    for label, v in d.items():
+        print(f"    {label:48s} {v * 1e3:7.2f} ms  {v / n_inc * 1e6:6.1f} us per increment")
 
 
 def opensees_run(n_el, n_inc, tol, system="BandGeneral"):
@@ -111,7 +181,11 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--tol", type=float, default=1e-6)
     ap.add_argument("--system", default="BandGeneral", help="OpenSees linear system")
+    ap.add_argument("--no-folder", action="store_true",
+                    help="femast writes no results folder (out=None; the tip kept by an on_frame recorder)")
     ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--parts", action="store_true", help="print femast's CPU time by part per increment "
+                    "(--repeat runs, no OpenSees) and stop")
     ap.add_argument("--strict", action="store_true", help="femast's strict correction test only "
                     "(Convergence(predicted=False), the rule before issue 21's predicted correction)")
     ap.add_argument("--docs", action="store_true")
@@ -120,19 +194,24 @@ def main(argv=None):
     n_el, K = args.elements, args.increments
     tmp = Path(tempfile.mkdtemp(prefix="femast_bend45_"))
     femast_run(n_el, 2, args.tol, tmp / "warm")     # numba cache load, not timed
-    print(f"{n_el}-element 45-degree bend, {K} load increments, a frame per increment; load average "
+    print(f"{n_el}-element 45-degree bend, {K} load increments, "
+          f"{'no results folder (tip recorded in memory)' if args.no_folder else 'a frame per increment'}; load average "
           f"{os.getloadavg()[0]:.2f} (2 shared cores)")
+    if args.parts:
+        parts(n_el, K, args.tol, None if args.no_folder else tmp, args.repeat, predicted=not args.strict)
+        shutil.rmtree(tmp, ignore_errors=True)
+        return 0
     if args.profile:
         pr = cProfile.Profile()
         pr.enable()
-        femast_run(n_el, K, args.tol, tmp / "profile", predicted=not args.strict)
+        femast_run(n_el, K, args.tol, None if args.no_folder else tmp / "profile", predicted=not args.strict)
         pr.disable()
         s = io.StringIO()
         pstats.Stats(pr, stream=s).sort_stats("tottime").print_stats(25)
         print(s.getvalue())
     fr, orr = [], []
     for r in range(args.repeat):                    # interleaved
-        fr.append(femast_run(n_el, K, args.tol, tmp / f"run{r}", predicted=not args.strict))
+        fr.append(femast_run(n_el, K, args.tol, None if args.no_folder else tmp / f"run{r}", predicted=not args.strict))
         if ok_os:
             orr.append(opensees_run(n_el, K, args.tol, args.system))
     shutil.rmtree(tmp, ignore_errors=True)
@@ -172,23 +251,26 @@ def main(argv=None):
 
     fig, axes = plt.subplots(1, 2, figsize=(9.6, 3.8))
     for ax, key, what in ((axes[0], "cpu", "CPU"), (axes[1], "wall", "wall")):
-        ax.plot(np.arange(len(fr)) + 1, [r[key] / K * 1e6 for r in fr], "o-", label="femast (frames written)")
+        ax.plot(np.arange(len(fr)) + 1, [r[key] / K * 1e6 for r in fr], "o-", label="femast (" + ("no folder" if args.no_folder else "frames written") + ")")
         ax.plot(np.arange(len(orr)) + 1, [r[key] / K * 1e6 for r in orr], "s-", label=f"OpenSees ({args.system})")
         ax.set_xlabel("run (interleaved)")
+        ax.set_xticks(np.arange(len(fr)) + 1)
         ax.set_ylabel(f"{what} time per increment (us)")
         ax.set_ylim(bottom=0)
         ax.grid(alpha=0.3)
     axes[0].legend()
     axes[0].set_title(f"CPU: femast/OpenSees {ratio_cpu:.2f}")
     axes[1].set_title(f"wall: best {ratio_best:.2f}, median {ratio_med:.2f} (load {os.getloadavg()[0]:.1f})")
-    fig.suptitle(f"{n_el}-element 45-degree bend, {K} increments (target <= 0.5)")
+    fig.suptitle(f"{n_el}-element 45-degree bend, {K} increments (target <= 0.5)"
+                 + (", femast without a results folder" if args.no_folder else ""))
     fig.tight_layout()
     out = HERE.parent / "out"
     out.mkdir(exist_ok=True)
-    fig.savefig(out / "bend45_peer.png", dpi=120)
-    print(f"figure: {out / 'bend45_peer.png'}")
+    name = "bend45_peer_nofolder.png" if args.no_folder else "bend45_peer.png"
+    fig.savefig(out / name, dpi=120)
+    print(f"figure: {out / name}")
     if args.docs:
-        shutil.copy(out / "bend45_peer.png", HERE.parent.parent / "docs" / "figures" / "performance_bend45.png")
+        shutil.copy(out / name, HERE.parent.parent / "docs" / "figures" / ("performance_" + name.replace("_peer", "")))
     return 0
 
 

@@ -72,11 +72,11 @@ class ResultsOutput(Observer):
 
     @property
     def frames(self) -> int:
-        """Frames written (or queued) so far."""
+        """Frames written so far."""
         return self.writer.count if self.writer is not None else 0
 
     def flush(self):
-        """Wait until every queued frame is on disk."""
+        """Every frame is on the OS once written (kept for callers that name the frames on disk)."""
         if self.writer is not None:
             self.writer.flush()
 
