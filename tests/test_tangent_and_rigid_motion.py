@@ -138,3 +138,32 @@ def test_prescribed_large_rotation_of_free_frame_is_rigid():
     np.testing.assert_allclose(X + res.frame(-1)["U"], X @ Q.T, atol=1e-10)  # exact rigid motion
     assert np.abs(res.frame(-1)["RF"]).max() < 1e-6  # N, N m: no reaction to a rigid rotation
     assert res.node_history(n[0], "rz")[-1] == pytest.approx(7.0, abs=1e-12)
+
+
+def test_small_rotation_logarithm_agrees_with_atan2_form():
+    """The beam kernel's logarithm (series of atan below 0.02 rad, issue 21) against the atan2 form
+    of logm_so3: within a few ulps across the switch (two roundings of one quaternion; both are within
+    6e-16 of mpmath's logarithm of the same matrices), the same bits above it."""
+    from numba import njit
+
+    from femast.rotations import logm_so3_small_into
+
+    @njit
+    def small(R):
+        out = np.empty(3)
+        logm_so3_small_into(R, out)
+        return out
+
+    rng = np.random.default_rng(7)
+    for t in np.concatenate([np.geomspace(1e-14, 0.02, 200), rng.uniform(0.0199, 0.0201, 50), [0.5, 2.0, 3.1]]):
+        d = rng.normal(size=3)
+        v = t * d / np.linalg.norm(d)
+        R = expm_so3(v)
+        ref = logm_so3(R)
+        got = small(R)
+        if t > 0.0201:
+            assert np.array_equal(got, ref)       # the atan2 form itself
+        else:
+            assert np.abs(got - ref).max() <= 1e-15 * np.abs(ref).max()   # a few ulps: round-off of one quaternion
+            assert np.abs(got - v).max() <= 2e-15 * t                        # and of the exact vector
+    assert np.array_equal(small(np.eye(3)), np.zeros(3))

@@ -28,7 +28,7 @@ import math
 import numpy as np
 from numba import carray, njit
 
-from ..rotations import logm_so3_into, ts_inv_into, ts_inv_T_times_derivative_into
+from ..rotations import logm_so3_small_into, ts_inv_into, ts_inv_T_times_derivative_into
 from ._stack import stack_buffer
 from .base import ElementFamily, ElementResponse
 
@@ -142,7 +142,7 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_facto
             for i in range(3):
                 for j in range(3):
                     A[i, j] = Rr[0, i] * T[a, 0, j] + Rr[1, i] * T[a, 1, j] + Rr[2, i] * T[a, 2, j]
-            logm_so3_into(A, th[a])
+            logm_so3_small_into(A, th[a])
             ts_inv_into(th[a], Ti[a])
             qe[a, 0] = T[a, 1, 1] * Rr[2, 2] - T[a, 2, 1] * Rr[1, 2]
             qe[a, 1] = T[a, 2, 1] * Rr[0, 2] - T[a, 0, 1] * Rr[2, 2]
