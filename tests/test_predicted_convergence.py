@@ -82,6 +82,16 @@ def test_one_iteration_fewer_on_the_hardening_spring_within_the_tolerance(P, tol
     assert abs(u_strict - u_star) < abs(u - u_star)
 
 
+def test_the_increments_step_and_one_correction_are_not_a_rate():
+    # P = 0.1 N: nearly linear (u / U0 ~ 0.01); the strict rule accepts iteration 3.  Iteration 2's
+    # simplified correction would pass (the rule counted from k = 2 accepted it), but its one
+    # contraction is that of a correction against the increment's own first step: not a rate
+    it_strict, _ = _spring(0.1, predicted=False)
+    it, u = _spring(0.1)
+    assert it_strict == 3 and it == 3
+    assert abs(u - _u_star(0.1)) <= 1e-6 * abs(u)
+
+
 def test_a_provisional_iterate_is_not_accepted_on_its_prediction():
     P = 100.0
     u_star = _u_star(P)

@@ -161,3 +161,26 @@ def test_cli_run_restart(reference, tmp_path, capsys):
     _frames_equal(reference, Results(out))
     assert main(["run", str(script), "--restart", str(tmp_path / "nowhere")]) == 2
     assert "no restart point" in capsys.readouterr().err
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self/fd"), reason="names fsync'd files through /proc")
+def test_a_restart_point_makes_the_frames_it_names_durable_first(tmp_path, monkeypatch):
+    """Frames are not fsync'd one by one (a process kill loses nothing written; docs/results.md),
+    but a restart point is meant to survive a power cut too: the frame log is fsync'd before each
+    restart.json that names its frames, and no fsync happens between restart points."""
+    synced = []
+    real = os.fsync
+
+    def fsync(fd):
+        synced.append(os.path.basename(os.readlink(f"/proc/self/fd/{fd}")))
+        real(fd)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    m, _ = build()
+    fm.Analysis(m, tmp_path / "run", progress=False, restart_every=5).run()
+    points = [i for i, name in enumerate(synced) if name.startswith("restart.json")]
+    assert len(points) >= 4   # the start (names no frame), every 5 increments of 20 + 10, the steps' ends
+    assert LOG_NAME not in synced[:points[0]]
+    for i in points[1:]:
+        assert LOG_NAME in synced[:i][-3:], synced   # the log, just before (with the point's own files)
+    assert synced.count(LOG_NAME) == len(points) - 1   # and only then

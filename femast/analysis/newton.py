@@ -298,7 +298,8 @@ class Newton:
                 if it > 0:
                     ok, ratio, forces_ok, size = system.converged(conv, r, du, Du, responses, P, iters + whole)
                     sizes.append(size)
-                    early = not ok and forces_ok and predict and iters >= 2
+                    # (k >= 3: the first iteration is the increment's step, then two corrections of iterates)
+                    early = not ok and forces_ok and predict and iters >= 3
                     if (ok or early) and any(q.provisional for q in responses):
                         ok = early = False   # an element answered with a predictor, not its law (ElementResponse)
                     if early:   # the predicted next correction (convergence.py)

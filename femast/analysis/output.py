@@ -76,7 +76,7 @@ class ResultsOutput(Observer):
         return self.writer.count if self.writer is not None else 0
 
     def flush(self):
-        """Every frame is on the OS once written (kept for callers that name the frames on disk)."""
+        """Make every frame written so far durable (fsync of the frame log; a restart point names them)."""
         if self.writer is not None:
             self.writer.flush()
 

@@ -106,7 +106,7 @@ class RestartOutput(Observer):
 
     def save(self, analysis, step_done: bool):
         an, st, summary = analysis, analysis.state, analysis.summary
-        an.output.flush()   # (frames are written as increments converge: every one up to here is on disk)
+        an.output.flush()   # every frame up to here on disk (fsync'd) before the restart point names them
         self.saves += 1
         k = self.saves
         state_file, extra_file = f"state-{k}.npz", f"extra-{k}.npz"

@@ -30,10 +30,11 @@ analysis' own thread the moment its increment converges, before the analysis tel
 (``on_frame`` recorders, other observers) or starts the next increment.  Once written, the bytes
 belong to the operating system: a process killed outright (kill -9, the OOM killer) loses no
 increment it finished, and at most the record it was writing is cut short (ignored on reading).
-Nothing is fsync'd: the OS writes its cache to disk within seconds (Linux: ~30 s), and only a
-power cut or an OS crash in that window can lose the last increments; call :func:`os.sync` after
-a run that must survive one.  fsync of a small model's frame (1-10 ms on a VM's disk) would cost
-more than its increment.  A frame of a small model costs ~0.03 ms to encode and append (see
+Frames are not fsync'd one by one: the OS writes its cache to disk within seconds (Linux: ~30 s),
+and only a power cut or an OS crash in that window can lose the last increments; call
+:func:`os.sync` after a run that must survive one (restart points fsync the log before naming its
+frames: :meth:`ResultsWriter.flush`).  An fsync per frame (1-10 ms on a VM's disk) would cost a
+small model more than its increment.  A frame of a small model costs ~0.03 ms to encode and append (see
 ``Step.output_frequency`` and ``Analysis(out=None)``).  A write error (a full disk) is raised in
 the analysis at the frame that could not be written, and the summary says "failed".
 """
@@ -202,8 +203,12 @@ class ResultsWriter:
         raise OSError(f"could not write results to '{self.folder}': {exc}") from exc
 
     def flush(self):
-        """Nothing to wait for: frames and status lines are written as they come (kept for callers
-        that name the frames on disk, such as a restart point)."""
+        """Make the frames written so far durable: fsync of the frame log (they are already the
+        operating system's, written as they came).  A restart point calls this before it names them
+        (restart.py fsyncs its own files too), so that it holds after a power cut as well; one
+        fsync per restart point, none per frame."""
+        if self._log is not None:
+            os.fsync(self._log)
 
     def _running(self) -> dict:
         return {"status": "running", "completed": False, "pid": os.getpid(), "host": socket.gethostname(),

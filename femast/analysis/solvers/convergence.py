@@ -30,10 +30,11 @@ without iteration k + 1 when, with every correction measured as in the correctio
 entry over the field's increment, the larger of the two fields):
 
 * the force test passes and no element answered provisionally;
-* at least two corrections were taken in this attempt and the last one contracted:
-  rho = |du_k| / |du_(k-1)| <= ``max_contraction`` (never on one iteration's rate, never on a
-  non-contracting sequence: on the 1000-bay mast's soft mode |du_3| = 0.995 |du_2| while c~ still
-  looks small, and the true |du_4| is 15 times c~);
+* k >= 3: the first iteration of an increment is its step, so iterations 2 .. k are at least two
+  corrections of Newton iterates, and the last one contracted: rho = |du_k| / |du_(k-1)| <=
+  ``max_contraction`` (never on one iteration's rate, never on a non-contracting sequence: on the
+  1000-bay mast's soft mode |du_3| = 0.995 |du_2| while c~ still looks small, and the true |du_4|
+  is 15 times c~);
 * c~ contracts too: theta = |c~| / |du_k| <= ``max_contraction``;
 * the error left in iterate k, estimated as the geometric series c~ / (1 - theta), is at most
   half the correction tolerance: 2 |c~| / (1 - theta) <= ``disp_tol`` |Du|.  The factor 2 covers the
