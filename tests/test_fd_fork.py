@@ -99,3 +99,15 @@ def test_serial_while_another_thread_runs():
     finally:
         stop.set()
         t.join()
+
+
+def test_the_heap_is_unfrozen_after_the_children(forking):
+    import gc
+
+    from femast.experiments.refits import frozen_heap
+
+    fj.evaluate_many(_fun, [np.array([0.1, 0.2]), np.array([0.3, 0.4])], 7)
+    assert gc.get_freeze_count() == 0
+    with frozen_heap():
+        assert gc.get_freeze_count() > 0
+    assert gc.get_freeze_count() == 0

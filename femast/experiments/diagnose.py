@@ -47,6 +47,7 @@ from ..effects.base import applicable_effects, forms_of, get_effect, loaded_scri
 from ..errors import ModelError
 from .compare import analyse
 from .core import Experiment, Measured
+from .figure_process import FigureProcess
 from .figures import diagnose_figure, display_scale
 from .fitting import fit, params_table, predict
 from .noise import noise_model, pinned_rows
@@ -122,6 +123,19 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     document), ``executor``, ``files``, ``success``, ``message``.
     """
     exp.require_model("diagnose")
+    # the figure is drawn by a process forked now, which imports matplotlib while this one fits the
+    # baseline on the other CPU (FE experiments, local refits; issue 21)
+    figs = (FigureProcess.start() if out is not None and scheduler is None and exp.fit_options.get("expensive")
+            else None)
+    try:
+        return _diagnose(exp, data, candidates, base_effects=base_effects, workers=workers, scheduler=scheduler,
+                         out=out, pairs=pairs, figs=figs)
+    finally:
+        if figs is not None:
+            figs.close()
+
+
+def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, pairs, figs) -> OptimizeResult:
     if isinstance(base_effects, str):
         base_effects = [e for e in base_effects.split(",") if e.strip()]
     base_effects = [n for n, _ in resolve(exp, list(base_effects))]
@@ -167,9 +181,9 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     for c in candidates:
         jobs.append(("candidate", c, c, base_effects + [c], start))
     payloads = [{**payload0, "effects": effs, "start": st} for *_, effs, st in jobs]
-    # the report's matplotlib is imported while the worker processes refit (issue 21)
+    # without a figure process, the report's matplotlib is imported while the worker processes refit
     fits_list, how = _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base,
-                               while_waiting=_import_pyplot if out is not None else None)
+                               while_waiting=_import_pyplot if out is not None and figs is None else None)
     s_pre = score(baseline, models, chans, data.n)
     jobs2 = []
     for (stage, c, spec, _, _), res in zip(jobs, fits_list):
@@ -329,7 +343,10 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     if out is not None:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
-        result.files["png"] = str(diagnose_figure(exp, data, result, out / "diagnose.png"))
+        png = out / "diagnose.png"
+        if figs is None or not figs.draw(diagnose_figure, exp, data, result, png):
+            diagnose_figure(exp, data, result, png)
+        result.files["png"] = str(png)
         result.files["json"] = str(out / "diagnose.json")
         result.files["html"] = str(out / "diagnose_report.html")
         report["files"] = result.files
