@@ -23,6 +23,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from ..post.frame_coder import SCALARS, FrameCoder
 from ..post.results import NullWriter, ResultsWriter
 from ..rotations import rotation_vectors
 
@@ -55,6 +56,7 @@ class ResultsOutput(Observer):
         self.recorders = [r for r in recorders if r is not None]
         self.writer = None
         self.pending = None   # a converged increment not written yet (Step.output_frequency)
+        self.coder, self.coders_made = None, 0   # frames encoded from the state (frame_coder.py)
 
     @property
     def active(self) -> bool:
@@ -111,8 +113,19 @@ class ResultsOutput(Observer):
         if not self.active:
             return
         st, sys_ = analysis.state, analysis.system
-        n = len(sys_.X0)
         converged = responses is not None   # (the initial frame has no reactions)
+        if responses is None:
+            responses = sys_.evaluate(sys_.committed_context())
+        outputs = {f.name: r.output for f, r in zip(analysis.families, responses)}
+        scalars = (step_name, inc, time, st.total_time, st.lam, iterations, st.strain_energy,
+                   st.stabilization_energy)
+        if self.coder is not None and not self.recorders:   # a folder only: the run's frames repeat one layout
+            record = self.coder.record(scalars, st.x, sys_.X0, st.R, st.spin, st.loads, sys_.cons_node,
+                                       sys_.cons_dof, st.reactions if converged else None, outputs)
+            if record is not None:
+                self.writer.append(record)
+                return
+        n = len(sys_.X0)
 
         def reactions():
             RF = np.zeros((n, 6))
@@ -122,12 +135,7 @@ class ResultsOutput(Observer):
 
         state = {"U": lambda: st.x - sys_.X0, "R": lambda: st.R.copy(), "UR": lambda: rotation_vectors(st.R),
                  "URA": lambda: st.spin.copy(), "RF": reactions, "P": lambda: st.loads.copy()}
-        data = {"step": step_name, "increment": inc, "time": time, "total_time": st.total_time,
-                "load_factor": st.lam, "iterations": iterations,
-                "strain_energy": st.strain_energy, "stabilization_energy": st.stabilization_energy}
-        if responses is None:
-            responses = sys_.evaluate(sys_.committed_context())
-        outputs = {f.name: r.output for f, r in zip(analysis.families, responses)}
+        data = dict(zip(SCALARS, scalars))
         if isinstance(self.writer, NullWriter):
             # recorders only (out=None): a frame that computes what a recorder reads (issue 21: an FE
             # experiment reads a few arrays of each increment); one kept by a recorder is completed
@@ -147,6 +155,9 @@ class ResultsOutput(Observer):
             for key, val in out.items():
                 data[f"el/{name}/{key}"] = val
         self.writer.frame(**data)
+        if not self.recorders and self.coders_made < 8:   # (made again after a new step name; not forever)
+            self.coders_made += 1
+            self.coder = FrameCoder.make(data, n)
         for record in self.recorders:
             record(data)
 

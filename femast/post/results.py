@@ -198,6 +198,14 @@ class ResultsWriter:
             self._failed(exc)
         self.count += 1
 
+    def append(self, record: bytes):
+        """Append one frame already encoded as a frame-log record (:class:`~femast.post.frame_coder.FrameCoder`)."""
+        try:
+            append_record(self._log, record)
+        except OSError as exc:
+            self._failed(exc)
+        self.count += 1
+
     def _failed(self, exc):
         self._error = exc
         raise OSError(f"could not write results to '{self.folder}': {exc}") from exc
