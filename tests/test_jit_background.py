@@ -78,20 +78,25 @@ def test_interpreted_kernels_give_the_compiled_results_bit_for_bit(tmp_path, mod
     assert np.array_equal(np.array(interp["v"]), np.array(compiled["v"]))   # bit for bit, no tolerance
 
 
+# child-process code: records the name of every kernel numba compiles in that process
+COMPILE_LISTENER = textwrap.dedent("""
+    from numba.core import event
+    compiled_here = []
+    class L(event.Listener):
+        def on_start(self, ev): compiled_here.append(ev.data["dispatcher"].py_func.__name__)
+        def on_end(self, ev): pass
+    event.register("numba:compile", L())
+""")
+
+
 def test_worker_fills_the_cache_and_the_next_call_loads_it(tmp_path):
     """With an empty cache the first call runs interpreted (nothing compiled in this process), a
     worker compiles the kernel into the cache and drops its claim, and the next call loads the
     compiled code from the cache (a cache hit, still no compile here)."""
-    code = textwrap.dedent("""
+    code = COMPILE_LISTENER + textwrap.dedent("""
         import json, time, glob, numpy as np
-        from numba.core import event
         import femast
         from femast import jit, rotations
-        compiled_here = []
-        class L(event.Listener):
-            def on_start(self, ev): compiled_here.append(ev.data["dispatcher"].py_func.__name__)
-            def on_end(self, ev): pass
-        event.register("numba:compile", L())
         jit.prepare()
         R = rotations.expm_so3.py_func(np.array([0.3, -0.2, 0.5]))
         first = rotations.logm_so3(R)
@@ -137,14 +142,8 @@ def test_helpers_of_interpreted_kernels_are_interpreted_not_compiled(tmp_path):
     """The band solver's residual kernels share an inlined helper (their maxima), and the two
     scatter encodings one kernel: run interpreted (an empty cache), they compile nothing in the
     foreground, the helper included, and give the direct sums' results."""
-    code = textwrap.dedent("""
+    code = COMPILE_LISTENER + textwrap.dedent("""
         import json, numpy as np, scipy.sparse as sp
-        from numba.core import event
-        compiled_here = []
-        class L(event.Listener):
-            def on_start(self, ev): compiled_here.append(ev.data["dispatcher"].py_func.__name__)
-            def on_end(self, ev): pass
-        event.register("numba:compile", L())
         from femast import jit_background
         from femast.analysis import assembly
         from femast.analysis.solvers import banded
