@@ -168,7 +168,7 @@ def test_helpers_of_interpreted_kernels_are_interpreted_not_compiled(tmp_path):
         data = np.full(4, 7.0)    # the first entry of each position assigns: no zeroing needed
         assembly._scatter_matrix(k, assembly.assigning_positions([pos], 4)[0], data)
         print(json.dumps({"compiled_here": compiled_here, "csc": list(csc), "split": list(split),
-                          "r_csc": r_csc.tolist(), "r": r.tolist(), "ref": (rhs - D @ x).tolist(),
+                          "r_csc": r_csc.tolist(), "r": r.tolist(), "ref": (rhs - D @ x).tolist(), "rhs": rhs.tolist(),
                           "rows": float(np.abs(D).sum(axis=1).max()), "data": data.tolist(), "plain": plain.tolist(),
                           "k": k.tolist()}))
     """)
@@ -179,6 +179,7 @@ def test_helpers_of_interpreted_kernels_are_interpreted_not_compiled(tmp_path):
     ref = np.array(out["ref"])
     assert np.allclose(out["r"], ref, rtol=0, atol=1e-14 * np.abs(ref).max())   # r = rhs - B x to round-off
     assert out["csc"][0] == np.abs(out["r"]).max() and np.isclose(out["csc"][1], out["rows"], rtol=1e-15)
+    assert out["csc"][3] == np.abs(out["rhs"]).max()
     k = np.array(out["k"])
     # -1 is outside; the sums of the entries at each position, in scatter order
     expected = [k[0, 0, 0] + k[1, 0, 0] + k[2, 1, 1], k[0, 0, 1] + k[1, 0, 1], k[0, 1, 1] + k[1, 1, 0],
