@@ -39,5 +39,10 @@ class StudyError(FemastError, ValueError):
     that matches nothing, a scheduler that cannot be reached.  Raised before any sample runs."""
 
 
+class ResultsWriteError(FemastError, OSError):
+    """A results folder could not be written (a full disk, a folder that became read-only): the
+    run stops at the frame that could not be written and its summary says "failed"."""
+
+
 class SampleTimeout(FemastError):
     """A sample of a study ran longer than the study's ``timeout_s`` (it is recorded as failed)."""

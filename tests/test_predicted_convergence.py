@@ -205,3 +205,63 @@ def test_scaled_size_is_the_correction_test_measure():
 def test_bad_max_contraction_is_a_model_error(bad):
     with pytest.raises(ModelError, match="max_contraction"):
         Convergence(max_contraction=bad)
+
+
+@pytest.mark.parametrize("is_rot", [[False, False, True, True], [True, True, True, True], [False] * 4, []],
+                         ids=["both fields", "rotations only", "translations only", "no DOFs"])
+def test_measure_reports_the_scaled_size_of_every_field_layout(is_rot):
+    """Convergence.measure's correction size (computed from the correction test's own maxima) equals
+    scaled_size for mixed, rotation-only, translation-only and empty fields, NaN included, and the
+    correction test passes exactly when that size is within disp_tol."""
+    c = Convergence()
+    mask = np.array(is_rot, dtype=bool)
+    n, L = mask.size, 3.0
+    rng = np.random.default_rng(5)
+    Du_cases = [rng.normal(size=n), np.zeros(n), rng.normal(size=n) * 1e-12]   # (floors for the last two)
+    for Du in Du_cases:
+        for scale in (1e-3, 1e-7, 0.0):
+            du = rng.normal(size=n) * scale * (np.abs(Du).max(initial=0.0) + 1e-9)
+            ok, _, forces, size = c.measure(np.zeros(n), du, Du, mask, 1.0, 1.0, L, iteration=5)
+            want = scaled_size(du, Du, mask, L)
+            assert size == want   # the same arithmetic: the same bits
+            assert forces and ok == (size <= c.disp_tol)
+    if n:
+        du = np.zeros(n)
+        du[-1] = math.nan
+        _, _, _, size = c.measure(np.zeros(n), du, np.ones(n), mask, 1.0, 1.0, L, iteration=5)
+        assert math.isnan(size) and math.isnan(scaled_size(du, np.ones(n), mask, L))
+    else:
+        assert scaled_size(np.zeros(0), np.zeros(0), mask, L) == 0.0
+
+
+@pytest.mark.parametrize("bad", ["half", None, math.nan])
+def test_max_contraction_that_is_not_a_number_is_a_model_error(bad):
+    with pytest.raises(ModelError, match="max_contraction"):
+        Convergence(max_contraction=bad)
+
+
+def test_a_stabilised_step_accepted_on_its_prediction_stays_within_the_tolerance():
+    """A viscously stabilised step of a truss model (translations only: no rotation field): the rule
+    accepts an iterate early there too, each frame stays within disp_tol of the strict run's
+    (times that increment's largest displacement), and the unstabilised step after it reaches the
+    equilibrium that scipy's fsolve gives for the two-bar system (tests/test_stabilize.py)."""
+    from test_stabilize import _exact_equilibrium, _guyed_mast
+
+    tol = fm.Convergence().disp_tol
+    runs = {}
+    for predicted in (False, True):
+        m, top = _guyed_mast(fm.Stabilize(), second_step=True)
+        frames = []
+        an = Analysis(m, None, progress=False, convergence=fm.Convergence(predicted=predicted),
+                      on_frame=lambda fr: frames.append(np.array(fr["U"])))
+        an.run()
+        runs[predicted] = (an.summary.steps[0]["iterations"], frames)
+    (it_strict, strict), (it_pred, pred) = runs[False], runs[True]
+    assert it_pred < it_strict   # the stabilised step took at least one early acceptance
+    assert len(pred) == len(strict)
+    for k in range(1, len(pred)):
+        assert np.abs(pred[k] - strict[k]).max() <= tol * np.abs(strict[k] - strict[k - 1]).max()
+    x_exact, z_exact = _exact_equilibrium()
+    pos = m.coordinates[m.index(top)] + pred[-1][m.index(top)]
+    # the force tolerance 1e-6 of ~400 N with stiffnesses ~1e5..1e7 N/m: ~1e-9 m (as test_stabilize)
+    assert pos[0] == pytest.approx(x_exact, abs=1e-9) and pos[2] == pytest.approx(z_exact, abs=1e-9)

@@ -194,6 +194,29 @@ def test_writer_keeps_every_frame_and_reports_a_write_error_at_once(tmp_path):
     assert s["status"] == "failed" and "No space left" in s["message"]
 
 
+def test_a_full_disk_at_the_start_is_a_named_error_and_a_failed_summary(tmp_path, monkeypatch):
+    """The mesh cannot be written (the disk is full when the run starts): a femast error naming the
+    folder (not a raw OSError), and the summary says "failed" (not "running" forever)."""
+    if not os.path.exists("/dev/full"):
+        pytest.skip("no /dev/full to stand for a full disk")
+    import femast.post.results as results
+    from femast.errors import FemastError, ResultsWriteError
+
+    def full_disk(path, **arrays):   # the OS's own ENOSPC
+        with open("/dev/full", "wb") as fh:
+            fh.write(b"x" * 8192)
+            fh.flush()
+
+    monkeypatch.setattr(results, "_atomic_savez", full_disk)
+    m, _ = _frame_model(1)
+    with pytest.raises(ResultsWriteError, match=r"could not write results to '.*r'.*No space left") as err:
+        fm.Analysis(m, tmp_path / "r", progress=False).run()
+    assert isinstance(err.value, FemastError) and isinstance(err.value, OSError)   # (caught as either)
+    s = json.loads((tmp_path / "r" / "summary.json").read_text())
+    assert s["status"] == "failed" and "No space left" in s["message"]
+    assert not list((tmp_path / "r").glob("*.tmp"))
+
+
 class _NaNTangent(ElementFamily):
     """A spring between the x DOFs of its two nodes whose tangent carries a NaN off the diagonal."""
 

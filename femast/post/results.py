@@ -35,8 +35,9 @@ and only a power cut or an OS crash in that window can lose the last increments;
 :func:`os.sync` after a run that must survive one (restart points fsync the log before naming its
 frames: :meth:`ResultsWriter.flush`).  An fsync per frame (1-10 ms on a VM's disk) would cost a
 small model more than its increment.  A frame of a small model costs ~0.03 ms to encode and append (see
-``Step.output_frequency`` and ``Analysis(out=None)``).  A write error (a full disk) is raised in
-the analysis at the frame that could not be written, and the summary says "failed".
+``Step.output_frequency`` and ``Analysis(out=None)``).  A write error (a full disk) raises
+:class:`~femast.errors.ResultsWriteError` in the analysis at the frame that could not be written (or
+at the start, if the mesh cannot be), and the summary says "failed".
 """
 
 from __future__ import annotations
@@ -54,7 +55,7 @@ from pathlib import Path
 import numpy as np
 
 from ..elements.base import DOF_NAMES
-from ..errors import FemastError
+from ..errors import FemastError, ResultsWriteError
 from .npz import (LOG_NAME, RECORD_MAGIC, TMP_SUFFIX, append_record, atomic_savez as _atomic_savez,  # noqa: F401
                   npz_bytes as _npz_bytes, record_bytes, scan_log, truncate_log)
 
@@ -140,6 +141,26 @@ class ResultsWriter:
         later frames and partial files are removed; status lines are appended)."""
         self.folder = prepare_folder(folder)
         self._started = _time.time()
+        self.count = resume or 0
+        self._error = None
+        self._log = self._sta = None
+        try:
+            self._start(model, families, resume)
+        except OSError as exc:   # a full disk, a read-only folder: named, and the summary says "failed"
+            self._close_files()
+            self._error = exc
+            try:
+                self._write_summary({"status": "failed", "completed": False,
+                                     "message": f"ResultsWriteError: {self._message(exc)}"})
+            except OSError:
+                pass
+            raise ResultsWriteError(self._message(exc)) from exc
+        except BaseException:
+            self._close_files()
+            raise
+
+    def _start(self, model, families, resume):
+        """The summary "running", the old frames cleared, the mesh, the frame log and status file opened."""
         # the stale summary of an earlier run goes first: a kill from here on leaves "running"
         write_json_atomic(self.folder / "summary.json", self._running())
         frames = self.folder / "frames"
@@ -161,22 +182,14 @@ class ResultsWriter:
         for f in families:
             mesh[f"conn/{f.name}"] = model.node_labels[np.asarray(f.nodes)]
             mesh[f"labels/{f.name}"] = np.asarray(getattr(f, "labels", np.arange(1, f.n_elements + 1)))
-        self.count = resume or 0
-        self._error = None
-        self._log = self._sta = None
-        try:
-            _atomic_savez(self.folder / "mesh.npz", **mesh)   # (replaces an earlier run's)
-            self._log = os.open(log, _APPEND, 0o666)
-            self._sta = os.open(self.folder / "status.sta", _APPEND | (0 if resume is not None else os.O_TRUNC),
-                                0o666)
-            if resume is not None:
-                self._write_line(f"{'':>12} restarted from frame {resume}\n")
-            else:
-                self._write_line(f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} "
-                                 f"{'TOTAL TIME':>11} {'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n")
-        except BaseException:
-            self._close_files()
-            raise
+        _atomic_savez(self.folder / "mesh.npz", **mesh)   # (replaces an earlier run's)
+        self._log = os.open(log, _APPEND, 0o666)
+        self._sta = os.open(self.folder / "status.sta", _APPEND | (0 if resume is not None else os.O_TRUNC), 0o666)
+        if resume is not None:
+            self._write_line(f"{'':>12} restarted from frame {resume}\n")
+        else:
+            self._write_line(f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} "
+                             f"{'TOTAL TIME':>11} {'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n")
 
     def status(self, step, inc, attempt, iterations, time, total_time, dtime, lam, note=""):
         """Write one status line to ``status.sta`` (one unbuffered append)."""
@@ -206,9 +219,13 @@ class ResultsWriter:
             self._failed(exc)
         self.count += 1
 
+    def _message(self, exc) -> str:
+        return (f"could not write results to '{self.folder}': {exc.strerror or exc}; free disk space or give "
+                "the analysis another results folder (out=)")
+
     def _failed(self, exc):
         self._error = exc
-        raise OSError(f"could not write results to '{self.folder}': {exc}") from exc
+        raise ResultsWriteError(self._message(exc)) from exc
 
     def flush(self):
         """Make the frames written so far durable: fsync of the frame log (they are already the
@@ -233,10 +250,12 @@ class ResultsWriter:
         """Close the frame log and the status file and write the final summary (``summary["status"]``
         says how the run ended; "failed" if a frame could not be written)."""
         self._close_files()
+        self._write_summary(summary)
+
+    def _write_summary(self, summary: dict):
         final = {**summary, "pid": os.getpid(), "host": socket.gethostname(), "started": self._started}
         if self._error is not None and final.get("status") == "completed":
-            final.update(status="failed", completed=False,
-                         message=f"could not write results to '{self.folder}': {self._error}")
+            final.update(status="failed", completed=False, message=f"ResultsWriteError: {self._message(self._error)}")
         write_json_atomic(self.folder / "summary.json", final)
 
 
@@ -289,7 +308,8 @@ class Results:
         if self.partial:
             warnings.warn(f"{self.folder}: ignoring {len(self.partial)} partial or foreign file(s) in frames/ "
                           f"({', '.join(self.partial[:5])}{', ...' if len(self.partial) > 5 else ''}"
-                          "): left by a run that was killed while writing", ResultsWarning, stacklevel=2)
+                          "): left by a run that was killed (or whose disk filled up) while writing", ResultsWarning,
+                          stacklevel=2)
         self._cache = {}
         sfile = self.folder / "summary.json"
         self.summary = None

@@ -137,7 +137,11 @@ class Convergence:
     max_contraction: float = 0.5
 
     def __post_init__(self):
-        if not 0.0 < float(self.max_contraction) < 1.0:
+        try:
+            ok = 0.0 < float(self.max_contraction) < 1.0   # (NaN: no)
+        except (TypeError, ValueError):   # not a number
+            ok = False
+        if not ok:
             raise ModelError(f"Convergence: max_contraction={self.max_contraction!r} must be between 0 and 1 "
                              "(e.g. 0.5)")
 
