@@ -87,17 +87,6 @@ def test_interpreted_kernels_give_the_compiled_results_bit_for_bit(tmp_path, mod
     assert np.array_equal(np.array(interp["v"]), np.array(compiled["v"]))   # bit for bit, no tolerance
 
 
-# child-process code: records the name of every kernel numba compiles in that process
-COMPILE_LISTENER = textwrap.dedent("""
-    from numba.core import event
-    compiled_here = []
-    class L(event.Listener):
-        def on_start(self, ev): compiled_here.append(ev.data["dispatcher"].py_func.__name__)
-        def on_end(self, ev): pass
-    event.register("numba:compile", L())
-""")
-
-
 def test_worker_fills_the_cache_and_the_next_call_loads_it(tmp_path):
     """With an empty cache the first call runs interpreted (nothing compiled in this process), a
     worker compiles the kernel into the cache and drops its claim, and the next call loads the
