@@ -3,6 +3,7 @@
 bit for bit; a child that fails is replaced by this process; serial where forking is unsafe."""
 
 import os
+import sys
 import threading
 
 import numpy as np
@@ -10,8 +11,8 @@ import pytest
 
 from femast.experiments import fe_jacobian as fj
 
-pytestmark = pytest.mark.skipif(not hasattr(os, "fork") or (os.cpu_count() or 1) < 2,
-                                reason="needs fork and two CPUs")
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux") or (os.cpu_count() or 1) < 2,
+                                reason="needs Linux (fork) and two CPUs")
 
 
 @pytest.fixture

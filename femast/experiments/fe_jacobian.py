@@ -11,6 +11,7 @@ and gives registered starts back bit for bit (so the run cache answers them).  U
 from __future__ import annotations
 
 import os
+import sys
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -104,10 +105,12 @@ FORK_COLUMNS = True   # evaluate a Jacobian's finite-difference columns in this 
 
 
 def _fork_ok(n_points: int) -> bool:
-    """Columns may be split with a forked child: several to compute, a second CPU, fork available, this
+    """Columns may be split with a forked child: several to compute, a second CPU, Linux's fork, this
     the main and only thread of a process that is not itself a worker of a pool (whose cores are taken:
     the refits of diagnose), and numba not running GNU OpenMP threads (a forked child of those aborts)."""
     if not FORK_COLUMNS or n_points < 2 or not hasattr(os, "fork") or (os.cpu_count() or 1) < 2:
+        return False
+    if not sys.platform.startswith("linux"):   # (where fork is multiprocessing's default; macOS: not safe)
         return False
     import multiprocessing
     import threading
