@@ -13,6 +13,15 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+# The start of a child script that lists the kernels compiled in its own process (compiled_here).
+COMPILE_LISTENER = textwrap.dedent("""
+    from numba.core import event
+    compiled_here = []
+    class L(event.Listener):
+        def on_start(self, ev): compiled_here.append(ev.data["dispatcher"].py_func.__name__)
+        def on_end(self, ev): pass
+    event.register("numba:compile", L())
+""")
 
 # A beam cantilever with a truss brace, bent and twisted through large rotations, then unloaded:
 # every kernel of the core path (beam and truss families, configuration update, assembly,
