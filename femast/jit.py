@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import os
 import sys
+import threading
 import time
 
 # cold compile CPU time of the main kernels, s (numba 0.68, one core of the development machine,
@@ -54,6 +55,7 @@ MEMO_KERNELS = frozenset({"femast.analysis.assembly._pattern_kernel",
                           "femast.analysis.solvers.ordering._permuted_csc"})
 MEMO_ENTRIES = 16
 _MEMO: dict = {}
+_MEMO_LOCK = threading.Lock()   # (models built in threads: a Study on dask threads)
 
 
 def _memo_key(kernel, args):
@@ -94,9 +96,11 @@ def setup_call(kernel, n_items: int, *args):
     hit = _MEMO.get(key)
     if hit is None:
         hit = kernel.py_func(*args)
-        if len(_MEMO) >= MEMO_ENTRIES:
-            _MEMO.pop(next(iter(_MEMO)))   # the oldest entry
-        _MEMO[key] = _copy_result(hit)
+        kept = _copy_result(hit)
+        with _MEMO_LOCK:
+            while _MEMO and len(_MEMO) >= MEMO_ENTRIES:
+                _MEMO.pop(next(iter(_MEMO)))   # the oldest entry
+            _MEMO[key] = kept
         return hit
     return _copy_result(hit)
 

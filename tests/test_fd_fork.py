@@ -112,3 +112,66 @@ def test_the_heap_is_unfrozen_after_the_children(forking):
     with frozen_heap():
         assert gc.get_freeze_count() > 0
     assert gc.get_freeze_count() == 0
+
+
+def _gone(pid):
+    """The process ``pid`` has ended and was reaped (no zombie, no orphan)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    return False
+
+
+def test_an_error_here_ends_the_child_at_once(forking, tmp_path):
+    """An error (or Ctrl-C) in this process's share: the child's points are not waited for; it is
+    killed and reaped before the error goes on."""
+    import time
+
+    parent = os.getpid()
+    pid_file = tmp_path / "child.pid"
+
+    def fun(u):
+        if os.getpid() != parent:
+            pid_file.write_text(str(os.getpid()))
+            time.sleep(60.0)   # a long FE run
+            return np.zeros(2)
+        time.sleep(0.5)        # (the child has started its run)
+        raise KeyboardInterrupt
+
+    t0 = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        fj.evaluate_many(fun, [np.array([1.0]), np.array([2.0])], 2)
+    assert time.monotonic() - t0 < 30.0   # not the child's 60 s
+    assert _gone(int(pid_file.read_text()))
+
+
+def test_a_stuck_child_is_killed_and_its_points_computed_here(forking, tmp_path, monkeypatch):
+    import time
+
+    monkeypatch.setattr(fj, "CHILD_WAIT", 1.0)
+    monkeypatch.setattr(fj, "CHILD_WAIT_MIN_S", 0.5)
+    parent = os.getpid()
+    pid_file = tmp_path / "child.pid"
+
+    def fun(u):
+        if os.getpid() != parent:
+            pid_file.write_text(str(os.getpid()))
+            time.sleep(60.0)   # stuck (e.g. on a lock that fork copied)
+        return np.full(3, u[0])
+
+    t0 = time.monotonic()
+    got = fj.evaluate_many(fun, [np.array([1.0]), np.array([2.0]), np.array([3.0])], 3)
+    assert time.monotonic() - t0 < 30.0
+    assert [g[0] for g in got] == [1.0, 2.0, 3.0]
+    assert _gone(int(pid_file.read_text()))
+
+
+def test_serial_off_linux(monkeypatch):
+    """fork is used on Linux only (macOS: not safe with its system libraries; Windows: none)."""
+    monkeypatch.setattr(fj, "_only_thread", lambda: True)
+    monkeypatch.setattr(sys, "platform", "darwin")
+    assert fj._fork_ok(4) is False
+    calls = []
+    got = fj.evaluate_many(lambda u: calls.append(os.getpid()) or np.zeros(1), [np.zeros(1)] * 3, 1)
+    assert len(got) == 3 and set(calls) == {os.getpid()}

@@ -72,3 +72,23 @@ def test_closed_without_a_request(forking):
 def test_no_child_where_forking_is_unsafe(monkeypatch):
     monkeypatch.setattr(fj, "_only_thread", lambda: False)
     assert FigureProcess.start() is None
+
+
+def _stuck(png):
+    import time
+
+    time.sleep(60.0)
+
+
+def test_a_stuck_child_is_killed_and_the_caller_draws(tmp_path, forking, monkeypatch):
+    import time
+
+    from femast.experiments import figure_process
+
+    monkeypatch.setattr(figure_process, "FIGURE_WAIT_S", 1.0)
+    fp = FigureProcess.start()
+    pid = fp.pid
+    t0 = time.monotonic()
+    assert not fp.draw(_stuck, tmp_path / "d.png")
+    assert time.monotonic() - t0 < 30.0   # not the child's 60 s
+    assert _reaped(pid)

@@ -13,6 +13,15 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+# The start of a child script that lists the kernels compiled in its own process (compiled_here).
+COMPILE_LISTENER = textwrap.dedent("""
+    from numba.core import event
+    compiled_here = []
+    class L(event.Listener):
+        def on_start(self, ev): compiled_here.append(ev.data["dispatcher"].py_func.__name__)
+        def on_end(self, ev): pass
+    event.register("numba:compile", L())
+""")
 
 # A beam cantilever with a truss brace, bent and twisted through large rotations, then unloaded:
 # every kernel of the core path (beam and truss families, configuration update, assembly,
@@ -76,17 +85,6 @@ def test_interpreted_kernels_give_the_compiled_results_bit_for_bit(tmp_path, mod
     assert compiled["n_hooked"] == 0 and interp["n_hooked"] > 5
     assert interp["it"] == compiled["it"]
     assert np.array_equal(np.array(interp["v"]), np.array(compiled["v"]))   # bit for bit, no tolerance
-
-
-# child-process code: records the name of every kernel numba compiles in that process
-COMPILE_LISTENER = textwrap.dedent("""
-    from numba.core import event
-    compiled_here = []
-    class L(event.Listener):
-        def on_start(self, ev): compiled_here.append(ev.data["dispatcher"].py_func.__name__)
-        def on_end(self, ev): pass
-    event.register("numba:compile", L())
-""")
 
 
 def test_worker_fills_the_cache_and_the_next_call_loads_it(tmp_path):
@@ -168,7 +166,7 @@ def test_helpers_of_interpreted_kernels_are_interpreted_not_compiled(tmp_path):
         data = np.full(4, 7.0)    # the first entry of each position assigns: no zeroing needed
         assembly._scatter_matrix(k, assembly.assigning_positions([pos], 4)[0], data)
         print(json.dumps({"compiled_here": compiled_here, "csc": list(csc), "split": list(split),
-                          "r_csc": r_csc.tolist(), "r": r.tolist(), "ref": (rhs - D @ x).tolist(),
+                          "r_csc": r_csc.tolist(), "r": r.tolist(), "ref": (rhs - D @ x).tolist(), "rhs": rhs.tolist(),
                           "rows": float(np.abs(D).sum(axis=1).max()), "data": data.tolist(), "plain": plain.tolist(),
                           "k": k.tolist()}))
     """)
@@ -179,6 +177,7 @@ def test_helpers_of_interpreted_kernels_are_interpreted_not_compiled(tmp_path):
     ref = np.array(out["ref"])
     assert np.allclose(out["r"], ref, rtol=0, atol=1e-14 * np.abs(ref).max())   # r = rhs - B x to round-off
     assert out["csc"][0] == np.abs(out["r"]).max() and np.isclose(out["csc"][1], out["rows"], rtol=1e-15)
+    assert out["csc"][3] == np.abs(out["rhs"]).max()
     k = np.array(out["k"])
     # -1 is outside; the sums of the entries at each position, in scatter order
     expected = [k[0, 0, 0] + k[1, 0, 0] + k[2, 1, 1], k[0, 0, 1] + k[1, 0, 1], k[0, 1, 1] + k[1, 1, 0],

@@ -269,3 +269,28 @@ def test_kill_9_loses_no_increment_the_run_reported_converged(tmp_path, reports,
     sta = [line.split() for line in (out / "status.sta").read_text().splitlines()[1:]]
     named = [int(row[1]) for row in sta if len(row) >= 8]
     assert named and max(named) <= len(res) - 1   # a status line never runs ahead of its frame
+
+
+def test_the_frame_log_reads_where_it_cannot_be_memory_mapped(tmp_path, monkeypatch):
+    """scan_log maps the log to read its record headers; on a file system that cannot map files
+    (some network and FUSE mounts) it reads them one by one: the same records, the torn tail too."""
+    import mmap
+
+    from femast.post import npz
+
+    log = tmp_path / "frames.npzs"
+    frames = [{"U": np.full((2, 3), float(k)), "step": "s"} for k in range(3)]
+    with open(log, "wb") as fh:
+        for fr in frames:
+            fh.write(npz.record_bytes(fr))
+        fh.write(npz.record_bytes(frames[0])[:40])   # a record cut short
+    mapped = npz.scan_log(log)
+
+    def no_mmap(*args, **kw):
+        raise OSError(19, "No such device")   # what mmap gives on a file system without it
+
+    monkeypatch.setattr(mmap, "mmap", no_mmap)
+    read = npz.scan_log(log)
+    assert read == mapped and len(read[0]) == 3 and read[1] == 40
+    got = list(npz.read_log(log))
+    assert [float(g["U"][0, 0]) for g in got] == [0.0, 1.0, 2.0]

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import sys
+import time
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -175,12 +176,16 @@ def evaluate_many(fun, points, size: int) -> list:
         finally:
             os._exit(code)
     os.close(wr)
+    mine = None
+    t0 = time.monotonic()
     try:
         mine = [fun(p) for p in points[:k]]
     finally:
-        with os.fdopen(rd, "rb") as fh:
-            data = fh.read()
-        _, status = os.waitpid(pid, 0)
+        # an error or Ctrl-C here: the child's points are not wanted, it is ended at once (no wait for
+        # its runs, no orphan); else it gets CHILD_WAIT x this process's time for its share (a child
+        # stuck on a lock that fork copied: killed, and its points computed here)
+        wait_s = 0.0 if mine is None else max(CHILD_WAIT * (time.monotonic() - t0), CHILD_WAIT_MIN_S)
+        data, status = _child_answer(pid, rd, wait_s)
         gc.unfreeze()
     n = len(points) - k
     if status == 0 and len(data) == 8 * size * n:
@@ -188,6 +193,46 @@ def evaluate_many(fun, points, size: int) -> list:
     else:
         theirs = [fun(p) for p in points[k:]]
     return mine + theirs
+
+
+CHILD_WAIT = 4.0          # the forked child's share may take this many times this process's share ...
+CHILD_WAIT_MIN_S = 60.0   # ... or this long (s), whichever is longer, before it is taken for stuck
+
+
+def _child_answer(pid: int, rd: int, wait_s: float) -> tuple[bytes, int]:
+    """(bytes the child wrote to the pipe ``rd`` until it closed it, its wait status), the child reaped;
+    a child that has not closed the pipe within ``wait_s`` seconds (0: at once), or when this process
+    is interrupted while waiting, is killed first (status then not 0).  ``rd`` is closed."""
+    import select
+
+    chunks = []
+    end = time.monotonic() + wait_s
+    closed = False
+    try:
+        while True:
+            left = end - time.monotonic()
+            if left <= 0.0 or not select.select([rd], [], [], left)[0]:
+                break
+            chunk = os.read(rd, 1 << 16)
+            if not chunk:
+                closed = True
+                break
+            chunks.append(chunk)
+    finally:
+        if not closed:
+            _kill(pid)
+        os.close(rd)
+        _, status = os.waitpid(pid, 0)
+    return b"".join(chunks), status
+
+
+def _kill(pid: int) -> None:
+    import signal
+
+    try:
+        os.kill(pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
 
 
 def _forward_differences(fun, step: float, lo, hi):

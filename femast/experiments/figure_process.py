@@ -63,9 +63,7 @@ class FigureProcess:
                 self.to_child = None
                 fh.write(struct.pack("<Q", len(payload)))
                 fh.write(payload)
-            with os.fdopen(self.from_child, "rb") as fh:
-                self.from_child = None
-                ok = fh.read(1) == b"1"
+            ok = _answer(self.from_child, FIGURE_WAIT_S) == b"1"
         except OSError:
             ok = False
         self.close()
@@ -84,12 +82,25 @@ class FigureProcess:
         if self.pid:
             try:
                 _, status = os.waitpid(self.pid, os.WNOHANG)
-                if _ == 0:   # still importing or waiting: it has nothing left to do
-                    os.kill(self.pid, signal.SIGTERM)
+                if _ == 0:   # still importing, waiting or drawing (stuck): it has nothing left to do
+                    os.kill(self.pid, signal.SIGKILL)
                     os.waitpid(self.pid, 0)
             except (ChildProcessError, ProcessLookupError, OSError):
                 pass
             self.pid = 0
+
+
+FIGURE_WAIT_S = 120.0   # s: a child that has not answered by then is taken for stuck (the caller draws)
+
+
+def _answer(fd: int, wait_s: float) -> bytes:
+    """The child's one-byte answer on ``fd``, or b"" if it closed the pipe or did not answer within
+    ``wait_s`` seconds."""
+    import select
+
+    if not select.select([fd], [], [], wait_s)[0]:
+        return b""
+    return os.read(fd, 1)
 
 
 def _read_exactly(fh, n: int) -> bytes:

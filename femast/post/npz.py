@@ -165,22 +165,36 @@ def append_record(fd: int, record: bytes) -> None:
 def scan_log(path) -> tuple[list, int]:
     """The records of a frame log: ([(offset of the .npz, its length), ...], bytes left over at the end
     -- a record cut short by a run killed while writing it, or anything that is not a record).
-    The headers are read through a memory map (no system call per record)."""
-    records = []
+    The headers are read through a memory map (no system call per record), or with a read per record
+    where the file system cannot map the file."""
     with open(path, "rb") as fh:
         size = os.fstat(fh.fileno()).st_size
         if size < _RECORD.size:
-            return records, size
-        with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mm:
-            size = len(mm)   # (the map's length: a writer may have appended since the fstat)
-            unpack, head = _RECORD.unpack_from, _RECORD.size
-            at = 0
-            while at + head <= size:
-                magic, length = unpack(mm, at)
-                if magic != RECORD_MAGIC or at + head + length > size:
-                    break
-                records.append((at + head, length))
-                at += head + length
+            return [], size
+        try:
+            mm = mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
+        except (OSError, ValueError):   # (a file system without mmap, or a file emptied since the fstat)
+            def header(at):
+                fh.seek(at)
+                return _RECORD.unpack(fh.read(_RECORD.size))
+
+            return _scan(header, size)
+        with mm:   # (the map's length: a writer may have appended since the fstat)
+            return _scan(lambda at: _RECORD.unpack_from(mm, at), len(mm))
+
+
+def _scan(header, size: int) -> tuple[list, int]:
+    """:func:`scan_log` of a file of ``size`` bytes whose record header at offset ``at`` is
+    ``header(at)`` (magic, length)."""
+    records = []
+    head = _RECORD.size
+    at = 0
+    while at + head <= size:
+        magic, length = header(at)
+        if magic != RECORD_MAGIC or at + head + length > size:
+            break
+        records.append((at + head, length))
+        at += head + length
     return records, size - at
 
 

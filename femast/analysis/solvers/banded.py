@@ -28,6 +28,8 @@ Zero pivots: ``dgbtrf`` reports an exactly zero one (``info > 0``); like SuperLU
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 from scipy.linalg import lapack
@@ -100,12 +102,13 @@ def _fill_split(L, U, chol):
 
 
 @njit(cache=True, inline="always")
-def _residual_maxima(r, rows, x):
-    """(max |r_i|, max rows_i, max |x_i|): the backward-error terms of :func:`refine` (inlined into
-    the residual kernels; the kernels' plain-Python fallback calls its Python function)."""
+def _residual_maxima(r, rows, x, rhs):
+    """(max |r_i|, max rows_i, max |x_i|, max |rhs_i|): the backward-error terms of :func:`refine`
+    (inlined into the residual kernels; the kernels' plain-Python fallback calls its Python function)."""
     rmax = 0.0
     amax = 0.0
     xmax = 0.0
+    bmax = 0.0
     for i in range(x.shape[0]):
         if abs(r[i]) > rmax:
             rmax = abs(r[i])
@@ -113,7 +116,9 @@ def _residual_maxima(r, rows, x):
             amax = rows[i]
         if abs(x[i]) > xmax:
             xmax = abs(x[i])
-    return rmax, amax, xmax
+        if abs(rhs[i]) > bmax:
+            bmax = abs(rhs[i])
+    return rmax, amax, xmax, bmax
 
 
 @njit(cache=True)
@@ -140,7 +145,7 @@ def _residual_split(L, U, x, rhs, r):
             sj += abs(v)
         r[j] = rj
         rows[j] = sj
-    return _residual_maxima(r, rows, x)
+    return _residual_maxima(r, rows, x, rhs)
 
 
 @njit(cache=True)
@@ -198,7 +203,7 @@ def _scatter(data, to, out):
 
 @njit(cache=True)
 def _residual(indptr, indices, data, x, b, r):
-    """r = b - B x for a CSC matrix B; returns (max |r|, max row sum of |B|, max |x|)."""
+    """r = b - B x for a CSC matrix B; returns (max |r|, max row sum of |B|, max |x|, max |b|)."""
     n = x.shape[0]
     for i in range(n):
         r[i] = b[i]
@@ -209,7 +214,7 @@ def _residual(indptr, indices, data, x, b, r):
             i = indices[k]
             r[i] -= data[k] * xj
             rows[i] += abs(data[k])
-    return _residual_maxima(r, rows, x)
+    return _residual_maxima(r, rows, x, b)
 
 
 class BandedFactor:
@@ -357,8 +362,7 @@ class BandedFactor:
             # K equals its symmetric part to 1e-15: the Cholesky solve is backward stable for K
             # itself (backward error <= asymmetry + Cholesky's), no residual check needed
             return lapack.dpbtrs(self._factor, rhs, lower=1)[0]
-        x, steps = refine(lambda v: lapack.dpbtrs(self._factor, v, lower=1)[0], (self._L, self._U) if self._from_band
-                          else self.B, rhs, self._r)
+        x, steps = refine(self._cholesky_solve, (self._L, self._U) if self._from_band else self.B, rhs, self._r)
         self.refinements += steps
         if x is not None:
             return x
@@ -366,6 +370,9 @@ class BandedFactor:
         self.fallbacks += 1
         self._factor_lu()
         return self.solve(rhs)
+
+    def _cholesky_solve(self, v):
+        return lapack.dpbtrs(self._factor, v, lower=1)[0]
 
 
 def refine(solve, B, rhs, r):
@@ -377,14 +384,14 @@ def refine(solve, B, rhs, r):
     ``r``: scratch (n,)."""
     x = solve(rhs)
     last = np.inf
-    bmax = np.abs(rhs).max(initial=0.0)
-    for step in range(MAX_REFINE + 1):
-        if isinstance(B, tuple):
-            rmax, amax, xmax = _residual_split(B[0], B[1], x, rhs, r)
+    split = isinstance(B, tuple)
+    for step in range(MAX_REFINE + 1):   # (the maxima from the residual kernel: no numpy temporaries)
+        if split:
+            rmax, amax, xmax, bmax = _residual_split(B[0], B[1], x, rhs, r)
         else:
-            rmax, amax, xmax = _residual(B.indptr, B.indices, B.data, x, rhs, r)
+            rmax, amax, xmax, bmax = _residual(B.indptr, B.indices, B.data, x, rhs, r)
         eta = rmax / (amax * xmax + bmax + 1e-300)
-        if eta <= BACKWARD_TOL or not np.isfinite(eta):
+        if eta <= BACKWARD_TOL or not math.isfinite(eta):
             return x, step
         if eta > 0.1 * last or step == MAX_REFINE:
             return None, step
