@@ -12,7 +12,9 @@ Quick start::
     print(res.node_history(b, "uz"))
 """
 
-from . import _aliases
+from . import _aliases, numba_cache
+
+numba_cache.check()  # delete numba caches whose njit helpers in other files changed (femast.numba_cache)
 
 _aliases.install()  # the import paths of before the package move (issue 15) keep working
 
