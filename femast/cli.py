@@ -192,14 +192,31 @@ def main(argv=None):
     # caller's thresholds come back at the end (main() called from Python: tests, notebooks)
     thresholds, frozen = gc.get_threshold(), gc.get_freeze_count()
     gc.set_threshold(max(thresholds[0], 20_000), 50, 100)
+    import warnings
+
+    format_warning = warnings.formatwarning
+    warnings.formatwarning = _one_line_warnings(format_warning)
     try:
         return _main(argv)
     finally:
+        warnings.formatwarning = format_warning
         gc.set_threshold(*thresholds)
         if argv is not None and not frozen:
             # called from Python with its own arguments (not the `femast` command, which exits now):
             # the heap that compare/diagnose froze for a quick exit goes back to the collector
             gc.unfreeze()
+
+
+def _one_line_warnings(python_format):
+    """A ``warnings.formatwarning`` that shows femast's own warnings (a partial frame in a results
+    folder, a data file's oddity, a large stabilisation energy) as one line for a command's user,
+    ``femast: warning: ...``, without the source line that raised it; others as ``python_format``."""
+    def format_warning(message, category, filename, lineno, line=None):
+        if category.__module__.startswith("femast"):
+            return f"femast: warning: {message}\n"
+        return python_format(message, category, filename, lineno, line)
+
+    return format_warning
 
 
 def _main(argv):
