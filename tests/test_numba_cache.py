@@ -82,6 +82,19 @@ def test_edited_helper_with_numba_cache_dir(tmp_path):
     assert _run(tmp_path, pkg, True, cache) == 6.0
 
 
+def test_two_processes_starting_at_once_after_an_edit(tmp_path):
+    pkg = _package(tmp_path, "")
+    assert _run(tmp_path, pkg, True) == 3.0
+    (pkg / "helper.py").write_text(HELPER.format(options="", factor="5.0"))
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env.update(PYTHONPATH=os.pathsep.join([str(tmp_path), str(REPO)]), GUARD="1")
+    procs = [subprocess.Popen([sys.executable, "-c", RUN, str(pkg)], env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    outs = [p.communicate(timeout=300) for p in procs]
+    assert [p.returncode for p in procs] == [0, 0], [err for _, err in outs]
+    assert [float(out.strip().splitlines()[-1]) for out, _ in outs] == [6.0, 6.0]
+
+
 def test_unchanged_tree_deletes_nothing(tmp_path):
     pkg = _package(tmp_path, "")
     assert _run(tmp_path, pkg, True) == 3.0
