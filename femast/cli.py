@@ -188,8 +188,21 @@ def main(argv=None):
     import gc
 
     # one short process: collect young objects every 20 000 allocations instead of 700 (a bay-torsion
-    # diagnosis made ~400 collections, 0.2-0.5 s of its serial CPU; 15 with this; issue 21)
-    gc.set_threshold(max(gc.get_threshold()[0], 20_000), 50, 100)
+    # diagnosis made ~400 collections, 0.2-0.5 s of its serial CPU; 15 with this; issue 21); the
+    # caller's thresholds come back at the end (main() called from Python: tests, notebooks)
+    thresholds, frozen = gc.get_threshold(), gc.get_freeze_count()
+    gc.set_threshold(max(thresholds[0], 20_000), 50, 100)
+    try:
+        return _main(argv)
+    finally:
+        gc.set_threshold(*thresholds)
+        if argv is not None and not frozen:
+            # called from Python with its own arguments (not the `femast` command, which exits now):
+            # the heap that compare/diagnose froze for a quick exit goes back to the collector
+            gc.unfreeze()
+
+
+def _main(argv):
     parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
     # --debug anywhere before a script's own arguments (``femast vtk R --debug``, ``femast --debug run S``)

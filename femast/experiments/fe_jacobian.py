@@ -196,7 +196,8 @@ def evaluate_many(fun, points, size: int) -> list:
 
 
 CHILD_WAIT = 4.0          # the forked child's share may take this many times this process's share ...
-CHILD_WAIT_MIN_S = 60.0   # ... or this long (s), whichever is longer, before it is taken for stuck
+CHILD_WAIT_MIN_S = 300.0  # ... or this long (s), whichever is longer, before it is taken for stuck (a cold
+#                           child may compile kernels in the foreground: tens of seconds)
 
 
 def _child_answer(pid: int, rd: int, wait_s: float) -> tuple[bytes, int]:

@@ -90,7 +90,8 @@ class FigureProcess:
             self.pid = 0
 
 
-FIGURE_WAIT_S = 120.0   # s: a child that has not answered by then is taken for stuck (the caller draws)
+FIGURE_WAIT_S = 300.0   # s: a child that has not answered by then is taken for stuck (the caller draws;
+#                        matplotlib's first import builds its font cache: tens of seconds)
 
 
 def _answer(fd: int, wait_s: float) -> bytes:
