@@ -175,3 +175,26 @@ def test_serial_off_linux(monkeypatch):
     calls = []
     got = fj.evaluate_many(lambda u: calls.append(os.getpid()) or np.zeros(1), [np.zeros(1)] * 3, 1)
     assert len(got) == 3 and set(calls) == {os.getpid()}
+
+
+def test_the_wait_works_on_descriptors_above_select_s_limit():
+    """The pipe of a process with many open files may be numbered above 1024, where select() fails."""
+    import resource
+
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    if hard != resource.RLIM_INFINITY and hard <= 1500:
+        pytest.skip("cannot open a descriptor above 1500 here")
+    r, w = os.pipe()
+    try:
+        if soft != resource.RLIM_INFINITY and soft <= 1500:
+            resource.setrlimit(resource.RLIMIT_NOFILE, (2048 if hard == resource.RLIM_INFINITY else min(hard, 2048),
+                                                        hard))
+        hi = os.dup2(r, 1500)
+        assert not fj.readable(hi, 0.01)   # nothing written yet
+        os.write(w, b"x")
+        assert fj.readable(hi, 1.0)
+        os.close(hi)
+    finally:
+        os.close(r)
+        os.close(w)
+        resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))

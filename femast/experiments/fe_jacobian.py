@@ -10,6 +10,7 @@ and gives registered starts back bit for bit (so the run cache answers them).  U
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
@@ -204,15 +205,13 @@ def _child_answer(pid: int, rd: int, wait_s: float) -> tuple[bytes, int]:
     """(bytes the child wrote to the pipe ``rd`` until it closed it, its wait status), the child reaped;
     a child that has not closed the pipe within ``wait_s`` seconds (0: at once), or when this process
     is interrupted while waiting, is killed first (status then not 0).  ``rd`` is closed."""
-    import select
-
     chunks = []
     end = time.monotonic() + wait_s
     closed = False
     try:
         while True:
             left = end - time.monotonic()
-            if left <= 0.0 or not select.select([rd], [], [], left)[0]:
+            if left <= 0.0 or not readable(rd, left):
                 break
             chunk = os.read(rd, 1 << 16)
             if not chunk:
@@ -225,6 +224,16 @@ def _child_answer(pid: int, rd: int, wait_s: float) -> tuple[bytes, int]:
         os.close(rd)
         _, status = os.waitpid(pid, 0)
     return b"".join(chunks), status
+
+
+def readable(fd: int, wait_s: float) -> bool:
+    """``fd`` has data (or its other end was closed) within ``wait_s`` seconds (poll: no limit on the
+    descriptor's number, unlike select's 1024)."""
+    import select
+
+    p = select.poll()
+    p.register(fd, select.POLLIN | select.POLLHUP | select.POLLERR)
+    return bool(p.poll(max(0, math.ceil(1000.0 * wait_s))))
 
 
 def _kill(pid: int) -> None:

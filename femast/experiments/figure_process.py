@@ -97,9 +97,9 @@ FIGURE_WAIT_S = 300.0   # s: a child that has not answered by then is taken for 
 def _answer(fd: int, wait_s: float) -> bytes:
     """The child's one-byte answer on ``fd``, or b"" if it closed the pipe or did not answer within
     ``wait_s`` seconds."""
-    import select
+    from .fe_jacobian import readable
 
-    if not select.select([fd], [], [], wait_s)[0]:
+    if not readable(fd, wait_s):
         return b""
     return os.read(fd, 1)
 
