@@ -50,8 +50,10 @@ def _package(tmp_path, options):
     return pkg
 
 
-def _run(tmp_path, pkg, guard):
+def _run(tmp_path, pkg, guard, numba_cache_dir=None):
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}   # numba's in-tree __pycache__
+    if numba_cache_dir is not None:
+        env["NUMBA_CACHE_DIR"] = str(numba_cache_dir)
     env.update(PYTHONPATH=os.pathsep.join([str(tmp_path), str(REPO)]), GUARD="1" if guard else "0")
     out = subprocess.run([sys.executable, "-c", RUN, str(pkg)], env=env, capture_output=True, text=True,
                          check=True, timeout=300)
@@ -68,6 +70,29 @@ def test_edited_helper_in_another_file(tmp_path, options, guard):
     # exact: small integers in doubles.  Without the guard numba loads caller's stale cache (the
     # old helper): this shows the bug is real on the installed numba.
     assert _run(tmp_path, pkg, guard) == (6.0 if guard else 3.0)
+
+
+def test_edited_helper_with_numba_cache_dir(tmp_path):
+    """The cache files are found through numba's locator wherever it puts them: NUMBA_CACHE_DIR."""
+    pkg = _package(tmp_path, "inline='always'")
+    cache = tmp_path / "numba-cache"
+    assert _run(tmp_path, pkg, True, cache) == 3.0
+    assert list(cache.rglob("caller.*.nbi")) and not list(pkg.rglob("*.nbi"))
+    (pkg / "helper.py").write_text(HELPER.format(options="inline='always'", factor="5.0"))
+    assert _run(tmp_path, pkg, True, cache) == 6.0
+
+
+def test_two_processes_starting_at_once_after_an_edit(tmp_path):
+    pkg = _package(tmp_path, "")
+    assert _run(tmp_path, pkg, True) == 3.0
+    (pkg / "helper.py").write_text(HELPER.format(options="", factor="5.0"))
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env.update(PYTHONPATH=os.pathsep.join([str(tmp_path), str(REPO)]), GUARD="1")
+    procs = [subprocess.Popen([sys.executable, "-c", RUN, str(pkg)], env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    outs = [p.communicate(timeout=300) for p in procs]
+    assert [p.returncode for p in procs] == [0, 0], [err for _, err in outs]
+    assert [float(out.strip().splitlines()[-1]) for out, _ in outs] == [6.0, 6.0]
 
 
 def test_unchanged_tree_deletes_nothing(tmp_path):
