@@ -162,14 +162,20 @@ def test_out_is_an_existing_file(tmp_path):
         fm.solve(m, f, progress=False)
 
 
-_KILL_SCRIPT = textwrap.dedent("""
-    import sys, femast as fm
+# the child scripts' model: a cantilever loaded in 10 000 tiny increments, so that a run is still
+# going when the test kills it ({n}: beam elements)
+_SLOW_CANTILEVER = """
     m = fm.Model("kill")
     a = m.node(0, 0, 0)
     b = m.node(1, 0, 0)
-    m.beam(a, b, fm.circular_tube(0.02, 0.016, E=70e9), n=20)
+    m.beam(a, b, fm.circular_tube(0.02, 0.016, E=70e9), n={n})
     m.fix(a)
     m.step("s", initial_increment=1e-4, max_increment=1e-4, max_increments=100000).load(b, fz=-50.0)
+"""
+
+_KILL_SCRIPT = textwrap.dedent("""
+    import sys, femast as fm
+""" + _SLOW_CANTILEVER.format(n=20) + """
     fm.solve(m, sys.argv[1], progress=False)
 """)
 
@@ -221,12 +227,7 @@ _REPORT_SCRIPT = textwrap.dedent("""
             sys.stdout.write(f"{increment} {float(an.x[-1, 2] - an.X0[-1, 2]).hex()}\\n")
             sys.stdout.flush()
 
-    m = fm.Model("kill")
-    a = m.node(0, 0, 0)
-    b = m.node(1, 0, 0)
-    m.beam(a, b, fm.circular_tube(0.02, 0.016, E=70e9), n=4)
-    m.fix(a)
-    m.step("s", initial_increment=1e-4, max_increment=1e-4, max_increments=100000).load(b, fz=-50.0)
+""" + _SLOW_CANTILEVER.format(n=4) + """
     fm.Analysis(m, sys.argv[1], progress=False, observers=[Report()]).run()
 """)
 
