@@ -31,8 +31,13 @@ import numpy as np
 import femast as fm
 from femast.adam import build_bay
 from femast.adam.post import bay_curve, plot_bay_torsion, relatch_angles, release_angles, write_curve_csv
-from femast.adam.steps import (CONVERGENCE, add_idealised_torsion, add_initial_steps, add_measured_torsion,
-                               measured_style_path)
+from femast.adam.steps import (
+    CONVERGENCE,
+    add_idealised_torsion,
+    add_initial_steps,
+    add_measured_torsion,
+    measured_style_path,
+)
 from femast.latch import ZONE_LABELS
 from femast.post.vtk import export_vtk
 
@@ -41,16 +46,17 @@ DOCS = ROOT / "docs" / "figures"
 
 SEED_NOTE = {
     "ideal": "seed Fig. 16: model of the ideal path, all four latches\n"
-             "release together; experiment: -35 N m to start, about\n"
-             "3 deg to unlatch three of four latches",
+    "release together; experiment: -35 N m to start, about\n"
+    "3 deg to unlatch three of four latches",
     "actual": "seed Fig. 17: model driven by the measured theta_z, x, y;\n"
-              "one latch stays latched after the other three release\n"
-              "(here: a synthetic measured-style path)",
+    "one latch stays latched after the other three release\n"
+    "(here: a synthetic measured-style path)",
 }
 
 
-def run_path(kind: str, out: Path, theta_max_deg: float, progress: bool, hysteresis=None, quick=False,
-             params_changes=None) -> dict:
+def run_path(
+    kind: str, out: Path, theta_max_deg: float, progress: bool, hysteresis=None, quick=False, params_changes=None
+) -> dict:
     changes = dict(params_changes or {})
     if hysteresis is not None:
         changes.update(hysteresis_force=hysteresis[0], hysteresis_length=hysteresis[1])
@@ -62,8 +68,9 @@ def run_path(kind: str, out: Path, theta_max_deg: float, progress: bool, hystere
         path = None
     else:
         add_initial_steps(am, hold_control=("ux", "uy", "rz"))
-        path = measured_style_path(am.params.b, theta_max=np.radians(theta_max_deg), hold_side=0,
-                                   n=41 if quick else 161)
+        path = measured_style_path(
+            am.params.b, theta_max=np.radians(theta_max_deg), hold_side=0, n=41 if quick else 161
+        )
         add_measured_torsion(am, path, name="twist-path", max_increment=4 * inc / 2 if quick else 0.0125)
     folder = out / kind
     t0 = time.perf_counter()
@@ -75,8 +82,11 @@ def run_path(kind: str, out: Path, theta_max_deg: float, progress: bool, hystere
     if path is not None:
         path.to_csv(folder / "path.csv")
     export_vtk(res, folder / "vtk", every=1 if not quick else 4)
-    title = ("ADAM bay, idealised path (seed Fig. 16)" if kind == "ideal"
-             else "ADAM bay, measured-style path with off-axis drift (seed Fig. 17)")
+    title = (
+        "ADAM bay, idealised path (seed Fig. 16)"
+        if kind == "ideal"
+        else "ADAM bay, measured-style path with off-axis drift (seed Fig. 17)"
+    )
     if hysteresis is not None:
         title += f"\nlatch hysteresis F_h = {hysteresis[0]:g} N, ell = {hysteresis[1] * 1e3:g} mm"
     png = plot_bay_torsion(curve, folder / "torsion.png", title=title, seed_note=SEED_NOTE[kind])
@@ -86,15 +96,31 @@ def run_path(kind: str, out: Path, theta_max_deg: float, progress: bool, hystere
     out_branch = twist & (np.gradient(np.abs(curve["theta"])) >= 0)
     i_peak = int(np.argmax(np.where(out_branch, np.abs(curve["M"]), -1)))
     info = {
-        "path": kind, "png": str(png), "csv": str(folder / "curve.csv"), "vtk": str(folder / "vtk" / "series.pvd"),
-        "increments": an.summary.increments, "iterations": an.summary.iterations, "cutbacks": an.summary.cutbacks,
-        "wall_time_s": wall, "stabilization_ratio": an.summary.steps[0].get("stabilization_ratio"),
-        "release_deg": rel.tolist(), "relatch_deg": back.tolist(),
-        "peak_moment_Nm": float(curve["M"][i_peak]), "peak_at_deg": float(np.degrees(curve["theta"][i_peak])),
+        "path": kind,
+        "png": str(png),
+        "csv": str(folder / "curve.csv"),
+        "vtk": str(folder / "vtk" / "series.pvd"),
+        "increments": an.summary.increments,
+        "iterations": an.summary.iterations,
+        "cutbacks": an.summary.cutbacks,
+        "wall_time_s": wall,
+        "stabilization_ratio": an.summary.steps[0].get("stabilization_ratio"),
+        "release_deg": rel.tolist(),
+        "relatch_deg": back.tolist(),
+        "peak_moment_Nm": float(curve["M"][i_peak]),
+        "peak_at_deg": float(np.degrees(curve["theta"][i_peak])),
         "latched_at_end": int(np.sum(curve["zone"][-1] == 0)),
-        "final_rotation_deg": float(np.degrees(curve["theta"][-1])), "final_moment_Nm": float(curve["M"][-1]),
-        "pretension_N": float(np.mean(curve["tension"][0 if len(curve["tension"]) == 1 else
-                                                        len(curve["step"]) - 1 - list(curve["step"])[::-1].index("pretension")])),
+        "final_rotation_deg": float(np.degrees(curve["theta"][-1])),
+        "final_moment_Nm": float(curve["M"][-1]),
+        "pretension_N": float(
+            np.mean(
+                curve["tension"][
+                    0
+                    if len(curve["tension"]) == 1
+                    else len(curve["step"]) - 1 - list(curve["step"])[::-1].index("pretension")
+                ]
+            )
+        ),
     }
     (folder / "summary.json").write_text(json.dumps(info, indent=2))
     return info
@@ -103,14 +129,20 @@ def run_path(kind: str, out: Path, theta_max_deg: float, progress: bool, hystere
 def print_summary(info: dict):
     rel = ", ".join("held" if np.isnan(v) else f"{v:.2f}" for v in info["release_deg"])
     print(f"\n== {info['path']} path ==")
-    print(f"  initial step: cables at {info['pretension_N']:.1f} N in equilibrium; stabilisation energy / strain "
-          f"energy = {info['stabilization_ratio']:.2e}")
+    print(
+        f"  initial step: cables at {info['pretension_N']:.1f} N in equilibrium; stabilisation energy / strain "
+        f"energy = {info['stabilization_ratio']:.2e}"
+    )
     print(f"  peak moment {info['peak_moment_Nm']:.1f} N m (seed sign) at {info['peak_at_deg']:.3f} deg")
     print(f"  latches reach zone {ZONE_LABELS[3]} at (deg), sides 0-3: {rel}")
-    print(f"  end: rotation {info['final_rotation_deg']:.4f} deg, moment {info['final_moment_Nm']:.3f} N m, "
-          f"{info['latched_at_end']} of 4 latches on their backstop")
-    print(f"  increments {info['increments']}, Newton iterations {info['iterations']}, cutbacks {info['cutbacks']}, "
-          f"wall time {info['wall_time_s']:.1f} s")
+    print(
+        f"  end: rotation {info['final_rotation_deg']:.4f} deg, moment {info['final_moment_Nm']:.3f} N m, "
+        f"{info['latched_at_end']} of 4 latches on their backstop"
+    )
+    print(
+        f"  increments {info['increments']}, Newton iterations {info['iterations']}, cutbacks {info['cutbacks']}, "
+        f"wall time {info['wall_time_s']:.1f} s"
+    )
     print(f"  outputs: {info['png']}, {info['csv']}, {info['vtk']}")
 
 
@@ -119,8 +151,14 @@ def main(argv=None):
     ap.add_argument("--path", choices=("ideal", "actual", "both"), default="both")
     ap.add_argument("--out", default="results/adam_bay_torsion")
     ap.add_argument("--theta", type=float, default=None, help="largest twist, degrees (ideal 3.5, actual 3.2)")
-    ap.add_argument("--hysteresis", type=float, nargs=2, metavar=("F_h", "ell"), default=None,
-                    help="latch hysteresis option: force (N) and length (m)")
+    ap.add_argument(
+        "--hysteresis",
+        type=float,
+        nargs=2,
+        metavar=("F_h", "ell"),
+        default=None,
+        help="latch hysteresis option: force (N) and length (m)",
+    )
     ap.add_argument("--docs", action="store_true", help="copy the figures to docs/figures/")
     ap.add_argument("--quick", action="store_true", help="coarse increments (for tests)")
     ap.add_argument("--no-progress", action="store_true")
@@ -130,16 +168,17 @@ def main(argv=None):
     infos = []
     for kind in kinds:
         theta = args.theta if args.theta is not None else (3.5 if kind == "ideal" else 3.2)
-        info = run_path(kind, out, theta, progress=not args.no_progress, hysteresis=args.hysteresis,
-                        quick=args.quick)
+        info = run_path(kind, out, theta, progress=not args.no_progress, hysteresis=args.hysteresis, quick=args.quick)
         print_summary(info)
         infos.append(info)
         if args.docs:
             suffix = "" if args.hysteresis is None else "_hysteresis"
             shutil.copy(info["png"], DOCS / f"adam_bay_{kind}{suffix}.png")
     total = sum(i["wall_time_s"] for i in infos)
-    print(f"\nadam_bay_torsion: {len(infos)} path(s), {sum(i['increments'] for i in infos)} increments, "
-          f"{sum(i['iterations'] for i in infos)} Newton iterations, wall time {total:.1f} s; results in {out}/")
+    print(
+        f"\nadam_bay_torsion: {len(infos)} path(s), {sum(i['increments'] for i in infos)} increments, "
+        f"{sum(i['iterations'] for i in infos)} Newton iterations, wall time {total:.1f} s; results in {out}/"
+    )
     return infos
 
 

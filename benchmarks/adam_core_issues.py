@@ -30,29 +30,33 @@ from femast.elements.base import IncrementContext
 
 def issue_stabilize():
     am = build_bay()
-    s = am.model.step("pretension", stabilize=fm.Stabilize(), initial_increment=1.0)   # default energy fraction
+    s = am.model.step("pretension", stabilize=fm.Stabilize(), initial_increment=1.0)  # default energy fraction
     s.prescribe(am.control, ux=0.0, uy=0.0, rz=0.0)
     an = fm.Analysis(am.model, tempfile.mkdtemp(), progress=False)
     res = an.run()
     r = an.system.residual(an.system.evaluate(IncrementContext(x_committed=an.x, R_committed=an.R)), an.loads)
-    print(f"1. Stabilize(): energy ratio {an.summary.steps[0]['stabilization_ratio']:.1e}, but the largest "
-          f"residual force without the viscous term is {np.abs(r[:an.dofmap.n_free]).max():.0f} N and the "
-          f"longerons carry {-res.frame(-1)['el/adam_longeron/section_forces'][0, 0, 0]:.0f} N instead of 192 N")
+    print(
+        f"1. Stabilize(): energy ratio {an.summary.steps[0]['stabilization_ratio']:.1e}, but the largest "
+        f"residual force without the viscous term is {np.abs(r[: an.dofmap.n_free]).max():.0f} N and the "
+        f"longerons carry {-res.frame(-1)['el/adam_longeron/section_forces'][0, 0, 0]:.0f} N instead of 192 N"
+    )
 
 
 def issue_floor():
-    am = build_mast(40, joint_penalty_factor=1e4)     # the ball joint's default penalty factor
+    am = build_mast(40, joint_penalty_factor=1e4)  # the ball joint's default penalty factor
     am.model.step("pretension", stabilize=fm.Stabilize(factor=1e-11), initial_increment=1.0)
     am.model.step("M+F").load(am.control, mz=6.8, fx=14.0)
-    an = fm.Analysis(am.model, tempfile.mkdtemp(), progress=False)   # default Convergence()
+    an = fm.Analysis(am.model, tempfile.mkdtemp(), progress=False)  # default Convergence()
     try:
         res = an.run()
     except fm.ConvergenceError as exc:
         print(f"2. (pretension failed: {str(exc)[:120]})")
         return
     st = an.summary.steps[-1]
-    print(f"2. default Convergence: step M+F (14 N, 6.8 N m) converged in {st['iterations']} iterations; "
-          f"tip ux = {res.node_history(am.control, 'ux')[-1] * 1e6:.3g} um (1740 um expected)")
+    print(
+        f"2. default Convergence: step M+F (14 N, 6.8 N m) converged in {st['iterations']} iterations; "
+        f"tip ux = {res.node_history(am.control, 'ux')[-1] * 1e6:.3g} um (1740 um expected)"
+    )
 
 
 if __name__ == "__main__":

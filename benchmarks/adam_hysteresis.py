@@ -81,8 +81,10 @@ def main(argv=None):
     ell = args.length
     summary = {"target_deg": args.target, "ell_m": ell}
     r0, c0, s0 = bay_cycle(0.0, ell, keep=out / "bay_off")
-    print(f"single bay, idealised path to 3.5 deg and back, then M -> 0: residual rotation {r0:.4f} deg "
-          f"without hysteresis (ball-joint friction only; seed's model: 0)")
+    print(
+        f"single bay, idealised path to 3.5 deg and back, then M -> 0: residual rotation {r0:.4f} deg "
+        f"without hysteresis (ball-joint friction only; seed's model: 0)"
+    )
     if args.force is None:
         evals = []
 
@@ -97,8 +99,10 @@ def main(argv=None):
     else:
         Fh = args.force
     r1, c1, s1 = bay_cycle(Fh, ell, keep=out / "bay_on")
-    print(f"with latch hysteresis F_h = {Fh:.1f} N, ell = {ell * 1e3:g} mm: residual rotation {r1:.4f} deg "
-          f"(seed's bay test: about 0.10 deg)")
+    print(
+        f"with latch hysteresis F_h = {Fh:.1f} N, ell = {ell * 1e3:g} mm: residual rotation {r1:.4f} deg "
+        f"(seed's bay test: about 0.10 deg)"
+    )
     summary.update({"F_h_N": Fh, "bay_residual_off_deg": r0, "bay_residual_on_deg": r1})
     # residual against the largest twist: nothing until a bead leaves its backstop
     sweep = []
@@ -118,8 +122,10 @@ def main(argv=None):
     import matplotlib.pyplot as plt
 
     fig, axs = plt.subplots(1, 3, figsize=(14.0, 4.6))
-    for c, lab, col in ((c0, "seed's latch law (no hysteresis)", "#2c7bb6"),
-                        (c1, f"hysteresis F_h = {Fh:.0f} N, ell = {ell * 1e3:g} mm", "#c0392b")):
+    for c, lab, col in (
+        (c0, "seed's latch law (no hysteresis)", "#2c7bb6"),
+        (c1, f"hysteresis F_h = {Fh:.0f} N, ell = {ell * 1e3:g} mm", "#c0392b"),
+    ):
         mv = np.array(["twist" in s for s in c["step"]])
         for ax in axs[:2]:
             ax.plot(np.degrees(c["theta"][mv]), c["M"][mv], "-", color=col, lw=1.4, label=lab)
@@ -152,12 +158,16 @@ def main(argv=None):
         for lab, F in (("off", 0.0), ("on", Fh)):
             labels, vals, travel, s = mast_cycles(F, ell, progress=not args.no_progress)
             res[lab] = (vals, travel, s)
-            print(f"40-bay mast, Table 1 x 3, hysteresis {lab}: residual theta_z {vals[-1, 5]:.2f} arcsec "
-                  f"({vals[-1, 5] / 3600:.4f} deg), x {vals[-1, 0]:.1f} um; bead travel {travel * 1e6:.3g} um "
-                  f"({s.iterations} iterations, {s.wall_time:.1f} s)")
+            print(
+                f"40-bay mast, Table 1 x 3, hysteresis {lab}: residual theta_z {vals[-1, 5]:.2f} arcsec "
+                f"({vals[-1, 5] / 3600:.4f} deg), x {vals[-1, 0]:.1f} um; bead travel {travel * 1e6:.3g} um "
+                f"({s.iterations} iterations, {s.wall_time:.1f} s)"
+            )
         d = res["on"][0][-1, 5] - res["off"][0][-1, 5]
-        print(f"difference made by the latch hysteresis: {d:.3g} arcsec; seed's scaling estimate 2.0 deg "
-              f"= {2.0 * 3600:.0f} arcsec (20 bays x 0.10 deg)")
+        print(
+            f"difference made by the latch hysteresis: {d:.3g} arcsec; seed's scaling estimate 2.0 deg "
+            f"= {2.0 * 3600:.0f} arcsec (20 bays x 0.10 deg)"
+        )
         summary["mast"] = {k: {"table": v[0].tolist(), "bead_travel_m": v[1]} for k, v in res.items()}
     print(f"\nadam_hysteresis: wall time {time.perf_counter() - t0:.1f} s; figure {png}")
     (out / "summary.json").write_text(json.dumps(summary, indent=2, default=float))

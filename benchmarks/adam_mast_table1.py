@@ -105,24 +105,37 @@ def main(argv=None):
         print("identifying cable_EA and longeron_t from Table 1 (x = 1740 um, theta_z = 3030 arcsec under M+F):")
         fit = fit_tip_response(params, verbose=True)
         params = fit.params
-        print(f"  fitted: cable_EA = {fit.x[0]:.5g} N, longeron_t = {fit.x[1] * 1e3:.4g} mm "
-              f"({fit.nfev} evaluations, {fit.wall_time:.1f} s, {fit.message})")
+        print(
+            f"  fitted: cable_EA = {fit.x[0]:.5g} N, longeron_t = {fit.x[1] * 1e3:.4g} mm "
+            f"({fit.nfev} evaluations, {fit.wall_time:.1f} s, {fit.message})"
+        )
         print(f"  d log(x, theta_z) / d log(EA, t) = {np.round(fit.sensitivity, 3).tolist()}")
-        summary["fit"] = {"names": list(fit.names), "x": fit.x.tolist(), "rel_error": fit.rel_error.tolist(),
-                          "sensitivity": fit.sensitivity.tolist(), "nfev": int(fit.nfev),
-                          "wall_time_s": fit.wall_time}
+        summary["fit"] = {
+            "names": list(fit.names),
+            "x": fit.x.tolist(),
+            "rel_error": fit.rel_error.tolist(),
+            "sensitivity": fit.sensitivity.tolist(),
+            "nfev": int(fit.nfev),
+            "wall_time_s": fit.wall_time,
+        }
     if args.hysteresis is not None:
         params = params.with_(hysteresis_force=args.hysteresis[0], hysteresis_length=args.hysteresis[1])
-    print(f"40-bay ADAM mast, {40 * params.l:.2f} m: b = {params.b} m, cable EA = {params.cable_EA:.4g} N, "
-          f"pretension {params.pretension:g} N, longeron {params.longeron_d * 1e3:g} x {params.longeron_t * 1e3:.3g} mm "
-          f"(E = {params.longeron_E / 1e9:g} GPa), mu = {params.mu}, B = {params.B * 1e3:g} mm"
-          + (f", latch hysteresis {params.hysteresis_force:g} N / {params.hysteresis_length * 1e3:g} mm"
-             if params.hysteresis_force > 0 else ""))
-    am, an, res, labels, vals, wall = run(params, out / "results", args.cycles, not args.no_progress,
-                                          args.increments)
+    print(
+        f"40-bay ADAM mast, {40 * params.l:.2f} m: b = {params.b} m, cable EA = {params.cable_EA:.4g} N, "
+        f"pretension {params.pretension:g} N, longeron {params.longeron_d * 1e3:g} x {params.longeron_t * 1e3:.3g} mm "
+        f"(E = {params.longeron_E / 1e9:g} GPa), mu = {params.mu}, B = {params.B * 1e3:g} mm"
+        + (
+            f", latch hysteresis {params.hysteresis_force:g} N / {params.hysteresis_length * 1e3:g} mm"
+            if params.hysteresis_force > 0
+            else ""
+        )
+    )
+    am, an, res, labels, vals, wall = run(params, out / "results", args.cycles, not args.no_progress, args.increments)
     st = an.summary.steps
-    print(f"initial step: stabilisation energy / strain energy = {st[0]['stabilization_ratio']:.2e} "
-          f"({st[0]['increments']} increments); then no stabilisation")
+    print(
+        f"initial step: stabilisation energy / strain energy = {st[0]['stabilization_ratio']:.2e} "
+        f"({st[0]['increments']} increments); then no stabilisation"
+    )
     print("\nTip of the 40-bay mast relative to the pretensioned state (femast beside seed 001 Table 1):")
     print(format_table1(labels, vals))
     with open(out / "table1.csv", "w", newline="") as fh:
@@ -134,32 +147,50 @@ def main(argv=None):
     first = labels.index("M+F")
     rel_x = vals[first, 0] / 1740.0 - 1
     rel_t = vals[first, 5] / 3030.0 - 1
-    print(f"\nunder the first M+F: x = {vals[first, 0]:.1f} um ({100 * rel_x:+.2f} % of 1740), "
-          f"theta_z = {vals[first, 5]:.1f} arcsec ({100 * rel_t:+.2f} % of 3030)")
-    print(f"residual after {args.cycles} cycle(s): x = {vals[-1, 0]:.3g} um, theta_z = {vals[-1, 5]:.4g} arcsec "
-          f"({vals[-1, 5] / 3600:.4f} deg); seed: 0.02 um, 0.38 arcsec; seed's scaling estimate with latch "
-          "hysteresis: 2.0 deg")
+    print(
+        f"\nunder the first M+F: x = {vals[first, 0]:.1f} um ({100 * rel_x:+.2f} % of 1740), "
+        f"theta_z = {vals[first, 5]:.1f} arcsec ({100 * rel_t:+.2f} % of 3030)"
+    )
+    print(
+        f"residual after {args.cycles} cycle(s): x = {vals[-1, 0]:.3g} um, theta_z = {vals[-1, 5]:.4g} arcsec "
+        f"({vals[-1, 5] / 3600:.4f} deg); seed: 0.02 um, 0.38 arcsec; seed's scaling estimate with latch "
+        "hysteresis: 2.0 deg"
+    )
     dT = np.array([res.frame(i)[f"el/{am.latch_family}/latch_dT"] for i in range(len(res))])
     bead = np.array([res.frame(i)[f"el/{am.latch_family}/bead_position"] for i in range(len(res))])
     ieq = len(res.steps) - 1 - res.steps[::-1].index("pretension")
     max_dT = float(np.abs(dT[ieq:]).max())
     max_travel = float((bead[ieq:] + params.latch.x_backstop).max())
-    print(f"latches: largest |dT| over the run {max_dT:.2f} N (a seated bead leaves the backstop above 43.9 N"
-          + (f" + {params.hysteresis_force:g} N of hysteresis" if params.hysteresis_force > 0 else "")
-          + f"); largest bead travel from the backstop {max_travel * 1e6:.3g} um")
+    print(
+        f"latches: largest |dT| over the run {max_dT:.2f} N (a seated bead leaves the backstop above 43.9 N"
+        + (f" + {params.hysteresis_force:g} N of hysteresis" if params.hysteresis_force > 0 else "")
+        + f"); largest bead travel from the backstop {max_travel * 1e6:.3g} um"
+    )
     summary.update({"max_latch_dT_N": max_dT, "max_bead_travel_m": max_travel})
     print("\n" + EXPLAIN)
-    print(f"\nrun: {an.summary.increments} increments, {an.summary.iterations} Newton iterations, "
-          f"{an.summary.cutbacks} cutbacks, wall time {wall:.1f} s (assembly {an.summary.assembly_time:.1f} s, "
-          f"linear solve {an.summary.solve_time:.1f} s); target < 60 s on 2 cores")
-    summary.update({"labels": labels, "table_um_arcsec": vals.tolist(), "wall_time_s": wall,
-                    "increments": an.summary.increments, "iterations": an.summary.iterations,
-                    "cutbacks": an.summary.cutbacks, "params": params.as_dict(),
-                    "stabilization_ratio": st[0]["stabilization_ratio"]})
+    print(
+        f"\nrun: {an.summary.increments} increments, {an.summary.iterations} Newton iterations, "
+        f"{an.summary.cutbacks} cutbacks, wall time {wall:.1f} s (assembly {an.summary.assembly_time:.1f} s, "
+        f"linear solve {an.summary.solve_time:.1f} s); target < 60 s on 2 cores"
+    )
+    summary.update(
+        {
+            "labels": labels,
+            "table_um_arcsec": vals.tolist(),
+            "wall_time_s": wall,
+            "increments": an.summary.increments,
+            "iterations": an.summary.iterations,
+            "cutbacks": an.summary.cutbacks,
+            "params": params.as_dict(),
+            "stabilization_ratio": st[0]["stabilization_ratio"],
+        }
+    )
     if args.compare_mu is not None:
         p2 = params.with_(mu=args.compare_mu)
         _, an2, _, lab2, v2, w2 = run(p2, out / f"results_mu{args.compare_mu:g}", 1, False)
-        print(f"\nsame mast with mu = {args.compare_mu:g} (one cycle; {an2.summary.iterations} iterations, {w2:.1f} s):")
+        print(
+            f"\nsame mast with mu = {args.compare_mu:g} (one cycle; {an2.summary.iterations} iterations, {w2:.1f} s):"
+        )
         print(format_table1(lab2, v2))
         summary["compare_mu"] = {"mu": args.compare_mu, "labels": lab2, "table_um_arcsec": v2.tolist()}
     if args.render:
@@ -168,9 +199,14 @@ def main(argv=None):
 
         steps = res.steps
         i_load = max(i for i, s in enumerate(steps) if s == "M+F#1")
-        png = render_png(res, out / "mast_distorted.png", frame=i_load, scale=args.scale,
-                         title=f"40-bay ADAM mast under M + F (M = {TABLE1_M} N m, F = {TABLE1_F} N), "
-                               f"displacements x {args.scale:g} (seed Fig. 18)")
+        png = render_png(
+            res,
+            out / "mast_distorted.png",
+            frame=i_load,
+            scale=args.scale,
+            title=f"40-bay ADAM mast under M + F (M = {TABLE1_M} N m, F = {TABLE1_F} N), "
+            f"displacements x {args.scale:g} (seed Fig. 18)",
+        )
         export_vtk(res, out / "vtk")
         print(f"rendered {png}; VTK series {out / 'vtk' / 'series.pvd'}")
         if args.docs:

@@ -15,8 +15,8 @@ plotstyle.use()
 import matplotlib.pyplot as plt
 import numpy as np
 
-from femast.verification import references as ref
 from femast.verification import arclength as va
+from femast.verification import references as ref
 
 
 def main(out="benchmarks/out"):
@@ -36,9 +36,12 @@ def main(out="benchmarks/out"):
     for k, comp in ((1, "v"), (2, "u")):
         ax[k].plot(getattr(path, comp), path.load, "k-", label="elastica (reference)")
         ax[k].plot(lee[comp], lee["P"], "o", ms=3, label="femast, 10 el./member")
-        ax[k].set(xlabel=f"load point {'vertical (down)' if comp == 'v' else 'horizontal'} displacement "
-                         "(length unit of L = 120)",
-                  ylabel="P (force unit of E = 7.2e6)", title=f"Lee's frame: P - {comp}")
+        ax[k].set(
+            xlabel=f"load point {'vertical (down)' if comp == 'v' else 'horizontal'} displacement "
+            "(length unit of L = 120)",
+            ylabel="P (force unit of E = 7.2e6)",
+            title=f"Lee's frame: P - {comp}",
+        )
     inside = lee["v"] <= path.v.max()
     err_lee = max(path.distance(lee["P"][inside], lee[c][inside], P_lim, 90.0, c).max() for c in "vu")
 
@@ -55,10 +58,14 @@ def main(out="benchmarks/out"):
     plotstyle.save(fig, out / "arc_length.png", dpi=100)
     pre = tog["v"] < 0.4
     print(f"von Mises truss: max |P - P_exact| / P_limit = {err_vm:.2e} over {len(vm['w'])} increments")
-    print(f"Lee's frame: limit load {lee['P'].max():.1f} (elastica {P_lim:.1f}, Simo-Vu-Quoc 18532), "
-          f"max path distance {100 * err_lee:.2f} % over {len(lee['v'])} increments")
-    print(f"Williams' toggle: limit load {tog['P'][pre].max():.3f} lb (elastica {Pt:.3f}), "
-          f"max path distance {100 * tpath.distance(tog['P'], tog['v'], Pt, 0.6).max():.2f} %")
+    print(
+        f"Lee's frame: limit load {lee['P'].max():.1f} (elastica {P_lim:.1f}, Simo-Vu-Quoc 18532), "
+        f"max path distance {100 * err_lee:.2f} % over {len(lee['v'])} increments"
+    )
+    print(
+        f"Williams' toggle: limit load {tog['P'][pre].max():.3f} lb (elastica {Pt:.3f}), "
+        f"max path distance {100 * tpath.distance(tog['P'], tog['v'], Pt, 0.6).max():.2f} %"
+    )
     print(f"figure: {out / 'arc_length.png'}")
 
 

@@ -38,10 +38,10 @@ from femast.elements.ball_joint import add_ball_joints, friction_loop_energy  # 
 
 OUT = Path(__file__).resolve().parent / "out"
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "figures"
-MU, B = 0.5, 0.004           # seed 001, Sec. II.B.1
-A, K_STICK = 0.03, 200.0     # rotation amplitude (rad), stick stiffness (N m/rad)
+MU, B = 0.5, 0.004  # seed 001, Sec. II.B.1
+A, K_STICK = 0.03, 200.0  # rotation amplitude (rad), stick stiffness (N m/rad)
 FORCES = (250.0, 500.0, 1000.0)
-TABLE_T = [0.0, 1.0, 3.0, 5.0, 7.0, 9.0]      # step times of the turning points
+TABLE_T = [0.0, 1.0, 3.0, 5.0, 7.0, 9.0]  # step times of the turning points
 TABLE_V = [0.0, 1.0, -1.0, 1.0, -1.0, 1.0]
 
 
@@ -52,11 +52,15 @@ def single_joint(P, folder):
     m.fix(a)
     m.fix(b, "uy", "uz", "rx", "ry")
     m.step("press").load(b, fx=-P).prescribe(b, rz=0.0)
-    m.step("cycle", period=TABLE_T[-1], max_increment=0.05).prescribe(
-        b, amplitude=fm.Amplitude(TABLE_T, TABLE_V), rz=A)
+    m.step("cycle", period=TABLE_T[-1], max_increment=0.05).prescribe(b, amplitude=fm.Amplitude(TABLE_T, TABLE_V), rz=A)
     res = fm.solve(m, folder, progress=False)
-    return dict(t=res.time, rz=res.node_history(b, "rz"), M=res.element_history("ball_joint", 1, "moment")[:, 2],
-                D=res.element_history("ball_joint", 1, "dissipated"), F=res.element_history("ball_joint", 1, "F"))
+    return dict(
+        t=res.time,
+        rz=res.node_history(b, "rz"),
+        M=res.element_history("ball_joint", 1, "moment")[:, 2],
+        D=res.element_history("ball_joint", 1, "dissipated"),
+        F=res.element_history("ball_joint", 1, "F"),
+    )
 
 
 def two_beams(folder, P=200.0, rot=0.01, L=0.5):
@@ -70,21 +74,29 @@ def two_beams(folder, P=200.0, rot=0.01, L=0.5):
     m.fix(n4, "uy", "uz", "rx", "ry")
     m.step("press").load(n4, fx=-P).prescribe(n4, rz=0.0)
     m.step("cycle", period=5.0, max_increment=0.05).prescribe(
-        n4, amplitude=fm.Amplitude(TABLE_T[:4], TABLE_V[:4]), rz=rot)
+        n4, amplitude=fm.Amplitude(TABLE_T[:4], TABLE_V[:4]), rz=rot
+    )
     res = fm.solve(m, folder, progress=False)
     M = res.element_history("ball_joint", 1, "moment")
-    return dict(t=res.time, Mz=M[:, 2], limit=res.element_history("ball_joint", 1, "limit"),
-                F=res.element_history("ball_joint", 1, "F"), slip=res.element_history("ball_joint", 1, "slip"))
+    return dict(
+        t=res.time,
+        Mz=M[:, 2],
+        limit=res.element_history("ball_joint", 1, "limit"),
+        F=res.element_history("ball_joint", 1, "F"),
+        slip=res.element_history("ball_joint", 1, "slip"),
+    )
 
 
 def main(show=False):
     tmp = Path(tempfile.mkdtemp(prefix="femast_ball_joint_"))
     runs = {P: single_joint(P, tmp / f"P{int(P)}") for P in FORCES}
     beams = two_beams(tmp / "beams")
-    lines = ["Friction ball joint, seed 001 Sec. II.B.1 (mu = 0.5, B = 4 mm)",
-             f"single joint, A = {A} rad, k_stick = {K_STICK} N m/rad, two cycles",
-             f"{'F (N)':>8} {'plateau (N m)':>14} {'mu B F':>8} {'cycle':>6} {'D numeric (J)':>14} "
-             f"{'D analytic (J)':>15} {'rel. err':>9}"]
+    lines = [
+        "Friction ball joint, seed 001 Sec. II.B.1 (mu = 0.5, B = 4 mm)",
+        f"single joint, A = {A} rad, k_stick = {K_STICK} N m/rad, two cycles",
+        f"{'F (N)':>8} {'plateau (N m)':>14} {'mu B F':>8} {'cycle':>6} {'D numeric (J)':>14} "
+        f"{'D analytic (J)':>15} {'rel. err':>9}",
+    ]
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.6))
     colors = plt.cm.viridis(np.linspace(0.1, 0.8, len(FORCES)))
     for c, P in zip(colors, FORCES):
@@ -100,8 +112,10 @@ def main(show=False):
             i_end = int(np.argmin(np.abs(h["t"] - t_end)))
             D_num = h["D"][i_end] - h["D"][int(np.argmin(np.abs(h["t"] - (t_end - 4.0))))]  # one cycle
             ax[1].plot(t_end, h["D"][i_start] + (k + 1) * exact, "o", mfc="none", color="k", ms=8)
-            lines.append(f"{P:8.0f} {np.abs(h['M']).max():14.6f} {Y:8.4f} {k + 1:6d} {D_num:14.8f} "
-                         f"{exact:15.8f} {abs(D_num / exact - 1):9.1e}")
+            lines.append(
+                f"{P:8.0f} {np.abs(h['M']).max():14.6f} {Y:8.4f} {k + 1:6d} {D_num:14.8f} "
+                f"{exact:15.8f} {abs(D_num / exact - 1):9.1e}"
+            )
     ax[0].set_xlabel("relative rotation about z (rad)")
     ax[0].set_ylabel("friction moment M_z (N m)")
     ax[0].set_title("(a) moment-rotation loops; dashed: +-mu B |F|", fontsize=10)
@@ -123,10 +137,13 @@ def main(show=False):
     ax[2].grid(alpha=0.3)
     fig.tight_layout()
     slip = beams["slip"] > 0
-    lines += ["", "two tubes with a ball joint (default k_pen, k_stick), 200 N compression:",
-              f"  |F| range {beams['F'][1:].min():.4f} .. {beams['F'].max():.4f} N; slipping increments "
-              f"{int(slip.sum())}; max | |M| - mu B |F| | while slipping "
-              f"{np.abs(np.abs(beams['Mz'][slip]) - beams['limit'][slip]).max():.2e} N m"]
+    lines += [
+        "",
+        "two tubes with a ball joint (default k_pen, k_stick), 200 N compression:",
+        f"  |F| range {beams['F'][1:].min():.4f} .. {beams['F'].max():.4f} N; slipping increments "
+        f"{int(slip.sum())}; max | |M| - mu B |F| | while slipping "
+        f"{np.abs(np.abs(beams['Mz'][slip]) - beams['limit'][slip]).max():.2e} N m",
+    ]
     OUT.mkdir(parents=True, exist_ok=True)
     DOCS.mkdir(parents=True, exist_ok=True)
     png = OUT / "ball_joint_loop.png"

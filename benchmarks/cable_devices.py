@@ -99,7 +99,7 @@ def sized_pulley(ax):
     moves[:, 1] = np.column_stack([t, -0.3 * t, 0.1 * t])
     res = run(fam, X, moves)
     dL0, dT, wrap = [], [], []
-    for (T, st, o), mv in zip(res, moves):
+    for (T, _st, o), mv in zip(res, moves):
         Xp = X + mv
         a, b = Xp[0] - Xp[1], Xp[2] - Xp[1]
         da, db = np.linalg.norm(a), np.linalg.norm(b)

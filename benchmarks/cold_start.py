@@ -39,8 +39,9 @@ TARGETS = {"getting_started": 8.0, "verification": 15.0}
 
 def _fresh_copy(tmp: Path) -> Path:
     src = tmp / "src"
-    shutil.copytree(ROOT / "femast", src / "femast",
-                    ignore=shutil.ignore_patterns("__pycache__", "*.nbi", "*.nbc", "*.pyc"))
+    shutil.copytree(
+        ROOT / "femast", src / "femast", ignore=shutil.ignore_patterns("__pycache__", "*.nbi", "*.nbc", "*.pyc")
+    )
     return src
 
 
@@ -107,11 +108,16 @@ def measure(case: str, warm: bool, in_process: bool = False) -> list[tuple]:
             worker_cpu, worker_end = _wait_for_workers(log, src, started)
             rows.append((label, wall, cpu, load, worker_cpu, worker_end))
         n_index = sum(f.endswith(".nbi") for _, _, fs in os.walk(src) for f in fs)
-        print(f"{case} (target < {TARGETS[case]:.0f} s cold; {n_index} numba index files written; "
-              f"{'compiled in the process' if in_process else 'background compile'}):")
+        print(
+            f"{case} (target < {TARGETS[case]:.0f} s cold; {n_index} numba index files written; "
+            f"{'compiled in the process' if in_process else 'background compile'}):"
+        )
         for label, wall, cpu, load, worker_cpu, worker_end in rows:
-            extra = (f"; background worker CPU {worker_cpu:5.1f} s, done {worker_end:5.1f} s after the start"
-                     if worker_cpu else "")
+            extra = (
+                f"; background worker CPU {worker_cpu:5.1f} s, done {worker_end:5.1f} s after the start"
+                if worker_cpu
+                else ""
+            )
             print(f"  {label:4s}: wall {wall:5.1f} s, CPU {cpu:5.1f} s (load {load:.1f}){extra}")
         return rows
     finally:
@@ -122,17 +128,24 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--only", choices=sorted(TARGETS), default=None, help="run one case (default: both)")
     ap.add_argument("--warm", action="store_true", help="also run each case a second time, cache written")
-    ap.add_argument("--in-process", action="store_true",
-                    help="compile in the script's process (FEMAST_BACKGROUND_COMPILE=0), as before the background worker")
+    ap.add_argument(
+        "--in-process",
+        action="store_true",
+        help="compile in the script's process (FEMAST_BACKGROUND_COMPILE=0), as before the background worker",
+    )
     args = ap.parse_args(argv)
-    print(f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}; femast from {ROOT / 'femast'} "
-          "(copied, empty cache)")
+    print(
+        f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}; femast from {ROOT / 'femast'} "
+        "(copied, empty cache)"
+    )
     verdict = []
-    for case in ([args.only] if args.only else ["getting_started", "verification"]):
+    for case in [args.only] if args.only else ["getting_started", "verification"]:
         (label, wall, cpu, load, worker_cpu, _), *_ = measure(case, args.warm, args.in_process)
-        verdict.append(f"{case}: cold {wall:.1f} s wall / {cpu:.1f} s CPU (load {load:.1f}), target < "
-                       f"{TARGETS[case]:.0f} s: "
-                       f"{'met' if wall < TARGETS[case] else ('met in CPU time' if cpu < TARGETS[case] else 'NOT MET')}")
+        verdict.append(
+            f"{case}: cold {wall:.1f} s wall / {cpu:.1f} s CPU (load {load:.1f}), target < "
+            f"{TARGETS[case]:.0f} s: "
+            f"{'met' if wall < TARGETS[case] else ('met in CPU time' if cpu < TARGETS[case] else 'NOT MET')}"
+        )
     print("\n".join(verdict))
     return 0
 

@@ -33,12 +33,12 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE / "peers"))
 
+import bend45  # noqa: E402
+import femast_mast  # noqa: E402
+from mast import build_mast  # noqa: E402
+
 import femast as fm  # noqa: E402
 from femast.analysis import Analysis  # noqa: E402
-
-from mast import build_mast  # noqa: E402
-import femast_mast  # noqa: E402
-import bend45  # noqa: E402
 
 TOL = 1e-6
 
@@ -46,14 +46,18 @@ TOL = 1e-6
 def _mast(n_bays):
     def build():
         return femast_mast.model(build_mast(n_bays), 10)[0]
+
     return build
 
 
 def _bend():
     m = fm.Model("bend45")
     n = np.asarray(m.nodes(bend45.geometry(8)))
-    m.beams(np.column_stack([n[:-1], n[1:]]), fm.Section(E=bend45.E, G=bend45.G, A=bend45.A, Iy=bend45.I,
-                                                          Iz=bend45.I, J=bend45.J), up=(0.0, 0.0, 1.0))
+    m.beams(
+        np.column_stack([n[:-1], n[1:]]),
+        fm.Section(E=bend45.E, G=bend45.G, A=bend45.A, Iy=bend45.I, Iz=bend45.I, J=bend45.J),
+        up=(0.0, 0.0, 1.0),
+    )
     m.fix(n[0])
     m.step("load", initial_increment=1.0 / 180, max_increment=1.0 / 180).load(n[-1], fz=bend45.P_END)
     return m
@@ -71,8 +75,13 @@ def _cantilever():
 def frames(model, conv):
     """(iterations, [(U, UR) per increment]) of one run."""
     out = []
-    an = Analysis(model, None, progress=False, convergence=conv,
-                  on_frame=lambda fr: out.append((np.array(fr["U"]), np.array(fr["UR"]))))
+    an = Analysis(
+        model,
+        None,
+        progress=False,
+        convergence=conv,
+        on_frame=lambda fr: out.append((np.array(fr["U"]), np.array(fr["UR"]))),
+    )
     an.run()
     return an.summary.iterations, out[1:]
 
@@ -100,10 +109,13 @@ def main(argv=None):
     models = [(f"mast, {n} bays", _mast(n), 1e-9) for n in args.bays]
     models += [("45-degree bend, 8 elements", _bend, 1e-9), ("cantilever (docs/solver.md)", _cantilever, 1e-8)]
     rows = []
-    print(f"error of the accepted states in units of the correction tolerance (disp_tol = {TOL:g}); "
-          f"load average {os.getloadavg()[0]:.1f}")
-    print(f"{'model':32s} {'iterations strict/predicted/reference':>38s} {'worst error strict':>19s} "
-          f"{'predicted':>10s}")
+    print(
+        f"error of the accepted states in units of the correction tolerance (disp_tol = {TOL:g}); "
+        f"load average {os.getloadavg()[0]:.1f}"
+    )
+    print(
+        f"{'model':32s} {'iterations strict/predicted/reference':>38s} {'worst error strict':>19s} {'predicted':>10s}"
+    )
     for name, build, ftol in models:
         it_s, f_s = frames(build(), fm.Convergence(force_tol=TOL, disp_tol=TOL, predicted=False))
         it_p, f_p = frames(build(), fm.Convergence(force_tol=TOL, disp_tol=TOL))
@@ -112,10 +124,13 @@ def main(argv=None):
         rows.append((name, e_s, e_p))
         print(f"{name:32s} {f'{it_s} / {it_p} / {it_r}':>38s} {e_s.max():19.2e} {e_p.max():10.2e}")
     worst = max(r[2].max() for r in rows)
-    print(f"largest error of a state accepted on its prediction: {worst:.2e} of the tolerance "
-          f"({'within' if worst <= 1 else 'NOT within'} it)")
+    print(
+        f"largest error of a state accepted on its prediction: {worst:.2e} of the tolerance "
+        f"({'within' if worst <= 1 else 'NOT within'} it)"
+    )
 
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 

@@ -64,9 +64,18 @@ from generalisation.cases import CASES, Case, generate  # noqa: E402
 from generalisation.gallery import gallery  # noqa: E402
 from generalisation.scoring import is_right, read_verdict, score  # noqa: E402
 
-QUICK = ("mt_friction_jenkins", "mt_clearance_tanh", "mt_progressive_asinh", "mt_pair_clearance_friction",
-         "mt_ool_thermal_drift", "lp_latch_band_gauss", "lp_stretch_twoslope", "lp_ool_ripple",
-         "mt_null_white", "lp_null_eq15")
+QUICK = (
+    "mt_friction_jenkins",
+    "mt_clearance_tanh",
+    "mt_progressive_asinh",
+    "mt_pair_clearance_friction",
+    "mt_ool_thermal_drift",
+    "lp_latch_band_gauss",
+    "lp_stretch_twoslope",
+    "lp_ool_ripple",
+    "mt_null_white",
+    "lp_null_eq15",
+)
 QUICK_REDRAWS = 3
 
 
@@ -83,28 +92,52 @@ def run_one(case: Case, redraw: int) -> dict:
     cols = generate(case, seed_of(case.name, redraw))
     exp = get_experiment(case.experiment)
     data = from_arrays(exp, **cols)
-    row = {"case": case.name, "redraw": redraw, "experiment": case.experiment, "expect": case.expect,
-           "expected_effects": list(case.effects), "noise": case.noise, "n": case.n, "path": case.path}
+    row = {
+        "case": case.name,
+        "redraw": redraw,
+        "experiment": case.experiment,
+        "expect": case.expect,
+        "expected_effects": list(case.effects),
+        "noise": case.noise,
+        "n": case.n,
+        "path": case.path,
+    }
     try:
         import inspect
+
         extra = {"pairs": True} if "pairs" in inspect.signature(diagnose).parameters else {}
         res = diagnose(exp, data, workers=1, **extra)
         report = json.loads(json.dumps(res.report, default=float))
     except Exception as exc:  # a failure of diagnose is a wrong verdict, reported as such
-        row.update(kind="error", effects=[], conclusion=f"diagnose failed: {type(exc).__name__}: {exc}",
-                   right=False, baseline_ratio=None, ranking=[], wall_s=time.perf_counter() - t0,
-                   cpu_s=time.process_time() - c0)
+        row.update(
+            kind="error",
+            effects=[],
+            conclusion=f"diagnose failed: {type(exc).__name__}: {exc}",
+            right=False,
+            baseline_ratio=None,
+            ranking=[],
+            wall_s=time.perf_counter() - t0,
+            cpu_s=time.process_time() - c0,
+        )
         return row
     v = read_verdict(report)
-    row.update(kind=v["kind"], effects=v["effects"], conclusion=v["conclusion"],
-               right=bool(is_right(case.expect, case.effects, v)),
-               baseline_ratio=report.get("baseline", {}).get("ratio"),
-               ranking=[{k: e.get(k) for k in ("effect", "ratio", "delta_bic", "significant", "explained_fraction")}
-                        for e in report.get("ranking", [])],
-               verdict_fields=report.get("verdict", {}),
-               noise_model={c: (m.get("kind") if isinstance(m, dict) else m)
-                            for c, m in (report.get("noise_model") or {}).items()},
-               wall_s=time.perf_counter() - t0, cpu_s=time.process_time() - c0)
+    row.update(
+        kind=v["kind"],
+        effects=v["effects"],
+        conclusion=v["conclusion"],
+        right=bool(is_right(case.expect, case.effects, v)),
+        baseline_ratio=report.get("baseline", {}).get("ratio"),
+        ranking=[
+            {k: e.get(k) for k in ("effect", "ratio", "delta_bic", "significant", "explained_fraction")}
+            for e in report.get("ranking", [])
+        ],
+        verdict_fields=report.get("verdict", {}),
+        noise_model={
+            c: (m.get("kind") if isinstance(m, dict) else m) for c, m in (report.get("noise_model") or {}).items()
+        },
+        wall_s=time.perf_counter() - t0,
+        cpu_s=time.process_time() - c0,
+    )
     return row
 
 
@@ -128,6 +161,7 @@ def run_all(cases, redraws: int, workers: int, progress: bool = True) -> list:
     bar = None
     if progress:
         from tqdm import tqdm
+
         bar = tqdm(total=len(jobs), desc="diagnose runs", unit="run")
     if workers <= 1:
         for c, r in jobs:
@@ -168,8 +202,9 @@ def verdict_label(row) -> str:
 def confusion(rows):
     """(row labels, column labels, counts (r, c)) of truth against verdict."""
     rl = list(dict.fromkeys(truth_label(r) for r in rows))
-    cl = sorted(set(verdict_label(r) for r in rows), key=lambda s: (s in ("not explained", "nothing missing"),
-                                                                    s.lstrip("~"), s))
+    cl = sorted(
+        set(verdict_label(r) for r in rows), key=lambda s: (s in ("not explained", "nothing missing"), s.lstrip("~"), s)
+    )
     M = np.zeros((len(rl), len(cl)), int)
     for r in rows:
         M[rl.index(truth_label(r)), cl.index(verdict_label(r))] += 1
@@ -198,7 +233,7 @@ def format_table(rows) -> str:
     w = max(len(s) for s in rl) + 2
     out.append("")
     out.append("confusion table (rows: what is in the data; columns: what diagnose said; runs):")
-    out.append(" " * w + " ".join(f"[{i}]" .rjust(5) for i in range(len(cl))))
+    out.append(" " * w + " ".join(f"[{i}]".rjust(5) for i in range(len(cl))))
     for i, lab in enumerate(rl):
         out.append(lab.ljust(w) + " ".join(f"{v:5d}" if v else "    ." for v in M[i]))
     out.append("columns: " + "; ".join(f"[{i}] {c}" for i, c in enumerate(cl)))
@@ -216,6 +251,7 @@ def ranked_first(rows) -> tuple:
 def figures(rows, summary, out: Path) -> list:
     """Confusion heat map and per-case ratio chart (PNG); returns the paths."""
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -227,14 +263,24 @@ def figures(rows, summary, out: Path) -> list:
     for i in range(len(rl)):
         for j in range(len(cl)):
             if M[i, j]:
-                ax.text(j, i, str(M[i, j]), ha="center", va="center", fontsize=8,
-                        color="white" if share[i, j] > 0.6 else "black")
+                ax.text(
+                    j,
+                    i,
+                    str(M[i, j]),
+                    ha="center",
+                    va="center",
+                    fontsize=8,
+                    color="white" if share[i, j] > 0.6 else "black",
+                )
     ax.set_xticks(range(len(cl)), cl, rotation=40, ha="right", fontsize=8)
     ax.set_yticks(range(len(rl)), rl, fontsize=8)
     ax.set_xlabel("verdict of diagnose (~X: form imperfect, X named)")
     ax.set_ylabel("hidden in the data")
-    ax.set_title(f"diagnose on independent data: score {100 * summary['score']:.0f} % (target 95), "
-                 f"false alarms {100 * summary['false_alarm_rate']:.0f} % (target 5)", fontsize=9)
+    ax.set_title(
+        f"diagnose on independent data: score {100 * summary['score']:.0f} % (target 95), "
+        f"false alarms {100 * summary['false_alarm_rate']:.0f} % (target 5)",
+        fontsize=9,
+    )
     fig.tight_layout()
     p = out / "confusion.png"
     fig.savefig(p, dpi=110)
@@ -246,8 +292,9 @@ def figures(rows, summary, out: Path) -> list:
     for r in rows:
         if r["expect"] == "null":
             nulls.setdefault(r["case"], []).append(r)
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(13, max(4, 0.27 * len(single) + 1.5)),
-                                 gridspec_kw={"width_ratios": [3, 1]})
+    fig, (a1, a2) = plt.subplots(
+        1, 2, figsize=(13, max(4, 0.27 * len(single) + 1.5)), gridspec_kw={"width_ratios": [3, 1]}
+    )
     y = np.arange(len(single))
     base = [r["baseline_ratio"] or np.nan for r in single]
     best = [min([e["ratio"] for e in r["ranking"] if e.get("ratio") is not None] or [np.nan]) for r in single]
@@ -259,6 +306,7 @@ def figures(rows, summary, out: Path) -> list:
     a1.invert_yaxis()
     a1.set_xscale("log")
     from matplotlib.ticker import FixedLocator, NullLocator, ScalarFormatter
+
     a1.xaxis.set_major_locator(FixedLocator([0.8, 1, 1.2, 1.5, 2, 3, 4, 6, 8, 10]))
     a1.xaxis.set_major_formatter(ScalarFormatter())
     a1.xaxis.set_minor_locator(NullLocator())
@@ -285,8 +333,9 @@ def figures(rows, summary, out: Path) -> list:
 
 def _commit() -> str:
     try:
-        return subprocess.run(["git", "-C", str(HERE), "rev-parse", "--short", "HEAD"], capture_output=True,
-                              text=True, timeout=10).stdout.strip()
+        return subprocess.run(
+            ["git", "-C", str(HERE), "rev-parse", "--short", "HEAD"], capture_output=True, text=True, timeout=10
+        ).stdout.strip()
     except Exception:
         return "?"
 
@@ -299,8 +348,9 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2, help="parallel processes (default 2)")
     ap.add_argument("--out", default=str(HERE / "out" / "diagnose_generalisation"), help="output folder")
     ap.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
-    ap.add_argument("--docs", action="store_true",
-                    help="also copy the figures to docs/figures/diagnose_generalisation_*.png")
+    ap.add_argument(
+        "--docs", action="store_true", help="also copy the figures to docs/figures/diagnose_generalisation_*.png"
+    )
     a = ap.parse_args(argv)
     cases = select(a.cases, a.quick)
     redraws = a.redraws if a.redraws is not None else (QUICK_REDRAWS if a.quick else 20)
@@ -311,34 +361,55 @@ def main(argv=None) -> int:
     rows = run_all(cases, redraws, a.workers, progress=True)
     wall = time.perf_counter() - t0
     summary = score(rows)
-    summary.update(commit=commit, wall_s=wall, workers=a.workers, runs=len(rows),
-                   cpu_s_runs=float(sum(r["cpu_s"] for r in rows)),
-                   cpu_s_parent=resource.getrusage(resource.RUSAGE_SELF).ru_utime,
-                   load=os.getloadavg(), quick=a.quick, cases_filter=a.cases, redraws=redraws)
+    summary.update(
+        commit=commit,
+        wall_s=wall,
+        workers=a.workers,
+        runs=len(rows),
+        cpu_s_runs=float(sum(r["cpu_s"] for r in rows)),
+        cpu_s_parent=resource.getrusage(resource.RUSAGE_SELF).ru_utime,
+        load=os.getloadavg(),
+        quick=a.quick,
+        cases_filter=a.cases,
+        redraws=redraws,
+    )
     print(format_table(rows))
     print()
-    print(f"score: {100 * summary['score']:.1f} % of {summary['cases']} cases right "
-          f"({summary['non_null_right']:.0f}/{summary['non_null_cases']} mechanism cases; null cases by the "
-          f"fraction of their redraws right)  [target >= 95 %]")
-    print(f"false-alarm rate: {100 * summary['false_alarm_rate']:.1f} % ({summary['false_alarms']} of "
-          f"{summary['null_runs']} null redraws not called 'nothing is missing')  [target <= 5 %]")
+    print(
+        f"score: {100 * summary['score']:.1f} % of {summary['cases']} cases right "
+        f"({summary['non_null_right']:.0f}/{summary['non_null_cases']} mechanism cases; null cases by the "
+        f"fraction of their redraws right)  [target >= 95 %]"
+    )
+    print(
+        f"false-alarm rate: {100 * summary['false_alarm_rate']:.1f} % ({summary['false_alarms']} of "
+        f"{summary['null_runs']} null redraws not called 'nothing is missing')  [target <= 5 %]"
+    )
     rf = ranked_first(rows)
     summary["ranked_first"] = {"right": rf[0], "of": rf[1]}
     print(f"secondary: the hidden mechanism is ranked first in {rf[0]} of {rf[1]} single-mechanism cases")
-    print(f"{len(rows)} runs in {wall:.0f} s wall with {a.workers} workers, {summary['cpu_s_runs']:.0f} s CPU in "
-          f"the runs; load average {summary['load'][0]:.1f}; commit {summary['commit']}")
+    print(
+        f"{len(rows)} runs in {wall:.0f} s wall with {a.workers} workers, {summary['cpu_s_runs']:.0f} s CPU in "
+        f"the runs; load average {summary['load'][0]:.1f}; commit {summary['commit']}"
+    )
     timing = {}
     for e in sorted(set(r["experiment"] for r in rows)):
         ts = [(r["cpu_s"], r["wall_s"], r["n"]) for r in rows if r["experiment"] == e]
         cpu, wall = np.array([t[0] for t in ts]), np.array([t[1] for t in ts])
-        timing[e] = {"cpu_median_s": float(np.median(cpu)), "cpu_max_s": float(cpu.max()),
-                     "wall_median_s": float(np.median(wall)), "wall_max_s": float(wall.max())}
-        print(f"diagnose per run, {e}: CPU median {np.median(cpu):.1f} s, max {cpu.max():.1f} s; wall median "
-              f"{np.median(wall):.1f} s, max {wall.max():.1f} s (one process per run, {a.workers} at once)")
+        timing[e] = {
+            "cpu_median_s": float(np.median(cpu)),
+            "cpu_max_s": float(cpu.max()),
+            "wall_median_s": float(np.median(wall)),
+            "wall_max_s": float(wall.max()),
+        }
+        print(
+            f"diagnose per run, {e}: CPU median {np.median(cpu):.1f} s, max {cpu.max():.1f} s; wall median "
+            f"{np.median(wall):.1f} s, max {wall.max():.1f} s (one process per run, {a.workers} at once)"
+        )
     summary["timing"] = timing
     paths = [] if a.no_figures else figures(rows, summary, out) + [Path(gallery(out / "forms.png"))]
     if a.docs and paths:
         import shutil
+
         for p in paths:
             shutil.copy(p, HERE.parent / "docs" / "figures" / f"diagnose_generalisation_{p.name}")
     (out / "results.json").write_text(json.dumps({"summary": summary, "runs": rows}, indent=1, default=float))

@@ -38,8 +38,13 @@ def _cpu() -> float:
 
 def timed(args) -> tuple:
     """(wall s, CPU s of the child and its workers, JSON report) of ``femast ARGS --json``."""
-    cmd = [sys.executable, "-c", "import sys; from femast.cli import main; sys.exit(main(sys.argv[1:]))", *args,
-           "--json"]
+    cmd = [
+        sys.executable,
+        "-c",
+        "import sys; from femast.cli import main; sys.exit(main(sys.argv[1:]))",
+        *args,
+        "--json",
+    ]
     c0, t0 = _cpu(), time.perf_counter()
     env = {k: v for k, v in os.environ.items() if k != "FEMAST_FE_CACHE"}  # cold: no disk cache of FE runs
     p = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env=env)
@@ -54,8 +59,11 @@ def mast_top_file(folder: Path) -> Path:
     from femast.experiments.synthetic import mast_top_data, mast_top_path
 
     exp = get_experiment("mast-top")
-    data, _ = mast_top_data(effects={"joint_clearance": {"c": 1.5e-4}, "friction_hysteresis": {"M_f": 12.0}},
-                            path=mast_top_path(n=500, kind="cycles", amplitude_N=150.0, seed=3), seed=3)
+    data, _ = mast_top_data(
+        effects={"joint_clearance": {"c": 1.5e-4}, "friction_hysteresis": {"M_f": 12.0}},
+        path=mast_top_path(n=500, kind="cycles", amplitude_N=150.0, seed=3),
+        seed=3,
+    )
     f = folder / "mast_top_500.csv"
     write_data(f, data, exp)
     return f
@@ -73,23 +81,31 @@ def main(argv=None) -> dict:
         print(f"mast-top, 500 samples, every effect and the pair stage, --workers {args.workers}; {_load()}")
         runs = []
         for _ in range(args.repeat):
-            wall, cpu, rep = timed(["diagnose", "mast-top", str(f), "--out", str(Path(tmp) / "mt"), "--workers",
-                                    str(args.workers)])
+            wall, cpu, rep = timed(
+                ["diagnose", "mast-top", str(f), "--out", str(Path(tmp) / "mt"), "--workers", str(args.workers)]
+            )
             fits = sum(len(e.get("forms", [])) for e in rep["ranking"]) + len(rep["pairs"]) + len(rep["form_check"])
             runs.append((wall, cpu))
-            print(f"  wall {wall:.2f} s, CPU {cpu:.2f} s ({fits} refits, {len(rep['pairs'])} pairs; "
-                  f"{rep['executor']}) -> {rep['verdict']['kind']} {rep['verdict']['missing_effects']}; {_load()}")
+            print(
+                f"  wall {wall:.2f} s, CPU {cpu:.2f} s ({fits} refits, {len(rep['pairs'])} pairs; "
+                f"{rep['executor']}) -> {rep['verdict']['kind']} {rep['verdict']['missing_effects']}; {_load()}"
+            )
         out["mast_top"] = {"wall_s": min(w for w, _ in runs), "cpu_s": min(c for _, c in runs)}
-        print(f"  best: wall {out['mast_top']['wall_s']:.2f} s, CPU {out['mast_top']['cpu_s']:.2f} s "
-              "(target: under 15 s on 2 cores)")
+        print(
+            f"  best: wall {out['mast_top']['wall_s']:.2f} s, CPU {out['mast_top']['cpu_s']:.2f} s "
+            "(target: under 15 s on 2 cores)"
+        )
         if not args.no_bay:
             print(f"bay-torsion example ({BAY.name}), --workers {args.workers}; {_load()}")
-            wall, cpu, rep = timed(["diagnose", "bay-torsion", str(BAY), "--out", str(Path(tmp) / "bay"), "--workers",
-                                    str(args.workers)])
+            wall, cpu, rep = timed(
+                ["diagnose", "bay-torsion", str(BAY), "--out", str(Path(tmp) / "bay"), "--workers", str(args.workers)]
+            )
             out["bay_torsion"] = {"wall_s": wall, "cpu_s": cpu}
-            print(f"  wall {wall:.2f} s, CPU {cpu:.2f} s ({len(rep['ranking'])} candidates, {len(rep['pairs'])} "
-                  f"pairs; {rep['executor']}) -> {rep['verdict']['kind']} {rep['verdict']['missing_effects']}; "
-                  f"{_load()} (target: under 20 s)")
+            print(
+                f"  wall {wall:.2f} s, CPU {cpu:.2f} s ({len(rep['ranking'])} candidates, {len(rep['pairs'])} "
+                f"pairs; {rep['executor']}) -> {rep['verdict']['kind']} {rep['verdict']['missing_effects']}; "
+                f"{_load()} (target: under 20 s)"
+            )
     return out
 
 

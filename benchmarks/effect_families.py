@@ -28,8 +28,15 @@ OUT = Path(__file__).resolve().parents[1] / "docs" / "figures" / "effect_familie
 
 
 def main() -> Path:
-    u = np.concatenate([np.linspace(0, 100, 201), np.linspace(100, -100, 401), np.linspace(-100, 100, 401),
-                        np.linspace(100, 40, 121), np.linspace(40, 70, 61)])
+    u = np.concatenate(
+        [
+            np.linspace(0, 100, 201),
+            np.linspace(100, -100, 401),
+            np.linspace(-100, 100, 401),
+            np.linspace(100, 40, 121),
+            np.linspace(40, 70, 61),
+        ]
+    )
     fig, ax = plt.subplots(1, 5, figsize=(21, 4.2))
     a = ax[0]
     a.plot(u, u, color="0.7", lw=1, label="elastic joint")
@@ -55,8 +62,12 @@ def main() -> Path:
     a.grid(alpha=0.3)
     a = ax[2]
     d = np.linspace(0, 1.2e-3, 400)
-    for g, lab in ((0.0, "exponential (gamma = 0, default form)"), (1.0, "linear (gamma = 1)"),
-                   (-1.0, "hyperbolic (gamma = -1)"), (2.0, "abrupt (gamma = 2)")):
+    for g, lab in (
+        (0.0, "exponential (gamma = 0, default form)"),
+        (1.0, "linear (gamma = 1)"),
+        (-1.0, "hyperbolic (gamma = -1)"),
+        (2.0, "abrupt (gamma = 2)"),
+    ):
         a.plot(1e3 * d, fade(d, 3e-4, g), label=lab)
     a.set_xlabel("bead distance from the backstop d (mm)")
     a.set_ylabel("share of F_h, w")
@@ -70,8 +81,13 @@ def main() -> Path:
     tau = np.linspace(0, 1, 200)
     a2 = a.twiny()
     a2.plot(tau, 1 / (1 - 0.2 * tau), "--", color="C2", label="pretension linear (lam = 0.2)")
-    a2.plot(tau, 1 / (1 - 0.2 * -np.expm1(-tau / 0.15) / -np.expm1(-1 / 0.15)), "--", color="C3",
-            label="pretension saturating (t_c = 0.15)")
+    a2.plot(
+        tau,
+        1 / (1 - 0.2 * -np.expm1(-tau / 0.15) / -np.expm1(-1 / 0.15)),
+        "--",
+        color="C3",
+        label="pretension saturating (t_c = 0.15)",
+    )
     a.set_xlabel("joint moment |m| (N m) -- solid")
     a2.set_xlabel("normalised time tau -- dashed")
     a.set_ylabel("compliance / baseline compliance")
@@ -79,9 +95,17 @@ def main() -> Path:
     a2.legend(fontsize=7, loc="upper left")
     a.grid(alpha=0.3)
     a = ax[4]
-    c = np.concatenate([np.linspace(0, 100, 201), np.linspace(100, 0, 201), np.linspace(0, -60, 121),
-                        np.linspace(-60, 0, 121), np.linspace(0, 70, 141), np.linspace(70, 30, 81),
-                        np.linspace(30, 60, 61)])
+    c = np.concatenate(
+        [
+            np.linspace(0, 100, 201),
+            np.linspace(100, 0, 201),
+            np.linspace(0, -60, 121),
+            np.linspace(-60, 0, 121),
+            np.linspace(0, 70, 141),
+            np.linspace(70, 30, 81),
+            np.linspace(30, 60, 61),
+        ]
+    )
     a.plot(c, c, color="0.7", lw=1, label="no hysteresis")
     a.plot(c, proportional_play(c, 0.2), label="play (eta = 0.2)")
     a.plot(c, proportional_iwan(c, 0.5, 1.0, 0.0), label="iwan (eta = 0.5, beta = 1)")

@@ -53,19 +53,19 @@ def bay_runs(repeat):
     drive = np.column_stack([prep["theta"], prep["ux"], prep["uy"]])[prep["rows"]]
     inputs = bt.bay_inputs({"latch_k": 1.08e5, "latch_mu": 0.065}, exp.options)
 
-    class WithFiles(Analysis):   # the experiment as it was: every frame written to a temporary folder
+    class WithFiles(Analysis):  # the experiment as it was: every frame written to a temporary folder
         def __init__(self, model, out=None, **kw):
-            self._tmp = tempfile.TemporaryDirectory(prefix="femast_bay_")   # removed with the analysis
+            self._tmp = tempfile.TemporaryDirectory(prefix="femast_bay_")  # removed with the analysis
             super().__init__(model, self._tmp.name, **kw)
 
     def run(files):
-        fa.Analysis = WithFiles if files else Analysis   # run_bay imports it from femast.analysis when called
+        fa.Analysis = WithFiles if files else Analysis  # run_bay imports it from femast.analysis when called
         try:
             return bt.run_bay(inputs, drive)
         finally:
             fa.Analysis = Analysis
 
-    run(False), run(True)   # numba cache loads
+    run(False), run(True)  # numba cache loads
     res = {False: [], True: []}
     outs = {}
     for _ in range(repeat):
@@ -86,7 +86,7 @@ def guyed(repeat):
 
     fe = MastFE(1200.0)
     fe.equilibrate()
-    W = np.array([[10.0, 0, 0, 0, 0, 0], [20.0, 5.0, 0, 0, 0, 1.0], [0, 0, 0, 0, 0, 0]])   # N, N m
+    W = np.array([[10.0, 0, 0, 0, 0, 0], [20.0, 5.0, 0, 0, 0, 1.0], [0, 0, 0, 0, 0, 0]])  # N, N m
     fe.run_wrenches(W)
     ts, _ = _times(lambda: fe.run_wrenches(W), repeat)
     print(f"guyed mast run_wrenches (pretension + 3 wrenches): {_fmt(ts, 1e3, 'ms')}")

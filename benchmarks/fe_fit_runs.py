@@ -58,7 +58,7 @@ def run_case(name: str, workers: int, tmp: Path, code: Path | None = None) -> di
         args += ["--workers", str(workers)]
     log = tmp / f"{name}.log"
     log.unlink(missing_ok=True)
-    env = {k: v for k, v in os.environ.items() if k != "FEMAST_FE_CACHE"}   # cold: no disk cache
+    env = {k: v for k, v in os.environ.items() if k != "FEMAST_FE_CACHE"}  # cold: no disk cache
     env["FEMAST_FE_RUN_LOG"] = str(log)
     env["PYTHONPATH"] = str(code or ROOT)
     cmd = [sys.executable, "-c", "import sys; from femast.cli import main; sys.exit(main(sys.argv[1:]))", *args]
@@ -77,9 +77,17 @@ def run_case(name: str, workers: int, tmp: Path, code: Path | None = None) -> di
     else:
         params = rep["params"]
         verdict = f"rms {rep['rms']:.4g} {rep['error_unit']}, {rep['ratio']:.3g} x noise"
-    return {"case": name, "wall_s": wall, "cpu_s": cpu, "fe_runs": len(runs),
-            "fe_seconds": sum(float(r[3]) for r in runs), "processes": len({r[0] for r in runs}),
-            "load": [load0, os.getloadavg()[0]], "verdict": verdict, "params": params}
+    return {
+        "case": name,
+        "wall_s": wall,
+        "cpu_s": cpu,
+        "fe_runs": len(runs),
+        "fe_seconds": sum(float(r[3]) for r in runs),
+        "processes": len({r[0] for r in runs}),
+        "load": [load0, os.getloadavg()[0]],
+        "verdict": verdict,
+        "params": params,
+    }
 
 
 def _param_text(params: dict) -> str:
@@ -97,8 +105,11 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
     ap.add_argument("--workers", type=int, default=0, help="diagnose --workers (0: the command's default)")
-    ap.add_argument("--other", help="another femast checkout (e.g. `git worktree add /tmp/old COMMIT`): each case "
-                                    "runs alternately there and here, --repeat times (interleaved A/B)")
+    ap.add_argument(
+        "--other",
+        help="another femast checkout (e.g. `git worktree add /tmp/old COMMIT`): each case "
+        "runs alternately there and here, --repeat times (interleaved A/B)",
+    )
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--save", help="write the figures of this run to a JSON file")
     ap.add_argument("--before", help="a JSON file of an earlier --save to compare with")
@@ -111,22 +122,30 @@ def main(argv=None) -> int:
             for k in range(args.repeat):
                 if args.other:
                     o = run_case(name, args.workers, Path(t), Path(args.other))
-                    print(f"{name} [other {args.other}]: {o['fe_runs']} FE runs, wall {o['wall_s']:.1f} s, CPU "
-                          f"{o['cpu_s']:.1f} s; load {o['load'][0]:.1f}; verdict {o['verdict']}; "
-                          f"{_param_text(o['params'])}")
+                    print(
+                        f"{name} [other {args.other}]: {o['fe_runs']} FE runs, wall {o['wall_s']:.1f} s, CPU "
+                        f"{o['cpu_s']:.1f} s; load {o['load'][0]:.1f}; verdict {o['verdict']}; "
+                        f"{_param_text(o['params'])}"
+                    )
                     before.setdefault(name, o)
                 r = run_case(name, args.workers, Path(t))
                 if k + 1 < args.repeat:
-                    print(f"{name}: {r['fe_runs']} FE runs, wall {r['wall_s']:.1f} s, CPU {r['cpu_s']:.1f} s; load "
-                          f"{r['load'][0]:.1f}")
+                    print(
+                        f"{name}: {r['fe_runs']} FE runs, wall {r['wall_s']:.1f} s, CPU {r['cpu_s']:.1f} s; load "
+                        f"{r['load'][0]:.1f}"
+                    )
             results[name] = r
-            print(f"{name}: {r['fe_runs']} FE runs ({r['fe_seconds']:.1f} s in them, {r['processes']} processes), "
-                  f"wall {r['wall_s']:.1f} s, CPU {r['cpu_s']:.1f} s; load {r['load'][0]:.1f} -> {r['load'][1]:.1f}"
-                  f" (2 cores)\n  verdict: {r['verdict']}\n  baseline: {_param_text(r['params'])}")
+            print(
+                f"{name}: {r['fe_runs']} FE runs ({r['fe_seconds']:.1f} s in them, {r['processes']} processes), "
+                f"wall {r['wall_s']:.1f} s, CPU {r['cpu_s']:.1f} s; load {r['load'][0]:.1f} -> {r['load'][1]:.1f}"
+                f" (2 cores)\n  verdict: {r['verdict']}\n  baseline: {_param_text(r['params'])}"
+            )
             b = before.get(name)
             if b:
-                print(f"  before: {b['fe_runs']} FE runs, wall {b['wall_s']:.1f} s, CPU {b['cpu_s']:.1f} s; "
-                      f"verdict {b['verdict']}; {_param_text(b['params'])}")
+                print(
+                    f"  before: {b['fe_runs']} FE runs, wall {b['wall_s']:.1f} s, CPU {b['cpu_s']:.1f} s; "
+                    f"verdict {b['verdict']}; {_param_text(b['params'])}"
+                )
                 same = b["verdict"] == r["verdict"] if name.endswith("diagnose") else True
                 within = []
                 for k, v in r["params"].items():
@@ -135,12 +154,15 @@ def main(argv=None) -> int:
                         within.append(abs(v["value"] - b["params"][k]["value"]) <= e)
                 print(f"  same verdict: {same}; parameters within their standard errors: {all(within)}")
             if name in TARGET_S:
-                print(f"  target: under {TARGET_S[name]:.0f} s on 2 cores: wall {r['wall_s']:.1f} s, CPU "
-                      f"{r['cpu_s']:.1f} s -> {'MET' if r['wall_s'] < TARGET_S[name] else 'NOT MET (wall)'}")
+                print(
+                    f"  target: under {TARGET_S[name]:.0f} s on 2 cores: wall {r['wall_s']:.1f} s, CPU "
+                    f"{r['cpu_s']:.1f} s -> {'MET' if r['wall_s'] < TARGET_S[name] else 'NOT MET (wall)'}"
+                )
     if args.save:
         Path(args.save).write_text(json.dumps(results, indent=2))
 
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
@@ -148,8 +170,11 @@ def main(argv=None) -> int:
     names = list(results)
     fig, axes = plt.subplots(1, 3, figsize=(12.0, 3.8))
     x = np.arange(len(names))
-    for ax, key, label in ((axes[0], "fe_runs", "FE runs"), (axes[1], "cpu_s", "CPU time, all processes (s)"),
-                           (axes[2], "wall_s", "wall time (s)")):
+    for ax, key, label in (
+        (axes[0], "fe_runs", "FE runs"),
+        (axes[1], "cpu_s", "CPU time, all processes (s)"),
+        (axes[2], "wall_s", "wall time (s)"),
+    ):
         if before:
             ax.bar(x - 0.2, [before.get(n, {}).get(key, np.nan) for n in names], 0.4, label="before", color="0.6")
         ax.bar(x + (0.2 if before else 0.0), [results[n][key] for n in names], 0.4, label="now", color="C0")
@@ -162,8 +187,10 @@ def main(argv=None) -> int:
     axes[0].legend()
     axes[1].set_yscale("log")
     axes[2].set_yscale("log")
-    fig.suptitle(f"FE fits: runs, CPU and wall time (--workers {args.workers or 'default'}; wall target dashed; load "
-                 f"{os.getloadavg()[0]:.1f} on 2 cores)")
+    fig.suptitle(
+        f"FE fits: runs, CPU and wall time (--workers {args.workers or 'default'}; wall target dashed; load "
+        f"{os.getloadavg()[0]:.1f} on 2 cores)"
+    )
     fig.tight_layout()
     out = ROOT / "benchmarks" / "out"
     out.mkdir(exist_ok=True)

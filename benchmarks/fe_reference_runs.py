@@ -49,10 +49,12 @@ def main(argv=None) -> int:
     inp = bt.bay_inputs({"latch_k": 107477.0, "latch_mu": 0.06837}, opt)
     ref = ReferencePath()
     a = bt.run_bay(inp, drive, 1, 1, record_path=ref)
-    bt.run_bay(inp, drive, 1, 1)   # warm
+    bt.run_bay(inp, drive, 1, 1)  # warm
     rows_out = []
-    print(f"reference: {a['increments']} increments, {a['iterations']} iterations; "
-          f"{len(ref)} recorded increments ({ref.nbytes() / 1e3:.0f} kB)")
+    print(
+        f"reference: {a['increments']} increments, {a['iterations']} iterations; "
+        f"{len(ref)} recorded increments ({ref.nbytes() / 1e3:.0f} kB)"
+    )
     for name, change in CASES.items():
         i2 = {**inp, **change}
         cpu = {False: [], True: []}
@@ -64,14 +66,26 @@ def main(argv=None) -> int:
                 cpu[use].append(time.process_time() - c)
         diff = float(np.abs(out[True]["Mz"] - out[False]["Mz"]).max())
         change_ = float(np.abs(out[False]["Mz"] - a["Mz"]).max())
-        r = (name, out[False]["iterations"], out[True]["iterations"], min(cpu[False]), np.median(cpu[False]),
-             min(cpu[True]), np.median(cpu[True]), diff, change_)
+        r = (
+            name,
+            out[False]["iterations"],
+            out[True]["iterations"],
+            min(cpu[False]),
+            np.median(cpu[False]),
+            min(cpu[True]),
+            np.median(cpu[True]),
+            diff,
+            change_,
+        )
         rows_out.append(r)
-        print(f"{name:22s} iterations {r[1]:4d} -> {r[2]:4d}; CPU min {r[3]:.3f} -> {r[5]:.3f} s, median "
-              f"{r[4]:.3f} -> {r[6]:.3f} s; |dMz| with/without reference {diff:.1e} N m (change against the "
-              f"reference {change_:.2g} N m)")
+        print(
+            f"{name:22s} iterations {r[1]:4d} -> {r[2]:4d}; CPU min {r[3]:.3f} -> {r[5]:.3f} s, median "
+            f"{r[4]:.3f} -> {r[6]:.3f} s; |dMz| with/without reference {diff:.1e} N m (change against the "
+            f"reference {change_:.2g} N m)"
+        )
 
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 

@@ -48,12 +48,32 @@ plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from femast.guyed import (cable_vectors, cantilever_compliance, cantilever_stiffness, compliance_3r, displacement_complete,  # noqa: E402
-                          fit_beam_E, mast_section, mast_stiffness, mast_top_wrenches, tension_distribution,
-                          trajectory_loads)
+from femast.guyed import (  # noqa: E402
+    cable_vectors,
+    cantilever_compliance,
+    cantilever_stiffness,
+    compliance_3r,
+    displacement_complete,
+    fit_beam_E,
+    mast_section,
+    mast_stiffness,
+    mast_top_wrenches,
+    tension_distribution,
+    trajectory_loads,
+)
 from femast.guyed.fe_mast import MastFE  # noqa: E402
-from femast.guyed.rocaspect import (E_1200N, E_NO_SHROUD, L_BEAM, POSE_0, TABLE_III, fig5a_trajectory,  # noqa: E402
-                                    mast_bases, mast_tops, rocaspect_geometry, rocaspect_shrouds)
+from femast.guyed.rocaspect import (  # noqa: E402
+    E_1200N,
+    E_NO_SHROUD,
+    L_BEAM,
+    POSE_0,
+    TABLE_III,
+    fig5a_trajectory,
+    mast_bases,
+    mast_tops,
+    rocaspect_geometry,
+    rocaspect_shrouds,
+)
 
 OUT = Path(__file__).resolve().parent / "out"
 DOCS_FIG = Path(__file__).resolve().parents[1] / "docs" / "figures" / "guyed_fe_mast_models.png"
@@ -130,16 +150,20 @@ def table(res, ref: str | None = None) -> str:
     """Max and RMS horizontal top displacement per model, and RMS / max differences to model ``ref``
     (default: the first model), in mm."""
     names0 = ref or next(iter(next(iter(res["pred"].values()))))
-    lines = [f"{'case':<11} {'model':<9} {'max |dc|':>9} {'rms |dc|':>9} {'rms diff':>9} {'max diff':>9}"
-             f"   (mm, x-y plane; diff to {names0})"]
+    lines = [
+        f"{'case':<11} {'model':<9} {'max |dc|':>9} {'rms |dc|':>9} {'rms diff':>9} {'max diff':>9}"
+        f"   (mm, x-y plane; diff to {names0})"
+    ]
     for case, preds in res["pred"].items():
         ref_d = preds[names0][:, :2]
         for m in preds:
             d = preds[m][:, :2]
             mag = np.linalg.norm(d, axis=1) * 1e3
             diff = np.linalg.norm(d - ref_d, axis=1) * 1e3
-            lines.append(f"{case:<11} {m:<9} {mag.max():9.2f} {np.sqrt((mag**2).mean()):9.2f} "
-                         f"{np.sqrt((diff**2).mean()):9.2f} {diff.max():9.2f}")
+            lines.append(
+                f"{case:<11} {m:<9} {mag.max():9.2f} {np.sqrt((mag**2).mean()):9.2f} "
+                f"{np.sqrt((diff**2).mean()):9.2f} {diff.max():9.2f}"
+            )
     return "\n".join(lines)
 
 
@@ -155,7 +179,9 @@ def plot(res, path: Path):
     l, _, _, Rb = cable_vectors(geom, traj[0])
     B = Rb + traj[0, :3]
     for j, (a, b) in enumerate(zip(geom.exit_points, B)):
-        ax.plot([a[0], b[0]], [a[1], b[1]], [a[2], b[2]], color="0.6", lw=0.8, label="cables at POSE_0" if j == 0 else None)
+        ax.plot(
+            [a[0], b[0]], [a[1], b[1]], [a[2], b[2]], color="0.6", lw=0.8, label="cables at POSE_0" if j == 0 else None
+        )
     corners = np.array([[sx, sy, sz] for sx in (-0.5, 0.5) for sy in (-0.5, 0.5) for sz in (-0.25, 0.25)])
     for i in range(8):
         for k in range(i + 1, 8):
@@ -164,18 +190,32 @@ def plot(res, path: Path):
                 ax.plot(e[:, 0], e[:, 1], e[:, 2], color="0.3", lw=0.8)
     ax.plot(traj[:, 0], traj[:, 1], traj[:, 2], "C3-", lw=2, label="platform centre")
     ax.scatter(*traj[0, :3], color="C3", s=30)
-    ax.set(xlabel="x (m)", ylabel="y (m)", zlabel="z (m)", title="(a) platform trajectory (cf. seed Fig. 5a)",
-           zlim=(0, 4.2))
+    ax.set(
+        xlabel="x (m)",
+        ylabel="y (m)",
+        zlabel="z (m)",
+        title="(a) platform trajectory (cf. seed Fig. 5a)",
+        zlim=(0, 4.2),
+    )
     ax.set_box_aspect((8.3, 6.8, 4.0))
     ax.legend(loc="upper right")
-    styles = {"3R": dict(color="C0", lw=2.5), "beam": dict(color="C1", ls="--", lw=2),
-              "complete": dict(color="C2", lw=1.5), "FE": dict(color="k", ls=":", lw=1.5)}
+    styles = {
+        "3R": dict(color="C0", lw=2.5),
+        "beam": dict(color="C1", ls="--", lw=2),
+        "complete": dict(color="C2", lw=1.5),
+        "FE": dict(color="k", ls=":", lw=1.5),
+    }
     for k, (case, preds) in enumerate(res["pred"].items()):
         a = fig.add_subplot(2, 2, k + 2)
         for m, d in preds.items():
             a.plot(d[:, 0] * 1e3, d[:, 1] * 1e3, label=m, **styles.get(m, {}))
         a.plot(0, 0, "ko", ms=4)
-        a.set(xlabel="dx of mast-1 top (mm)", ylabel="dy (mm)", title=f"({'bcd'[k]}) " + (case if case == "no shrouds" else f"shroud pretension {case}"), aspect="equal")
+        a.set(
+            xlabel="dx of mast-1 top (mm)",
+            ylabel="dy (mm)",
+            title=f"({'bcd'[k]}) " + (case if case == "no shrouds" else f"shroud pretension {case}"),
+            aspect="equal",
+        )
         a.grid(alpha=0.3)
         a.legend()
     fig.suptitle("Seed 000: mast-1 top displacement from the initial pose, analytic and FE models (cf. Fig. 6)")
@@ -191,19 +231,26 @@ def main(argv=None):
     res = compute()
     png = OUT / "guyed_mast_models.png"
     plot(res, png)
-    print(f"trajectory: {len(res['trajectory'])} poses; tensions {res['tau'].min():.0f}..{res['tau'].max():.0f} N; "
-          f"mast-1 top force change |df| up to {np.linalg.norm(res['dw'][:, :3], axis=1).max():.0f} N")
-    print("beam E per case (Pa): " + ", ".join(f"{c.name}: {c.E_beam:.3g}" for c in res["cases"])
-          + "  (400 N: identified from the 3R curve; the seed gives none)")
+    print(
+        f"trajectory: {len(res['trajectory'])} poses; tensions {res['tau'].min():.0f}..{res['tau'].max():.0f} N; "
+        f"mast-1 top force change |df| up to {np.linalg.norm(res['dw'][:, :3], axis=1).max():.0f} N"
+    )
+    print(
+        "beam E per case (Pa): "
+        + ", ".join(f"{c.name}: {c.E_beam:.3g}" for c in res["cases"])
+        + "  (400 N: identified from the 3R curve; the seed gives none)"
+    )
     print(table(res))
     if any(c.fe_tension is not None and c.fe_tension.size for c in res["cases"]):
         print(table(res, ref="FE"))
         for c in res["cases"]:
             if c.fe_tension is not None and c.fe_tension.size:
                 t = c.fe_tension
-                print(f"FE shroud tensions, {c.name}: at POSE_0 {np.round(t[0]).tolist()} N; along the path "
-                      + ", ".join(f"#{r + 1} {t[:, r].min():.0f}..{t[:, r].max():.0f}" for r in range(t.shape[1]))
-                      + " N")
+                print(
+                    f"FE shroud tensions, {c.name}: at POSE_0 {np.round(t[0]).tolist()} N; along the path "
+                    + ", ".join(f"#{r + 1} {t[:, r].min():.0f}..{t[:, r].max():.0f}" for r in range(t.shape[1]))
+                    + " N"
+                )
     print(f"figure: {png}  ({time.perf_counter() - t0:.1f} s)")
     if "--docs" in argv:
         DOCS_FIG.parent.mkdir(parents=True, exist_ok=True)

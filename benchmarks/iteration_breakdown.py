@@ -127,8 +127,10 @@ def breakdown(n_bays, runs):
         superlu += getattr(r["analysis"].solver, "superlu_seconds", float("nan"))
         facts += getattr(r["analysis"].solver, "factorizations", 0)
     ms = 1e3 / iters
-    print(f"\n{n_bays}-bay mast ({len(mast.conn)} beams), {runs} runs, {iters // runs} iterations and "
-          f"{facts // runs} factorisations each; per Newton iteration, ms (load {os.getloadavg()[0]:.1f}):")
+    print(
+        f"\n{n_bays}-bay mast ({len(mast.conn)} beams), {runs} runs, {iters // runs} iterations and "
+        f"{facts // runs} factorisations each; per Newton iteration, ms (load {os.getloadavg()[0]:.1f}):"
+    )
     print(f"  {'':58} {'wall':>8} {'CPU':>8} {'calls/it':>8}")
     print(f"  {'whole run (analysis.run)':<58} {total * ms:8.3f} {cpu * ms:8.3f}")
     print(f"  {'  increments only (no per-run set-up, close)':<58} {increments * ms:8.3f}")
@@ -137,16 +139,34 @@ def breakdown(n_bays, runs):
     for label in sorted(acc, key=order.index):
         w, c, n = acc[label]
         print(f"  {label:<58} {w * ms:8.3f} {c * ms:8.3f} {n / iters:8.2f}")
-    print(f"  iteration / linear solver: {total / superlu:.2f} (whole run), {increments / superlu:.2f} "
-          "(increments only)")
-    linear = [label for label in ("factorisation (from the solver's matrix)", "factorisation (CSR path)",
-                                  "solve (incl. refinement)") if label in acc]
-    if linear:   # the figure in CPU time (contention disturbs it less): the timed parts' own CPU
+    print(
+        f"  iteration / linear solver: {total / superlu:.2f} (whole run), {increments / superlu:.2f} (increments only)"
+    )
+    linear = [
+        label
+        for label in (
+            "factorisation (from the solver's matrix)",
+            "factorisation (CSR path)",
+            "solve (incl. refinement)",
+        )
+        if label in acc
+    ]
+    if linear:  # the figure in CPU time (contention disturbs it less): the timed parts' own CPU
         lin_cpu = sum(acc[label][1] for label in linear)
         print(f"  iteration / linear solver, CPU: {cpu / lin_cpu:.2f} (whole run)")
-        return {"bays": n_bays, "whole": cpu * ms, "superlu": lin_cpu * ms, "cpu": True,
-                "parts": {k: v[1] * ms for k, v in acc.items()}}
-    return {"bays": n_bays, "whole": total * ms, "superlu": superlu * ms, "parts": {k: v[0] * ms for k, v in acc.items()}}
+        return {
+            "bays": n_bays,
+            "whole": cpu * ms,
+            "superlu": lin_cpu * ms,
+            "cpu": True,
+            "parts": {k: v[1] * ms for k, v in acc.items()},
+        }
+    return {
+        "bays": n_bays,
+        "whole": total * ms,
+        "superlu": superlu * ms,
+        "parts": {k: v[0] * ms for k, v in acc.items()},
+    }
 
 
 def plot(results, path):
@@ -159,11 +179,19 @@ def plot(results, path):
     plotstyle.use()
     import matplotlib.pyplot as plt
 
-    shown = ["element evaluation (all families + finiteness)", "beam kernel (element forces + tangents)",
-             "tangent assembly into the solver's matrix", "tangent assembly into CSR",
-             "residual assembly (internal forces - loads)", "residual assembly", "convergence test",
-             "configuration update", "commit (per increment)", "results frame (per increment)",
-             "results frame (gather + hand-over)"]
+    shown = [
+        "element evaluation (all families + finiteness)",
+        "beam kernel (element forces + tangents)",
+        "tangent assembly into the solver's matrix",
+        "tangent assembly into CSR",
+        "residual assembly (internal forces - loads)",
+        "residual assembly",
+        "convergence test",
+        "configuration update",
+        "commit (per increment)",
+        "results frame (per increment)",
+        "results frame (gather + hand-over)",
+    ]
     fig, ax = plt.subplots(figsize=(9, 1.2 + 0.9 * len(results)))
     for y, r in enumerate(results):
         left = 1.0
@@ -174,13 +202,24 @@ def plot(results, path):
                 ax.barh(y, w, left=left, color=f"C{i}", label=name if y == 0 else None)
                 left += w
         rest = r["whole"] / r["superlu"] - left
-        ax.barh(y, max(rest, 0.0), left=left, color="w", edgecolor="k", hatch="//",
-                label="the rest (Python between the parts)" if y == 0 else None)
+        ax.barh(
+            y,
+            max(rest, 0.0),
+            left=left,
+            color="w",
+            edgecolor="k",
+            hatch="//",
+            label="the rest (Python between the parts)" if y == 0 else None,
+        )
         ax.text(r["whole"] / r["superlu"] + 0.02, y, f"{r['whole'] / r['superlu']:.2f}", va="center")
     ax.axvline(1.3, color="r", ls=":", label="target 1.3 (issue 21)")
-    ax.set(yticks=range(len(results)), yticklabels=[f"{r['bays']} bays" for r in results],
-           xlabel=("CPU" if results[0].get("cpu") else "wall") + " time per Newton iteration / linear solver's in the same runs",
-           title="where a Newton iteration goes (truss mast of beam-columns)")
+    ax.set(
+        yticks=range(len(results)),
+        yticklabels=[f"{r['bays']} bays" for r in results],
+        xlabel=("CPU" if results[0].get("cpu") else "wall")
+        + " time per Newton iteration / linear solver's in the same runs",
+        title="where a Newton iteration goes (truss mast of beam-columns)",
+    )
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.35), ncol=3)
     fig.tight_layout()
     plotstyle.save(fig, path, dpi=110)
@@ -196,7 +235,7 @@ def main(argv=None):
 
     print(f"femast at {os.path.dirname(femast.__file__)}")
     results = [breakdown(nb, args.runs) for nb in args.bays]
-    if all(r["superlu"] == r["superlu"] for r in results):   # an old femast has no SuperLU timer (nan)
+    if all(r["superlu"] == r["superlu"] for r in results):  # an old femast has no SuperLU timer (nan)
         out = os.path.join(HERE, "out", "iteration_breakdown.png")
         os.makedirs(os.path.dirname(out), exist_ok=True)
         plot(results, out)

@@ -48,8 +48,12 @@ def main(n_monte_carlo: int = 50) -> dict:
     clean = [simulate_pull_test(true, d, EA=EA, n_steps=300) for d in (UNLATCHING, LATCHING)]
     tests = noisy(clean, np.random.default_rng(2024))
     res = fit_pull_tests(tests, h=true.h, R=true.R, sigma_T=SIG_T, sigma_x=SIG_D)
-    est = np.array([fit_pull_tests(noisy(clean, np.random.default_rng(s)), h=true.h, R=true.R,
-                                   sigma_T=SIG_T, sigma_x=SIG_D).x for s in range(n_monte_carlo)])
+    est = np.array(
+        [
+            fit_pull_tests(noisy(clean, np.random.default_rng(s)), h=true.h, R=true.R, sigma_T=SIG_T, sigma_x=SIG_D).x
+            for s in range(n_monte_carlo)
+        ]
+    )
     mc_std = est.std(axis=0)
     units = {"r": (1e3, "mm"), "x_backstop": (1e3, "mm"), "k": (1e-3, "N/mm"), "mu": (1.0, "-")}
     print(f"{'param':>10s} {'true':>9s} {'fit':>9s} {'stderr':>9s} {'MC std':>9s} {'z':>6s}")
@@ -57,11 +61,15 @@ def main(n_monte_carlo: int = 50) -> dict:
     for i, name in enumerate(res.names):
         f, u = units[name]
         z = (res.x[i] - theta[i]) / res.stderr[i]
-        print(f"{name:>10s} {theta[i] * f:9.4f} {res.x[i] * f:9.4f} {res.stderr[i] * f:9.4f} "
-              f"{mc_std[i] * f:9.4f} {z:6.2f}  {u}")
+        print(
+            f"{name:>10s} {theta[i] * f:9.4f} {res.x[i] * f:9.4f} {res.stderr[i] * f:9.4f} "
+            f"{mc_std[i] * f:9.4f} {z:6.2f}  {u}"
+        )
         rows[name] = dict(true=theta[i], fit=res.x[i], stderr=res.stderr[i], mc_std=mc_std[i])
-    print(f"reduced chi-square {res.chi2_reduced:.3f}, {res.used.sum()} of {res.used.size} points used, "
-          f"{res.nfev} evaluations, {res.message}")
+    print(
+        f"reduced chi-square {res.chi2_reduced:.3f}, {res.used.sum()} of {res.used.size} points used, "
+        f"{res.nfev} evaluations, {res.message}"
+    )
 
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.4), sharey=True)
     mm = 1e3
@@ -83,10 +91,13 @@ def main(n_monte_carlo: int = 50) -> dict:
         axs[1].plot(x * mm, latch_force(x, d, true), "--", color=c, lw=0.8)
     axs[1].axvline(-res.params.x_backstop * mm, color="k", lw=1.5, label="fitted backstop")
     axs[1].plot([], [], "--", color="0.3", lw=0.8, label="true law")
-    txt = "\n".join(f"{n} = {rows[n]['fit'] * units[n][0]:.4g} ± {rows[n]['stderr'] * units[n][0]:.2g} {units[n][1]}"
-                    for n in res.names)
-    axs[1].text(0.98, 0.97, txt, transform=axs[1].transAxes, ha="right", va="top", fontsize=8,
-                bbox=dict(fc="w", ec="0.7"))
+    txt = "\n".join(
+        f"{n} = {rows[n]['fit'] * units[n][0]:.4g} ± {rows[n]['stderr'] * units[n][0]:.2g} {units[n][1]}"
+        for n in res.names
+    )
+    axs[1].text(
+        0.98, 0.97, txt, transform=axs[1].transAxes, ha="right", va="top", fontsize=8, bbox=dict(fc="w", ec="0.7")
+    )
     axs[1].set_title("Fig. 10 analogue: least-squares fit (h, R given)", fontsize=10)
     axs[1].legend(fontsize=7, loc="lower left")
     for ax in axs:

@@ -66,29 +66,42 @@ def main(show_paths: bool = True) -> dict:
     ax.plot(x * mm, unl, "--", color="tab:red", lw=1.0, label=r"Eq. 14, $dx>0$ (unlatching branch)")
     ax.plot(x * mm, lat, "--", color="tab:blue", lw=1.0, label=r"Eq. 14, $dx<0$ (latching branch)")
     ax.plot([-p.x_backstop * mm] * 2, [ylo, unl[0]], color="k", lw=2.5, label="backstop (any inward pull)")
-    result = {"peak_unlatching_N": float(unl.max()), "peak_latching_N": float(lat.min()),
-              "x_contact_mm": xct * mm, "dT_out_backstop_N": float(unl[0])}
+    result = {
+        "peak_unlatching_N": float(unl.max()),
+        "peak_latching_N": float(lat.min()),
+        "x_contact_mm": xct * mm,
+        "dT_out_backstop_N": float(unl[0]),
+    }
     if show_paths:
-        for direction, color, lab in ((UNLATCHING, "tab:red", "unlatching test (T2 pulls, T1 slack)"),
-                                      (LATCHING, "tab:blue", "latching test (T1 pulls, T2 slack)")):
+        for direction, color, lab in (
+            (UNLATCHING, "tab:red", "unlatching test (T2 pulls, T1 slack)"),
+            (LATCHING, "tab:blue", "latching test (T1 pulls, T2 slack)"),
+        ):
             t = simulate_pull_test(p, direction, EA=2e5, n_steps=800, x_far=4e-3, T_max=70.0)
             xs, ys = t.x_true * mm, t.dT()
             # a snap is a jump of the bead between two grip steps: draw it dotted
             jump = np.flatnonzero(np.abs(np.diff(xs)) > 0.05)
             segs = np.split(np.arange(xs.size), jump + 1)
             for i, seg in enumerate(segs):
-                ax.plot(xs[seg], ys[seg], color=color, lw=2.2, alpha=0.9, label=f"element path, {lab}" if i == 0 else None)
+                ax.plot(
+                    xs[seg], ys[seg], color=color, lw=2.2, alpha=0.9, label=f"element path, {lab}" if i == 0 else None
+                )
             for j in jump:
-                ax.annotate("", xy=(xs[j + 1], ys[j + 1]), xytext=(xs[j], ys[j]),
-                            arrowprops=dict(arrowstyle="->", color=color, ls=":", lw=1.5))
+                ax.annotate(
+                    "",
+                    xy=(xs[j + 1], ys[j + 1]),
+                    xytext=(xs[j], ys[j]),
+                    arrowprops=dict(arrowstyle="->", color=color, ls=":", lw=1.5),
+                )
                 result[f"snap_{'out' if direction > 0 else 'in'}_mm"] = (float(xs[j]), float(xs[j + 1]))
     ax.axhline(0, color="k", lw=0.5)
     ax.set_xlim(-p.x_backstop * mm - 0.15, 4.0)
     ax.set_ylim(ylo, yhi)
     ax.set_xlabel("bead position x, distance to latch (mm)   [x > 0: outside, backstop at x = -x_backstop]")
     ax.set_ylabel(r"$\Delta T = T_2 - T_1$ (N)")
-    ax.set_title("Latch law, seed 001 Fig. 10: r=1.1 mm, x_bs=2.0 mm, k=100 N/mm, mu=0.07, h=1.5 mm, R=2.4 mm",
-                 fontsize=9)
+    ax.set_title(
+        "Latch law, seed 001 Fig. 10: r=1.1 mm, x_bs=2.0 mm, k=100 N/mm, mu=0.07, h=1.5 mm, R=2.4 mm", fontsize=9
+    )
     ax.plot([], [], ":", color="0.3", label="snap (bead jumps; dotted arrows)")
     ax.legend(loc="upper right", bbox_to_anchor=(1.0, 0.86), fontsize=7.5, framealpha=0.9)
     fig.tight_layout()

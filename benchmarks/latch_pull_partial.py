@@ -25,8 +25,9 @@ from latch_rig import SeedLatch, paths, simulate, to_columns  # noqa: E402
 SEED = {"r": 1.1e-3, "x_backstop": 2.0e-3, "k": 1e5, "mu": 0.07}
 
 
-def fe_partial_unlatching(x_turn: float = -0.8e-3, EA: float = 2.0e5, L_in: float = 0.3, L_out: float = 0.5,
-                          increment: float = 0.004):
+def fe_partial_unlatching(
+    x_turn: float = -0.8e-3, EA: float = 2.0e5, L_in: float = 0.3, L_out: float = 0.5, increment: float = 0.004
+):
     """FE pull test: outer cable pulls the bead off the backstop to ``x_turn`` (m), then the grip
     returns 0.05 mm behind its start (inner section slack throughout).
 
@@ -47,13 +48,13 @@ def fe_partial_unlatching(x_turn: float = -0.8e-3, EA: float = 2.0e5, L_in: floa
     m.fix(latch, "uy", "uz", "rx", "ry", "rz")
     m.fix(grip, "uy", "uz", "rx", "ry", "rz")
     m.truss(frame, latch, EA=1e8)  # the latch body on a stiff mount, 1e9 N/m
-    m.add_family(CableLatchFamily([[a, latch, grip]], EA=EA, L0=L_in + L_out, latch_node=1, bead=Lb, latch=P,
-                                  name="cable"))
+    m.add_family(
+        CableLatchFamily([[a, latch, grip]], EA=EA, L0=L_in + L_out, latch_node=1, bead=Lb, latch=P, name="cable")
+    )
     T_turn = float(latch_force(x_turn, +1, P))
     u = (x_turn + P.x_backstop) + T_turn * (L_out + x_turn) / EA  # grip travel to put the bead at x_turn
     amp = fm.Amplitude([0.0, 0.5, 1.0], [0.0, 1.0, -0.05e-3 / u])
-    m.step("out and back", initial_increment=increment, max_increment=increment).prescribe(grip, ux=u,
-                                                                                            amplitude=amp)
+    m.step("out and back", initial_increment=increment, max_increment=increment).prescribe(grip, ux=u, amplitude=amp)
     with tempfile.TemporaryDirectory() as tmp:
         res = fm.Analysis(m, tmp, progress=False).run()
         if not res.summary["completed"]:
@@ -104,23 +105,39 @@ def main():
     fe = fe_partial_unlatching()
     data = from_arrays(exp, x_mm=1e3 * fe["x15"], dT_N=fe["dT"], side=np.ones(fe["dT"].size))
     pred = predict(exp, data, SEED)["dT_N"]
-    print(f"FE partial unlatching (zone b, {fe['dT'].size} increments): max |model - FE| = "
-          f"{np.abs(pred - fe['dT']).max():.2e} N")
+    print(
+        f"FE partial unlatching (zone b, {fe['dT'].size} increments): max |model - FE| = "
+        f"{np.abs(pred - fe['dT']).max():.2e} N"
+    )
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
-    for ax, name in zip(axes, ("partial unlatching, zone (b)", "partial unlatching, zone (c)",
-                               "partial latching, zone (c)")):
+    for ax, name in zip(
+        axes, ("partial unlatching, zone (b)", "partial unlatching, zone (c)", "partial latching, zone (c)")
+    ):
         run, cols, p = runs[name]
         ax.plot(cols["x_mm"], cols["dT_N"], ".", ms=2, color="0.6", label="independent rig data (0.5 N noise)")
         ax.plot(cols["x_mm"], p, "-", lw=1.0, color="C3", label="latch-pull model, loaded side (issue 22)")
-        ax.plot(1e3 * run["x_meas"], direction_rule(run["x_meas"], run["dT"], SEED), "--", lw=0.8, color="C0",
-                label="before: clipped by direction of motion")
+        ax.plot(
+            1e3 * run["x_meas"],
+            direction_rule(run["x_meas"], run["dT"], SEED),
+            "--",
+            lw=0.8,
+            color="C0",
+            label="before: clipped by direction of motion",
+        )
         if name.endswith("zone (b)"):
-            ax.plot(1e3 * fe["x15"], fe["dT"], "o", ms=3, mfc="none", color="k", markevery=4,
-                    label="FE run, cable/latch element")
+            ax.plot(
+                1e3 * fe["x15"],
+                fe["dT"],
+                "o",
+                ms=3,
+                mfc="none",
+                color="k",
+                markevery=4,
+                label="FE run, cable/latch element",
+            )
         ax.axhline(0, color="k", lw=0.5)
-        ax.set_title(name + (" (outer cable loaded)" if "unlatching" in name else " (inner cable loaded)"),
-                     fontsize=9)
+        ax.set_title(name + (" (outer cable loaded)" if "unlatching" in name else " (inner cable loaded)"), fontsize=9)
         ax.set_xlabel("bead position x (mm), Eq. 15")
         ax.set_ylabel("dT = T2 - T1 (N)")
         ax.set_xlim(-2.2, 3.0)

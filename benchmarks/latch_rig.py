@@ -71,8 +71,9 @@ def _first(f, a: float, b: float, step: float = 2e-7) -> float:
     return b
 
 
-def simulate(latch: SeedLatch, knots, side, n_per_m: float = 1.2e5, k_cable: float = 4e5, x_start=None,
-             n_min: int = 60):
+def simulate(
+    latch: SeedLatch, knots, side, n_per_m: float = 1.2e5, k_cable: float = 4e5, x_start=None, n_min: int = 60
+):
     """Quasi-static pull test along a grip path.
 
     knots : grip positions (m, the bead position at which the loaded cable is just taut) visited
@@ -107,8 +108,7 @@ def to_columns(run: dict, noise_N: float = 0.5, noise_mm: float = 0.01, seed: in
     """``latch-pull`` data columns (``x_mm``, ``dT_N`` and, if ``side``, ``side``) with Gaussian noise."""
     rng = np.random.default_rng(seed)
     n = run["dT"].size
-    cols = {"x_mm": 1e3 * run["x_meas"] + rng.normal(0.0, noise_mm, n),
-            "dT_N": run["dT"] + rng.normal(0.0, noise_N, n)}
+    cols = {"x_mm": 1e3 * run["x_meas"] + rng.normal(0.0, noise_mm, n), "dT_N": run["dT"] + rng.normal(0.0, noise_N, n)}
     if side:
         cols["side"] = run["side"].astype(float)
     return cols
@@ -123,23 +123,25 @@ def paths(latch: SeedLatch, k_cable: float = 4e5) -> dict:
     rel_out = latch.dT(-xb, +1)  # outer-cable force that lifts the bead off the backstop
     return {
         # hold on the backstop, unlatch out of contact, latch back into the backstop, hold
-        "full strokes": ([stop, hold_in, stop, 4e-3, -1.2e-3, hold_in, stop],
-                         [-1, -1, +1, -1, -1, -1], None),
+        "full strokes": ([stop, hold_in, stop, 4e-3, -1.2e-3, hold_in, stop], [-1, -1, +1, -1, -1, -1], None),
         # unlatching pass reversed behind the roller axis: the rollers pull the bead back, the
         # taut outer cable holds it on the latching branch down to the backstop
-        "partial unlatching, zone (b)": ([stop, -0.8e-3, stop - 0.03e-3, -1.4e-3, stop - 0.03e-3, 4e-3],
-                                         [+1, +1, +1, +1, +1], None),
+        "partial unlatching, zone (b)": (
+            [stop, -0.8e-3, stop - 0.03e-3, -1.4e-3, stop - 0.03e-3, 4e-3],
+            [+1, +1, +1, +1, +1],
+            None,
+        ),
         # reversed just in front of the roller axis: the outer cable goes slack and the bead stays;
         # the cable takes it up again on the way out
-        "partial unlatching, zone (c)": ([stop, 0.12e-3, -1.0e-3, 4e-3],
-                                         [+1, +1, +1], None),
+        "partial unlatching, zone (c)": ([stop, 0.12e-3, -1.0e-3, 4e-3], [+1, +1, +1], None),
         # latching pass reversed in zone (c) before the backstop: the rollers push the bead out
         # and the taut inner cable holds it on the unlatching branch
-        "partial latching, zone (c)": ([4e-3, 0.5e-3, 4e-3, 0.9e-3, 4e-3],
-                                       [-1, -1, -1, -1], 4e-3),
+        "partial latching, zone (c)": ([4e-3, 0.5e-3, 4e-3, 0.9e-3, 4e-3], [-1, -1, -1, -1], 4e-3),
         # holds on the backstop: the inner cable pulls the seated bead, the outer cable pulls
         # it below the force that would lift it off
-        "holds on the backstop": ([stop, hold_in, stop, stop + 0.8 * rel_out / k_cable, stop,
-                                   stop - 30.0 / k_cable, stop],
-                                  [-1, -1, +1, +1, -1, -1], None),
+        "holds on the backstop": (
+            [stop, hold_in, stop, stop + 0.8 * rel_out / k_cable, stop, stop - 30.0 / k_cable, stop],
+            [-1, -1, +1, +1, -1, -1],
+            None,
+        ),
     }

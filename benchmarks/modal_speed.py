@@ -56,10 +56,14 @@ def main():
     for ax, nb in zip(axes[0], args.bays):
         am, modes, nf, n_el, n_struct, ts, walls, cpus = run(nb)
         load = os.getloadavg()
-        print(f"{nb}-bay mast: {nf} free DOFs, {n_el} elements ({n_struct} beams and latch cables); static "
-              f"pretension state {ts:.2f} s")
-        print(f"  10 modes: wall {np.median(walls):.3f} s (runs {', '.join(f'{w:.3f}' for w in walls)}), "
-              f"CPU {np.median(cpus):.3f} s; load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}")
+        print(
+            f"{nb}-bay mast: {nf} free DOFs, {n_el} elements ({n_struct} beams and latch cables); static "
+            f"pretension state {ts:.2f} s"
+        )
+        print(
+            f"  10 modes: wall {np.median(walls):.3f} s (runs {', '.join(f'{w:.3f}' for w in walls)}), "
+            f"CPU {np.median(cpus):.3f} s; load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}"
+        )
         print("  f (Hz): " + ", ".join(f"{f:.3f}" for f in modes.frequencies))
         x = modes.x
         z = x[:, 2]
@@ -67,8 +71,13 @@ def main():
         for k in (0, 2, 3):
             if k < len(modes):
                 d = modes.shapes[k, :, :3] * scale
-                ax.plot(x[:, 0] + d[:, 0] + x[:, 1] + d[:, 1], z + d[:, 2], ".", ms=1.5,
-                        label=f"mode {k + 1}: {modes.frequencies[k]:.2f} Hz")
+                ax.plot(
+                    x[:, 0] + d[:, 0] + x[:, 1] + d[:, 1],
+                    z + d[:, 2],
+                    ".",
+                    ms=1.5,
+                    label=f"mode {k + 1}: {modes.frequencies[k]:.2f} Hz",
+                )
         ax.set_title(f"{nb}-bay ADAM mast, prestressed modes")
         ax.set_xlabel("x + y (m)")
         ax.set_ylabel("z (m)")

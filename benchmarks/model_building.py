@@ -25,9 +25,10 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
 
+from mast import E_AL, G_AL, SECTIONS, build_mast  # noqa: E402
+
 import femast as fm  # noqa: E402
 from femast.analysis import Analysis  # noqa: E402
-from mast import E_AL, G_AL, SECTIONS, build_mast  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 
@@ -56,8 +57,10 @@ def timed(fn, *args):
 def same(a, b):
     if len(a.beams) != len(b.beams) or not np.array_equal(a.coordinates, b.coordinates):
         return False
-    return all(p.label == q.label and p.nodes == q.nodes and p.section is q.section and np.array_equal(p.up, q.up)
-               for p, q in zip(a.beams, b.beams))
+    return all(
+        p.label == q.label and p.nodes == q.nodes and p.section is q.section and np.array_equal(p.up, q.up)
+        for p, q in zip(a.beams, b.beams)
+    )
 
 
 def main(argv=None):
@@ -73,7 +76,7 @@ def main(argv=None):
         mast = build_mast(nb)
         t = {"per element": [], "arrays": []}
         c = {"per element": [], "arrays": []}
-        for _ in range(args.repeat):          # interleaved A/B
+        for _ in range(args.repeat):  # interleaved A/B
             a, ta, ca = timed(per_element, mast, secs)
             b, tb, cb = timed(from_arrays, mast, secs)
             t["per element"].append(ta)
@@ -86,17 +89,24 @@ def main(argv=None):
         rows.append((nb, min(t["per element"]), min(t["arrays"]), t_an))
         print(f"\n{nb} bays: {len(mast.X)} nodes, {len(mast.conn)} beams; models identical: {ok}")
         for k in t:
-            print(f"  {k:12s}: best {min(t[k]):.4f} s, median {statistics.median(t[k]):.4f} s wall; "
-                  f"CPU best {min(c[k]):.4f} s")
-        print(f"  speed-up (best/best): {min(t['per element']) / min(t['arrays']):.0f}x; analysis set-up of the "
-              f"array-built model: {t_an:.3f} s wall, {c_an:.3f} s CPU")
+            print(
+                f"  {k:12s}: best {min(t[k]):.4f} s, median {statistics.median(t[k]):.4f} s wall; "
+                f"CPU best {min(c[k]):.4f} s"
+            )
+        print(
+            f"  speed-up (best/best): {min(t['per element']) / min(t['arrays']):.0f}x; analysis set-up of the "
+            f"array-built model: {t_an:.3f} s wall, {c_an:.3f} s CPU"
+        )
         if nb == 1000:
             best = min(t["arrays"])
-            print(f"  target: 1000-bay mast built in < 0.1 s: {best:.4f} s best, "
-                  f"{statistics.median(t['arrays']):.4f} s median -> {'MET' if best < 0.1 else 'NOT MET'}")
+            print(
+                f"  target: 1000-bay mast built in < 0.1 s: {best:.4f} s best, "
+                f"{statistics.median(t['arrays']):.4f} s median -> {'MET' if best < 0.1 else 'NOT MET'}"
+            )
     print(f"load average at end: {os.getloadavg()[0]:.2f}")
 
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -107,7 +117,7 @@ def main(argv=None):
     ax.loglog(nb, tan, "^--", color="0.5", label="Analysis set-up (array-built model)")
     ax.axhline(0.1, color="C3", lw=0.8, ls=":", label="target at 1000 bays: 0.1 s")
     ax.set_xlabel("bays (12 beams per bay)")
-    ax.set_ylabel("wall time, best of %d (s)" % args.repeat)
+    ax.set_ylabel(f"wall time, best of {args.repeat} (s)")
     ax.set_title("Building the truss mast of benchmarks/peers")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)

@@ -30,19 +30,19 @@ sys.path.insert(0, os.path.join(HERE, "peers"))
 
 def minimal_run(mast, n_inc):
     """Solve with the minimal loop; returns (seconds, iterations, SuperLU seconds, tip displacements)."""
+    import femast_mast
     import scipy.sparse as sp
     from scipy.sparse.linalg._dsolve._superlu import gstrf
 
-    import femast_mast
     from femast.analysis import Analysis
     from femast.analysis.assembly import _scatter_matrix, _scatter_vector
     from femast.analysis.configuration import update_configuration
-    from femast.elements.beam_corot import beam_family_kernel
-    from femast.post.results import ResultsWriter
-    from femast.rotations import rotation_vectors
     from femast.analysis.solvers.convergence import Convergence, force_moment_abs_max
     from femast.analysis.solvers.linear import _unpermute
     from femast.analysis.solvers.ordering import permuted_positions
+    from femast.elements.beam_corot import beam_family_kernel
+    from femast.post.results import ResultsWriter
+    from femast.rotations import rotation_vectors
 
     m, _ = femast_mast.model(mast, n_inc)
     out = tempfile.mkdtemp(prefix="femast_floor_")
@@ -50,11 +50,12 @@ def minimal_run(mast, n_inc):
     an = Analysis(m, out, progress=False, convergence=Convergence(force_tol=tol, disp_tol=tol))
     fam, solver, nf = an.families[0], an.solver, an.dofmap.n_free
     eqs = an.assembler.eqs[0]
-    pos = permuted_positions(solver._gather, an.assembler.pos_ff[0])   # into the permuted CSC matrix B
+    pos = permuted_positions(solver._gather, an.assembler.pos_ff[0])  # into the permuted CSC matrix B
     B, perm = solver._B, solver._perm
     ind, ptr = B.indices.astype(np.intc), B.indptr.astype(np.intc)
-    opts = dict(DiagPivotThresh=solver.pivot_threshold, ColPerm="NATURAL", PanelSize=None, Relax=None,
-                SymmetricMode=True)
+    opts = dict(
+        DiagPivotThresh=solver.pivot_threshold, ColPerm="NATURAL", PanelSize=None, Relax=None, SymmetricMode=True
+    )
     P_end = np.zeros((len(an.X0), 6))
     for c in m.steps[0].loads:
         P_end[m.index(c.node), c.dof] = c.magnitude
@@ -73,15 +74,17 @@ def minimal_run(mast, n_inc):
         while True:
             f, K = np.empty((n, 12)), np.empty((n, 12, 12))
             sf, energy = np.empty((n, 2, 6)), np.empty(n)
-            beam_family_kernel(fam.nodes, x, R, fam.E0, fam.l0, fam.EA, fam.GJ, fam.EIy, fam.EIz, fam.length_factor,
-                               f, K, sf, energy)
+            beam_family_kernel(
+                fam.nodes, x, R, fam.E0, fam.l0, fam.EA, fam.GJ, fam.EIy, fam.EIz, fam.length_factor, f, K, sf, energy
+            )
             F[:] = 0.0
             _scatter_vector(f, eqs, F)
             r = P - F[:nf]
-            if du is not None:   # femast's convergence test, with the analysis' reference forces
+            if du is not None:  # femast's convergence test, with the analysis' reference forces
                 fm, mm = force_moment_abs_max(f)
-                if an.convergence.check(r, du, Du, an.is_rot, max(fm, 1e-2 * mm / L), max(mm, 1e-2 * fm * L),
-                                        L, iters)[0]:
+                if an.convergence.check(r, du, Du, an.is_rot, max(fm, 1e-2 * mm / L), max(mm, 1e-2 * fm * L), L, iters)[
+                    0
+                ]:
                     break
             B.data[:] = 0.0
             _scatter_matrix(K, pos, B.data)
@@ -95,8 +98,15 @@ def minimal_run(mast, n_inc):
             update_configuration(x, spin, R, W, an.free_node, an.free_dof, du, no_i, no_i, no_f)
             Du += du
             iters += 1
-        writer.frame(U=x - an.X0, R=R.copy(), UR=rotation_vectors(R), URA=spin.copy(), P=P_end * inc / n_inc,
-                     RF=np.zeros((len(x), 6)), **{"el/beam/section_forces": sf})
+        writer.frame(
+            U=x - an.X0,
+            R=R.copy(),
+            UR=rotation_vectors(R),
+            URA=spin.copy(),
+            P=P_end * inc / n_inc,
+            RF=np.zeros((len(x), 6)),
+            **{"el/beam/section_forces": sf},
+        )
         writer.status("load", inc, 1, iters, inc / n_inc, inc / n_inc, 1 / n_inc, inc / n_inc)
     seconds = time.perf_counter() - t0
     writer.close({})
@@ -121,10 +131,12 @@ def main(argv=None):
         r = femast_mast.solve(mast, 10)
         s = r["analysis"].summary
         slu_a = r["analysis"].solver.superlu_seconds
-        print(f"  minimal loop: {1e3 * sec / it:6.3f} ms/iteration, ratio {sec / slu:.2f} ({it} iterations, "
-              f"tip differs from the analysis' by {np.abs(tip - ref['tip_u']).max():.1e} m)   "
-              f"Analysis: {1e3 * s.increment_time / r['iterations']:6.3f} ms/iteration, ratio "
-              f"{s.increment_time / slu_a:.2f} over the increments, {r['analyze'] / slu_a:.2f} over the run")
+        print(
+            f"  minimal loop: {1e3 * sec / it:6.3f} ms/iteration, ratio {sec / slu:.2f} ({it} iterations, "
+            f"tip differs from the analysis' by {np.abs(tip - ref['tip_u']).max():.1e} m)   "
+            f"Analysis: {1e3 * s.increment_time / r['iterations']:6.3f} ms/iteration, ratio "
+            f"{s.increment_time / slu_a:.2f} over the increments, {r['analyze'] / slu_a:.2f} over the run"
+        )
 
 
 if __name__ == "__main__":

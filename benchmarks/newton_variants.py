@@ -71,9 +71,15 @@ def run_mast(n_bays, tangent):
     an = Analysis(m, None, progress=False, on_frame=lambda f: None, tangent=tangent, observers=[obs])
     c0, t0 = time.process_time(), time.perf_counter()
     an.run()
-    return dict(obs=obs, wall=time.perf_counter() - t0, cpu=time.process_time() - c0, u=an.x - an.X0,
-                iterations=an.summary.iterations, factorizations=an.solver.factorizations,
-                increments=an.summary.increments)
+    return dict(
+        obs=obs,
+        wall=time.perf_counter() - t0,
+        cpu=time.process_time() - c0,
+        u=an.x - an.X0,
+        iterations=an.summary.iterations,
+        factorizations=an.solver.factorizations,
+        increments=an.summary.increments,
+    )
 
 
 def run_adam_bay(tangent):
@@ -93,7 +99,7 @@ def run_adam_bay(tangent):
             super().__init__(model, out, tangent=tangent, **kw)
             kept["an"] = self
 
-    fa.Analysis = Variant   # run_bay imports Analysis from femast.analysis when called
+    fa.Analysis = Variant  # run_bay imports Analysis from femast.analysis when called
     try:
         c0, t0 = time.process_time(), time.perf_counter()
         out = bt.run_bay(inputs, drive)
@@ -101,8 +107,15 @@ def run_adam_bay(tangent):
     finally:
         fa.Analysis = Analysis
     an = kept["an"]
-    return dict(obs=obs, wall=wall, cpu=cpu, u=np.asarray(out["Mz"], dtype=float), iterations=an.summary.iterations,
-                factorizations=an.solver.factorizations, increments=an.summary.increments)
+    return dict(
+        obs=obs,
+        wall=wall,
+        cpu=cpu,
+        u=np.asarray(out["Mz"], dtype=float),
+        iterations=an.summary.iterations,
+        factorizations=an.solver.factorizations,
+        increments=an.summary.increments,
+    )
 
 
 def plot(all_runs, png):
@@ -128,8 +141,10 @@ def plot(all_runs, png):
         axes[1, j].set_yscale("log")
         for ax in axes[:, j]:
             ax.grid(True, alpha=0.3)
-    fig.suptitle(f"Newton variants, 'auto' = full (load {os.getloadavg()[0]:.1f} on 2 shared cores: CPU time "
-                 "of this process)", fontsize=10)
+    fig.suptitle(
+        f"Newton variants, 'auto' = full (load {os.getloadavg()[0]:.1f} on 2 shared cores: CPU time of this process)",
+        fontsize=10,
+    )
     plotstyle.save(fig, png)
     print(f"figure: {png}")
 
@@ -148,17 +163,21 @@ def main(argv=None):
         models["ADAM bay, friction + latches"] = run_adam_bay
     all_runs = {}
     for model, run in models.items():
-        run("full")   # warm-up, discarded: the numba caches of the model's families load here
+        run("full")  # warm-up, discarded: the numba caches of the model's families load here
         runs = {v: run(v) for v in VARIANTS}
         all_runs[model] = runs
         ref = runs["full"]["u"]
         print(f"\n{model}   [load {os.getloadavg()[0]:.1f}]")
-        print(f"  {'variant':13s} {'incs':>5s} {'cutbacks':>8s} {'iters':>6s} {'facts':>6s} {'wall s':>7s} {'cpu s':>6s} "
-              f"{'diff vs full':>12s}")
+        print(
+            f"  {'variant':13s} {'incs':>5s} {'cutbacks':>8s} {'iters':>6s} {'facts':>6s} {'wall s':>7s} {'cpu s':>6s} "
+            f"{'diff vs full':>12s}"
+        )
         for v, r in runs.items():
             d = np.abs(r["u"] - ref).max() / max(np.abs(ref).max(), 1e-300) if r["u"].shape == ref.shape else np.nan
-            print(f"  {v:13s} {r['increments']:5d} {r['obs'].cutbacks:8d} {r['iterations']:6d} {r['factorizations']:6d} "
-                  f"{r['wall']:7.3f} {r['cpu']:6.3f} {d:12.1e}")
+            print(
+                f"  {v:13s} {r['increments']:5d} {r['obs'].cutbacks:8d} {r['iterations']:6d} {r['factorizations']:6d} "
+                f"{r['wall']:7.3f} {r['cpu']:6.3f} {d:12.1e}"
+            )
     plot(all_runs, args.png)
     return 0
 

@@ -70,8 +70,14 @@ def figures(traj, res, out: Path):
             ax.plot(s, e, color=colors[model], label=model)
             bad = ~r.feasible
             if bad.any():
-                ax.plot(s[bad], np.zeros(bad.sum()), "x", color=colors[model], ms=5,
-                        label=f"{model}: pose not held ({bad.sum()}, a cable goes slack)")
+                ax.plot(
+                    s[bad],
+                    np.zeros(bad.sum()),
+                    "x",
+                    color=colors[model],
+                    ms=5,
+                    label=f"{model}: pose not held ({bad.sum()}, a cable goes slack)",
+                )
         ax.set_title(f"shroud pretension {pt:g} N", fontsize=10)
         ax.set_ylabel("platform position error, mm")
         ax.grid(alpha=0.3)
@@ -87,8 +93,13 @@ def figures(traj, res, out: Path):
 
     fig, axs = plt.subplots(1, 2, figsize=(13, 5))
     for model in MODELS:
-        axs[0].plot(PRETENSIONS, [1e3 * res[model, p].position_error[res[model, p].feasible].max()
-                                  for p in PRETENSIONS], "o-", color=colors[model], label=model)
+        axs[0].plot(
+            PRETENSIONS,
+            [1e3 * res[model, p].position_error[res[model, p].feasible].max() for p in PRETENSIONS],
+            "o-",
+            color=colors[model],
+            label=model,
+        )
     axs[0].set_xlabel("shroud pretension, N")
     axs[0].set_ylabel("largest platform position error, mm (poses held)")
     axs[0].legend()
@@ -97,13 +108,27 @@ def figures(traj, res, out: Path):
     ax = axs[1]
     ax.plot(traj[:, 0], traj[:, 1], "k-", lw=0.8, label="commanded (rigid-frame controller)")
     scale = 20.0
-    ax.plot(traj[:, 0] + scale * r.error[:, 0], traj[:, 1] + scale * r.error[:, 1], "C3-",
-            label=f"actual, error x{scale:g} (FE masts, 1200 N)")
+    ax.plot(
+        traj[:, 0] + scale * r.error[:, 0],
+        traj[:, 1] + scale * r.error[:, 1],
+        "C3-",
+        label=f"actual, error x{scale:g} (FE masts, 1200 N)",
+    )
     E0 = r.exit_points[0]
     dE = r.exit_points - E0
     k = int(np.argmax(r.position_error))
-    ax.quiver(E0[:, 0], E0[:, 1], dE[k, :, 0], dE[k, :, 1], angles="xy", scale_units="xy", scale=1 / 30.0,
-              color="C0", width=0.004, label="exit-point correction x30 (worst pose)")
+    ax.quiver(
+        E0[:, 0],
+        E0[:, 1],
+        dE[k, :, 0],
+        dE[k, :, 1],
+        angles="xy",
+        scale_units="xy",
+        scale=1 / 30.0,
+        color="C0",
+        width=0.004,
+        label="exit-point correction x30 (worst pose)",
+    )
     ax.plot(E0[:, 0], E0[:, 1], "C0.", ms=4)
     ax.set_aspect("equal")
     ax.set_xlim(-0.8, 9.1)
@@ -129,18 +154,24 @@ def main(argv=None):
     out.mkdir(parents=True, exist_ok=True)
     traj, res = run_all(args.n)
     print(f"{len(traj)} poses; errors against the rigid-frame prediction")
-    print(f"{'model':<12} {'pretension N':>12} {'max pos mm':>11} {'rms pos mm':>11} {'max rot mrad':>13} {'infeasible':>10}")
+    print(
+        f"{'model':<12} {'pretension N':>12} {'max pos mm':>11} {'rms pos mm':>11} {'max rot mrad':>13} {'infeasible':>10}"
+    )
     for (model, pt), r in res.items():
         ok = r.feasible
         pe = r.position_error[ok]
-        print(f"{model:<12} {pt:>12g} {1e3 * pe.max():>11.2f} {1e3 * np.sqrt(np.mean(pe**2)):>11.2f} "
-              f"{1e3 * r.orientation_error[ok].max():>13.2f} {int((~ok).sum()):>10d}")
+        print(
+            f"{model:<12} {pt:>12g} {1e3 * pe.max():>11.2f} {1e3 * np.sqrt(np.mean(pe**2)):>11.2f} "
+            f"{1e3 * r.orientation_error[ok].max():>13.2f} {int((~ok).sum()):>10d}"
+        )
     for p in figures(traj, res, out):
         print(f"figure: {p}")
     if not args.no_speed:
         n, wall, cp, l0, l1, passes = speed()
-        print(f"speed: {n}-pose trajectory with FE masts (1200 N, {passes} FE passes): wall {wall:.1f} s, "
-              f"CPU {cp:.1f} s, load average {l0:.1f} -> {l1:.1f} (2 cores)")
+        print(
+            f"speed: {n}-pose trajectory with FE masts (1200 N, {passes} FE passes): wall {wall:.1f} s, "
+            f"CPU {cp:.1f} s, load average {l0:.1f} -> {l1:.1f} (2 cores)"
+        )
 
 
 if __name__ == "__main__":

@@ -64,19 +64,24 @@ def main():
         an.solver._factor_permuted(B).solve(rhs[an.solver._perm])
     t_bare = (time.perf_counter() - t0) / reps
     t_it = wall / s.iterations
-    print(f"1000-element roll-up benchmark: {args.elements} elements, {an.dofmap.n_free} free DOFs, "
-          f"{s.increments} increments")
+    print(
+        f"1000-element roll-up benchmark: {args.elements} elements, {an.dofmap.n_free} free DOFs, "
+        f"{s.increments} increments"
+    )
     print(f"  JIT / cache load (small warm-up model): {jit:8.3f} s")
     print(f"  wall time                             : {wall:8.3f} s")
     print(f"  Newton iterations                     : {s.iterations:8d}")
     print(f"  time per iteration                    : {t_it * 1e3:8.2f} ms")
-    print(f"  in the run: assembly {s.assembly_time:.3f} s, linear solve {s.solve_time:.3f} s, "
-          f"other {wall - s.assembly_time - s.solve_time:.3f} s")
-    print(f"  isolated, same matrix: assembly {t_asm * 1e3:.2f} ms, femast factorise + solve {t_sol * 1e3:.2f} ms "
-          f"(bare SuperLU, same ordering: {t_bare * 1e3:.2f} ms, ordering {an.solver.chosen}) "
-          f"-> ratio assembly/solve = {t_asm / t_sol:.2f} (target <= 1)")
-    print(f"  time per iteration / (factorise + solve) = {t_it / t_sol:.2f} (bare: {t_it / t_bare:.2f}; "
-          f"target <= 1.5)")
+    print(
+        f"  in the run: assembly {s.assembly_time:.3f} s, linear solve {s.solve_time:.3f} s, "
+        f"other {wall - s.assembly_time - s.solve_time:.3f} s"
+    )
+    print(
+        f"  isolated, same matrix: assembly {t_asm * 1e3:.2f} ms, femast factorise + solve {t_sol * 1e3:.2f} ms "
+        f"(bare SuperLU, same ordering: {t_bare * 1e3:.2f} ms, ordering {an.solver.chosen}) "
+        f"-> ratio assembly/solve = {t_asm / t_sol:.2f} (target <= 1)"
+    )
+    print(f"  time per iteration / (factorise + solve) = {t_it / t_sol:.2f} (bare: {t_it / t_bare:.2f}; target <= 1.5)")
     print(f"  tip distance from root: {np.linalg.norm(X):.2e} m (closed circle: 0)")
 
 

@@ -42,17 +42,17 @@ from pathlib import Path
 import numpy as np
 
 import femast.studies as st
-from femast.post import plotstyle
 from femast.adam import BayParameters
-from femast.adam.shape_study import GROUPS, SCATTER, stated_inputs, tip_history
+from femast.adam.shape_study import SCATTER, stated_inputs, tip_history
+from femast.post import plotstyle
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs" / "figures"
 ARCSEC = 180.0 / np.pi * 3600.0
-ATK_LENGTH_M = 1.3e-3          # seed 001 Sec. I: ATK's length accuracy and repeatability, +- m over 60 m
+ATK_LENGTH_M = 1.3e-3  # seed 001 Sec. I: ATK's length accuracy and repeatability, +- m over 60 m
 ATK_ROT_RAD = np.radians(0.02)  # +- 0.02 deg of rotational misalignment over 60 m
-ATK_BAYS = 350                  # 350 bays of 0.171 m: 59.9 m, ATK's 60 m
-SEED_BAY_RESIDUAL_RAD = np.radians(0.10)   # seed Sec. VIII: residual rotation of one bay at zero moment
+ATK_BAYS = 350  # 350 bays of 0.171 m: 59.9 m, ATK's 60 m
+SEED_BAY_RESIDUAL_RAD = np.radians(0.10)  # seed Sec. VIII: residual rotation of one bay at zero moment
 FIELDS = [f for _, f, *_ in SCATTER]
 GROUP_OF = {f: g for g, f, *_ in SCATTER}
 
@@ -65,29 +65,55 @@ METRICS = (
     ("cycle_lateral", "um", "load-cycle residual: lateral"),
     ("cycle_twist", "arcsec", "load-cycle residual: twist"),
 )
-XLABEL = {"deploy_axial": "dz", "deploy_lateral": "|(dx, dy)|", "deploy_tilt": "|(dthx, dthy)|", "deploy_twist": "dthz",
-          "cycle_lateral": "|(dx, dy)|", "cycle_twist": "dthz"}
+XLABEL = {
+    "deploy_axial": "dz",
+    "deploy_lateral": "|(dx, dy)|",
+    "deploy_tilt": "|(dthx, dthy)|",
+    "deploy_twist": "dthz",
+    "cycle_lateral": "|(dx, dy)|",
+    "cycle_twist": "dthz",
+}
 SIGNED = ("deploy_axial", "deploy_twist", "cycle_twist")
 SCALE = {"um": 1e6, "arcsec": ARCSEC}
 
 
 def sample_run(n_bays: int, cycles: int):
     """The run function of the study: one sample -> tip position (m) and rotation (rad) per level."""
+
     def run(mu, latch_k, latch_mu, pretension, longeron_dL, batten_dL, arm_dL, cable_dL):
-        values = dict(mu=mu, latch_k=latch_k, latch_mu=latch_mu, pretension=pretension, longeron_dL=longeron_dL,
-                      batten_dL=batten_dL, arm_dL=arm_dL, cable_dL=cable_dL)
+        values = dict(
+            mu=mu,
+            latch_k=latch_k,
+            latch_mu=latch_mu,
+            pretension=pretension,
+            longeron_dL=longeron_dL,
+            batten_dL=batten_dL,
+            arm_dL=arm_dL,
+            cable_dL=cable_dL,
+        )
         h = tip_history(n_bays, values, cycles=cycles)
-        return {"tip_u": h["u"], "tip_rot": h["theta"], "iterations": float(h["iterations"]),
-                "cutbacks": float(h["cutbacks"])}
+        return {
+            "tip_u": h["u"],
+            "tip_rot": h["theta"],
+            "iterations": float(h["iterations"]),
+            "cutbacks": float(h["cutbacks"]),
+        }
+
     return run
 
 
 def make_study(n_bays: int, cycles: int, sensitivity: bool, seed: int = 1):
     inputs = [st.Uniform(field, lo, hi, size=size) for _, field, lo, hi, size, _ in stated_inputs(n_bays)]
-    return st.Study(run=sample_run(n_bays, cycles), inputs=inputs,
-                    outputs=["tip_u", "tip_rot", "iterations", "cutbacks"], sampler="sobol" if sensitivity else "lhs",
-                    seed=seed, sensitivity=sensitivity, units={"tip_u": "m", "tip_rot": "rad"},
-                    name=f"ADAM {n_bays} bays, stated scatter")
+    return st.Study(
+        run=sample_run(n_bays, cycles),
+        inputs=inputs,
+        outputs=["tip_u", "tip_rot", "iterations", "cutbacks"],
+        sampler="sobol" if sensitivity else "lhs",
+        seed=seed,
+        sensitivity=sensitivity,
+        units={"tip_u": "m", "tip_rot": "rad"},
+        name=f"ADAM {n_bays} bays, stated scatter",
+    )
 
 
 def metrics(u, th, nom_u, nom_th) -> dict:
@@ -112,7 +138,7 @@ def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=Fal
     t0 = time.perf_counter()
     folder = out / (f"bays{n_bays}" if sensitivity else f"bays{n_bays}_plain")
     nominal = tip_history(n_bays, None, cycles=cycles)
-    if report_only:   # the runs are on disk (an earlier call): statistics and figures only
+    if report_only:  # the runs are on disk (an earlier call): statistics and figures only
         summary = "results read from disk (--report-only)"
     else:
         study = make_study(n_bays, cycles, sensitivity)
@@ -120,7 +146,7 @@ def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=Fal
     res = st.load(folder)
     blocks = ("A", "B") if sensitivity else ("A",)
     u, th = res.output("tip_u", blocks=blocks), res.output("tip_rot", blocks=blocks)
-    if len(u) == 0 or np.ndim(u) != 3:     # nothing finished yet
+    if len(u) == 0 or np.ndim(u) != 3:  # nothing finished yet
         m = {name: np.array([]) for name, *_ in METRICS}
     else:
         m = metrics(u, th, nominal["u"], nominal["theta"])
@@ -134,14 +160,24 @@ def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=Fal
         mAB = [metrics(fAB[i], gAB[i], nominal["u"], nominal["theta"]) for i in range(len(fAB))]
         for name, *_ in METRICS:
             try:
-                sob[name] = st.sobol_indices(mA[name], mB[name], np.array([r[name] for r in mAB]),
-                                             names=res.input_names)
-            except Exception as exc:   # a constant output (e.g. no residual at all) has no indices
+                sob[name] = st.sobol_indices(
+                    mA[name], mB[name], np.array([r[name] for r in mAB]), names=res.input_names
+                )
+            except Exception as exc:  # a constant output (e.g. no residual at all) has no indices
                 print(f"  no Sobol' indices for {name}: {exc}")
         sob["_dropped"] = dropped
-    return {"n_bays": n_bays, "big": big, "nominal": nominal, "metrics": m, "summary": str(summary), "sobol": sob,
-            "failures": res.failures(), "counts": res.counts(), "run_seconds": cpu,
-            "wall_s": time.perf_counter() - t0}
+    return {
+        "n_bays": n_bays,
+        "big": big,
+        "nominal": nominal,
+        "metrics": m,
+        "summary": str(summary),
+        "sobol": sob,
+        "failures": res.failures(),
+        "counts": res.counts(),
+        "run_seconds": cpu,
+        "wall_s": time.perf_counter() - t0,
+    }
 
 
 # ------------------------------------------------------------------ figures
@@ -160,8 +196,10 @@ def fig_distributions(r, png):
         ax.set_ylabel("runs")
         ax.set_title(plotstyle.fit_title(ax, what))
         ax.legend(loc="best")
-    fig.suptitle(f"{r['n_bays']}-bay ADAM mast ({r['n_bays'] * BayParameters().l:.2f} m), stated scatter: "
-                 f"{len(r['metrics']['deploy_axial'])} runs")
+    fig.suptitle(
+        f"{r['n_bays']}-bay ADAM mast ({r['n_bays'] * BayParameters().l:.2f} m), stated scatter: "
+        f"{len(r['metrics']['deploy_axial'])} runs"
+    )
     fig.tight_layout()
     return plotstyle.save(fig, png)
 
@@ -194,11 +232,10 @@ def fig_growth(results, png):
             lo = np.nan_to_num(est - np.array([p["low"] for p in ps]))
             hi = np.nan_to_num(np.array([p["high"] for p in ps]) - est)
             b, a = growth_fit(results, name, u)
-            ax.errorbar(n * lb, est, yerr=[lo, hi], marker="o", capsize=3, color=f"C{k}",
-                        label=f"{what} (~ n^{b:.2f})")
+            ax.errorbar(n * lb, est, yerr=[lo, hi], marker="o", capsize=3, color=f"C{k}", label=f"{what} (~ n^{b:.2f})")
             if np.isfinite(b):
                 nn = np.array([n.min(), big[0]["n_bays"] if big else ATK_BAYS], float)
-                ax.plot(nn * lb, a * nn ** b, ls=":", color=f"C{k}", lw=1)
+                ax.plot(nn * lb, a * nn**b, ls=":", color=f"C{k}", lw=1)
             if big:
                 v = np.abs(big[0]["metrics"][name] * SCALE[u])
                 ax.plot(np.full(len(v), big[0]["n_bays"] * lb), v, ls="none", marker="x", color=f"C{k}")
@@ -214,9 +251,11 @@ def fig_growth(results, png):
         ax.set_xlabel(plotstyle.axis_label("mast length", "m"))
         ax.set_ylabel(plotstyle.axis_label("95th percentile of |error|", unit))
         ax.legend(loc="best", fontsize=7.5)
-    fig.suptitle("Growth with the number of bays: o 95th percentile of the sampled runs (bars: its distribution-free "
-                 "95 % interval; no upper bound below 72 runs), dotted: power-law fit, x: each run of the long mast",
-                 fontsize=9)
+    fig.suptitle(
+        "Growth with the number of bays: o 95th percentile of the sampled runs (bars: its distribution-free "
+        "95 % interval; no upper bound below 72 runs), dotted: power-law fit, x: each run of the long mast",
+        fontsize=9,
+    )
     fig.tight_layout()
     return plotstyle.save(fig, png)
 
@@ -239,10 +278,12 @@ def fig_sensitivity(r, png):
         ax.set_ylabel("Sobol' index (1)")
         ax.set_title(plotstyle.fit_title(ax, dict((m, w) for m, _, w in METRICS)[name]))
         ax.legend(loc="best", fontsize=7)
-    for ax in axes.ravel()[len(names):]:
+    for ax in axes.ravel()[len(names) :]:
         ax.set_visible(False)
-    fig.suptitle(f"Which inputs drive the tip error: {r['n_bays']}-bay mast, "
-                 f"{next(iter(sob.values()))['n']} base samples x {len(FIELDS) + 2} runs")
+    fig.suptitle(
+        f"Which inputs drive the tip error: {r['n_bays']}-bay mast, "
+        f"{next(iter(sob.values()))['n']} base samples x {len(FIELDS) + 2} runs"
+    )
     fig.tight_layout()
     return plotstyle.save(fig, png)
 
@@ -280,10 +321,14 @@ def _fmt(p, unit):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--bays", type=int, nargs="+", default=[10, 20],
-                    help="masts with Sobol' indices (Saltelli layout)")
-    ap.add_argument("--samples", type=int, nargs="+", default=[32, 32],
-                    help="base samples per --bays mast (x 10 runs; one number or one per mast)")
+    ap.add_argument("--bays", type=int, nargs="+", default=[10, 20], help="masts with Sobol' indices (Saltelli layout)")
+    ap.add_argument(
+        "--samples",
+        type=int,
+        nargs="+",
+        default=[32, 32],
+        help="base samples per --bays mast (x 10 runs; one number or one per mast)",
+    )
     ap.add_argument("--plain-bays", type=int, nargs="*", default=[40], help="masts with plain (LHS) samples only")
     ap.add_argument("--plain-samples", type=int, default=64)
     ap.add_argument("--big", type=int, default=350, help="bays of the long mast, a few plain samples (0: none)")
@@ -297,22 +342,34 @@ def main(argv=None):
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print("stated scatter (uniform, independent per element):")
-    for g, field, lo, hi, size, unit in stated_inputs(10):
+    for g, field, lo, hi, _size, unit in stated_inputs(10):
         print(f"  {g:15s} {field:12s} [{lo:.4g}, {hi:.4g}] {unit}")
     results = []
     samples = args.samples if len(args.samples) == len(args.bays) else [args.samples[0]] * len(args.bays)
     for n, ns in zip(args.bays, samples):
         print(f"\n== {n} bays ({n * BayParameters().l:.2f} m): {ns} base samples x {len(FIELDS) + 2} runs")
-        results.append(run_mast(n, ns, args.cycles, args.workers, out, sensitivity=True,
-                                report_only=args.report_only))
+        results.append(run_mast(n, ns, args.cycles, args.workers, out, sensitivity=True, report_only=args.report_only))
     for n in args.plain_bays:
         print(f"\n== {n} bays ({n * BayParameters().l:.2f} m): {args.plain_samples} plain (LHS) samples")
-        results.append(run_mast(n, args.plain_samples, args.cycles, args.workers, out, sensitivity=False,
-                                report_only=args.report_only))
+        results.append(
+            run_mast(
+                n, args.plain_samples, args.cycles, args.workers, out, sensitivity=False, report_only=args.report_only
+            )
+        )
     if args.big:
         print(f"\n== {args.big} bays ({args.big * BayParameters().l:.2f} m): {args.big_samples} plain samples")
-        results.append(run_mast(args.big, args.big_samples, args.cycles, args.workers, out, sensitivity=False,
-                                report_only=args.report_only, big=True))
+        results.append(
+            run_mast(
+                args.big,
+                args.big_samples,
+                args.cycles,
+                args.workers,
+                out,
+                sensitivity=False,
+                report_only=args.report_only,
+                big=True,
+            )
+        )
     nominal_only = []
     for r in [r for r in results if len(r["metrics"]["deploy_axial"]) == 0]:
         print(f"\n{r['n_bays']} bays: no finished run on disk; only the nominal mast is shown")
@@ -323,48 +380,70 @@ def main(argv=None):
         n = r["n_bays"]
         sec = r["run_seconds"]
         print(f"\n{n} bays: {r['summary']}")
-        print(f"  per run: median {np.median(sec):.2f} s, max {np.max(sec):.2f} s; failed runs {len(r['failures'])}"
-              + (f" (first: {r['failures'][0][1][:120]})" if r["failures"] else ""))
-        row = {"n_bays": n, "length_m": n * BayParameters().l, "runs": len(r["metrics"]["deploy_axial"]),
-               "failed": len(r["failures"]), "median_run_s": float(np.median(sec)), "p95_abs": {}, "sobol": {}}
+        print(
+            f"  per run: median {np.median(sec):.2f} s, max {np.max(sec):.2f} s; failed runs {len(r['failures'])}"
+            + (f" (first: {r['failures'][0][1][:120]})" if r["failures"] else "")
+        )
+        row = {
+            "n_bays": n,
+            "length_m": n * BayParameters().l,
+            "runs": len(r["metrics"]["deploy_axial"]),
+            "failed": len(r["failures"]),
+            "median_run_s": float(np.median(sec)),
+            "p95_abs": {},
+            "sobol": {},
+        }
         for name, unit, what in METRICS:
             p = p95_abs(r["metrics"][name] * SCALE[unit])
             row["p95_abs"][name] = p
             print(f"  {what:45s} 95th pct of |.|: {_fmt(p, unit)}")
         nom = r["nominal"]
-        print(f"  nominal mast: deployed tip z {nom['u'][0, 2] * 1e6:.2f} um; load-cycle residual twist "
-              f"{(nom['theta'][-1, 2] - nom['theta'][0, 2]) * ARCSEC:.1f} arcsec, lateral "
-              f"{np.hypot(*(nom['u'][-1, :2] - nom['u'][0, :2])) * 1e6:.1f} um")
+        print(
+            f"  nominal mast: deployed tip z {nom['u'][0, 2] * 1e6:.2f} um; load-cycle residual twist "
+            f"{(nom['theta'][-1, 2] - nom['theta'][0, 2]) * ARCSEC:.1f} arcsec, lateral "
+            f"{np.hypot(*(nom['u'][-1, :2] - nom['u'][0, :2])) * 1e6:.1f} um"
+        )
         for name, s in r["sobol"].items():
             if name.startswith("_"):
                 continue
             top = np.argsort(s["ST"])[::-1][:3]
-            print(f"  Sobol' {name:15s} " + ", ".join(f"{s['names'][i]} S1 {s['S1'][i]:.2f} ST {s['ST'][i]:.2f}"
-                                                        for i in top))
+            print(
+                f"  Sobol' {name:15s} "
+                + ", ".join(f"{s['names'][i]} S1 {s['S1'][i]:.2f} ST {s['ST'][i]:.2f}" for i in top)
+            )
             row["sobol"][name] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in s.items()}
         summary["masts"].append(row)
     main_mast = max((r for r in results if not r["big"]), key=lambda r: r["n_bays"])
-    pngs = [fig_distributions(main_mast, out / "shape_accuracy_distributions.png"),
-            fig_growth(results, out / "shape_accuracy_growth.png"),
-            fig_sensitivity(max((r for r in results if r["sobol"]), key=lambda r: r["n_bays"]),   # the longest
-                            out / "shape_accuracy_sensitivity.png"),
-            fig_residual_scaling(results, out / "shape_accuracy_residual_scaling.png", nominal_only)]
+    pngs = [
+        fig_distributions(main_mast, out / "shape_accuracy_distributions.png"),
+        fig_growth(results, out / "shape_accuracy_growth.png"),
+        fig_sensitivity(
+            max((r for r in results if r["sobol"]), key=lambda r: r["n_bays"]),  # the longest
+            out / "shape_accuracy_sensitivity.png",
+        ),
+        fig_residual_scaling(results, out / "shape_accuracy_residual_scaling.png", nominal_only),
+    ]
     nb = args.big or ATK_BAYS
     big = next((r for r in results if r["n_bays"] == nb and r["big"]), None)
     print(f"\n{nb} bays ({nb * BayParameters().l:.1f} m) against ATK's requirement (over 60 m):")
     for name, unit, what in METRICS:
         lim = ATK_LENGTH_M * 1e6 if unit == "um" else ATK_ROT_RAD * ARCSEC
         b, a = growth_fit(results, name, unit)
-        line = f"  {what:40s} fit 95th pct ~ n^{b:.2f}: {a * nb ** b:.4g} {unit} = {a * nb ** b / lim:.3g} x ATK"
+        line = f"  {what:40s} fit 95th pct ~ n^{b:.2f}: {a * nb**b:.4g} {unit} = {a * nb**b / lim:.3g} x ATK"
         if big is not None and big["big"]:
             v = np.abs(big["metrics"][name] * SCALE[unit])
             pb = p95_abs(v)
-            line += (f"; {len(v)} runs: 95th pct {_fmt(pb, unit)} = {pb['estimate'] / lim:.3g} x ATK, "
-                     f"max {v.max():.4g} {unit}")
+            line += (
+                f"; {len(v)} runs: 95th pct {_fmt(pb, unit)} = {pb['estimate'] / lim:.3g} x ATK, "
+                f"max {v.max():.4g} {unit}"
+            )
         print(line)
-        summary.setdefault("at_big", {})[name] = {"exponent": b, "fit_p95": a * nb ** b, "atk": lim,
-                                                  "runs": (np.abs(big["metrics"][name] * SCALE[unit]).tolist()
-                                                           if big is not None else [])}
+        summary.setdefault("at_big", {})[name] = {
+            "exponent": b,
+            "fit_p95": a * nb**b,
+            "atk": lim,
+            "runs": (np.abs(big["metrics"][name] * SCALE[unit]).tolist() if big is not None else []),
+        }
     (out / "summary.json").write_text(json.dumps(summary, indent=1, default=float))
     print("figures: " + ", ".join(str(p) for p in pngs))
     if args.docs:

@@ -38,22 +38,27 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks" / "peers"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
+from solver_backends import Capture, adam_bay_tangents, backward_error  # noqa: E402
+
 from femast.analysis.solvers import backends, linear  # noqa: E402
 from femast.analysis.solvers.banded import BandedFactor, band_of  # noqa: E402
-from solver_backends import Capture, adam_bay_tangents, backward_error  # noqa: E402
 
 ENGINES = ("superlu", "banded", "banded-lu", "dense")
 
 
 def bend_tangents(n_el):
     import bend45
+
     import femast as fm
     from femast.analysis import Analysis
 
     m = fm.Model("bend")
     n = np.asarray(m.nodes(bend45.geometry(n_el)))
-    m.beams(np.column_stack([n[:-1], n[1:]]), fm.Section(E=bend45.E, G=bend45.G, A=1.0, Iy=bend45.I, Iz=bend45.I,
-                                                         J=bend45.J), up=(0.0, 0.0, 1.0))
+    m.beams(
+        np.column_stack([n[:-1], n[1:]]),
+        fm.Section(E=bend45.E, G=bend45.G, A=1.0, Iy=bend45.I, Iz=bend45.I, J=bend45.J),
+        up=(0.0, 0.0, 1.0),
+    )
     m.fix(n[0])
     m.step("load", initial_increment=0.1, max_increment=0.1).load(n[-1], fz=300.0)
     with Capture() as cap:
@@ -63,8 +68,9 @@ def bend_tangents(n_el):
 
 def mast_tangents(n_bays):
     import femast_mast
-    from femast.analysis import Analysis
     from mast import build_mast
+
+    from femast.analysis import Analysis
 
     m, _ = femast_mast.model(build_mast(n_bays), 4)
     with Capture() as cap:
@@ -79,7 +85,7 @@ def grid_tangents(k=3):
     from femast.analysis import Analysis
 
     m = fm.Model("grid")
-    idx = np.arange(k ** 3).reshape(k, k, k)
+    idx = np.arange(k**3).reshape(k, k, k)
     X = np.array([(i, j, l) for i in range(k) for j in range(k) for l in range(k)], float)
     labels = np.asarray(m.nodes(X))
     sec = fm.Section(E=2e11, G=8e10, A=1e-3, Iy=1e-6, Iz=1e-6, J=2e-6)
@@ -123,10 +129,15 @@ def main(argv=None):
     cases += [(f"mast {b} bays", lambda b=b: mast_tangents(b)) for b in (2, 5, 10)]
     cases += [("grid 3x3x3", grid_tangents), ("ADAM bay", adam_bay_tangents)]
     rows = []
-    print(f"load average {os.getloadavg()[0]:.2f} (2 shared cores); CPU us per factorisation + solve "
-          f"through SparseLU, best of {args.rounds} interleaved rounds")
-    print(f"{'model':<14s} {'n':>4s} {'band':>4s} {'nnz':>6s} " + " ".join(f"{e:>10s}" for e in ENGINES)
-          + "  auto      backward errors")
+    print(
+        f"load average {os.getloadavg()[0]:.2f} (2 shared cores); CPU us per factorisation + solve "
+        f"through SparseLU, best of {args.rounds} interleaved rounds"
+    )
+    print(
+        f"{'model':<14s} {'n':>4s} {'band':>4s} {'nnz':>6s} "
+        + " ".join(f"{e:>10s}" for e in ENGINES)
+        + "  auto      backward errors"
+    )
     for name, make in cases:
         tangents = make()
         B = tangents[len(tangents) // 2]
@@ -146,10 +157,16 @@ def main(argv=None):
         auto.factorize(K)
         b = band_of(B.indptr, B.indices)
         rows.append((name, n, best))
-        print(f"{name:<14s} {n:4d} {b:4d} {K.nnz:6d} " + " ".join(f"{best[e] * 1e6:10.1f}" for e in ENGINES)
-              + f"  {auto.engine:<9s} " + " ".join(f"{berr[e]:.0e}" for e in ENGINES))
-    print(f"load average {os.getloadavg()[0]:.2f}; automatic rule: dense LU up to "
-          f"{backends.DENSE_MAX_DOFS} DOFs, then the band rule, PARDISO, SuperLU")
+        print(
+            f"{name:<14s} {n:4d} {b:4d} {K.nnz:6d} "
+            + " ".join(f"{best[e] * 1e6:10.1f}" for e in ENGINES)
+            + f"  {auto.engine:<9s} "
+            + " ".join(f"{berr[e]:.0e}" for e in ENGINES)
+        )
+    print(
+        f"load average {os.getloadavg()[0]:.2f}; automatic rule: dense LU up to "
+        f"{backends.DENSE_MAX_DOFS} DOFs, then the band rule, PARDISO, SuperLU"
+    )
     import matplotlib
 
     matplotlib.use("Agg")

@@ -37,9 +37,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks" / "peers"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
+from femast.analysis.solvers import (
+    backends,  # noqa: E402
+    linear,  # noqa: E402
+)
 from femast.errors import SingularModelError  # noqa: E402
-from femast.analysis.solvers import backends  # noqa: E402
-from femast.analysis.solvers import linear  # noqa: E402
 
 NAMES = ("superlu", "banded", "cholmod", "pardiso")
 
@@ -69,6 +71,7 @@ class Capture:
 def mast_tangents(n_bays):
     import femast_mast
     from mast import build_mast
+
     from femast.analysis import Analysis
 
     m, _ = femast_mast.model(build_mast(n_bays), 10)
@@ -91,8 +94,9 @@ def adam_bay_tangents():
 
 
 def adam_mast_tangents():
-    import femast as fm
     from adam_mast_table1 import build
+
+    import femast as fm
     from femast.adam import BayParameters
     from femast.adam.steps import CONVERGENCE
 
@@ -130,10 +134,19 @@ def measure(K, name, reps, rhs):
     x = np.empty_like(y)
     x[lu._perm] = y
     kind = getattr(f, "kind", "lu")
-    return dict(fact_best=min(fact), fact_med=statistics.median(fact), solve_med=statistics.median(solve),
-                cpu_fact_med=statistics.median(cfact), cpu_solve_med=statistics.median(csolve),
-                fill=f.nnz / K.nnz, kind=kind, berr=backward_error(K, x, rhs), x=x,
-                refinements=getattr(f, "refinements", 0), engine=lu.engine)
+    return dict(
+        fact_best=min(fact),
+        fact_med=statistics.median(fact),
+        solve_med=statistics.median(solve),
+        cpu_fact_med=statistics.median(cfact),
+        cpu_solve_med=statistics.median(csolve),
+        fill=f.nnz / K.nnz,
+        kind=kind,
+        berr=backward_error(K, x, rhs),
+        x=x,
+        refinements=getattr(f, "refinements", 0),
+        engine=lu.engine,
+    )
 
 
 def near_singular(K, rhs):
@@ -142,8 +155,10 @@ def near_singular(K, rhs):
     S = (0.5 * (K + K.T)).toarray()
     w = np.linalg.eigvalsh(S)
     out = {}
-    for label, shift in (("indefinite (shift between eigenvalues 1 and 2)", 0.5 * (w[0] + w[1])),
-                         ("nearly singular (smallest eigenvalue 1e-14 x largest)", w[0] - 1e-14 * w[-1])):
+    for label, shift in (
+        ("indefinite (shift between eigenvalues 1 and 2)", 0.5 * (w[0] + w[1])),
+        ("nearly singular (smallest eigenvalue 1e-14 x largest)", w[0] - 1e-14 * w[-1]),
+    ):
         A = sp.csc_matrix(S - shift * np.eye(S.shape[0]))
         row = {}
         for name in NAMES:
@@ -169,13 +184,18 @@ def plot(rows, png):
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     width = 0.8 / len(NAMES)
     for k, name in enumerate(NAMES):
-        t = [(rows[m][name]["cpu_fact_med"] + rows[m][name]["cpu_solve_med"]) * 1e3 if rows[m].get(name) else np.nan
-             for m in models]
+        t = [
+            (rows[m][name]["cpu_fact_med"] + rows[m][name]["cpu_solve_med"]) * 1e3 if rows[m].get(name) else np.nan
+            for m in models
+        ]
         f = [rows[m][name]["fill"] if rows[m].get(name) else np.nan for m in models]
         xs = np.arange(len(models)) + (k - 1.5) * width
         axes[0].bar(xs, t, width, label=name)
         axes[1].bar(xs, f, width, label=name)
-    for ax, lab in ((axes[0], "factorisation + solve, CPU ms (median)"), (axes[1], "entries of the factors / entries of K")):
+    for ax, lab in (
+        (axes[0], "factorisation + solve, CPU ms (median)"),
+        (axes[1], "entries of the factors / entries of K"),
+    ):
         ax.set_xticks(np.arange(len(models)))
         ax.set_xticklabels(models, rotation=20, ha="right", fontsize=8)
         ax.set_yscale("log")
@@ -184,8 +204,9 @@ def plot(rows, png):
     axes[0].legend(fontsize=8)
     axes[0].set_title("time per tangent (lower is better)")
     axes[1].set_title("fill-in")
-    fig.suptitle(f"linear-solver back-ends on femast tangents (load {os.getloadavg()[0]:.1f}, 2 cores shared)",
-                 fontsize=10)
+    fig.suptitle(
+        f"linear-solver back-ends on femast tangents (load {os.getloadavg()[0]:.1f}, 2 cores shared)", fontsize=10
+    )
     plotstyle.save(fig, png)
     print(f"figure: {png}")
 
@@ -219,10 +240,14 @@ def main(argv=None):
         asym = abs(K - K.T).max() / abs(K).max()
         band = backends.band_of(K.indptr, K.indices)
         auto = backends.choose("auto", K, "rcm")
-        print(f"\n{label}: {K.shape[0]} DOFs, nnz(K) {K.nnz}, RCM half-bandwidth {band}, |K - K^T| / |K| = "
-              f"{asym:.1e}, {len(tangents)} tangents in the run; auto choice: {auto}   [load {os.getloadavg()[0]:.1f}]")
-        print(f"  {'back-end':9s} {'fact best':>9s} {'fact med':>9s} {'CPU med':>8s} {'solve':>8s} {'fill':>6s}  {'did':9s} "
-              f"{'refine':>6s} {'backward err':>12s} {'x vs SuperLU':>12s}")
+        print(
+            f"\n{label}: {K.shape[0]} DOFs, nnz(K) {K.nnz}, RCM half-bandwidth {band}, |K - K^T| / |K| = "
+            f"{asym:.1e}, {len(tangents)} tangents in the run; auto choice: {auto}   [load {os.getloadavg()[0]:.1f}]"
+        )
+        print(
+            f"  {'back-end':9s} {'fact best':>9s} {'fact med':>9s} {'CPU med':>8s} {'solve':>8s} {'fill':>6s}  {'did':9s} "
+            f"{'refine':>6s} {'backward err':>12s} {'x vs SuperLU':>12s}"
+        )
         rows[label] = {}
         ref = None
         for name in NAMES:
@@ -233,9 +258,11 @@ def main(argv=None):
                 continue
             ref = r["x"] if name == "superlu" else ref
             dx = np.abs(r["x"] - ref).max() / np.abs(ref).max()
-            print(f"  {name:9s} {r['fact_best'] * 1e3:8.2f}  {r['fact_med'] * 1e3:8.2f}  {r['cpu_fact_med'] * 1e3:7.2f} "
-                  f"{r['solve_med'] * 1e3:7.2f} "
-                  f"{r['fill']:6.2f}  {r['kind']:9s} {r['refinements']:6d} {r['berr']:12.1e} {dx:12.1e}")
+            print(
+                f"  {name:9s} {r['fact_best'] * 1e3:8.2f}  {r['fact_med'] * 1e3:8.2f}  {r['cpu_fact_med'] * 1e3:7.2f} "
+                f"{r['solve_med'] * 1e3:7.2f} "
+                f"{r['fill']:6.2f}  {r['kind']:9s} {r['refinements']:6d} {r['berr']:12.1e} {dx:12.1e}"
+            )
     print("\nbehaviour on an indefinite and a nearly singular tangent (the first model's, symmetrised):")
     for label, row in near_singular(first_K, np.random.default_rng(1).normal(size=first_K.shape[0])).items():
         print(f"  {label}:")

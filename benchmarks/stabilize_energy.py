@@ -50,9 +50,11 @@ def main(out="benchmarks/out"):
     ax[1].legend()
     fig.tight_layout()
     plotstyle.save(fig, out / "stabilize_energy.png", dpi=100)
-    print(f"final ratio {an.summary.steps[0]['stabilization_ratio']:.4f}; "
-          f"lean stabilised {res.frame(int(np.flatnonzero(sel)[-1]))['U'][1, 0] * 1e3:.4f} mm, "
-          f"equilibrium {res.frame(-1)['U'][1, 0] * 1e3:.4f} mm; figure {out / 'stabilize_energy.png'}")
+    print(
+        f"final ratio {an.summary.steps[0]['stabilization_ratio']:.4f}; "
+        f"lean stabilised {res.frame(int(np.flatnonzero(sel)[-1]))['U'][1, 0] * 1e3:.4f} mm, "
+        f"equilibrium {res.frame(-1)['U'][1, 0] * 1e3:.4f} mm; figure {out / 'stabilize_energy.png'}"
+    )
 
 
 if __name__ == "__main__":

@@ -29,26 +29,38 @@ def make_factory(n_bays: int, cycles: int = 1):
         add_initial_steps(am)
         add_table1_steps(am, cycles=cycles)
         return am.model
+
     return adam_mast
 
 
-def adam_study(n_bays: int = 10, cycles: int = 1, sensitivity: bool = False, sampler: str = "sobol",
-               seed: int = 1) -> st.Study:
+def adam_study(
+    n_bays: int = 10, cycles: int = 1, sensitivity: bool = False, sampler: str = "sobol", seed: int = 1
+) -> st.Study:
     """The study of an ``n_bays`` mast: tip displacement (m) and rotation (rad) at the end of every
     step relative to the pretensioned state; the residual twist after the cycle (rad)."""
-    am = build_mast(n_bays)   # for the labels only
+    am = build_mast(n_bays)  # for the labels only
     n_long = len(longeron_labels(am.model))
     last = f"0b#{cycles}"
     return st.Study(
         model=make_factory(n_bays, cycles),
-        inputs=[st.Uniform("mu", 0.4, 0.6), st.Uniform("pretension", 153.0, 187.0),
-                st.TruncatedNormal("dL_longeron", 0.0, 0.025e-3, low=-0.05e-3, high=0.05e-3, size=n_long)],
-        outputs=[st.NodeOutput("tip_u", node=am.control, quantity="U", relative_to="pretension"),
-                 st.NodeOutput("tip_rot", node=am.control, quantity="URA", relative_to="pretension"),
-                 st.NodeOutput("residual_rz", node=am.control, quantity="URA", components="z", at=last,
-                               relative_to="pretension")],
-        analysis={"convergence": CONVERGENCE}, sampler=sampler, seed=seed, sensitivity=sensitivity,
-        name=f"adam{n_bays}")
+        inputs=[
+            st.Uniform("mu", 0.4, 0.6),
+            st.Uniform("pretension", 153.0, 187.0),
+            st.TruncatedNormal("dL_longeron", 0.0, 0.025e-3, low=-0.05e-3, high=0.05e-3, size=n_long),
+        ],
+        outputs=[
+            st.NodeOutput("tip_u", node=am.control, quantity="U", relative_to="pretension"),
+            st.NodeOutput("tip_rot", node=am.control, quantity="URA", relative_to="pretension"),
+            st.NodeOutput(
+                "residual_rz", node=am.control, quantity="URA", components="z", at=last, relative_to="pretension"
+            ),
+        ],
+        analysis={"convergence": CONVERGENCE},
+        sampler=sampler,
+        seed=seed,
+        sensitivity=sensitivity,
+        name=f"adam{n_bays}",
+    )
 
 
 study = adam_study(int(os.environ.get("ADAM_BAYS", "10")))

@@ -34,16 +34,16 @@ from femast.elements.shroud_cable import unstretched_length
 from femast.elements.shroud_law import DyneemaLaw
 from femast.guyed.fe_mast import MastFE
 
-T_NOMINAL = 1200.0                               # N, the seed's pretension
-ALPHA_SHROUD, ALPHA_TUBE = -12e-6, 23e-6          # 1/K (Dyneema along the fibre, aluminium)
-WORK_LOAD = {"fx": 200.0, "fy": 160.0, "fz": -160.0}   # N, the cable's pull toward the platform
+T_NOMINAL = 1200.0  # N, the seed's pretension
+ALPHA_SHROUD, ALPHA_TUBE = -12e-6, 23e-6  # 1/K (Dyneema along the fibre, aluminium)
+WORK_LOAD = {"fx": 200.0, "fy": 160.0, "fz": -160.0}  # N, the cable's pull toward the platform
 STEPS = ["thermal", "load"]
 
 _nominal = MastFE(T_NOMINAL)
 _nominal.build()
-TOP = _nominal.top                               # node label of the top
+TOP = _nominal.top  # node label of the top
 _sh = _nominal.shrouds_nominal
-LENGTHS = np.linalg.norm(_sh.lower - _sh.upper, axis=1)   # m, rope lengths in the nominal geometry
+LENGTHS = np.linalg.norm(_sh.lower - _sh.upper, axis=1)  # m, rope lengths in the nominal geometry
 
 
 def guyed_mast(dL_shroud, pretension, dT):
@@ -51,10 +51,15 @@ def guyed_mast(dL_shroud, pretension, dT):
     law = DyneemaLaw()
     # a rope tensioned to T in the nominal geometry is that much shorter than one tensioned to 1200 N
     dL_pre = unstretched_length(law, np.asarray(pretension), LENGTHS) - _nominal.L0
-    fe = MastFE(T_NOMINAL, length_error=np.asarray(dL_shroud) + dL_pre, temperature_change_K=dT,
-                shroud_alpha_per_K=ALPHA_SHROUD, beam_alpha_per_K=ALPHA_TUBE)
+    fe = MastFE(
+        T_NOMINAL,
+        length_error=np.asarray(dL_shroud) + dL_pre,
+        temperature_change_K=dT,
+        shroud_alpha_per_K=ALPHA_SHROUD,
+        beam_alpha_per_K=ALPHA_TUBE,
+    )
     m = fe.build()
-    if dT == 0.0:                               # keep the same steps (MastFE adds "thermal" only if dT != 0)
+    if dT == 0.0:  # keep the same steps (MastFE adds "thermal" only if dT != 0)
         m.step("thermal")
     m.step("load").load(fe.top, **WORK_LOAD)
     return m
@@ -62,12 +67,20 @@ def guyed_mast(dL_shroud, pretension, dT):
 
 study = st.Study(
     model=guyed_mast,
-    inputs=[st.TruncatedNormal("dL_shroud", 0.0, 0.5e-3, low=-1e-3, high=1e-3, size=3),
-            st.Normal("pretension", T_NOMINAL, 60.0, size=3),
-            st.Uniform("dT", -20.0, 20.0)],
-    outputs=[st.NodeOutput("top_u", node=TOP, quantity="U", at=STEPS),
-             st.NodeOutput("top_rot", node=TOP, quantity="URA", at=STEPS)],
-    sensitivity=True, seed=1, timeout_s=120.0, name="guyed_mast")
+    inputs=[
+        st.TruncatedNormal("dL_shroud", 0.0, 0.5e-3, low=-1e-3, high=1e-3, size=3),
+        st.Normal("pretension", T_NOMINAL, 60.0, size=3),
+        st.Uniform("dT", -20.0, 20.0),
+    ],
+    outputs=[
+        st.NodeOutput("top_u", node=TOP, quantity="U", at=STEPS),
+        st.NodeOutput("top_rot", node=TOP, quantity="URA", at=STEPS),
+    ],
+    sensitivity=True,
+    seed=1,
+    timeout_s=120.0,
+    name="guyed_mast",
+)
 
 
 def nominal_outputs():
@@ -89,7 +102,7 @@ def error_figure(folder, png):
 
     res = st.load(folder)
     u0, _ = nominal_outputs()
-    err = res.output("top_u") - u0[None]                    # (n, 2, 3) m
+    err = res.output("top_u") - u0[None]  # (n, 2, 3) m
     e = err * 1e3
     dT = res.inputs("dT")
     fig, ax = plt.subplots(1, 3, figsize=(13, 4.2))
@@ -130,27 +143,36 @@ def main(argv=None):
 
     report(a.out, print_table=False, figures=True)
     err = error_figure(a.out, Path(a.out) / "figures" / "top_error.png")
-    mag = np.linalg.norm(err, axis=2) * 1e3                 # mm
+    mag = np.linalg.norm(err, axis=2) * 1e3  # mm
     for j, step in enumerate(STEPS):
         p95 = st.percentile(mag[:, j], 0.95)
-        print(f"after '{step}': |top error| median {np.median(mag[:, j]):.2f} mm, 95th percentile "
-              f"{p95['estimate']:.2f} mm (95 % interval {p95['low']:.2f}-{p95['high']:.2f} mm), "
-              f"max {mag[:, j].max():.2f} mm over {len(mag)} samples")
+        print(
+            f"after '{step}': |top error| median {np.median(mag[:, j]):.2f} mm, 95th percentile "
+            f"{p95['estimate']:.2f} mm (95 % interval {p95['low']:.2f}-{p95['high']:.2f} mm), "
+            f"max {mag[:, j].max():.2f} mm over {len(mag)} samples"
+        )
     res = st.load(a.out)
     fA, fB, fAB, dropped = res.saltelli("top_u")
     u0, _ = nominal_outputs()
     names = [i.name for i in study.inputs]
     for j, step in enumerate(STEPS):
-        e = [np.linalg.norm(f[..., j, :] - u0[j], axis=-1) for f in (fA, fB, fAB)]   # |error|, m
+        e = [np.linalg.norm(f[..., j, :] - u0[j], axis=-1) for f in (fA, fB, fAB)]  # |error|, m
         idx = st.sobol_indices(*e, names)
-        print(f"Sobol' indices of |top error| after '{step}' ({dropped} base samples dropped): " + ", ".join(
-            f"{n}: S1 {idx['S1'][k]:.2f} [{idx['S1_low'][k]:.2f}, {idx['S1_high'][k]:.2f}] ST {idx['ST'][k]:.2f} "
-            f"[{idx['ST_low'][k]:.2f}, {idx['ST_high'][k]:.2f}]" for k, n in enumerate(names)))
+        print(
+            f"Sobol' indices of |top error| after '{step}' ({dropped} base samples dropped): "
+            + ", ".join(
+                f"{n}: S1 {idx['S1'][k]:.2f} [{idx['S1_low'][k]:.2f}, {idx['S1_high'][k]:.2f}] ST {idx['ST'][k]:.2f} "
+                f"[{idx['ST_low'][k]:.2f}, {idx['ST_high'][k]:.2f}]"
+                for k, n in enumerate(names)
+            )
+        )
     if a.figures:
         import shutil
 
-        for src, dst in (("top_error.png", "studies_guyed_top_error.png"),
-                         ("sensitivity.png", "studies_guyed_sensitivity.png")):
+        for src, dst in (
+            ("top_error.png", "studies_guyed_top_error.png"),
+            ("sensitivity.png", "studies_guyed_sensitivity.png"),
+        ):
             shutil.copy(Path(a.out) / "figures" / src, Path(a.figures) / dst)
     return 0 if s.failed == 0 else 3
 

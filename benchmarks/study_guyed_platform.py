@@ -34,10 +34,10 @@ from femast.guyed.fe_mast import MastFE
 from femast.guyed.platform_pose import CableRobot, MastSet, rigid_masts, solve_pose
 from femast.guyed.rocaspect import POSE_0, fig5a_trajectory, rocaspect_geometry, rocaspect_shrouds
 
-T_NOMINAL = 1200.0                                # N
-ALPHA_SHROUD, ALPHA_TUBE = -12e-6, 23e-6           # 1/K
+T_NOMINAL = 1200.0  # N
+ALPHA_SHROUD, ALPHA_TUBE = -12e-6, 23e-6  # 1/K
 ROBOT = CableRobot(rocaspect_geometry())
-PATH = fig5a_trajectory(3)                        # 19 poses (m, rad): the Fig. 5a rectangle and climb
+PATH = fig5a_trajectory(3)  # 19 poses (m, rad): the Fig. 5a rectangle and climb
 FAR = int(np.argmax(np.linalg.norm(PATH[:, :3] - POSE_0[:3], axis=1)))
 CAL = solve_pose(ROBOT, rigid_masts(4), POSE_0)  # the calibration state (rigid frame)
 _LAW = DyneemaLaw()
@@ -52,8 +52,14 @@ def mast_response(i, dL, pretension, dT):
     """Top compliance (6, 6) of mast i at its (heated) state and its top displacement (6,) from the
     calibration state to the end of the temperature change."""
     dL_pre = unstretched_length(_LAW, np.asarray(pretension), _LENGTHS[i]) - _L0_NOM[i]
-    fe = MastFE(T_NOMINAL, mast=i, length_error=np.asarray(dL) + dL_pre, temperature_change_K=dT,
-                shroud_alpha_per_K=ALPHA_SHROUD, beam_alpha_per_K=ALPHA_TUBE)
+    fe = MastFE(
+        T_NOMINAL,
+        mast=i,
+        length_error=np.asarray(dL) + dL_pre,
+        temperature_change_K=dT,
+        shroud_alpha_per_K=ALPHA_SHROUD,
+        beam_alpha_per_K=ALPHA_TUBE,
+    )
     fe.solve()
     last = {step: u for step, u, _ in fe._frames}
     u_cal = last["pretension"]
@@ -65,7 +71,7 @@ def platform(dL_shroud, pretension, dT):
     """One sample: 12 length errors (m) and pretensions (N), masts 1-4 x shrouds 1-3; dT (K)."""
     C, delta = [], []
     for i in range(4):
-        c, d = mast_response(i, dL_shroud[3 * i:3 * i + 3], pretension[3 * i:3 * i + 3], dT)
+        c, d = mast_response(i, dL_shroud[3 * i : 3 * i + 3], pretension[3 * i : 3 * i + 3], dT)
         C.append(c)
         delta.append(d)
     masts = MastSet("sample", np.array(C))
@@ -81,12 +87,18 @@ def platform(dL_shroud, pretension, dT):
 
 study = st.Study(
     run=platform,
-    inputs=[st.TruncatedNormal("dL_shroud", 0.0, 0.5e-3, low=-1e-3, high=1e-3, size=12),
-            st.Normal("pretension", T_NOMINAL, 60.0, size=12),
-            st.Uniform("dT", -20.0, 20.0)],
+    inputs=[
+        st.TruncatedNormal("dL_shroud", 0.0, 0.5e-3, low=-1e-3, high=1e-3, size=12),
+        st.Normal("pretension", T_NOMINAL, 60.0, size=12),
+        st.Uniform("dT", -20.0, 20.0),
+    ],
     outputs=["error_cal", "error_far", "error_max"],
     units={"error_cal": "m", "error_far": "m", "error_max": "m"},
-    sensitivity=True, seed=1, timeout_s=300.0, name="guyed_platform")
+    sensitivity=True,
+    seed=1,
+    timeout_s=300.0,
+    name="guyed_platform",
+)
 
 
 def figure(folder, png):
@@ -133,13 +145,17 @@ def main(argv=None):
     res = st.load(a.out)
     e = res.output("error_max") * 1e3
     q = st.percentile(e, 0.95)
-    print(f"largest |platform position error| over the path: median {np.median(e):.2f} mm, 95th percentile "
-          f"{q['estimate']:.2f} mm (95 % interval {q['low']:.2f}-{q['high']:.2f} mm) over {len(e)} samples")
+    print(
+        f"largest |platform position error| over the path: median {np.median(e):.2f} mm, 95th percentile "
+        f"{q['estimate']:.2f} mm (95 % interval {q['low']:.2f}-{q['high']:.2f} mm) over {len(e)} samples"
+    )
     if a.figures:
         import shutil
 
-        for src, dst in (("platform_error.png", "studies_guyed_platform_error.png"),
-                         ("sensitivity.png", "studies_guyed_platform_sensitivity.png")):
+        for src, dst in (
+            ("platform_error.png", "studies_guyed_platform_error.png"),
+            ("sensitivity.png", "studies_guyed_platform_sensitivity.png"),
+        ):
             shutil.copy(Path(a.out) / "figures" / src, Path(a.figures) / dst)
     return 0 if s.failed == 0 else 3
 

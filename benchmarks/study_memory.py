@@ -14,7 +14,7 @@ import subprocess
 import sys
 import tempfile
 
-CHILD = r'''
+CHILD = r"""
 import resource, sys, time
 import numpy as np
 import femast.studies as st
@@ -37,7 +37,7 @@ rep_peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 print(f"{n:>7} samples: {s.ok} ok; peak RSS after imports {base / 1024:.0f} MB, after the run "
       f"{run_peak / 1024:.0f} MB ({t_run:.0f} s), after the report {rep_peak / 1024:.0f} MB "
       f"({time.perf_counter() - t:.0f} s); {len(list(__import__('pathlib').Path(folder).glob('chunks/*')))} chunk files")
-'''
+"""
 
 
 def main():

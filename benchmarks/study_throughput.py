@@ -24,12 +24,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import femast.studies as st  # noqa: E402
-from femast.post import plotstyle  # noqa: E402
 from study_adam import adam_study  # noqa: E402
 
+import femast.studies as st  # noqa: E402
+from femast.post import plotstyle  # noqa: E402
+
 OUT = Path(__file__).resolve().parent / "out" / "study_throughput"
-TARGET_S = 600.0   # the issue: 1000 samples of the 10-bay mast in 10 minutes on 2 cores
+TARGET_S = 600.0  # the issue: 1000 samples of the 10-bay mast in 10 minutes on 2 cores
 
 
 def load():
@@ -71,26 +72,35 @@ def main(argv=None):
         s, ld = timed(adam_study(bays), n, workers=1)
         w, c = per_sample(s)
         rows[bays] = (w, c)
-        print(f"{bays:>3} bays, 1 worker, {n} samples: {w:.2f} s wall / sample, {c:.2f} s CPU / sample -> "
-              f"{1 / c:.2f} runs/s per core (CPU), {1 / w:.2f} runs/s wall (load {ld:.1f}; warm-up "
-              f"{s.warmup_time:.1f} s not counted)", flush=True)
+        print(
+            f"{bays:>3} bays, 1 worker, {n} samples: {w:.2f} s wall / sample, {c:.2f} s CPU / sample -> "
+            f"{1 / c:.2f} runs/s per core (CPU), {1 / w:.2f} runs/s wall (load {ld:.1f}; warm-up "
+            f"{s.warmup_time:.1f} s not counted)",
+            flush=True,
+        )
 
     # -- speed-up 1 -> 2 local workers (10 bays), interleaved A B A B
     sp = {1: [], 2: []}
-    for rep in range(2):
+    for _rep in range(2):
         for w_ in (1, 2):
             s, ld = timed(adam_study(10), args.samples, workers=w_)
             sp[w_].append((s.wall_time - s.warmup_time, s.cpu_time - s.warmup_cpu, ld))
-            print(f"  10 bays, {w_} worker(s), {args.samples} samples: {s.wall_time - s.warmup_time:.1f} s wall "
-                  f"(after warm-up), CPU {s.cpu_time - s.warmup_cpu:.1f} s, load {ld:.1f}", flush=True)
+            print(
+                f"  10 bays, {w_} worker(s), {args.samples} samples: {s.wall_time - s.warmup_time:.1f} s wall "
+                f"(after warm-up), CPU {s.cpu_time - s.warmup_cpu:.1f} s, load {ld:.1f}",
+                flush=True,
+            )
     w1 = np.median([x[0] for x in sp[1]])
     w2 = np.median([x[0] for x in sp[2]])
     c1 = np.median([x[1] for x in sp[1]])
     c2 = np.median([x[1] for x in sp[2]])
-    print(f"speed-up 1 -> 2 local workers: {w1 / w2:.2f} (median wall {w1:.1f} s vs {w2:.1f} s; "
-          f"ideal 2 on an idle 2-core machine, load now {load():.1f}); CPU of the samples {c1:.1f} s vs {c2:.1f} s: "
-          f"the work does not grow with the workers, so on 2 idle cores the speed-up is at most "
-          f"2 x {c1:.1f} / {c2:.1f} = {2 * c1 / c2:.2f}", flush=True)
+    print(
+        f"speed-up 1 -> 2 local workers: {w1 / w2:.2f} (median wall {w1:.1f} s vs {w2:.1f} s; "
+        f"ideal 2 on an idle 2-core machine, load now {load():.1f}); CPU of the samples {c1:.1f} s vs {c2:.1f} s: "
+        f"the work does not grow with the workers, so on 2 idle cores the speed-up is at most "
+        f"2 x {c1:.1f} / {c2:.1f} = {2 * c1 / c2:.2f}",
+        flush=True,
+    )
 
     # -- dask overhead per sample vs local processes: a trivial sample (pure engine cost), then 10 bays
     trivial_study = st.Study(run=trivial, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], name="trivial")
@@ -103,34 +113,46 @@ def main(argv=None):
     except ImportError:
         print("dask.distributed not installed: no dask measurement (pip install 'dask[distributed]')")
     else:
-        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                      dashboard_address=None) as cl, distributed.Client(cl) as client:
+        with (
+            distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl,
+            distributed.Client(cl) as client,
+        ):
             sd, ld2 = timed(trivial_study, n_triv, scheduler=client)
             ov["dask"] = sd.wall_time / n_triv
-            print(f"engine cost per sample (trivial sample, {n_triv} samples, 2 workers): local processes "
-                  f"{ov['local'] * 1e3:.2f} ms, dask {ov['dask'] * 1e3:.2f} ms -> dask overhead "
-                  f"{(ov['dask'] - ov['local']) * 1e3:.2f} ms per sample (load {ld1:.1f} / {ld2:.1f})", flush=True)
+            print(
+                f"engine cost per sample (trivial sample, {n_triv} samples, 2 workers): local processes "
+                f"{ov['local'] * 1e3:.2f} ms, dask {ov['dask'] * 1e3:.2f} ms -> dask overhead "
+                f"{(ov['dask'] - ov['local']) * 1e3:.2f} ms per sample (load {ld1:.1f} / {ld2:.1f})",
+                flush=True,
+            )
             sdm, ld3 = timed(adam_study(10), args.samples, scheduler=client)
         slm, ld4 = timed(adam_study(10), args.samples, workers=2)
         dask_rows = (sdm.wall_time - sdm.warmup_time, slm.wall_time - slm.warmup_time)
-        print(f"10 bays, {args.samples} samples, 2 workers: dask {dask_rows[0]:.1f} s, local {dask_rows[1]:.1f} s "
-              f"wall after warm-up ({(dask_rows[0] - dask_rows[1]) / args.samples * 1e3:+.0f} ms per sample; "
-              f"load {ld3:.1f} / {ld4:.1f})", flush=True)
+        print(
+            f"10 bays, {args.samples} samples, 2 workers: dask {dask_rows[0]:.1f} s, local {dask_rows[1]:.1f} s "
+            f"wall after warm-up ({(dask_rows[0] - dask_rows[1]) / args.samples * 1e3:+.0f} ms per sample; "
+            f"load {ld3:.1f} / {ld4:.1f})",
+            flush=True,
+        )
 
     # -- the 1000-sample target
     c10 = rows[10][1]
     proj = 1000 * c10 / 2
-    print(f"1000-sample 10-bay study on 2 idle cores (projected from {c10:.2f} s CPU / sample): {proj:.0f} s "
-          f"({proj / 60:.1f} min; target < {TARGET_S / 60:.0f} min: {'met' if proj < TARGET_S else 'NOT met'})")
+    print(
+        f"1000-sample 10-bay study on 2 idle cores (projected from {c10:.2f} s CPU / sample): {proj:.0f} s "
+        f"({proj / 60:.1f} min; target < {TARGET_S / 60:.0f} min: {'met' if proj < TARGET_S else 'NOT met'})"
+    )
     full = None
     if args.full:
         ld = load()
         s, _ = timed(adam_study(10), 1000, workers=2)
         full = s
-        print(f"1000-sample 10-bay study, 2 local workers: wall {s.wall_time:.0f} s ({s.wall_time / 60:.1f} min), "
-              f"CPU {s.cpu_time:.0f} s, {s.ok} ok, {s.failed} failed, load {ld:.1f} before / {load():.1f} after; "
-              f"target < {TARGET_S / 60:.0f} min wall: {'met' if s.wall_time < TARGET_S else 'NOT met'} "
-              f"(CPU / 2 = {s.cpu_time / 2:.0f} s)")
+        print(
+            f"1000-sample 10-bay study, 2 local workers: wall {s.wall_time:.0f} s ({s.wall_time / 60:.1f} min), "
+            f"CPU {s.cpu_time:.0f} s, {s.ok} ok, {s.failed} failed, load {ld:.1f} before / {load():.1f} after; "
+            f"target < {TARGET_S / 60:.0f} min wall: {'met' if s.wall_time < TARGET_S else 'NOT met'} "
+            f"(CPU / 2 = {s.cpu_time / 2:.0f} s)"
+        )
 
     # -- figure
     plt = plotstyle.pyplot()

@@ -18,10 +18,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from femast import progress
-from femast.verification import references as ref
 from femast import verification as v
 from femast.post.render import render_png
 from femast.post.vtk import export_vtk
+from femast.verification import references as ref
 
 
 def main():
@@ -94,7 +94,7 @@ def main():
     X0 = res.X[-1]
     for c, name in enumerate("xyz"):
         ax.plot(P, X0[c] + res.node_history(tipn, "u" + name), "o-", ms=3, label=f"femast tip {name}")
-    for author, table in ref.BEND45_PUBLISHED.items():
+    for _author, table in ref.BEND45_PUBLISHED.items():
         for load, pos in table.items():
             ax.plot([load] * 3, pos, "k+", ms=8)
     ax.plot([], [], "k+", label="published (Bathe-Bolourchi, Simo-Vu-Quoc, Crisfield, ...)")
@@ -140,8 +140,10 @@ def main():
     print(table)
     (out / "verification_table.txt").write_text(table + "\n")
     n_bad = sum(not r.passed for r in rows)
-    print(f"\n{len(rows) - n_bad} of {len(rows)} checks within tolerance; figures in {out}/verification.png, "
-          f"VTK series {pvd}")
+    print(
+        f"\n{len(rows) - n_bad} of {len(rows)} checks within tolerance; figures in {out}/verification.png, "
+        f"VTK series {pvd}"
+    )
     return 1 if n_bad else 0
 
 
@@ -157,24 +159,30 @@ def modal_cases(out):
     ax = axes[0]
     order = np.argsort(modes.x[:, 0])
     for k in (0, 2, 4):
-        yz = modes.shapes[k, order, 1:3]      # a mode of a degenerate (y, z) pair: w(x) along one direction
+        yz = modes.shapes[k, order, 1:3]  # a mode of a degenerate (y, z) pair: w(x) along one direction
         w = yz @ np.linalg.svd(yz, full_matrices=False)[2][0]
-        ax.plot(modes.x[order, 0], w * np.sign(w[len(w) // 4 or 1]),   # errors: the table, not the legend
-                label=f"f = {plotstyle.num(modes.frequencies[k], 4)} Hz (exact {25 * (k // 2 + 1):.0f} Hz)")
+        ax.plot(
+            modes.x[order, 0],
+            w * np.sign(w[len(w) // 4 or 1]),  # errors: the table, not the legend
+            label=f"f = {plotstyle.num(modes.frequencies[k], 4)} Hz (exact {25 * (k // 2 + 1):.0f} Hz)",
+        )
     ax.set_xlabel("x (m)")
     ax.set_ylabel("transverse mode shape (mass-normalised, m/sqrt(kg))")
     ax.set_title("Taut string, T = 100 N, m' = 0.01 kg/m, 100 cables")
     ax.legend(fontsize=8)
     r, modes = vm.cantilever()
     rows += r
-    f_exact = [row.reference for row in r]   # the closed forms of the table (Euler-Bernoulli cantilever)
+    f_exact = [row.reference for row in r]  # the closed forms of the table (Euler-Bernoulli cantilever)
     ax = axes[1]
     order = np.argsort(modes.x[:, 0])
     for k in (0, 2, 4):
         yz = modes.shapes[k, order, 1:3]
         w = yz @ np.linalg.svd(yz, full_matrices=False)[2][0]
-        ax.plot(modes.x[order, 0], w / w[np.argmax(np.abs(w))],
-                label=f"f = {plotstyle.num(modes.frequencies[k], 4)} Hz (exact {plotstyle.num(f_exact[k // 2], 4)} Hz)")
+        ax.plot(
+            modes.x[order, 0],
+            w / w[np.argmax(np.abs(w))],
+            label=f"f = {plotstyle.num(modes.frequencies[k], 4)} Hz (exact {plotstyle.num(f_exact[k // 2], 4)} Hz)",
+        )
     ax.set_xlabel("x / L (-)")
     ax.set_ylabel("transverse mode shape, 1 at its largest (-)")
     ax.set_title("Cantilever, EI = m = L = 1, 20 beams")

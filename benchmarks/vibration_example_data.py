@@ -18,13 +18,16 @@ import numpy as np
 
 B, L_BAY = 0.25, 6.84 / 40
 HALF_DIAGONAL = 0.5 * math.hypot(B, L_BAY)
-CABLE = 7850.0 * 3.4006e4 / 200e9        # kg/m
+CABLE = 7850.0 * 3.4006e4 / 200e9  # kg/m
 MASS = 0.0211 + 4 * 0.5 * CABLE * HALF_DIAGONAL
-LOSS = 15.0                               # N, hidden
-NOISE = 0.12                              # Hz
+LOSS = 15.0  # N, hidden
+NOISE = 0.12  # Hz
 
 
-def main(path=Path(__file__).resolve().parents[1] / "femast" / "examples" / "vibration_example.csv"):
+EXAMPLE = Path(__file__).resolve().parents[1] / "femast" / "examples" / "vibration_example.csv"
+
+
+def main(path=EXAMPLE):
     rng = np.random.default_rng(18)
     settings = np.arange(120.0, 201.0, 10.0)
     T = settings - LOSS

@@ -18,21 +18,40 @@ numba_cache.check()  # delete numba caches whose njit helpers in other files cha
 
 _aliases.install()  # the import paths of before the package move (issue 15) keep working
 
-from .model.amplitudes import Amplitude
 from .analysis import Analysis, solve
+from .analysis.solvers.arclength import ArcLength
+from .analysis.solvers.control import DisplacementControl, LoadControl
+from .analysis.solvers.convergence import Convergence
+from .analysis.solvers.stabilize import Stabilize
 from .errors import ConvergenceError, DataFileError, EquilibriumError, FemastError, ModelError, SingularModelError
 from .model import Model
-from .post.results import Results
+from .model.amplitudes import Amplitude
 from .model.sections import Section, circular_solid, circular_tube, shear_modulus, square_solid, square_tube
-from .analysis.solvers.control import DisplacementControl, LoadControl
-from .analysis.solvers.stabilize import Stabilize
-from .analysis.solvers.arclength import ArcLength
-from .analysis.solvers.convergence import Convergence
+from .post.results import Results
 
 __all__ = [
-    "Amplitude", "Analysis", "solve", "Model", "Results", "Section", "circular_solid", "circular_tube",
-    "square_solid", "square_tube", "shear_modulus", "DisplacementControl", "LoadControl", "Convergence", "Stabilize", "ArcLength",
-    "FemastError", "ModelError", "SingularModelError", "ConvergenceError", "DataFileError", "EquilibriumError",
+    "Amplitude",
+    "Analysis",
+    "solve",
+    "Model",
+    "Results",
+    "Section",
+    "circular_solid",
+    "circular_tube",
+    "square_solid",
+    "square_tube",
+    "shear_modulus",
+    "DisplacementControl",
+    "LoadControl",
+    "Convergence",
+    "Stabilize",
+    "ArcLength",
+    "FemastError",
+    "ModelError",
+    "SingularModelError",
+    "ConvergenceError",
+    "DataFileError",
+    "EquilibriumError",
 ]
 __version__ = "0.1.0"
 

@@ -28,7 +28,7 @@ OLD_PATHS = {
     "femast.dofs": "femast.analysis.dofs",
     "femast.reduction": "femast.analysis.reduction",
     "femast.configuration": "femast.analysis.configuration",
-    "femast.solvers": "femast.analysis.solvers",          # and its submodules
+    "femast.solvers": "femast.analysis.solvers",  # and its submodules
     "femast.mass": "femast.modal.mass",
     "femast.modal_output": "femast.modal.output",
     "femast.frequency_step": "femast.modal.step",
@@ -39,7 +39,7 @@ OLD_PATHS = {
     "femast.verification_arclength": "femast.verification.arclength",
     "femast.verification_modal": "femast.verification.modal",
     "femast.references": "femast.verification.references",
-    "femast.guyed.shroud": "femast.elements.shroud_law",   # the law of the shroud element (issue 15)
+    "femast.guyed.shroud": "femast.elements.shroud_law",  # the law of the shroud element (issue 15)
 }
 
 

@@ -20,26 +20,27 @@ def _run(args):
         raise FemastError(f"no such script: {script}")
     script_args = list(args.script_args)
     restart = args.restart
-    if "--restart" in script_args:   # femast run SCRIPT --restart FOLDER
+    if "--restart" in script_args:  # femast run SCRIPT --restart FOLDER
         i = script_args.index("--restart")
         if i + 1 >= len(script_args):
             raise FemastError("--restart needs the results folder of the run to continue: --restart FOLDER")
         restart = script_args[i + 1]
-        del script_args[i:i + 2]
+        del script_args[i : i + 2]
     if restart is not None:
         # the analyses of the script whose results folder is RESTART continue from its restart point
         from .analysis.restart import ENV, RESTART_DIR
 
         if not (Path(restart) / RESTART_DIR / "restart.json").is_file():
-            raise FemastError(f"{restart}: no restart point; run the analysis with restart_every=n to be able "
-                              "to restart it")
+            raise FemastError(
+                f"{restart}: no restart point; run the analysis with restart_every=n to be able to restart it"
+            )
         old = os.environ.get(ENV)
         os.environ[ENV] = str(restart)
     sys.argv = [str(script)] + script_args
     try:
         runpy.run_path(str(script), run_name="__main__")
     finally:
-        if restart is not None:   # (main() may be called again in the same process)
+        if restart is not None:  # (main() may be called again in the same process)
             if old is None:
                 os.environ.pop(ENV, None)
             else:
@@ -49,7 +50,7 @@ def _run(args):
 def _vtk(args):
     from .post.vtk import export_vtk
 
-    out = Path(args.out) / Path(args.results).resolve().name   # ./vtk/NAME: beside render's ./render (issue 17)
+    out = Path(args.out) / Path(args.results).resolve().name  # ./vtk/NAME: beside render's ./render (issue 17)
     pvd = export_vtk(args.results, out, every=args.every)
     print(f"wrote {pvd} (open it in ParaView; apply 'Warp By Vector' with U to see the deformed shape)")
 
@@ -77,8 +78,10 @@ def _render(args):
     else:
         frame = len(res) - 1 if args.frame == "last" else args.frame
         if not -len(res) <= frame < len(res):
-            raise FemastError(f"--frame {frame}: frame {frame} does not exist; {args.results} has {len(res)} frames "
-                              f"(0 to {len(res) - 1}); give a frame in that range, 'last' or 'max'")
+            raise FemastError(
+                f"--frame {frame}: frame {frame} does not exist; {args.results} has {len(res)} frames "
+                f"(0 to {len(res) - 1}); give a frame in that range, 'last' or 'max'"
+            )
         frame = range(len(res))[frame]
         why = f"frame {frame} of {len(res)}"
     name = f"{Path(args.results).resolve().name}_frame{frame}.png"
@@ -102,8 +105,10 @@ def _info(args):
     print(f"{res.folder}: {len(res)} frames, {len(res.node_labels)} nodes, families: {', '.join(res.families)}")
     if res.summary:
         s = res.summary
-        print(f"  status: {res.status}; increments {s.get('increments', 0)}, iterations {s.get('iterations', 0)}, "
-              f"cutbacks {s.get('cutbacks', 0)}, wall time {s.get('wall_time', 0.0):.2f} s")
+        print(
+            f"  status: {res.status}; increments {s.get('increments', 0)}, iterations {s.get('iterations', 0)}, "
+            f"cutbacks {s.get('cutbacks', 0)}, wall time {s.get('wall_time', 0.0):.2f} s"
+        )
         for st in s.get("steps", []):
             print(f"  step {st['name']}: {st['increments']} increments, {st['iterations']} iterations")
         if s.get("message"):
@@ -122,51 +127,92 @@ class _Help(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpF
 
 def build_parser() -> argparse.ArgumentParser:
     """femast's argument parser (every command; the lists in the help come from the registries)."""
-    parser = argparse.ArgumentParser(prog="femast", description="Nonlinear FE for jointed deployable masts. "
-                                     "`femast COMMAND --help` explains a command.", formatter_class=_Help)
-    parser.add_argument("--quiet", action="store_true", help="no progress bars or first-run notices (they never "
-                                                             "show when stderr is not a terminal)")
-    parser.add_argument("--debug", action="store_true",
-                        help="show the full Python traceback of an error (default: one line naming the item)")
+    parser = argparse.ArgumentParser(
+        prog="femast",
+        description="Nonlinear FE for jointed deployable masts. `femast COMMAND --help` explains a command.",
+        formatter_class=_Help,
+    )
+    parser.add_argument(
+        "--quiet",
+        action="store_true",
+        help="no progress bars or first-run notices (they never show when stderr is not a terminal)",
+    )
+    parser.add_argument(
+        "--debug",
+        action="store_true",
+        help="show the full Python traceback of an error (default: one line naming the item)",
+    )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    p = sub.add_parser("run", help="run a model or benchmark script", formatter_class=_Help,
-                       description="Run a Python script (a model, a benchmark) as `python SCRIPT ARGS` would.")
-    p.add_argument("--restart", metavar="FOLDER", default=None,
-                   help="continue the run whose results folder is FOLDER from its last restart point "
-                        "(also accepted after SCRIPT; default: start afresh)")
+    p = sub.add_parser(
+        "run",
+        help="run a model or benchmark script",
+        formatter_class=_Help,
+        description="Run a Python script (a model, a benchmark) as `python SCRIPT ARGS` would.",
+    )
+    p.add_argument(
+        "--restart",
+        metavar="FOLDER",
+        default=None,
+        help="continue the run whose results folder is FOLDER from its last restart point "
+        "(also accepted after SCRIPT; default: start afresh)",
+    )
     p.add_argument("script", help="path of the Python script to run")
     p.add_argument("script_args", nargs=argparse.REMAINDER, help="arguments passed on to the script (default: none)")
     p.set_defaults(func=_run)
-    p = sub.add_parser("vtk", help="export a results folder to .vtu files and a .pvd series", formatter_class=_Help,
-                       description="Write one .vtu file per frame and a .pvd series for ParaView (open the .pvd, "
-                                   "apply 'Warp By Vector' with U).")
+    p = sub.add_parser(
+        "vtk",
+        help="export a results folder to .vtu files and a .pvd series",
+        formatter_class=_Help,
+        description="Write one .vtu file per frame and a .pvd series for ParaView (open the .pvd, "
+        "apply 'Warp By Vector' with U).",
+    )
     p.add_argument("results", help="results folder written by an analysis (fm.solve(model, FOLDER))")
-    p.add_argument("--out", default="vtk", help="folder in which a subfolder named after RESULTS gets the "
-                                                 "series (default: vtk, in the working directory)")
+    p.add_argument(
+        "--out",
+        default="vtk",
+        help="folder in which a subfolder named after RESULTS gets the series (default: vtk, in the working directory)",
+    )
     p.add_argument("--every", type=int, default=1, help="write every n-th frame")
     p.set_defaults(func=_vtk)
-    p = sub.add_parser("render", help="render the deformed shape to PNG off-screen", formatter_class=_Help,
-                       description="Render one frame's deformed shape (coloured by |U|, over the undeformed "
-                                   "shape) to a PNG, without a display.  By default the frame of largest "
-                                   "displacement; the output says which frame it drew.")
+    p = sub.add_parser(
+        "render",
+        help="render the deformed shape to PNG off-screen",
+        formatter_class=_Help,
+        description="Render one frame's deformed shape (coloured by |U|, over the undeformed "
+        "shape) to a PNG, without a display.  By default the frame of largest "
+        "displacement; the output says which frame it drew.",
+    )
     p.add_argument("results", help="results folder written by an analysis")
-    p.add_argument("png", nargs="?", default=None,
-                   help="PNG file to write (default: OUT/RESULTSNAME_frameN.png)")
-    p.add_argument("--out", default="render", help="folder of the PNG when no PNG is named (default: render, in "
-                                                   "the working directory)")
-    p.add_argument("--frame", type=_frame_arg, default="max",
-                   help="frame number (negative from the end), 'last', or 'max' for the largest displacement")
+    p.add_argument("png", nargs="?", default=None, help="PNG file to write (default: OUT/RESULTSNAME_frameN.png)")
+    p.add_argument(
+        "--out",
+        default="render",
+        help="folder of the PNG when no PNG is named (default: render, in the working directory)",
+    )
+    p.add_argument(
+        "--frame",
+        type=_frame_arg,
+        default="max",
+        help="frame number (negative from the end), 'last', or 'max' for the largest displacement",
+    )
     p.add_argument("--scale", type=float, default=1.0, help="displacement magnification")
     p.set_defaults(func=_render)
-    p = sub.add_parser("info", help="summarise a results folder", formatter_class=_Help,
-                       description="Frames, nodes, element families and the run summary of a results folder.")
+    p = sub.add_parser(
+        "info",
+        help="summarise a results folder",
+        formatter_class=_Help,
+        description="Frames, nodes, element families and the run summary of a results folder.",
+    )
     p.add_argument("results", help="results folder written by an analysis")
     p.set_defaults(func=_info)
-    p = sub.add_parser("warmup", help="compile every femast kernel now (for CI images and cluster workers)",
-                       formatter_class=_Help,
-                       description="Compile femast's numba kernels into numba's on-disk cache by running small "
-                                   "models of every element family, so that the first real run does not wait "
-                                   "for the compiler.  Quick when the cache is already written.")
+    p = sub.add_parser(
+        "warmup",
+        help="compile every femast kernel now (for CI images and cluster workers)",
+        formatter_class=_Help,
+        description="Compile femast's numba kernels into numba's on-disk cache by running small "
+        "models of every element family, so that the first real run does not wait "
+        "for the compiler.  Quick when the cache is already written.",
+    )
     p.set_defaults(func=_warmup)
     try:
         from .cli_experiments import register  # compare / diagnose (issue 7), when present
@@ -174,13 +220,14 @@ def build_parser() -> argparse.ArgumentParser:
         register = None
     if register is not None:
         register(sub, _Help)
-    from .studies.cli import register as register_study   # femast study (issue 20)
+    from .studies.cli import register as register_study  # femast study (issue 20)
 
     register_study(sub, _Help)
     for name, sp in sub.choices.items():  # --quiet also after the command (SUPPRESS: keeps the main one's value)
         if name != "run":
-            sp.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS,
-                            help="no progress bars or first-run notices")
+            sp.add_argument(
+                "--quiet", action="store_true", default=argparse.SUPPRESS, help="no progress bars or first-run notices"
+            )
     return parser
 
 
@@ -211,6 +258,7 @@ def _one_line_warnings(python_format):
     """A ``warnings.formatwarning`` that shows femast's own warnings (a partial frame in a results
     folder, a data file's oddity, a large stabilisation energy) as one line for a command's user,
     ``femast: warning: ...``, without the source line that raised it; others as ``python_format``."""
+
     def format_warning(message, category, filename, lineno, line=None):
         if category.__module__.startswith("femast"):
             return f"femast: warning: {message}\n"
@@ -265,7 +313,7 @@ def _guarded(func, args, debug=False) -> int:
     except BrokenPipeError:
         _silence_stdout()
         return 1
-    return code if isinstance(code, int) else 0   # a command may return its own exit code (femast study: 3)
+    return code if isinstance(code, int) else 0  # a command may return its own exit code (femast study: 3)
 
 
 def _silence_stdout():
@@ -298,8 +346,10 @@ def error_line(exc: BaseException, script=None) -> str:
         if mine:
             where = f"{script} line {mine[-1][1]}: "
     msg = str(exc).splitlines()[0] if str(exc) else ""
-    return (f"{where}{type(exc).__name__}{': ' + msg if msg else ''} (not a femast error: rerun with "
-            "--debug for the traceback, and report it if the input looks right)")
+    return (
+        f"{where}{type(exc).__name__}{': ' + msg if msg else ''} (not a femast error: rerun with "
+        "--debug for the traceback, and report it if the input looks right)"
+    )
 
 
 if __name__ == "__main__":

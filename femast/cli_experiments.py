@@ -47,8 +47,12 @@ def _first_sentence(text: str) -> str:
     """The first sentence of ``text`` on one line."""
     text = " ".join((text or "").split())
     for i in range(len(text) - 1):
-        if text[i] == "." and text[i + 1] == " " and not text[max(0, i - 3):i].endswith(("Eq", "Sec", "e.g", "i.e", "Fig", "Eqs", "Tab")):
-            return text[:i + 1]
+        if (
+            text[i] == "."
+            and text[i + 1] == " "
+            and not text[max(0, i - 3) : i].endswith(("Eq", "Sec", "e.g", "i.e", "Fig", "Eqs", "Tab"))
+        ):
+            return text[: i + 1]
     return text
 
 
@@ -58,9 +62,16 @@ def experiment_rows() -> list[dict]:
     from .effects import applicable_effects
     from .experiments import list_experiments
 
-    return [{"name": e.name, "title": e.title, "physics": _first_sentence(e.doc) if e.doc else e.title,
-             "example": examples.BY_EXPERIMENT.get(e.name),
-             "effects": [f.name for f in applicable_effects(e)]} for e in list_experiments()]
+    return [
+        {
+            "name": e.name,
+            "title": e.title,
+            "physics": _first_sentence(e.doc) if e.doc else e.title,
+            "example": examples.BY_EXPERIMENT.get(e.name),
+            "effects": [f.name for f in applicable_effects(e)],
+        }
+        for e in list_experiments()
+    ]
 
 
 def effect_rows(experiment=None) -> list[dict]:
@@ -73,8 +84,15 @@ def effect_rows(experiment=None) -> list[dict]:
         exps = [n for n in e.implementations if e.applies_to(n)]
         if experiment is not None and experiment not in exps:
             continue
-        rows.append({"name": e.name, "title": e.title, "physics": _first_sentence(e.physics), "experiments": exps,
-                     "seed": e.seed})
+        rows.append(
+            {
+                "name": e.name,
+                "title": e.title,
+                "physics": _first_sentence(e.physics),
+                "experiments": exps,
+                "seed": e.seed,
+            }
+        )
     return rows
 
 
@@ -189,59 +207,100 @@ def register(subparsers, fmt=None) -> None:
     exps = ", ".join(e.name for e in list_experiments())
     effs = ", ".join(e.name for e in list_effects())
     kw = {"formatter_class": fmt} if fmt else {}
-    exp_help = (f"built-in experiment ({exps}; `femast experiments` says what each is) or the path of a Python "
-                "script defining `experiment`")
-    data_help = ("measured data, a CSV file with a header row (formats: `femast experiments`, docs/experiments.md), "
-                 "or 'example' for the example shipped with femast")
+    exp_help = (
+        f"built-in experiment ({exps}; `femast experiments` says what each is) or the path of a Python "
+        "script defining `experiment`"
+    )
+    data_help = (
+        "measured data, a CSV file with a header row (formats: `femast experiments`, docs/experiments.md), "
+        "or 'example' for the example shipped with femast"
+    )
     out_help = "output folder (default: ./%(prog_cmd)s/EXPERIMENT_DATASTEM in the working directory)"
     p = subparsers.add_parser(
-        "compare", help="run a model along measured data and show where it fails", **kw,
+        "compare",
+        help="run a model along measured data and show where it fails",
+        **kw,
         description="Run the model of EXPERIMENT along the measured path of DATA (fitting its parameters "
-                    "with --fit); print the overall and per-channel RMS error, the noise floor and the worst "
-                    "segments of the path; write compare.png, compare.json and append to history.jsonl in the "
-                    "output folder.  Example: femast compare mast-top example --fit")
+        "with --fit); print the overall and per-channel RMS error, the noise floor and the worst "
+        "segments of the path; write compare.png, compare.json and append to history.jsonl in the "
+        "output folder.  Example: femast compare mast-top example --fit",
+    )
     p.add_argument("experiment", help=exp_help)
     p.add_argument("data", help=data_help)
-    p.add_argument("--effects", default=None, help=f"comma-separated effects to switch on: names ({effs}; "
-                                                   "`femast effects EXPERIMENT`), SCRIPT.py or SCRIPT.py:name "
-                                                   "(default: none)")
-    p.add_argument("--fit", action="store_true", help="fit the model and effect parameters (default: run with "
-                                                      "the default parameters)")
+    p.add_argument(
+        "--effects",
+        default=None,
+        help=f"comma-separated effects to switch on: names ({effs}; "
+        "`femast effects EXPERIMENT`), SCRIPT.py or SCRIPT.py:name "
+        "(default: none)",
+    )
+    p.add_argument(
+        "--fit",
+        action="store_true",
+        help="fit the model and effect parameters (default: run with the default parameters)",
+    )
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "compare"})
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.set_defaults(func=_compare)
     p = subparsers.add_parser(
-        "diagnose", help="rank the physical effects the model may be missing", **kw,
+        "diagnose",
+        help="rank the physical effects the model may be missing",
+        **kw,
         description="Fit the model of EXPERIMENT, refit it with each applicable candidate effect (in parallel), "
-                    "rank them by BIC and conclude: the missing effect, 'nothing is missing' or 'none of the "
-                    "candidates explains this'. Writes diagnose.png and diagnose.json in the output folder.  "
-                    "Example: femast diagnose mast-top example")
+        "rank them by BIC and conclude: the missing effect, 'nothing is missing' or 'none of the "
+        "candidates explains this'. Writes diagnose.png and diagnose.json in the output folder.  "
+        "Example: femast diagnose mast-top example",
+    )
     p.add_argument("experiment", help=exp_help)
     p.add_argument("data", help=data_help)
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "diagnose"})
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
-    p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all CPUs, or "
-                                                              "none when the refits are quick)")
-    p.add_argument("--scheduler", default=None, help="dask.distributed scheduler address tcp://host:port "
-                                                     "(default: local processes)")
-    p.add_argument("--effects", default=None, help="comma-separated effects already in the model being "
-                                                   "diagnosed (default: none)")
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="local worker processes (default: all CPUs, or none when the refits are quick)",
+    )
+    p.add_argument(
+        "--scheduler",
+        default=None,
+        help="dask.distributed scheduler address tcp://host:port (default: local processes)",
+    )
+    p.add_argument(
+        "--effects", default=None, help="comma-separated effects already in the model being diagnosed (default: none)"
+    )
     p.set_defaults(func=_diagnose)
-    p = subparsers.add_parser("experiments", help="list the experiments compare/diagnose know, one line each", **kw,
-                              description="List every registered experiment with what it models, its shipped "
-                                          "example data and the effects implemented for it.")
+    p = subparsers.add_parser(
+        "experiments",
+        help="list the experiments compare/diagnose know, one line each",
+        **kw,
+        description="List every registered experiment with what it models, its shipped "
+        "example data and the effects implemented for it.",
+    )
     p.add_argument("--json", action="store_true", help="print a JSON list instead of text")
     p.set_defaults(func=_experiments)
-    p = subparsers.add_parser("effects", help="list the physical effects (all, or those of one experiment)", **kw,
-                              description="List the registered effects with one sentence of physics each and "
-                                          "the experiments they are implemented for.")
-    p.add_argument("experiment", nargs="?", default=None,
-                   help=f"only the effects implemented for this experiment ({exps}; default: all)")
+    p = subparsers.add_parser(
+        "effects",
+        help="list the physical effects (all, or those of one experiment)",
+        **kw,
+        description="List the registered effects with one sentence of physics each and "
+        "the experiments they are implemented for.",
+    )
+    p.add_argument(
+        "experiment",
+        nargs="?",
+        default=None,
+        help=f"only the effects implemented for this experiment ({exps}; default: all)",
+    )
     p.add_argument("--json", action="store_true", help="print a JSON list instead of text")
     p.set_defaults(func=_effects)
-    p = subparsers.add_parser("examples", help="list the example data shipped with femast", **kw,
-                              description="List the example data files installed with femast (usable as "
-                                          "'example' in compare/diagnose, or femast.examples.path(NAME) in "
-                                          "Python).")
+    p = subparsers.add_parser(
+        "examples",
+        help="list the example data shipped with femast",
+        **kw,
+        description="List the example data files installed with femast (usable as "
+        "'example' in compare/diagnose, or femast.examples.path(NAME) in "
+        "Python).",
+    )
     p.add_argument("--copy", metavar="DIR", default=None, help="copy them to folder DIR (default: only list them)")
     p.set_defaults(func=_examples)

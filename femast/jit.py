@@ -29,7 +29,7 @@ import time
 # cold compile CPU time of the main kernels, s (numba 0.68, one core of the development machine,
 # recorded with numba's compile events; benchmarks/cold_start.py measures the whole first run).
 COMPILE_S = {
-    "femast.elements.beam_corot.beam_family_kernel": 8.5,   # 11-12 s before the end loops (issue 17)
+    "femast.elements.beam_corot.beam_family_kernel": 8.5,  # 11-12 s before the end loops (issue 17)
     "femast.analysis.configuration.update_configuration": 1.9,
     "femast.rotations.apply_spins": 1.0,
     "femast.analysis.solvers.convergence.force_moment_abs_max": 0.9,
@@ -43,7 +43,7 @@ _installed = False
 # Python on inputs up to this many items: a small model then never compiles them (nor queues them
 # for the background compile, which would delay the element kernels' compile), at a few ms of
 # Python; larger inputs call the compiled kernel.
-SETUP_PYTHON_MAX = 20_000   # inner-loop iterations (~10 ms of Python)
+SETUP_PYTHON_MAX = 20_000  # inner-loop iterations (~10 ms of Python)
 
 
 # Set-up kernels that return new arrays computed from their arguments alone and write none of them
@@ -51,11 +51,10 @@ SETUP_PYTHON_MAX = 20_000   # inner-loop iterations (~10 ms of Python)
 # arguments, so a process that builds the same small model again and again (the FE fits of
 # femast.experiments: 50-60 runs of one bay in a diagnosis) computes its pattern once (issue 21:
 # the bay's assembly pattern is 12 ms of its 82 ms per run in Python).
-MEMO_KERNELS = frozenset({"femast.analysis.assembly._pattern_kernel",
-                          "femast.analysis.solvers.ordering._permuted_csc"})
+MEMO_KERNELS = frozenset({"femast.analysis.assembly._pattern_kernel", "femast.analysis.solvers.ordering._permuted_csc"})
 MEMO_ENTRIES = 16
 _MEMO: dict = {}
-_MEMO_LOCK = threading.Lock()   # (models built in threads: a Study on dask threads)
+_MEMO_LOCK = threading.Lock()  # (models built in threads: a Study on dask threads)
 
 
 def _memo_key(kernel, args):
@@ -99,7 +98,7 @@ def setup_call(kernel, n_items: int, *args):
         kept = _copy_result(hit)
         with _MEMO_LOCK:
             while _MEMO and len(_MEMO) >= MEMO_ENTRIES:
-                _MEMO.pop(next(iter(_MEMO)))   # the oldest entry
+                _MEMO.pop(next(iter(_MEMO)))  # the oldest entry
             _MEMO[key] = kept
         return hit
     return _copy_result(hit)
@@ -159,11 +158,18 @@ def _announce(background: bool = False) -> None:
         return
     est = max(estimate_s(uncached()), 1.0)
     if background:
-        print(f"femast: compiling femast kernels in a background process, first run only, ~{est:.0f} s; "
-              "small analyses run uncompiled meanwhile (`femast warmup` compiles ahead)", file=sys.stderr, flush=True)
+        print(
+            f"femast: compiling femast kernels in a background process, first run only, ~{est:.0f} s; "
+            "small analyses run uncompiled meanwhile (`femast warmup` compiles ahead)",
+            file=sys.stderr,
+            flush=True,
+        )
     else:
-        print(f"femast: compiling femast kernels, first run only, ~{est:.0f} s (`femast warmup` does it ahead)",
-              file=sys.stderr, flush=True)
+        print(
+            f"femast: compiling femast kernels, first run only, ~{est:.0f} s (`femast warmup` does it ahead)",
+            file=sys.stderr,
+            flush=True,
+        )
 
 
 def _on_compile(event):
@@ -258,15 +264,19 @@ def _warm_laws():
     proportional_play(x, 0.1)
 
 
-PARTS = (("core: beams, trusses, solver", _warm_core), ("ADAM bay: cables, latches, ball joints", _warm_adam),
-         ("guyed mast: shroud cables", _warm_guyed), ("latch law and effect operators", _warm_laws))
+PARTS = (
+    ("core: beams, trusses, solver", _warm_core),
+    ("ADAM bay: cables, latches, ball joints", _warm_adam),
+    ("guyed mast: shroud cables", _warm_guyed),
+    ("latch law and effect operators", _warm_laws),
+)
 
 
 def warmup(report=print) -> float:
     """Compile (or load from the cache) every femast kernel in this process; returns the wall time, s."""
     t_all = time.perf_counter()
     before = os.environ.get("FEMAST_BACKGROUND_COMPILE")
-    os.environ["FEMAST_BACKGROUND_COMPILE"] = "0"     # compile here, not in a background worker
+    os.environ["FEMAST_BACKGROUND_COMPILE"] = "0"  # compile here, not in a background worker
     try:
         for what, fn in PARTS:
             t0 = time.perf_counter()

@@ -48,15 +48,15 @@ from pathlib import Path
 
 import numpy as np
 
-INTERPRET_MAX_ITEMS = 20_000   # array items in a call's arguments above which it is not interpreted
-INTERPRET_MAX_S = 0.1          # an interpreted call slower than this (s): later calls wait for the worker
-_POLL_S = 0.02                 # s between checks while waiting for the worker
+INTERPRET_MAX_ITEMS = 20_000  # array items in a call's arguments above which it is not interpreted
+INTERPRET_MAX_S = 0.1  # an interpreted call slower than this (s): later calls wait for the worker
+_POLL_S = 0.02  # s between checks while waiting for the worker
 _DEBUG = os.environ.get("FEMAST_JIT_DEBUG", "") not in ("", "0")
 
-_hooked: dict[int, "_Hook"] = {}
+_hooked: dict[int, _Hook] = {}
 _interpreted: dict[int, object] = {}
 _worker: subprocess.Popen | None = None
-_announce = None               # callable(str) printing the one notice (set by femast.jit)
+_announce = None  # callable(str) printing the one notice (set by femast.jit)
 
 
 def mode() -> str:
@@ -92,8 +92,10 @@ def _python_equivalents():
 
     from .elements._stack import stack_buffer
 
-    return {id(stack_buffer): lambda n: np.empty(n),          # scratch, written before it is read
-            id(numba.carray): lambda buf, shape: buf.reshape(shape)}
+    return {
+        id(stack_buffer): lambda n: np.empty(n),  # scratch, written before it is read
+        id(numba.carray): lambda buf, shape: buf.reshape(shape),
+    }
 
 
 def interpreted(dispatcher):
@@ -109,7 +111,7 @@ def interpreted(dispatcher):
     g = dict(f.__globals__)
     equivalents = _python_equivalents()
     out = pytypes.FunctionType(f.__code__, g, f.__name__, f.__defaults__, f.__closure__)
-    _interpreted[key] = out   # before the recursion: a kernel may call itself
+    _interpreted[key] = out  # before the recursion: a kernel may call itself
     for name, value in list(g.items()):
         if isinstance(value, CPUDispatcher):
             g[name] = interpreted(value)
@@ -166,11 +168,17 @@ def _start_worker() -> subprocess.Popen:
     global _worker
     if _worker is not None and _worker.poll() is None:
         return _worker
-    root = str(Path(__file__).resolve().parents[1])   # the folder holding this femast package
+    root = str(Path(__file__).resolve().parents[1])  # the folder holding this femast package
     env = dict(os.environ, FEMAST_BACKGROUND_COMPILE="0", FEMAST_QUIET="1")
     env["PYTHONPATH"] = os.pathsep.join([root] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p])
-    _worker = subprocess.Popen([sys.executable, "-m", "femast.jit_background"], stdin=subprocess.PIPE,
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, text=True)
+    _worker = subprocess.Popen(
+        [sys.executable, "-m", "femast.jit_background"],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        env=env,
+        text=True,
+    )
     atexit.register(_let_worker_finish, _worker)
     return _worker
 
@@ -191,8 +199,14 @@ def _request(dispatcher, sig, claim: str) -> bool:
     try:
         worker = _start_worker()
         Path(claim).write_text(str(worker.pid))
-        line = json.dumps({"module": dispatcher.py_func.__module__, "name": dispatcher.py_func.__name__,
-                           "sig": base64.b64encode(pickle.dumps(sig)).decode(), "claim": claim})
+        line = json.dumps(
+            {
+                "module": dispatcher.py_func.__module__,
+                "name": dispatcher.py_func.__name__,
+                "sig": base64.b64encode(pickle.dumps(sig)).decode(),
+                "claim": claim,
+            }
+        )
         worker.stdin.write(line + "\n")
         worker.stdin.flush()
     except (OSError, pickle.PicklingError, ValueError):
@@ -208,8 +222,8 @@ class _Hook:
         self.dispatcher = dispatcher
         self.original = dispatcher._compile_for_args
         self.index = _index_path(dispatcher)
-        self.last_s = 0.0          # duration of the last interpreted call, s
-        self.requested = set()     # claims this process has queued
+        self.last_s = 0.0  # duration of the last interpreted call, s
+        self.requested = set()  # claims this process has queued
 
     def __call__(self, *args, **kws):
         d = self.dispatcher
@@ -225,13 +239,13 @@ class _Hook:
         claim = _claim_path(self.index, sig)
         if not _claimed(claim):
             if os.path.exists(self.index) or claim in self.requested:
-                return self.original(*args)      # on disk now (or the worker failed): load or compile
+                return self.original(*args)  # on disk now (or the worker failed): load or compile
             if not _request(d, sig, claim):
                 return self.original(*args)
             self.requested.add(claim)
             _notice()
         if _n_items(args) > INTERPRET_MAX_ITEMS or self.last_s > INTERPRET_MAX_S:
-            return self._compiled_now(args, claim)   # too big to interpret
+            return self._compiled_now(args, claim)  # too big to interpret
         return self._run_interpreted
 
     def _compiled_now(self, args, claim):
@@ -258,14 +272,17 @@ class _Hook:
         return self.original(*args)
 
     def _run_interpreted(self, *args):
-        t0 = time.process_time()    # CPU time: a loaded machine must not make a small model wait
+        t0 = time.process_time()  # CPU time: a loaded machine must not make a small model wait
         try:
             return interpreted(self.dispatcher)(*args)
         finally:
             self.last_s = time.process_time() - t0
             if _DEBUG:
-                print(f"jit_background: {self.dispatcher.py_func.__name__} interpreted in {self.last_s:.4f} s "
-                      f"({_n_items(args)} items)", file=sys.stderr)
+                print(
+                    f"jit_background: {self.dispatcher.py_func.__name__} interpreted in {self.last_s:.4f} s "
+                    f"({_n_items(args)} items)",
+                    file=sys.stderr,
+                )
 
 
 def _notice():
@@ -273,7 +290,7 @@ def _notice():
         _announce()
 
 
-_installed_for = None   # the loaded femast modules at the last install (nothing new: no scan)
+_installed_for = None  # the loaded femast modules at the last install (nothing new: no scan)
 
 
 def install() -> int:
@@ -283,8 +300,9 @@ def install() -> int:
     global _installed_for
     if not enabled():
         return 0
-    loaded = frozenset((name, id(mod)) for name, mod in list(sys.modules.items())
-                       if name.startswith("femast") and mod is not None)
+    loaded = frozenset(
+        (name, id(mod)) for name, mod in list(sys.modules.items()) if name.startswith("femast") and mod is not None
+    )
     if loaded == _installed_for:
         return len(_hooked)
     from .jit import _dispatchers
@@ -347,8 +365,14 @@ def _compile(req) -> None:
         pass
     finally:
         _remove(claim)
-        _log({"kernel": f"{req['module']}.{req['name']}", "ok": ok, "cpu_s": time.process_time() - c0,
-              "wall_s": time.perf_counter() - t0})
+        _log(
+            {
+                "kernel": f"{req['module']}.{req['name']}",
+                "ok": ok,
+                "cpu_s": time.process_time() - c0,
+                "wall_s": time.perf_counter() - t0,
+            }
+        )
 
 
 def _log(record: dict) -> None:

@@ -107,13 +107,13 @@ class LatchParameters:
     R: float = 2.4e-3
 
     @classmethod
-    def seed_fit(cls) -> "LatchParameters":
+    def seed_fit(cls) -> LatchParameters:
         """The fit of seed 001, Section III.C: r = 1.1 mm, x_backstop = 2.0 mm,
         k = 100 N/mm, mu = 0.07, h = 1.5 mm, R = 2.4 mm (returned in SI)."""
         return cls(r=1.1e-3, x_backstop=2.0e-3, k=100e3, mu=0.07, h=1.5e-3, R=2.4e-3)
 
     @classmethod
-    def from_mm(cls, r, x_backstop, k, mu, h, R) -> "LatchParameters":
+    def from_mm(cls, r, x_backstop, k, mu, h, R) -> LatchParameters:
         """Build from lengths in mm and k in N/mm (the seed's units)."""
         return cls(r=r * 1e-3, x_backstop=x_backstop * 1e-3, k=k * 1e3, mu=mu, h=h * 1e-3, R=R * 1e-3)
 
@@ -126,7 +126,7 @@ class LatchParameters:
         """x_contact = sqrt((r+R)^2 - (h+r)^2), m: rollers touch the bead for |x| < x_contact (Eq. 6)."""
         return contact_half_width(self)
 
-    def validate(self, where: str = "latch") -> "LatchParameters":
+    def validate(self, where: str = "latch") -> LatchParameters:
         """Raise :class:`ModelError` if the parameters cannot describe a working latch."""
         validate_latch_array(self.as_array(), where)
         return self

@@ -87,8 +87,18 @@ def remove_cable_stretch(d, T, EA, L_cable, d0=0.0, sign=1):
     return sign * (d - T * L_cable / EA - d0)
 
 
-def simulate_pull_test(params=None, direction=UNLATCHING, *, EA=2.0e5, L_cable=0.5, L_other=0.3,
-                       slack=0.02, n_steps=300, x_far=4e-3, T_max=None) -> PullTest:
+def simulate_pull_test(
+    params=None,
+    direction=UNLATCHING,
+    *,
+    EA=2.0e5,
+    L_cable=0.5,
+    L_other=0.3,
+    slack=0.02,
+    n_steps=300,
+    x_far=4e-3,
+    T_max=None,
+) -> PullTest:
     """Quasi-static pull test computed with the cable/latch element (exact, noise-free).
 
     The loaded cable (unstretched length L_cable, m, rigidity EA, N) is pulled by a grip
@@ -99,8 +109,13 @@ def simulate_pull_test(params=None, direction=UNLATCHING, *, EA=2.0e5, L_cable=0
     with the Eq. 15 constants of the rig (so that ``bead_position`` inverts it up to the
     length change of the loaded cable, T (x - x_start) / EA).
     """
-    p = params if isinstance(params, LatchParameters) else LatchParameters.seed_fit() if params is None \
+    p = (
+        params
+        if isinstance(params, LatchParameters)
+        else LatchParameters.seed_fit()
+        if params is None
         else LatchParameters(*np.asarray(params, float))
+    )
     p.validate("simulate_pull_test")
     xg = np.linspace(-p.x_backstop, contact_half_width(p), 2001)
     peak = max(np.abs(latch_force(xg, LATCHING, p)).max(), np.abs(latch_force(xg, UNLATCHING, p)).max())
@@ -122,8 +137,7 @@ def simulate_pull_test(params=None, direction=UNLATCHING, *, EA=2.0e5, L_cable=0
         grip, d_end = 0, L_cable + (x0 + p.x_backstop) + T_max * L_cable / EA + 1e-3
     else:
         raise ModelError("simulate_pull_test: direction must be +1 (unlatching) or -1 (latching)")
-    fam = CableLatchFamily(np.array([[0, 1, 2]]), EA=EA, L0=L0, latch_node=1, bead=Lb, latch=p, x0=x0,
-                           name="pull_test")
+    fam = CableLatchFamily(np.array([[0, 1, 2]]), EA=EA, L0=L0, latch_node=1, bead=Lb, latch=p, x0=x0, name="pull_test")
     st = fam.initial_state()
     sec = 1 if direction == UNLATCHING else 0
     d_all = np.linspace(abs(X[grip, 0]), d_end, n_steps)
@@ -139,8 +153,16 @@ def simulate_pull_test(params=None, direction=UNLATCHING, *, EA=2.0e5, L_cable=0
         if direction == LATCHING and T >= T_max:
             break
     d0 = L0 - Lb if direction == UNLATCHING else Lb
-    return PullTest(d=np.array(d_out), T=np.array(T_out), direction=int(direction), EA=EA,
-                    L_cable=L_cable, d0=d0, sign=int(direction), x_true=np.array(x_out))
+    return PullTest(
+        d=np.array(d_out),
+        T=np.array(T_out),
+        direction=int(direction),
+        EA=EA,
+        L_cable=L_cable,
+        d0=d0,
+        sign=int(direction),
+        x_true=np.array(x_out),
+    )
 
 
 def _graph_residuals(theta, x, dT, sig, h, R, sigma_T, sigma_x):
@@ -181,8 +203,9 @@ def initial_guess(x, dT, h, R, noise_T=1.0):
     return np.array([r, xb, k, 0.05])
 
 
-def fit_latch(x, dT, direction, *, h, R, p0=None, sigma_T=0.5, sigma_x=1e-5, bounds=None,
-              **least_squares_kw) -> OptimizeResult:
+def fit_latch(
+    x, dT, direction, *, h, R, p0=None, sigma_T=0.5, sigma_x=1e-5, bounds=None, **least_squares_kw
+) -> OptimizeResult:
     """Fit r, x_backstop, k, mu of the latch law (Eq. 14) to (x_i, dT_i) data.
 
     x : bead positions, m (stretch removed, Eq. 15).  dT : force jumps, N.
@@ -241,10 +264,22 @@ def fit_latch(x, dT, direction, *, h, R, p0=None, sigma_T=0.5, sigma_x=1e-5, bou
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(stderr, stderr)
     return OptimizeResult(
-        x=theta, stderr=stderr, cov=cov, corr=corr, names=FIT_NAMES,
+        x=theta,
+        stderr=stderr,
+        cov=cov,
+        corr=corr,
+        names=FIT_NAMES,
         params=LatchParameters(r=theta[0], x_backstop=theta[1], k=theta[2], mu=theta[3], h=h, R=R),
-        success=bool(sol.success), status=sol.status, message=sol.message + msg_cov, nfev=sol.nfev,
-        cost=sol.cost, fun=sol.fun, jac=J, chi2_reduced=chi2, n_points=m, p0=p0,
+        success=bool(sol.success),
+        status=sol.status,
+        message=sol.message + msg_cov,
+        nfev=sol.nfev,
+        cost=sol.cost,
+        fun=sol.fun,
+        jac=J,
+        chi2_reduced=chi2,
+        n_points=m,
+        p0=p0,
         active_mask=sol.active_mask,
     )
 

@@ -33,8 +33,8 @@ import os
 import re
 
 ENV = "FEMAST_NUMBA_CACHE_GUARD"
-TREE_STAMP = "__femast_tree__.stamp"   # in the cache directory of the package's __init__.py
-DEPS_SUFFIX = ".femast-deps"           # beside a module's cache files: <stem>.femast-deps
+TREE_STAMP = "__femast_tree__.stamp"  # in the cache directory of the package's __init__.py
+DEPS_SUFFIX = ".femast-deps"  # beside a module's cache files: <stem>.femast-deps
 
 
 def _py_files(root: str) -> list[str]:
@@ -89,7 +89,7 @@ def _import_nodes(text: str) -> list[ast.stmt]:
     for m in _IMPORT.finditer(text):
         try:
             out.extend(ast.parse(m.group(1)).body)
-        except SyntaxError:   # an "import ..." line of a docstring
+        except SyntaxError:  # an "import ..." line of a docstring
             continue
     return out
 
@@ -113,7 +113,7 @@ def _imports(text: str, modname: str, is_package: bool) -> set[str]:
                 out.add(a.name)
         elif isinstance(node, ast.ImportFrom):
             if node.level:
-                base = pkg_parts[:len(pkg_parts) - (node.level - 1)]
+                base = pkg_parts[: len(pkg_parts) - (node.level - 1)]
                 if node.module:
                     base = base + node.module.split(".")
                 base_name = ".".join(base)
@@ -183,7 +183,7 @@ def cache_dir(py_file: str) -> str | None:
         ns: dict = {}
         exec(code, ns)
         return CompileResultCacheImpl(ns["_f"]).locator.get_cache_path()
-    except Exception:   # no locator (read-only install), an unusual numba: skip quietly
+    except Exception:  # no locator (read-only install), an unusual numba: skip quietly
         return None
 
 
@@ -200,7 +200,7 @@ def _write(path: str, text: str) -> None:
     try:
         with open(tmp, "w", encoding="ascii") as fh:
             fh.write(text + "\n")
-        os.replace(tmp, path)   # atomic: a concurrent reader sees the old or the new stamp
+        os.replace(tmp, path)  # atomic: a concurrent reader sees the old or the new stamp
     except OSError:
         try:
             os.remove(tmp)
@@ -216,8 +216,9 @@ def cache_files(directory: str, py_file: str) -> list[str]:
         names = os.listdir(directory)
     except OSError:
         return []
-    return [os.path.join(directory, n) for n in names
-            if n.startswith(prefix) and (n.endswith(".nbi") or n.endswith(".nbc"))]
+    return [
+        os.path.join(directory, n) for n in names if n.startswith(prefix) and (n.endswith(".nbi") or n.endswith(".nbc"))
+    ]
 
 
 def check(root: str | None = None, package: str | None = None) -> list[str]:
@@ -252,7 +253,7 @@ def check(root: str | None = None, package: str | None = None) -> list[str]:
             try:
                 os.remove(c)
                 deleted.append(c)
-            except OSError:   # deleted by another process meanwhile, or not ours to delete
+            except OSError:  # deleted by another process meanwhile, or not ours to delete
                 pass
         _write(record, new)
     _write(stamp_file, tree)

@@ -52,8 +52,7 @@ def _bar(**kw):
 @contextlib.contextmanager
 def task(desc: str, unit: str = "evaluations"):
     """A bar counting the :func:`tick` calls made inside the ``with`` block (innermost task gets them)."""
-    bar = _bar(desc=desc, unit=f" {unit}", total=None,
-               bar_format="{desc}: {n_fmt}{unit} [{elapsed}]{postfix}")
+    bar = _bar(desc=desc, unit=f" {unit}", total=None, bar_format="{desc}: {n_fmt}{unit} [{elapsed}]{postfix}")
     entry = (bar, {})
     _ACTIVE.append(entry)
     try:

@@ -30,7 +30,7 @@ def run_python_blocks(page: str, cwd=None) -> str:
             tee = _Tee(sys.stdout, buf)
             with contextlib.redirect_stdout(tee):
                 exec(compile(m.group(1), f"{page}[{i}]", "exec"), {"__name__": "__doc_example__"})
-            quoted = quoted_output(text[m.end():])
+            quoted = quoted_output(text[m.end() :])
             if quoted is not None:
                 check_output(quoted, buf.getvalue(), f"{page}, example {i + 1}")
     finally:
@@ -118,7 +118,7 @@ def _same_line(quoted: str, printed: str) -> bool:
         return False
     tol = [3 * _ulp(a) for a in q]
     for m in re.finditer(r"(" + _NUMBER.pattern + r")\s*\+-\s*(" + _NUMBER.pattern + r")", quoted):
-        k = len(_NUMBER.findall(quoted[:m.start()]))  # index of V among the line's numbers
+        k = len(_NUMBER.findall(quoted[: m.start()]))  # index of V among the line's numbers
         tol[k] = max(tol[k], 0.1 * abs(float(q[k + 1])))
     return all(abs(float(a) - float(b)) <= t for a, b, t in zip(q, p, tol))
 
@@ -128,8 +128,9 @@ def quoted_in(quoted: str, out: str) -> bool:
     to what :func:`_same_line` allows -- never compared as text."""
     parts = _NUMBER.split(quoted)
     nums = _NUMBER.findall(quoted)
-    pattern = "".join(re.escape(t) + ("(" + _NUMBER.pattern + ")" if i < len(nums) else "")
-                      for i, t in enumerate(parts))
+    pattern = "".join(
+        re.escape(t) + ("(" + _NUMBER.pattern + ")" if i < len(nums) else "") for i, t in enumerate(parts)
+    )
     for m in re.finditer(pattern, out):
         if _same_line(quoted, m.group(0)):
             return True
@@ -159,7 +160,7 @@ def replay_transcript(block: str, folder, capsys, ignore=lambda line: False, wha
                 assert main(cmd[1:]) == 0, line
                 out = capsys.readouterr().out
             elif cmd[0] == "head":
-                out = "".join((Path(folder) / cmd[-1]).read_text().splitlines(True)[:int(cmd[1][1:])])
+                out = "".join((Path(folder) / cmd[-1]).read_text().splitlines(True)[: int(cmd[1][1:])])
             continue
         if line.strip() and not ignore(line):
             assert _printed(line.rstrip(), out), f"{what} quotes a line the command does not print:\n{line}"
@@ -197,8 +198,8 @@ def printed_in(quoted: str, out: str, ulps: float = 3.0) -> bool:
         sl = _NUMBER.sub("#", line)
         start = sl.find(sq)
         while start >= 0:
-            k = sl[:start].count("#")   # numbers of the line before the fragment
-            got = [float(m.group()) for m in tokens[k:k + len(qn)]]
+            k = sl[:start].count("#")  # numbers of the line before the fragment
+            got = [float(m.group()) for m in tokens[k : k + len(qn)]]
             if len(got) == len(qn) and all(abs(a - b) <= ulps * u * (1 + 1e-9) for a, b, u in zip(qn, got, qu)):
                 return True
             start = sl.find(sq, start + 1)

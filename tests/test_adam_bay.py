@@ -14,9 +14,15 @@ from scipy.optimize import brentq, minimize
 import femast as fm
 from femast.adam import BayParameters, build_bay, build_mast, eq1_height, eq1_twist
 from femast.adam.post import bay_curve, release_angles, write_curve_csv
-from femast.adam.steps import (CONVERGENCE, MeasuredPath, add_idealised_torsion, add_initial_steps,
-                               add_measured_torsion, measured_style_path)
-from femast.latch import LatchParameters, ZONE_BACKSTOP, ZONE_FREE
+from femast.adam.steps import (
+    CONVERGENCE,
+    MeasuredPath,
+    add_idealised_torsion,
+    add_initial_steps,
+    add_measured_torsion,
+    measured_style_path,
+)
+from femast.latch import ZONE_BACKSTOP, ZONE_FREE, LatchParameters
 
 P = BayParameters()
 
@@ -26,10 +32,10 @@ def test_eq1_closed_form_and_inverse():
     b, l = 0.25, 0.171
     th = np.linspace(0.0, math.acos(1 - l * l / b / b), 7)
     h = eq1_height(th, b, l)
-    assert h[0] == pytest.approx(l, rel=1e-15)          # deployed: h = l (exact arithmetic)
-    assert h[-1] == pytest.approx(0.0, abs=1e-7)         # stowed: h = 0 (round-off of the arccos)
+    assert h[0] == pytest.approx(l, rel=1e-15)  # deployed: h = l (exact arithmetic)
+    assert h[-1] == pytest.approx(0.0, abs=1e-7)  # stowed: h = 0 (round-off of the arccos)
     assert np.allclose(eq1_twist(h, b, l), th, atol=1e-7)  # inverse; arccos near 1 loses half the digits
-    assert np.isnan(eq1_height(1.2, b, l))               # beyond the stowed angle
+    assert np.isnan(eq1_height(1.2, b, l))  # beyond the stowed angle
 
 
 def test_stowing_with_stiff_members_follows_eq1(tmp_path):
@@ -53,18 +59,21 @@ def test_stowing_with_stiff_members_follows_eq1(tmp_path):
 
 
 # ---------------------------------------------------------------------------- bad input
-@pytest.mark.parametrize("kwargs, match", [
-    (dict(b=-0.2), "b = -0.2"),
-    (dict(l=0.5), "cannot fold flat"),
-    (dict(corner=0.2), "corner pieces"),
-    (dict(longeron_t=0.02), "more than half the outer"),
-    (dict(mu=-0.1), "mu"),
-    (dict(n_longeron=0), "n_longeron"),
-    (dict(pretension=5e3), "5% strain"),
-    (dict(cable_EA=float("nan")), "cable_EA"),
-    (dict(latch="seed"), "LatchParameters"),
-    (dict(longeron_nu=0.7), "Poisson"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(b=-0.2), "b = -0.2"),
+        (dict(l=0.5), "cannot fold flat"),
+        (dict(corner=0.2), "corner pieces"),
+        (dict(longeron_t=0.02), "more than half the outer"),
+        (dict(mu=-0.1), "mu"),
+        (dict(n_longeron=0), "n_longeron"),
+        (dict(pretension=5e3), "5% strain"),
+        (dict(cable_EA=float("nan")), "cable_EA"),
+        (dict(latch="seed"), "LatchParameters"),
+        (dict(longeron_nu=0.7), "Poisson"),
+    ],
+)
 def test_bad_parameters_are_named(kwargs, match):
     with pytest.raises(fm.ModelError, match=match):
         BayParameters(**kwargs)
@@ -99,9 +108,9 @@ def test_builder_layout_and_alternate_folding():
     lat = am.latch
     assert lat.n_elements == 12 and np.all(lat.latch_node == 1)
     # mirror images: a fold +1 bay's latch cable starts at corner k+1, a fold -1 bay's at corner k
-    assert lat.nodes[0, 0] == am.corners[0, 0]                     # bay 0 folds under -twist
-    assert lat.nodes[4, 0] == am.corners[1, 1]                     # bay 1 (side 0) under +twist
-    assert len(am.model.rigid_bodies) == 2 * 4 + 1                # two interior frames + the top frame
+    assert lat.nodes[0, 0] == am.corners[0, 0]  # bay 0 folds under -twist
+    assert lat.nodes[4, 0] == am.corners[1, 1]  # bay 1 (side 0) under +twist
+    assert len(am.model.rigid_bodies) == 2 * 4 + 1  # two interior frames + the top frame
 
 
 # ---------------------------------------------------------------------------- pretension
@@ -119,7 +128,7 @@ def test_pretension_equilibrium(pretensioned):
     fr = res.frame(-1)
     st = an.summary.steps
     assert st[0]["name"] == "pretension" and "stabilization_ratio" in st[0]
-    assert st[0]["stabilization_ratio"] < 1e-4            # the viscous forces did (almost) no work
+    assert st[0]["stabilization_ratio"] < 1e-4  # the viscous forces did (almost) no work
     assert len(st) == 1
     # no external load: the reactions (base and held control DOFs) sum to zero (forces and moments)
     X = res.X + fr["U"]
@@ -127,19 +136,20 @@ def test_pretension_equilibrium(pretensioned):
     F = RF[:, :3].sum(axis=0)
     Mo = (np.cross(X, RF[:, :3]) + RF[:, 3:]).sum(axis=0)
     T = fr["el/adam_latch/tension"]
-    assert np.abs(F).max() < 1e-6 * T.max()               # 1e-6: the force tolerance (~0.01 N) on 170 N
+    assert np.abs(F).max() < 1e-6 * T.max()  # 1e-6: the force tolerance (~0.01 N) on 170 N
     assert np.abs(Mo).max() < 1e-6 * T.max() * P.b
     # symmetric bay: all eight latch-cable sections and all eight arms carry one tension
     N = fr["el/adam_arm/N"]
-    assert np.ptp(T) < 1e-8 * T.mean() and np.ptp(N) < 1e-8 * N.mean()   # symmetry up to round-off
-    assert 160.0 < T.mean() < P.pretension                 # the structure shortens: cables lose a little
+    assert np.ptp(T) < 1e-8 * T.mean() and np.ptp(N) < 1e-8 * N.mean()  # symmetry up to round-off
+    assert 160.0 < T.mean() < P.pretension  # the structure shortens: cables lose a little
     # top frame: the vertical pull of the eight arms = the compression of the four longerons
     idx = {int(l): i for i, l in enumerate(res.node_labels)}
     arms = res.mesh["conn/adam_arm"]
-    pull = sum(N[e] * (X[idx[t], 2] - X[idx[u], 2]) / np.linalg.norm(X[idx[t]] - X[idx[u]])
-               for e, (u, t) in enumerate(arms))
+    pull = sum(
+        N[e] * (X[idx[t], 2] - X[idx[u], 2]) / np.linalg.norm(X[idx[t]] - X[idx[u]]) for e, (u, t) in enumerate(arms)
+    )
     sf = fr["el/adam_longeron/section_forces"]
-    assert -sf[:, :, 0].mean() * 4 == pytest.approx(pull, rel=1e-6)   # 1e-6: force tolerance
+    assert -sf[:, :, 0].mean() * 4 == pytest.approx(pull, rel=1e-6)  # 1e-6: force tolerance
     assert np.all(fr["el/adam_latch/latch_zone"] == ZONE_BACKSTOP)
 
 
@@ -171,8 +181,11 @@ def _reference_release_twist(p: BayParameters):
         B, T = corners(t)
 
         def E(U):
-            Ls = ((a0, np.linalg.norm(U - T[0])), (a1, np.linalg.norm(U - T[1])),
-                  (c0, np.linalg.norm(U - B[1]) + np.linalg.norm(U - B[0])))
+            Ls = (
+                (a0, np.linalg.norm(U - T[0])),
+                (a1, np.linalg.norm(U - T[1])),
+                (c0, np.linalg.norm(U - B[1]) + np.linalg.norm(U - B[0])),
+            )
             return sum(0.5 * EA * max(L - L0, 0.0) ** 2 / L0 for L0, L in Ls)
 
         U = minimize(E, U0, method="BFGS", options=dict(gtol=1e-12)).x
@@ -192,7 +205,7 @@ def test_idealised_path_releases_all_latches_together_near_the_reference(tmp_pat
     c = bay_curve(res, am)
     rel = release_angles(c)
     assert np.all(np.isfinite(rel))
-    assert np.ptp(rel) == 0.0                               # symmetric bay: the same increment for all four
+    assert np.ptp(rel) == 0.0  # symmetric bay: the same increment for all four
     ref = _reference_release_twist(am.params)
     step = 0.02 * theta_max
     # one increment (the release is detected at the first frame in zone (d)) plus 1 % for what the
@@ -209,7 +222,7 @@ def test_measured_style_path_gives_asymmetric_release(tmp_path):
     am = build_bay()
     path = measured_style_path(am.params.b, theta_max=math.radians(3.2), hold_side=0, n=41)
     drift = np.hypot(path.x, path.y).max()
-    assert 5e-3 < drift < 1.2e-2                            # "displacements of up to 1 cm" (seed Sec. VI.A)
+    assert 5e-3 < drift < 1.2e-2  # "displacements of up to 1 cm" (seed Sec. VI.A)
     path.to_csv(tmp_path / "path.csv")
     back = MeasuredPath.from_csv(tmp_path / "path.csv")
     assert np.allclose(back.theta, path.theta) and np.allclose(back.x, path.x)
@@ -218,7 +231,7 @@ def test_measured_style_path_gives_asymmetric_release(tmp_path):
     res = fm.Analysis(am.model, tmp_path / "res", progress=False, convergence=CONVERGENCE).run()
     c = bay_curve(res, am)
     rel = release_angles(c)
-    assert np.isnan(rel[0])                                 # the side the bay turns about stays latched
-    assert np.all(np.isfinite(rel[1:]))                     # the other three release ...
-    assert len(set(np.round(rel[1:], 9))) == 3              # ... one after the other
+    assert np.isnan(rel[0])  # the side the bay turns about stays latched
+    assert np.all(np.isfinite(rel[1:]))  # the other three release ...
+    assert len(set(np.round(rel[1:], 9))) == 3  # ... one after the other
     assert not np.any(c["zone"][:, 0] == ZONE_FREE)

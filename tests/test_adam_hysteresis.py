@@ -16,7 +16,7 @@ import femast as fm
 from femast.adam import build_bay
 from femast.adam.steps import CONVERGENCE, add_idealised_torsion, add_initial_steps
 from femast.elements.base import IncrementContext
-from femast.elements.cable_latch import SLIP_IN, SLIP_OUT, STICK, BACKSTOP, CableLatchFamily, cable_equations
+from femast.elements.cable_latch import BACKSTOP, SLIP_IN, SLIP_OUT, STICK, CableLatchFamily, cable_equations
 from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.testing import fd_tangent
 
@@ -45,14 +45,31 @@ def ev(fam, X, st):
     return fam.evaluate(X, None, st, IncrementContext())
 
 
-@pytest.mark.parametrize("x0, node, dx", [(None, 2, 0.5 * MM), (None, 2, 2 * MM), (1.8 * MM, 0, -1.5 * MM),
-                                          (0.1 * MM, 2, 0.05 * MM), (-1.5 * MM, 0, -0.4 * MM)])
+@pytest.mark.parametrize(
+    "x0, node, dx",
+    [
+        (None, 2, 0.5 * MM),
+        (None, 2, 2 * MM),
+        (1.8 * MM, 0, -1.5 * MM),
+        (0.1 * MM, 2, 0.05 * MM),
+        (-1.5 * MM, 0, -0.4 * MM),
+    ],
+)
 def test_option_off_is_the_seed_law_bit_for_bit(x0, node, dx):
     X = X3.copy()
     X[node, 0] += dx
     a = family(x0, hyst=False)
-    b = CableLatchFamily(a.nodes, EA=a.EA, L0=a.L0, latch_node=1, bead=a.bead, latch=P, x0=a.x0,
-                         hysteresis_force=0.0, hysteresis_length=ELL)
+    b = CableLatchFamily(
+        a.nodes,
+        EA=a.EA,
+        L0=a.L0,
+        latch_node=1,
+        bead=a.bead,
+        latch=P,
+        x0=a.x0,
+        hysteresis_force=0.0,
+        hysteresis_length=ELL,
+    )
     ra, rb = ev(a, X, a.initial_state()), ev(b, X, b.initial_state())
     assert np.array_equal(ra.f, rb.f) and np.array_equal(ra.k, rb.k) and np.array_equal(ra.state, rb.state)
 
@@ -73,11 +90,11 @@ def test_band_is_widened_near_the_backstop():
     target = lo_seed - 0.4 * H
     for hyst in (False, True):
         fam = family(x, hyst=hyst)
-        st = fam.initial_state()                 # committed bead at x, both sides at T0
-        s = fam.bead[0] - x                      # unstretched cable before the latch (held)
+        st = fam.initial_state()  # committed bead at x, both sides at T0
+        s = fam.bead[0] - x  # unstretched cable before the latch (held)
         LB = np.linalg.norm(X3[2] - X3[1])
         TB = EA * (LB / (fam.L0[0] - s) - 1.0)
-        LA = s * (1.0 + (TB - target) / EA)      # section 1 length giving T2 - T1 = target (stick trial)
+        LA = s * (1.0 + (TB - target) / EA)  # section 1 length giving T2 - T1 = target (stick trial)
         e = (X3[0] - X3[1]) / np.linalg.norm(X3[0] - X3[1])
         X = X3.copy()
         X[0] = X3[1] + LA * e
@@ -85,15 +102,18 @@ def test_band_is_widened_near_the_backstop():
         if hyst:
             assert r.state[0, 1] == STICK and r.state[0, 0] == x
             T = r.output["tension"][0]
-            assert T[1] - T[0] == pytest.approx(target, abs=1e-9)   # round-off of the hand computation
+            assert T[1] - T[0] == pytest.approx(target, abs=1e-9)  # round-off of the hand computation
         else:
             assert r.state[0, 1] in (SLIP_IN, BACKSTOP) and r.state[0, 0] < x
 
 
-@pytest.mark.parametrize("x0, node, dx, status, sigma", [
-    (None, 2, 2.0 * MM, SLIP_OUT, UNLATCHING),      # pulled off the backstop through the hysteresis zone
-    (-0.5 * MM, 0, -1.2 * MM, SLIP_IN, LATCHING),   # pulled back in towards the backstop
-])
+@pytest.mark.parametrize(
+    "x0, node, dx, status, sigma",
+    [
+        (None, 2, 2.0 * MM, SLIP_OUT, UNLATCHING),  # pulled off the backstop through the hysteresis zone
+        (-0.5 * MM, 0, -1.2 * MM, SLIP_IN, LATCHING),  # pulled back in towards the backstop
+    ],
+)
 def test_sliding_bead_follows_widened_branch(x0, node, dx, status, sigma):
     fam = family(x0)
     st = fam.initial_state()
@@ -105,28 +125,42 @@ def test_sliding_bead_follows_widened_branch(x0, node, dx, status, sigma):
     assert -P.x_backstop < x < 0.0 and H_by_hand(x) > 0.1
     T = r.output["tension"][0]
     expected = float(latch_force(x, sigma, P)) + sigma * H_by_hand(x)
-    assert T[1] - T[0] == pytest.approx(expected, abs=1e-8)     # the kernel's root tolerance (N)
-    res = cable_equations(X, T, r.state[0, 2:], EA, fam.L0[0], latch_node=1, bead=fam.bead[0], latch=P,
-                          status=status, x_committed=st[0, 0], hysteresis_force=FH, hysteresis_length=ELL)
-    assert np.abs(res).max() < 1e-8                             # all 2n equations (N and m)
+    assert T[1] - T[0] == pytest.approx(expected, abs=1e-8)  # the kernel's root tolerance (N)
+    res = cable_equations(
+        X,
+        T,
+        r.state[0, 2:],
+        EA,
+        fam.L0[0],
+        latch_node=1,
+        bead=fam.bead[0],
+        latch=P,
+        status=status,
+        x_committed=st[0, 0],
+        hysteresis_force=FH,
+        hysteresis_length=ELL,
+    )
+    assert np.abs(res).max() < 1e-8  # all 2n equations (N and m)
     # consistent tangent: central differences, h = 1e-7 m (error ~ h^2 f''' + eps f / h)
     Kfd = fd_tangent(fam, X, None, st, h=1e-7, dofs=range(3))[0]
     idx = np.array([6 * a + c for a in range(3) for c in range(3)])
-    np.testing.assert_allclose(r.k[0][np.ix_(idx, idx)], Kfd[np.ix_(idx, idx)], rtol=0,
-                               atol=2e-6 * np.abs(r.k).max())
+    np.testing.assert_allclose(r.k[0][np.ix_(idx, idx)], Kfd[np.ix_(idx, idx)], rtol=0, atol=2e-6 * np.abs(r.k).max())
 
 
 def test_release_from_backstop_needs_the_extra_force():
     """Seated on the backstop the bead leaves at dT_out(-x_b) + F_h (43.9 N + 40 N), not at 43.9 N."""
     thr = float(latch_force(-P.x_backstop, UNLATCHING, P))
-    assert thr == pytest.approx(43.9, abs=0.05)                   # the seed's fit (docs/cable_latch_element.md)
-    for hyst, target, expect in ((False, thr + 0.5 * FH, SLIP_OUT), (True, thr + 0.5 * FH, BACKSTOP),
-                                 (True, thr + 1.5 * FH, SLIP_OUT)):
+    assert thr == pytest.approx(43.9, abs=0.05)  # the seed's fit (docs/cable_latch_element.md)
+    for hyst, target, expect in (
+        (False, thr + 0.5 * FH, SLIP_OUT),
+        (True, thr + 0.5 * FH, BACKSTOP),
+        (True, thr + 1.5 * FH, SLIP_OUT),
+    ):
         fam = family(None, hyst=hyst)
-        s = fam.bead[0] + P.x_backstop             # bead on the backstop
+        s = fam.bead[0] + P.x_backstop  # bead on the backstop
         LA = np.linalg.norm(X3[1] - X3[0])
         TA = EA * (LA / s - 1.0)
-        LB = (fam.L0[0] - s) * (1.0 + (TA + target) / EA)   # section 2 length for T2 - T1 = target
+        LB = (fam.L0[0] - s) * (1.0 + (TA + target) / EA)  # section 2 length for T2 - T1 = target
         e = (X3[2] - X3[1]) / np.linalg.norm(X3[2] - X3[1])
         X = X3.copy()
         X[2] = X3[1] + LB * e
@@ -138,13 +172,14 @@ def test_bad_hysteresis_input():
     with pytest.raises(fm.ModelError, match="hysteresis_force"):
         family(None).__class__([[0, 1, 2]], EA=EA, L0=1.0, latch_node=1, bead=0.4, latch=P, hysteresis_force=-1.0)
     with pytest.raises(fm.ModelError, match="hysteresis_length"):
-        CableLatchFamily([[0, 1, 2]], EA=EA, L0=1.0, latch_node=1, bead=0.4, latch=P, hysteresis_force=1.0,
-                         hysteresis_length=0.0)
+        CableLatchFamily(
+            [[0, 1, 2]], EA=EA, L0=1.0, latch_node=1, bead=0.4, latch=P, hysteresis_force=1.0, hysteresis_length=0.0
+        )
 
 
 # ---------------------------------------------------------------------------- the bay
 def _bay_residual(tmp_path, **changes):
-    am = build_bay(mu=0.0, **changes)          # frictionless joints: only the latches can keep a twist
+    am = build_bay(mu=0.0, **changes)  # frictionless joints: only the latches can keep a twist
     add_initial_steps(am, hold_control=("ux", "uy"))
     add_idealised_torsion(am, math.radians(1.0), max_increment=0.04)
     res = fm.Analysis(am.model, tmp_path, progress=False, convergence=CONVERGENCE).run()

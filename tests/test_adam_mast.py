@@ -25,8 +25,8 @@ def one_cycle(tmp_path_factory):
 
 def test_mast_geometry():
     am = build_mast(40)
-    assert am.height == pytest.approx(6.84, rel=1e-12)          # seed: 40 bays, 6.84 m
-    assert am.folds[:4].tolist() == [1, -1, 1, -1]               # alternate folding (seed Sec. VIII)
+    assert am.height == pytest.approx(6.84, rel=1e-12)  # seed: 40 bays, 6.84 m
+    assert am.folds[:4].tolist() == [1, -1, 1, -1]  # alternate folding (seed Sec. VIII)
 
 
 def test_table1_tip_response_matches_the_seed_under_M_plus_F(one_cycle):
@@ -49,8 +49,8 @@ def test_table1_loads_do_not_move_any_bead(one_cycle):
     dT = np.array([res.frame(i)["el/adam_latch/latch_dT"] for i in range(len(res))])
     zone = np.array([res.frame(i)["el/adam_latch/latch_zone"] for i in range(len(res))])
     release = float(latch_force(-am.params.latch.x_backstop, UNLATCHING, am.params.latch))
-    assert np.abs(dT).max() < 0.5 * release                      # far from the 43.9 N release
-    assert np.all(zone == 0)                                      # every bead stays on its backstop
+    assert np.abs(dT).max() < 0.5 * release  # far from the 43.9 N release
+    assert np.all(zone == 0)  # every bead stays on its backstop
 
 
 def test_table_layout():
@@ -69,6 +69,6 @@ def test_identification_recovers_the_recorded_values():
     p = BayParameters()
     fit = fit_tip_response(p.with_(cable_EA=1.5 * p.cable_EA, longeron_t=0.6 * p.longeron_t))
     assert fit.success
-    assert np.abs(fit.rel_error).max() < 1e-3                    # two targets, two parameters: exact fit
+    assert np.abs(fit.rel_error).max() < 1e-3  # two targets, two parameters: exact fit
     assert fit.x[0] == pytest.approx(p.cable_EA, rel=0.01)
     assert fit.x[1] == pytest.approx(p.longeron_t, rel=0.01)

@@ -17,8 +17,13 @@ def _family(am, name):
 
 def _deploy(am, frames=None):
     add_initial_steps(am)
-    an = fm.Analysis(am.model, None, progress=False, convergence=CONVERGENCE,
-                     on_frame=(lambda fr: None) if frames is None else frames.append)
+    an = fm.Analysis(
+        am.model,
+        None,
+        progress=False,
+        convergence=CONVERGENCE,
+        on_frame=(lambda fr: None) if frames is None else frames.append,
+    )
     an.run()
     return an
 
@@ -34,12 +39,13 @@ def test_per_element_values_reach_the_right_elements():
     joints = _family(am, am.joint_family)
     for j in range(n):
         for c in range(4):
-            for e in range(2):     # bottom joint ties the longeron's bottom end to corner (j, c)
-                row = np.flatnonzero((joints.nodes[:, 0] == am.longerons[j, c, e])
-                                     & (joints.nodes[:, 1] == am.corners[j + e, c]))
+            for e in range(2):  # bottom joint ties the longeron's bottom end to corner (j, c)
+                row = np.flatnonzero(
+                    (joints.nodes[:, 0] == am.longerons[j, c, e]) & (joints.nodes[:, 1] == am.corners[j + e, c])
+                )
                 assert row.size == 1 and joints.mu[row[0]] == mu[j, c, e]
     latch = am.latch
-    np.testing.assert_array_equal(latch.latch[:, 2], k.ravel())        # rows in latch_labels order
+    np.testing.assert_array_equal(latch.latch[:, 2], k.ravel())  # rows in latch_labels order
     np.testing.assert_array_equal(latch.latch[:, 3], lmu.ravel())
     # each side's latch cable carries its pretension in the built geometry (both sections)
     X = np.zeros((am.model.node_labels.max() + 1, 3))
@@ -69,10 +75,10 @@ def test_uniform_longeron_length_error_lifts_the_tip_without_tilt_or_twist():
     for d in (dL, 2 * dL):
         an = _deploy(build_mast(n, alternate=False, scatter=MastScatter(longeron_dL=d)))
         u = an.x[ctl] - base.x[ctl]
-        assert abs(u[0]) < 1e-3 * u[2] and abs(u[1]) < 1e-3 * u[2]   # the chiral cable net: a few 1e-4 of the rise
+        assert abs(u[0]) < 1e-3 * u[2] and abs(u[1]) < 1e-3 * u[2]  # the chiral cable net: a few 1e-4 of the rise
         rise.append(u[2])
     assert 0 < rise[0] < n * dL
-    np.testing.assert_allclose(rise[1], 2 * rise[0], rtol=1e-3)   # second order in dL / l ~ 3e-4
+    np.testing.assert_allclose(rise[1], 2 * rise[0], rtol=1e-3)  # second order in dL / l ~ 3e-4
 
 
 def test_short_latch_cable_section_raises_its_tension_by_EA_d_over_2L():
@@ -92,17 +98,26 @@ def test_short_latch_cable_section_raises_its_tension_by_EA_d_over_2L():
     dT = out[1][0] - out[0][0]
     LA = 0.5 * p.diagonal
     ref = p.cable_EA * d / (2 * LA)
-    assert 0.95 * ref < dT <= ref * (1 + 1e-9)   # the bay's compliance takes ~1 % (measured 0.989 ref)
+    assert 0.95 * ref < dT <= ref * (1 + 1e-9)  # the bay's compliance takes ~1 % (measured 0.989 ref)
 
 
-@pytest.mark.parametrize("sc, words", [
-    (dict(mu=np.r_[[0.5] * 7, -0.1].reshape(1, 4, 2)), r"MastScatter.mu\[0, 3, 1\] \(bay 0, corner 3, end 1\) = -0.1"),
-    (dict(latch_k=np.zeros((1, 4))), r"MastScatter.latch_k\[0, 0\] \(bay 0, side 0\) = 0.0 N/m must be > 0"),
-    (dict(pretension=np.full((2, 4), 170.0)), r"MastScatter.pretension: give a number or an array of shape \(1, 4\)"),
-    (dict(longeron_dL=0.05), r"MastScatter.longeron_dL\[0, 0\] .* give it in m"),
-    (dict(batten_dL=np.nan), r"MastScatter.batten_dL\[0, 0\] \(frame 0, side 0\) = nan"),
-    (dict(friction=0.5), r"unknown item\(s\) 'friction'"),
-])
+@pytest.mark.parametrize(
+    "sc, words",
+    [
+        (
+            dict(mu=np.r_[[0.5] * 7, -0.1].reshape(1, 4, 2)),
+            r"MastScatter.mu\[0, 3, 1\] \(bay 0, corner 3, end 1\) = -0.1",
+        ),
+        (dict(latch_k=np.zeros((1, 4))), r"MastScatter.latch_k\[0, 0\] \(bay 0, side 0\) = 0.0 N/m must be > 0"),
+        (
+            dict(pretension=np.full((2, 4), 170.0)),
+            r"MastScatter.pretension: give a number or an array of shape \(1, 4\)",
+        ),
+        (dict(longeron_dL=0.05), r"MastScatter.longeron_dL\[0, 0\] .* give it in m"),
+        (dict(batten_dL=np.nan), r"MastScatter.batten_dL\[0, 0\] \(frame 0, side 0\) = nan"),
+        (dict(friction=0.5), r"unknown item\(s\) 'friction'"),
+    ],
+)
 def test_bad_scatter_names_the_item(sc, words):
     with pytest.raises(ModelError, match=words):
         build_mast(1, scatter=sc)
@@ -120,11 +135,11 @@ def test_stated_scatter_samples_lie_in_their_bounds_and_midpoints_are_nominal():
     assert not np.any(sc["longeron_dL"]) and not np.any(sc["cable_dL"])
     rng = np.random.default_rng(0)
     vals = sample_scatter({g: rng.random(need[g]) for g in GROUPS}, n)
-    for g, field, lo, hi, size, unit in stated_inputs(n):
+    for _g, field, lo, hi, size, _unit in stated_inputs(n):
         a = np.asarray(vals[field])
         assert a.size == size and np.all((a >= lo) & (a <= hi)), field
     pre = [(lo, hi) for _, f, lo, hi, _, _ in stated_inputs(n) if f == "pretension"]
-    np.testing.assert_allclose(pre, [(153.0, 187.0)], rtol=1e-15)   # 170 N +- 10 %, round-off of 170 x 1.1
+    np.testing.assert_allclose(pre, [(153.0, 187.0)], rtol=1e-15)  # 170 N +- 10 %, round-off of 170 x 1.1
     with pytest.raises(ModelError, match="group 'latch' needs 24 uniform numbers"):
         sample_scatter({g: rng.random(need[g] - (g == "latch")) for g in GROUPS}, n)
 
@@ -137,4 +152,4 @@ def test_tip_history_reports_every_load_level_and_the_nominal_mast_deploys_strai
     # the nominal mast shortens under its pretension, with no sideways motion or rotation
     # (round-off and the 1e-9 force tolerance: far below 1 nm and 1e-8 rad)
     assert h["u"][0, 2] < 0 and np.abs(h["u"][0, :2]).max() < 1e-9 and np.abs(h["theta"][0]).max() < 1e-8
-    assert h["theta"][1, 2] > 0 > h["theta"][3, 2]      # M twists the tip one way, -M the other
+    assert h["theta"][1, 2] > 0 > h["theta"][3, 2]  # M twists the tip one way, -M the other

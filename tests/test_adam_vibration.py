@@ -21,7 +21,7 @@ def test_eq16_read_in_lbf_matches_the_seed_figures():
     # Fig. 13: peaks of 125-188 N inside its 55-85 Hz axis
     f = v.eq16_frequency(np.array([125.0, 188.0]))
     assert np.all((f > 55) & (f < 85))
-    np.testing.assert_allclose(v.eq16_tension(f), [125.0, 188.0], rtol=1e-12)   # exact inverse
+    np.testing.assert_allclose(v.eq16_tension(f), [125.0, 188.0], rtol=1e-12)  # exact inverse
 
 
 def test_mock_side_resonance_is_the_taut_cable_closed_form():
@@ -46,7 +46,7 @@ def test_unit_mass_identified_from_eq16():
     # m_eff = sum(1/L_i) c / (2 pi)^2.  1 %: the two fits weight the range differently
     f1, f2 = v.eq16_frequency(np.array(v.EQ16_RANGE_N))
     ff = np.linspace(f1, f2, 201)
-    c = np.sum(ff ** 2 * v.eq16_tension(ff)) / np.sum(ff ** 4)
+    c = np.sum(ff**2 * v.eq16_tension(ff)) / np.sum(ff**4)
     m_eff = 4 / (0.5 * BayParameters().diagonal) * c / (2 * math.pi) ** 2
     assert fit.effective_mass == pytest.approx(m_eff, rel=1e-2)
     # the inverse use returns the model's own tensions at the model's frequencies (T = c f^2 exact)

@@ -31,8 +31,20 @@ def _mast_csv(mutate=None, header="fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_m,dy_m,dz
     rows = []
     for i in range(N):
         f = 10.0 * math.sin(0.3 * i)
-        rows.append([f"{f:.6g}", "0", "-1", "0", "0", "0", f"{1e-5 * f + 1e-7 * i:.6g}",
-                     f"{2e-6 * f - 3e-8 * i:.6g}", f"{1e-7 * i:.6g}", f"{0.1 * i:.6g}"])
+        rows.append(
+            [
+                f"{f:.6g}",
+                "0",
+                "-1",
+                "0",
+                "0",
+                "0",
+                f"{1e-5 * f + 1e-7 * i:.6g}",
+                f"{2e-6 * f - 3e-8 * i:.6g}",
+                f"{1e-7 * i:.6g}",
+                f"{0.1 * i:.6g}",
+            ]
+        )
     if mutate:
         mutate(rows)
     return "\n".join([header] + [",".join(r) for r in rows]) + "\n"
@@ -41,6 +53,7 @@ def _mast_csv(mutate=None, header="fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_m,dy_m,dz
 def _set(row, col, value):
     def m(rows):
         rows[row][col] = value
+
     return m
 
 
@@ -81,27 +94,58 @@ CASES = [
     ("1e308-cell", "latch-pull", _latch_with(7, 1, "1e308"), r"line 9, column 'dT_N': 1e\+308 N is beyond 1e\+15"),
     ("1e20-input", "latch-pull", _latch_with(7, 0, "-1e20"), r"line 9, column 'x_mm': -1e\+20 mm is beyond"),
     ("1e16-cell", "latch-pull", _latch_with(0, 1, "1e16"), r"line 2, column 'dT_N': 1e\+16 N is beyond"),
-    ("all-zero-channel", "latch-pull", _latch_csv([(r[0], "0") for r in _latch_rows()]),
-     r"column 'dT_N' is zero on every row"),
-    ("constant-channel", "latch-pull", _latch_csv([(r[0], "5.5") for r in _latch_rows()]),
-     r"column 'dT_N' has the same value 5.5 N on every row"),
+    (
+        "all-zero-channel",
+        "latch-pull",
+        _latch_csv([(r[0], "0") for r in _latch_rows()]),
+        r"column 'dT_N' is zero on every row",
+    ),
+    (
+        "constant-channel",
+        "latch-pull",
+        _latch_csv([(r[0], "5.5") for r in _latch_rows()]),
+        r"column 'dT_N' has the same value 5.5 N on every row",
+    ),
     ("all-zero-file", "latch-pull", _latch_csv([("0", "0")] * N), r"column 'dT_N' is zero on every row"),
     ("too-few-rows", "latch-pull", _latch_csv(_latch_rows(5)), r"5 data row\(s\); latch-pull needs at least 10"),
     ("header-only", "latch-pull", "x_mm,dT_N\n", r"0 data row\(s\)"),
-    ("time-backwards", "latch-pull", _latch_csv([(r[0], r[1], f"{(i if i != 7 else 2):g}")
-                                                 for i, r in enumerate(_latch_rows())], header="x_mm,dT_N,t_s"),
-     r"line 9, column 't_s': time goes backwards"),
+    (
+        "time-backwards",
+        "latch-pull",
+        _latch_csv(
+            [(r[0], r[1], f"{(i if i != 7 else 2):g}") for i, r in enumerate(_latch_rows())], header="x_mm,dT_N,t_s"
+        ),
+        r"line 9, column 't_s': time goes backwards",
+    ),
     ("binary", "latch-pull", b"\xff\xfe\x00\x01\x89PNG\r\n", r"not a text \(UTF-8\) CSV file"),
     ("nul-byte", "latch-pull", "x_mm,dT_N\n1.0,\x002.0\n", r"line 2: not valid CSV|line 2, column 'dT_N'"),
-    ("mast-missing-dz", "mast-top", _mast_csv(header="fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_m,dy_m,dzz_m,t_s"),
-     r"column 'dzz_m' is not a mast-top column.*did you mean 'dz_m'"),
-    ("mast-extra-column", "mast-top", _mast_csv(lambda rows: [r.append("20") for r in rows],
-                                                header="fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_m,dy_m,dz_m,t_s,temp_C"),
-     r"column 'temp_C' is not a mast-top column"),
-    ("mast-constant-dx", "mast-top", _mast_csv(lambda rows: [r.__setitem__(6, "1e-3") for r in rows]),
-     r"column 'dx_m' has the same value 0.001 m on every row"),
-    ("mast-zero-dy", "mast-top", _mast_csv(lambda rows: [r.__setitem__(7, "0") for r in rows]),
-     r"column 'dy_m' is zero on every row"),
+    (
+        "mast-missing-dz",
+        "mast-top",
+        _mast_csv(header="fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_m,dy_m,dzz_m,t_s"),
+        r"column 'dzz_m' is not a mast-top column.*did you mean 'dz_m'",
+    ),
+    (
+        "mast-extra-column",
+        "mast-top",
+        _mast_csv(
+            lambda rows: [r.append("20") for r in rows],
+            header="fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_m,dy_m,dz_m,t_s,temp_C",
+        ),
+        r"column 'temp_C' is not a mast-top column",
+    ),
+    (
+        "mast-constant-dx",
+        "mast-top",
+        _mast_csv(lambda rows: [r.__setitem__(6, "1e-3") for r in rows]),
+        r"column 'dx_m' has the same value 0.001 m on every row",
+    ),
+    (
+        "mast-zero-dy",
+        "mast-top",
+        _mast_csv(lambda rows: [r.__setitem__(7, "0") for r in rows]),
+        r"column 'dy_m' is zero on every row",
+    ),
     ("mast-1e308-force", "mast-top", _mast_csv(_set(3, 0, "1e308")), r"line 5, column 'fx_N': 1e\+308 N is beyond"),
     ("mast-nan-time", "mast-top", _mast_csv(_set(2, 9, "nan")), r"line 4, column 't_s': nan is not a finite"),
     ("mast-time-backwards", "mast-top", _mast_csv(_set(10, 9, "0.05")), r"line 12, column 't_s': time goes backwards"),
@@ -122,8 +166,8 @@ def test_malformed_data_file(name, experiment, content, message, tmp_path):
             warnings.simplefilter("ignore", DataWarning)
             read_data(get_experiment(experiment), path)
     msg = str(info.value)
-    assert f"{name}.csv" in msg, msg           # the file is named
-    assert __import__("re").search(message, msg), msg   # and the item (line, column, separator)
+    assert f"{name}.csv" in msg, msg  # the file is named
+    assert __import__("re").search(message, msg), msg  # and the item (line, column, separator)
 
 
 ARRAY_CASES = [
@@ -149,10 +193,13 @@ def test_duplicated_rows_warn_and_say_how_they_bias_the_noise(tmp_path):
     doubled = [r for r in rows for _ in range(2)]
     path = tmp_path / "doubled.csv"
     path.write_text(_latch_csv(doubled))
-    with pytest.warns(DataWarning, match=r"doubled.csv: 20 row\(s\) repeat the row before them exactly "
-                                         r"\(line\(s\) 3, 5, 7.*noise floor too small"):
+    with pytest.warns(
+        DataWarning,
+        match=r"doubled.csv: 20 row\(s\) repeat the row before them exactly "
+        r"\(line\(s\) 3, 5, 7.*noise floor too small",
+    ):
         data = read_data(get_experiment("latch-pull"), path)
-    assert data.n == 2 * N   # accepted, not altered
+    assert data.n == 2 * N  # accepted, not altered
 
 
 def test_the_noise_floor_effect_the_warning_names():
@@ -163,8 +210,8 @@ def test_the_noise_floor_effect_the_warning_names():
     rng = np.random.default_rng(16)
     r = rng.normal(0.0, 1.0, 4000)
     single, doubled = noise_floor(r), noise_floor(np.repeat(r, 2))
-    assert 0.9 < single < 1.1                         # the estimator is right on white noise (4000 samples: ~3%)
-    assert 0.3 < doubled / single < 0.75              # doubled rows: well below the truth
+    assert 0.9 < single < 1.1  # the estimator is right on white noise (4000 samples: ~3%)
+    assert 0.3 < doubled / single < 0.75  # doubled rows: well below the truth
 
 
 def test_cli_reports_a_bad_data_file_in_one_line(tmp_path, capsys):

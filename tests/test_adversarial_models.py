@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import femast as fm
-from femast.model.amplitudes import Amplitude
 from femast.elements.ball_joint import BallJointFamily
+from femast.model.amplitudes import Amplitude
 
 
 def _sec(**kw):
@@ -43,6 +43,7 @@ def _step_run(**options):
         m, a, b = _cantilever()
         m.step("s", **options).load(b, fz=-1.0)
         _run(m)
+
     return build
 
 
@@ -51,8 +52,9 @@ def _modified_step(field, value):
         m, a, b = _cantilever()
         s = m.step("s")
         s.load(b, fz=-1.0)
-        setattr(s, field, value)   # set after creation: checked again when the analysis starts
+        setattr(s, field, value)  # set after creation: checked again when the analysis starts
         _run(m)
+
     return build
 
 
@@ -60,6 +62,7 @@ def _load(**comp):
     def build():
         m, a, b = _cantilever()
         m.step("s").load(b, **comp)
+
     return build
 
 
@@ -133,6 +136,7 @@ def _out_is_a_file(tmp_path):
         f = tmp_path / "taken.txt"
         f.write_text("x")
         _run(m, f)
+
     return build
 
 
@@ -143,6 +147,7 @@ def _out_under_a_file(tmp_path):
         f = tmp_path / "plain"
         f.write_text("x")
         _run(m, f / "sub")
+
     return build
 
 
@@ -153,6 +158,7 @@ def _ball(**kw):
         args = dict(nodes=np.array([[a, b]]), k_pen=1e6, k_stick=10.0)
         args.update(kw)
         m.add_family(BallJointFamily(**args))
+
     return build
 
 
@@ -173,8 +179,12 @@ CASES = [
     ("label-fraction", lambda: _m().node(0, 0, 0, label=1.5), E, r"node label = 1.5 must be a whole number"),
     ("label-text", lambda: _m().node(0, 0, 0, label="a"), E, r"node label = 'a' must be a whole number"),
     ("label-huge", lambda: _m().node(0, 0, 0, label=10**30), E, r"node label = .* too large"),
-    ("label-twice", lambda: [m := _m(), m.node(0, 0, 0, label=3), m.node(1, 0, 0, label=3)], E,
-     r"node 3 is defined twice"),
+    (
+        "label-twice",
+        lambda: [m := _m(), m.node(0, 0, 0, label=3), m.node(1, 0, 0, label=3)],
+        E,
+        r"node 3 is defined twice",
+    ),
     ("nodes-3x2", lambda: _m().nodes(np.zeros((3, 2))), E, r"nodes\(\): .*\(n, 3\) array.*shape \(3, 2\)"),
     ("nodes-2x4", lambda: _m().nodes(np.zeros((2, 4))), E, r"nodes\(\): .*shape \(2, 4\)"),
     ("nodes-3d", lambda: _m().nodes(np.zeros((2, 3, 1))), E, r"nodes\(\): .*shape \(2, 3, 1\)"),
@@ -182,81 +192,214 @@ CASES = [
     ("nodes-text", lambda: _m().nodes([["a", "b", "c"]]), E, r"nodes\(\): coordinates must be an \(n, 3\) array"),
     # elements
     ("beam-unknown-node", lambda: [m := _m(), m.beam(m.node(0, 0, 0), 99, _sec())], E, r"beam: unknown node 99"),
-    ("beam-fraction-node", lambda: [m := _m(), m.node(0, 0, 0), m.node(1, 0, 0), m.beam(1, 1.5, _sec())], E,
-     r"beam: unknown node 1.5"),
-    ("beam-coincident", lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(0, 0, 0), _sec())], E,
-     r"beam 1-2: nodes 1 and 2 coincide"),
-    ("beam-up-parallel", lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(0, 0, 1), _sec(), up=(0, 0, 1))], E,
-     r"beam 1-2: up-vector .* parallel"),
-    ("beam-up-2-values", lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(1, 0, 0), _sec(), up=(0, 1))], E,
-     r"beam 1-2: up-vector .* must be 3 numbers"),
-    ("beam-up-nan", lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(1, 0, 0), _sec(), up=(0, np.nan, 1))], E,
-     r"beam 1-2: up-vector = nan"),
-    ("beam-n-zero", lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(1, 0, 0), _sec(), n=0)], E,
-     r"beam 1-2: number of elements n = 0 must be at least 1"),
-    ("beam-n-fraction", lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(1, 0, 0), _sec(), n=2.5)], E,
-     r"beam 1-2: number of elements n = 2.5 must be a whole number"),
-    ("beam-not-section", lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(1, 0, 0), 70e9)], E,
-     r"beam 1-2: section must be a femast Section"),
-    ("truss-EA-negative", lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=-5.0)], E,
-     r"truss 1-2: EA = -5.0 N must be positive"),
-    ("truss-EA-nan", lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=float("nan"))], E,
-     r"truss 1-2: EA = nan is not finite"),
-    ("truss-EA-1e300", lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=1e300)], E,
-     r"truss 1-2: EA = 1e\+300 N is beyond"),
-    ("truss-EA-text", lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA="1e5")], E,
-     r"truss 1-2: EA = '1e5' is not a number"),
-    ("truss-L0-negative", lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=1e5, L0=-1)], E,
-     r"truss 1-2: unstretched length L0 = -1.0 m must be positive"),
-    ("truss-L0-and-pretension", lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=1e5, L0=1,
-                                                            pretension=5)], E, r"truss 1-2: give L0 or pretension"),
-    ("truss-pretension-impossible", lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=1e5,
-                                                                pretension=-2e5)], E, r"truss 1-2: pretension"),
-    ("truss-coincident", lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(0, 0, 0), EA=1e5)], E,
-     r"truss 1-2: nodes 1 and 2 coincide"),
+    (
+        "beam-fraction-node",
+        lambda: [m := _m(), m.node(0, 0, 0), m.node(1, 0, 0), m.beam(1, 1.5, _sec())],
+        E,
+        r"beam: unknown node 1.5",
+    ),
+    (
+        "beam-coincident",
+        lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(0, 0, 0), _sec())],
+        E,
+        r"beam 1-2: nodes 1 and 2 coincide",
+    ),
+    (
+        "beam-up-parallel",
+        lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(0, 0, 1), _sec(), up=(0, 0, 1))],
+        E,
+        r"beam 1-2: up-vector .* parallel",
+    ),
+    (
+        "beam-up-2-values",
+        lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(1, 0, 0), _sec(), up=(0, 1))],
+        E,
+        r"beam 1-2: up-vector .* must be 3 numbers",
+    ),
+    (
+        "beam-up-nan",
+        lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(1, 0, 0), _sec(), up=(0, np.nan, 1))],
+        E,
+        r"beam 1-2: up-vector = nan",
+    ),
+    (
+        "beam-n-zero",
+        lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(1, 0, 0), _sec(), n=0)],
+        E,
+        r"beam 1-2: number of elements n = 0 must be at least 1",
+    ),
+    (
+        "beam-n-fraction",
+        lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(1, 0, 0), _sec(), n=2.5)],
+        E,
+        r"beam 1-2: number of elements n = 2.5 must be a whole number",
+    ),
+    (
+        "beam-not-section",
+        lambda: [m := _m(), m.beam(m.node(0, 0, 0), m.node(1, 0, 0), 70e9)],
+        E,
+        r"beam 1-2: section must be a femast Section",
+    ),
+    (
+        "truss-EA-negative",
+        lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=-5.0)],
+        E,
+        r"truss 1-2: EA = -5.0 N must be positive",
+    ),
+    (
+        "truss-EA-nan",
+        lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=float("nan"))],
+        E,
+        r"truss 1-2: EA = nan is not finite",
+    ),
+    (
+        "truss-EA-1e300",
+        lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=1e300)],
+        E,
+        r"truss 1-2: EA = 1e\+300 N is beyond",
+    ),
+    (
+        "truss-EA-text",
+        lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA="1e5")],
+        E,
+        r"truss 1-2: EA = '1e5' is not a number",
+    ),
+    (
+        "truss-L0-negative",
+        lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=1e5, L0=-1)],
+        E,
+        r"truss 1-2: unstretched length L0 = -1.0 m must be positive",
+    ),
+    (
+        "truss-L0-and-pretension",
+        lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=1e5, L0=1, pretension=5)],
+        E,
+        r"truss 1-2: give L0 or pretension",
+    ),
+    (
+        "truss-pretension-impossible",
+        lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(1, 0, 0), EA=1e5, pretension=-2e5)],
+        E,
+        r"truss 1-2: pretension",
+    ),
+    (
+        "truss-coincident",
+        lambda: [m := _m(), m.truss(m.node(0, 0, 0), m.node(0, 0, 0), EA=1e5)],
+        E,
+        r"truss 1-2: nodes 1 and 2 coincide",
+    ),
     ("ball-joint-mu-negative", _ball(mu=-0.1), E, r"ball joint.*mu = -0.1"),
-    ("ball-joint-nodes-shape", _ball(nodes=np.array([[1, 2, 3]])), E, r"ball joints 'ball_joint': nodes must be an \(n, 2\)"),
+    (
+        "ball-joint-nodes-shape",
+        _ball(nodes=np.array([[1, 2, 3]])),
+        E,
+        r"ball joints 'ball_joint': nodes must be an \(n, 2\)",
+    ),
     ("ball-joint-k-nan", _ball(k_pen=float("nan")), E, r"ball joint.*k_pen = nan"),
     # sections and materials
-    ("section-E-nan", lambda: fm.Section(E=float("nan"), G=1, A=1, Iy=1, Iz=1, J=1, name="s1"), E,
-     r"section 's1': property E=nan"),
-    ("section-E-text", lambda: fm.Section(E="70GPa", G=1, A=1, Iy=1, Iz=1, J=1, name="s2"), E,
-     r"section 's2': property E='70GPa' is not a number"),
-    ("section-G-missing", lambda: fm.Section(E=1, G=None, A=1, Iy=1, Iz=1, J=1, name="s3"), E,
-     r"section 's3': property G is missing"),
-    ("section-E-1e300", lambda: fm.Section(E=1e300, G=1, A=1, Iy=1, Iz=1, J=1, name="s4"), E,
-     r"section 's4': property E=1e\+300 Pa is beyond"),
-    ("section-A-negative", lambda: fm.Section(E=1, G=1, A=-1e-4, Iy=1, Iz=1, J=1, name="s5"), E,
-     r"section 's5': property A=-0.0001"),
-    ("section-J-zero", lambda: fm.Section(E=1, G=1, A=1, Iy=1, Iz=1, J=0.0, name="s6"), E,
-     r"section 's6': property J=0.0"),
-    ("poisson-minus-one", lambda: fm.circular_tube(0.02, 0.016, E=70e9, nu=-1.0, name="t1"), E,
-     r"section 't1': Poisson's ratio nu = -1 must be greater than -1"),
-    ("poisson-0.7", lambda: fm.circular_tube(0.02, 0.016, E=70e9, nu=0.7, name="t2"), E,
-     r"section 't2': Poisson's ratio nu = 0.7 must be at most 0.5"),
-    ("E-string-helper", lambda: fm.circular_tube(0.02, 0.016, E="70e9", name="t3"), E,
-     r"section 't3': Young's modulus E = '70e9' is not a number"),
-    ("E-negative-helper", lambda: fm.square_tube(0.02, 0.016, E=-1.0, name="t4"), E,
-     r"section 't4': Young's modulus E = -1 Pa must be positive"),
-    ("inner-above-outer", lambda: fm.circular_tube(0.02, 0.03, E=70e9, name="t5"), E,
-     r"section 't5': need 0 <= inner \(0.03\) < outer"),
-    ("outer-nan", lambda: fm.circular_tube(float("nan"), 0.01, E=70e9, name="t6"), E,
-     r"section 't6': outer size=nan"),
+    (
+        "section-E-nan",
+        lambda: fm.Section(E=float("nan"), G=1, A=1, Iy=1, Iz=1, J=1, name="s1"),
+        E,
+        r"section 's1': property E=nan",
+    ),
+    (
+        "section-E-text",
+        lambda: fm.Section(E="70GPa", G=1, A=1, Iy=1, Iz=1, J=1, name="s2"),
+        E,
+        r"section 's2': property E='70GPa' is not a number",
+    ),
+    (
+        "section-G-missing",
+        lambda: fm.Section(E=1, G=None, A=1, Iy=1, Iz=1, J=1, name="s3"),
+        E,
+        r"section 's3': property G is missing",
+    ),
+    (
+        "section-E-1e300",
+        lambda: fm.Section(E=1e300, G=1, A=1, Iy=1, Iz=1, J=1, name="s4"),
+        E,
+        r"section 's4': property E=1e\+300 Pa is beyond",
+    ),
+    (
+        "section-A-negative",
+        lambda: fm.Section(E=1, G=1, A=-1e-4, Iy=1, Iz=1, J=1, name="s5"),
+        E,
+        r"section 's5': property A=-0.0001",
+    ),
+    (
+        "section-J-zero",
+        lambda: fm.Section(E=1, G=1, A=1, Iy=1, Iz=1, J=0.0, name="s6"),
+        E,
+        r"section 's6': property J=0.0",
+    ),
+    (
+        "poisson-minus-one",
+        lambda: fm.circular_tube(0.02, 0.016, E=70e9, nu=-1.0, name="t1"),
+        E,
+        r"section 't1': Poisson's ratio nu = -1 must be greater than -1",
+    ),
+    (
+        "poisson-0.7",
+        lambda: fm.circular_tube(0.02, 0.016, E=70e9, nu=0.7, name="t2"),
+        E,
+        r"section 't2': Poisson's ratio nu = 0.7 must be at most 0.5",
+    ),
+    (
+        "E-string-helper",
+        lambda: fm.circular_tube(0.02, 0.016, E="70e9", name="t3"),
+        E,
+        r"section 't3': Young's modulus E = '70e9' is not a number",
+    ),
+    (
+        "E-negative-helper",
+        lambda: fm.square_tube(0.02, 0.016, E=-1.0, name="t4"),
+        E,
+        r"section 't4': Young's modulus E = -1 Pa must be positive",
+    ),
+    (
+        "inner-above-outer",
+        lambda: fm.circular_tube(0.02, 0.03, E=70e9, name="t5"),
+        E,
+        r"section 't5': need 0 <= inner \(0.03\) < outer",
+    ),
+    ("outer-nan", lambda: fm.circular_tube(float("nan"), 0.01, E=70e9, name="t6"), E, r"section 't6': outer size=nan"),
     ("outer-text", lambda: fm.square_tube("2 cm", 0.01, E=70e9, name="t7"), E, r"section 't7': outer size='2 cm'"),
     # steps and increments
     ("period-zero", lambda: _m().step("p0", period=0.0), E, r"step 'p0': period = 0 s must be positive"),
     ("period-nan", lambda: _m().step("p1", period=float("nan")), E, r"step 'p1': period = nan is not finite"),
     ("period-negative", lambda: _m().step("p2", period=-1.0), E, r"step 'p2': period = -1 s must be positive"),
     ("initial-nan", _step_run(initial_increment=float("nan")), E, r"step 's': initial_increment = nan"),
-    ("initial-negative", _step_run(initial_increment=-0.1), E, r"step 's': initial_increment = -0.1 s must be positive"),
-    ("min-above-max", _step_run(min_increment=0.5, max_increment=0.1), E,
-     r"step 's': min_increment = 0.5 s is larger than max_increment = 0.1 s"),
-    ("initial-above-period", _step_run(initial_increment=2.0), E,
-     r"step 's': initial_increment = 2 s is longer than the step period"),
-    ("initial-below-min", _step_run(initial_increment=0.01, min_increment=0.1), E,
-     r"step 's': initial_increment = 0.01 s is smaller than min_increment"),
-    ("initial-above-max", _step_run(initial_increment=0.5, max_increment=0.1), E,
-     r"step 's': initial_increment = 0.5 s is larger than max_increment"),
+    (
+        "initial-negative",
+        _step_run(initial_increment=-0.1),
+        E,
+        r"step 's': initial_increment = -0.1 s must be positive",
+    ),
+    (
+        "min-above-max",
+        _step_run(min_increment=0.5, max_increment=0.1),
+        E,
+        r"step 's': min_increment = 0.5 s is larger than max_increment = 0.1 s",
+    ),
+    (
+        "initial-above-period",
+        _step_run(initial_increment=2.0),
+        E,
+        r"step 's': initial_increment = 2 s is longer than the step period",
+    ),
+    (
+        "initial-below-min",
+        _step_run(initial_increment=0.01, min_increment=0.1),
+        E,
+        r"step 's': initial_increment = 0.01 s is smaller than min_increment",
+    ),
+    (
+        "initial-above-max",
+        _step_run(initial_increment=0.5, max_increment=0.1),
+        E,
+        r"step 's': initial_increment = 0.5 s is larger than max_increment",
+    ),
     ("max-increments-zero", _step_run(max_increments=0), E, r"step 's': max_increments = 0 must be at least 1"),
     ("max-increments-fraction", _step_run(max_increments=2.5), E, r"step 's': max_increments = 2.5 must be a whole"),
     ("hit-time-outside", _step_run(hit_times=(2.0,)), E, r"step 's': hit time 2 s is outside the step"),
@@ -272,8 +415,12 @@ CASES = [
     ("load-text", _load(fx="10"), E, r"step 's': load fx on node 2 = '10' is not a number"),
     ("load-unknown-component", _load(fw=1.0), E, r"step 's': unknown load component 'fw' on node 2"),
     ("load-empty", _load(), E, r"step 's': load on node 2 has no components"),
-    ("prescribe-nan", lambda: [(mb := _cantilever()), mb[0].step("s").prescribe(mb[2], ux=float("nan"))], E,
-     r"step 's': prescribed ux on node 2 = nan"),
+    (
+        "prescribe-nan",
+        lambda: [(mb := _cantilever()), mb[0].step("s").prescribe(mb[2], ux=float("nan"))],
+        E,
+        r"step 's': prescribed ux on node 2 = nan",
+    ),
     ("load-unconnected-node", _unconnected_load, E, r"step 's': load fy on node 4: no element is connected"),
     ("moment-on-truss-node", _moment_on_truss, E, r"step 's': load mz on node 2: .*no stiffness to rz"),
     ("rotation-on-truss-node", _rotation_on_truss, E, r"step 's': prescribed value rx on node 2"),
@@ -289,10 +436,18 @@ CASES = [
     # constraints, amplitudes
     ("rigid-body-one-node", lambda: [m := _m(), m.rigid_body(m.node(0, 0, 0), [1])], E, r"rigid body 'rigid-1'"),
     ("tie-self", lambda: [m := _m(), m.tie(m.node(0, 0, 0), 1)], E, r"tie: node 1 tied to itself"),
-    ("tie-unknown-dof", lambda: [m := _m(), m.node(0, 0, 0), m.node(0, 0, 0), m.tie(1, 2, "uq")], E,
-     r"unknown DOF 'uq'"),
-    ("rotate-zero-axis", lambda: [(mb := _cantilever()), mb[0].step("s").rotate(mb[2], (0, 0, 0), 0.1)], E,
-     r"step 's': rotation axis"),
+    (
+        "tie-unknown-dof",
+        lambda: [m := _m(), m.node(0, 0, 0), m.node(0, 0, 0), m.tie(1, 2, "uq")],
+        E,
+        r"unknown DOF 'uq'",
+    ),
+    (
+        "rotate-zero-axis",
+        lambda: [(mb := _cantilever()), mb[0].step("s").rotate(mb[2], (0, 0, 0), 0.1)],
+        E,
+        r"step 's': rotation axis",
+    ),
     ("amplitude-nan", lambda: Amplitude([0, 0.5, 1], [0, float("nan"), 1]), E, r"row 1 .* not finite"),
 ]
 
@@ -320,12 +475,12 @@ def test_equilibrium_check_catches_a_lost_load_and_passes_a_balanced_one():
 
     x = np.array([[0.0, 0, 0], [1.0, 0, 0]])
     P = np.zeros((2, 6))
-    P[1, 2] = -10.0                          # 10 N down at the tip
+    P[1, 2] = -10.0  # 10 N down at the tip
     RF = np.zeros((2, 6))
-    RF[0, 2], RF[0, 4] = 10.0, -10.0         # the clamp: 10 N up and the moment of the tip load
+    RF[0, 2], RF[0, 4] = 10.0, -10.0  # the clamp: 10 N up and the moment of the tip load
     r_free = np.zeros(6)
     free_dof = np.arange(6)
-    check_equilibrium(x, P, RF, r_free, free_dof, "increment 1")          # balanced: silent
+    check_equilibrium(x, P, RF, r_free, free_dof, "increment 1")  # balanced: silent
     with pytest.raises(fm.EquilibriumError, match=r"increment 3: the reactions do not balance .* node 2"):
         check_equilibrium(x, P, np.zeros((2, 6)), r_free, free_dof, "increment 3", labels=np.array([1, 2]))
 
@@ -334,5 +489,5 @@ def test_analysis_checks_the_balance_of_beam_and_truss_models():
     m, a, b = _cantilever()
     m.step("s").load(b, fz=-1.0)
     an = fm.Analysis(m, None, progress=False, on_frame=lambda d: None)
-    assert an.system.check_balance          # every family self-equilibrated: checked each increment
+    assert an.system.check_balance  # every family self-equilibrated: checked each increment
     an.run()

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from femast.verification import references as ref
 from femast.verification import arclength as va
+from femast.verification import references as ref
 
 
 def test_von_mises_truss_follows_the_analytic_snap_through():
@@ -12,10 +12,10 @@ def test_von_mises_truss_follows_the_analytic_snap_through():
     # the issue asks 0.5 % of the limit load; the truss is exact up to the Newton tolerance
     r = va.von_mises_truss()
     assert r["w"].max() >= 2.5 * r["h"]
-    assert r["P"].min() < -0.9 * r["P_limit"]            # went through the negative branch
+    assert r["P"].min() < -0.9 * r["P_limit"]  # went through the negative branch
     err = np.abs(r["P"] - r["P_exact"]).max() / r["P_limit"]
     assert err < 5e-3
-    assert err < 1e-8                                      # in fact exact to the force tolerance
+    assert err < 1e-8  # in fact exact to the force tolerance
 
 
 @pytest.fixture(scope="module")
@@ -35,11 +35,11 @@ def test_lee_frame_limit_load(lee):
 def test_lee_frame_post_buckling_path(lee):
     # every FE point within 1 % (of the limit load / the 90 displacement range) of the elastica path,
     # in both displacement components, through the snap-back in u
-    path = ref.lee_frame_path(ds=0.1)   # arc-length spacing 0.1: chord error well below 1 %
+    path = ref.lee_frame_path(ds=0.1)  # arc-length spacing 0.1: chord error well below 1 %
     P_lim, _ = ref.lee_frame_limit_load()
     inside = lee["v"] <= path.v.max()
     assert inside.sum() > 50
-    assert lee["P"].min() < -0.4 * P_lim                  # reached the negative branch
+    assert lee["P"].min() < -0.4 * P_lim  # reached the negative branch
     for comp in ("v", "u"):
         d = path.distance(lee["P"][inside], lee[comp][inside], P_lim, 90.0, comp)
         assert d.max() < 1e-2, comp

@@ -10,12 +10,27 @@ from femast.analysis.assembly import _block_pattern, _scatter_diagonal, _scatter
 
 def reference_pattern(eq_list, row_lo, row_hi, col_lo, col_hi):
     """Sorted (row, col) entries of the block and the position of each element entry (-1: outside)."""
-    keys = sorted({(r - row_lo, c - col_lo) for eqs in eq_list for el in eqs for r in el for c in el
-                   if row_lo <= r < row_hi and col_lo <= c < col_hi})
+    keys = sorted(
+        {
+            (r - row_lo, c - col_lo)
+            for eqs in eq_list
+            for el in eqs
+            for r in el
+            for c in el
+            if row_lo <= r < row_hi and col_lo <= c < col_hi
+        }
+    )
     index = {k: p for p, k in enumerate(keys)}
-    positions = [np.array([[[index.get((r - row_lo, c - col_lo), -1) if r >= 0 and c >= 0 else -1 for c in el]
-                            for r in el] for el in eqs], dtype=np.int64).reshape(len(eqs), eqs.shape[1], eqs.shape[1])
-                 for eqs in eq_list]
+    positions = [
+        np.array(
+            [
+                [[index.get((r - row_lo, c - col_lo), -1) if r >= 0 and c >= 0 else -1 for c in el] for r in el]
+                for el in eqs
+            ],
+            dtype=np.int64,
+        ).reshape(len(eqs), eqs.shape[1], eqs.shape[1])
+        for eqs in eq_list
+    ]
     return keys, positions
 
 
@@ -24,8 +39,10 @@ def test_block_pattern_matches_an_entry_by_entry_reference(seed):
     rng = np.random.default_rng(seed)
     n = int(rng.integers(1, 30))
     # families of 1-12 equations per element, -1 for DOFs that are not equations
-    eq_list = [rng.integers(-1, n, size=(int(rng.integers(0, 20)), int(rng.integers(1, 13))))
-               for _ in range(int(rng.integers(1, 4)))]
+    eq_list = [
+        rng.integers(-1, n, size=(int(rng.integers(0, 20)), int(rng.integers(1, 13))))
+        for _ in range(int(rng.integers(1, 4)))
+    ]
     nf = int(rng.integers(0, n + 1))
     for block in ((0, nf, 0, nf), (0, nf, nf, n), (0, n, 0, n)):
         mat, positions = _block_pattern(eq_list, *block)
@@ -64,7 +81,7 @@ def test_assigning_scatter_needs_no_zeroing_and_gives_the_same_sums():
         _scatter_matrix(k, pos, ref)
     enc = assigning_positions(positions, mat.nnz)
     assert all(p.dtype == np.int32 for p in enc)
-    data = rng.normal(size=mat.nnz) * 1e6   # what a previous assembly left there
+    data = rng.normal(size=mat.nnz) * 1e6  # what a previous assembly left there
     Assembler.tangent_into(None, k_list, data, enc, assigning=True)
     assert np.array_equal(data, ref)
 
@@ -79,7 +96,7 @@ def test_setup_kernels_give_the_same_results_as_plain_python(seed, monkeypatch):
     eq_list = [rng.integers(-1, 30, size=(25, 12))]
     k = rng.normal(size=(25, 12, 12))
     results = []
-    for limit in (10 ** 9, -1):   # everything in Python, then everything compiled
+    for limit in (10**9, -1):  # everything in Python, then everything compiled
         monkeypatch.setattr(jit, "SETUP_PYTHON_MAX", limit)
         mat, (pos,) = _block_pattern(eq_list, 0, 20, 0, 20)
         diag = np.zeros(20)

@@ -94,12 +94,14 @@ def test_non_convergence_keeps_converged_increments_and_says_where(tmp_path):
     m.step("pull", initial_increment=0.5).load(b, fx=10.0)
     m.step("push", initial_increment=0.1, max_increment=0.1).load(b, fx=-10.0)
     out = tmp_path / "run"
-    with pytest.raises(fm.ConvergenceError, match=r"step 'push': increment fell below the minimum .* step time 0\.[45]"):
+    with pytest.raises(
+        fm.ConvergenceError, match=r"step 'push': increment fell below the minimum .* step time 0\.[45]"
+    ):
         fm.solve(m, out, progress=False)
     res = fm.Results(out)
     steps = res.steps
-    assert steps.count("pull") == 2                      # both converged increments of step 1 kept
-    assert steps.count("push") >= 4                       # the push increments before the cable went slack
+    assert steps.count("pull") == 2  # both converged increments of step 1 kept
+    assert steps.count("push") >= 4  # the push increments before the cable went slack
     t_last = res.scalar_history("time")[-1]
     # cut back towards the slack point, then gave up; the slack point itself (load = N = 0 at t = 0.5)
     # is an equilibrium that a linear increment reaches in one iteration

@@ -45,10 +45,16 @@ def single_joint_model(P, A, k_stick=2000.0, max_increment=0.1, family=None, nam
 
 
 def histories(res, b, fam="ball_joint"):
-    return dict(t=res.time, rz=res.node_history(b, "rz"), M=res.element_history(fam, 1, "moment")[:, 2],
-                F=res.element_history(fam, 1, "F"), limit=res.element_history(fam, 1, "limit"),
-                slip=res.element_history(fam, 1, "slip"), D=res.element_history(fam, 1, "dissipated"),
-                rmz=res.node_history(b, "rmz"))
+    return dict(
+        t=res.time,
+        rz=res.node_history(b, "rz"),
+        M=res.element_history(fam, 1, "moment")[:, 2],
+        F=res.element_history(fam, 1, "F"),
+        limit=res.element_history(fam, 1, "limit"),
+        slip=res.element_history(fam, 1, "slip"),
+        D=res.element_history(fam, 1, "dissipated"),
+        rmz=res.node_history(b, "rmz"),
+    )
 
 
 def at(h, total_time):
@@ -91,7 +97,7 @@ def test_loop_plateau_and_energy_per_cycle(tmp_path, P, max_increment):
     # cuts the stick-slip corner that falls inside an increment (a triangle of at most
     # 2Y x one increment's rotation), a few % with 0.1 s increments, ~15% with 0.7 s
     i0, i1 = at(h, 2.0), at(h, 6.0)
-    Mc, rc = h["M"][i0:i1 + 1], h["rz"][i0:i1 + 1]
+    Mc, rc = h["M"][i0 : i1 + 1], h["rz"][i0 : i1 + 1]
     area = float(np.sum(0.5 * (Mc[1:] + Mc[:-1]) * np.diff(rc)))
     assert area == pytest.approx(exact, rel=0.2 if max_increment > 0.5 else 0.05)  # corner cut by coarse increments
 

@@ -14,10 +14,11 @@ def test_committed_beads_and_zones_equal_the_latch_outputs():
 
     am = build_bay(bt.bay_parameters(bt.bay_inputs({}, bt.EXPERIMENT.options)))
     add_initial_steps(am, hold_control=("ux", "uy", "rz"))
-    th = np.radians([0.0, 1.0, 2.6, 3.0, 1.5, 0.0])   # through the release and back: all four zones
+    th = np.radians([0.0, 1.0, 2.6, 3.0, 1.5, 0.0])  # through the release and back: all four zones
     t = np.arange(len(th), dtype=float)
-    am.model.step("path", period=t[-1], initial_increment=1.0, max_increment=1.0, min_increment=1e-5,
-                  max_increments=600).follow(am.control, t, rz=th, ux=0 * t, uy=0 * t)
+    am.model.step(
+        "path", period=t[-1], initial_increment=1.0, max_increment=1.0, min_increment=1e-5, max_increments=600
+    ).follow(am.control, t, rz=th, ux=0 * t, uy=0 * t)
     fam = am.latch_family
     got, want = [], []
 
@@ -33,4 +34,4 @@ def test_committed_beads_and_zones_equal_the_latch_outputs():
     zone = np.array([w[1] for w in want])
     assert np.array_equal(out["bead"], bead, equal_nan=True)
     assert np.array_equal(out["zone"], zone)
-    assert len(np.unique(zone)) >= 3   # the path visits several zones (the comparison means something)
+    assert len(np.unique(zone)) >= 3  # the path visits several zones (the comparison means something)

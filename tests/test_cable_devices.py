@@ -4,11 +4,10 @@ import math
 
 import numpy as np
 import pytest
+from numba import njit
 from scipy.optimize import brentq
 
 from femast.elements.base import IncrementContext
-from numba import njit
-
 from femast.elements.cable_devices import CableDeviceFamily, Clamp, Latch, Pulley, UserDevice, wrap_geometry
 from femast.elements.cable_latch import CableLatchFamily
 from femast.errors import ModelError
@@ -44,9 +43,13 @@ def rotation(seed):
     q = np.random.default_rng(seed).standard_normal(4)
     q /= np.linalg.norm(q)
     w, x, y, z = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 # a cable turning 90 deg over one pulley at node 1
@@ -96,9 +99,11 @@ def test_capstan_stick_band_closed_form():
 def belt_by_hand(L, l0_fixed, wraps, L0_free, sliding):
     """Tensions of a cable whose last sections slide over capstans, solved by hand: T_{k+1} = T_k e^(mu phi_k)
     on the sliding part, l0_i = L_i / (1 + T_i / EA), sum of the sliding part's l0 = L0_free (brentq on T)."""
+
     def lengths(t):
         Ts = t * np.exp(MU * np.concatenate([[0.0], np.cumsum(wraps)]))
         return Ts, L[sliding] / (1.0 + Ts / EA)
+
     t = brentq(lambda t: lengths(t)[1].sum() - L0_free, 1e-9, 1e6, xtol=1e-14, rtol=1e-15)
     return lengths(t)[0]
 
@@ -173,9 +178,9 @@ def test_two_latches_release_one_after_the_other():
     out_B = np.flatnonzero(beads[:, 1] >= xc)[0]
     out_A = np.flatnonzero(beads[:, 0] >= xc)[0]
     assert out_B < out_A  # B first
-    assert np.all(beads[:out_B + 1, 0] == beads[0, 0])  # A does not move before B is out
+    assert np.all(beads[: out_B + 1, 0] == beads[0, 0])  # A does not move before B is out
     # the largest jump each latch held is its branch peak (0.5 % = the load step near the peak)
-    assert jumps[:out_B + 1, 1].max() == pytest.approx(peakB, rel=5e-3)
+    assert jumps[: out_B + 1, 1].max() == pytest.approx(peakB, rel=5e-3)
     assert jumps[: out_A + 1, 0].max() == pytest.approx(peakA, rel=5e-3)
     assert peakA > 3 * peakB  # distinct laws: the order is not an accident of geometry
 
@@ -221,13 +226,16 @@ def test_clamp_fixes_the_cable():
 XT = np.array([[0.0, 0.0, 0.0], [1.0, 0.2, 0.1], [1.3, 1.1, -0.2], [2.2, 1.4, 0.3]])
 
 
-@pytest.mark.parametrize("devices, pull, modes", [
-    ([Pulley(mu=MU), Pulley()], 0.01, [1, 3]),
-    ([Pulley(mu=MU), Pulley(mu=0.1)], 0.02, [1, 1]),
-    ([Pulley(mu=MU, radius=0.1), Pulley()], 0.01, [1, 3]),
-    ([Pulley(radius=0.15), Pulley(mu=0.2)], 0.0002, [3, 0]),
-    ([Clamp(), Pulley(mu=0.2)], 0.03, [0, 1]),
-])
+@pytest.mark.parametrize(
+    "devices, pull, modes",
+    [
+        ([Pulley(mu=MU), Pulley()], 0.01, [1, 3]),
+        ([Pulley(mu=MU), Pulley(mu=0.1)], 0.02, [1, 1]),
+        ([Pulley(mu=MU, radius=0.1), Pulley()], 0.01, [1, 3]),
+        ([Pulley(radius=0.15), Pulley(mu=0.2)], 0.0002, [3, 0]),
+        ([Clamp(), Pulley(mu=0.2)], 0.03, [0, 1]),
+    ],
+)
 def test_tangent_matches_finite_differences(devices, pull, modes):
     fam = CableDeviceFamily.pretensioned([[0, 1, 2, 3]], XT, EA, 80.0, devices)
     X = XT.copy()
@@ -337,9 +345,14 @@ def test_collinear_sized_pulley_and_adjacent_pulleys():
         CableDeviceFamily.pretensioned([[0, 1, 2, 3]], X, EA, 10.0, [Pulley(radius=0.1), Pulley(radius=0.1)])
 
 
-@pytest.mark.parametrize("dev, words", [
-    (Pulley(mu=-0.1), "mu = -0.1"), (Pulley(radius=float("nan")), "radius"), ("pulley", "is not a device"),
-])
+@pytest.mark.parametrize(
+    "dev, words",
+    [
+        (Pulley(mu=-0.1), "mu = -0.1"),
+        (Pulley(radius=float("nan")), "radius"),
+        ("pulley", "is not a device"),
+    ],
+)
 def test_bad_devices(dev, words):
     with pytest.raises(ModelError, match=words):
         CableDeviceFamily([[0, 1, 2]], EA, 2.0, [dev], s0=[1.0])
@@ -365,8 +378,7 @@ def test_user_device_law():
     T_out - T_in = F; combined with a built-in capstan on the same cable."""
     F = 40.0
     X = np.array([[0.0, 0, 0], [1.0, 0, 0], [1.0, 1.0, 0], [2.0, 1.0, 0]])
-    fam = CableDeviceFamily.pretensioned([[0, 1, 2, 3]], X, EA, 20.0,
-                                         [UserDevice(brake_law, (F,)), Pulley(mu=0.2)])
+    fam = CableDeviceFamily.pretensioned([[0, 1, 2, 3]], X, EA, 20.0, [UserDevice(brake_law, (F,)), Pulley(mu=0.2)])
     Xp = X.copy()
     Xp[3, 0] += 0.02
     r = ev(fam, Xp, fam.initial_state())

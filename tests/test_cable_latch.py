@@ -13,8 +13,8 @@ from femast.elements.cable_latch import (
     cable_equations,
 )
 from femast.errors import ModelError
-from femast.testing import fd_tangent as _fd
 from femast.latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force
+from femast.testing import fd_tangent as _fd
 
 P = LatchParameters.seed_fit()
 MM = 1e-3
@@ -120,8 +120,18 @@ def test_all_2n_equations_hold(x0, node, dx, status):
     fam, st, X = _slip_case(x0, node, dx)
     r = evaluate(fam, X, st)
     assert r.state[0, 1] == status
-    res = cable_equations(X, r.output["tension"][0], r.state[0, 2:], EA, fam.L0[0], latch_node=1,
-                          bead=fam.bead[0], latch=P, status=status, x_committed=st[0, 0])
+    res = cable_equations(
+        X,
+        r.output["tension"][0],
+        r.state[0, 2:],
+        EA,
+        fam.L0[0],
+        latch_node=1,
+        bead=fam.bead[0],
+        latch=P,
+        status=status,
+        x_committed=st[0, 0],
+    )
     assert np.all(np.abs(res[:2]) < 1e-9)  # constitutive laws, N: solver tolerance ~1e-13 of EA
     assert abs(res[2]) < 1e-14  # Eq. 4, m: round-off on a 1 m cable
     assert abs(res[3]) < 1e-8  # latch jump (N, or m when sticking): solver tolerance
@@ -208,9 +218,10 @@ def test_batch_equals_single_elements():
     X2[5, 0] += 0.05 * MM
     r = evaluate(fam, X2, fam.initial_state())
     for e in range(2):
-        single = CableLatchFamily(np.array([[0, 1, 2]]), EA=EA, L0=fam.L0[e], latch_node=1, bead=fam.bead[e],
-                                  latch=P, x0=fam.x0[e])
-        rs = evaluate(single, X2[3 * e: 3 * e + 3], single.initial_state())
+        single = CableLatchFamily(
+            np.array([[0, 1, 2]]), EA=EA, L0=fam.L0[e], latch_node=1, bead=fam.bead[e], latch=P, x0=fam.x0[e]
+        )
+        rs = evaluate(single, X2[3 * e : 3 * e + 3], single.initial_state())
         np.testing.assert_allclose(r.f[e], rs.f[0], rtol=1e-14, atol=1e-12)  # same arithmetic
         np.testing.assert_allclose(r.k[e], rs.k[0], rtol=1e-14, atol=1e-9)  # same arithmetic
 
@@ -327,8 +338,9 @@ def test_coincident_nodes():
 
 def test_initial_state_layout():
     X = np.array([[0, 0, 0], [0.2, 0.05, 0], [0.35, 0.2, 0.05], [0.5, 0.1, 0.1], [0.7, 0.0, 0.0]], float)
-    fam = CableLatchFamily([[0, 1, 2, 3, 4], [0, 1, 2, 3, 4]], EA=EA, L0=0.9, latch_node=[2, 0], bead=0.45,
-                           latch=[P, P], x0=[1e-3, 0.0])
+    fam = CableLatchFamily(
+        [[0, 1, 2, 3, 4], [0, 1, 2, 3, 4]], EA=EA, L0=0.9, latch_node=[2, 0], bead=0.45, latch=[P, P], x0=[1e-3, 0.0]
+    )
     st = fam.initial_state()
     np.testing.assert_allclose(st[0], [1e-3, 0, 0.2245, 0.2245, 0.2255, 0.2255], rtol=1e-12)  # hand split
     np.testing.assert_allclose(st[1, 2:], 0.225, rtol=1e-12)  # no latch: L0 / n
@@ -341,8 +353,8 @@ def test_committed_configuration_is_checked_once_per_increment_but_for_every_new
     fam = CableLatchFamily([[0, 1, 2]], EA=EA, L0=0.85, latch_node=1, bead=0.4, latch=P, name="side_C")
     st = fam.initial_state()
     Xc = X3.copy()
-    fam.evaluate(X3, None, st, IncrementContext(x_committed=Xc))     # fine
-    fam.L0 = np.array([0.5])      # now too short for the anchors (a user change between increments)
+    fam.evaluate(X3, None, st, IncrementContext(x_committed=Xc))  # fine
+    fam.L0 = np.array([0.5])  # now too short for the anchors (a user change between increments)
     # another iteration of the same increment (the same committed array): not checked again
     fam.evaluate(X3, None, st, IncrementContext(x_committed=Xc))
     # the next increment passes a new committed array with the same values: checked, and it fails

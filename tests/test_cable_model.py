@@ -22,8 +22,11 @@ def test_force_controlled_unlatching_in_a_model(tmp_path):
     m.fix(latch)
     m.fix(grip, "uy", "uz", "rx", "ry", "rz")
     s0, L0B = 0.3, 0.5
-    m.add_family(CableLatchFamily([[a, latch, grip]], EA=EA, L0=s0 + L0B, latch_node=1,
-                                  bead=s0 - P.x_backstop, latch=P, name="cable"))
+    m.add_family(
+        CableLatchFamily(
+            [[a, latch, grip]], EA=EA, L0=s0 + L0B, latch_node=1, bead=s0 - P.x_backstop, latch=P, name="cable"
+        )
+    )
     F = 60.0
     m.step("pull", max_increment=0.1).load(grip, fx=F)
     res = fm.Analysis(m, tmp_path / "run", progress=False).run()

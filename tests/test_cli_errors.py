@@ -34,8 +34,12 @@ def _one_line_error(capsys, argv, *needles):
 
 
 def test_render_missing_frame(results, capsys, tmp_path):
-    _one_line_error(capsys, ["render", str(results), str(tmp_path / "x.png"), "--frame", "99"],
-                    "frame 99 does not exist", "3 frames")
+    _one_line_error(
+        capsys,
+        ["render", str(results), str(tmp_path / "x.png"), "--frame", "99"],
+        "frame 99 does not exist",
+        "3 frames",
+    )
 
 
 def test_vtk_every_zero(results, capsys):

@@ -20,7 +20,7 @@ def test_main_restores_the_collector(tmp_path, capsys):
     assert main(["compare", "mast-top", "example", "--out", str(tmp_path / "o"), "--json"]) == 0
     capsys.readouterr()
     assert gc.get_threshold() == before
-    assert gc.get_freeze_count() == 0   # (compare froze the heap before its exit)
+    assert gc.get_freeze_count() == 0  # (compare froze the heap before its exit)
 
 
 def test_a_partial_frame_is_one_warning_line_on_the_command_line(tmp_path, capsys):
@@ -37,12 +37,17 @@ def test_a_partial_frame_is_one_warning_line_on_the_command_line(tmp_path, capsy
     m.step("s", initial_increment=0.5, max_increment=0.5).load(b, fz=-10.0)
     fm.solve(m, tmp_path / "r", progress=False)
     with open(tmp_path / "r" / "frames" / LOG_NAME, "ab") as fh:
-        fh.write(b"FEMASTFR\x00\x10\x00\x00\x00\x00\x00\x00PK")   # a record cut short
+        fh.write(b"FEMASTFR\x00\x10\x00\x00\x00\x00\x00\x00PK")  # a record cut short
     # a fresh process: pytest records warnings instead of printing them
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
-    p = subprocess.run([sys.executable, "-m", "femast.cli", "info", str(tmp_path / "r")], env=env,
-                       capture_output=True, text=True, timeout=300)
-    assert p.returncode == 0 and "3 frames" in p.stdout   # the initial state and the two increments, before the cut
+    p = subprocess.run(
+        [sys.executable, "-m", "femast.cli", "info", str(tmp_path / "r")],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert p.returncode == 0 and "3 frames" in p.stdout  # the initial state and the two increments, before the cut
     lines = [l for l in p.stderr.splitlines() if "partial" in l]
     assert len(lines) == 1 and lines[0].startswith("femast: warning:") and "partial last frame" in lines[0]
     assert "cli.py" not in p.stderr

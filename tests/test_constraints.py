@@ -43,7 +43,9 @@ def test_small_rotation_torsional_stiffness_matches_beam_theory():
     c = m.xyz(ctrl)
     for t in tops:
         X = m.xyz(t)
-        np.testing.assert_allclose(U[m.index(t)], (Q - np.eye(3)) @ (X - c), atol=1e-16)  # roundoff of 0.3 m coordinates
+        np.testing.assert_allclose(
+            U[m.index(t)], (Q - np.eye(3)) @ (X - c), atol=1e-16
+        )  # roundoff of 0.3 m coordinates
 
 
 def test_large_rotation_about_any_axis_is_exact_for_tied_nodes():
@@ -63,13 +65,13 @@ def test_large_rotation_about_any_axis_is_exact_for_tied_nodes():
     c = X[m.index(ctrl)]
     expect = (X - c) @ Q.T + c + np.array([0.1, 0, 0])
     np.testing.assert_allclose(X + res.frame(-1)["U"], expect, atol=1e-12)  # exact rigid motion
-    assert np.abs(res.frame(-1)["el/beam/section_forces"]).max() < 1e-6    # N, N m: no deformation
+    assert np.abs(res.frame(-1)["el/beam/section_forces"]).max() < 1e-6  # N, N m: no deformation
 
 
 def test_reduced_tangent_with_rigid_body_matches_finite_differences():
     # loaded, deformed tower: the reduced tangent T^T K T + G (lever-arm term) against central FD
     m, ctrl, tops, sec = _tower()
-    side = m.node(0.6, 0.0, 0.5)                          # an extra tied node carrying a load
+    side = m.node(0.6, 0.0, 0.5)  # an extra tied node carrying a load
     m.rigid_bodies[0] = m.rigid_bodies[0].__class__("top frame", ctrl, tuple(tops) + (side,))
     m.truss(side, m.node(1.2, 0.0, 0.0), EA=1e6)
     m.fix(m.node_labels[-1])

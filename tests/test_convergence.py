@@ -13,13 +13,21 @@ from femast.analysis.solvers.convergence import Convergence
 
 def _check(conv, r, du, Du, iteration):
     is_rot = np.array([False, False, True])
-    return conv.check(np.asarray(r, float), np.asarray(du, float), np.asarray(Du, float), is_rot,
-                      ref_force=1.0, ref_moment=1.0, length=1.0, iteration=iteration)[0]
+    return conv.check(
+        np.asarray(r, float),
+        np.asarray(du, float),
+        np.asarray(Du, float),
+        is_rot,
+        ref_force=1.0,
+        ref_moment=1.0,
+        length=1.0,
+        iteration=iteration,
+    )[0]
 
 
 def test_linear_increment_rule():
-    conv = Convergence()   # force_tol 1e-6, disp_tol 1e-6, linear_tol 1e-8
-    du = Du = [1e-3, 0.0, 1e-3]   # first iteration: the correction is the whole increment
+    conv = Convergence()  # force_tol 1e-6, disp_tol 1e-6, linear_tol 1e-8
+    du = Du = [1e-3, 0.0, 1e-3]  # first iteration: the correction is the whole increment
     # residual 1e-10 of the reference after one iteration: a linear increment, accepted
     assert _check(conv, [1e-10, 0.0, 1e-10], du, Du, iteration=1)
     # the same state at a later iteration is judged by the correction test (ratio 1: not converged)
@@ -27,7 +35,7 @@ def test_linear_increment_rule():
     # residual 1e-7: inside force_tol but not linear, and the correction is the whole increment
     assert not _check(conv, [1e-7, 0.0, 0.0], du, Du, iteration=1)
     # the tighter of linear_tol and force_tol applies: with force_tol 1e-9, 1e-8.5 is not linear
-    assert not _check(Convergence(force_tol=1e-9), [10 ** -8.5, 0.0, 0.0], du, Du, iteration=1)
+    assert not _check(Convergence(force_tol=1e-9), [10**-8.5, 0.0, 0.0], du, Du, iteration=1)
 
 
 def test_a_round_off_load_change_converges_with_friction_joints():

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from femast.verification import references as ref
 from femast import verification as v
+from femast.verification import references as ref
 
 
 def _assert_rows(rows):

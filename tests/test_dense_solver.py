@@ -7,14 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from test_linear_backends import backward_error, chain_matrix
 
 import femast as fm
 from femast.analysis import Analysis
 from femast.analysis.solvers import backends, dense
 from femast.analysis.solvers.linear import SparseLU
 from femast.errors import SingularModelError
-
-from test_linear_backends import backward_error, chain_matrix
 
 
 def solve(A, backend, b, pivot_check="always"):
@@ -27,7 +26,7 @@ def solve(A, backend, b, pivot_check="always"):
 def test_dense_lu_solves_like_numpy(asym):
     A = chain_matrix(n=40, b=7, asym=asym)
     b = np.random.default_rng(2).normal(size=40)
-    for backend in ("dense", "auto"):   # 40 DOFs: the automatic rule takes the dense LU
+    for backend in ("dense", "auto"):  # 40 DOFs: the automatic rule takes the dense LU
         lu, x = solve(A, backend, b)
         assert lu.engine == "dense"
         # LU with partial pivoting: backward stable (~1e-16 x a small growth factor)
@@ -40,11 +39,11 @@ def test_dense_lu_solves_like_numpy(asym):
 def test_dense_lu_indefinite():
     A = chain_matrix(n=50)
     w = np.linalg.eigvalsh(A.toarray())
-    A2 = (A - 0.5 * (w[2] + w[3]) * sp.identity(50)).tocsr()   # 3 negative eigenvalues: a limit point passed
+    A2 = (A - 0.5 * (w[2] + w[3]) * sp.identity(50)).tocsr()  # 3 negative eigenvalues: a limit point passed
     b = np.random.default_rng(4).normal(size=50)
     lu, x = solve(A2, "auto", b)
     assert lu.engine == "dense"
-    assert backward_error(A2, x, b) <= 1e-14   # as above
+    assert backward_error(A2, x, b) <= 1e-14  # as above
     x_ref = np.linalg.solve(A2.toarray(), b)
     # the shift leaves cond ~ 1e3-1e4: forward error ~ cond x 1e-16
     assert np.abs(x - x_ref).max() <= 1e-9 * np.abs(x_ref).max()
@@ -53,18 +52,18 @@ def test_dense_lu_indefinite():
 def test_dense_lu_singular_is_reported():
     A = chain_matrix(n=40).tolil()
     big = abs(A).max()
-    for eps in (0.0, 1e-15):   # exactly singular, and a pivot far below 1e-13 of the largest
+    for eps in (0.0, 1e-15):  # exactly singular, and a pivot far below 1e-13 of the largest
         S = A.copy()
         S[20, :] = 0.0
         S[:, 20] = 0.0
         S[20, 20] = eps * big
         S = S.tocsr()
-        if eps == 0.0:   # keep the diagonal entry in the pattern (an assembled tangent has it)
+        if eps == 0.0:  # keep the diagonal entry in the pattern (an assembled tangent has it)
             S = (S + sp.csr_matrix(([1e-300], ([20], [20])), shape=S.shape)).tocsr()
             S.data[S.data == 1e-300] = 0.0
         with pytest.raises(SingularModelError):
             solve(S, "dense", np.ones(40))
-        with pytest.raises(SingularModelError):   # the first factorisation of a pattern is always tested
+        with pytest.raises(SingularModelError):  # the first factorisation of a pattern is always tested
             solve(S, "auto", np.ones(40), pivot_check="auto")
 
 
@@ -95,8 +94,11 @@ def bend(n_el=8):
     m = fm.Model("bend")
     ang = np.linspace(0.0, np.pi / 4, n_el + 1)
     n = np.asarray(m.nodes(np.column_stack([100 * (1 - np.cos(ang)), 100 * np.sin(ang), 0 * ang])))
-    m.beams(np.column_stack([n[:-1], n[1:]]), fm.Section(E=1e7, G=5e6, A=1.0, Iy=1 / 12, Iz=1 / 12, J=0.140577),
-            up=(0.0, 0.0, 1.0))
+    m.beams(
+        np.column_stack([n[:-1], n[1:]]),
+        fm.Section(E=1e7, G=5e6, A=1.0, Iy=1 / 12, Iz=1 / 12, J=0.140577),
+        up=(0.0, 0.0, 1.0),
+    )
     m.fix(n[0])
     m.step("load", initial_increment=0.1, max_increment=0.1).load(n[-1], fz=600.0)
     return m

@@ -9,8 +9,17 @@ import pytest
 from femast.errors import DataFileError, ModelError
 from femast.experiments import Measured
 from femast.experiments.fitting import bic
-from femast.experiments.noise import (ChannelNoise, ar1_threshold, channel_noise, difference_phi, effective_n,
-                                      given_sigma, heteroscedastic_fit, information_criterion, lag1)
+from femast.experiments.noise import (
+    ChannelNoise,
+    ar1_threshold,
+    channel_noise,
+    difference_phi,
+    effective_n,
+    given_sigma,
+    heteroscedastic_fit,
+    information_criterion,
+    lag1,
+)
 
 
 def _ar1(phi, n, sigma, rng):
@@ -77,12 +86,14 @@ def test_information_criterion_is_the_bic_for_white_noise_and_uses_n_eff():
     corr = {c: ChannelNoise(c, "ar1", np.ones(200), 0.5, effective_n(200, 0.5)) for c in "abc"}
     N = 3 * 200 / 3.0  # (1 - 0.5) / (1 + 0.5) = 1/3
     assert information_criterion(z, 200, corr, 4) == pytest.approx(
-        N * math.log(float(z @ z) / 3.0 / N) + 4 * math.log(N), rel=1e-12)
+        N * math.log(float(z @ z) / 3.0 / N) + 4 * math.log(N), rel=1e-12
+    )
 
 
 def test_given_sigma_column_is_used_and_checked():
-    d = Measured("latch-pull", {"x_mm": np.zeros(12), "dT_N": np.zeros(12), "sigma_dT_N": np.full(12, 0.3)},
-                 path="pull.csv")
+    d = Measured(
+        "latch-pull", {"x_mm": np.zeros(12), "dT_N": np.zeros(12), "sigma_dT_N": np.full(12, 0.3)}, path="pull.csv"
+    )
     np.testing.assert_array_equal(given_sigma(d, "dT_N"), 0.3)
     m = channel_noise("dT_N", np.zeros(12), 12, given=given_sigma(d, "dT_N"))
     assert m.kind == "given" and "sigma_dT_N" in m.reason

@@ -15,15 +15,28 @@ THR = 1.2
 
 def _e(effect, ratio, dbic, r0=3.0, form=""):
     frac = share(r0, ratio)
-    return {"effect": effect, "ratio": ratio, "delta_bic": dbic, "explained_fraction": frac, "form": form,
-            **flags(dbic, frac)}
+    return {
+        "effect": effect,
+        "ratio": ratio,
+        "delta_bic": dbic,
+        "explained_fraction": frac,
+        "form": form,
+        **flags(dbic, frac),
+    }
 
 
 def _pair(effects, ratio, dbic, best_single, r0=3.0):
     frac = share(r0, ratio)
-    return {"effects": effects, "forms": ["", ""], "ratio": ratio, "delta_bic": dbic, "explained_fraction": frac,
-            **flags(dbic, frac), "gain_over_best_single": dbic - best_single["delta_bic"],
-            "share_over_best_single": frac - best_single["explained_fraction"]}
+    return {
+        "effects": effects,
+        "forms": ["", ""],
+        "ratio": ratio,
+        "delta_bic": dbic,
+        "explained_fraction": frac,
+        **flags(dbic, frac),
+        "gain_over_best_single": dbic - best_single["delta_bic"],
+        "share_over_best_single": frac - best_single["explained_fraction"],
+    }
 
 
 def test_share_and_significance_need_both_criteria():
@@ -103,8 +116,13 @@ def test_smooth_friction_loop_is_found_as_friction():
 
 def test_piecewise_linear_clearance_is_found_with_its_closing_scale():
     # a gap of +-2e-4 rad closed linearly over +-20 N m (a piecewise-linear contact, not tanh)
-    d = diagnose(get_experiment("mast-top"), _mast_data(lambda m: m / K + 2e-4 * np.clip(m / 20.0, -1, 1)),
-                 ["joint_clearance", "friction_hysteresis", "cable_hysteresis"], workers=1, pairs=False)
+    d = diagnose(
+        get_experiment("mast-top"),
+        _mast_data(lambda m: m / K + 2e-4 * np.clip(m / 20.0, -1, 1)),
+        ["joint_clearance", "friction_hysteresis", "cable_hysteresis"],
+        workers=1,
+        pairs=False,
+    )
     assert d.verdict["kind"] == "missing_effect" and d.verdict["missing_effect"] == "joint_clearance"
     top = d.ranking[0]
     assert top["form"] == "smooth" and top["ratio"] <= d.at_noise
@@ -123,8 +141,7 @@ def test_latch_pull_null_redraws_with_eq15_noise_and_a_small_friction():
         assert d.verdict["kind"] == "nothing_missing", (seed, d.verdict["conclusion"])
         assert d.noise_model["dT_N"].kind.startswith("heteroscedastic")
     for seed in range(3):  # ... and a bead friction of 0.4 N claimed 3 of 3
-        data, _ = latch_pull_data(effects={"friction_hysteresis": {"F_f": 0.4}}, seed=seed, noise_N=0.3,
-                                  noise_mm=0.02)
+        data, _ = latch_pull_data(effects={"friction_hysteresis": {"F_f": 0.4}}, seed=seed, noise_N=0.3, noise_mm=0.02)
         d = diagnose(exp, data, workers=1)
         assert d.verdict["missing_effects"] == ["friction_hysteresis"], (seed, d.verdict["conclusion"])
 

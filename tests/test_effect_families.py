@@ -44,8 +44,9 @@ def test_iwan_uniform_strengths_follow_the_closed_form_virgin_curve_and_masing_b
     R, N = 10.0, IWAN_ELEMENTS
     u = np.concatenate([np.linspace(0, 15, 301), np.linspace(15, -15, 601)])
     y = iwan(u, R, 1.0, 0.0)
-    expect = np.concatenate([_virgin_uniform(u[:301], R), _virgin_uniform(15.0, R) - 2 * _virgin_uniform(
-        (15.0 - u[301:]) / 2, R)])
+    expect = np.concatenate(
+        [_virgin_uniform(u[:301], R), _virgin_uniform(15.0, R) - 2 * _virgin_uniform((15.0 - u[301:]) / 2, R)]
+    )
     # mid-quantile rule on an integrand with one slope kink: virgin error <= R / (8 N^2), the Masing
     # branch doubles it (f(U) - 2 f(.)): R / (4 N^2)
     np.testing.assert_allclose(y[:301], expect[:301], atol=R / (8 * N**2) * (1 + 1e-9))
@@ -89,11 +90,14 @@ def test_proportional_iwan_uniform_coefficients_follow_the_closed_form_return_br
 
 def test_forms_are_listed_and_selected_by_name():
     exp = get_experiment("mast-top")
-    assert forms_of("friction_hysteresis", "mast-top") == ("friction_hysteresis", "friction_hysteresis/jenkins",
-                                                            "friction_hysteresis/iwan")
-    (name, impl), = resolve(exp, ["friction_hysteresis/iwan"])
+    assert forms_of("friction_hysteresis", "mast-top") == (
+        "friction_hysteresis",
+        "friction_hysteresis/jenkins",
+        "friction_hysteresis/iwan",
+    )
+    ((name, impl),) = resolve(exp, ["friction_hysteresis/iwan"])
     assert name == "friction_hysteresis/iwan" and [p.name for p in impl.parameters] == ["M_f", "beta", "alpha"]
-    (name, impl), = resolve(exp, ["friction_hysteresis/play"])  # the default form by its name
+    ((name, impl),) = resolve(exp, ["friction_hysteresis/play"])  # the default form by its name
     assert name == "friction_hysteresis"
     with pytest.raises(ModelError, match="unknown form 'dahl'.*play, jenkins, iwan"):
         resolve(exp, ["friction_hysteresis/dahl"])
@@ -109,9 +113,10 @@ def test_generalised_forms_reduce_exactly_to_the_default_forms_mast_top():
     exp, data = _mt()
     ms = 0.01 * np.max(np.abs(exp.prepared(data)["m"]), axis=0)
     base = {"k_theta1": 2.6e5, "k_theta2": 2.4e5}
-    for old, new in [({"friction_hysteresis": {"M_f": 7.0}}, {"friction_hysteresis/jenkins": {"M_f": 7.0, "alpha": 0.0}}),
-                     ({"progressive_stiffness": {"beta": 3e-4}},
-                      {"progressive_stiffness/quadratic": {"beta": 3e-4, "beta2": 0.0}})]:
+    for old, new in [
+        ({"friction_hysteresis": {"M_f": 7.0}}, {"friction_hysteresis/jenkins": {"M_f": 7.0, "alpha": 0.0}}),
+        ({"progressive_stiffness": {"beta": 3e-4}}, {"progressive_stiffness/quadratic": {"beta": 3e-4, "beta2": 0.0}}),
+    ]:
         a, b = predict(exp, data, base, old), predict(exp, data, base, new)
         for c in exp.channels:
             np.testing.assert_array_equal(a[c], b[c])

@@ -85,12 +85,31 @@ def _run_json(capsys, argv):
 
 def test_compare_json_files_and_history_show_the_error_falling(tmp_path, capsys):
     out = tmp_path / "out"
-    runs = [[], ["--fit"], ["--effects", "joint_clearance", "--fit"],
-            ["--effects", "joint_clearance,friction_hysteresis", "--fit"]]
+    runs = [
+        [],
+        ["--fit"],
+        ["--effects", "joint_clearance", "--fit"],
+        ["--effects", "joint_clearance,friction_hysteresis", "--fit"],
+    ]
     reports = [_run_json(capsys, ["compare", "mast-top", str(MT_DATA), "--out", str(out), "--json"] + r) for r in runs]
     r = reports[-1]
-    for key in ("experiment", "data", "n_samples", "effects", "fit", "params", "error_unit", "rms", "noise_rms",
-                "ratio", "channels", "segments_by_kind", "worst_segments", "version", "files"):
+    for key in (
+        "experiment",
+        "data",
+        "n_samples",
+        "effects",
+        "fit",
+        "params",
+        "error_unit",
+        "rms",
+        "noise_rms",
+        "ratio",
+        "channels",
+        "segments_by_kind",
+        "worst_segments",
+        "version",
+        "files",
+    ):
         assert key in r
     assert r["experiment"] == "mast-top" and r["n_samples"] == 500 and r["error_unit"] == "m"
     assert set(r["channels"]) == {"dx_m", "dy_m", "dz_m"}
@@ -121,25 +140,66 @@ def test_diagnose_json_schema_of_issue_7(tmp_path, capsys):
     assert [e["delta_bic"] for e in r["ranking"]] == sorted(e["delta_bic"] for e in r["ranking"])
     assert set(r["verdict"]) >= {"missing_effect", "explained"}
     # the example hides two effects: the best single one does not explain it all, the pair does (issue 14)
-    assert r["verdict"] == {**r["verdict"], "missing_effect": None, "explained": True, "kind": "missing_pair",
-                            "best_candidate": "joint_clearance"}
+    assert r["verdict"] == {
+        **r["verdict"],
+        "missing_effect": None,
+        "explained": True,
+        "kind": "missing_pair",
+        "best_candidate": "joint_clearance",
+    }
     assert sorted(r["verdict"]["missing_effects"]) == ["friction_hysteresis", "joint_clearance"]
     assert {"noise_model", "n_eff", "pairs", "form_check"} <= set(r)
     assert {"form", "forms", "ic_gain", "share_ok"} <= set(r["ranking"][0])
     assert (tmp_path / "diagnose.png").stat().st_size > 0 and (tmp_path / "diagnose.json").is_file()
-    r = _run_json(capsys, ["diagnose", "mast-top", str(MT_DATA), "--out", str(tmp_path), "--json",
-                           "--effects", "joint_clearance", "--workers", "1"])
+    r = _run_json(
+        capsys,
+        [
+            "diagnose",
+            "mast-top",
+            str(MT_DATA),
+            "--out",
+            str(tmp_path),
+            "--json",
+            "--effects",
+            "joint_clearance",
+            "--workers",
+            "1",
+        ],
+    )
     assert r["verdict"]["missing_effect"] == "friction_hysteresis" and r["verdict"]["explained"] is True
 
 
 def test_text_output(tmp_path, capsys):
-    assert main(["compare", "latch-pull", str(ROOT / "femast/examples/latch_pull_example.csv"), "--fit",
-                 "--out", str(tmp_path)]) == 0
+    assert (
+        main(
+            [
+                "compare",
+                "latch-pull",
+                str(ROOT / "femast/examples/latch_pull_example.csv"),
+                "--fit",
+                "--out",
+                str(tmp_path),
+            ]
+        )
+        == 0
+    )
     text = capsys.readouterr().out
     assert "overall RMS error" in text and "noise floor" in text and "worst segments:" in text
     assert "x_backstop =" in text and "file lines" in text
-    assert main(["diagnose", "latch-pull", str(ROOT / "femast/examples/latch_pull_example.csv"),
-                 "--out", str(tmp_path), "--workers", "1"]) == 0
+    assert (
+        main(
+            [
+                "diagnose",
+                "latch-pull",
+                str(ROOT / "femast/examples/latch_pull_example.csv"),
+                "--out",
+                str(tmp_path),
+                "--workers",
+                "1",
+            ]
+        )
+        == 0
+    )
     text = capsys.readouterr().out
     assert "verdict: missing effect: latch_hysteresis" in text and "reading of #1" in text
 
@@ -163,8 +223,10 @@ def test_user_experiment_and_effect_from_a_script(spring, tmp_path, capsys):
     assert r["verdict"]["missing_effect"] == "spring_slip"
     s = r["ranking"][0]["params"]["s"]
     assert abs(s["value"] - 2e-4) < 4 * s["stderr"]  # within 4 standard errors of the hidden slip
-    r = _run_json(capsys, ["compare", str(script), str(csv), "--effects", "spring_slip", "--fit", "--out",
-                           str(tmp_path), "--json"])
+    r = _run_json(
+        capsys,
+        ["compare", str(script), str(csv), "--effects", "spring_slip", "--fit", "--out", str(tmp_path), "--json"],
+    )
     assert r["ratio"] <= 1.2
 
 
@@ -178,12 +240,25 @@ def test_user_effect_script_for_a_built_in_experiment(tmp_path, capsys, request)
     data.columns["dy_m"] = data["dy_m"] - 2e-4 * tau
     csv = write_data(tmp_path / "drifting.csv", data, get_experiment("mast-top"))
     base = _run_json(capsys, ["compare", "mast-top", str(csv), "--fit", "--json", "--out", str(tmp_path)])
-    r = _run_json(capsys, ["compare", "mast-top", str(csv), "--fit", "--json", "--out", str(tmp_path),
-                           "--effects", f"{eff}:thermal_drift"])
+    r = _run_json(
+        capsys,
+        [
+            "compare",
+            "mast-top",
+            str(csv),
+            "--fit",
+            "--json",
+            "--out",
+            str(tmp_path),
+            "--effects",
+            f"{eff}:thermal_drift",
+        ],
+    )
     assert base["ratio"] > 2 and r["ratio"] <= 1.2
     assert r["params"]["thermal_drift.vx"]["value"] == pytest.approx(4e-4, rel=0.05)  # 0.4 mm drift, 0.05 mm noise
-    r2 = _run_json(capsys, ["compare", "mast-top", str(csv), "--fit", "--json", "--out", str(tmp_path),
-                            "--effects", str(eff)])  # every effect of the script
+    r2 = _run_json(
+        capsys, ["compare", "mast-top", str(csv), "--fit", "--json", "--out", str(tmp_path), "--effects", str(eff)]
+    )  # every effect of the script
     assert r2["effects"] == ["thermal_drift"]
 
 
@@ -193,8 +268,7 @@ def test_dask_local_cluster(spring):
     exp = get_experiment(str(script))
     data = read_data(exp, csv)
     serial = diagnose(exp, data, workers=1)
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster:
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         d = diagnose(exp, data, scheduler=cluster.scheduler_address)
         # the workers are fresh processes: they re-loaded the user script to rebuild the experiment
         assert d.executor.startswith("dask.distributed at tcp://")

@@ -26,9 +26,15 @@ def _rows(n=12, cols=9):
     return [",".join(f"{0.1 * (i + j):g}" for j in range(cols)) for i in range(n)]
 
 
-@pytest.mark.parametrize("name,exp", [("mast_top_example.csv", "mast-top"), ("latch_pull_example.csv", "latch-pull"),
-                                      ("tip_cycle_seed001_table1.csv", "tip-cycle"),
-                                      ("bay_torsion_format.csv", "bay-torsion")])
+@pytest.mark.parametrize(
+    "name,exp",
+    [
+        ("mast_top_example.csv", "mast-top"),
+        ("latch_pull_example.csv", "latch-pull"),
+        ("tip_cycle_seed001_table1.csv", "tip-cycle"),
+        ("bay_torsion_format.csv", "bay-torsion"),
+    ],
+)
 def test_example_files_follow_their_format(name, exp):
     e = get_experiment(exp)
     d = read_data(e, DATA / name)
@@ -57,14 +63,19 @@ def test_write_read_round_trip_with_comments_and_time(tmp_path):
 
 def test_missing_column(tmp_path):
     p = _write(tmp_path, [HEADER.replace(",dz_m", "")] + _rows(cols=8))
-    with pytest.raises(DataFileError, match=r"d\.csv line 1: missing column\(s\) dz_m; mast-top needs .*dx_m, dy_m, dz_m"):
+    with pytest.raises(
+        DataFileError, match=r"d\.csv line 1: missing column\(s\) dz_m; mast-top needs .*dx_m, dy_m, dz_m"
+    ):
         read_data(MT, p)
 
 
 def test_extra_column(tmp_path):
     p = _write(tmp_path, [HEADER + ",temp_C"] + _rows(cols=10))
-    with pytest.raises(DataFileError, match=r"d\.csv line 1: column 'temp_C' is not a mast-top column; accepted "
-                                            r"columns: fx_N, .*dz_m, t_s \(optional\)"):
+    with pytest.raises(
+        DataFileError,
+        match=r"d\.csv line 1: column 'temp_C' is not a mast-top column; accepted "
+        r"columns: fx_N, .*dz_m, t_s \(optional\)",
+    ):
         read_data(MT, p)
 
 
@@ -91,8 +102,11 @@ def test_non_numeric_and_empty_cells(tmp_path):
     cells[7] = "1.2.3"
     rows[2] = ",".join(cells)
     p = _write(tmp_path, [HEADER] + rows)
-    with pytest.raises(DataFileError, match=r"line 4, column 'dy_m': '1\.2\.3' is not a number; every cell must be a "
-                                            r"decimal number in m"):
+    with pytest.raises(
+        DataFileError,
+        match=r"line 4, column 'dy_m': '1\.2\.3' is not a number; every cell must be a "
+        r"decimal number in m",
+    ):
         read_data(MT, p)
     rows = _rows()
     cells = rows[0].split(",")
@@ -131,8 +145,11 @@ def test_no_header_duplicate_column_time_backwards_missing_file(tmp_path):
 
 def test_latch_pull_bad_column_lists_the_latch_columns(tmp_path):
     p = _write(tmp_path, ["x_m,dT_N"] + [f"{i},{i}" for i in range(12)])
-    with pytest.raises(DataFileError, match=r"column 'x_m' is not a latch-pull column \(did you mean 'x_mm'\?\); "
-                                            r"accepted columns: x_mm, dT_N, side \(optional\), t_s \(optional\)"):
+    with pytest.raises(
+        DataFileError,
+        match=r"column 'x_m' is not a latch-pull column \(did you mean 'x_mm'\?\); "
+        r"accepted columns: x_mm, dT_N, side \(optional\), t_s \(optional\)",
+    ):
         read_data(get_experiment("latch-pull"), p)
 
 
@@ -143,10 +160,15 @@ def test_from_arrays_checks_too():
 
 def test_unknown_effect_names_the_effect_and_the_accepted_ones():
     data, _ = mast_top_data(seed=2)
-    with pytest.raises(ModelError, match=r"unknown effect 'backlash' for mast-top; accepted effects: .*joint_clearance"):
+    with pytest.raises(
+        ModelError, match=r"unknown effect 'backlash' for mast-top; accepted effects: .*joint_clearance"
+    ):
         compare(MT, data, ["backlash"])
-    with pytest.raises(ModelError, match=r"effect 'latch_hysteresis' does not apply to mast-top \(it applies to "
-                                         r"latch-pull.*accepted effects: .*friction_hysteresis"):
+    with pytest.raises(
+        ModelError,
+        match=r"effect 'latch_hysteresis' does not apply to mast-top \(it applies to "
+        r"latch-pull.*accepted effects: .*friction_hysteresis",
+    ):
         compare(MT, data, ["latch_hysteresis"])
     with pytest.raises(ModelError, match=r"effect 'ball_joint_friction' does not apply to mast-top"):
         diagnose(MT, data, ["ball_joint_friction"], workers=1)
@@ -161,16 +183,22 @@ experiment = Experiment(name="rig-x", title="a rig whose model is not written ye
 
 
 def test_unknown_and_pending_experiments(tmp_path):
-    with pytest.raises(ModelError, match=r"unknown experiment 'mast'; accepted: mast-top, latch-pull, bay-torsion, "
-                                         r"tip-cycle, vibration, platform-pose or the path of a Python script"):
+    with pytest.raises(
+        ModelError,
+        match=r"unknown experiment 'mast'; accepted: mast-top, latch-pull, bay-torsion, "
+        r"tip-cycle, vibration, platform-pose or the path of a Python script",
+    ):
         get_experiment("mast")
     # an experiment may be registered with its data format before its model exists (model=None)
     script = tmp_path / "rig_x.py"
     script.write_text(PENDING_SCRIPT)
     rig = get_experiment(str(script))
     data = from_arrays(rig, F_N=np.arange(12.0), u_m=np.linspace(0.0, 1e-3, 12))  # the format is checked already
-    with pytest.raises(ModelError, match=r"experiment 'rig-x' is registered with its data format but is pending "
-                                         r"a model, so compare cannot run yet"):
+    with pytest.raises(
+        ModelError,
+        match=r"experiment 'rig-x' is registered with its data format but is pending "
+        r"a model, so compare cannot run yet",
+    ):
         compare(rig, data)
     with pytest.raises(ModelError, match="pending a model"):
         diagnose(rig, data)
@@ -183,8 +211,20 @@ def test_cli_reports_bad_input_and_exits_2(tmp_path, capsys):
     assert main(["compare", "mast-top", str(p), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "femast: error:" in err and "d.csv line 1: column 'fy'" in err and "fy_N" in err
-    assert main(["compare", "mast-top", str(DATA / "mast_top_example.csv"), "--effects", "nonsense",
-                 "--out", str(tmp_path / "o")]) == 2
+    assert (
+        main(
+            [
+                "compare",
+                "mast-top",
+                str(DATA / "mast_top_example.csv"),
+                "--effects",
+                "nonsense",
+                "--out",
+                str(tmp_path / "o"),
+            ]
+        )
+        == 2
+    )
     assert "unknown effect 'nonsense' for mast-top; accepted effects:" in capsys.readouterr().err
     script = tmp_path / "rig_x.py"
     script.write_text(PENDING_SCRIPT)

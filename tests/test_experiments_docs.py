@@ -4,7 +4,7 @@ import re
 from pathlib import Path
 
 import pytest
-from doc_examples import replay_transcript, run_python_blocks, printed_in
+from doc_examples import printed_in, replay_transcript, run_python_blocks
 
 from femast.effects import list_effects, unregister_effect
 
@@ -23,7 +23,7 @@ def test_python_examples_run(page, capsys, tmp_path):
                 unregister_effect(e.name)
     out = capsys.readouterr().out
     for q in re.findall(r"prints `([^`]+)`", text):
-        assert printed_in(q, out), f"{page}: the page says it prints {q!r}"   # numbers as numbers
+        assert printed_in(q, out), f"{page}: the page says it prints {q!r}"  # numbers as numbers
 
 
 def test_tutorial_commands_print_what_the_page_quotes(tmp_path, capsys, monkeypatch):
@@ -31,6 +31,8 @@ def test_tutorial_commands_print_what_the_page_quotes(tmp_path, capsys, monkeypa
     blocks = re.findall(r"```console\n(.*?)```", text, re.S)
     assert len(blocks) >= 5
     monkeypatch.chdir(tmp_path)  # outputs (tutorial/...) go to a temporary folder; the data are femast's examples
-    checked = sum(replay_transcript(block, tmp_path, capsys, ignore=lambda line: line.strip() == "...",
-                                    what="the tutorial") for block in blocks)
+    checked = sum(
+        replay_transcript(block, tmp_path, capsys, ignore=lambda line: line.strip() == "...", what="the tutorial")
+        for block in blocks
+    )
     assert checked > 40

@@ -5,15 +5,35 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from femast.effects import (Effect, Implementation, add_implementation, applicable_effects, get_effect, list_effects,
-                            play, proportional_play, register_effect, resolve, unregister_effect)
+from femast.effects import (
+    Effect,
+    Implementation,
+    add_implementation,
+    applicable_effects,
+    get_effect,
+    list_effects,
+    play,
+    proportional_play,
+    register_effect,
+    resolve,
+    unregister_effect,
+)
 from femast.errors import ModelError
 from femast.experiments import Parameter, get_experiment, list_experiments, predict
 from femast.experiments.synthetic import mast_top_data, mast_top_path
 
 ROOT = Path(__file__).resolve().parents[1]
-REQUIRED = ("joint_clearance", "friction_hysteresis", "beam_flexibility", "progressive_stiffness",
-            "cable_hysteresis", "latch_hysteresis", "ball_joint_friction", "off_axis_motion", "pretension_loss")
+REQUIRED = (
+    "joint_clearance",
+    "friction_hysteresis",
+    "beam_flexibility",
+    "progressive_stiffness",
+    "cable_hysteresis",
+    "latch_hysteresis",
+    "ball_joint_friction",
+    "off_axis_motion",
+    "pretension_loss",
+)
 BUILT_IN = REQUIRED + ("stretch_error",)
 
 
@@ -51,8 +71,14 @@ def test_every_effect_is_documented_with_units_bounds_and_applicability():
 def test_applicability_of_the_built_in_effects():
     mt = {e.name for e in applicable_effects("mast-top")}
     lp = {e.name for e in applicable_effects("latch-pull")}
-    assert {"joint_clearance", "friction_hysteresis", "beam_flexibility", "progressive_stiffness",
-            "cable_hysteresis", "pretension_loss"} <= mt
+    assert {
+        "joint_clearance",
+        "friction_hysteresis",
+        "beam_flexibility",
+        "progressive_stiffness",
+        "cable_hysteresis",
+        "pretension_loss",
+    } <= mt
     assert {"latch_hysteresis", "friction_hysteresis", "stretch_error", "cable_hysteresis"} <= lp
     # the FE experiments (their own tests: tests/test_experiments_fe.py)
     bt = {e.name for e in applicable_effects("bay-torsion")}
@@ -77,10 +103,17 @@ def test_register_a_user_effect_and_extend_an_existing_one():
     def shift(d, p, ctx):
         return d + p["a"]
 
-    eff = Effect(name="test_offset", title="offset", physics="a constant offset of the top " * 4,
-                 signature="a constant", implementations={"mast-top": Implementation(
-                     hook="top_displacement", apply=shift,
-                     parameters=(Parameter("a", "m", 1e-4, -1.0, 1.0, "offset"),))})
+    eff = Effect(
+        name="test_offset",
+        title="offset",
+        physics="a constant offset of the top " * 4,
+        signature="a constant",
+        implementations={
+            "mast-top": Implementation(
+                hook="top_displacement", apply=shift, parameters=(Parameter("a", "m", 1e-4, -1.0, 1.0, "offset"),)
+            )
+        },
+    )
     register_effect(eff, replace_existing=True)
     try:
         with pytest.raises(ModelError, match="already registered"):
@@ -91,8 +124,11 @@ def test_register_a_user_effect_and_extend_an_existing_one():
         moved = predict(get_experiment("mast-top"), data, effects={"test_offset": {"a": 1e-3}})
         np.testing.assert_allclose(moved["dx_m"] - base["dx_m"], 1e-3)  # default rtol 1e-7: an exact shift
         # make an effect apply to another (a user's) experiment
-        add_implementation("test_offset", "spring-x", Implementation(
-            hook="h", apply=shift, parameters=eff.implementations["mast-top"].parameters))
+        add_implementation(
+            "test_offset",
+            "spring-x",
+            Implementation(hook="h", apply=shift, parameters=eff.implementations["mast-top"].parameters),
+        )
         assert get_effect("test_offset").applies_to("spring-x")
     finally:  # other tests' diagnoses must not see it
         unregister_effect("test_offset")
@@ -103,9 +139,14 @@ def test_effects_do_not_change_the_model_at_their_neutral_values():
     exp = get_experiment("mast-top")
     data, _ = mast_top_data(path=mast_top_path(n=80, moment_Nm=100.0, seed=2), noise_m=0.0)
     base = predict(exp, data)
-    neutral = {"joint_clearance": {"c": 0.0}, "friction_hysteresis": {"M_f": 0.0},
-               "progressive_stiffness": {"beta": 0.0}, "cable_hysteresis": {"eta": 0.0},
-               "pretension_loss": {"lam": 0.0}, "beam_flexibility": {"E": 1e30}}
+    neutral = {
+        "joint_clearance": {"c": 0.0},
+        "friction_hysteresis": {"M_f": 0.0},
+        "progressive_stiffness": {"beta": 0.0},
+        "cable_hysteresis": {"eta": 0.0},
+        "pretension_loss": {"lam": 0.0},
+        "beam_flexibility": {"E": 1e30},
+    }
     for name, p in neutral.items():
         got = predict(exp, data, effects={name: p})
         # exactly neutral up to round-off (E = 1e30 Pa leaves a 1e-20 relative compliance)

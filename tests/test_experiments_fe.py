@@ -35,7 +35,7 @@ def _misfit(exp, data, truth_params, truth_effects, fitted_pred, sigma):
     """Noise-free misfit of the fitted baseline per row (truth model along the path), in noise units."""
     oracle = predict(exp, data, truth_params, truth_effects)
     z = np.array([(oracle[c] - fitted_pred[c]) / sigma[c] for c in exp.channels])
-    return np.sqrt((z ** 2).mean(axis=0))
+    return np.sqrt((z**2).mean(axis=0))
 
 
 def _sample_noise(exp, data, truth):
@@ -57,8 +57,9 @@ def test_bay_baseline_is_the_issue5_bay_driven_along_the_measured_path():
         res = fm.Analysis(am.model, d, progress=False, convergence=CONVERGENCE).run()
         curve = bay_curve(res, am)
     ref = curve["M"][[i for i, s in enumerate(curve["step"]) if s == "twist-path"]]
-    data = Measured("bay-torsion", {"theta_deg": np.degrees(path.theta), "ux_m": path.x, "uy_m": path.y,
-                                    "Mz_Nm": np.zeros(13)})
+    data = Measured(
+        "bay-torsion", {"theta_deg": np.degrees(path.theta), "ux_m": path.x, "uy_m": path.y, "Mz_Nm": np.zeros(13)}
+    )
     got = predict(BT, data)["Mz_Nm"]
     assert got[0] == pytest.approx(0.0, abs=1e-6)  # the pretensioned bay holds no moment at theta = 0
     # same model, same increments, only the step time differs: Newton round-off (~1e-6 N m seen)
@@ -75,14 +76,19 @@ def test_bay_effects_change_the_fe_inputs_as_documented():
     drive = np.column_stack([th, np.zeros(7), np.zeros(7)])
     for name, prm, check in [
         ("ball_joint_friction", {"mu": 0.3}, lambda b, d: b["mu"] == 0.3),
-        ("latch_hysteresis", {"F_h": 7.0}, lambda b, d: b["hysteresis_force"] == 7.0
-         and b["hysteresis_length"] == BT.options["latch_hysteresis_length_m"]),
+        (
+            "latch_hysteresis",
+            {"F_h": 7.0},
+            lambda b, d: (
+                b["hysteresis_force"] == 7.0 and b["hysteresis_length"] == BT.options["latch_hysteresis_length_m"]
+            ),
+        ),
         ("pretension_loss", {"dT0": -30.0}, lambda b, d: b["pretension"] == 140.0),
     ]:
-        (nm, impl), = resolve(BT, [name])
+        ((nm, impl),) = resolve(BT, [name])
         out = EffectStack([(nm, impl, prm)]).apply(impl.hook, dict(base), options=BT.options, params=p)
         assert check(out, None), name
-    (nm, impl), = resolve(BT, ["off_axis_motion"])
+    ((nm, impl),) = resolve(BT, ["off_axis_motion"])
     e = 0.012
     out = EffectStack([(nm, impl, {"e": e})]).apply("control_path", drive, options=BT.options, params=p)
     # the top centre turns about an axis at (0, e) (towards side 0): it moves on a circle of radius e
@@ -110,8 +116,14 @@ def test_bay_runs_are_cached_in_memory_and_on_disk(tmp_path):
 
 
 def test_bay_long_files_are_driven_through_a_subset_of_rows():
-    th = np.concatenate([np.linspace(0.0, 3.0, 150), np.linspace(3.0, 1.2, 80)[1:], np.linspace(1.2, 2.5, 60)[1:],
-                         np.linspace(2.5, 0.0, 90)[1:]])
+    th = np.concatenate(
+        [
+            np.linspace(0.0, 3.0, 150),
+            np.linspace(3.0, 1.2, 80)[1:],
+            np.linspace(1.2, 2.5, 60)[1:],
+            np.linspace(2.5, 0.0, 90)[1:],
+        ]
+    )
     rows = fe_rows(th, np.zeros(th.size), np.zeros(th.size), 40)
     assert rows.size <= 43 and rows[0] == 0 and rows[-1] == th.size - 1  # 40 spread + ends + 3 turning points
     assert {149, 228, 287} <= set(rows)  # the turning points of the twist are driven exactly
@@ -129,8 +141,9 @@ def test_bay_long_files_are_driven_through_a_subset_of_rows():
 def test_bay_short_path_hidden_latch_hysteresis_is_found():
     # a real diagnosis kept small: 15 rows in the latched range (0 -> 0.9 deg -> 0), two candidates
     path = {"theta_deg": 0.9 * (1.0 - np.abs(np.linspace(-1.0, 1.0, 15)))}
-    data, truth = bay_torsion_data({"latch_k": 1.05e5}, {"latch_hysteresis": {"F_h": 10.0}}, path, noise_Nm=0.15,
-                                   seed=21)
+    data, truth = bay_torsion_data(
+        {"latch_k": 1.05e5}, {"latch_hysteresis": {"F_h": 10.0}}, path, noise_Nm=0.15, seed=21
+    )
     c = compare(BT, data, fit=True)
     assert c.ratio > 2.0  # 10 N of hysteresis against 0.15 N m of noise
     # the latch zones of seed Fig. 6 are segments (the bay never releases on this path: zones (a)-(b) only);
@@ -149,27 +162,50 @@ def test_bay_short_path_hidden_latch_hysteresis_is_found():
 # =============================================================================== bay-torsion, slow
 BAY_CASES = [
     # (effect, truth, path, noise N m, baseline params, seed)
-    ("latch_hysteresis", {"F_h": 8.0}, dict(n=41, theta_max_deg=3.2, kind="cycle"), 0.2,
-     {"latch_k": 1.1e5, "latch_mu": 0.06}, 1),
-    ("ball_joint_friction", {"mu": 0.15}, dict(n=41, theta_max_deg=3.0, kind="partial"), 0.25,
-     {"latch_k": 0.95e5, "latch_mu": 0.07}, 2),
-    ("pretension_loss", {"dT0": -40.0}, dict(n=61, theta_max_deg=3.4, kind="release"), 0.15,
-     {"latch_k": 1.0e5, "latch_mu": 0.08}, 3),
-    ("off_axis_motion", {"e": 0.015}, dict(n=41, theta_max_deg=3.2, kind="cycle"), 0.2,
-     {"latch_k": 1.05e5, "latch_mu": 0.065}, 4),
+    (
+        "latch_hysteresis",
+        {"F_h": 8.0},
+        dict(n=41, theta_max_deg=3.2, kind="cycle"),
+        0.2,
+        {"latch_k": 1.1e5, "latch_mu": 0.06},
+        1,
+    ),
+    (
+        "ball_joint_friction",
+        {"mu": 0.15},
+        dict(n=41, theta_max_deg=3.0, kind="partial"),
+        0.25,
+        {"latch_k": 0.95e5, "latch_mu": 0.07},
+        2,
+    ),
+    (
+        "pretension_loss",
+        {"dT0": -40.0},
+        dict(n=61, theta_max_deg=3.4, kind="release"),
+        0.15,
+        {"latch_k": 1.0e5, "latch_mu": 0.08},
+        3,
+    ),
+    (
+        "off_axis_motion",
+        {"e": 0.015},
+        dict(n=41, theta_max_deg=3.2, kind="cycle"),
+        0.2,
+        {"latch_k": 1.05e5, "latch_mu": 0.065},
+        4,
+    ),
 ]
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("effect,truth,path,noise,params,seed", BAY_CASES, ids=[c[0] for c in BAY_CASES])
 def test_bay_hidden_effect_is_localised_ranked_first_and_identified(effect, truth, path, noise, params, seed):
-    data, tr = bay_torsion_data(params, {effect: truth}, bay_torsion_path(seed=seed, **path), noise_Nm=noise,
-                                seed=seed)
+    data, tr = bay_torsion_data(params, {effect: truth}, bay_torsion_path(seed=seed, **path), noise_Nm=noise, seed=seed)
     c = compare(BT, data, fit=True)
     assert c.ratio > 1.5  # the hidden effect is well above the noise
     misfit = _misfit(BT, data, params, {effect: truth}, c.predicted, c.noise)
     w = c.worst[0]
-    assert misfit[w["start_row"]:w["end_row"] + 1].mean() >= LOCAL_FACTOR * misfit.mean()
+    assert misfit[w["start_row"] : w["end_row"] + 1].mean() >= LOCAL_FACTOR * misfit.mean()
     d = diagnose(BT, data, workers=2)
     top = d.ranking[0]
     assert top["effect"] == effect and top["significant"]
@@ -185,8 +221,9 @@ def test_bay_hidden_effect_is_localised_ranked_first_and_identified(effect, trut
 
 @pytest.mark.slow
 def test_bay_null_case_nothing_is_missing():
-    data, _ = bay_torsion_data({"latch_k": 1.0e5, "latch_mu": 0.07}, {}, bay_torsion_path(n=61, seed=5),
-                               noise_Nm=0.2, seed=5)
+    data, _ = bay_torsion_data(
+        {"latch_k": 1.0e5, "latch_mu": 0.07}, {}, bay_torsion_path(n=61, seed=5), noise_Nm=0.2, seed=5
+    )
     d = diagnose(BT, data, workers=2)
     assert d.verdict["missing_effect"] is None and d.verdict["explained"] is True
     assert not any(e["significant"] for e in d.ranking)
@@ -228,9 +265,8 @@ def test_tip_baseline_is_the_issue5_mast_under_the_table1_sequence():
 def test_tip_effects_and_options():
     exp = get_experiment("tip-cycle", n_bays=3, ball_mu=0.0)
     assert [p.name for p in exp.parameters] == ["cable_EA"]  # the wall is an option: tip data cannot see it
-    assert {e.name for e in applicable_effects(exp)} == {
-        "ball_joint_friction", "latch_hysteresis", "pretension_loss"}
-    (nm, impl), = resolve(exp, ["ball_joint_friction"])
+    assert {e.name for e in applicable_effects(exp)} == {"ball_joint_friction", "latch_hysteresis", "pretension_loss"}
+    ((nm, impl),) = resolve(exp, ["ball_joint_friction"])
     assert impl.hook == "bay_parameters"
     assert exp.weight("rz_rad") == pytest.approx(6.84)  # rotations count as tip motion of the 6.84 m mast
 
@@ -250,13 +286,12 @@ TIP_CASES = [
 def test_tip_hidden_effect_is_localised_ranked_first_and_identified(effect, truth, path, n_bays, seed):
     exp = get_experiment("tip-cycle", n_bays=n_bays)
     params = {"cable_EA": 3.0e4}
-    data, tr = tip_cycle_data(params, {effect: truth}, tip_cycle_path(seed=seed, **path), seed=seed,
-                              experiment=exp)
+    data, tr = tip_cycle_data(params, {effect: truth}, tip_cycle_path(seed=seed, **path), seed=seed, experiment=exp)
     c = compare(exp, data, fit=True)
     assert c.ratio > 1.5  # the hidden effect is well above the noise (4x seen)
     misfit = _misfit(exp, data, params, {effect: truth}, c.predicted, c.noise)
     w = c.worst[0]
-    assert misfit[w["start_row"]:w["end_row"] + 1].mean() >= LOCAL_FACTOR * misfit.mean()
+    assert misfit[w["start_row"] : w["end_row"] + 1].mean() >= LOCAL_FACTOR * misfit.mean()
     d = diagnose(exp, data, workers=2)
     top = d.ranking[0]
     assert top["effect"] == effect and top["significant"]
@@ -285,12 +320,19 @@ def test_tutorial_section8_commands_print_what_the_page_quotes(tmp_path, capsys,
     from doc_examples import replay_transcript
 
     text = (ROOT / "docs" / "compare_and_diagnose.md").read_text()
-    sec = text[text.index("## 8. An FE experiment"):text.index("## What was hidden")]
+    sec = text[text.index("## 8. An FE experiment") : text.index("## What was hidden")]
     monkeypatch.chdir(tmp_path)  # the data are femast's shipped examples: any folder works
-    checked = sum(replay_transcript(block, tmp_path, capsys, what="section 8",
-                                    # the process count follows the machine
-                                    ignore=lambda line: "local processes" in line)
-                  for block in re.findall(r"```text\n(.*?)```", sec, re.S))
+    checked = sum(
+        replay_transcript(
+            block,
+            tmp_path,
+            capsys,
+            what="section 8",
+            # the process count follows the machine
+            ignore=lambda line: "local processes" in line,
+        )
+        for block in re.findall(r"```text\n(.*?)```", sec, re.S)
+    )
     assert checked > 30  # the section quotes 40 lines besides the process count
     rep = json.loads((tmp_path / "tutorial" / "bay" / "diagnose.json").read_text())
     f_h = rep["ranking"][0]["params"]["F_h"]
@@ -305,10 +347,19 @@ def test_a_refit_that_cannot_run_is_reported_not_fatal():
     def _boom(bay, p, ctx):
         raise fm.errors.ModelError("no convergence (test)")
 
-    register_effect(Effect(name="test_boom", title="an effect whose FE run fails", physics="-" * 90,
-                           signature="none", implementations={"bay-torsion": Implementation(
-                               hook="bay_parameters", apply=_boom,
-                               parameters=(Parameter("a", "-", 1.0, 0.0, 2.0, "a parameter"),))}))
+    register_effect(
+        Effect(
+            name="test_boom",
+            title="an effect whose FE run fails",
+            physics="-" * 90,
+            signature="none",
+            implementations={
+                "bay-torsion": Implementation(
+                    hook="bay_parameters", apply=_boom, parameters=(Parameter("a", "-", 1.0, 0.0, 2.0, "a parameter"),)
+                )
+            },
+        )
+    )
     try:
         path = {"theta_deg": 0.6 * (1.0 - np.abs(np.linspace(-1.0, 1.0, 11)))}
         data, _ = bay_torsion_data({}, {"latch_hysteresis": {"F_h": 10.0}}, path, noise_Nm=0.15, seed=22)

@@ -15,23 +15,49 @@ OTHER = {"r": 1.3e-3, "x_backstop": 1.8e-3, "k": 8e4, "mu": 0.1}  # a stiffer-fr
 
 CASES = [
     # (effect, truth, baseline params, noise N, noise mm, passes, seed, relative tolerance and its reason)
-    ("latch_hysteresis", {"F_h": 8.0, "ell": 4e-4}, SEED_FIT, 0.5, 0.01, 2, 1,
-     0.15),  # F_h and ell trade off (correlation ~0.8): 8 N over 0.4 mm is resolved to ~10 %
-    ("latch_hysteresis", {"F_h": 6.0, "ell": 3e-4}, OTHER, 0.3, 0.005, 1, 2,
-     0.15),  # one pass with lower noise: as above
-    ("friction_hysteresis", {"F_f": 1.5}, OTHER, 0.5, 0.01, 2, 3,
-     0.10),  # a constant offset over the whole path: well determined
-    ("stretch_error", {"c_s": 5e-6}, SEED_FIT, 0.8, 0.01, 2, 4,
-     0.05),  # a 0.3 mm shear at 60 N against 0.01 mm noise
+    (
+        "latch_hysteresis",
+        {"F_h": 8.0, "ell": 4e-4},
+        SEED_FIT,
+        0.5,
+        0.01,
+        2,
+        1,
+        0.15,
+    ),  # F_h and ell trade off (correlation ~0.8): 8 N over 0.4 mm is resolved to ~10 %
+    (
+        "latch_hysteresis",
+        {"F_h": 6.0, "ell": 3e-4},
+        OTHER,
+        0.3,
+        0.005,
+        1,
+        2,
+        0.15,
+    ),  # one pass with lower noise: as above
+    (
+        "friction_hysteresis",
+        {"F_f": 1.5},
+        OTHER,
+        0.5,
+        0.01,
+        2,
+        3,
+        0.10,
+    ),  # a constant offset over the whole path: well determined
+    ("stretch_error", {"c_s": 5e-6}, SEED_FIT, 0.8, 0.01, 2, 4, 0.05),  # a 0.3 mm shear at 60 N against 0.01 mm noise
 ]
 
 
-@pytest.mark.parametrize("effect,truth,base,noise_N,noise_mm,passes,seed,rel", CASES,
-                         ids=[f"{c[0]}-s{c[6]}" for c in CASES])
-def test_hidden_effect_is_localised_ranked_first_and_identified(effect, truth, base, noise_N, noise_mm, passes,
-                                                                seed, rel):
-    data, _ = latch_pull_data(base, {effect: truth}, passes=passes, noise_N=noise_N, noise_mm=noise_mm, seed=seed,
-                              x_far_mm=(4.0, 3.3))
+@pytest.mark.parametrize(
+    "effect,truth,base,noise_N,noise_mm,passes,seed,rel", CASES, ids=[f"{c[0]}-s{c[6]}" for c in CASES]
+)
+def test_hidden_effect_is_localised_ranked_first_and_identified(
+    effect, truth, base, noise_N, noise_mm, passes, seed, rel
+):
+    data, _ = latch_pull_data(
+        base, {effect: truth}, passes=passes, noise_N=noise_N, noise_mm=noise_mm, seed=seed, x_far_mm=(4.0, 3.3)
+    )
     c = compare(EXP, data, fit=True)
     assert c.ratio > 1.4  # the hidden effect is well above the noise
     w = c.worst[0]
@@ -100,5 +126,11 @@ def test_compare_reports_latch_zones_and_directions():
     data, _ = latch_pull_data(SEED_FIT, {"latch_hysteresis": {"F_h": 8.0, "ell": 4e-4}}, seed=31)
     c = compare(EXP, data, fit=True)
     kinds = {k["kind"] for k in c.by_kind}
-    assert {"zone (a) at backstop", "zone (b) behind roller axis", "latching (dx < 0)",
-            "unlatching (dx > 0)", "loading", "peak"} <= kinds
+    assert {
+        "zone (a) at backstop",
+        "zone (b) behind roller axis",
+        "latching (dx < 0)",
+        "unlatching (dx > 0)",
+        "loading",
+        "peak",
+    } <= kinds

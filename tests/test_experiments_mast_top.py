@@ -39,8 +39,7 @@ CASES = [
 ]
 
 
-@pytest.mark.parametrize("effect,truth,kind,moment,noise,k,seed", CASES,
-                         ids=[f"{c[0]}-{c[2]}-s{c[6]}" for c in CASES])
+@pytest.mark.parametrize("effect,truth,kind,moment,noise,k,seed", CASES, ids=[f"{c[0]}-{c[2]}-s{c[6]}" for c in CASES])
 def test_hidden_effect_is_localised_ranked_first_and_identified(effect, truth, kind, moment, noise, k, seed):
     params = {"k_theta1": k[0], "k_theta2": k[1]}
     path = mast_top_path(n=500, kind=kind, amplitude_N=110.0 + 15 * seed, moment_Nm=moment, seed=seed)
@@ -55,7 +54,7 @@ def test_hidden_effect_is_localised_ranked_first_and_identified(effect, truth, k
     else:
         misfit = _misfit(EXP, data, params, {effect: truth}, c.predicted, c.noise)
         w = c.worst[0]
-        assert misfit[w["start_row"]:w["end_row"] + 1].mean() >= LOCAL_FACTOR * misfit.mean()
+        assert misfit[w["start_row"] : w["end_row"] + 1].mean() >= LOCAL_FACTOR * misfit.mean()
 
     # diagnose: the hidden effect first, significant, explains the data
     d = diagnose(EXP, data, workers=1)
@@ -67,8 +66,9 @@ def test_hidden_effect_is_localised_ranked_first_and_identified(effect, truth, k
         est, se = top["params"][name]["value"], top["params"][name]["stderr"]
         assert abs(est - value) <= N_SIGMA * se, (name, est, se, value)
         assert abs(est - value) <= REL_TOL * abs(value), (name, est, value)
-    sample_noise = np.sqrt(np.mean([np.mean((data[ch] - predict(EXP, data, params, {effect: truth})[ch]) ** 2)
-                                    for ch in EXP.channels]))
+    sample_noise = np.sqrt(
+        np.mean([np.mean((data[ch] - predict(EXP, data, params, {effect: truth})[ch]) ** 2) for ch in EXP.channels])
+    )
     assert top["rms"] <= REFIT_TOL * sample_noise
     assert top["ratio"] <= AT_NOISE
 
@@ -90,8 +90,12 @@ def test_clearance_fails_near_zero_load_and_friction_with_the_direction_of_loadi
 
 @pytest.mark.parametrize("kind,noise,seed", [("cycles", 5e-5, 21), ("seed000", 2e-5, 22)])
 def test_null_case_nothing_is_missing(kind, noise, seed):
-    data, _ = mast_top_data({"k_theta1": 2.2e5, "k_theta2": 2.2e5},
-                            path=mast_top_path(n=400, kind=kind, cycles=3, seed=seed), noise_m=noise, seed=seed)
+    data, _ = mast_top_data(
+        {"k_theta1": 2.2e5, "k_theta2": 2.2e5},
+        path=mast_top_path(n=400, kind=kind, cycles=3, seed=seed),
+        noise_m=noise,
+        seed=seed,
+    )
     d = diagnose(EXP, data, workers=1)
     assert d.verdict["missing_effect"] is None and d.verdict["explained"] is True
     assert not any(e["significant"] for e in d.ranking)
@@ -110,8 +114,11 @@ def test_out_of_library_thermal_drift_is_not_explained():
 
 @pytest.mark.slow  # the same loop runs by default on the shipped data (test_experiments_docs, _cli)
 def test_two_hidden_effects_are_found_one_after_the_other():
-    data, _ = mast_top_data(effects={"joint_clearance": {"c": 1.5e-4}, "friction_hysteresis": {"M_f": 12.0}},
-                            path=mast_top_path(kind="cycles", seed=41), seed=41)
+    data, _ = mast_top_data(
+        effects={"joint_clearance": {"c": 1.5e-4}, "friction_hysteresis": {"M_f": 12.0}},
+        path=mast_top_path(kind="cycles", seed=41),
+        seed=41,
+    )
     d1 = diagnose(EXP, data, workers=1)  # issue 14: the pair is fitted jointly and named at once
     assert d1.verdict["kind"] == "missing_pair" and d1.verdict["best_candidate"] == "joint_clearance"
     assert sorted(d1.verdict["missing_effects"]) == ["friction_hysteresis", "joint_clearance"]
@@ -134,8 +141,9 @@ def test_baseline_is_the_seed000_3r_model_with_its_sign_correction():
 
 
 def test_fit_recovers_the_joint_stiffnesses_with_calibrated_uncertainty():
-    data, _ = mast_top_data({"k_theta1": 2.7e5, "k_theta2": 2.3e5}, path=mast_top_path(kind="ramps", seed=51),
-                            noise_m=5e-5, seed=51)
+    data, _ = mast_top_data(
+        {"k_theta1": 2.7e5, "k_theta2": 2.3e5}, path=mast_top_path(kind="ramps", seed=51), noise_m=5e-5, seed=51
+    )
     r = compare(EXP, data, fit=True).run
     assert r.success
     np.testing.assert_array_less(np.abs(r.x - [2.7e5, 2.3e5]), N_SIGMA * r.stderr)

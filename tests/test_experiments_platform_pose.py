@@ -17,15 +17,17 @@ TRAJ = fig5a_trajectory(2)
 
 def data_from(pose, traj=TRAJ, exp=None):
     exp = exp or get_experiment("platform-pose")
-    return from_arrays(exp, x_cmd_m=traj[:, 0], y_cmd_m=traj[:, 1], z_cmd_m=traj[:, 2],
-                       x_m=pose[:, 0], y_m=pose[:, 1], z_m=pose[:, 2])
+    return from_arrays(
+        exp, x_cmd_m=traj[:, 0], y_cmd_m=traj[:, 1], z_cmd_m=traj[:, 2], x_m=pose[:, 0], y_m=pose[:, 1], z_m=pose[:, 2]
+    )
 
 
 def test_baseline_is_the_platform_pose_solver():
     ref = pose_trajectory(ROBOT, masts_3r(1200.0), TRAJ)
     pred = predict(get_experiment("platform-pose"), data_from(ref.pose))
-    np.testing.assert_allclose(np.column_stack([pred[c] for c in ("x_m", "y_m", "z_m")]), ref.pose[:, :3],
-                               atol=1e-12)  # the same solve (Newton to 1e-11)
+    np.testing.assert_allclose(
+        np.column_stack([pred[c] for c in ("x_m", "y_m", "z_m")]), ref.pose[:, :3], atol=1e-12
+    )  # the same solve (Newton to 1e-11)
 
 
 def test_mast_top_effect_applies_and_equals_its_linear_equivalent():
@@ -40,7 +42,9 @@ def test_mast_top_effect_applies_and_equals_its_linear_equivalent():
     got = np.column_stack([pred[c] for c in ("x_m", "y_m", "z_m")])
     base = np.column_stack([v for v in predict(exp, data_from(ref.pose)).values()])
     assert np.abs(ref.pose[:, :3] - base).max() > 1e-3  # the effect moves the platform by mm
-    np.testing.assert_allclose(got, ref.pose[:, :3], atol=1e-9)  # a linear effect: the secant compliance is exact after one pass
+    np.testing.assert_allclose(
+        got, ref.pose[:, :3], atol=1e-9
+    )  # a linear effect: the secant compliance is exact after one pass
 
 
 def test_fitted_baseline_follows_data_from_another_model():
@@ -59,8 +63,15 @@ def test_fitted_baseline_follows_data_from_another_model():
 
 def test_bad_input():
     exp = get_experiment("platform-pose")
-    cols = dict(x_cmd_m=TRAJ[:, 0], y_cmd_m=TRAJ[:, 1], z_cmd_m=TRAJ[:, 2], x_m=TRAJ[:, 0], y_m=TRAJ[:, 1],
-                z_m=TRAJ[:, 2], tau1_N=np.full(len(TRAJ), 100.0))
+    cols = dict(
+        x_cmd_m=TRAJ[:, 0],
+        y_cmd_m=TRAJ[:, 1],
+        z_cmd_m=TRAJ[:, 2],
+        x_m=TRAJ[:, 0],
+        y_m=TRAJ[:, 1],
+        z_m=TRAJ[:, 2],
+        tau1_N=np.full(len(TRAJ), 100.0),
+    )
     with pytest.raises(ModelError, match="all eight tension columns"):
         predict(exp, from_arrays(exp, **cols))
     with pytest.raises(ModelError, match="act on the 3R mast model"):

@@ -1,12 +1,12 @@
 """The ``vibration`` experiment (issue 18): data, baseline against the closed form, effects,
 and diagnose on the shipped example (hidden pretension loss, generator independent of femast)."""
 
-import femast.examples
 import math
 
 import numpy as np
 import pytest
 
+import femast.examples
 from femast.adam.mass import UNIT_MASS, cable_mass_per_length
 from femast.adam.parameters import BayParameters
 from femast.effects import get_effect
@@ -32,7 +32,7 @@ def test_baseline_is_the_taut_cable_resonance_and_fit_option_sets_parameters():
     # 1e-6: the Newton tolerance of the static state
     assert f[0] == pytest.approx(_closed_form(130.0, UNIT_MASS), rel=1e-6)
     assert f[1] == pytest.approx(_closed_form(170.0, UNIT_MASS), rel=1e-6)
-    assert f[2] > 5 * f[1]   # mode 2 is in plane: the cables' EA, far above
+    assert f[2] > 5 * f[1]  # mode 2 is in plane: the cables' EA, far above
 
 
 def test_effects_shift_frequencies_as_their_physics_says():
@@ -102,4 +102,4 @@ def test_user_model_builder():
     # the joint_stick spring acts along the drive direction (z): it stiffens one of the two
     # transverse modes, k = 2T/L + k_stick
     g = predict(exp, data, {"pretension": 170.0}, {"joint_stick": {"k_stick": 100.0}})["f_Hz"]
-    np.testing.assert_allclose(g, f, rtol=1e-6)   # mode 1 is the y mode, the spring is along z
+    np.testing.assert_allclose(g, f, rtol=1e-6)  # mode 1 is the y mode, the spring is along z

@@ -11,8 +11,9 @@ import pytest
 
 from femast.experiments import fe_jacobian as fj
 
-pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux") or (os.cpu_count() or 1) < 2,
-                                reason="needs Linux (fork) and two CPUs")
+pytestmark = pytest.mark.skipif(
+    not sys.platform.startswith("linux") or (os.cpu_count() or 1) < 2, reason="needs Linux (fork) and two CPUs"
+)
 
 
 @pytest.fixture
@@ -74,7 +75,7 @@ def test_serial_outside_the_main_thread_and_when_switched_off(forking, monkeypat
     t.start()
     t.join()
     assert out["ok"] is False
-    assert fj._fork_ok(1) is False   # one point: nothing to split
+    assert fj._fork_ok(1) is False  # one point: nothing to split
     monkeypatch.setattr(fj, "FORK_COLUMNS", False)
     assert fj._fork_ok(4) is False
 
@@ -87,7 +88,7 @@ def test_jacobian_with_forked_columns_equals_the_serial_one(forking, monkeypatch
         monkeypatch.setattr(fj, "FORK_COLUMNS", fork)
         j = fj._FEJacobian(_fun, 1e-3, lo, hi)
         jac[fork] = j.jac(u)
-        assert j.runs == 3   # the point itself and two columns
+        assert j.runs == 3  # the point itself and two columns
     assert np.array_equal(jac[True], jac[False])
 
 
@@ -134,15 +135,15 @@ def test_an_error_here_ends_the_child_at_once(forking, tmp_path):
     def fun(u):
         if os.getpid() != parent:
             pid_file.write_text(str(os.getpid()))
-            time.sleep(60.0)   # a long FE run
+            time.sleep(60.0)  # a long FE run
             return np.zeros(2)
-        time.sleep(0.5)        # (the child has started its run)
+        time.sleep(0.5)  # (the child has started its run)
         raise KeyboardInterrupt
 
     t0 = time.monotonic()
     with pytest.raises(KeyboardInterrupt):
         fj.evaluate_many(fun, [np.array([1.0]), np.array([2.0])], 2)
-    assert time.monotonic() - t0 < 30.0   # not the child's 60 s
+    assert time.monotonic() - t0 < 30.0  # not the child's 60 s
     assert _gone(int(pid_file.read_text()))
 
 
@@ -157,7 +158,7 @@ def test_a_stuck_child_is_killed_and_its_points_computed_here(forking, tmp_path,
     def fun(u):
         if os.getpid() != parent:
             pid_file.write_text(str(os.getpid()))
-            time.sleep(60.0)   # stuck (e.g. on a lock that fork copied)
+            time.sleep(60.0)  # stuck (e.g. on a lock that fork copied)
         return np.full(3, u[0])
 
     t0 = time.monotonic()
@@ -187,10 +188,11 @@ def test_the_wait_works_on_descriptors_above_select_s_limit():
     r, w = os.pipe()
     try:
         if soft != resource.RLIM_INFINITY and soft <= 1500:
-            resource.setrlimit(resource.RLIMIT_NOFILE, (2048 if hard == resource.RLIM_INFINITY else min(hard, 2048),
-                                                        hard))
+            resource.setrlimit(
+                resource.RLIMIT_NOFILE, (2048 if hard == resource.RLIM_INFINITY else min(hard, 2048), hard)
+            )
         hi = os.dup2(r, 1500)
-        assert not fj.readable(hi, 0.01)   # nothing written yet
+        assert not fj.readable(hi, 0.01)  # nothing written yet
         os.write(w, b"x")
         assert fj.readable(hi, 1.0)
         os.close(hi)

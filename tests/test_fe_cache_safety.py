@@ -19,8 +19,14 @@ class _Payload:
 
 
 def _value():
-    return {"Mz": np.array([1.0, -2.5, 3e-17]), "zone": np.array([[0, 1], [2, 3]]), "increments": 7,
-            "wall_time": 0.25, "note": "ok", "flag": True}
+    return {
+        "Mz": np.array([1.0, -2.5, 3e-17]),
+        "zone": np.array([[0, 1], [2, 3]]),
+        "increments": 7,
+        "wall_time": 0.25,
+        "note": "ok",
+        "flag": True,
+    }
 
 
 def _compute_counter():
@@ -29,6 +35,7 @@ def _compute_counter():
     def compute():
         calls.append(1)
         return _value()
+
     return compute, calls
 
 
@@ -45,7 +52,7 @@ def test_round_trip_is_bit_for_bit_and_from_disk(tmp_path):
     fe_cache.clear()
     compute, calls = _compute_counter()
     a = _cached(tmp_path, compute)
-    fe_cache.clear()   # another process: only the disk entry is left
+    fe_cache.clear()  # another process: only the disk entry is left
     b = _cached(tmp_path, compute)
     assert len(calls) == 1 and fe_cache.stats()["disk_hits"] == 1
     assert set(a) == set(b)
@@ -62,13 +69,13 @@ def test_a_planted_pickle_is_never_loaded(tmp_path):
     _cached(tmp_path, compute)
     path = _entry(tmp_path)
     marker = tmp_path / "pwned"
-    for planted in (path, path.with_suffix(".pkl")):   # under the entry's name, and the old pickle name
+    for planted in (path, path.with_suffix(".pkl")):  # under the entry's name, and the old pickle name
         planted.write_bytes(pickle.dumps(_Payload(str(marker))))
     fe_cache.clear()
     _cached(tmp_path, compute)
-    assert not marker.exists()            # no code ran
-    assert len(calls) == 2                # a miss: computed again
-    assert fe_cache.read_entry(path, path.stem) is not None   # and the entry rewritten as data
+    assert not marker.exists()  # no code ran
+    assert len(calls) == 2  # a miss: computed again
+    assert fe_cache.read_entry(path, path.stem) is not None  # and the entry rewritten as data
 
 
 def test_object_arrays_truncated_foreign_and_tampered_entries_are_misses(tmp_path):

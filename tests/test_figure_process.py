@@ -10,13 +10,14 @@ import pytest
 from femast.experiments import fe_jacobian as fj
 from femast.experiments.figure_process import FigureProcess
 
-pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux") or (os.cpu_count() or 1) < 2,
-                                reason="needs Linux (fork) and two CPUs")
+pytestmark = pytest.mark.skipif(
+    not sys.platform.startswith("linux") or (os.cpu_count() or 1) < 2, reason="needs Linux (fork) and two CPUs"
+)
 
 
 @pytest.fixture
 def forking(monkeypatch):
-    monkeypatch.setattr(fj, "_only_thread", lambda: True)   # (earlier tests may have left threads behind)
+    monkeypatch.setattr(fj, "_only_thread", lambda: True)  # (earlier tests may have left threads behind)
 
 
 def _plot(png, title):
@@ -53,7 +54,7 @@ def test_the_child_writes_the_figure(tmp_path, forking):
 def test_what_does_not_pickle_or_fails_is_left_to_the_caller(tmp_path, forking):
     fp = FigureProcess.start()
     pid = fp.pid
-    assert not fp.draw(lambda png: _plot(png, "x"), tmp_path / "b.png")   # a lambda does not pickle
+    assert not fp.draw(lambda png: _plot(png, "x"), tmp_path / "b.png")  # a lambda does not pickle
     assert not (tmp_path / "b.png").exists() and _reaped(pid)
     fp = FigureProcess.start()
     pid = fp.pid
@@ -65,7 +66,7 @@ def test_closed_without_a_request(forking):
     fp = FigureProcess.start()
     pid = fp.pid
     fp.close()
-    fp.close()   # twice: nothing left to do
+    fp.close()  # twice: nothing left to do
     assert _reaped(pid)
 
 
@@ -90,5 +91,5 @@ def test_a_stuck_child_is_killed_and_the_caller_draws(tmp_path, forking, monkeyp
     pid = fp.pid
     t0 = time.monotonic()
     assert not fp.draw(_stuck, tmp_path / "d.png")
-    assert time.monotonic() - t0 < 30.0   # not the child's 60 s
+    assert time.monotonic() - t0 < 30.0  # not the child's 60 s
     assert _reaped(pid)

@@ -76,8 +76,9 @@ def test_error_text_is_not_mixed_with_a_bar(monkeypatch, capsys, tmp_path):
 
 # ------------------------------------------------------------------ compile notice
 def _fake_event(module):
-    return types.SimpleNamespace(is_start=True, data={"dispatcher": types.SimpleNamespace(
-        py_func=types.SimpleNamespace(__module__=module))})
+    return types.SimpleNamespace(
+        is_start=True, data={"dispatcher": types.SimpleNamespace(py_func=types.SimpleNamespace(__module__=module))}
+    )
 
 
 def test_compile_notice_once_per_process_and_only_for_femast(monkeypatch, capsys):
@@ -211,7 +212,9 @@ def test_render_defaults_to_the_largest_displacement(tmp_path, monkeypatch, caps
     k, umax = largest_displacement_frame(res)
     # the load is largest at the end of the load step (frames: 0, 4 load increments, 2 unload)
     assert res.frame(k)["step"] == "load" and k == res.steps.index("unload") - 1
-    assert umax == pytest.approx(abs(res.node_history(tip, "uz")[k]), rel=1e-3)  # the tip moves most; |ux| ~ uz^2/L << |uz|
+    assert umax == pytest.approx(
+        abs(res.node_history(tip, "uz")[k]), rel=1e-3
+    )  # the tip moves most; |ux| ~ uz^2/L << |uz|
     monkeypatch.chdir(tmp_path)
     assert main(["render", str(tmp_path / "lu")]) == 0
     out = capsys.readouterr().out
@@ -238,15 +241,23 @@ def test_index_has_the_task_entries_and_its_links_resolve():
     import re
 
     text = (ROOT / "docs" / "index.md").read_text()
-    for task in ("Build your own mast", "Run a load cycle", "View in ParaView", "Compare your own data",
-                 "Add your own effect", "Run on a cluster"):
+    for task in (
+        "Build your own mast",
+        "Run a load cycle",
+        "View in ParaView",
+        "Compare your own data",
+        "Add your own effect",
+        "Run on a cluster",
+    ):
         assert f"**{task}**" in text, task
     for page, anchor in re.findall(r"\]\(([\w.]+\.md)(?:#([\w-]+))?\)", text):
         doc = ROOT / "docs" / page
         assert doc.is_file(), page
         if anchor:  # GitHub's heading slug: lower case, punctuation dropped, spaces to '-'
-            slugs = {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-")
-                     for h in re.findall(r"^#+ (.*)$", doc.read_text(), re.M)}
+            slugs = {
+                re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-")
+                for h in re.findall(r"^#+ (.*)$", doc.read_text(), re.M)
+            }
             assert anchor in slugs, f"{page}#{anchor}"
 
 

@@ -6,8 +6,7 @@ from numpy with Gaussian noise (no femast code generates them)."""
 import numpy as np
 import pytest
 
-from femast.experiments import Column, Experiment, Parameter
-from femast.experiments import fitting
+from femast.experiments import Column, Experiment, Parameter, fitting
 from femast.experiments.core import Measured
 
 A_TRUE, B_TRUE, C_TRUE = 2.0, 1.3, 0.4
@@ -23,13 +22,23 @@ def _model(params, data, effects, options):
 
 def _experiment(secant=True):
     exp = Experiment(
-        name="rise", title="a first-order rise", columns=(Column("t_s", "s", "time"), Column("y", "-", "response")),
-        channels=("y",), parameters=(Parameter("a", "-", 1.5, 0.1, 10.0, "final value"),
-                                     Parameter("b", "1/s", 0.8, 0.01, 10.0, "rate")),
-        model=_model, hooks={"response": "y (n,)"},
+        name="rise",
+        title="a first-order rise",
+        columns=(Column("t_s", "s", "time"), Column("y", "-", "response")),
+        channels=("y",),
+        parameters=(Parameter("a", "-", 1.5, 0.1, 10.0, "final value"), Parameter("b", "1/s", 0.8, 0.01, 10.0, "rate")),
+        model=_model,
+        hooks={"response": "y (n,)"},
         # the FE experiments' settings (bay-torsion, tip-cycle): loose tolerances, a 1e-3 step
-        fit_options={"diff_step": 1e-3, "xtol": 1e-4, "ftol": 1e-4, "gtol": 1e-8, "max_nfev_per_param": 30,
-                     "expensive": True})
+        fit_options={
+            "diff_step": 1e-3,
+            "xtol": 1e-4,
+            "ftol": 1e-4,
+            "gtol": 1e-8,
+            "max_nfev_per_param": 30,
+            "expensive": True,
+        },
+    )
     return exp
 
 
@@ -60,7 +69,7 @@ def test_secant_fit_matches_the_finite_difference_fit_with_fewer_runs(monkeypatc
     # about n/2 = 60 (whitened) is 0.006, i.e. sqrt(2 x 0.006) = 0.11 standard errors
     assert np.all(np.abs(sec.x - fd.x) <= 0.15 * fd.stderr)
     # the covariance comes from a finite-difference Jacobian at the solution in both
-    np.testing.assert_allclose(sec.stderr, fd.stderr, rtol=1e-3)   # same J up to the 1e-3 FD step
+    np.testing.assert_allclose(sec.stderr, fd.stderr, rtol=1e-3)  # same J up to the 1e-3 FD step
     assert sec.fe_runs < fd.fe_runs
     # and the fit is right: the truth lies within 4 standard errors (noise 0.01 on 120 points)
     assert np.all(np.abs(sec.x - [A_TRUE, B_TRUE]) <= 4 * sec.stderr)
@@ -73,14 +82,14 @@ def test_start_sensitivity_replaces_the_first_jacobian_runs():
     # the sensitivity is d(predicted)/d(parameter): check it against a central difference of the model
     t = data["t_s"]
     a, b = first.x
-    da = (1.0 - np.exp(-b * t))
+    da = 1.0 - np.exp(-b * t)
     # a is fitted in log scale (bounds 0.1-10): a forward step h = 1e-3 in ln a is a step (e^h - 1) a, so the
     # difference quotient over h carries (e^h - 1) / h - 1 = h / 2 = 5e-4 of relative error
     np.testing.assert_allclose(first.sensitivity["a"], da, rtol=6e-4, atol=1e-12)
     again = fitting.fit(exp, data, start=dict(zip(first.names, first.x)), start_sensitivity=first.sensitivity)
     plain = fitting.fit(exp, data, start=dict(zip(first.names, first.x)))
-    assert np.all(np.abs(again.x - first.x) <= 0.15 * first.stderr)   # ftol, as above
-    assert again.fe_runs <= plain.fe_runs - 2      # the two first-Jacobian columns were not run
+    assert np.all(np.abs(again.x - first.x) <= 0.15 * first.stderr)  # ftol, as above
+    assert again.fe_runs <= plain.fe_runs - 2  # the two first-Jacobian columns were not run
 
 
 def test_a_poor_seed_does_not_change_the_answer():
@@ -90,7 +99,7 @@ def test_a_poor_seed_does_not_change_the_answer():
     ref = fitting.fit(exp, data)
     bad = {k: -3.0 * v for k, v in ref.sensitivity.items()}
     res = fitting.fit(exp, data, start={"a": 1.5, "b": 0.8}, start_sensitivity=bad)
-    assert np.all(np.abs(res.x - ref.x) <= 0.15 * ref.stderr)   # ftol, as above
+    assert np.all(np.abs(res.x - ref.x) <= 0.15 * ref.stderr)  # ftol, as above
 
 
 @pytest.mark.parametrize("seed", [1, 2])
@@ -100,5 +109,5 @@ def test_single_channel_noise_reestimate_needs_no_second_fit(seed):
     exp, data = _experiment(), _data(seed)
     res = fitting.fit(exp, data)
     z = (data["y"] - res.predicted["y"]) / res.noise["y"]
-    np.testing.assert_allclose(res.fun, z, rtol=1e-12)       # residual whitened by the final noise
+    np.testing.assert_allclose(res.fun, z, rtol=1e-12)  # residual whitened by the final noise
     np.testing.assert_allclose(res.cost, 0.5 * z @ z, rtol=1e-12)

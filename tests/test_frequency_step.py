@@ -16,7 +16,7 @@ def _string(n=40, T=80.0, mpl=0.02, L=1.0):
     for p, q in zip(nodes[:-1], nodes[1:]):
         m.truss(p, q, EA=1e6, pretension=T, mass_per_length=mpl)
     m.fix(nodes[0])
-    m.fix(nodes[-1], "uy", "uz")   # ux: prescribed in the tests' static step
+    m.fix(nodes[-1], "uy", "uz")  # ux: prescribed in the tests' static step
     return m, nodes
 
 

@@ -185,10 +185,11 @@ def test_noise_free_null_data_is_the_seed_baseline(name):
     # breakaway force once did: 4 samples 1-4 N above the static band on the backstop)
     from dataclasses import replace
 
+    from generalisation.cases import generate, get_case
+    from generalisation.rigs import K_JOINTS
+
     from femast.experiments import from_arrays, get_experiment
     from femast.experiments.core import NO_EFFECTS
-    from generalisation.cases import get_case, generate
-    from generalisation.rigs import K_JOINTS
 
     case = replace(get_case(name), level=1e-12)
     exp = get_experiment(case.experiment)
@@ -204,24 +205,53 @@ def test_noise_free_null_data_is_the_seed_baseline(name):
 
 # --------------------------------------------------------------------------- scoring and the harness
 def test_verdict_adapter_reads_old_and_new_reports():
-    old = {"verdict": {"missing_effect": "joint_clearance", "explained": True, "best_candidate": "joint_clearance",
-                       "conclusion": "missing effect: joint_clearance (joint clearance); with it ..."}}
-    assert read_verdict(old) == {"kind": "missing", "effects": ["joint_clearance"], "conclusion":
-                                 old["verdict"]["conclusion"]}
-    none = {"verdict": {"missing_effect": None, "explained": False, "best_candidate": "x",
-                        "conclusion": "none of the candidates explains this: the best, x, ..."}}
+    old = {
+        "verdict": {
+            "missing_effect": "joint_clearance",
+            "explained": True,
+            "best_candidate": "joint_clearance",
+            "conclusion": "missing effect: joint_clearance (joint clearance); with it ...",
+        }
+    }
+    assert read_verdict(old) == {
+        "kind": "missing",
+        "effects": ["joint_clearance"],
+        "conclusion": old["verdict"]["conclusion"],
+    }
+    none = {
+        "verdict": {
+            "missing_effect": None,
+            "explained": False,
+            "best_candidate": "x",
+            "conclusion": "none of the candidates explains this: the best, x, ...",
+        }
+    }
     assert read_verdict(none)["kind"] == "not_explained"
     null = {"verdict": {"missing_effect": None, "explained": True, "conclusion": "nothing is missing: ..."}}
     assert read_verdict(null)["kind"] == "nothing"
-    form = {"verdict": {"missing_effect": None, "conclusion": "mechanism found, form imperfect: friction_hysteresis"
-                        " explains 80 %", "best_candidate": "friction_hysteresis"}}
-    assert read_verdict(form) == {"kind": "form_imperfect", "effects": ["friction_hysteresis"],
-                                  "conclusion": form["verdict"]["conclusion"]}
-    pair = {"verdict": {"kind": "missing_effect", "missing_effect": "joint_clearance+friction_hysteresis",
-                        "conclusion": "missing effect: joint_clearance + friction_hysteresis"}}
+    form = {
+        "verdict": {
+            "missing_effect": None,
+            "conclusion": "mechanism found, form imperfect: friction_hysteresis explains 80 %",
+            "best_candidate": "friction_hysteresis",
+        }
+    }
+    assert read_verdict(form) == {
+        "kind": "form_imperfect",
+        "effects": ["friction_hysteresis"],
+        "conclusion": form["verdict"]["conclusion"],
+    }
+    pair = {
+        "verdict": {
+            "kind": "missing_effect",
+            "missing_effect": "joint_clearance+friction_hysteresis",
+            "conclusion": "missing effect: joint_clearance + friction_hysteresis",
+        }
+    }
     assert read_verdict(pair)["effects"] == ["friction_hysteresis", "joint_clearance"]
-    slashed = {"verdict": {"kind": "missing_effect", "missing_effect": "friction_hysteresis/jenkins",
-                           "conclusion": "?"}}
+    slashed = {
+        "verdict": {"kind": "missing_effect", "missing_effect": "friction_hysteresis/jenkins", "conclusion": "?"}
+    }
     assert read_verdict(slashed)["effects"] == ["friction_hysteresis"]  # a form names its mechanism
     v = read_verdict(pair)
     assert is_right("pair", ("joint_clearance", "friction_hysteresis"), v)
@@ -231,21 +261,41 @@ def test_verdict_adapter_reads_old_and_new_reports():
 
 
 def test_verdict_adapter_reads_the_issue14_kinds():
-    pair = {"verdict": {"kind": "missing_pair", "missing_effect": None, "missing_effects": ["latch_hysteresis",
-                        "stretch_error"], "mechanism": None, "conclusion": "missing effects: ..."}}
+    pair = {
+        "verdict": {
+            "kind": "missing_pair",
+            "missing_effect": None,
+            "missing_effects": ["latch_hysteresis", "stretch_error"],
+            "mechanism": None,
+            "conclusion": "missing effects: ...",
+        }
+    }
     assert read_verdict(pair)["kind"] == "missing"
     assert read_verdict(pair)["effects"] == ["latch_hysteresis", "stretch_error"]
-    form = {"verdict": {"kind": "form_imperfect", "missing_effect": None, "missing_effects": [],
-                        "mechanism": "joint_clearance", "best_candidate": "joint_clearance", "conclusion": "..."}}
+    form = {
+        "verdict": {
+            "kind": "form_imperfect",
+            "missing_effect": None,
+            "missing_effects": [],
+            "mechanism": "joint_clearance",
+            "best_candidate": "joint_clearance",
+            "conclusion": "...",
+        }
+    }
     assert read_verdict(form)["kind"] == "form_imperfect" and read_verdict(form)["effects"] == ["joint_clearance"]
-    for kind, expect in (("nothing_missing", "nothing"), ("not_explained", "not_explained"),
-                         ("missing_effect", "missing"), ("better_form", "missing")):
+    for kind, expect in (
+        ("nothing_missing", "nothing"),
+        ("not_explained", "not_explained"),
+        ("missing_effect", "missing"),
+        ("better_form", "missing"),
+    ):
         assert read_verdict({"verdict": {"kind": kind, "conclusion": "?"}})["kind"] == expect
 
 
 def test_score_weighs_each_null_case_as_one_case():
-    rows = ([{"case": "a", "expect": "effect", "right": True}, {"case": "b", "expect": "ool", "right": False}]
-            + [{"case": "n", "expect": "null", "right": i < 15} for i in range(20)])
+    rows = [{"case": "a", "expect": "effect", "right": True}, {"case": "b", "expect": "ool", "right": False}] + [
+        {"case": "n", "expect": "null", "right": i < 15} for i in range(20)
+    ]
     s = score(rows)
     assert s["score"] == pytest.approx((1 + 0 + 15 / 20) / 3)
     assert s["false_alarm_rate"] == pytest.approx(5 / 20) and s["null_runs"] == 20

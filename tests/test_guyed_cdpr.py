@@ -7,8 +7,17 @@ from scipy.spatial import ConvexHull, HalfspaceIntersection
 from scipy.spatial.transform import Rotation
 
 from femast.errors import ModelError
-from femast.guyed.cdpr import (GRAVITY, CdprGeometry, cable_forces_on_masts, cable_vectors, gravity_wrench,
-                               mast_top_wrenches, rotation_matrix, tension_distribution, wrench_matrix)
+from femast.guyed.cdpr import (
+    GRAVITY,
+    CdprGeometry,
+    cable_forces_on_masts,
+    cable_vectors,
+    gravity_wrench,
+    mast_top_wrenches,
+    rotation_matrix,
+    tension_distribution,
+    wrench_matrix,
+)
 from femast.guyed.rocaspect import FRAME, POSE_0, fig5a_trajectory, rocaspect_geometry
 
 GEOM = rocaspect_geometry()
@@ -81,9 +90,15 @@ def test_barycenter_matches_independent_polygon_centroid():
 def test_min_norm_matches_generic_qp():
     pose = POSES[3]
     W, wg = wrench_matrix(GEOM, pose), gravity_wrench(GEOM, pose)
-    ref = minimize(lambda t: t @ t, np.full(8, 200.0), jac=lambda t: 2 * t, method="SLSQP",
-                   constraints={"type": "eq", "fun": lambda t: W @ t + wg, "jac": lambda t: W},
-                   bounds=[(GEOM.tau_min, GEOM.tau_max)] * 8, options={"ftol": 1e-14, "maxiter": 500})
+    ref = minimize(
+        lambda t: t @ t,
+        np.full(8, 200.0),
+        jac=lambda t: 2 * t,
+        method="SLSQP",
+        constraints={"type": "eq", "fun": lambda t: W @ t + wg, "jac": lambda t: W},
+        bounds=[(GEOM.tau_min, GEOM.tau_max)] * 8,
+        options={"ftol": 1e-14, "maxiter": 500},
+    )
     # SLSQP converges to ~1e-6 relative; our solution is an exact 2D projection
     np.testing.assert_allclose(tension_distribution(GEOM, pose, "min_norm").tau, ref.x, rtol=1e-5)
 
@@ -117,8 +132,15 @@ def test_mast_top_wrenches_satisfy_global_equilibrium():
 
 def test_mast_force_is_tension_times_u_plus_v():
     # Eq. 7 on one hand-made cable: exit at the origin, platform straight along +x, winch straight down.
-    g = CdprGeometry(exit_points=np.zeros((1, 3)), anchor_points=np.zeros((1, 3)), winch_points=[[0, 0, -2.0]],
-                     mast_of_cable=[0], mast_bases=[[0, 0, -3.0]], mast_tops=[[0, 0, 0.5]], mass=1.0)
+    g = CdprGeometry(
+        exit_points=np.zeros((1, 3)),
+        anchor_points=np.zeros((1, 3)),
+        winch_points=[[0, 0, -2.0]],
+        mast_of_cable=[0],
+        mast_bases=[[0, 0, -3.0]],
+        mast_tops=[[0, 0, 0.5]],
+        mass=1.0,
+    )
     f = cable_forces_on_masts(g, [3.0, 0, 0], [100.0])
     np.testing.assert_allclose(f, [[100.0, 0, -100.0]], rtol=1e-15)  # exact arithmetic
     w = mast_top_wrenches(g, [3.0, 0, 0], [100.0])

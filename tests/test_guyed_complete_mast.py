@@ -4,14 +4,28 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from femast.elements.shroud_law import (
+    SEED_X_S,
+    DyneemaLaw,
+    axial_rigidity_secant,
+    axial_rigidity_tangent,
+    shroud_stiffness,
+    strain_from_tension,
+    tension_from_strain,
+)
 from femast.errors import ModelError
 from femast.guyed.cantilever import cantilever_compliance, cantilever_stiffness, mast_section
-from femast.guyed.complete_mast import (ShroudSet, active_stiffness, displacement_complete, mast_stiffness,
-                                        passive_stiffness, passive_stiffness_blocks, shroud_geometry,
-                                        shroud_wrench_matrix)
+from femast.guyed.complete_mast import (
+    ShroudSet,
+    active_stiffness,
+    displacement_complete,
+    mast_stiffness,
+    passive_stiffness,
+    passive_stiffness_blocks,
+    shroud_geometry,
+    shroud_wrench_matrix,
+)
 from femast.guyed.rocaspect import E_NO_SHROUD, L_BEAM, mast_tops, rocaspect_shrouds
-from femast.elements.shroud_law import (SEED_X_S, DyneemaLaw, axial_rigidity_secant, axial_rigidity_tangent,
-                                 shroud_stiffness, strain_from_tension, tension_from_strain)
 
 LAW = DyneemaLaw()
 TOP = np.array([0.1, 0.2, 4.0])
@@ -26,8 +40,9 @@ def test_dyneema_law_units_and_seed_values():
     # k0 is an axial rigidity (N): EA at zero load; at 1200 N: k0 + k1 1200 + k2 1200^2 by hand.
     assert axial_rigidity_secant(LAW, 0.0) == SEED_X_S[0]
     assert axial_rigidity_tangent(LAW, 0.0) == pytest.approx(SEED_X_S[0], rel=1e-15)  # same formula at 0
-    assert axial_rigidity_secant(LAW, 1200.0) == pytest.approx(935353.664 + 144.32 * 1200 - 0.000465 * 1200**2,
-                                                               rel=1e-15)  # round-off
+    assert axial_rigidity_secant(LAW, 1200.0) == pytest.approx(
+        935353.664 + 144.32 * 1200 - 0.000465 * 1200**2, rel=1e-15
+    )  # round-off
     # Eq. 25: a 4 m shroud at 1200 N, secant form: (k0 + k1 tau + k2 tau^2) / l in N/m
     assert shroud_stiffness(LAW, 1200.0, 4.0, kind="secant") == pytest.approx(1107868.064 / 4.0, rel=1e-12)
     # the tangent is 18 % stiffer at 1200 N (progressive rope)
@@ -38,7 +53,9 @@ def test_tangent_rigidity_is_derivative_of_tension_strain_law():
     for tau in (0.0, 400.0, 1200.0, 3000.0):
         eps = strain_from_tension(LAW, tau)
         h = 1e-9
-        fd = (tension_from_strain(LAW, eps + h) - tension_from_strain(LAW, max(eps - h, 0.0))) / (eps + h - max(eps - h, 0))
+        fd = (tension_from_strain(LAW, eps + h) - tension_from_strain(LAW, max(eps - h, 0.0))) / (
+            eps + h - max(eps - h, 0)
+        )
         # central difference on a smooth law: truncation ~h^2 and round-off ~1e-16 tau / h
         assert axial_rigidity_tangent(LAW, tau) == pytest.approx(fd, rel=1e-6)
 
@@ -76,8 +93,16 @@ def _shroud_wrench_after_motion(dx, law_fn, lengths0):
 
 
 def _fd_stiffness(law_fn, lengths0, h=1e-6):
-    return np.column_stack([(_shroud_wrench_after_motion(h * e, law_fn, lengths0)
-                             - _shroud_wrench_after_motion(-h * e, law_fn, lengths0)) / (2 * h) for e in np.eye(6)])
+    return np.column_stack(
+        [
+            (
+                _shroud_wrench_after_motion(h * e, law_fn, lengths0)
+                - _shroud_wrench_after_motion(-h * e, law_fn, lengths0)
+            )
+            / (2 * h)
+            for e in np.eye(6)
+        ]
+    )
 
 
 def test_active_plus_passive_equals_finite_difference_of_shroud_wrench():
@@ -162,8 +187,9 @@ def test_shrouds_stiffen_the_mast_more_with_more_pretension():
     bare = np.diag(cantilever_compliance(L_BEAM, mast_section(E_NO_SHROUD)))[:2]
     assert np.all(lateral[1] < lateral[0]) and np.all(lateral[0] < 0.5 * bare)
     # the wrench matrix of Eq. 21 has unit force columns
-    np.testing.assert_allclose(np.linalg.norm(shroud_wrench_matrix(top, rocaspect_shrouds(0, 400))[:3], axis=0), 1.0,
-                               rtol=1e-15)
+    np.testing.assert_allclose(
+        np.linalg.norm(shroud_wrench_matrix(top, rocaspect_shrouds(0, 400))[:3], axis=0), 1.0, rtol=1e-15
+    )
 
 
 def test_bad_shroud_input_is_rejected():

@@ -27,7 +27,7 @@ def test_benchmark_accepts_a_fourth_model():
     models = {**bench.MODELS, "FE": lambda case, dw: 0.5 * bench.predict_3r(case, dw)}  # stand-in 4th model
     res = bench.compute(models, n_per_segment=4)
     assert "FE" in bench.table(res)
-    for case, pred in res["pred"].items():
+    for _case, pred in res["pred"].items():
         assert set(pred) == {"3R", "beam", "complete", "FE"}
         # the trajectory ends at the initial pose: zero wrench change, zero displacement (round-off)
         for d in pred.values():

@@ -6,13 +6,18 @@ import pytest
 
 import femast as fm
 from femast.elements.shroud_cable import ShroudCableFamily, add_shrouds, unstretched_length
-from femast.errors import ModelError
-from femast.guyed.complete_mast import active_stiffness
-from femast.guyed.fe_mast import (MastFE, beam_column_geometric_stiffness,
-                                  compare_stiffness, relative_difference, rotation_scaling)
-from femast.guyed.cantilever import mast_section
-from femast.guyed.rocaspect import E_NO_SHROUD, L_BEAM, mast_tops
 from femast.elements.shroud_law import DyneemaLaw, axial_rigidity_tangent, strain_from_tension, tension_from_strain
+from femast.errors import ModelError
+from femast.guyed.cantilever import mast_section
+from femast.guyed.complete_mast import active_stiffness
+from femast.guyed.fe_mast import (
+    MastFE,
+    beam_column_geometric_stiffness,
+    compare_stiffness,
+    relative_difference,
+    rotation_scaling,
+)
+from femast.guyed.rocaspect import E_NO_SHROUD, L_BEAM, mast_tops
 from femast.rotations import expm_so3
 from femast.testing import fd_tangent
 
@@ -57,8 +62,9 @@ def test_shroud_tangent_parts_add_up_and_material_part_is_the_law():
         fam.tangent_parts = p
         parts[p] = fam.evaluate(x, R, None)
     fam.tangent_parts = "full"
-    np.testing.assert_allclose(parts["material"].k + parts["geometric"].k, parts["full"].k, rtol=0,
-                               atol=1e-12 * np.abs(parts["full"].k).max())  # round-off of a sum
+    np.testing.assert_allclose(
+        parts["material"].k + parts["geometric"].k, parts["full"].k, rtol=0, atol=1e-12 * np.abs(parts["full"].k).max()
+    )  # round-off of a sum
     assert np.all(parts["none"].k == 0.0)
     out = parts["full"].output
     # tension and material tangent are Eq. 25 / Eq. 27 of femast.elements.shroud_law (same formulas)
@@ -127,7 +133,8 @@ def test_bad_input_gives_clear_model_errors():
         fam.evaluate(np.zeros((2, 3)), np.tile(np.eye(3), (2, 1, 1)), None)
     with pytest.raises(ModelError, match="beyond the range of the rope law"):  # k1 eps > 1: no finite root
         ShroudCableFamily([[0, 1]], 1.0, [1e6, 200.0, 0.0]).evaluate(
-            np.array([[0.0, 0, 0], [1.01, 0, 0]]), np.tile(np.eye(3), (2, 1, 1)), None)
+            np.array([[0.0, 0, 0], [1.01, 0, 0]]), np.tile(np.eye(3), (2, 1, 1)), None
+        )
     with pytest.raises(ModelError, match="pretension.*>= 0"):
         MastFE(-10.0)
 
@@ -155,9 +162,9 @@ def test_beam_and_passive_parts_match_to_1e6(cmp1200, cmp400):
     # the tangent Eq. 25: 1e-6 is the requirement (measured ~1e-14)
     for c in (cmp1200, cmp400):
         assert c["rel_beam"] < 1e-6
-        assert c["rel_passive0"] < 1e-6   # shrouds taut at 0 N, nominal geometry: K_p(tau = 0)
-        assert c["rel_passive"] < 1e-6    # at the pretensioned equilibrium
-        assert c["rel_shroud"] < 1e-6     # K_a + K_p together
+        assert c["rel_passive0"] < 1e-6  # shrouds taut at 0 N, nominal geometry: K_p(tau = 0)
+        assert c["rel_passive"] < 1e-6  # at the pretensioned equilibrium
+        assert c["rel_shroud"] < 1e-6  # K_a + K_p together
 
 
 def test_active_part_matches_with_the_same_conventions(cmp1200, cmp400):
@@ -250,8 +257,10 @@ def test_wall_attachment_variant_runs_and_is_slightly_softer():
     c_wall = np.linalg.inv(wall.top_stiffness())[0, 0]
     assert c_top < c_wall < 1.01 * c_top  # measured +0.07 %: the rigid-top assumption is harmless
     assert np.allclose(top.top_point, mast_tops()[0])
-    assert relative_difference(active_stiffness(top.state().top, top.analytic_shrouds()),
-                               top.stiffness_parts()["K_a_FE"]) < 1e-6
+    assert (
+        relative_difference(active_stiffness(top.state().top, top.analytic_shrouds()), top.stiffness_parts()["K_a_FE"])
+        < 1e-6
+    )
 
 
 def test_docs_fe_example_runs_and_matches_its_printed_output():
@@ -271,5 +280,5 @@ def test_docs_fe_example_runs_and_matches_its_printed_output():
     assert len(got) == len(expected)
     from doc_examples import assert_same_numbers
 
-    for q, p in zip(expected, got):   # to one unit of the last printed digit (0.01 mm, 0.1 N)
+    for q, p in zip(expected, got):  # to one unit of the last printed digit (0.01 mm, 0.1 N)
         assert_same_numbers(q, p)

@@ -3,14 +3,21 @@
 import numpy as np
 import pytest
 
+from femast.elements.shroud_law import SEED_X_S, DyneemaLaw, strain_from_tension
 from femast.errors import ModelError
 from femast.guyed.cantilever import cantilever_compliance, mast_section
 from femast.guyed.cdpr import trajectory_loads
 from femast.guyed.identify import fit_3r, fit_beam_E, fit_shroud_law, seed_eq29_matrix, shroud_design_matrix
 from femast.guyed.mast_3r import displacement_3r
-from femast.guyed.rocaspect import (E_1200N, L_BEAM, TABLE_III, fig5a_trajectory, mast_bases, mast_tops,
-                                    rocaspect_geometry)
-from femast.elements.shroud_law import SEED_X_S, DyneemaLaw, strain_from_tension
+from femast.guyed.rocaspect import (
+    E_1200N,
+    L_BEAM,
+    TABLE_III,
+    fig5a_trajectory,
+    mast_bases,
+    mast_tops,
+    rocaspect_geometry,
+)
 
 R_OC = mast_tops()[0] - mast_bases()[0]
 _, _WR = trajectory_loads(rocaspect_geometry(), fig5a_trajectory(12))

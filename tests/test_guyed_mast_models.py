@@ -5,9 +5,15 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from femast.errors import ModelError
-from femast.guyed.cantilever import (R_BE_VERTICAL, beam_rotation, cantilever_compliance,
-                                     cantilever_compliance_parts, cantilever_stiffness, displacement_beam,
-                                     mast_section)
+from femast.guyed.cantilever import (
+    R_BE_VERTICAL,
+    beam_rotation,
+    cantilever_compliance,
+    cantilever_compliance_parts,
+    cantilever_stiffness,
+    displacement_beam,
+    mast_section,
+)
 from femast.guyed.mast_3r import compliance_3r, displacement_3r, jacobian_3r
 from femast.guyed.rocaspect import E_1200N, L_BEAM, S_IN, S_OUT, TABLE_III
 
@@ -20,8 +26,12 @@ def test_eq6_translational_columns_follow_the_physical_motion():
     # Rotating the rigid mast by h about the base axis e_k moves the top by R(h e_k) r - r; its
     # derivative is the true column.  The corrected J matches it; the printed sign is its negative.
     h = 1e-7
-    fd = np.column_stack([(Rotation.from_rotvec(h * e).apply(R_OC) - Rotation.from_rotvec(-h * e).apply(R_OC))
-                          / (2 * h) for e in np.eye(3)])
+    fd = np.column_stack(
+        [
+            (Rotation.from_rotvec(h * e).apply(R_OC) - Rotation.from_rotvec(-h * e).apply(R_OC)) / (2 * h)
+            for e in np.eye(3)
+        ]
+    )
     J = jacobian_3r(R_OC)
     np.testing.assert_allclose(J[:3], fd, atol=1e-8)  # central-difference round-off ~ 1e-16 * 4 m / 1e-7
     np.testing.assert_allclose(jacobian_3r(R_OC, seed_sign=True)[:3], -fd, atol=1e-8)  # same
@@ -96,12 +106,16 @@ def test_eq30_rows_with_corrected_row_2():
     C_E, C_G = cantilever_compliance_parts(L, sec)
     dw = RNG.normal(size=6)
     w1, w2, w3, w4, w5, w6 = dw
-    rows_E = np.array([L**3 / (3 * I) * w1 + L**2 / (2 * I) * w5,
-                       L**3 / (3 * I) * w2 - L**2 / (2 * I) * w4,
-                       L / A * w3,
-                       -(L**2) / (2 * I) * w2 + L / I * w4,
-                       L**2 / (2 * I) * w1 + L / I * w5,
-                       0.0])
+    rows_E = np.array(
+        [
+            L**3 / (3 * I) * w1 + L**2 / (2 * I) * w5,
+            L**3 / (3 * I) * w2 - L**2 / (2 * I) * w4,
+            L / A * w3,
+            -(L**2) / (2 * I) * w2 + L / I * w4,
+            L**2 / (2 * I) * w1 + L / I * w5,
+            0.0,
+        ]
+    )
     np.testing.assert_allclose(C_E @ dw, rows_E, rtol=1e-12, atol=1e-6)  # round-off on terms ~1e7
     np.testing.assert_allclose(C_G @ dw, [0, 0, 0, 0, 0, L / J * w6], rtol=1e-12, atol=1e-6)
     printed_row2 = L**3 / (3 * I) * w2 + L**2 / (2 * I) * w4
@@ -133,18 +147,22 @@ def test_displacements_are_linear_in_batches():
     dw = RNG.normal(size=(7, 6))
     C = cantilever_compliance(L_BEAM, mast_section(7e10))
     np.testing.assert_allclose(displacement_beam(C, dw), (C @ dw.T).T, rtol=1e-14)  # same product
-    np.testing.assert_allclose(displacement_3r(K_THETA, R_OC, dw)[3], compliance_3r(K_THETA, R_OC) @ dw[3],
-                               rtol=1e-12, atol=1e-18)
+    np.testing.assert_allclose(
+        displacement_3r(K_THETA, R_OC, dw)[3], compliance_3r(K_THETA, R_OC) @ dw[3], rtol=1e-12, atol=1e-18
+    )
 
 
-@pytest.mark.parametrize("call, match", [
-    (lambda: compliance_3r([2e5, 0.0, 1e5], R_OC), "k_theta.*positive.*N m/rad"),
-    (lambda: compliance_3r([2e5, -1.0, 1e5], R_OC), "entry 1"),
-    (lambda: mast_section(-7e10), "Young's modulus"),
-    (lambda: cantilever_compliance(0.0, mast_section(7e10)), "beam length L.*m"),
-    (lambda: mast_section(7e10, s_in=0.12), "inner"),
-    (lambda: beam_rotation((0, 0, 0)), "zero length"),
-])
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda: compliance_3r([2e5, 0.0, 1e5], R_OC), "k_theta.*positive.*N m/rad"),
+        (lambda: compliance_3r([2e5, -1.0, 1e5], R_OC), "entry 1"),
+        (lambda: mast_section(-7e10), "Young's modulus"),
+        (lambda: cantilever_compliance(0.0, mast_section(7e10)), "beam length L.*m"),
+        (lambda: mast_section(7e10, s_in=0.12), "inner"),
+        (lambda: beam_rotation((0, 0, 0)), "zero length"),
+    ],
+)
 def test_bad_input_is_rejected(call, match):
     with pytest.raises(ModelError, match=match):
         call()

@@ -23,8 +23,7 @@ def reports(tmp_path_factory):
     folder = tmp_path_factory.mktemp("reports")
     out = folder / "mast"
     assert main(["compare", "mast-top", "example", "--out", str(out), "--json"]) == 0
-    assert main(["diagnose", "latch-pull", "example", "--out", str(folder / "latch"), "--workers", "1",
-                 "--json"]) == 0
+    assert main(["diagnose", "latch-pull", "example", "--out", str(folder / "latch"), "--workers", "1", "--json"]) == 0
     return {"compare": out / "compare_report.html", "diagnose": folder / "latch" / "diagnose_report.html"}
 
 
@@ -45,7 +44,7 @@ def test_report_is_self_contained(reports, kind):
     imgs = _images(text)
     assert len(imgs) == text.count("<img")
     assert imgs and all(base64.b64decode(i)[:8] == PNG_MAGIC for i in imgs)
-    assert 'id=verdict' in text
+    assert "id=verdict" in text
 
 
 def test_compare_report_content(reports):
@@ -85,12 +84,25 @@ def test_report_renders_in_headless_chromium(reports, kind, tmp_path):
         pytest.skip("Chromium is not installed (Debian: apt-get install chromium); the static checks above ran")
     page = tmp_path / "probe.html"  # the report plus a probe script that reports what the browser shows
     page.write_text(reports[kind].read_text(encoding="utf-8").replace("</body>", _PROBE), encoding="utf-8")
-    cmd = [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-           "--disable-component-update", "--disable-sync", "--no-first-run", f"--user-data-dir={tmp_path / 'profile'}",
-           "--virtual-time-budget=10000", "--dump-dom", page.as_uri()]
+    cmd = [
+        CHROMIUM,
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--no-first-run",
+        f"--user-data-dir={tmp_path / 'profile'}",
+        "--virtual-time-budget=10000",
+        "--dump-dom",
+        page.as_uri(),
+    ]
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=180)
     m = re.search(r'<pre id="probe">(.*?)</pre>', p.stdout)
     assert m, f"Chromium printed no probe result (exit {p.returncode}):\n{p.stderr[-2000:]}"
-    probe = json.loads(m.group(1).replace("&quot;", '"').replace("&amp;", "&").replace("&lt;", "<").replace("&gt;", ">"))
+    probe = json.loads(
+        m.group(1).replace("&quot;", '"').replace("&amp;", "&").replace("&lt;", "<").replace("&gt;", ">")
+    )
     assert probe["images"] >= 1 and probe["loaded"] == probe["images"]
     assert probe["verdict"] and probe["verdict"].startswith("Verdict:")

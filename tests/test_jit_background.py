@@ -77,14 +77,16 @@ def test_interpreted_kernels_give_the_compiled_results_bit_for_bit(tmp_path, mod
     """Same arithmetic in the same order on IEEE doubles: the final state of a large-rotation run
     is identical to the last bit, and so is the number of Newton iterations."""
     (tmp_path / "model_bg.py").write_text(model)
-    code = ("import sys, json, numpy as np; sys.path.insert(0, '.'); from model_bg import run; "
-            "import femast.jit_background as jb; v, it = run(); "
-            "print(json.dumps({'v': v.tolist(), 'it': it, 'n_hooked': len(jb._hooked)}))")
+    code = (
+        "import sys, json, numpy as np; sys.path.insert(0, '.'); from model_bg import run; "
+        "import femast.jit_background as jb; v, it = run(); "
+        "print(json.dumps({'v': v.tolist(), 'it': it, 'n_hooked': len(jb._hooked)}))"
+    )
     compiled = json.loads(_child(code, {"FEMAST_BACKGROUND_COMPILE": "0"}, tmp_path))
     interp = json.loads(_child(code, {"FEMAST_BACKGROUND_COMPILE": "interpret"}, tmp_path))
     assert compiled["n_hooked"] == 0 and interp["n_hooked"] > 5
     assert interp["it"] == compiled["it"]
-    assert np.array_equal(np.array(interp["v"]), np.array(compiled["v"]))   # bit for bit, no tolerance
+    assert np.array_equal(np.array(interp["v"]), np.array(compiled["v"]))  # bit for bit, no tolerance
 
 
 def test_worker_fills_the_cache_and_the_next_call_loads_it(tmp_path):
@@ -109,12 +111,13 @@ def test_worker_fills_the_cache_and_the_next_call_loads_it(tmp_path):
                           "compiled_here": compiled_here, "signatures": len(d.signatures),
                           "hits": sum(d.stats.cache_hits.values())}))
     """)
-    out = json.loads(_child(code, {"NUMBA_CACHE_DIR": str(tmp_path / "cache"), "FEMAST_BACKGROUND_COMPILE": "1"},
-                            tmp_path))
-    assert out["claims"] == 1                 # the worker was asked, the call did not wait
-    assert out["compiled_here"] == []         # nothing compiled in this process
-    assert out["signatures"] == 1 and out["hits"] == 1   # the second call loaded the worker's code
-    assert out["first"] == out["second"]      # interpreted and compiled: the same bits
+    out = json.loads(
+        _child(code, {"NUMBA_CACHE_DIR": str(tmp_path / "cache"), "FEMAST_BACKGROUND_COMPILE": "1"}, tmp_path)
+    )
+    assert out["claims"] == 1  # the worker was asked, the call did not wait
+    assert out["compiled_here"] == []  # nothing compiled in this process
+    assert out["signatures"] == 1 and out["hits"] == 1  # the second call loaded the worker's code
+    assert out["first"] == out["second"]  # interpreted and compiled: the same bits
     assert list((tmp_path / "cache").rglob("*logm_so3*.nbi"))
 
 
@@ -170,16 +173,21 @@ def test_helpers_of_interpreted_kernels_are_interpreted_not_compiled(tmp_path):
                           "rows": float(np.abs(D).sum(axis=1).max()), "data": data.tolist(), "plain": plain.tolist(),
                           "k": k.tolist()}))
     """)
-    out = json.loads(_child(code, {"NUMBA_CACHE_DIR": str(tmp_path / "cache"), "FEMAST_BACKGROUND_COMPILE": "interpret"},
-                            tmp_path))
+    out = json.loads(
+        _child(code, {"NUMBA_CACHE_DIR": str(tmp_path / "cache"), "FEMAST_BACKGROUND_COMPILE": "interpret"}, tmp_path)
+    )
     assert out["compiled_here"] == []
-    assert out["csc"] == out["split"] and out["r"] == out["r_csc"]   # the same sums in the same order
+    assert out["csc"] == out["split"] and out["r"] == out["r_csc"]  # the same sums in the same order
     ref = np.array(out["ref"])
-    assert np.allclose(out["r"], ref, rtol=0, atol=1e-14 * np.abs(ref).max())   # r = rhs - B x to round-off
+    assert np.allclose(out["r"], ref, rtol=0, atol=1e-14 * np.abs(ref).max())  # r = rhs - B x to round-off
     assert out["csc"][0] == np.abs(out["r"]).max() and np.isclose(out["csc"][1], out["rows"], rtol=1e-15)
     assert out["csc"][3] == np.abs(out["rhs"]).max()
     k = np.array(out["k"])
     # -1 is outside; the sums of the entries at each position, in scatter order
-    expected = [k[0, 0, 0] + k[1, 0, 0] + k[2, 1, 1], k[0, 0, 1] + k[1, 0, 1], k[0, 1, 1] + k[1, 1, 0],
-                k[2, 0, 0] + k[2, 0, 1]]
-    assert out["plain"] == expected and out["data"] == expected   # same order: the same bits
+    expected = [
+        k[0, 0, 0] + k[1, 0, 0] + k[2, 1, 1],
+        k[0, 0, 1] + k[1, 0, 1],
+        k[0, 1, 1] + k[1, 1, 0],
+        k[2, 0, 0] + k[2, 0, 1],
+    ]
+    assert out["plain"] == expected and out["data"] == expected  # same order: the same bits

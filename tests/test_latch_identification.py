@@ -51,8 +51,9 @@ def test_simulated_tests_follow_the_law(clean_tests):
         x = t.bead_position()
         assert np.max(np.abs(x[taut] - t.x_true[taut])) < 1e-6  # T dx / EA <= 110 N * 6 mm / 2e6 N
         moving = taut & (t.x_true > -TRUE.x_backstop)
-        np.testing.assert_allclose(t.dT()[moving], latch_force(t.x_true[moving], t.direction, TRUE),
-                                   atol=1e-7)  # element solve tolerance
+        np.testing.assert_allclose(
+            t.dT()[moving], latch_force(t.x_true[moving], t.direction, TRUE), atol=1e-7
+        )  # element solve tolerance
     unl, lat = clean_tests
     assert unl.x_true[0] == -TRUE.x_backstop and lat.x_true[-1] == -TRUE.x_backstop
     peak = latch_force(np.linspace(-TRUE.x_backstop, 0.0, 20001), UNLATCHING, TRUE).max()
@@ -81,8 +82,9 @@ def test_standard_errors_match_monte_carlo_spread(clean_tests):
 
 
 def test_fit_starting_far_away(clean_tests):
-    res = fit_pull_tests(noisy(clean_tests, 2), h=TRUE.h, R=TRUE.R, sigma_T=SIG_T, sigma_x=SIG_D,
-                         p0=[1.5e-3, 1.5e-3, 0.6e5, 0.02])
+    res = fit_pull_tests(
+        noisy(clean_tests, 2), h=TRUE.h, R=TRUE.R, sigma_T=SIG_T, sigma_x=SIG_D, p0=[1.5e-3, 1.5e-3, 0.6e5, 0.02]
+    )
     np.testing.assert_allclose(res.x, THETA, rtol=0.02)  # same basin: < 2 % as above
 
 

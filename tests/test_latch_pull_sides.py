@@ -93,8 +93,9 @@ def test_unlatching_reversed_in_zone_b_follows_the_latching_branch():
     back = moving_in & (run["x_bead"] > -1.8e-3) & (np.arange(run["dT"].size) < 400)
     assert back.sum() > 50 and run["dT"][back].min() > 10.0
     x = 1e-3 * cols["x_mm"][back]
-    np.testing.assert_allclose(run["dT"][back], latch_force(x, LATCHING, LatchParameters.seed_fit()),
-                               atol=0.5)  # 2 um position noise on a slope up to 130 N/mm: 0.26 N, 2x margin
+    np.testing.assert_allclose(
+        run["dT"][back], latch_force(x, LATCHING, LatchParameters.seed_fit()), atol=0.5
+    )  # 2 um position noise on a slope up to 130 N/mm: 0.26 N, 2x margin
     assert np.sqrt(np.mean((pred[back] - run["dT"][back]) ** 2)) < 0.6  # same noise budget, RMS
 
 
@@ -177,8 +178,9 @@ def test_side_column_words_and_errors(tmp_path):
     run, cols, _ = _data("partial unlatching, zone (c)")
     f = tmp_path / "pull.csv"
     words = np.where(cols["side"] > 0, "out", "in")
-    f.write_text("x_mm,dT_N,side\n" + "".join(f"{a:.6f},{b:.4f},{w}\n" for a, b, w in
-                                              zip(cols["x_mm"], cols["dT_N"], words)))
+    f.write_text(
+        "x_mm,dT_N,side\n" + "".join(f"{a:.6f},{b:.4f},{w}\n" for a, b, w in zip(cols["x_mm"], cols["dT_N"], words))
+    )
     data = read_data(EXP, f)
     np.testing.assert_array_equal(data["side"], cols["side"])
     bad = tmp_path / "bad.csv"
@@ -207,8 +209,9 @@ def test_partial_reversal_matches_an_fe_run_of_one_cable_latch_element():
     assert np.all(fe["T"][:, 0] == 0.0)  # inner section slack: a one-sided test
     back = st == SLIP_IN
     assert fe["dT"][back].min() > 20.0  # pulled back by the rollers, held by the taut outer cable
-    np.testing.assert_allclose(fe["x15"][fe["T"][:, 1] > 0], fe["x"][fe["T"][:, 1] > 0],
-                               atol=1e-12)  # Eq. 15 with the loaded length inverts Eq. 2 (round-off of 0.5 m)
+    np.testing.assert_allclose(
+        fe["x15"][fe["T"][:, 1] > 0], fe["x"][fe["T"][:, 1] > 0], atol=1e-12
+    )  # Eq. 15 with the loaded length inverts Eq. 2 (round-off of 0.5 m)
     data = from_arrays(EXP, x_mm=1e3 * fe["x15"], dT_N=fe["dT"], side=np.ones(fe["dT"].size))
     pred = predict(EXP, data, TRUE)["dT_N"]
     # the element solves the bead position to ~1e-12 m; times branch slopes up to 1.3e5 N/m that is

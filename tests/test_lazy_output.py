@@ -13,12 +13,12 @@ def test_lazy_output_computes_once_on_first_read():
         return {"a": np.arange(3.0), "b": np.ones(2)}
 
     out = LazyOutput(make)
-    assert calls == []                       # nothing computed by building it
+    assert calls == []  # nothing computed by building it
     assert "a" in out and len(out) == 2
     assert sorted(out) == ["a", "b"]
     np.testing.assert_array_equal(out["a"], [0.0, 1.0, 2.0])
     assert dict(out.items())["b"].tolist() == [1.0, 1.0]
-    assert calls == [1]                      # and only once, however often it is read
+    assert calls == [1]  # and only once, however often it is read
 
 
 def test_lazy_outputs_are_those_of_their_own_evaluation():
@@ -33,7 +33,7 @@ def test_lazy_outputs_are_those_of_their_own_evaluation():
     assert len(fams) == 2
     x0 = am.model.coordinates
     R = np.tile(np.eye(3), (len(x0), 1, 1))
-    x1 = x0 + 1e-4 * np.random.default_rng(1).standard_normal(x0.shape)   # 0.1 mm: a small motion
+    x1 = x0 + 1e-4 * np.random.default_rng(1).standard_normal(x0.shape)  # 0.1 mm: a small motion
     for fam in fams:
         st = fam.initial_state()
         first = fam.evaluate(x0, R, st)
@@ -41,4 +41,4 @@ def test_lazy_outputs_are_those_of_their_own_evaluation():
         second = fam.evaluate(x1, R, st)
         assert any(not np.array_equal(second.output[k], eager[k], equal_nan=True) for k in eager), fam.name
         for k, v in eager.items():
-            np.testing.assert_array_equal(first.output[k], v, err_msg=f"{fam.name} {k}")   # same bits
+            np.testing.assert_array_equal(first.output[k], v, err_msg=f"{fam.name} {k}")  # same bits

@@ -10,10 +10,10 @@ import scipy.sparse as sp
 
 import femast as fm
 from femast.analysis import Analysis
-from femast.errors import ModelError, SingularModelError
 from femast.analysis.solvers import backends
 from femast.analysis.solvers.banded import BandedFactor, band_of, band_rule
 from femast.analysis.solvers.linear import SparseLU
+from femast.errors import ModelError, SingularModelError
 
 
 def chain_matrix(n=300, b=7, asym=0.0, shift=0.0, seed=1):
@@ -69,19 +69,19 @@ def test_banded_unsymmetric_uses_the_lu():
     b = np.random.default_rng(3).normal(size=A.shape[0])
     lu, x = solve_with(A, "banded", b)
     assert lu._lu.kind == "lu"
-    assert backward_error(A, x, b) <= 1e-14   # partial pivoting LU: backward stable (1e-16 x growth)
+    assert backward_error(A, x, b) <= 1e-14  # partial pivoting LU: backward stable (1e-16 x growth)
 
 
 def test_banded_indefinite_falls_back_to_lu():
     A = chain_matrix()
     w = np.linalg.eigvalsh(A.toarray())
-    A2 = (A - 0.5 * (w[3] + w[4]) * sp.identity(A.shape[0])).tocsr()   # 4 negative eigenvalues
+    A2 = (A - 0.5 * (w[3] + w[4]) * sp.identity(A.shape[0])).tocsr()  # 4 negative eigenvalues
     b = np.random.default_rng(4).normal(size=A.shape[0])
     lu, x = solve_with(A2, "banded", b)
     assert lu._lu.kind == "lu"
-    assert backward_error(A2, x, b) <= 1e-14   # as above
+    assert backward_error(A2, x, b) <= 1e-14  # as above
     x_ref = np.linalg.solve(A2.toarray(), b)
-    assert np.abs(x - x_ref).max() <= 1e-8 * np.abs(x_ref).max()   # cond ~ 1e5 here
+    assert np.abs(x - x_ref).max() <= 1e-8 * np.abs(x_ref).max()  # cond ~ 1e5 here
 
 
 @pytest.mark.parametrize("backend", ["superlu", "banded"])
@@ -90,14 +90,14 @@ def test_singular_and_nearly_singular_tangents_are_reported(backend):
     A = chain_matrix().tolil()
     i = 150
     big = abs(A).max()
-    for eps in (0.0, 1e-15):   # exactly singular, and a pivot far below 1e-13 of the largest
+    for eps in (0.0, 1e-15):  # exactly singular, and a pivot far below 1e-13 of the largest
         S = A.copy()
         S[i, :] = 0.0
         S[:, i] = 0.0
         S[i, i] = eps * big
         S = S.tocsr()
         S.eliminate_zeros()
-        if eps == 0.0:   # keep the diagonal entry in the pattern (an assembled tangent has it)
+        if eps == 0.0:  # keep the diagonal entry in the pattern (an assembled tangent has it)
             S = (S + sp.csr_matrix(([1e-300], ([i], [i])), shape=S.shape)).tocsr()
             S.data[S.data == 1e-300] = 0.0
         with pytest.raises(SingularModelError):
@@ -116,21 +116,21 @@ def test_band_rule_mast_yes_compact_mesh_no():
     I = sp.identity(g)
     L3 = (sp.kron(sp.kron(L1, I), I) + sp.kron(sp.kron(I, L1), I) + sp.kron(sp.kron(I, I), L1)).tocsr()
     lu = SparseLU(ordering="rcm")
-    L3 = (L3 + 10 * sp.identity(g ** 3)).tocsr()
+    L3 = (L3 + 10 * sp.identity(g**3)).tocsr()
     lu.factorize(L3)
     assert not band_rule(L3.shape[0], band_of(lu._B.indptr, lu._B.indices), L3.nnz)
     # not banded, >= 1000 DOFs: PARDISO where installed, else SuperLU
     assert lu.chosen == "rcm" and lu.engine == ("pardiso" if backends.available("pardiso")[0] else "superlu")
     b = np.ones(L3.shape[0])
-    assert backward_error(L3, lu.solve(b), b) <= 1e-14   # either LU is backward stable
+    assert backward_error(L3, lu.solve(b), b) <= 1e-14  # either LU is backward stable
 
 
 def test_small_unbanded_model_stays_on_superlu():
     A = chain_matrix(n=300, b=7)
     P = sp.csr_matrix(np.random.default_rng(7).permutation(np.eye(300)))
-    lu = SparseLU(ordering="mmd")           # not RCM: no band
+    lu = SparseLU(ordering="mmd")  # not RCM: no band
     lu.factorize((P @ A @ P.T).tocsr())
-    assert lu.engine == "superlu"           # 300 DOFs < PARDISO_MIN_DOFS
+    assert lu.engine == "superlu"  # 300 DOFs < PARDISO_MIN_DOFS
 
 
 def test_unknown_backend_is_a_model_error():
@@ -145,7 +145,7 @@ def test_missing_optional_backend_falls_back_with_a_message(monkeypatch):
     with pytest.warns(UserWarning, match="pip install 'femast\\[pardiso\\]'"):
         lu, x = solve_with(A, "pardiso", b)
     assert lu.engine == "superlu"
-    assert backward_error(A, x, b) <= 1e-14   # SuperLU: backward stable
+    assert backward_error(A, x, b) <= 1e-14  # SuperLU: backward stable
 
 
 @pytest.mark.parametrize("backend", ["cholmod", "pardiso"])
@@ -169,9 +169,9 @@ def mast_model(n_bays=6):
     frames = [[m.node(0.5 * np.cos(a), 0.5 * np.sin(a), 1.0 * j) for a in ang] for j in range(n_bays + 1)]
     for j in range(n_bays):
         for k in range(3):
-            m.beam(frames[j][k], frames[j + 1][k], sec, up=(1.0, 0.0, 0.0))     # longeron (along z)
-            m.beam(frames[j + 1][k], frames[j + 1][(k + 1) % 3], sec)           # batten (horizontal)
-            m.beam(frames[j][k], frames[j + 1][(k + 1) % 3], sec)               # diagonal
+            m.beam(frames[j][k], frames[j + 1][k], sec, up=(1.0, 0.0, 0.0))  # longeron (along z)
+            m.beam(frames[j + 1][k], frames[j + 1][(k + 1) % 3], sec)  # batten (horizontal)
+            m.beam(frames[j][k], frames[j + 1][(k + 1) % 3], sec)  # diagonal
     for nd in frames[0]:
         m.fix(nd)
     st = m.step("load", initial_increment=0.25, max_increment=0.25)
@@ -222,7 +222,7 @@ def test_band_storage_input_factorises_bit_for_bit_as_the_csc_input(asym, shift)
     assert csc.refinements == direct.refinements and csc.fallbacks == direct.fallbacks
     assert direct.kind == ("lu" if asym == 1e-2 or shift else "cholesky")
     if asym == 1e-10:
-        assert direct.refinements > 0   # the refinement against B (from the band storage) ran
+        assert direct.refinements > 0  # the refinement against B (from the band storage) ran
 
 
 def test_band_positions_through_the_permutation_compose_the_two_maps():
@@ -237,4 +237,4 @@ def test_band_positions_through_the_permutation_compose_the_two_maps():
     pos = np.random.default_rng(9).integers(-1, K.nnz, size=(30, 4, 4))
     np.testing.assert_array_equal(f.band_positions(pos, gather), f.band_positions(permuted_positions(gather, pos)))
     direct = f.band_positions(np.arange(B.nnz))
-    assert np.unique(direct).size == B.nnz   # one slot per entry of B
+    assert np.unique(direct).size == B.nnz  # one slot per entry of B

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 import femast as fm
-from femast.model.amplitudes import Amplitude
 from femast.analysis import Analysis
 from femast.errors import ModelError
+from femast.model.amplitudes import Amplitude
 from femast.testing import fd_tangent
 
 
@@ -36,19 +36,19 @@ def test_determinate_truss_with_one_long_member_moves_without_stress():
     m.step("misfit")
     an, frames = _run(m)
     L = np.hypot(a, h)
-    x = ((L + dL) ** 2 - L ** 2) / (4 * a)
+    x = ((L + dL) ** 2 - L**2) / (4 * a)
     y = np.sqrt((L + dL) ** 2 - (x + a) ** 2)
     # round-off of the positions (1e-16 m) and Newton's tolerance on a stress-free solution
     np.testing.assert_allclose(an.x[m.index(C)], [x, y, 0.0], atol=1e-12)
     N = an.system.evaluate(an.system.committed_context())[0].output["N"]
-    assert np.abs(N).max() <= 1e-9 * EA * dL / L   # no stress: round-off of EA (l - L s) / L
+    assert np.abs(N).max() <= 1e-9 * EA * dL / L  # no stress: round-off of EA (l - L s) / L
 
 
 def test_cantilever_beam_with_length_error_and_n_elements_grows_by_it_without_stress():
     dL = 0.5e-3
     m = fm.Model("cantilever")
     root, tip = m.node(0, 0, 0), m.node(1.2, 0, 0)
-    labels = m.beam(root, tip, _tube(), n=4, length_error_m=dL)   # dL / 4 on each element
+    labels = m.beam(root, tip, _tube(), n=4, length_error_m=dL)  # dL / 4 on each element
     assert sorted(m.length_errors.values()) == [dL / 4] * 4
     m.fix(root)
     m.step("misfit")
@@ -56,7 +56,7 @@ def test_cantilever_beam_with_length_error_and_n_elements_grows_by_it_without_st
     assert len(labels) == 4
     np.testing.assert_allclose(an.x[m.index(tip)], [1.2 + dL, 0, 0], atol=1e-13)  # round-off on 1.2 m
     sf = an.system.evaluate(an.system.committed_context())[0].output["section_forces"]
-    assert np.abs(sf).max() <= 1e-9 * 70e9 * _tube().A * dL   # round-off of N
+    assert np.abs(sf).max() <= 1e-9 * 70e9 * _tube().A * dL  # round-off of N
 
 
 @pytest.mark.parametrize("kind", ["truss", "beam"])
@@ -80,10 +80,10 @@ def test_free_thermal_expansion_follows_the_amplitude_without_stress(kind):
         dT = float(amp(fr["time"])) * (T1 - T0)
         # round-off of positions of ~2 m (1e-15 relative) and of U = x - X0
         assert abs(fr["U"][i, 0] - L * alpha * dT) <= 1e-13
-    assert len(frames) >= 5   # 4 increments of 0.25 s at least (hit at the amplitude's 0.5 s)
+    assert len(frames) >= 5  # 4 increments of 0.25 s at least (hit at the amplitude's 0.5 s)
     N = an.system.evaluate(an.system.committed_context())[0]
     forces = N.output["N"] if kind == "truss" else N.output["section_forces"]
-    assert np.abs(forces).max() <= 1e-6   # N (no stress; EA alpha dT would be ~1e3 N)
+    assert np.abs(forces).max() <= 1e-6  # N (no stress; EA alpha dT would be ~1e3 N)
 
 
 @pytest.mark.parametrize("kind", ["truss", "beam"])
@@ -119,17 +119,19 @@ def test_bimetallic_bar_strain_and_forces():
     al = np.array([23e-6, 12e-6])
     m = fm.Model("bimetallic")
     n1, n2 = m.node(0, 0, 0), m.node(L, 0, 0)
-    t = [m.truss(n1, n2, EA[0], alpha_per_K=al[0], family="alu"),
-         m.truss(n1, n2, EA[1], alpha_per_K=al[1], family="steel")]
+    t = [
+        m.truss(n1, n2, EA[0], alpha_per_K=al[0], family="alu"),
+        m.truss(n1, n2, EA[1], alpha_per_K=al[1], family="steel"),
+    ]
     m.fix(n1)
     m.fix(n2, "uy", "uz")
     m.step("heat").temperature(dT, family=["alu", "steel"])
     an, _ = _run(m)
     eps = (EA @ al) * dT / EA.sum()
-    assert abs(an.x[m.index(n2), 0] - L * (1 + eps)) <= 1e-14   # round-off on 0.8 m
+    assert abs(an.x[m.index(n2), 0] - L * (1 + eps)) <= 1e-14  # round-off on 0.8 m
     resp = an.system.evaluate(an.system.committed_context())
     N = np.array([resp[k].output["N"][0] for k in range(2)])
-    np.testing.assert_allclose(N, EA * (eps - al * dT), rtol=1e-7)   # Newton tolerance on the balance
+    np.testing.assert_allclose(N, EA * (eps - al * dT), rtol=1e-7)  # Newton tolerance on the balance
     assert len(t) == 2
 
 
@@ -152,10 +154,10 @@ def test_three_bar_truss_with_a_long_middle_bar_matches_compatibility():
     an, _ = _run(m)
     v = -(an.x[m.index(D), 1] + h)
     N = dict(zip([outer1, mid, outer2], an.system.evaluate(an.system.committed_context())[0].output["N"]))
-    k = 1 + 2 * c ** 3
+    k = 1 + 2 * c**3
     # geometric nonlinearity: relative differences O(delta / h) = 1e-6
     np.testing.assert_allclose(v, delta / k, rtol=1e-5)
-    Nmid = -2 * EA * delta * c ** 3 / (h * k)
+    Nmid = -2 * EA * delta * c**3 / (h * k)
     np.testing.assert_allclose(N[mid], Nmid, rtol=1e-5)
     np.testing.assert_allclose([N[outer1], N[outer2]], -Nmid / (2 * c), rtol=1e-5)
 
@@ -170,14 +172,21 @@ def test_tangents_with_length_factor_match_finite_differences():
     nodes = np.array([[0, 1], [2, 3], [4, 5], [6, 7]])
     E0 = np.array([element_frame(X[a], X[b], rng.normal(size=3)) for a, b in nodes])
     l0 = np.linalg.norm(X[nodes[:, 1]] - X[nodes[:, 0]], axis=1)
-    beams = BeamFamily(nodes, E0, l0, EA=rng.uniform(1e2, 1e3, 4), GJ=rng.uniform(1, 5, 4),
-                       EIy=rng.uniform(1, 5, 4), EIz=rng.uniform(1, 5, 4))
-    beams.length_factor[:] = 1 + rng.uniform(-0.05, 0.05, 4)   # misfit + thermal strain of a few %
+    beams = BeamFamily(
+        nodes,
+        E0,
+        l0,
+        EA=rng.uniform(1e2, 1e3, 4),
+        GJ=rng.uniform(1, 5, 4),
+        EIy=rng.uniform(1, 5, 4),
+        EIz=rng.uniform(1, 5, 4),
+    )
+    beams.length_factor[:] = 1 + rng.uniform(-0.05, 0.05, 4)  # misfit + thermal strain of a few %
     x = X + 0.05 * rng.normal(size=X.shape)
     R = np.array([expm_so3(0.8 * rng.normal(size=3)) for _ in range(8)])
     K = beams.evaluate(x, R, None).k
     Kfd = fd_tangent(beams, x, R)
-    for e in range(4):   # central FD, h = 1e-6: truncation ~1e-10 relative
+    for e in range(4):  # central FD, h = 1e-6: truncation ~1e-10 relative
         assert np.abs(K[e] - Kfd[e]).max() <= 1e-6 * np.abs(K[e]).max()
     trusses = TrussFamily(nodes, l0, [1e3] * 4, [False, True, False, True])
     trusses.length_factor[:] = [1.03, 0.97, 0.98, 1.01]
@@ -212,7 +221,7 @@ def test_assembled_tangent_with_temperature_matches_finite_differences_of_the_re
 
     h = 1e-7
     Kfd = np.column_stack([(internal(h * e) - internal(-h * e)) / (2 * h) for e in np.eye(nf)])
-    assert np.abs(K - Kfd).max() <= 1e-5 * np.abs(K).max()   # FD truncation and round-off ~1e-8
+    assert np.abs(K - Kfd).max() <= 1e-5 * np.abs(K).max()  # FD truncation and round-off ~1e-8
 
 
 def test_temperatures_carry_over_steps_and_unchanged_models_are_not_touched():
@@ -246,7 +255,7 @@ def test_bad_inputs_name_the_item_and_the_unit():
     with pytest.raises(ModelError, match="non-positive"):
         m.length_error(e, -1.0)
     with pytest.raises(ModelError, match="1/K"):
-        m.thermal_expansion(23.0)            # ppm/K given as 1/K
+        m.thermal_expansion(23.0)  # ppm/K given as 1/K
     with pytest.raises(ModelError, match="1/K"):
         m.thermal_expansion(float("inf"))
     with pytest.raises(ModelError, match="K or degC"):
@@ -284,7 +293,7 @@ def test_bimetallic_strip_bends_with_timoshenkos_curvature():
     E1, a1, E2, a2 = 200e9, 12e-6, 70e9, 23e-6
 
     def layer(E, t):
-        return fs.Section(E=E, G=E / 2.6, A=w * t, Iy=t * w ** 3 / 12, Iz=w * t ** 3 / 12, J=w * t ** 3 / 3)
+        return fs.Section(E=E, G=E / 2.6, A=w * t, Iy=t * w**3 / 12, Iz=w * t**3 / 12, J=w * t**3 / 3)
 
     m = fm.Model("bimetallic strip")
     bottom = [m.node(L * i / n_el, 0, -t1 / 2) for i in range(n_el + 1)]
@@ -298,7 +307,7 @@ def test_bimetallic_strip_bends_with_timoshenkos_curvature():
     m.step("heat").temperature(dT)
     an, frames = _run(m)
     mm, nn, h = t1 / t2, E1 / E2, t1 + t2
-    kappa = 6 * (a2 - a1) * dT * (1 + mm) ** 2 / (h * (3 * (1 + mm) ** 2 + (1 + mm * nn) * (mm ** 2 + 1 / (mm * nn))))
+    kappa = 6 * (a2 - a1) * dT * (1 + mm) ** 2 / (h * (3 * (1 + mm) ** 2 + (1 + mm * nn) * (mm**2 + 1 / (mm * nn))))
     ry = frames[-1]["URA"][m.index(bottom[-1]), 1]
     # aluminium on top expands more: the strip curls down (+ry).  Uniform curvature is exact for the
     # cubic corotational elements (a circular arc); measured 2e-8 relative, 1e-6 leaves Newton's tolerance
@@ -318,5 +327,5 @@ def test_increments_end_on_the_temperature_amplitudes_points():
     _, frames = _run(m)
     times = [f["time"] for f in frames[1:]]
     assert times[0] == pytest.approx(0.3, abs=1e-12) and times[-1] == pytest.approx(1.0, abs=1e-12)
-    for f in frames[1:]:   # round-off of displacements of 1e-3 m
+    for f in frames[1:]:  # round-off of displacements of 1e-3 m
         assert abs(f["U"][m.index(n2), 0] - alpha * dT * L * float(amp(f["time"]))) <= 1e-15

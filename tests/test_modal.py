@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 import femast as fm
-from femast.verification import modal as vm
 from femast.errors import ModelError, StateError
-from femast.modal.mass import assemble_mass, total_mass
 from femast.modal import modal_analysis
+from femast.modal.mass import assemble_mass, total_mass
+from femast.verification import modal as vm
 
 
 def _fresh(model):
@@ -22,7 +22,7 @@ def _fresh(model):
 def test_taut_string(cable):
     rows, _ = vm.taut_string(cable=cable)
     for r in rows:
-        assert r.passed, r   # 1e-3: the issue's figure; the mesh (100 elements) is in the case name
+        assert r.passed, r  # 1e-3: the issue's figure; the mesh (100 elements) is in the case name
 
 
 def test_cantilever_modes():
@@ -34,7 +34,7 @@ def test_pinned_beam_frequency_squared_linear_in_axial_force():
     rows, (ratios, f2, exact) = vm.pinned_beam_axial()
     for r in rows:
         assert r.passed, r
-    assert f2[0] < 0 < f2[1]   # past the Euler load the straight state is unstable
+    assert f2[0] < 0 < f2[1]  # past the Euler load the straight state is unstable
 
 
 def test_rigid_body_on_springs_and_pendulum():
@@ -62,7 +62,7 @@ def test_total_mass_of_beams_trusses_points():
     m.point_mass(2, 0.7, inertia=1e-3)
     expected = sec.rho * sec.A * L + 0.5 * 1.0 + 0.7
     # sum of the translational block over all active DOFs (fixed ones included) = total mass
-    assert total_mass(_fresh(m)) == pytest.approx(expected, rel=1e-12)   # round-off of a sum
+    assert total_mass(_fresh(m)) == pytest.approx(expected, rel=1e-12)  # round-off of a sum
 
 
 def test_beam_mass_gives_rigid_body_kinetic_energy_in_any_orientation():
@@ -83,10 +83,10 @@ def test_beam_mass_gives_rigid_body_kinetic_energy_in_any_orientation():
         e = (an.X0[1] - an.X0[0]) / L
         w = np.cross(e, [0.0, 0.0, 1.0])
         w /= np.linalg.norm(w)
-        vel = np.cross(w, X)              # rigid spin about node 1 (the origin)
+        vel = np.cross(w, X)  # rigid spin about node 1 (the origin)
         u = np.where(dof < 3, vel[np.arange(len(dof)), np.minimum(dof, 2)], w[np.clip(dof - 3, 0, 2)])
         # translational part m L^2/3 plus the torsional rotary inertia about the axis (0: w normal)
-        assert u @ (M @ u) == pytest.approx(mass * L * L / 3.0, rel=1e-9)   # Hermite shape: exact
+        assert u @ (M @ u) == pytest.approx(mass * L * L / 3.0, rel=1e-9)  # Hermite shape: exact
 
 
 def test_point_mass_offset_is_parallel_axis():
@@ -122,7 +122,7 @@ def test_frequencies_do_not_depend_on_the_orientation_of_a_prestressed_string():
         m.fix(nodes[-1])
         m.step("s")
         f.append(modal_analysis(_fresh(m), 4).frequencies)
-    np.testing.assert_allclose(f[0], f[1], rtol=1e-9)   # invariance: round-off only
+    np.testing.assert_allclose(f[0], f[1], rtol=1e-9)  # invariance: round-off only
 
 
 def test_modes_written_and_read(tmp_path):
@@ -155,7 +155,7 @@ def test_unconverged_state_is_refused():
     m = fm.Model("unbalanced")
     a, b, c = m.node(0, 0, 0), m.node(1, 0, 0), m.node(2, 0, 0)
     m.truss(a, b, EA=1e5, pretension=100.0, mass_per_length=0.1)
-    m.truss(b, c, EA=1e5, pretension=50.0, mass_per_length=0.1)   # node b pulled by 50 N net
+    m.truss(b, c, EA=1e5, pretension=50.0, mass_per_length=0.1)  # node b pulled by 50 N net
     m.fix(a)
     m.fix(c)
     m.step("s")
@@ -184,7 +184,6 @@ def test_modes_of_every_saved_increment_follow_the_axial_load(tmp_path):
     against f0^2 (1 + P/P_E) (tolerance 1e-3 f0^2, as in the verification case), written to the
     results folder; and the animated VTK series of the last frame's modes."""
     from femast.modal.output import ModesRecorder, export_modes_vtk
-    from femast.verification.modal import pinned_beam_axial
 
     E, EI, EA, L = 1e4, 1.0, 1e6, 1.0
     sec = fm.Section(E=E, G=E / 2, A=EA / E, Iy=EI / E, Iz=EI / E, J=2 * EI / E, rho=E / EA)
@@ -193,7 +192,7 @@ def test_modes_of_every_saved_increment_follow_the_axial_load(tmp_path):
     m.beam(a, b, sec, up=(0, 1, 0), n=48)
     m.fix(a, "ux", "uy", "uz", "rx")
     m.fix(b, "uy", "uz")
-    PE = math.pi ** 2 * EI / L ** 2
+    PE = math.pi**2 * EI / L**2
     m.step("pull", initial_increment=0.25, max_increment=0.25).load(b, fx=0.8 * PE)
     an = fm.Analysis(m, tmp_path / "res", progress=False)
     rec = ModesRecorder(an, n_modes=2)
@@ -202,7 +201,7 @@ def test_modes_of_every_saved_increment_follow_the_axial_load(tmp_path):
     f0sq = (math.pi / 2) ** 2
     f = rec.frequencies[:, 0]
     assert f.shape == (5,)
-    np.testing.assert_allclose(f ** 2, f0sq * (1 + P), atol=1e-3 * f0sq)
+    np.testing.assert_allclose(f**2, f0sq * (1 + P), atol=1e-3 * f0sq)
     assert len(list((tmp_path / "res" / "modes").glob("frame_*.npz"))) == 5
     pvd = export_modes_vtk(rec.modes[-1], tmp_path / "vtk", n_frames=8)
     assert len(pvd) == 2 and len(list(pvd[0].parent.glob("*.vtu"))) == 8
@@ -218,15 +217,14 @@ def test_cable_device_family_with_mass_per_length_is_a_beaded_string():
     N, L, T, mpl = 20, 2.0, 150.0, 0.01
     m = fm.Model("cable over pulleys")
     labels = [m.node(L * k / N, 0, 0) for k in range(N + 1)]
-    fam = CableDeviceFamily.pretensioned(np.arange(N + 1), m.coordinates, 1e6, T, [Pulley()] * (N - 1),
-                                         name="cable")
+    fam = CableDeviceFamily.pretensioned(np.arange(N + 1), m.coordinates, 1e6, T, [Pulley()] * (N - 1), name="cable")
     fam.nodes = np.asarray([labels])
     fam.mass_per_length = mpl
     m.add_family(fam)
     m.fix(labels[0])
     m.fix(labels[-1])
     for lab in labels[1:-1]:
-        m.fix(lab, "ux")   # the pulleys slide the cable, not themselves: hold them along it
+        m.fix(lab, "ux")  # the pulleys slide the cable, not themselves: hold them along it
     m.step("hold")
     f = modal_analysis(_fresh(m), 4).frequencies.reshape(2, 2).mean(axis=1)
     h = L / N

@@ -21,15 +21,23 @@ def _mast_arrays(n_bays=3, b=1.0, h=0.8):
     pairs, kind, up = [], [], []
     for j in range(n_bays):
         for k in range(4):
-            pairs.append((4 * j + k, 4 * (j + 1) + k)); kind.append(0); up.append(corners[k] / r)
-            pairs.append((4 * (j + 1) + k, 4 * (j + 1) + (k + 1) % 4)); kind.append(1); up.append((0, 0, 1.0))
-            pairs.append((4 * j + k, 4 * (j + 1) + (k + 1) % 4)); kind.append(2)
+            pairs.append((4 * j + k, 4 * (j + 1) + k))
+            kind.append(0)
+            up.append(corners[k] / r)
+            pairs.append((4 * (j + 1) + k, 4 * (j + 1) + (k + 1) % 4))
+            kind.append(1)
+            up.append((0, 0, 1.0))
+            pairs.append((4 * j + k, 4 * (j + 1) + (k + 1) % 4))
+            kind.append(2)
             up.append((corners[k] + corners[(k + 1) % 4]) / np.linalg.norm(corners[k] + corners[(k + 1) % 4]))
     return X, np.array(pairs), np.array(kind), np.array(up, float)
 
 
-SECS = [fm.circular_tube(0.030, 0.026, E=70e9), fm.circular_tube(0.025, 0.021, E=70e9),
-        fm.circular_tube(0.012, 0.008, E=70e9)]
+SECS = [
+    fm.circular_tube(0.030, 0.026, E=70e9),
+    fm.circular_tube(0.025, 0.021, E=70e9),
+    fm.circular_tube(0.012, 0.008, E=70e9),
+]
 FAMS = ["longeron", "batten", "diagonal"]
 
 
@@ -47,8 +55,14 @@ def _per_element(n_bays=3):
     m = fm.Model("mast")
     labels = [m.node(*x) for x in X]
     for e, (a, b) in enumerate(pairs):
-        m.beam(labels[a], labels[b], SECS[kind[e]], up=tuple(up[e]), family=FAMS[kind[e]],
-               length_error_m=1e-4 if e == 5 else 0.0)
+        m.beam(
+            labels[a],
+            labels[b],
+            SECS[kind[e]],
+            up=tuple(up[e]),
+            family=FAMS[kind[e]],
+            length_error_m=1e-4 if e == 5 else 0.0,
+        )
     return _finish(m, labels, n_bays)
 
 
@@ -74,8 +88,13 @@ def test_beams_from_arrays_make_the_same_model_and_solution_bit_for_bit():
     assert np.array_equal(a.coordinates, b.coordinates)
     assert len(a.beams) == len(b.beams) == 36
     for p, q in zip(a.beams, b.beams):
-        assert (p.label, p.nodes, p.section, p.family, p.mass_per_length) == \
-               (q.label, q.nodes, q.section, q.family, q.mass_per_length)
+        assert (p.label, p.nodes, p.section, p.family, p.mass_per_length) == (
+            q.label,
+            q.nodes,
+            q.section,
+            q.family,
+            q.mass_per_length,
+        )
         assert np.array_equal(p.up, q.up)
     assert a.length_errors == b.length_errors == {6: 1e-4}
     for fa, fb in zip(build_families(a), build_families(b)):
@@ -85,17 +104,18 @@ def test_beams_from_arrays_make_the_same_model_and_solution_bit_for_bit():
     sa, sb = _solve(a), _solve(b)
     assert sa.summary.iterations == sb.summary.iterations
     assert np.array_equal(sa.x, sb.x) and np.array_equal(sa.R, sb.R)
-    assert np.abs(sa.x - sa.X0).max() > 1e-4   # the load does move the mast (the comparison is not vacuous)
+    assert np.abs(sa.x - sa.X0).max() > 1e-4  # the load does move the mast (the comparison is not vacuous)
 
 
 def test_shared_values_and_per_element_values_agree():
     X, pairs, kind, up = _mast_arrays(1)
-    sel = pairs[kind == 1]                     # battens: one shared up-vector and section
+    sel = pairs[kind == 1]  # battens: one shared up-vector and section
     m1, m2 = fm.Model("a"), fm.Model("b")
     l1, l2 = np.asarray(m1.nodes(X)), np.asarray(m2.nodes(X))
     e1 = m1.beams(l1[sel], SECS[1], up=(0, 0, 1), mass_per_length=0.5)
-    e2 = m2.beams(l2[sel], [SECS[1]] * len(sel), up=np.tile([0, 0, 1.0], (len(sel), 1)),
-                  mass_per_length=np.full(len(sel), 0.5))
+    e2 = m2.beams(
+        l2[sel], [SECS[1]] * len(sel), up=np.tile([0, 0, 1.0], (len(sel), 1)), mass_per_length=np.full(len(sel), 0.5)
+    )
     assert e1.tolist() == e2.tolist() == [1, 2, 3, 4]
     for p, q in zip(m1.beams, m2.beams):
         assert (p.nodes, p.section, p.mass_per_length) == (q.nodes, q.section, q.mass_per_length)
@@ -113,8 +133,13 @@ def _truss_model(bulk):
         n = np.asarray(m.nodes(X))
         L = np.linalg.norm(X[4] - X[0])
         m.trusses(n[pairs[:2]], EA[:2], L0=[0.999 * L, 0.998 * L], tension_only=True, alpha_per_K=[0.0, 2e-5])
-        m.trusses(n[pairs[2:4]], EA[2:4], pretension=[50.0, 80.0], tension_only=np.array([True, True]),
-                  mass_per_length=[0.1, 0.2])
+        m.trusses(
+            n[pairs[2:4]],
+            EA[2:4],
+            pretension=[50.0, 80.0],
+            tension_only=np.array([True, True]),
+            mass_per_length=[0.1, 0.2],
+        )
         m.trusses(n[pairs[4:]], EA[4:], family="strut", length_error_m=-1e-3)
     else:
         n = [m.node(*x) for x in X]
@@ -139,13 +164,13 @@ def test_trusses_from_arrays_make_the_same_model_and_solution_bit_for_bit():
     assert (a.length_errors, a.expansion) == (b.length_errors, b.expansion)
     sa, sb = _solve(a), _solve(b)
     assert np.array_equal(sa.x, sb.x)
-    assert abs(sa.x[4, 2] - sa.X0[4, 2]) > 1e-4   # the centre does sag under the load
+    assert abs(sa.x[4, 2] - sa.X0[4, 2]) > 1e-4  # the centre does sag under the load
 
 
 def test_element_frames_equal_element_frame_bit_for_bit():
     rng = np.random.default_rng(7)
     x1, x2, up = rng.normal(size=(200, 3)), rng.normal(size=(200, 3)), rng.normal(size=(200, 3))
-    up[3] = x2[3] - x1[3]          # parallel: flagged, like element_frame's None
+    up[3] = x2[3] - x1[3]  # parallel: flagged, like element_frame's None
     E0, parallel = element_frames(x1, x2, up)
     assert parallel.tolist() == [element_frame(x1[i], x2[i], up[i]) is None for i in range(200)]
     for i in np.flatnonzero(~parallel):
@@ -163,17 +188,20 @@ def test_nodes_continue_the_labels_like_node_calls():
     assert m1.node(3, 0, 0) == 13
 
 
-@pytest.mark.parametrize("nodes, kwargs, words", [
-    ([[1, 2], [2, 99]], {}, ["element 1", "nodes 2-99", "unknown node 99", "model.node"]),
-    ([[1, 2], [3, 3]], {}, ["element 1", "coincide"]),
-    ([[1, 2], [2, 3]], {"up": [[0, 0, 1], [0, np.nan, 1]]}, ["element 1", "not finite"]),
-    ([[1, 2], [2, 3]], {"up": [[0, 0, 1], [0, 1, 0]]}, ["element 1", "parallel", "up-vector"]),
-    ([[1.0, 2.0], [np.nan, 3.0]], {}, ["element 1", "not a node label"]),
-    ([[1, 2, 3]], {}, ["(n_elements, 2)", "shape (1, 3)"]),
-    ([[1, 2], [2, 3]], {"section": "tube"}, ["Section"]),
-    ([[1, 2], [2, 3]], {"mass_per_length": [0.1, -1.0]}, ["element 1", "mass_per_length", ">= 0"]),
-    ([[1, 2], [2, 3]], {"family": ["a"]}, ["one name", "(2)"]),
-])
+@pytest.mark.parametrize(
+    "nodes, kwargs, words",
+    [
+        ([[1, 2], [2, 99]], {}, ["element 1", "nodes 2-99", "unknown node 99", "model.node"]),
+        ([[1, 2], [3, 3]], {}, ["element 1", "coincide"]),
+        ([[1, 2], [2, 3]], {"up": [[0, 0, 1], [0, np.nan, 1]]}, ["element 1", "not finite"]),
+        ([[1, 2], [2, 3]], {"up": [[0, 0, 1], [0, 1, 0]]}, ["element 1", "parallel", "up-vector"]),
+        ([[1.0, 2.0], [np.nan, 3.0]], {}, ["element 1", "not a node label"]),
+        ([[1, 2, 3]], {}, ["(n_elements, 2)", "shape (1, 3)"]),
+        ([[1, 2], [2, 3]], {"section": "tube"}, ["Section"]),
+        ([[1, 2], [2, 3]], {"mass_per_length": [0.1, -1.0]}, ["element 1", "mass_per_length", ">= 0"]),
+        ([[1, 2], [2, 3]], {"family": ["a"]}, ["one name", "(2)"]),
+    ],
+)
 def test_bad_beam_arrays_name_the_element_and_the_fix(nodes, kwargs, words):
     m = fm.Model("m")
     m.nodes([[0, 0, 0], [0, 1, 0], [0, 2, 0]])
@@ -183,16 +211,19 @@ def test_bad_beam_arrays_name_the_element_and_the_fix(nodes, kwargs, words):
         m.beams(np.array(nodes), **kw)
     for w in words:
         assert w in str(err.value), (w, str(err.value))
-    assert not m.beams   # nothing added by a refused call
+    assert not m.beams  # nothing added by a refused call
 
 
-@pytest.mark.parametrize("kwargs, words", [
-    ({"EA": [1e5, 0.0]}, ["element 1", "EA", "> 0"]),
-    ({"EA": 1e5, "L0": 1.0, "pretension": 1.0}, ["L0 or pretension"]),
-    ({"EA": 1e5, "pretension": [0.0, -2e5]}, ["element 1", "impossible"]),
-    ({"EA": 1e5, "tension_only": [1, 0]}, ["tension_only", "bool"]),
-    ({"EA": 1e5, "L0": [1.0, np.inf]}, ["element 1", "L0", "finite"]),
-])
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({"EA": [1e5, 0.0]}, ["element 1", "EA", "> 0"]),
+        ({"EA": 1e5, "L0": 1.0, "pretension": 1.0}, ["L0 or pretension"]),
+        ({"EA": 1e5, "pretension": [0.0, -2e5]}, ["element 1", "impossible"]),
+        ({"EA": 1e5, "tension_only": [1, 0]}, ["tension_only", "bool"]),
+        ({"EA": 1e5, "L0": [1.0, np.inf]}, ["element 1", "L0", "finite"]),
+    ],
+)
 def test_bad_truss_arrays_name_the_element_and_the_fix(kwargs, words):
     m = fm.Model("m")
     m.nodes([[0, 0, 0], [0, 1, 0], [0, 2, 0]])

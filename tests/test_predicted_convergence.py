@@ -22,7 +22,7 @@ from femast.analysis.solvers.convergence import Convergence, scaled_size
 from femast.elements.base import ElementFamily, ElementResponse
 from femast.errors import ModelError
 
-K, U0 = 1e3, 0.01    # the spring: f(u) = K u (1 + (u / U0)^2), N and m
+K, U0 = 1e3, 0.01  # the spring: f(u) = K u (1 + (u / U0)^2), N and m
 
 
 class _Hardening(ElementFamily):
@@ -52,9 +52,9 @@ class _Hardening(ElementFamily):
 def _u_star(P):
     """The spring's equilibrium under P (N): the real root of K u^3 / U0^2 + K u - P = 0 (Cardano:
     one real root, the cubic is increasing)."""
-    a = K / U0 ** 2
-    q, r = K / (3 * a), -P / (2 * a)        # depressed cubic u^3 + 3 q u + 2 r = 0
-    s = math.sqrt(r * r + q ** 3)
+    a = K / U0**2
+    q, r = K / (3 * a), -P / (2 * a)  # depressed cubic u^3 + 3 q u + 2 r = 0
+    s = math.sqrt(r * r + q**3)
     return math.copysign(abs(-r + s) ** (1 / 3), -r + s) + math.copysign(abs(-r - s) ** (1 / 3), -r - s)
 
 
@@ -71,7 +71,7 @@ def _spring(P, band=None, **conv):
 @pytest.mark.parametrize("P, tol", [(100.0, 1e-6), (10.0, 1e-3)])
 def test_one_iteration_fewer_on_the_hardening_spring_within_the_tolerance(P, tol):
     u_star = _u_star(P)
-    assert K * u_star * (1 + (u_star / U0) ** 2) == pytest.approx(P, rel=1e-14)   # the closed form
+    assert K * u_star * (1 + (u_star / U0) ** 2) == pytest.approx(P, rel=1e-14)  # the closed form
     it_strict, u_strict = _spring(P, force_tol=tol, disp_tol=tol, predicted=False)
     it, u = _spring(P, force_tol=tol, disp_tol=tol)
     assert it == it_strict - 1
@@ -97,7 +97,7 @@ def test_a_provisional_iterate_is_not_accepted_on_its_prediction():
     u_star = _u_star(P)
     it_strict, _ = _spring(P, predicted=False)
     it, u = _spring(P)
-    assert it == it_strict - 1 and abs(u - u_star) > 1e-14   # the early iterate, 1.7e-7 u* away
+    assert it == it_strict - 1 and abs(u - u_star) > 1e-14  # the early iterate, 1.7e-7 u* away
     # the same run, with every answer 1e-14 .. 1e-4 m from the solution marked provisional: the
     # early iterate is refused, the strict one (~1e-16 m away) accepted
     it_p, u_p = _spring(P, band=(1e-14, 1e-4, u_star))
@@ -116,10 +116,15 @@ def _cantilever():
 
 def _frames(conv):
     frames = []
-    an = Analysis(_cantilever(), None, progress=False, convergence=conv,
-                  on_frame=lambda fr: frames.append((np.array(fr["U"]), np.array(fr["UR"]))))
+    an = Analysis(
+        _cantilever(),
+        None,
+        progress=False,
+        convergence=conv,
+        on_frame=lambda fr: frames.append((np.array(fr["U"]), np.array(fr["UR"]))),
+    )
     an.run()
-    return an, frames[1:]   # the increments' frames (the first is the initial state)
+    return an, frames[1:]  # the increments' frames (the first is the initial state)
 
 
 def test_the_cantilever_agrees_with_a_tightly_converged_run_to_the_tolerance():
@@ -142,7 +147,7 @@ def test_the_cantilever_agrees_with_a_tightly_converged_run_to_the_tolerance():
 
 
 def test_the_rule_refuses_one_rate_and_a_non_contracting_sequence():
-    c = Convergence()   # disp_tol 1e-6, max_contraction 0.5
+    c = Convergence()  # disp_tol 1e-6, max_contraction 0.5
     # a quadratic sequence (the 40-bay mast's increment 0: corrections 9.4e-4, 2.0e-4, then c~ 6.7e-10)
     assert c.accept_predicted(9.38e-4, 2.04e-4, 6.66e-10)
     # the 1000-bay mast's soft mode: |du_3| = 0.995 |du_2|, c~ = 2.45e-8 looks converged, but the
@@ -176,6 +181,7 @@ class _System:
 
         class _S:
             solve_time = 0.0
+
         self.summary = _S()
 
     def scaled_size(self, v, Du):
@@ -184,8 +190,8 @@ class _System:
 
 def test_newton_solves_for_the_prediction_only_after_a_contraction():
     sys_, nw, conv = _System(), Newton(), Convergence()
-    r, Du = np.array([1.0, 0.0, 0.0]), np.array([1.0, 0.0, 1.0])   # c~ = 1e-9 of Du
-    assert not nw._predicted(sys_, conv, r, Du, [3.93e-3, 3.91e-3])   # not contracting
+    r, Du = np.array([1.0, 0.0, 0.0]), np.array([1.0, 0.0, 1.0])  # c~ = 1e-9 of Du
+    assert not nw._predicted(sys_, conv, r, Du, [3.93e-3, 3.91e-3])  # not contracting
     assert sys_.solver.solves == 0
     assert nw._predicted(sys_, conv, r, Du, [1e-3, 2e-4])
     assert sys_.solver.solves == 1
@@ -207,8 +213,11 @@ def test_bad_max_contraction_is_a_model_error(bad):
         Convergence(max_contraction=bad)
 
 
-@pytest.mark.parametrize("is_rot", [[False, False, True, True], [True, True, True, True], [False] * 4, []],
-                         ids=["both fields", "rotations only", "translations only", "no DOFs"])
+@pytest.mark.parametrize(
+    "is_rot",
+    [[False, False, True, True], [True, True, True, True], [False] * 4, []],
+    ids=["both fields", "rotations only", "translations only", "no DOFs"],
+)
 def test_measure_reports_the_scaled_size_of_every_field_layout(is_rot):
     """Convergence.measure's correction size (computed from the correction test's own maxima) equals
     scaled_size for mixed, rotation-only, translation-only and empty fields, NaN included, and the
@@ -217,13 +226,13 @@ def test_measure_reports_the_scaled_size_of_every_field_layout(is_rot):
     mask = np.array(is_rot, dtype=bool)
     n, L = mask.size, 3.0
     rng = np.random.default_rng(5)
-    Du_cases = [rng.normal(size=n), np.zeros(n), rng.normal(size=n) * 1e-12]   # (floors for the last two)
+    Du_cases = [rng.normal(size=n), np.zeros(n), rng.normal(size=n) * 1e-12]  # (floors for the last two)
     for Du in Du_cases:
         for scale in (1e-3, 1e-7, 0.0):
             du = rng.normal(size=n) * scale * (np.abs(Du).max(initial=0.0) + 1e-9)
             ok, _, forces, size = c.measure(np.zeros(n), du, Du, mask, 1.0, 1.0, L, iteration=5)
             want = scaled_size(du, Du, mask, L)
-            assert size == want   # the same arithmetic: the same bits
+            assert size == want  # the same arithmetic: the same bits
             assert forces and ok == (size <= c.disp_tol)
     if n:
         du = np.zeros(n)
@@ -252,12 +261,17 @@ def test_a_stabilised_step_accepted_on_its_prediction_stays_within_the_tolerance
     for predicted in (False, True):
         m, top = _guyed_mast(fm.Stabilize(), second_step=True)
         frames = []
-        an = Analysis(m, None, progress=False, convergence=fm.Convergence(predicted=predicted),
-                      on_frame=lambda fr: frames.append(np.array(fr["U"])))
+        an = Analysis(
+            m,
+            None,
+            progress=False,
+            convergence=fm.Convergence(predicted=predicted),
+            on_frame=lambda fr: frames.append(np.array(fr["U"])),
+        )
         an.run()
         runs[predicted] = (an.summary.steps[0]["iterations"], frames)
     (it_strict, strict), (it_pred, pred) = runs[False], runs[True]
-    assert it_pred < it_strict   # the stabilised step took at least one early acceptance
+    assert it_pred < it_strict  # the stabilised step took at least one early acceptance
     assert len(pred) == len(strict)
     for k in range(1, len(pred)):
         assert np.abs(pred[k] - strict[k]).max() <= tol * np.abs(strict[k] - strict[k - 1]).max()

@@ -3,8 +3,6 @@ solves with the reactions balancing the applied loads (checked here from the fra
 of the analysis' own check) and finite results, or stops with a femast error: never a raw
 exception, a NaN or a hang.  200 examples in the default suite, 1000 in the slow one."""
 
-import math
-
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -14,8 +12,9 @@ import femast as fm
 
 BAD_NUMBERS = [float("nan"), float("inf"), -1.0, 0.0, 1e200, -1e300]
 
-direction = st.sampled_from([(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 0), (0, 1, 1), (1, 0, 1), (-1, 0, 0),
-                             (0, -1, 0), (0, 0, -1), (1, -1, 1)])
+direction = st.sampled_from(
+    [(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 0), (0, 1, 1), (1, 0, 1), (-1, 0, 0), (0, -1, 0), (0, 0, -1), (1, -1, 1)]
+)
 pair = st.tuples(st.integers(0, 5), st.integers(0, 5))
 kind = st.sampled_from(["beam", "beam", "truss"])
 
@@ -36,15 +35,24 @@ def random_model(draw):
     up_choices = st.sampled_from([(0, 0, 1), (0, 1, 0), (1, 0, 0)])
     elements = [(k, k + 1, draw(kind), draw(st.floats(0.3, 3.0)), draw(up_choices)) for k in range(n - 1)]
     extra = draw(st.lists(pair, max_size=3))
-    elements += [(i % n, j % n, draw(kind), draw(st.floats(0.3, 3.0)), draw(up_choices))
-                 for i, j in extra if i % n != j % n]
-    fixes = [(0, "all")] + draw(st.lists(st.tuples(st.integers(1, n - 1),
-                                                   st.sampled_from(["all", "translations", "ux", "rz"])),
-                                         max_size=2))
-    loads = draw(st.lists(st.tuples(st.integers(1, n - 1), st.sampled_from(["fx", "fy", "fz", "mx", "my", "mz"]),
-                                    st.floats(-50.0, 50.0)), min_size=1, max_size=4))
-    adversarial = draw(st.sampled_from([None, None, None, None, None, None, None, None,
-                                        "E", "EA", "load", "coord", "increment"]))
+    elements += [
+        (i % n, j % n, draw(kind), draw(st.floats(0.3, 3.0)), draw(up_choices)) for i, j in extra if i % n != j % n
+    ]
+    fixes = [(0, "all")] + draw(
+        st.lists(st.tuples(st.integers(1, n - 1), st.sampled_from(["all", "translations", "ux", "rz"])), max_size=2)
+    )
+    loads = draw(
+        st.lists(
+            st.tuples(
+                st.integers(1, n - 1), st.sampled_from(["fx", "fy", "fz", "mx", "my", "mz"]), st.floats(-50.0, 50.0)
+            ),
+            min_size=1,
+            max_size=4,
+        )
+    )
+    adversarial = draw(
+        st.sampled_from([None, None, None, None, None, None, None, None, "E", "EA", "load", "coord", "increment"])
+    )
     bad = draw(st.sampled_from(BAD_NUMBERS))
     inc = draw(st.sampled_from([None, 0.5, 0.25]))
     return dict(pts=pts, elements=elements, fixes=fixes, loads=loads, adversarial=adversarial, bad=bad, inc=inc)
@@ -60,7 +68,7 @@ def _build_and_run(spec):
         if kind == "beam":
             d = np.subtract(pts[j], pts[i])
             if np.all(np.isfinite(d)) and np.linalg.norm(np.cross(d, up)) < 1e-3 * np.linalg.norm(d):
-                up = tuple(np.eye(3)[np.argmin(np.abs(d))])   # the least parallel global axis
+                up = tuple(np.eye(3)[np.argmin(np.abs(d))])  # the least parallel global axis
             E = spec["bad"] if spec["adversarial"] == "E" else 70e9 * scale
             m.beam(labels[i], labels[j], fm.circular_tube(0.02, 0.016, E=E), up=up)
         else:
@@ -68,8 +76,12 @@ def _build_and_run(spec):
             m.truss(labels[i], labels[j], EA=EA)
     for i, dofs in spec["fixes"]:
         m.fix(labels[i], dofs)
-    step = m.step("s", initial_increment=spec["inc"] if spec["adversarial"] != "increment" else spec["bad"],
-                  min_increment=0.05, max_increments=20)
+    step = m.step(
+        "s",
+        initial_increment=spec["inc"] if spec["adversarial"] != "increment" else spec["bad"],
+        min_increment=0.05,
+        max_increments=20,
+    )
     for k, (i, comp, value) in enumerate(spec["loads"]):
         if spec["adversarial"] == "load" and k == 0:
             value = spec["bad"]
@@ -115,8 +127,9 @@ def _check(spec):
 def test_random_models_solve_in_equilibrium_or_fail_cleanly():
     outcomes = []
 
-    @settings(max_examples=200, deadline=None, derandomize=True, database=None,
-              suppress_health_check=[HealthCheck.too_slow])
+    @settings(
+        max_examples=200, deadline=None, derandomize=True, database=None, suppress_health_check=[HealthCheck.too_slow]
+    )
     @given(random_model())
     def run(spec):
         outcomes.append(_check(spec))

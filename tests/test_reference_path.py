@@ -34,8 +34,14 @@ def _cantilever(E=70e9, drive="load", dt=0.1):
 
 def _run(model, reference=None, record=None):
     frames = []
-    an = Analysis(model, None, progress=False, convergence=CONV, on_frame=frames.append,
-                  observers=[record] if record is not None else ())
+    an = Analysis(
+        model,
+        None,
+        progress=False,
+        convergence=CONV,
+        on_frame=frames.append,
+        observers=[record] if record is not None else (),
+    )
     an.reference = reference
     an.run()
     return an, frames
@@ -45,21 +51,21 @@ def _run(model, reference=None, record=None):
 def test_a_nearby_run_started_from_the_reference_reaches_the_same_solution_in_fewer_iterations(drive):
     ref = ReferencePath()
     _run(_cantilever(drive=drive)[0], record=ref)
-    assert len(ref) == 10   # one recorded increment per converged increment
-    m, tip = _cantilever(E=70.07e9, drive=drive)   # 0.1 % stiffer: a finite-difference step of a fit
+    assert len(ref) == 10  # one recorded increment per converged increment
+    m, tip = _cantilever(E=70.07e9, drive=drive)  # 0.1 % stiffer: a finite-difference step of a fit
     plain, f0 = _run(m)
     m2, _ = _cantilever(E=70.07e9, drive=drive)
     fast, f1 = _run(m2, reference=ref)
     assert fast.summary.increments == plain.summary.increments
     assert fast.summary.iterations <= 0.7 * plain.summary.iterations
     i = m.index(tip)
-    for a, b in zip(f0[1:], f1[1:]):   # every converged increment: same displacements and reactions
+    for a, b in zip(f0[1:], f1[1:]):  # every converged increment: same displacements and reactions
         u0, u1 = a["U"], b["U"]
         # both meet the 1e-9 displacement test from different starts; 1e-7 of the largest motion
         # leaves room for a few soft directions amplifying it
         np.testing.assert_allclose(u1, u0, rtol=0, atol=1e-7 * np.abs(u0).max())
         np.testing.assert_allclose(b["RF"], a["RF"], rtol=0, atol=1e-7 * np.abs(a["RF"]).max())
-    assert np.abs(f0[-1]["U"][i]).max() > 0.1   # a large deflection, not a linear case
+    assert np.abs(f0[-1]["U"][i]).max() > 0.1  # a large deflection, not a linear case
 
 
 def test_a_reference_without_matching_increments_changes_nothing():
@@ -83,7 +89,7 @@ def test_a_reference_of_another_model_size_is_ignored():
     m.step("bend", initial_increment=0.1, max_increment=0.1).load(b, fz=-400.0, my=30.0)
     _run(m, record=ref)
     plain, f0 = _run(_cantilever()[0])
-    other, f1 = _run(_cantilever()[0], reference=ref)   # 4 elements recorded, 8 now: other DOFs
+    other, f1 = _run(_cantilever()[0], reference=ref)  # 4 elements recorded, 8 now: other DOFs
     assert other.summary.iterations == plain.summary.iterations
     np.testing.assert_array_equal(f0[-1]["U"], f1[-1]["U"])
 
@@ -94,8 +100,8 @@ def test_bay_runs_with_a_reference_are_cached_under_their_own_key_and_agree():
     N m on the example; 1e-3 N m is 1/200 of the example's noise), and a changed drive path runs
     without the reference."""
     from femast import examples
-    from femast.experiments import fe_cache, fe_reference, get_experiment, read_data
     from femast.experiments import bay_torsion as bt
+    from femast.experiments import fe_cache, fe_reference, get_experiment, read_data
 
     exp = get_experiment("bay-torsion")
     data = read_data(exp, examples.for_experiment("bay-torsion"))
@@ -107,11 +113,11 @@ def test_bay_runs_with_a_reference_are_cached_under_their_own_key_and_agree():
     opts = {**exp.options, "fe_reference": p0}
     m0 = fe_cache.stats()["misses"]
     fast = bt.model(p1, data, None, opts)["Mz_Nm"]
-    assert fe_cache.stats()["misses"] == m0 + 2     # the reference run (p0) and the run with it
+    assert fe_cache.stats()["misses"] == m0 + 2  # the reference run (p0) and the run with it
     np.testing.assert_allclose(fast, plain, rtol=0, atol=1e-3)
     m1 = fe_cache.stats()["misses"]
     again = bt.model(p1, data, None, opts)["Mz_Nm"]
-    assert fe_cache.stats()["misses"] == m1       # a cache hit, the same values
+    assert fe_cache.stats()["misses"] == m1  # a cache hit, the same values
     np.testing.assert_array_equal(again, fast)
     ref0 = bt.model(p0, data, None, opts)["Mz_Nm"]  # the reference itself: its plain run, cached
     assert fe_cache.stats()["misses"] == m1
@@ -137,6 +143,6 @@ def test_a_lazy_frame_has_the_keys_and_values_of_a_written_frame_and_a_kept_one_
         disk = res.frame(i)
         assert set(fr) == set(disk)
         for k in ("U", "UR", "URA", "RF", "P"):
-            np.testing.assert_array_equal(fr[k], disk[k])   # bit for bit: the same computation
+            np.testing.assert_array_equal(fr[k], disk[k])  # bit for bit: the same computation
         np.testing.assert_array_equal(read[i], disk["U"])
     assert "el/nope/x" not in kept[0] and "U" in kept[0]

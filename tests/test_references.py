@@ -11,7 +11,6 @@ from scipy.optimize import brentq
 
 from femast.verification import references as ref
 
-
 # ----------------------------------------------------------------------------- elastica
 
 
@@ -83,8 +82,9 @@ def test_elastica_branches_agree_at_k_half():
 def test_pure_bending_against_ode(turns):
     L, EI = 2.0, 3.0
     M = 2 * math.pi * turns * EI / L
-    sol = solve_ivp(lambda s, y: [math.cos(M / EI * s), math.sin(M / EI * s)], (0, L), [0.0, 0.0],
-                    rtol=1e-12, atol=1e-14)
+    sol = solve_ivp(
+        lambda s, y: [math.cos(M / EI * s), math.sin(M / EI * s)], (0, L), [0.0, 0.0], rtol=1e-12, atol=1e-14
+    )
     x, y, rot = ref.pure_bending_tip(M, L, EI)
     # independent quadrature at rtol 1e-12: agreement to ~1e-12 L
     assert x == pytest.approx(sol.y[0, -1], abs=1e-10 * L)
@@ -174,9 +174,16 @@ def _char_det(q, left, right):
     return np.linalg.det(np.array(rows(0.0, left) + rows(1.0, right)))
 
 
-@pytest.mark.parametrize("support,ends", [("pinned-pinned", ("pinned", "pinned")), ("fixed-free", ("fixed", "free")),
-                                          ("fixed-pinned", ("fixed", "pinned")), ("fixed-fixed", ("fixed", "fixed")),
-                                          ("fixed-guided", ("fixed", "guided"))])
+@pytest.mark.parametrize(
+    "support,ends",
+    [
+        ("pinned-pinned", ("pinned", "pinned")),
+        ("fixed-free", ("fixed", "free")),
+        ("fixed-pinned", ("fixed", "pinned")),
+        ("fixed-fixed", ("fixed", "fixed")),
+        ("fixed-guided", ("fixed", "guided")),
+    ],
+)
 def test_euler_loads_against_characteristic_equation(support, ends):
     qs = np.linspace(0.05, 10.0, 4000)
     d = np.array([_char_det(q, *ends) for q in qs])
@@ -204,8 +211,14 @@ def test_imperfect_column_against_bvp():
             return np.vstack((y[1], w0dd - P / EI * y[0]))
 
         x = np.linspace(0, L, 101)
-        sol = solve_bvp(f, lambda a, b: np.array([a[0], b[0]]), x, np.vstack((e0 * np.sin(np.pi * x / L), 0 * x)),
-                        tol=1e-12, max_nodes=100000)
+        sol = solve_bvp(
+            f,
+            lambda a, b: np.array([a[0], b[0]]),
+            x,
+            np.vstack((e0 * np.sin(np.pi * x / L), 0 * x)),
+            tol=1e-12,
+            max_nodes=100000,
+        )
         # collocation tolerance 1e-12 relative to e0-sized deflections
         assert ref.imperfect_column_deflection(P, EI, L, e0) == pytest.approx(sol.sol(L / 2)[0], rel=1e-7)
         assert ref.imperfect_column_deflection(P, EI, L, e0, x=L / 4) == pytest.approx(sol.sol(L / 4)[0], rel=1e-7)
@@ -221,8 +234,13 @@ def test_column_postbuckling_against_shooting(alpha_deg):
     ratio, w, short = ref.euler_column_postbuckling(alpha)
     EI, L = 1.0, 1.0
     P = ratio * math.pi**2 * EI / L**2
-    sol = solve_ivp(lambda s, y: [y[1], -P / EI * math.sin(y[0]), math.cos(y[0]), math.sin(y[0])],
-                    (0, L / 2), [alpha, 0.0, 0.0, 0.0], rtol=1e-12, atol=1e-14)
+    sol = solve_ivp(
+        lambda s, y: [y[1], -P / EI * math.sin(y[0]), math.cos(y[0]), math.sin(y[0])],
+        (0, L / 2),
+        [alpha, 0.0, 0.0, 0.0],
+        rtol=1e-12,
+        atol=1e-14,
+    )
     th, _, x, y = sol.y[:, -1]
     # ODE integrated at rtol 1e-12: agreement ~1e-11
     assert th == pytest.approx(0.0, abs=1e-9)
@@ -303,8 +321,9 @@ def test_planar_chain_reproduces_exact_cantilever_elastica():
     P = k * EI / L**2
     tip = ref.elastica_tip_load(k)
     x_tip = L * (1 - tip.u_over_L)
-    chain = ref.planar._PlanarChain([(0.0, 0.0), (L, 0.0)], EI, 1e30, "clamp", "clamp", load_node=1,
-                             load_dir=(0.0, -1.0), h=L / 400)
+    chain = ref.planar._PlanarChain(
+        [(0.0, 0.0), (L, 0.0)], EI, 1e30, "clamp", "clamp", load_node=1, load_dir=(0.0, -1.0), h=L / 400
+    )
     # reactions (0, P) and root bending moment M(0) = -P x_tip (hogging, clockwise on [0, s])
     (x, y, th, M), _ = chain.integrate(np.array([0.0, P, -P * x_tip]), 0.0)
     # RK4 with 400 steps: global error ~1e-10 of L
@@ -326,19 +345,25 @@ def _linear_frame(nodes, elems, EI, EA, fixed, load_node, load):
         ea, ei = EA / L, EI / L**3
         k[np.ix_([0, 3], [0, 3])] = ea * np.array([[1, -1], [-1, 1]])
         idx = [1, 2, 4, 5]
-        k[np.ix_(idx, idx)] = ei * np.array([[12, 6 * L, -12, 6 * L], [6 * L, 4 * L * L, -6 * L, 2 * L * L],
-                                             [-12, -6 * L, 12, -6 * L], [6 * L, 2 * L * L, -6 * L, 4 * L * L]])
+        k[np.ix_(idx, idx)] = ei * np.array(
+            [
+                [12, 6 * L, -12, 6 * L],
+                [6 * L, 4 * L * L, -6 * L, 2 * L * L],
+                [-12, -6 * L, 12, -6 * L],
+                [6 * L, 2 * L * L, -6 * L, 4 * L * L],
+            ]
+        )
         T = np.zeros((6, 6))
         for i in (0, 3):
-            T[i:i + 3, i:i + 3] = [[c, s, 0], [-s, c, 0], [0, 0, 1]]
+            T[i : i + 3, i : i + 3] = [[c, s, 0], [-s, c, 0], [0, 0, 1]]
         dofs = [3 * a, 3 * a + 1, 3 * a + 2, 3 * b, 3 * b + 1, 3 * b + 2]
         K[np.ix_(dofs, dofs)] += T.T @ k @ T
     f = np.zeros(3 * n)
-    f[3 * load_node:3 * load_node + 2] = load
+    f[3 * load_node : 3 * load_node + 2] = load
     free = [i for i in range(3 * n) if i not in fixed]
     u = np.zeros(3 * n)
     u[free] = np.linalg.solve(K[np.ix_(free, free)], f[free])
-    return u[3 * load_node:3 * load_node + 3]
+    return u[3 * load_node : 3 * load_node + 3]
 
 
 def _shoot(chain, P, L):
@@ -413,8 +438,9 @@ def test_williams_toggle_small_load_is_linear_frame_solution():
     q = _shoot(chain, P, 1.0)
     disp, _ = chain.monitor(q, P)
     nodes = [(-d["half_span"], 0.0), (0.0, d["rise"]), (d["half_span"], 0.0)]
-    u = _linear_frame(nodes, [(0, 1), (1, 2)], d["E"] * I, d["E"] * A, fixed={0, 1, 2, 6, 7, 8}, load_node=1,
-                      load=(0.0, -P))
+    u = _linear_frame(
+        nodes, [(0, 1), (1, 2)], d["E"] * I, d["E"] * A, fixed={0, 1, 2, 6, 7, 8}, load_node=1, load=(0.0, -P)
+    )
     # shallow arch: the linear stiffness changes by O(P/P_limit) ~ 3e-5 relative
     assert disp[1] == pytest.approx(u[1], rel=1e-4)
 

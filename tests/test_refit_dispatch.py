@@ -17,7 +17,7 @@ def _fake_task(payload):
 
 
 def test_expensive_refits_get_a_process_each_and_the_helper_runs_meanwhile(monkeypatch):
-    monkeypatch.setattr(refits, "_refit_task", _fake_task)   # forked workers see the patched module
+    monkeypatch.setattr(refits, "_refit_task", _fake_task)  # forked workers see the patched module
     monkeypatch.setattr(refits, "_START_METHOD", "fork")
     exp = get_experiment("bay-torsion")
     assert exp.fit_options.get("expensive")
@@ -30,8 +30,8 @@ def test_expensive_refits_get_a_process_each_and_the_helper_runs_meanwhile(monke
     pids, how = refits._dispatch(exp, None, payloads, {}, {}, None, None, 1.0, while_waiting=helper)
     n = min(4, refits.OVERSUBSCRIBE * (os.cpu_count() or 1))
     assert how == f"{n} local processes"
-    assert len(set(pids)) == n          # four 0.3 s tasks sleeping concurrently: each in its own process
-    assert seen == [True]               # the helper ran once, in a thread, and was joined
+    assert len(set(pids)) == n  # four 0.3 s tasks sleeping concurrently: each in its own process
+    assert seen == [True]  # the helper ran once, in a thread, and was joined
 
 
 def test_an_explicit_worker_count_is_kept(monkeypatch):

@@ -42,7 +42,7 @@ def _frames_equal(a: Results, b: Results):
         for k in fa:
             x, y = np.asarray(fa[k]), np.asarray(fb[k])
             assert x.dtype == y.dtype and x.shape == y.shape, (i, k)
-            assert x.tobytes() == y.tobytes(), f"frame {i}, {k} differs"   # bit for bit
+            assert x.tobytes() == y.tobytes(), f"frame {i}, {k} differs"  # bit for bit
 
 
 @pytest.fixture(scope="module")
@@ -56,7 +56,7 @@ def test_stopped_run_restarted_equals_the_uninterrupted_one(reference, tmp_path)
     out = tmp_path / "run"
     m, _ = build()
 
-    def stop(frame):   # Ctrl-C in the second step, between restart points (every 3 increments)
+    def stop(frame):  # Ctrl-C in the second step, between restart points (every 3 increments)
         if frame["step"] == "back" and frame["increment"] == 5:
             raise KeyboardInterrupt
 
@@ -105,13 +105,16 @@ def test_kill_9_at_random_moments_then_restart(reference, tmp_path):
     for trial in range(4):
         out = tmp_path / f"k{trial}"
         script = tmp_path / f"run{trial}.py"
-        script.write_text(MODEL + textwrap.dedent(f"""
+        script.write_text(
+            MODEL
+            + textwrap.dedent(f"""
             import sys
             m, _ = build()
             fm.Analysis(m, {str(out)!r}, progress=False, restart_every=1).run()
-        """))
+        """)
+        )
         cmd = [sys.executable, str(script)]
-        for attempt in range(3):
+        for _attempt in range(3):
             frames = out / "frames"
             have = _frames_on_disk(frames)
             p = subprocess.Popen(cmd, env=_env())
@@ -119,8 +122,7 @@ def test_kill_9_at_random_moments_then_restart(reference, tmp_path):
             # start-up, imports and numba's cache, takes seconds on a busy machine), plus a random delay
             target = min(have + rng.randint(1, 10), len(reference) - 1)
             deadline = time.time() + 300
-            while p.poll() is None and time.time() < deadline and \
-                    _frames_on_disk(frames) < target:
+            while p.poll() is None and time.time() < deadline and _frames_on_disk(frames) < target:
                 time.sleep(0.01)
             time.sleep(rng.uniform(0.0, 0.05))
             if p.poll() is None:
@@ -131,13 +133,13 @@ def test_kill_9_at_random_moments_then_restart(reference, tmp_path):
             if (out / "restart" / "restart.json").exists():
                 restarts += 1
                 continue
-            cmd = [sys.executable, str(script)]   # killed before the first restart point: start over
+            cmd = [sys.executable, str(script)]  # killed before the first restart point: start over
         p = subprocess.run(cmd, env=_env(), capture_output=True, text=True, timeout=600)
         assert p.returncode == 0, p.stderr
         res = Results(out)
         assert res.status == "completed"
         _frames_equal(reference, res)
-    assert kills >= 3 and restarts >= 3, (kills, restarts)   # the test did kill and restart runs
+    assert kills >= 3 and restarts >= 3, (kills, restarts)  # the test did kill and restart runs
 
 
 def test_cli_run_restart(reference, tmp_path, capsys):
@@ -146,15 +148,18 @@ def test_cli_run_restart(reference, tmp_path, capsys):
 
     out = tmp_path / "cli"
     script = tmp_path / "job.py"
-    script.write_text(MODEL + textwrap.dedent(f"""
+    script.write_text(
+        MODEL
+        + textwrap.dedent(f"""
         import sys
         m, _ = build()
         def stop(frame):
             if "--stop" in sys.argv and frame["step"] == "bend" and frame["increment"] == 9:
                 raise KeyboardInterrupt
         fm.Analysis(m, {str(out)!r}, progress=False, restart_every=2, on_frame=stop).run()
-    """))
-    assert main(["run", str(script), "--stop"]) == 130          # Ctrl-C: "femast: interrupted"
+    """)
+    )
+    assert main(["run", str(script), "--stop"]) == 130  # Ctrl-C: "femast: interrupted"
     assert "interrupted" in capsys.readouterr().err
     assert main(["run", str(script), "--restart", str(out)]) == 0
     assert os.environ.get("FEMAST_RESTART") is None
@@ -179,8 +184,8 @@ def test_a_restart_point_makes_the_frames_it_names_durable_first(tmp_path, monke
     m, _ = build()
     fm.Analysis(m, tmp_path / "run", progress=False, restart_every=5).run()
     points = [i for i, name in enumerate(synced) if name.startswith("restart.json")]
-    assert len(points) >= 4   # the start (names no frame), every 5 increments of 20 + 10, the steps' ends
-    assert LOG_NAME not in synced[:points[0]]
+    assert len(points) >= 4  # the start (names no frame), every 5 increments of 20 + 10, the steps' ends
+    assert LOG_NAME not in synced[: points[0]]
     for i in points[1:]:
-        assert LOG_NAME in synced[:i][-3:], synced   # the log, just before (with the point's own files)
-    assert synced.count(LOG_NAME) == len(points) - 1   # and only then
+        assert LOG_NAME in synced[:i][-3:], synced  # the log, just before (with the point's own files)
+    assert synced.count(LOG_NAME) == len(points) - 1  # and only then

@@ -48,9 +48,9 @@ def test_frames_are_plain_npz_readable_without_femast(cantilever_results):
     raw = (res.folder / "frames" / "frames.npzs").read_bytes()
     blobs, at = [], 0
     while at < len(raw):
-        assert raw[at:at + 8] == b"FEMASTFR"
-        n = int(np.frombuffer(raw[at + 8:at + 16], "<u8")[0])
-        blobs.append(raw[at + 16:at + 16 + n])
+        assert raw[at : at + 8] == b"FEMASTFR"
+        n = int(np.frombuffer(raw[at + 8 : at + 16], "<u8")[0])
+        blobs.append(raw[at + 16 : at + 16 + n])
         at += 16 + n
     assert len(blobs) == len(res)
     with np.load(io.BytesIO(blobs[2])) as f:

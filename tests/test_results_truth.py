@@ -54,7 +54,7 @@ def test_summary_is_running_during_the_run_and_replaces_a_stale_one(tmp_path):
     seen = []
     m2, _ = _cantilever()
     fm.solve(m2, out, progress=False, on_frame=lambda d: seen.append(_summary(out)["status"]))
-    assert seen and set(seen) == {"running"}   # the earlier run's "completed" is gone from the start
+    assert seen and set(seen) == {"running"}  # the earlier run's "completed" is gone from the start
     assert _summary(out)["status"] == "completed"
 
 
@@ -77,7 +77,7 @@ def test_singular_first_increment_is_failed_with_reason(tmp_path, capsys):
     m = fm.Model()
     a, b = m.node(0, 0, 0), m.node(1, 0, 0)
     m.beam(a, b, fm.circular_tube(0.02, 0.016, E=70e9), n=2)
-    m.fix(a, "ux", "uy", "uz", "ry", "rz")   # torsion left free: a mechanism
+    m.fix(a, "ux", "uy", "uz", "ry", "rz")  # torsion left free: a mechanism
     m.step("s").load(b, fy=1.0)
     with pytest.raises(fm.SingularModelError):
         fm.solve(m, tmp_path / "r", progress=True)
@@ -108,7 +108,7 @@ def test_partial_and_corrupt_frames(tmp_path):
     log = tmp_path / "r" / "frames" / LOG_NAME
     last = res.frame(-1)["U"].copy()
     whole = log.read_bytes()
-    with open(log, "ab") as fh:            # a sixth frame, killed half-way through its write
+    with open(log, "ab") as fh:  # a sixth frame, killed half-way through its write
         fh.write(RECORD_MAGIC + struct.pack("<Q", 4000) + b"PK\x03\x04 half a zip")
     with pytest.warns(ResultsWarning, match=r"frames\.npzs \(a partial last frame"):
         r2 = Results(tmp_path / "r")
@@ -118,11 +118,11 @@ def test_partial_and_corrupt_frames(tmp_path):
     offsets = []
     pos = 0
     while pos < len(whole):
-        n = struct.unpack("<Q", whole[pos + 8:pos + 16])[0]
+        n = struct.unpack("<Q", whole[pos + 8 : pos + 16])[0]
         offsets.append(pos + 16)
         pos += 16 + n
     damaged = bytearray(whole)
-    damaged[offsets[3]:offsets[3] + 4] = b"XXXX"
+    damaged[offsets[3] : offsets[3] + 4] = b"XXXX"
     log.write_bytes(bytes(damaged))
     r3 = Results(tmp_path / "r")
     with pytest.raises(fm.FemastError, match=r"frames\.npzs: frame 3 is unreadable"):
@@ -147,7 +147,7 @@ def test_folder_of_one_file_per_frame_still_reads(tmp_path):
         r2 = Results(tmp_path / "r")
     assert len(r2) == 5 and np.array_equal(r2.frame(-1)["U"], last)
     assert r2.node_history(b, "uz").shape == (5,)
-    (frames / "000004.npz").write_bytes(b"not a zip at all")   # frame 3 (frame 0 is 000001)
+    (frames / "000004.npz").write_bytes(b"not a zip at all")  # frame 3 (frame 0 is 000001)
     with pytest.warns(ResultsWarning):
         r3 = Results(tmp_path / "r")
     with pytest.raises(fm.FemastError, match=r"000004\.npz: frame 3 is unreadable"):
@@ -173,11 +173,15 @@ _SLOW_CANTILEVER = """
     m.step("s", initial_increment=1e-4, max_increment=1e-4, max_increments=100000).load(b, fz=-50.0)
 """
 
-_KILL_SCRIPT = textwrap.dedent("""
+_KILL_SCRIPT = textwrap.dedent(
+    """
     import sys, femast as fm
-""" + _SLOW_CANTILEVER.format(n=20) + """
+"""
+    + _SLOW_CANTILEVER.format(n=20)
+    + """
     fm.solve(m, sys.argv[1], progress=False)
-""")
+"""
+)
 
 
 def test_kill_9_and_read(tmp_path):
@@ -200,18 +204,18 @@ def test_kill_9_and_read(tmp_path):
         p.send_signal(signal.SIGKILL)
         p.wait()
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ResultsWarning)   # a *.tmp may or may not be left
+        warnings.simplefilter("ignore", ResultsWarning)  # a *.tmp may or may not be left
         res = Results(out)
     assert len(res) >= 15
     assert _summary(out)["status"] == "running" and res.status == "interrupted"
-    U = np.array([res.frame(i)["U"] for i in range(len(res))])   # every frame reads
+    U = np.array([res.frame(i)["U"] for i in range(len(res))])  # every frame reads
     assert np.all(np.isfinite(U))
     inc = res.scalar_history("increment")
-    assert np.array_equal(inc, np.arange(len(res)))   # consecutive: nothing lost before the last
+    assert np.array_equal(inc, np.arange(len(res)))  # consecutive: nothing lost before the last
 
 
-
-_REPORT_SCRIPT = textwrap.dedent("""
+_REPORT_SCRIPT = textwrap.dedent(
+    """
     import sys, time, femast as fm
     import femast.post.results as results
     from femast.analysis.output import Observer
@@ -227,9 +231,12 @@ _REPORT_SCRIPT = textwrap.dedent("""
             sys.stdout.write(f"{increment} {float(an.x[-1, 2] - an.X0[-1, 2]).hex()}\\n")
             sys.stdout.flush()
 
-""" + _SLOW_CANTILEVER.format(n=4) + """
+"""
+    + _SLOW_CANTILEVER.format(n=4)
+    + """
     fm.Analysis(m, sys.argv[1], progress=False, observers=[Report()]).run()
-""")
+"""
+)
 
 
 @pytest.mark.parametrize("reports, delay_s", [(3, 0.0), (40, 0.0137)])
@@ -251,25 +258,25 @@ def test_kill_9_loses_no_increment_the_run_reported_converged(tmp_path, reports,
             line = p.stdout.readline()
             assert line, "the run ended before it could be killed"
             lines.append(line)
-        time.sleep(delay_s)   # (the kill lands anywhere in an increment, not just after a report)
+        time.sleep(delay_s)  # (the kill lands anywhere in an increment, not just after a report)
     finally:
         p.send_signal(signal.SIGKILL)
         p.wait()
-    lines += p.stdout.read().splitlines(keepends=True)   # what it reported before it died
+    lines += p.stdout.read().splitlines(keepends=True)  # what it reported before it died
     p.stdout.close()
     reported = [line.split() for line in lines if line.endswith(b"\n")]
     assert len(reported) >= reports
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ResultsWarning)   # a record cut short by the kill may be left
+        warnings.simplefilter("ignore", ResultsWarning)  # a record cut short by the kill may be left
         res = Results(out)
-    assert len(res) >= len(reported) + 1   # the initial frame and every reported increment
+    assert len(res) >= len(reported) + 1  # the initial frame and every reported increment
     for inc, uz in reported:
         fr = res.frame(int(inc))
         assert int(fr["increment"]) == int(inc)
-        assert fr["U"][-1, 2] == float.fromhex(uz.decode())   # the converged state, not a later one
+        assert fr["U"][-1, 2] == float.fromhex(uz.decode())  # the converged state, not a later one
     sta = [line.split() for line in (out / "status.sta").read_text().splitlines()[1:]]
     named = [int(row[1]) for row in sta if len(row) >= 8]
-    assert named and max(named) <= len(res) - 1   # a status line never runs ahead of its frame
+    assert named and max(named) <= len(res) - 1  # a status line never runs ahead of its frame
 
 
 def test_the_frame_log_reads_where_it_cannot_be_memory_mapped(tmp_path, monkeypatch):
@@ -284,11 +291,11 @@ def test_the_frame_log_reads_where_it_cannot_be_memory_mapped(tmp_path, monkeypa
     with open(log, "wb") as fh:
         for fr in frames:
             fh.write(npz.record_bytes(fr))
-        fh.write(npz.record_bytes(frames[0])[:40])   # a record cut short
+        fh.write(npz.record_bytes(frames[0])[:40])  # a record cut short
     mapped = npz.scan_log(log)
 
     def no_mmap(*args, **kw):
-        raise OSError(19, "No such device")   # what mmap gives on a file system without it
+        raise OSError(19, "No such device")  # what mmap gives on a file system without it
 
     monkeypatch.setattr(mmap, "mmap", no_mmap)
     read = npz.scan_log(log)

@@ -60,10 +60,10 @@ def test_remembered_results_equal_computed_ones_and_are_copies(monkeypatch):
         again = jit.setup_call(_pattern_kernel, 10, *args)
         for a, b, c in zip(fresh, first, again):
             assert np.array_equal(a, b) and np.array_equal(a, c)
-        again[0][:] = -7       # a caller writing into its result changes nothing remembered
+        again[0][:] = -7  # a caller writing into its result changes nothing remembered
         third = jit.setup_call(_pattern_kernel, 10, *args)
         assert np.array_equal(third[0], fresh[0])
-    assert len(jit._MEMO) == 3     # three distinct argument sets, three entries
+    assert len(jit._MEMO) == 3  # three distinct argument sets, three entries
     # the same pattern through the public function, twice, and another model's differs
     m1, p1 = _block_pattern([_pattern_args(0)[0]], 0, 20, 0, 20)
     m2, p2 = _block_pattern([_pattern_args(0)[0]], 0, 20, 0, 20)
@@ -89,7 +89,7 @@ def test_memo_is_bounded(monkeypatch):
 def test_large_inputs_are_not_remembered(monkeypatch):
     monkeypatch.setattr(jit, "_MEMO", {})
     monkeypatch.setattr(jit, "SETUP_PYTHON_MAX", 5)
-    res = jit.setup_call(_pattern_kernel, 10, *_pattern_args(0)[1])   # compiled path
+    res = jit.setup_call(_pattern_kernel, 10, *_pattern_args(0)[1])  # compiled path
     assert not jit._MEMO
     for a, b in zip(res, _pattern_kernel.py_func(*_pattern_args(0)[1])):
         assert np.array_equal(a, b)

@@ -22,7 +22,7 @@ from femast.testing import fd_tangent
 
 LAW = DyneemaLaw()
 K0, K1, K2 = LAW.k0, LAW.k1, LAW.k2
-T0 = 1200.0          # N, the seed's pretension
+T0 = 1200.0  # N, the seed's pretension
 
 
 def g(tau):
@@ -60,8 +60,11 @@ def test_pretensioned_rope_cut_short_carries_the_law_at_its_new_strain():
     L = 5.0
     X = np.array([[0.0, 0.0, 0.0], [3.0, 4.0, 0.0]])
     L0 = float(unstretched_length(LAW, T0, L))
-    for d, expected in ((2e-3, tension(L / (L0 - 2e-3) - 1.0)), (-0.3e-3, tension(L / (L0 + 0.3e-3) - 1.0)),
-                        (-0.01, 0.0)):
+    for d, expected in (
+        (2e-3, tension(L / (L0 - 2e-3) - 1.0)),
+        (-0.3e-3, tension(L / (L0 + 0.3e-3) - 1.0)),
+        (-0.01, 0.0),
+    ):
         fam = ShroudCableFamily([[0, 1]], L0, LAW, length_error=-d)
         out = fam.evaluate(X, None, None).output
         # the law's inverse is closed form in the kernel and a root here: round-off ~1e-13
@@ -70,9 +73,9 @@ def test_pretensioned_rope_cut_short_carries_the_law_at_its_new_strain():
     # first order: the tension gains EA_t d L / L0^2 (d eps = L d / L0^2; EA_t = g^2 / (k0 - k2 tau^2) at T0)
     fam = ShroudCableFamily([[0, 1]], L0, LAW, length_error=-1e-6)
     gain = fam.evaluate(X, None, None).output["tension"][0] - T0
-    EAt = g(T0) ** 2 / (K0 - K2 * T0 ** 2)
+    EAt = g(T0) ** 2 / (K0 - K2 * T0**2)
     # second order: (d EA_t / d tau) dtau / (2 EA_t) ~ 300 x 0.26 N / 2.2 MN = 4e-5 (the law stiffens)
-    assert gain == pytest.approx(EAt * 1e-6 * L / L0 ** 2, rel=1e-4)
+    assert gain == pytest.approx(EAt * 1e-6 * L / L0**2, rel=1e-4)
 
 
 def _series(d=0.0, alpha=0.0, dT=0.0, amplitude=None, increments=4):
@@ -137,11 +140,11 @@ def test_heated_rope_free_to_grow_keeps_its_force_and_grows_by_alpha_dT():
     m.step("heat").temperature(dT, family="r")
     frames = _frames(m)
     end = {f["step"]: f for f in frames}
-    assert end["heat"]["el/r/tension"][0] == pytest.approx(F, rel=1e-10)   # Newton's tolerance
+    assert end["heat"]["el/r/tension"][0] == pytest.approx(F, rel=1e-10)  # Newton's tolerance
     du = end["heat"]["U"][1, 2] - end["load"]["U"][1, 2]
     expected = -fam.L0[0] * alpha * dT * (1.0 + strain(F))
-    assert du == pytest.approx(expected, rel=1e-7)   # 1.5 mm; equilibrium to 1e-9 of F
-    assert np.all(m.families[0].length_factor == 1.0)   # the analysis heated its own copy
+    assert du == pytest.approx(expected, rel=1e-7)  # 1.5 mm; equilibrium to 1e-9 of F
+    assert np.all(m.families[0].length_factor == 1.0)  # the analysis heated its own copy
 
 
 # ------------------------------------------------------------------ a beam guyed by two ropes
@@ -152,8 +155,8 @@ def test_cantilever_guyed_by_two_ropes_one_cut_short_deflects_as_the_hand_calcul
     (Euler-Bernoulli tip stiffness; the ropes stay horizontal to O(u^2 / H))."""
     H, a, d = 3.651, 3.0, 1e-3
     E, s_out, s_in = 6.55e10, 0.1, 0.094
-    I = (s_out ** 4 - s_in ** 4) / 12.0
-    sec = Section(E=E, G=E / 2.6, A=s_out ** 2 - s_in ** 2, Iy=I, Iz=I, J=2 * I)
+    I = (s_out**4 - s_in**4) / 12.0
+    sec = Section(E=E, G=E / 2.6, A=s_out**2 - s_in**2, Iy=I, Iz=I, J=2 * I)
     m = fm.Model("guyed cantilever")
     base, tip = m.node(0, 0, 0), m.node(0, 0, H)
     m.beam(base, tip, sec, up=(0.0, 1.0, 0.0), n=8, family="tube")
@@ -164,15 +167,15 @@ def test_cantilever_guyed_by_two_ropes_one_cut_short_deflects_as_the_hand_calcul
     add_shrouds(m, [[tip, pa], [tip, ma]], tension=T0, length_error=[-d, 0.0], name="guy")
     m.step("cut")
     f = _frames(m)[-1]
-    kb = 3.0 * E * I / H ** 3
+    kb = 3.0 * E * I / H**3
     L0 = a / (1.0 + strain(T0))
-    u = brentq(lambda u: kb * u - (tension((a - u) / (L0 - d) - 1.0) - tension((a + u) / L0 - 1.0)),
-               0.0, d, xtol=1e-15)
+    u = brentq(lambda u: kb * u - (tension((a - u) / (L0 - d) - 1.0) - tension((a + u) / L0 - 1.0)), 0.0, d, xtol=1e-15)
     # neglected: the tip's drop u^2 / H ~ 1e-7 m tilting the ropes (cos ~ 1 - 1e-15), the beam's
     # large-rotation terms ~ (u / H)^2 ~ 2e-8; Newton 1e-9 (measured 2e-10)
     assert f["U"][1, 0] == pytest.approx(u, rel=1e-7)
-    np.testing.assert_allclose(f["el/guy/tension"], [tension((a - u) / (L0 - d) - 1.0),
-                                                     tension((a + u) / L0 - 1.0)], rtol=1e-6)
+    np.testing.assert_allclose(
+        f["el/guy/tension"], [tension((a - u) / (L0 - d) - 1.0), tension((a + u) / L0 - 1.0)], rtol=1e-6
+    )
     # the rope nearly wins: u is most of d / 2 (rope stiffness >> the tube's 3 EI / H^3 = 2.5 kN/m)
     assert 0.45 * d < u < 0.5 * d
 
@@ -188,11 +191,11 @@ def test_fe_mast_heated_shrouds_equal_the_same_length_error():
     long = MastFE(1200.0, length_error=hot.L0 * alpha * dT)
     long.solve()
     a, b = hot.state(), long.state()
-    np.testing.assert_allclose(a.tension, b.tension, rtol=1e-8)      # Newton 1e-9 on ~1.3 kN
+    np.testing.assert_allclose(a.tension, b.tension, rtol=1e-8)  # Newton 1e-9 on ~1.3 kN
     np.testing.assert_allclose(a.displacement, b.displacement, rtol=0, atol=1e-8 * np.abs(b.displacement).max())
     nominal = MastFE(1200.0)
     nominal.solve()
-    assert np.all(a.tension > nominal.state().tension + 50.0)   # 360 ppm shorter: ~+120 N each
+    assert np.all(a.tension > nominal.state().tension + 50.0)  # 360 ppm shorter: ~+120 N each
     assert [fr[0] for fr in hot._frames][-1] == "thermal"
 
 
@@ -224,9 +227,9 @@ def test_fe_mast_heated_top_rises_as_the_hand_calculation_of_tube_and_shrouds():
 
     delta = brentq(lambda z: kt * (at * dT * L_BEAM - z) - np.sum(c * (taus(z) - s0.tension)), 0.0, at * dT * L_BEAM)
     rise = s1.displacement[2] - s0.displacement[2]
-    assert rise == pytest.approx(delta, rel=1e-3)           # measured 4e-5
-    np.testing.assert_allclose(s1.tension, taus(delta), rtol=0.02)   # measured 1.1 %
-    assert rise < 0.95 * at * dT * L_BEAM                   # the tightening ropes hold the tube back
+    assert rise == pytest.approx(delta, rel=1e-3)  # measured 4e-5
+    np.testing.assert_allclose(s1.tension, taus(delta), rtol=0.02)  # measured 1.1 %
+    assert rise < 0.95 * at * dT * L_BEAM  # the tightening ropes hold the tube back
 
 
 def test_fe_mast_one_shroud_short_moves_the_top_as_its_linearised_stiffness_says():
@@ -235,6 +238,7 @@ def test_fe_mast_one_shroud_short_moves_the_top_as_its_linearised_stiffness_says
     a fixed top); linearisation error: the law stiffens, (d EA_t / d tau) dtau / (2 EA_t) ~ 3e-3 at
     dtau ~ 25 N (measured 1.4e-3 of the motion)."""
     from femast.elements.shroud_law import axial_rigidity_tangent
+
     d = 1e-4
     nom = MastFE(1200.0)
     nom.solve()
@@ -243,14 +247,14 @@ def test_fe_mast_one_shroud_short_moves_the_top_as_its_linearised_stiffness_says
     dvec = st.lower - st.upper
     length = np.linalg.norm(dvec, axis=1)
     e = dvec / length[:, None]
-    B = np.vstack([e.T, np.cross(st.upper - st.top, e).T])[:, 0]   # wrench of a unit tension of rope 0
+    B = np.vstack([e.T, np.cross(st.upper - st.top, e).T])[:, 0]  # wrench of a unit tension of rope 0
     dtau = axial_rigidity_tangent(LAW, st.tension[0]) * length[0] / nom.L0[0] ** 2 * d
     lin = np.linalg.solve(K, B * dtau)
     cut = MastFE(1200.0, length_error=[-d, 0.0, 0.0])
     cut.solve()
     du = cut.state().displacement - st.displacement
     np.testing.assert_allclose(du, lin, rtol=0, atol=3e-3 * np.abs(lin).max())
-    assert np.abs(du[:3]).max() > 1e-5    # a real motion (tens of micrometres)
+    assert np.abs(du[:3]).max() > 1e-5  # a real motion (tens of micrometres)
 
 
 def test_fe_mast_equilibrate_absorbs_length_errors():
@@ -261,8 +265,8 @@ def test_fe_mast_equilibrate_absorbs_length_errors():
     ref.equilibrate()
     err = MastFE(1200.0, length_error=dL)
     err.equilibrate()
-    np.testing.assert_allclose(err.state().tension, 1200.0, rtol=2e-9)       # equilibrate's tolerance
-    np.testing.assert_allclose(err.L0 + dL, ref.L0, rtol=0, atol=1e-9)      # 1e-9 of 1.2 kN on ~4 m ropes
+    np.testing.assert_allclose(err.state().tension, 1200.0, rtol=2e-9)  # equilibrate's tolerance
+    np.testing.assert_allclose(err.L0 + dL, ref.L0, rtol=0, atol=1e-9)  # 1e-9 of 1.2 kN on ~4 m ropes
 
 
 # ------------------------------------------------------------------ tangent and bad input
@@ -280,21 +284,25 @@ def test_tangent_matches_finite_differences_with_errors_and_heat():
     r = fam.evaluate(X, R, None)
     assert np.all(r.output["tension"] > 0.0)
     # the stress-free length the law sees
-    np.testing.assert_allclose(r.output["strain"], length / ((length / 1.002 + fam.length_error) * fam.length_factor)
-                               - 1.0, rtol=1e-12)
+    np.testing.assert_allclose(
+        r.output["strain"], length / ((length / 1.002 + fam.length_error) * fam.length_factor) - 1.0, rtol=1e-12
+    )
     Kfd = fd_tangent(fam, X, R)
     for e in range(n):
         # central FD, h = 1e-6 m/rad on ~2 m ropes: truncation and round-off below 1e-7 of K
         np.testing.assert_allclose(r.k[e], Kfd[e], atol=1e-7 * np.abs(r.k[e]).max())
 
 
-@pytest.mark.parametrize("value, words", [
-    ([1e-3, 2e-3], r"one value per rope, shape \(3,\).*got shape \(2,\)"),
-    ([[1e-3, 0, 0]], r"one value per rope.*shape \(1, 3\)"),
-    ([0.0, float("nan"), 0.0], r"guys element 2: length_error = nan m is not finite"),
-    ([0.0, 0.0, -10.0], r"guys element 3: length_error = -10.0 m leaves the rope a stress-free length -5 m"),
-    ("short", r"must be numbers in m"),
-])
+@pytest.mark.parametrize(
+    "value, words",
+    [
+        ([1e-3, 2e-3], r"one value per rope, shape \(3,\).*got shape \(2,\)"),
+        ([[1e-3, 0, 0]], r"one value per rope.*shape \(1, 3\)"),
+        ([0.0, float("nan"), 0.0], r"guys element 2: length_error = nan m is not finite"),
+        ([0.0, 0.0, -10.0], r"guys element 3: length_error = -10.0 m leaves the rope a stress-free length -5 m"),
+        ("short", r"must be numbers in m"),
+    ],
+)
 def test_bad_length_errors_name_the_rope(value, words):
     with pytest.raises(ModelError, match=words):
         ShroudCableFamily([[0, 1], [2, 3], [4, 5]], 5.0, LAW, length_error=value, name="guys")
@@ -331,7 +339,7 @@ def test_guyed_study_script_runs_its_samples(tmp_path):
     s = st.run(study, tmp_path / "g", samples=2)
     assert s.complete and s.failed == 0 and s.ok == 10
     res = st.load(tmp_path / "g")
-    uz = res.output("top_u", blocks=("A", "B"))[:, 0, 2]      # after 'thermal'
+    uz = res.output("top_u", blocks=("A", "B"))[:, 0, 2]  # after 'thermal'
     dT = res.inputs("dT", blocks=("A", "B"))
     # the vertical error is the temperature's (1.55 mm at 20 K; shroud errors move z by < 0.01 mm)
     assert np.all(np.sign(uz - np.median(uz)) == np.sign(dT - np.median(dT)))
@@ -344,12 +352,13 @@ def test_platform_study_calibration_removes_the_static_lean_of_erroneous_shrouds
     import runpy
     from pathlib import Path
 
-    ns = runpy.run_path(str(Path(__file__).resolve().parents[1] / "benchmarks" / "study_guyed_platform.py"),
-                        run_name="__femast_study__")
+    ns = runpy.run_path(
+        str(Path(__file__).resolve().parents[1] / "benchmarks" / "study_guyed_platform.py"), run_name="__femast_study__"
+    )
     rng = np.random.default_rng(0)
     dL, pre = rng.normal(0.0, 0.5e-3, 12), rng.normal(T0, 60.0, 12)
     cold = ns["platform"](dL, pre, 0.0)
-    assert np.abs(cold["error_cal"]).max() < 1e-9       # solve_pose's Newton tolerance (1e-11) on metres
-    assert cold["error_max"] > 1e-3                      # the cable wrenches along the path still bend the masts
+    assert np.abs(cold["error_cal"]).max() < 1e-9  # solve_pose's Newton tolerance (1e-11) on metres
+    assert cold["error_max"] > 1e-3  # the cable wrenches along the path still bend the masts
     warm = ns["platform"](dL, pre, 20.0)
-    assert np.abs(warm["error_cal"][2]) > 1e-3           # masts 1.5 mm taller: millimetres at the platform
+    assert np.abs(warm["error_cal"][2]) > 1e-3  # masts 1.5 mm taller: millimetres at the platform

@@ -27,7 +27,7 @@ from femast.elements._ball_joint_kernels import I_M, I_SLIP, N_STATE, REVERSED, 
 from femast.elements.base import ElementFamily, ElementResponse
 from femast.errors import ConvergenceError
 
-MU, B = 0.5, 0.004      # seed 001 Sec. II.B.1
+MU, B = 0.5, 0.004  # seed 001 Sec. II.B.1
 K_PEN, K_S = 1e8, 2000.0
 
 
@@ -44,24 +44,23 @@ def _joint(theta_z, prev_moment_z, F=100.0, committed_mz=0.0):
     prev[I_M + 2] = prev_moment_z
     f, K, new, out = np.zeros(12), np.zeros((12, 12)), np.zeros(N_STATE), np.zeros(11)
     xb = np.array([F / K_PEN, 0.0, 0.0])
-    ball_joint_element(np.zeros(3), xb, np.eye(3), Rb, np.zeros(3), K_PEN, K_S, MU, B, st, f, K, new, out,
-                       prev, True)
+    ball_joint_element(np.zeros(3), xb, np.eye(3), Rb, np.zeros(3), K_PEN, K_S, MU, B, st, f, K, new, out, prev, True)
     return f, K, new
 
 
 def test_reversed_joint_is_answered_stuck():
-    Y = MU * B * 100.0                       # 0.2 N m
-    theta = -5 * Y / K_S                     # trial moment -5 Y: far outside the cone
+    Y = MU * B * 100.0  # 0.2 N m
+    theta = -5 * Y / K_S  # trial moment -5 Y: far outside the cone
     # previous iterate slipped the other way (+Y): stuck, m = m_c + k_s theta (closed form)
     f, K, new = _joint(theta, +Y)
     assert new[I_SLIP] == REVERSED
-    assert f[11] == pytest.approx(K_S * theta, rel=1e-12)     # (1e-12: round-off of log/exp of theta)
-    assert K[11, 11] == pytest.approx(K_S, rel=1e-6)          # Ts^-1(theta) = I + O(theta), theta 5e-4 rad
+    assert f[11] == pytest.approx(K_S * theta, rel=1e-12)  # (1e-12: round-off of log/exp of theta)
+    assert K[11, 11] == pytest.approx(K_S, rel=1e-6)  # Ts^-1(theta) = I + O(theta), theta 5e-4 rad
     # previous iterate slipped the same way: the law itself, m = -Y (radial return)
     f, K, new = _joint(theta, -Y)
     assert new[I_SLIP] == 1.0
     assert f[11] == pytest.approx(-Y, rel=1e-12)
-    assert abs(K[11, 11]) < 1e-9 * K_S                        # no stiffness along the slip direction
+    assert abs(K[11, 11]) < 1e-9 * K_S  # no stiffness along the slip direction
 
 
 class _Provisional(ElementFamily):
@@ -78,7 +77,7 @@ class _Provisional(ElementFamily):
         K = np.zeros((1, 6, 6))
         f[0, 0] = self.k * (x[self.nodes[0, 0], 0] - 1.0)
         K[0, 0, 0] = self.k
-        for i in (1, 2):                     # hold uy, uz
+        for i in (1, 2):  # hold uy, uz
             f[0, i] = self.k * x[self.nodes[0, 0], i]
             K[0, i, i] = self.k
         return ElementResponse(f=f, k=K, state=state, provisional=self.calls <= self.n_bad)
@@ -100,7 +99,7 @@ def test_provisional_answers_are_never_accepted(n_bad, converges):
     # a linear problem is accepted after its first iteration; a provisional answer there is not
     # (the family is also evaluated outside the iterations, so the count of refusals is not n_bad)
     assert (an.summary.iterations == 1) == (n_bad == 0)
-    assert an.state.x[0, 0] - 1.0 == pytest.approx(10.0 / 1e3, rel=1e-12)   # u = F / k
+    assert an.state.x[0, 0] - 1.0 == pytest.approx(10.0 / 1e3, rel=1e-12)  # u = F / k
 
 
 def _scattered_mast(n_bays, seed, steps_out):
@@ -135,7 +134,7 @@ def test_scattered_40_bay_mast_converges_without_cutbacks():
     assert an.summary.iterations <= 100
     _check_coulomb(frames)
     joint = next(i for i, f in enumerate(an.families) if f.name == am.joint_family)
-    assert not np.any(an.state.families[joint][:, I_SLIP] == REVERSED)   # never committed
+    assert not np.any(an.state.families[joint][:, I_SLIP] == REVERSED)  # never committed
 
 
 @pytest.mark.slow
@@ -144,9 +143,15 @@ def test_nominal_100_bay_mast_converges_without_cutbacks():
     am = build_mast(100)
     add_initial_steps(am)
     add_table1_steps(am, cycles=1)
-    an = fm.Analysis(am.model, None, convergence=CONVERGENCE, progress=False,
-                     on_frame=lambda fr: frames.append(
-                         {k: np.asarray(fr[f"el/adam_joint/{k}"]).copy() for k in ("moment_norm", "limit", "slip")}))
+    an = fm.Analysis(
+        am.model,
+        None,
+        convergence=CONVERGENCE,
+        progress=False,
+        on_frame=lambda fr: frames.append(
+            {k: np.asarray(fr[f"el/adam_joint/{k}"]).copy() for k in ("moment_norm", "limit", "slip")}
+        ),
+    )
     an.run()
     # measured 52 iterations, 0 cutbacks (main 81f2bc4: 1135 iterations, 4 cutbacks, 140 increments)
     assert an.summary.cutbacks == 0

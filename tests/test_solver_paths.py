@@ -17,10 +17,10 @@ import scipy.sparse.linalg as spla
 
 import femast as fm
 from femast.analysis import Analysis
+from femast.analysis.solvers.linear import SparseLU
 from femast.elements.base import ElementFamily, ElementResponse
 from femast.errors import ConvergenceError
 from femast.post.results import ResultsWriter
-from femast.analysis.solvers.linear import SparseLU
 
 
 def _frame_model(n_bays=3):
@@ -69,7 +69,7 @@ def test_reused_responses_save_one_evaluation_per_increment_and_change_nothing(t
     assert count.calls == fast.summary.iterations + 2
     slow = Analysis(m, tmp_path / "slow", progress=False, tangent="full")
     for f in slow.families:
-        f.path_independent = False   # the instance attribute hides the class's True
+        f.path_independent = False  # the instance attribute hides the class's True
     count_slow = _Counting(slow)
     slow.run()
     assert count_slow.calls == slow.summary.iterations + slow.summary.increments + 1
@@ -82,14 +82,14 @@ def test_reused_responses_save_one_evaluation_per_increment_and_change_nothing(t
 def test_direct_assembly_into_the_solver_matches_a_csr_tangent(tmp_path):
     m, rows = _frame_model()
     an = Analysis(m, tmp_path / "r", progress=False)
-    assert an.solver.chosen == "rcm" and an.solver.analyses == 1   # ordering chosen at set-up
+    assert an.solver.chosen == "rcm" and an.solver.analyses == 1  # ordering chosen at set-up
     an.run()
-    assert an.solver.analyses == 1   # never re-analysed
+    assert an.solver.analyses == 1  # never re-analysed
     resp = an.system.evaluate(None)
     an.system.residual(resp, an.loads)
     K, _ = an.system.tangent(resp, with_fc=False)
     Kfc, none = an.system.factorize_tangent(resp, with_fc=False)
-    assert Kfc is None and none is None   # went straight into the solver's matrix
+    assert Kfc is None and none is None  # went straight into the solver's matrix
     rhs = np.random.default_rng(1).normal(size=K.shape[0])
     x_direct = an.solver.solve(rhs)
     x_ref = spla.spsolve(K.tocsc(), rhs)
@@ -101,28 +101,29 @@ def _grid_laplacian(n):
     """3D n^3 grid Laplacian plus identity: compact, not chain-like (RCM envelope >> nnz)."""
     one = sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])
     eye = sp.identity(n)
-    L = (sp.kron(sp.kron(one, eye), eye) + sp.kron(sp.kron(eye, one), eye) + sp.kron(sp.kron(eye, eye), one))
-    return (L + sp.identity(n ** 3)).tocsr()
+    L = sp.kron(sp.kron(one, eye), eye) + sp.kron(sp.kron(eye, one), eye) + sp.kron(sp.kron(eye, eye), one)
+    return (L + sp.identity(n**3)).tocsr()
 
 
 def test_rcm_kept_from_the_pattern_only_when_its_envelope_bounds_the_fill():
     # a banded (chain-like) matrix: the RCM envelope holds nnz(K) entries, RCM is kept at once
     n = 200
-    band = sp.diags([np.ones(n - 2), -np.ones(n - 1), 4 * np.ones(n), -np.ones(n - 1), np.ones(n - 2)],
-                    [-2, -1, 0, 1, 2]).tocsr()
+    band = sp.diags(
+        [np.ones(n - 2), -np.ones(n - 1), 4 * np.ones(n), -np.ones(n - 1), np.ones(n - 2)], [-2, -1, 0, 1, 2]
+    ).tocsr()
     s = SparseLU()
     assert s.analyse(band) == "rcm"
     s.factorize(band)
     b = np.arange(n, dtype=float)
-    np.testing.assert_allclose(band @ s.solve(b), b, rtol=1e-12)   # well conditioned (diag. dominant)
+    np.testing.assert_allclose(band @ s.solve(b), b, rtol=1e-12)  # well conditioned (diag. dominant)
     # a compact 3D grid: envelope >> 2 nnz, so the choice is left to trial factorisations
     G = _grid_laplacian(8)
     s = SparseLU()
     assert s.analyse(G) is None and s.chosen is None
     s.factorize(G)
-    assert s.chosen == "mmd"   # minimum degree beats RCM on a 3D grid
+    assert s.chosen == "mmd"  # minimum degree beats RCM on a 3D grid
     b = np.ones(G.shape[0])
-    np.testing.assert_allclose(G @ s.solve(b), b, rtol=1e-10)   # condition number ~25
+    np.testing.assert_allclose(G @ s.solve(b), b, rtol=1e-10)  # condition number ~25
 
 
 def test_direct_superlu_call_gives_splus_factorisation_bit_for_bit():
@@ -130,19 +131,18 @@ def test_direct_superlu_call_gives_splus_factorisation_bit_for_bit():
     rng = np.random.default_rng(3)
     n = 120
     K = (sp.random(n, n, density=0.05, random_state=rng) + sp.diags(rng.uniform(-1e-3, 1.0, n))).tocsr()
-    K = (K + abs(K).T * 0.0).tocsr()   # structurally symmetric, as femast tangents are
+    K = (K + abs(K).T * 0.0).tocsr()  # structurally symmetric, as femast tangents are
     K.sort_indices()
     s = SparseLU(ordering="rcm")
     assert s.analyse(K) == "rcm"
     s.values[:] = K.data[s._gather]
-    s.factorize_values()                          # the direct binding
+    s.factorize_values()  # the direct binding
     B = s._B
-    ref = spla.splu(B, permc_spec="NATURAL", diag_pivot_thresh=s.pivot_threshold,
-                    options=dict(SymmetricMode=True))
+    ref = spla.splu(B, permc_spec="NATURAL", diag_pivot_thresh=s.pivot_threshold, options=dict(SymmetricMode=True))
     b = rng.standard_normal(n)
-    assert np.array_equal(s._lu.solve(b), ref.solve(b))          # same pivots, same arithmetic
+    assert np.array_equal(s._lu.solve(b), ref.solve(b))  # same pivots, same arithmetic
     assert np.array_equal(s._lu.perm_r, ref.perm_r) and s._lu.nnz == ref.nnz
-    assert np.any(ref.perm_r != np.arange(n))                   # rows were interchanged
+    assert np.any(ref.perm_r != np.arange(n))  # rows were interchanged
 
 
 def test_out_none_writes_nothing_and_passes_the_same_frames_to_the_recorder(tmp_path, monkeypatch):
@@ -151,24 +151,24 @@ def test_out_none_writes_nothing_and_passes_the_same_frames_to_the_recorder(tmp_
     on_disk = fm.Analysis(m, tmp_path / "r", progress=False).run()
     recorded = []
     assert fm.Analysis(m, None, progress=False, on_frame=recorded.append).run() is None
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["r"]   # no folder, frame or status file
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r"]  # no folder, frame or status file
     assert len(recorded) == len(on_disk) == 1 + 4
-    for i, fr in enumerate(recorded):   # the same solution, bit for bit (writing does not change it)
+    for i, fr in enumerate(recorded):  # the same solution, bit for bit (writing does not change it)
         np.testing.assert_array_equal(fr["U"], on_disk.frame(i)["U"])
         np.testing.assert_array_equal(fr["el/beam/section_forces"], on_disk.frame(i)["el/beam/section_forces"])
     with pytest.warns(UserWarning, match="keeps no results"):
         an = fm.Analysis(m, None, progress=False)
     an.run()
-    np.testing.assert_array_equal(an.x - an.X0, recorded[-1]["U"])   # the final state is kept
+    np.testing.assert_array_equal(an.x - an.X0, recorded[-1]["U"])  # the final state is kept
 
 
 def test_writer_keeps_every_frame_and_reports_a_write_error_at_once(tmp_path):
     m, rows = _frame_model()
     recorded = []
     res = fm.Analysis(m, tmp_path / "r", progress=False, on_frame=recorded.append).run()
-    assert len(res) == 1 + 4   # the initial frame and the 4 increments, all on disk after the run
+    assert len(res) == 1 + 4  # the initial frame and the 4 increments, all on disk after the run
     u = [res.frame(i)["U"] for i in range(len(res))]
-    assert all(np.abs(a - b).max() > 0 for a, b in zip(u, u[1:]))   # distinct frames, in order
+    assert all(np.abs(a - b).max() > 0 for a, b in zip(u, u[1:]))  # distinct frames, in order
     # the recorder saw exactly what is on disk, frame by frame
     assert len(recorded) == len(res)
     for i, fr in enumerate(recorded):
@@ -185,11 +185,11 @@ def test_writer_keeps_every_frame_and_reports_a_write_error_at_once(tmp_path):
         pytest.skip("no /dev/full to stand for a full disk")
     w = ResultsWriter(tmp_path / "w", Frozen(), [])
     os.close(w._log)
-    w._log = os.open("/dev/full", os.O_WRONLY)   # the frame log's disk is full (ENOSPC)
-    with pytest.raises(OSError, match="could not write results"):   # at the frame, not later
+    w._log = os.open("/dev/full", os.O_WRONLY)  # the frame log's disk is full (ENOSPC)
+    with pytest.raises(OSError, match="could not write results"):  # at the frame, not later
         w.frame(U=np.zeros((1, 3)))
     assert w.count == 0
-    w.close({"status": "completed", "completed": True})   # a run that went on would not be "completed"
+    w.close({"status": "completed", "completed": True})  # a run that went on would not be "completed"
     s = json.loads((tmp_path / "w" / "summary.json").read_text())
     assert s["status"] == "failed" and "No space left" in s["message"]
 
@@ -202,7 +202,7 @@ def test_a_full_disk_at_the_start_is_a_named_error_and_a_failed_summary(tmp_path
     import femast.post.results as results
     from femast.errors import FemastError, ResultsWriteError
 
-    def full_disk(path, **arrays):   # the OS's own ENOSPC
+    def full_disk(path, **arrays):  # the OS's own ENOSPC
         with open("/dev/full", "wb") as fh:
             fh.write(b"x" * 8192)
             fh.flush()
@@ -211,7 +211,7 @@ def test_a_full_disk_at_the_start_is_a_named_error_and_a_failed_summary(tmp_path
     m, _ = _frame_model(1)
     with pytest.raises(ResultsWriteError, match=r"could not write results to '.*r'.*No space left") as err:
         fm.Analysis(m, tmp_path / "r", progress=False).run()
-    assert isinstance(err.value, FemastError) and isinstance(err.value, OSError)   # (caught as either)
+    assert isinstance(err.value, FemastError) and isinstance(err.value, OSError)  # (caught as either)
     s = json.loads((tmp_path / "r" / "summary.json").read_text())
     assert s["status"] == "failed" and "No space left" in s["message"]
     assert not list((tmp_path / "r").glob("*.tmp"))
@@ -257,12 +257,13 @@ def test_reduced_tangent_matches_the_sparse_product():
     n_act, n_ind, nf = 40, 30, 24
     K = sp.random(n_act, n_act, density=0.15, random_state=4, format="csr") + sp.identity(n_act, format="csr")
     K.sort_indices()
-    T = (sp.random(n_act, n_ind, density=0.06, random_state=5, format="csr")
-         + sp.eye(n_act, n_ind, format="csr")).tocsr()
+    T = (
+        sp.random(n_act, n_ind, density=0.06, random_state=5, format="csr") + sp.eye(n_act, n_ind, format="csr")
+    ).tocsr()
     T.sort_indices()
     g_rows, g_cols = rng.integers(0, n_ind, 12), rng.integers(0, n_ind, 12)
     red = ReducedTangent(K, T, g_rows, g_cols, nf)
-    for _ in range(2):   # refilled in place with new values on the same patterns
+    for _ in range(2):  # refilled in place with new values on the same patterns
         K.data[:] = rng.normal(size=K.nnz)
         T.data[:] = rng.normal(size=T.nnz)
         g = rng.normal(size=12)
@@ -288,8 +289,8 @@ def test_output_frequency_writes_every_nth_and_the_last_increment_of_a_step(tmp_
     sparse = fm.solve(_cantilever(3), tmp_path / "sparse", progress=False)
     assert sparse.steps == ["initial"] + ["load"] * 4 + ["back"] * 4
     assert sparse.scalar_history("increment").tolist() == [0, 3, 6, 9, 10, 1, 2, 3, 4]
-    same = [0, 3, 6, 9, 10, 11, 12, 13, 14]   # the frames of the every-increment run at those increments
-    for i, j in enumerate(same):              # the solution does not depend on what is written
+    same = [0, 3, 6, 9, 10, 11, 12, 13, 14]  # the frames of the every-increment run at those increments
+    for i, j in enumerate(same):  # the solution does not depend on what is written
         np.testing.assert_array_equal(sparse.frame(i)["U"], every.frame(j)["U"])
         np.testing.assert_array_equal(sparse.frame(i)["RF"], every.frame(j)["RF"])
 
@@ -299,7 +300,7 @@ def test_a_run_that_gives_up_writes_its_last_converged_increment(tmp_path):
     with pytest.raises(ConvergenceError, match="max_increments=5"):
         fm.solve(_cantilever(3, max_increments=5), tmp_path / "sparse", progress=False)
     sparse = fm.Results(tmp_path / "sparse")
-    assert sparse.scalar_history("increment").tolist() == [0, 3, 5]    # 5: written when the step gave up
+    assert sparse.scalar_history("increment").tolist() == [0, 3, 5]  # 5: written when the step gave up
     np.testing.assert_array_equal(sparse.frame(2)["U"], every.frame(5)["U"])
     np.testing.assert_array_equal(sparse.frame(2)["RF"], every.frame(5)["RF"])
 
@@ -331,7 +332,7 @@ def test_sparse_lu_solves_matrices_inside_and_outside_the_analysed_pattern():
     s = SparseLU(ordering="mmd")
     s.factorize(A)
     b = rng.standard_normal(n)
-    np.testing.assert_allclose(s.solve(b), spla.spsolve(A.tocsc(), b), rtol=1e-12)   # well conditioned
+    np.testing.assert_allclose(s.solve(b), spla.spsolve(A.tocsc(), b), rtol=1e-12)  # well conditioned
     # a pattern inside the analysed one (entries dropped), refilled in place twice
     sub = A.copy()
     sub.data[np.abs(sub.data) < 0.3] = 0.0
@@ -341,9 +342,9 @@ def test_sparse_lu_solves_matrices_inside_and_outside_the_analysed_pattern():
         sub.data *= scale
         s.factorize(sub)
         np.testing.assert_allclose(s.solve(b), spla.spsolve(sub.tocsc(), b), rtol=1e-12)
-    assert s.analyses == 1                      # no new ordering for a sub-pattern
+    assert s.analyses == 1  # no new ordering for a sub-pattern
     # an entry outside it: the union is analysed once, then solved
-    i, j = np.argwhere(A.toarray() == 0)[0]    # a structural zero of A
+    i, j = np.argwhere(A.toarray() == 0)[0]  # a structural zero of A
     out = (A + sp.csr_matrix(([1e-3, 1e-3], ([i, j], [j, i])), shape=(n, n))).tocsr()
     assert out.nnz > A.nnz
     s.factorize(out)

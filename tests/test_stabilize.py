@@ -8,10 +8,10 @@ from scipy.optimize import fsolve
 
 import femast as fm
 
-H, A = 2.0, 1.0            # mast height, anchor offset (m)
+H, A = 2.0, 1.0  # mast height, anchor offset (m)
 EA_MAST, EA_GUY = 1e7, 2e5  # N
-SLACK = 3e-4                # guys 0.03 % longer than their initial span: slack at the start
-PX, PZ = 50.0, -400.0       # top load (N): lateral and compressive
+SLACK = 3e-4  # guys 0.03 % longer than their initial span: slack at the start
+PX, PZ = 50.0, -400.0  # top load (N): lateral and compressive
 
 
 def _guyed_mast(stabilize=None, second_step=False):
@@ -62,7 +62,7 @@ def test_stabilised_step_converges_near_equilibrium_with_small_energy_ratio():
     an = fm.Analysis(m, tempfile.mkdtemp(), progress=False)
     res = an.run()
     info = an.summary.steps[0]
-    assert 0 < info["stabilization_ratio"] < 0.05        # the 5 % bound
+    assert 0 < info["stabilization_ratio"] < 0.05  # the 5 % bound
     x_exact, z_exact = _exact_equilibrium()
     steps = res.steps
     i_stab = max(i for i, s in enumerate(steps) if s == "load")
@@ -92,16 +92,18 @@ def test_damped_tangent_keeps_the_tangents_pattern_and_equals_scipys_sum():
     an = Analysis(_guyed_mast()[0], tempfile.mkdtemp(), progress=False)
     rng = np.random.default_rng(5)
     K = sp.random(6, 6, density=0.4, random_state=5, format="csr") + sp.eye(6, format="csr")
-    K.data[::3] = 0.0                                   # explicit zeros, as early in a stabilised step
+    K.data[::3] = 0.0  # explicit zeros, as early in a stabilised step
     c = rng.random(6)
     D = an.system.plus_diagonal(K, c)
-    np.testing.assert_array_equal(D.toarray(), (K + sp.diags(c)).toarray())   # the same sums, same bits
+    np.testing.assert_array_equal(D.toarray(), (K + sp.diags(c)).toarray())  # the same sums, same bits
     assert np.array_equal(D.indptr, K.indptr) and np.array_equal(D.indices, K.indices)  # zeros kept:
-    assert D.nnz == K.nnz                                                                # one pattern
-    assert an.system.plus_diagonal(K, 2 * c) is D                                     # refilled in place
+    assert D.nnz == K.nnz  # one pattern
+    assert an.system.plus_diagonal(K, 2 * c) is D  # refilled in place
     np.testing.assert_array_equal(D.toarray(), (K + sp.diags(2 * c)).toarray())
-    K2 = sp.csr_matrix(np.triu(np.ones((4, 4)), 1))     # no diagonal entries: scipy's sum
-    np.testing.assert_array_equal(an.system.plus_diagonal(K2, np.ones(4)).toarray(), np.triu(np.ones((4, 4)), 1) + np.eye(4))
+    K2 = sp.csr_matrix(np.triu(np.ones((4, 4)), 1))  # no diagonal entries: scipy's sum
+    np.testing.assert_array_equal(
+        an.system.plus_diagonal(K2, np.ones(4)).toarray(), np.triu(np.ones((4, 4)), 1) + np.eye(4)
+    )
 
 
 def test_a_stabilised_adam_run_analyses_one_ordering():

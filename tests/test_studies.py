@@ -16,14 +16,14 @@ from femast.studies.sampling import Design
 
 # ------------------------------------------------------------------ model functions (plain formulas)
 def ishigami(x1, x2, x3, a=7.0, b=0.1):
-    return {"y": np.sin(x1) + a * np.sin(x2) ** 2 + b * x3 ** 4 * np.sin(x1)}
+    return {"y": np.sin(x1) + a * np.sin(x2) ** 2 + b * x3**4 * np.sin(x1)}
 
 
 # Ishigami indices, closed form (Sobol' & Levitan 1999; Saltelli et al. 2008, Sec. 4.4), a = 7, b = 0.1
 _A, _B = 7.0, 0.1
-_V1 = 0.5 * (1 + _B * np.pi ** 4 / 5) ** 2
-_V2 = _A ** 2 / 8
-_V13 = _B ** 2 * np.pi ** 8 * (1 / 18 - 1 / 50)
+_V1 = 0.5 * (1 + _B * np.pi**4 / 5) ** 2
+_V2 = _A**2 / 8
+_V13 = _B**2 * np.pi**8 * (1 / 18 - 1 / 50)
 _V = _V1 + _V2 + _V13
 ISHIGAMI_S1 = np.array([_V1, _V2, 0.0]) / _V
 ISHIGAMI_ST = np.array([_V1 + _V13, _V2, _V13]) / _V
@@ -42,7 +42,7 @@ def test_ishigami_closed_form_indices():
 def test_jansen_estimators_converge_to_ishigami_indices():
     # the design's own Saltelli layout, evaluated vectorised: 2^15 scrambled Sobol' base samples
     d = Design(_uniform_pi(), sampler="sobol", seed=3, sensitivity=True)
-    n = 2 ** 15
+    n = 2**15
     runs = np.arange(n * d.runs_per_sample)
     base, block, u = d.points(runs, n)
     v = d.values(u)
@@ -62,10 +62,10 @@ def test_linear_model_indices_and_intervals():
     v = d.values(u)
     y = (c[0] * v["x0"] + c[1] * v["x1"] + c[2] * v["x2"]).reshape(n, 5)
     res = st.sobol_indices(y[:, 0], y[:, 1], y[:, 2:].T, resamples=400)
-    exact = c ** 2 * s_ ** 2 / np.sum(c ** 2 * s_ ** 2)
+    exact = c**2 * s_**2 / np.sum(c**2 * s_**2)
     for k in ("S1", "ST"):
-        se = (res[k + "_high"] - res[k + "_low"]) / (2 * 1.96)     # bootstrap standard error
-        assert np.all(se < 0.05)                                   # ~1/sqrt(n) scale, not an inflated interval
+        se = (res[k + "_high"] - res[k + "_low"]) / (2 * 1.96)  # bootstrap standard error
+        assert np.all(se < 0.05)  # ~1/sqrt(n) scale, not an inflated interval
         # the error within 4 bootstrap standard errors (a false alarm: ~1e-4 per index)
         assert np.all(np.abs(res[k] - exact) < 4 * se), (k, res[k], exact, se)
 
@@ -94,9 +94,14 @@ def test_percentile_interval_matches_binomial_ranks():
 
 
 def test_distributions_and_copula():
-    n = 2 ** 14
-    ins = [st.Normal("a", 2.0, 0.5), st.Uniform("b", -1.0, 3.0), st.TruncatedNormal("c", 0.0, 1.0, low=-0.5, high=2.0),
-           st.LogNormal("d", 3.0, 0.2), st.Normal("e", 0.0, 1.0, size=4)]
+    n = 2**14
+    ins = [
+        st.Normal("a", 2.0, 0.5),
+        st.Uniform("b", -1.0, 3.0),
+        st.TruncatedNormal("c", 0.0, 1.0, low=-0.5, high=2.0),
+        st.LogNormal("d", 3.0, 0.2),
+        st.Normal("e", 0.0, 1.0, size=4),
+    ]
     d = Design(ins, sampler="sobol", seed=2, correlation={("a", "d"): 0.6})
     _, _, u = d.points(np.arange(n), n)
     v = d.values(u)
@@ -119,7 +124,7 @@ def test_points_do_not_depend_on_chunking():
         n = 50
         runs = np.arange(n * 5)
         _, _, whole = d.points(runs, n)
-        parts = np.vstack([d.points(runs[i:i + 7], n)[2] for i in range(0, len(runs), 7)])
+        parts = np.vstack([d.points(runs[i : i + 7], n)[2] for i in range(0, len(runs), 7)])
         assert np.array_equal(whole, parts), sampler
         # AB^g rows: A's columns except g's, which come from B
         u = whole.reshape(n, 5, 3)
@@ -139,7 +144,7 @@ def test_run_store_and_indices_through_the_runner(tmp_path):
     fA, fB, fAB, dropped = res.saltelli("y")
     # stored outputs are the function of the stored inputs
     x = {n: res.inputs(n) for n in ("x1", "x2", "x3")}
-    assert np.allclose(res.output("y"), ishigami(**x)["y"], rtol=0, atol=1e-12)   # float64 round trip
+    assert np.allclose(res.output("y"), ishigami(**x)["y"], rtol=0, atol=1e-12)  # float64 round trip
     assert dropped == 0 and fAB.shape == (3, 64)
 
 
@@ -150,8 +155,9 @@ def _flaky(x, level):
 
 
 def test_failures_recorded_with_their_reason(tmp_path):
-    study = st.Study(run=lambda x: _flaky(x, 0.7), inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y", "z"],
-                     sampler="mc", seed=9)
+    study = st.Study(
+        run=lambda x: _flaky(x, 0.7), inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y", "z"], sampler="mc", seed=9
+    )
     s = st.run(study, tmp_path / "f", samples=200, chunk_size=16)
     res = st.load(tmp_path / "f")
     t = res.table(["x", "status", "error"])
@@ -165,8 +171,7 @@ def test_failures_recorded_with_their_reason(tmp_path):
 
 def test_interrupt_then_resume_equals_one_run(tmp_path):
     one = st.run(_ishigami_study(sensitivity=True, sampler="mc"), tmp_path / "one", samples=40, chunk_size=9)
-    part = st.run(_ishigami_study(sensitivity=True, sampler="mc"), tmp_path / "two", samples=40, chunk_size=9,
-                  limit=57)
+    part = st.run(_ishigami_study(sensitivity=True, sampler="mc"), tmp_path / "two", samples=40, chunk_size=9, limit=57)
     assert not part.complete and part.ran == 57 and "resume" in str(part)
     rest = st.run(_ishigami_study(sensitivity=True, sampler="mc"), tmp_path / "two", samples=40, chunk_size=5)
     assert rest.complete and rest.resumed == 57 and rest.ran == 200 - 57 and one.complete
@@ -199,11 +204,15 @@ def cantilever(E, F):
 
 
 def _cantilever_study(outputs=None, **kw):
-    outs = outputs if outputs is not None else [
-        st.NodeOutput("tip_w", node=2, quantity="U", components="z"),
-        st.NodeOutput("tip_rot", node=2, quantity="URA", components="y", at="load", relative_to="initial")]
-    return st.Study(model=cantilever, inputs=[st.Normal("E", 70e9, 5e9), st.Uniform("F", 0.5, 1.5)],
-                    outputs=outs, **kw)
+    outs = (
+        outputs
+        if outputs is not None
+        else [
+            st.NodeOutput("tip_w", node=2, quantity="U", components="z"),
+            st.NodeOutput("tip_rot", node=2, quantity="URA", components="y", at="load", relative_to="initial"),
+        ]
+    )
+    return st.Study(model=cantilever, inputs=[st.Normal("E", 70e9, 5e9), st.Uniform("F", 0.5, 1.5)], outputs=outs, **kw)
 
 
 def test_model_outputs_match_the_cantilever_closed_form(tmp_path):
@@ -211,13 +220,13 @@ def test_model_outputs_match_the_cantilever_closed_form(tmp_path):
     assert s.complete and s.failed == 0
     res = st.load(tmp_path / "c")
     E, F = res.inputs("E"), res.inputs("F")
-    I = np.pi / 64 * (D_M ** 4 - (D_M - 2 * T_M) ** 4)
+    I = np.pi / 64 * (D_M**4 - (D_M - 2 * T_M) ** 4)
     w, rot = res.output("tip_w"), res.output("tip_rot")
-    assert w.shape == (6, 2)                        # (steps load, unload) of the z component
+    assert w.shape == (6, 2)  # (steps load, unload) of the z component
     # Euler-Bernoulli tip deflection F L^3 / 3EI and rotation F L^2 / 2EI; the rest is the
     # geometric nonlinearity, O((w/L)^2) ~ 1e-6 relative at these loads, and shear (d/L)^2 ~ 4e-4
-    assert np.allclose(-w[:, 0], F * L_M ** 3 / (3 * E * I), rtol=2e-3)
-    assert np.allclose(rot, F * L_M ** 2 / (2 * E * I), rtol=2e-3)
+    assert np.allclose(-w[:, 0], F * L_M**3 / (3 * E * I), rtol=2e-3)
+    assert np.allclose(rot, F * L_M**2 / (2 * E * I), rtol=2e-3)
     # unloaded: back to zero (elastic), to the correction tolerance (disp_tol 1e-6 of the unload
     # increment, the loaded deflection: since issue 21 an increment may be accepted on its predicted
     # next correction, ~1e-7 of it here, without the extra iteration that went to round-off)
@@ -225,20 +234,32 @@ def test_model_outputs_match_the_cantilever_closed_form(tmp_path):
 
 
 # ------------------------------------------------------------------ bad input, before any sample
-@pytest.mark.parametrize("make, words", [
-    (lambda: st.Normal("a", 0.0, -1.0), ["'a'", "std", "> 0"]),
-    (lambda: st.Uniform("b", 2.0, 1.0), ["'b'", "low", "below high"]),
-    (lambda: st.TruncatedNormal("c", 0.0, 1.0, low=10.0, high=11.0), ["'c'", "no probability"]),
-    (lambda: st.TruncatedNormal("c", 0.0, 1.0, low=1.0, high=0.0), ["'c'", "below high"]),
-    (lambda: st.LogNormal("d", -1.0, 0.1), ["'d'", "median", "> 0"]),
-    (lambda: st.Normal("e", float("nan"), 1.0), ["'e'", "mean", "not finite"]),
-    (lambda: st.Normal("f", 0.0, 1.0, size=0), ["'f'", "size"]),
-    (lambda: Design([st.Normal("a", 0, 1), st.Normal("b", 0, 1), st.Normal("c", 0, 1)],
-                    correlation={("a", "b"): 0.9, ("b", "c"): 0.9, ("a", "c"): -0.9}), ["not positive definite"]),
-    (lambda: Design([st.Normal("a", 0, 1)], correlation={("a", "zz"): 0.5}), ["'zz'", "not an input"]),
-    (lambda: Design([st.Normal("a", 0, 1), st.Normal("b", 0, 1)], correlation={("a", "b"): 0.5},
-                    sensitivity=True), ["independent"]),
-])
+@pytest.mark.parametrize(
+    "make, words",
+    [
+        (lambda: st.Normal("a", 0.0, -1.0), ["'a'", "std", "> 0"]),
+        (lambda: st.Uniform("b", 2.0, 1.0), ["'b'", "low", "below high"]),
+        (lambda: st.TruncatedNormal("c", 0.0, 1.0, low=10.0, high=11.0), ["'c'", "no probability"]),
+        (lambda: st.TruncatedNormal("c", 0.0, 1.0, low=1.0, high=0.0), ["'c'", "below high"]),
+        (lambda: st.LogNormal("d", -1.0, 0.1), ["'d'", "median", "> 0"]),
+        (lambda: st.Normal("e", float("nan"), 1.0), ["'e'", "mean", "not finite"]),
+        (lambda: st.Normal("f", 0.0, 1.0, size=0), ["'f'", "size"]),
+        (
+            lambda: Design(
+                [st.Normal("a", 0, 1), st.Normal("b", 0, 1), st.Normal("c", 0, 1)],
+                correlation={("a", "b"): 0.9, ("b", "c"): 0.9, ("a", "c"): -0.9},
+            ),
+            ["not positive definite"],
+        ),
+        (lambda: Design([st.Normal("a", 0, 1)], correlation={("a", "zz"): 0.5}), ["'zz'", "not an input"]),
+        (
+            lambda: Design(
+                [st.Normal("a", 0, 1), st.Normal("b", 0, 1)], correlation={("a", "b"): 0.5}, sensitivity=True
+            ),
+            ["independent"],
+        ),
+    ],
+)
 def test_impossible_distributions_are_refused(make, words):
     with pytest.raises(StudyError) as e:
         make()
@@ -249,29 +270,36 @@ def test_impossible_distributions_are_refused(make, words):
 def _never_runs(tmp_path, study, **kw):
     with pytest.raises(StudyError) as e:
         st.run(study, tmp_path / "bad", samples=4, **kw)
-    assert not list((tmp_path / "bad").glob("chunks/*.parquet"))   # no sample ran
+    assert not list((tmp_path / "bad").glob("chunks/*.parquet"))  # no sample ran
     return str(e.value)
 
 
 def test_input_matching_nothing_in_the_model(tmp_path):
-    study = st.Study(model=cantilever, inputs=[st.Normal("E", 70e9, 5e9), st.Uniform("F", 0.5, 1.5),
-                                               st.Uniform("Fx", 0.0, 1.0)],
-                     outputs=[st.NodeOutput("w", node=2)])
+    study = st.Study(
+        model=cantilever,
+        inputs=[st.Normal("E", 70e9, 5e9), st.Uniform("F", 0.5, 1.5), st.Uniform("Fx", 0.0, 1.0)],
+        outputs=[st.NodeOutput("w", node=2)],
+    )
     msg = _never_runs(tmp_path, study)
     assert "'Fx' matches nothing" in msg and "cantilever()" in msg and "E, F" in msg
     study = st.Study(model=cantilever, inputs=[st.Normal("E", 70e9, 5e9)], outputs=[st.NodeOutput("w", node=2)])
     assert "needs 'F'" in _never_runs(tmp_path, study)
 
 
-@pytest.mark.parametrize("out, words", [
-    (st.NodeOutput("w", node=99), ["'w'", "unknown node 99"]),
-    (st.NodeOutput("w", node=2, at="pull"), ["'w'", "no step 'pull'", "'load'"]),
-    (st.NodeOutput("w", node=2, relative_to="pre"), ["no step 'pre'"]),
-    (st.ElementOutput("n", family="cables", key="N"), ["'n'", "no element family 'cables'", "'beam'"]),
-    (st.ElementOutput("n", family="beam", key="axial_force"), ["'n'", "no output 'axial_force'"]),
-    (st.ElementOutput("n", family="beam", key="section_forces", component=(0, 6)), ["'n'", "component (0, 6)",
-                                                                                     "outside"]),
-])
+@pytest.mark.parametrize(
+    "out, words",
+    [
+        (st.NodeOutput("w", node=99), ["'w'", "unknown node 99"]),
+        (st.NodeOutput("w", node=2, at="pull"), ["'w'", "no step 'pull'", "'load'"]),
+        (st.NodeOutput("w", node=2, relative_to="pre"), ["no step 'pre'"]),
+        (st.ElementOutput("n", family="cables", key="N"), ["'n'", "no element family 'cables'", "'beam'"]),
+        (st.ElementOutput("n", family="beam", key="axial_force"), ["'n'", "no output 'axial_force'"]),
+        (
+            st.ElementOutput("n", family="beam", key="section_forces", component=(0, 6)),
+            ["'n'", "component (0, 6)", "outside"],
+        ),
+    ],
+)
 def test_output_that_does_not_exist(tmp_path, out, words):
     msg = _never_runs(tmp_path, _cantilever_study(outputs=[out]))
     for w in words:
@@ -297,8 +325,12 @@ def test_run_function_missing_output(tmp_path):
     msg = _never_runs(tmp_path, study)
     assert "nominal sample" in msg and "output(s) q not returned" in msg
     # missing in some samples only: those samples fail, with the reason
-    study = st.Study(run=lambda x: {"y": x, **({"q": 1.0} if x < 0.8 else {})}, inputs=[st.Uniform("x", 0, 1)],
-                     outputs=["y", "q"], sampler="mc")
+    study = st.Study(
+        run=lambda x: {"y": x, **({"q": 1.0} if x < 0.8 else {})},
+        inputs=[st.Uniform("x", 0, 1)],
+        outputs=["y", "q"],
+        sampler="mc",
+    )
     s = st.run(study, tmp_path / "m", samples=50)
     res = st.load(tmp_path / "m")
     n_bad = int(np.sum(res.table(["x"])["x"] >= 0.8))
@@ -314,12 +346,15 @@ def test_other_study_in_the_folder_is_refused(tmp_path):
 # ------------------------------------------------------------------ dask and the command line
 def _dask_same_as_serial(tmp_path, processes):
     distributed = pytest.importorskip("distributed")
-    a = st.run(_ishigami_study(sensitivity=True), tmp_path / "a", samples=16)
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=processes,
-                                  dashboard_address=None) as cl, distributed.Client(cl) as client:
+    st.run(_ishigami_study(sensitivity=True), tmp_path / "a", samples=16)
+    with (
+        distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=processes, dashboard_address=None) as cl,
+        distributed.Client(cl) as client,
+    ):
         b = st.run(_ishigami_study(sensitivity=True), tmp_path / "b", samples=16, scheduler=client)
-        c = st.run(_ishigami_study(sensitivity=True), tmp_path / "c", samples=16, scheduler=cl.scheduler_address,
-                   limit=30)
+        c = st.run(
+            _ishigami_study(sensitivity=True), tmp_path / "c", samples=16, scheduler=cl.scheduler_address, limit=30
+        )
     assert b.engine == "dask" and b.complete and b.workers == 2 and c.ran == 30
     ta = st.load(tmp_path / "a").table(["y", "x1", "block"])
     tb = st.load(tmp_path / "b").table(["y", "x1", "block"])
@@ -340,7 +375,7 @@ def test_dask_worker_processes_give_the_serial_results(tmp_path):
     _dask_same_as_serial(tmp_path, processes=True)
 
 
-STUDY_SCRIPT = '''
+STUDY_SCRIPT = """
 import numpy as np
 import femast.studies as st
 
@@ -351,7 +386,7 @@ study = st.Study(run=ishigami, inputs=[st.Uniform(n, -np.pi, np.pi) for n in ("x
                  outputs=["y"], sensitivity=True, name="ishigami")
 if __name__ == "__main__":
     raise SystemExit("the study command must not run the main block")
-'''
+"""
 
 
 def test_cli_study_runs_reports_and_resumes(tmp_path, capsys):
@@ -388,11 +423,13 @@ def test_cli_study_exits_3_when_runs_failed_also_after_a_resume(tmp_path, capsys
     script = tmp_path / "half.py"
     script.write_text(FAILING_SCRIPT)
     out = tmp_path / "res"
-    assert main(["--quiet", "study", str(script), "--samples", "16", "--workers", "1", "--out", str(out),
-                 "--no-report"]) == 3
+    assert (
+        main(["--quiet", "study", str(script), "--samples", "16", "--workers", "1", "--out", str(out), "--no-report"])
+        == 3
+    )
     cap = capsys.readouterr()
     n_failed = st.load(out).counts()["failed"]
-    assert 0 < n_failed < 16       # x > 0.5 in about half of 16 Sobol' points
+    assert 0 < n_failed < 16  # x > 0.5 in about half of 16 Sobol' points
     assert f"{n_failed} FAILED" in cap.out and f"{n_failed} run(s) FAILED; exit code 3" in cap.err
     # resuming a complete study runs nothing new, and still says the study holds failures
     assert main(["--quiet", "study", str(script), "--samples", "16", "--out", str(out), "--no-report"]) == 3
@@ -411,7 +448,7 @@ def test_cli_study_errors_are_one_line(tmp_path, capsys):
     assert "not both" in capsys.readouterr().err
 
 
-SLOW_SCRIPT = '''
+SLOW_SCRIPT = """
 import time
 import numpy as np
 import femast.studies as st
@@ -422,7 +459,7 @@ def slow(a, b):
 
 study = st.Study(run=slow, inputs=[st.Normal("a", 1.0, 0.5), st.Uniform("b", 0.0, 2.0)], outputs=["y", "v"],
                  sampler="mc", seed=3, name="slow")
-'''
+"""
 
 
 @pytest.mark.slow
@@ -439,8 +476,23 @@ def test_ctrl_c_then_resume_equals_one_run(tmp_path):
     script = tmp_path / "slow_study.py"
     script.write_text(SLOW_SCRIPT)
     out = tmp_path / "interrupted"
-    cmd = [sys.executable, "-m", "femast.cli", "--quiet", "study", str(script), "--samples", "600", "--workers", "2",
-           "--chunk-size", "10", "--out", str(out), "--no-report"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "femast.cli",
+        "--quiet",
+        "study",
+        str(script),
+        "--samples",
+        "600",
+        "--workers",
+        "2",
+        "--chunk-size",
+        "10",
+        "--out",
+        str(out),
+        "--no-report",
+    ]
     env = dict(__import__("os").environ, PYTHONPATH=str(Path(fm.__file__).resolve().parents[1]))
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     t0 = time.time()
@@ -450,13 +502,25 @@ def test_ctrl_c_then_resume_equals_one_run(tmp_path):
     _, err = p.communicate(timeout=60)
     assert p.returncode == 130 and "interrupted" in err, err
     partial = st.load(out).counts()["runs"]
-    assert 0 < partial < 600                                   # stopped part-way
+    assert 0 < partial < 600  # stopped part-way
     r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
     assert r.returncode == 0 and f"({partial} already on disk)" in r.stdout and "study complete" in r.stdout, r.stderr
-    one = st.run(st.Study(run=_slow_local, inputs=[st.Normal("a", 1.0, 0.5), st.Uniform("b", 0.0, 2.0)],
-                          outputs=["y", "v"], sampler="mc", seed=3, name="slow"), tmp_path / "one", samples=600)
-    a, b = st.load(tmp_path / "one").table(["a", "b", "y", "v", "status"]), st.load(out).table(["a", "b", "y", "v",
-                                                                                                  "status"])
+    st.run(
+        st.Study(
+            run=_slow_local,
+            inputs=[st.Normal("a", 1.0, 0.5), st.Uniform("b", 0.0, 2.0)],
+            outputs=["y", "v"],
+            sampler="mc",
+            seed=3,
+            name="slow",
+        ),
+        tmp_path / "one",
+        samples=600,
+    )
+    a, b = (
+        st.load(tmp_path / "one").table(["a", "b", "y", "v", "status"]),
+        st.load(out).table(["a", "b", "y", "v", "status"]),
+    )
     for k in a:
         assert np.array_equal(a[k], b[k]), k
 
@@ -484,14 +548,29 @@ def test_more_samples_later_extend_the_same_study(tmp_path):
 def test_report_names_steps_and_components(tmp_path, capsys):
     from femast.studies.report import report
 
-    st.run(_cantilever_study(outputs=[st.NodeOutput("tip", node=2, quantity="U", components=["x", "z"]),
-                                      st.ElementOutput("m_max", family="beam", key="section_forces",
-                                                       component=(slice(None), slice(4, 6)), reduce="absmax",
-                                                       at="load", unit="N m")]),
-           tmp_path / "r", samples=4)
+    st.run(
+        _cantilever_study(
+            outputs=[
+                st.NodeOutput("tip", node=2, quantity="U", components=["x", "z"]),
+                st.ElementOutput(
+                    "m_max",
+                    family="beam",
+                    key="section_forces",
+                    component=(slice(None), slice(4, 6)),
+                    reduce="absmax",
+                    at="load",
+                    unit="N m",
+                ),
+            ]
+        ),
+        tmp_path / "r",
+        samples=4,
+    )
     res = st.load(tmp_path / "r")
-    assert res.component_label("tip", (0, 1)) == "tip[load, uz]" and res.component_label("tip", (1, 0)) == \
-        "tip[unload, ux]"
+    assert (
+        res.component_label("tip", (0, 1)) == "tip[load, uz]"
+        and res.component_label("tip", (1, 0)) == "tip[unload, ux]"
+    )
     rep = report(tmp_path / "r", print_table=True, figures=False)
     out = capsys.readouterr().out
     assert "tip[load, uz]" in out and "m_max" in out
@@ -505,7 +584,7 @@ def _dies(x):
     if x > 0.9:
         import os
 
-        os._exit(3)   # a worker process dying (a crash in compiled code, the OOM killer)
+        os._exit(3)  # a worker process dying (a crash in compiled code, the OOM killer)
     return {"y": x}
 
 
@@ -514,12 +593,12 @@ def test_a_dying_worker_process_is_a_clear_error_and_resumable(tmp_path):
     with pytest.raises(StudyError, match="a worker process died"):
         st.run(study, tmp_path / "d", samples=200, workers=2, chunk_size=5)
     done = st.load(tmp_path / "d").counts()["runs"]
-    assert done < 200   # what finished is kept (and a rerun resumes from it)
+    assert done < 200  # what finished is kept (and a rerun resumes from it)
 
 
 def test_sobol_convergence_approaches_the_ishigami_indices():
     d = Design(_uniform_pi(), sampler="sobol", seed=3, sensitivity=True)
-    n = 2 ** 13
+    n = 2**13
     _, _, u = d.points(np.arange(n * 5), n)
     y = ishigami(**d.values(u))["y"].reshape(n, 5)
     c = st.sobol_convergence(y[:, 0], y[:, 1], y[:, 2:].T)
@@ -542,15 +621,16 @@ def test_statistics_refuse_what_they_cannot_estimate():
         st.sobol_indices(np.ones(8), np.ones(8), np.ones((2, 8)))
     with pytest.raises(StudyError, match=r"\(k, n\)"):
         st.sobol_indices(np.arange(8.0), np.arange(8.0), np.ones((2, 7)))
-    p = st.percentile(np.arange(10.0), 0.99)   # 10 samples cannot bound the 99 % percentile from above
+    p = st.percentile(np.arange(10.0), 0.99)  # 10 samples cannot bound the 99 % percentile from above
     assert np.isnan(p["high"]) and p["low"] <= p["estimate"]
 
 
 def test_report_of_a_study_whose_samples_all_failed(tmp_path, capsys):
     from femast.studies.report import report
 
-    study = st.Study(run=lambda x: _flaky(x, -1.0), inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y", "z"],
-                     units={"y": "m"})
+    study = st.Study(
+        run=lambda x: _flaky(x, -1.0), inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y", "z"], units={"y": "m"}
+    )
     # the nominal sample fails by non-convergence (not a definition error): the study runs, every sample fails
     s = st.run(study, tmp_path / "f", samples=4)
     assert s.failed == 4 and s.ok == 0
@@ -562,7 +642,7 @@ def _sometimes_slow(x):
     if x > 0.8:
         import time
 
-        time.sleep(5.0)   # a sample that struggles (cutbacks, a hang)
+        time.sleep(5.0)  # a sample that struggles (cutbacks, a hang)
     return {"y": x}
 
 
@@ -570,15 +650,16 @@ def _sometimes_slow(x):
 def test_samples_over_the_timeout_are_recorded_failed(tmp_path, workers):
     import time
 
-    study = st.Study(run=_sometimes_slow, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], sampler="mc", seed=2,
-                     timeout_s=0.3)
+    study = st.Study(
+        run=_sometimes_slow, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], sampler="mc", seed=2, timeout_s=0.3
+    )
     t0 = time.perf_counter()
     s = st.run(study, tmp_path / "t", samples=20, workers=workers)
     res = st.load(tmp_path / "t")
     n_slow = int(np.sum(res.table(["x"])["x"] > 0.8))
     assert n_slow > 0 and s.failed == n_slow and s.ok == 20 - n_slow
     assert all("SampleTimeout: the sample ran over timeout_s = 0.3 s" in r for _, r in res.failures())
-    assert time.perf_counter() - t0 < 5.0 * n_slow / workers   # the slow samples were cut short
+    assert time.perf_counter() - t0 < 5.0 * n_slow / workers  # the slow samples were cut short
     with pytest.raises(StudyError, match="timeout_s"):
         st.Study(run=_sometimes_slow, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], timeout_s=0)
 
@@ -592,7 +673,8 @@ def _slow_cantilever(F):
     m.fix(a)
     inc = 1e-4 if F > 1.3 else 0.5
     m.step("load", initial_increment=inc, max_increment=inc, max_increments=20000, output_frequency=20000).load(
-        b, fz=-F)
+        b, fz=-F
+    )
     return m
 
 
@@ -615,12 +697,12 @@ def test_deadline_stops_an_analysis_in_a_thread_and_costs_nothing_without_one():
         out["t"] = time.perf_counter() - t0
         out["after"] = remaining()
 
-    th = threading.Thread(target=job)   # not the main thread: no SIGALRM could reach it
+    th = threading.Thread(target=job)  # not the main thread: no SIGALRM could reach it
     th.start()
     th.join(60)
     assert out["err"] == "stopped: over 0.3 s"
-    assert out["t"] < 3.0           # stopped at an iteration after 0.3 s; unstopped: 10 000 increments, 6 s
-    assert out["after"] is None     # the deadline ends with its block
+    assert out["t"] < 3.0  # stopped at an iteration after 0.3 s; unstopped: 10 000 increments, 6 s
+    assert out["after"] is None  # the deadline ends with its block
     # nested: the earlier deadline holds
     with deadline(10.0):
         with deadline(100.0):
@@ -628,31 +710,38 @@ def test_deadline_stops_an_analysis_in_a_thread_and_costs_nothing_without_one():
     with pytest.raises(fm.ModelError, match="must be > 0"):
         with deadline(0.0):
             pass
-    check()   # no deadline: nothing
+    check()  # no deadline: nothing
     n = 200_000
     t0 = time.perf_counter()
     for _ in range(n):
         check()
     per_call = (time.perf_counter() - t0) / n
-    assert per_call < 5e-6    # 0.1-0.2 us measured; an iteration of this 2-beam model takes ~300 us
+    assert per_call < 5e-6  # 0.1-0.2 us measured; an iteration of this 2-beam model takes ~300 us
 
 
 def test_timeout_on_dask_thread_workers_records_the_slow_samples_failed(tmp_path):
     import time
 
     distributed = pytest.importorskip("distributed")
-    study = st.Study(model=_slow_cantilever, inputs=[st.Uniform("F", 0.5, 1.5)],
-                     outputs=[st.NodeOutput("tip_w", node=2, quantity="U", components="z")],
-                     sampler="mc", seed=3, timeout_s=0.5)
+    study = st.Study(
+        model=_slow_cantilever,
+        inputs=[st.Uniform("F", 0.5, 1.5)],
+        outputs=[st.NodeOutput("tip_w", node=2, quantity="U", components="z")],
+        sampler="mc",
+        seed=3,
+        timeout_s=0.5,
+    )
     t0 = time.perf_counter()
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cl, distributed.Client(cl) as client:
+    with (
+        distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cl,
+        distributed.Client(cl) as client,
+    ):
         s = st.run(study, tmp_path / "d", samples=12, scheduler=client)
     res = st.load(tmp_path / "d")
     n_slow = int(np.sum(res.table(["F"])["F"] > 1.3))
     assert s.engine == "dask" and n_slow > 0 and s.failed == n_slow and s.ok == 12 - n_slow
     assert all("SampleTimeout: the sample ran over timeout_s = 0.5 s" in r for _, r in res.failures())
-    assert time.perf_counter() - t0 < 60.0   # unstopped, each slow sample runs 10 000 increments
+    assert time.perf_counter() - t0 < 60.0  # unstopped, each slow sample runs 10 000 increments
 
 
 # ------------------------------------------------------------------ correlation between the members of one input
@@ -660,7 +749,7 @@ def test_member_equicorrelation_and_exponential_correlation_are_sampled():
     """Normal scores of the members carry the stated correlation; marginals unchanged.  n = 2^14
     points: the standard error of a sample correlation is (1 - rho^2) / sqrt(n) <= 0.008, so 0.03
     is ~4 standard errors (0.02 for the KS distance, ~1.4 / sqrt(n) = 0.011 at 95 %)."""
-    n = 2 ** 14
+    n = 2**14
     rho = 0.6
     x = st.Normal("dL", 0.0, 2.0, size=5, member_correlation=rho)
     d = Design([x, st.Uniform("mu", 0.0, 1.0)], sampler="sobol", seed=4)
@@ -690,7 +779,7 @@ def test_member_equicorrelation_and_exponential_correlation_are_sampled():
 def test_member_correlation_holds_in_every_saltelli_block_and_keeps_indices_defined():
     """With sensitivity the group's columns are swapped together (A, B, AB:x), so every block has the
     correlation; the Sobol' indices of the groups stay those of independent groups."""
-    n = 2 ** 12
+    n = 2**12
     x = st.Normal("a", 0.0, 1.0, size=3, member_correlation=0.5)
     d = Design([x, st.Normal("b", 0.0, 1.0)], sampler="sobol", seed=2, sensitivity=True)
     runs = np.arange(n * d.runs_per_sample)
@@ -698,28 +787,33 @@ def test_member_correlation_holds_in_every_saltelli_block_and_keeps_indices_defi
     v = d.values(u)["a"]
     for j in range(d.runs_per_sample):
         C = np.corrcoef(v[block == j].T)
-        assert np.abs(C[~np.eye(3, dtype=bool)] - 0.5).max() < 0.05    # n = 4096: 4 standard errors
+        assert np.abs(C[~np.eye(3, dtype=bool)] - 0.5).max() < 0.05  # n = 4096: 4 standard errors
     # Y = sum of the members + b: Var(sum) = 3 + 6 * 0.5 = 6, Var(b) = 1 -> S_a = 6/7, S_b = 1/7
     vals = d.values(u)
     y = vals["a"].sum(axis=1) + vals["b"]
     fA, fB = y[block == 0], y[block == 1]
     fAB = np.stack([y[block == 2], y[block == 3]])
     idx = st.sobol_indices(fA, fB, fAB, ["a", "b"])
-    np.testing.assert_allclose(idx["S1"], [6 / 7, 1 / 7], atol=0.03)   # 4096 Sobol' samples: bootstrap se ~0.008
+    np.testing.assert_allclose(idx["S1"], [6 / 7, 1 / 7], atol=0.03)  # 4096 Sobol' samples: bootstrap se ~0.008
     np.testing.assert_allclose(idx["ST"], [6 / 7, 1 / 7], atol=0.03)
 
 
-@pytest.mark.parametrize("make, words", [
-    (lambda: st.Normal("a", 0, 1, member_correlation=0.5), ["'a'", "per-member input"]),
-    (lambda: st.Normal("a", 0, 1, size=4, member_correlation=-0.5), ["'a'", "(-0.3333, 1)", "4 members"]),
-    (lambda: st.Normal("a", 0, 1, size=4, member_correlation=1.0), ["'a'", "must lie in"]),
-    (lambda: st.Normal("a", 0, 1, size=3, member_correlation=float("nan")), ["'a'", "not finite"]),
-    (lambda: st.Normal("a", 0, 1, size=3, member_correlation=np.eye(2)), ["'a'", "(3, 3)", "(2, 2)"]),
-    (lambda: st.Uniform("a", 0, 1, size=2, member_correlation=[[1, 0.5], [0.4, 1]]), ["symmetric"]),
-    (lambda: st.Uniform("a", 0, 1, size=3, member_correlation=[[1, .9, -.9], [.9, 1, .9], [-.9, .9, 1]]),
-     ["not positive definite"]),
-    (lambda: st.exponential_correlation([0.0, 1.0], 0.0), ["length", "> 0"]),
-])
+@pytest.mark.parametrize(
+    "make, words",
+    [
+        (lambda: st.Normal("a", 0, 1, member_correlation=0.5), ["'a'", "per-member input"]),
+        (lambda: st.Normal("a", 0, 1, size=4, member_correlation=-0.5), ["'a'", "(-0.3333, 1)", "4 members"]),
+        (lambda: st.Normal("a", 0, 1, size=4, member_correlation=1.0), ["'a'", "must lie in"]),
+        (lambda: st.Normal("a", 0, 1, size=3, member_correlation=float("nan")), ["'a'", "not finite"]),
+        (lambda: st.Normal("a", 0, 1, size=3, member_correlation=np.eye(2)), ["'a'", "(3, 3)", "(2, 2)"]),
+        (lambda: st.Uniform("a", 0, 1, size=2, member_correlation=[[1, 0.5], [0.4, 1]]), ["symmetric"]),
+        (
+            lambda: st.Uniform("a", 0, 1, size=3, member_correlation=[[1, 0.9, -0.9], [0.9, 1, 0.9], [-0.9, 0.9, 1]]),
+            ["not positive definite"],
+        ),
+        (lambda: st.exponential_correlation([0.0, 1.0], 0.0), ["length", "> 0"]),
+    ],
+)
 def test_bad_member_correlation_is_named(make, words):
     with pytest.raises(StudyError) as e:
         make()
@@ -750,6 +844,6 @@ def test_first_order_indices_do_not_depend_on_the_output_mean():
     for c in (0.0, 1000.0):
         y = c + v["a"] + 0.5 * v["b"]
         out.append(st.sobol_indices(y[block == 0], y[block == 1], np.stack([y[block == 2], y[block == 3]])))
-    np.testing.assert_allclose(out[1]["S1"], out[0]["S1"], rtol=0, atol=1e-9)   # round-off of the offset
-    np.testing.assert_allclose(out[1]["S1"], [0.8, 0.2], atol=0.1)   # 512 MC samples: ~3 standard errors
+    np.testing.assert_allclose(out[1]["S1"], out[0]["S1"], rtol=0, atol=1e-9)  # round-off of the offset
+    np.testing.assert_allclose(out[1]["S1"], [0.8, 0.2], atol=0.1)  # 512 MC samples: ~3 standard errors
     assert np.all(out[1]["S1_high"] - out[1]["S1_low"] < 0.5)

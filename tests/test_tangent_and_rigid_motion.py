@@ -20,12 +20,19 @@ def _random_beams(rng, n=6):
     nodes = np.arange(2 * n).reshape(n, 2)
     E0 = np.array([element_frame(X[a], X[b], rng.normal(size=3)) for a, b in nodes])
     l0 = np.linalg.norm(X[nodes[:, 1]] - X[nodes[:, 0]], axis=1)
-    fam = BeamFamily(nodes, E0, l0, EA=rng.uniform(1e2, 1e3, n), GJ=rng.uniform(1, 5, n),
-                     EIy=rng.uniform(1, 5, n), EIz=rng.uniform(1, 5, n))
+    fam = BeamFamily(
+        nodes,
+        E0,
+        l0,
+        EA=rng.uniform(1e2, 1e3, n),
+        GJ=rng.uniform(1, 5, n),
+        EIy=rng.uniform(1, 5, n),
+        EIz=rng.uniform(1, 5, n),
+    )
     # large rigid motion plus moderate deformation
     x = np.empty_like(X)
     R = np.empty((2 * n, 3, 3))
-    for e, (a, b) in enumerate(nodes):
+    for _e, (a, b) in enumerate(nodes):
         Q = expm_so3(rng.normal(size=3) * 2.5)
         c = rng.normal(size=3)
         x[a] = Q @ X[a] + c + 0.05 * rng.normal(size=3)
@@ -46,8 +53,9 @@ def test_rotation_maps_against_finite_differences():
         spin = np.array([W[2, 1], W[0, 2], W[1, 0]])
         # Ts^-1 maps the spin back to dtheta; FD error O(h^2) ~ 1e-11
         np.testing.assert_allclose(ts_inv(th) @ spin, d, atol=1e-8)
-        np.testing.assert_allclose(logm_so3(expm_so3(th)), th if np.linalg.norm(th) < math.pi else logm_so3(expm_so3(th)),
-                                   atol=1e-13)
+        np.testing.assert_allclose(
+            logm_so3(expm_so3(th)), th if np.linalg.norm(th) < math.pi else logm_so3(expm_so3(th)), atol=1e-13
+        )
         m = rng.normal(size=3)
         K = ts_inv_T_times_derivative(th, m)
         Kfd = np.column_stack([(ts_inv(th + h * e).T @ m - ts_inv(th - h * e).T @ m) / (2 * h) for e in np.eye(3)])
@@ -162,8 +170,8 @@ def test_small_rotation_logarithm_agrees_with_atan2_form():
         ref = logm_so3(R)
         got = small(R)
         if t > 0.0201:
-            assert np.array_equal(got, ref)       # the atan2 form itself
+            assert np.array_equal(got, ref)  # the atan2 form itself
         else:
-            assert np.abs(got - ref).max() <= 1e-15 * np.abs(ref).max()   # a few ulps: round-off of one quaternion
-            assert np.abs(got - v).max() <= 2e-15 * t                        # and of the exact vector
+            assert np.abs(got - ref).max() <= 1e-15 * np.abs(ref).max()  # a few ulps: round-off of one quaternion
+            assert np.abs(got - v).max() <= 2e-15 * t  # and of the exact vector
     assert np.array_equal(small(np.eye(3)), np.zeros(3))

@@ -47,4 +47,4 @@ def test_spring_tangent_matches_finite_differences(page):
     R = np.array([expm_so3(rng.normal(size=3)), expm_so3(rng.normal(size=3))])
     K = fam.evaluate(x, R, None).k[0]
     Kfd = fd_tangent(fam, x, R)[0]
-    assert np.abs(K - Kfd).max() <= 1e-6 * np.abs(K).max()   # central FD, h = 1e-6: ~1e-10
+    assert np.abs(K - Kfd).max() <= 1e-6 * np.abs(K).max()  # central FD, h = 1e-6: ~1e-10

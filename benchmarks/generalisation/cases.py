@@ -21,8 +21,18 @@ import numpy as np
 
 from . import mechanisms as mech
 from . import noise as nz
-from .rigs import (K_JOINTS, LATCH, hold_force, joint_moments, latch_law, latch_path, mast_path, roller_opening,
-                   top_translation, viscous_joint)
+from .rigs import (
+    K_JOINTS,
+    LATCH,
+    hold_force,
+    joint_moments,
+    latch_law,
+    latch_path,
+    mast_path,
+    roller_opening,
+    top_translation,
+    viscous_joint,
+)
 
 SIGMA_TRACKER_M = 50e-6  # laser tracker noise per axis (m), mast top
 SIGMA_LOADCELL_N = 0.5  # load cell noise (N), latch pull
@@ -56,104 +66,351 @@ def _m(name, form, **params):
 # moments in N m, rotations in rad (mast top); forces in N, positions in m (latch pull)
 CASES = (
     # ---------------------------------------------------------------- mast top, one mechanism
-    Case("mt_friction_dahl", "mast-top", "effect", ("friction_hysteresis",),
-         (_m("friction", "dahl", F_c=8.0, sigma=3e5, alpha=1.0),), level=0.5, doc="Dahl joint friction, smooth loops"),
-    Case("mt_friction_boucwen", "mast-top", "effect", ("friction_hysteresis",),
-         (_m("friction", "boucwen", F_y=10.0, u_y=5e-5, n=2.0),), path="biaxial", n=400, level=0.5,
-         doc="Bouc-Wen joint friction, biaxial excursions"),
-    Case("mt_friction_jenkins", "mast-top", "effect", ("friction_hysteresis",),
-         (_m("friction", "jenkins", k_s=2.5e5, F_s=7.0),), noise="ar1", n=600, level=0.5,
-         doc="elasto-slip joint (finite stick stiffness), AR(1) noise"),
-    Case("mt_clearance_tanh", "mast-top", "effect", ("joint_clearance",),
-         (_m("clearance", "tanh", c=1.0e-4, m0=3.0),), doc="clearance closing smoothly over ~10 % of the load"),
-    Case("mt_clearance_hertz", "mast-top", "effect", ("joint_clearance",),
-         (_m("clearance", "hertz", c=0.5e-4, k0=2e4, K=5.7e7),), noise="hetero", n=300,
-         doc="play then Hertzian contact, heteroscedastic noise, 300 samples"),
-    Case("mt_clearance_piecewise", "mast-top", "effect", ("joint_clearance",),
-         (_m("clearance", "piecewise", c=0.5e-4, k0=2.5e4, k1=5e6),), level=0.4, n=800,
-         doc="play with a soft inner spring then linear contact, low noise, 800 samples"),
-    Case("mt_progressive_duffing", "mast-top", "effect", ("progressive_stiffness",),
-         (_m("stiffening", "duffing", k3_rel=1.0e8),), amp=40.0, level=0.7, doc="cubic hardening of the joints"),
-    Case("mt_progressive_asinh", "mast-top", "effect", ("progressive_stiffness",),
-         (_m("stiffening", "asinh", m0=6.0),), noise="ar1", n=400, amp=40.0, level=0.7,
-         doc="tangent stiffness growing with the load, AR(1) noise"),
-    Case("mt_cable_loop_quadratic", "mast-top", "effect", ("cable_hysteresis",),
-         (_m("cable_loop", "quadratic", eps=1.0),), amp=20.0, level=0.7, doc="shroud loop closing at zero, quadratic return"),
-    Case("mt_cable_loop_power", "mast-top", "effect", ("cable_hysteresis",),
-         (_m("cable_loop", "power", eps=1.0),), noise="hetero", amp=20.0, level=0.7, doc="shroud loop, power-law return branch"),
-    Case("mt_pretension_exp", "mast-top", "effect", ("pretension_loss",),
-         (_m("drift", "exp", lam=0.6, tau0=0.3),), path="onesided", amp=20.0, level=0.6, doc="creep relaxation of the shrouds"),
-    Case("mt_pretension_step", "mast-top", "effect", ("pretension_loss",),
-         (_m("drift", "step", lam=0.5),), noise="ar1", amp=20.0, doc="a shroud slips in its grip half-way"),
-    Case("mt_beam_timoshenko", "mast-top", "effect", ("beam_flexibility",),
-         (_m("beam", "timoshenko", EI=0.8e5, GA=2e5),), path="moments",
-         doc="lattice mast as a Timoshenko beam (bending + shear), top moments in the path"),
-    Case("mt_beam_stepped", "mast-top", "effect", ("beam_flexibility",),
-         (_m("beam", "stepped", EI1=3e5, EI2=0.5e5, L1=2.0),), path="moments", n=400,
-         doc="two-section (telescopic) beam, top moments in the path"),
+    Case(
+        "mt_friction_dahl",
+        "mast-top",
+        "effect",
+        ("friction_hysteresis",),
+        (_m("friction", "dahl", F_c=8.0, sigma=3e5, alpha=1.0),),
+        level=0.5,
+        doc="Dahl joint friction, smooth loops",
+    ),
+    Case(
+        "mt_friction_boucwen",
+        "mast-top",
+        "effect",
+        ("friction_hysteresis",),
+        (_m("friction", "boucwen", F_y=10.0, u_y=5e-5, n=2.0),),
+        path="biaxial",
+        n=400,
+        level=0.5,
+        doc="Bouc-Wen joint friction, biaxial excursions",
+    ),
+    Case(
+        "mt_friction_jenkins",
+        "mast-top",
+        "effect",
+        ("friction_hysteresis",),
+        (_m("friction", "jenkins", k_s=2.5e5, F_s=7.0),),
+        noise="ar1",
+        n=600,
+        level=0.5,
+        doc="elasto-slip joint (finite stick stiffness), AR(1) noise",
+    ),
+    Case(
+        "mt_clearance_tanh",
+        "mast-top",
+        "effect",
+        ("joint_clearance",),
+        (_m("clearance", "tanh", c=1.0e-4, m0=3.0),),
+        doc="clearance closing smoothly over ~10 % of the load",
+    ),
+    Case(
+        "mt_clearance_hertz",
+        "mast-top",
+        "effect",
+        ("joint_clearance",),
+        (_m("clearance", "hertz", c=0.5e-4, k0=2e4, K=5.7e7),),
+        noise="hetero",
+        n=300,
+        doc="play then Hertzian contact, heteroscedastic noise, 300 samples",
+    ),
+    Case(
+        "mt_clearance_piecewise",
+        "mast-top",
+        "effect",
+        ("joint_clearance",),
+        (_m("clearance", "piecewise", c=0.5e-4, k0=2.5e4, k1=5e6),),
+        level=0.4,
+        n=800,
+        doc="play with a soft inner spring then linear contact, low noise, 800 samples",
+    ),
+    Case(
+        "mt_progressive_duffing",
+        "mast-top",
+        "effect",
+        ("progressive_stiffness",),
+        (_m("stiffening", "duffing", k3_rel=1.0e8),),
+        amp=40.0,
+        level=0.7,
+        doc="cubic hardening of the joints",
+    ),
+    Case(
+        "mt_progressive_asinh",
+        "mast-top",
+        "effect",
+        ("progressive_stiffness",),
+        (_m("stiffening", "asinh", m0=6.0),),
+        noise="ar1",
+        n=400,
+        amp=40.0,
+        level=0.7,
+        doc="tangent stiffness growing with the load, AR(1) noise",
+    ),
+    Case(
+        "mt_cable_loop_quadratic",
+        "mast-top",
+        "effect",
+        ("cable_hysteresis",),
+        (_m("cable_loop", "quadratic", eps=1.0),),
+        amp=20.0,
+        level=0.7,
+        doc="shroud loop closing at zero, quadratic return",
+    ),
+    Case(
+        "mt_cable_loop_power",
+        "mast-top",
+        "effect",
+        ("cable_hysteresis",),
+        (_m("cable_loop", "power", eps=1.0),),
+        noise="hetero",
+        amp=20.0,
+        level=0.7,
+        doc="shroud loop, power-law return branch",
+    ),
+    Case(
+        "mt_pretension_exp",
+        "mast-top",
+        "effect",
+        ("pretension_loss",),
+        (_m("drift", "exp", lam=0.6, tau0=0.3),),
+        path="onesided",
+        amp=20.0,
+        level=0.6,
+        doc="creep relaxation of the shrouds",
+    ),
+    Case(
+        "mt_pretension_step",
+        "mast-top",
+        "effect",
+        ("pretension_loss",),
+        (_m("drift", "step", lam=0.5),),
+        noise="ar1",
+        amp=20.0,
+        doc="a shroud slips in its grip half-way",
+    ),
+    Case(
+        "mt_beam_timoshenko",
+        "mast-top",
+        "effect",
+        ("beam_flexibility",),
+        (_m("beam", "timoshenko", EI=0.8e5, GA=2e5),),
+        path="moments",
+        doc="lattice mast as a Timoshenko beam (bending + shear), top moments in the path",
+    ),
+    Case(
+        "mt_beam_stepped",
+        "mast-top",
+        "effect",
+        ("beam_flexibility",),
+        (_m("beam", "stepped", EI1=3e5, EI2=0.5e5, L1=2.0),),
+        path="moments",
+        n=400,
+        doc="two-section (telescopic) beam, top moments in the path",
+    ),
     # ---------------------------------------------------------------- mast top, pairs and out of library
-    Case("mt_pair_clearance_friction", "mast-top", "pair", ("joint_clearance", "friction_hysteresis"),
-         (_m("clearance", "tanh", c=0.6e-4, m0=5.0), _m("friction", "jenkins", k_s=3e5, F_s=7.0)),
-         doc="smooth clearance and elasto-slip friction together"),
-    Case("mt_pair_stiffening_pretension", "mast-top", "pair", ("progressive_stiffness", "pretension_loss"),
-         (_m("stiffening", "duffing", k3_rel=1.0e8), _m("drift", "exp", lam=0.5, tau0=0.3)), amp=30.0,
-         doc="hardening joints and a pretension creeping away"),
-    Case("mt_ool_thermal_drift", "mast-top", "ool", (),
-         (_m("thermal", "sine", A=0.25e-3, cycles=1.3),), doc="thermal drift of the top, independent of the load"),
-    Case("mt_ool_viscous", "mast-top", "ool", (),
-         (_m("viscous", "kelvin", T=6.0),), path="variable_rate",
-         doc="viscous (rate-dependent) joints, slow and fast cycles"),
+    Case(
+        "mt_pair_clearance_friction",
+        "mast-top",
+        "pair",
+        ("joint_clearance", "friction_hysteresis"),
+        (_m("clearance", "tanh", c=0.6e-4, m0=5.0), _m("friction", "jenkins", k_s=3e5, F_s=7.0)),
+        doc="smooth clearance and elasto-slip friction together",
+    ),
+    Case(
+        "mt_pair_stiffening_pretension",
+        "mast-top",
+        "pair",
+        ("progressive_stiffness", "pretension_loss"),
+        (_m("stiffening", "duffing", k3_rel=1.0e8), _m("drift", "exp", lam=0.5, tau0=0.3)),
+        amp=30.0,
+        doc="hardening joints and a pretension creeping away",
+    ),
+    Case(
+        "mt_ool_thermal_drift",
+        "mast-top",
+        "ool",
+        (),
+        (_m("thermal", "sine", A=0.25e-3, cycles=1.3),),
+        doc="thermal drift of the top, independent of the load",
+    ),
+    Case(
+        "mt_ool_viscous",
+        "mast-top",
+        "ool",
+        (),
+        (_m("viscous", "kelvin", T=6.0),),
+        path="variable_rate",
+        doc="viscous (rate-dependent) joints, slow and fast cycles",
+    ),
     # ---------------------------------------------------------------- latch pull, one mechanism
-    Case("lp_friction_dahl", "latch-pull", "effect", ("friction_hysteresis",),
-         (_m("friction", "dahl", F_c=3.0, sigma=4e4, alpha=1.0),), noise="eq15",
-         doc="Dahl friction of the bead/cable, Eq. 15 noise"),
-    Case("lp_friction_jenkins", "latch-pull", "effect", ("friction_hysteresis",),
-         (_m("friction", "jenkins", k_s=5e4, F_s=3.0),), doc="elasto-slip friction"),
-    Case("lp_friction_boucwen", "latch-pull", "effect", ("friction_hysteresis",),
-         (_m("friction", "boucwen", F_y=3.0, u_y=8e-5, n=2.0),), noise="ar1", n=450,
-         doc="Bouc-Wen friction, AR(1) load-cell noise"),
-    Case("lp_latch_band_gauss", "latch-pull", "effect", ("latch_hysteresis",),
-         (_m("latch_band", "gauss", F_h=8.0, ell=4e-4),), noise="eq15", doc="seated-bead band, Gaussian fade"),
-    Case("lp_latch_band_linear", "latch-pull", "effect", ("latch_hysteresis",),
-         (_m("latch_band", "linear", F_h=7.0, ell=6e-4),), doc="seated-bead band, linear fade"),
-    Case("lp_latch_band_lorentz", "latch-pull", "effect", ("latch_hysteresis",),
-         (_m("latch_band", "lorentz", F_h=8.0, ell=2.5e-4),), noise="eq15", n=320,
-         doc="seated-bead band, Lorentzian fade, 320 samples"),
-    Case("lp_clearance_tanh", "latch-pull", "effect", ("joint_clearance",),
-         (_m("clearance", "tanh", c=8e-5, m0=3.0),), noise="eq15", doc="latch body play, smooth"),
-    Case("lp_clearance_piecewise", "latch-pull", "effect", ("joint_clearance",),
-         (_m("clearance", "piecewise", c=8e-5, k0=3.75e4, k1=1e7),), level=0.5, n=700,
-         doc="latch body play, piecewise-linear contact, low noise"),
-    Case("lp_stretch_quadratic", "latch-pull", "effect", ("stretch_error",),
-         (_m("stretch", "quadratic", eps=0.6, T_ref=30.0),), noise="eq15",
-         doc="stiffening cable, linear stretch removed by Eq. 15"),
-    Case("lp_stretch_twoslope", "latch-pull", "effect", ("stretch_error",),
-         (_m("stretch", "twoslope", eps_pos=0.8, eps_neg=0.2),),
-         doc="the two pulling cables' compliances wrong by different amounts"),
-    Case("lp_cable_loop_quadratic", "latch-pull", "effect", ("cable_hysteresis",),
-         (_m("cable_loop", "quadratic", eps=0.6, C_h=1e-5),), noise="eq15", doc="cable stretch loop"),
-    Case("lp_cable_loop_power", "latch-pull", "effect", ("cable_hysteresis",),
-         (_m("cable_loop", "power", eps=0.7, C_h=1e-5),), doc="cable stretch loop, power-law return"),
+    Case(
+        "lp_friction_dahl",
+        "latch-pull",
+        "effect",
+        ("friction_hysteresis",),
+        (_m("friction", "dahl", F_c=3.0, sigma=4e4, alpha=1.0),),
+        noise="eq15",
+        doc="Dahl friction of the bead/cable, Eq. 15 noise",
+    ),
+    Case(
+        "lp_friction_jenkins",
+        "latch-pull",
+        "effect",
+        ("friction_hysteresis",),
+        (_m("friction", "jenkins", k_s=5e4, F_s=3.0),),
+        doc="elasto-slip friction",
+    ),
+    Case(
+        "lp_friction_boucwen",
+        "latch-pull",
+        "effect",
+        ("friction_hysteresis",),
+        (_m("friction", "boucwen", F_y=3.0, u_y=8e-5, n=2.0),),
+        noise="ar1",
+        n=450,
+        doc="Bouc-Wen friction, AR(1) load-cell noise",
+    ),
+    Case(
+        "lp_latch_band_gauss",
+        "latch-pull",
+        "effect",
+        ("latch_hysteresis",),
+        (_m("latch_band", "gauss", F_h=8.0, ell=4e-4),),
+        noise="eq15",
+        doc="seated-bead band, Gaussian fade",
+    ),
+    Case(
+        "lp_latch_band_linear",
+        "latch-pull",
+        "effect",
+        ("latch_hysteresis",),
+        (_m("latch_band", "linear", F_h=7.0, ell=6e-4),),
+        doc="seated-bead band, linear fade",
+    ),
+    Case(
+        "lp_latch_band_lorentz",
+        "latch-pull",
+        "effect",
+        ("latch_hysteresis",),
+        (_m("latch_band", "lorentz", F_h=8.0, ell=2.5e-4),),
+        noise="eq15",
+        n=320,
+        doc="seated-bead band, Lorentzian fade, 320 samples",
+    ),
+    Case(
+        "lp_clearance_tanh",
+        "latch-pull",
+        "effect",
+        ("joint_clearance",),
+        (_m("clearance", "tanh", c=8e-5, m0=3.0),),
+        noise="eq15",
+        doc="latch body play, smooth",
+    ),
+    Case(
+        "lp_clearance_piecewise",
+        "latch-pull",
+        "effect",
+        ("joint_clearance",),
+        (_m("clearance", "piecewise", c=8e-5, k0=3.75e4, k1=1e7),),
+        level=0.5,
+        n=700,
+        doc="latch body play, piecewise-linear contact, low noise",
+    ),
+    Case(
+        "lp_stretch_quadratic",
+        "latch-pull",
+        "effect",
+        ("stretch_error",),
+        (_m("stretch", "quadratic", eps=0.6, T_ref=30.0),),
+        noise="eq15",
+        doc="stiffening cable, linear stretch removed by Eq. 15",
+    ),
+    Case(
+        "lp_stretch_twoslope",
+        "latch-pull",
+        "effect",
+        ("stretch_error",),
+        (_m("stretch", "twoslope", eps_pos=0.8, eps_neg=0.2),),
+        doc="the two pulling cables' compliances wrong by different amounts",
+    ),
+    Case(
+        "lp_cable_loop_quadratic",
+        "latch-pull",
+        "effect",
+        ("cable_hysteresis",),
+        (_m("cable_loop", "quadratic", eps=0.6, C_h=1e-5),),
+        noise="eq15",
+        doc="cable stretch loop",
+    ),
+    Case(
+        "lp_cable_loop_power",
+        "latch-pull",
+        "effect",
+        ("cable_hysteresis",),
+        (_m("cable_loop", "power", eps=0.7, C_h=1e-5),),
+        doc="cable stretch loop, power-law return",
+    ),
     # ---------------------------------------------------------------- latch pull, pairs and out of library
-    Case("lp_pair_band_stretch", "latch-pull", "pair", ("latch_hysteresis", "stretch_error"),
-         (_m("latch_band", "gauss", F_h=8.0, ell=4e-4), _m("stretch", "twoslope", eps_pos=0.8, eps_neg=0.2)),
-         noise="eq15", doc="seated-bead band and a stretch-removal error"),
-    Case("lp_pair_friction_clearance", "latch-pull", "pair", ("friction_hysteresis", "joint_clearance"),
-         (_m("friction", "dahl", F_c=3.0, sigma=4e4, alpha=1.0), _m("clearance", "piecewise", c=8e-5, k0=3.75e4,
-                                                                     k1=1e7)),
-         doc="Dahl friction and latch body play"),
-    Case("lp_ool_ripple", "latch-pull", "ool", (), (_m("ripple", "sine", A=3.0, wavelength=3.5e-4),),
-         doc="roller out-of-roundness: a force ripple with the bead position"),
-    Case("lp_ool_zero_drift", "latch-pull", "ool", (), (_m("zero_drift", "sine", A=2.0),), noise="eq15",
-         doc="load-cell zero drift during the test"),
+    Case(
+        "lp_pair_band_stretch",
+        "latch-pull",
+        "pair",
+        ("latch_hysteresis", "stretch_error"),
+        (_m("latch_band", "gauss", F_h=8.0, ell=4e-4), _m("stretch", "twoslope", eps_pos=0.8, eps_neg=0.2)),
+        noise="eq15",
+        doc="seated-bead band and a stretch-removal error",
+    ),
+    Case(
+        "lp_pair_friction_clearance",
+        "latch-pull",
+        "pair",
+        ("friction_hysteresis", "joint_clearance"),
+        (
+            _m("friction", "dahl", F_c=3.0, sigma=4e4, alpha=1.0),
+            _m("clearance", "piecewise", c=8e-5, k0=3.75e4, k1=1e7),
+        ),
+        doc="Dahl friction and latch body play",
+    ),
+    Case(
+        "lp_ool_ripple",
+        "latch-pull",
+        "ool",
+        (),
+        (_m("ripple", "sine", A=3.0, wavelength=3.5e-4),),
+        doc="roller out-of-roundness: a force ripple with the bead position",
+    ),
+    Case(
+        "lp_ool_zero_drift",
+        "latch-pull",
+        "ool",
+        (),
+        (_m("zero_drift", "sine", A=2.0),),
+        noise="eq15",
+        doc="load-cell zero drift during the test",
+    ),
     # ---------------------------------------------------------------- nulls (20 redraws each)
     Case("mt_null_white", "mast-top", "null", redraws=20, doc="baseline only, white noise"),
     Case("mt_null_ar1", "mast-top", "null", noise="ar1", redraws=20, doc="baseline only, AR(1) noise"),
-    Case("mt_null_hetero", "mast-top", "null", noise="hetero", path="biaxial", n=300, redraws=20,
-         doc="baseline only, heteroscedastic noise, 300 samples"),
+    Case(
+        "mt_null_hetero",
+        "mast-top",
+        "null",
+        noise="hetero",
+        path="biaxial",
+        n=300,
+        redraws=20,
+        doc="baseline only, heteroscedastic noise, 300 samples",
+    ),
     Case("lp_null_white", "latch-pull", "null", redraws=20, doc="baseline only, white load-cell noise"),
-    Case("lp_null_eq15", "latch-pull", "null", noise="eq15", redraws=20,
-         doc="baseline only, Eq. 15 stretch removal (heteroscedastic)"),
+    Case(
+        "lp_null_eq15",
+        "latch-pull",
+        "null",
+        noise="eq15",
+        redraws=20,
+        doc="baseline only, Eq. 15 stretch removal (heteroscedastic)",
+    ),
     Case("lp_null_ar1", "latch-pull", "null", noise="ar1", n=400, redraws=20, doc="baseline only, AR(1) noise"),
 )
 
@@ -175,12 +432,18 @@ def _joint_rotation(m, k, mechs, t, tau):
             if form == "jenkins":
                 u, _ = mech.jenkins_load_controlled(m, k, p["k_s"], p["F_s"])
             else:
-                g = (mech.dahl_tangent(p["F_c"], p["sigma"], p["alpha"]) if form == "dahl"
-                     else mech.bouc_wen_tangent(p["F_y"], p["u_y"], p["n"]))
+                g = (
+                    mech.dahl_tangent(p["F_c"], p["sigma"], p["alpha"])
+                    if form == "dahl"
+                    else mech.bouc_wen_tangent(p["F_y"], p["u_y"], p["n"])
+                )
                 u, _ = mech.smooth_load_controlled(m, k, g)
         elif name == "stiffening":
-            u = (mech.duffing_rotation(m, k, p["k3_rel"] * k) if form == "duffing"
-                 else mech.asinh_rotation(m, k, p["m0"]))
+            u = (
+                mech.duffing_rotation(m, k, p["k3_rel"] * k)
+                if form == "duffing"
+                else mech.asinh_rotation(m, k, p["m0"])
+            )
         elif name == "cable_loop":
             u = (mech.loop_quadratic(m, p["eps"]) if form == "quadratic" else mech.loop_power(m, p["eps"])) / k
         elif name == "viscous":
@@ -246,8 +509,11 @@ def _friction_force(x, mechs):
         if name == "friction":
             if form == "jenkins":
                 return mech.jenkins_driven(x, p["k_s"], p["F_s"])
-            g = (mech.dahl_tangent(p["F_c"], p["sigma"], p["alpha"]) if form == "dahl"
-                 else mech.bouc_wen_tangent(p["F_y"], p["u_y"], p["n"]))
+            g = (
+                mech.dahl_tangent(p["F_c"], p["sigma"], p["alpha"])
+                if form == "dahl"
+                else mech.bouc_wen_tangent(p["F_y"], p["u_y"], p["n"])
+            )
             return mech.smooth_driven(x, g, substeps=10)
     return np.zeros_like(x)
 
@@ -266,8 +532,9 @@ def latch_truth(case: Case, rng):
             b = p["F_h"] * mech.fade(x + xb, p["ell"], form)
             dT = dT + np.where(kind > 0, b, np.where(kind < 0, -b, 0.0))
         elif name == "ripple":
-            dT = dT + np.where((kind != 0) & (roller_opening(x) > 0),
-                               p["A"] * np.sin(2 * np.pi * (x + xb) / p["wavelength"]), 0.0)
+            dT = dT + np.where(
+                (kind != 0) & (roller_opening(x) > 0), p["A"] * np.sin(2 * np.pi * (x + xb) / p["wavelength"]), 0.0
+            )
     dT = np.where(kind > 0, np.maximum(dT, 0.0), np.where(kind < 0, np.minimum(dT, 0.0), dT))
     # holds: pushed onto the backstop, released, pulled up to the force at which the bead moves
     # (the first sample of the next pass, still at x = -x_b: the top of the static band, Eq. 9)
@@ -304,7 +571,7 @@ def _latch(case: Case, rng) -> dict:
             loop = mech.loop_quadratic(dT, p["eps"]) if form == "quadratic" else mech.loop_power(dT, p["eps"])
             xm = xm + p["C_h"] * (loop - dT)
     dTm = dT.copy()
-    for name, form, p in case.mechanisms:
+    for name, _form, p in case.mechanisms:
         if name == "zero_drift":
             dTm = dTm + p["A"] * (tau + 0.6 * np.sin(2 * np.pi * 1.5 * tau))
     sig = SIGMA_LOADCELL_N * case.level
@@ -313,8 +580,9 @@ def _latch(case: Case, rng) -> dict:
     elif case.noise == "ar1":
         dTm = dTm + nz.ar1(rng, x.size, sig, AR_PHI)
     elif case.noise == "eq15":
-        xm, dTm = nz.eq15_measurement(rng, xm, dTm, EQ15["C"], EQ15["sigma_T"] * case.level,
-                                      EQ15["sigma_d"] * case.level)
+        xm, dTm = nz.eq15_measurement(
+            rng, xm, dTm, EQ15["C"], EQ15["sigma_T"] * case.level, EQ15["sigma_d"] * case.level
+        )
     else:
         raise ValueError(f"noise {case.noise!r} is not a latch-pull noise model (white, ar1, eq15)")
     return {"x_mm": 1e3 * xm, "dT_N": dTm, "t_s": t}

@@ -13,6 +13,7 @@ from .rigs import latch_law
 def gallery(path) -> str:
     """Draw one panel per mechanism family, each with its forms, and save a PNG at ``path``."""
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 

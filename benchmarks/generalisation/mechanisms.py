@@ -30,19 +30,23 @@ import numpy as np
 # --------------------------------------------------------------------------- smooth operators
 def dahl_tangent(F_c: float, sigma: float, alpha: float = 1.0):
     """Tangent ``dF/du (F, s)`` of the Dahl model (force scale F_c, initial stiffness sigma)."""
+
     def g(F, s):
         a = 1.0 - s * F / F_c
         return sigma * np.copysign(abs(a) ** alpha, a)
+
     return g
 
 
 def bouc_wen_tangent(F_y: float, u_y: float, n: float = 1.0, beta: float = 0.5, gamma: float = 0.5):
     """Tangent ``dF/du (F, s)`` of the Bouc-Wen model with ``F = F_y z`` (yield force F_y, yield
     displacement u_y, sharpness n; beta + gamma = 1 bounds |F| by F_y)."""
+
     def g(F, s):
         z = F / F_y
         sz = s * z
         return (F_y / u_y) * (1.0 - abs(z) ** n * ((beta if sz > 0 else -beta if sz < 0 else 0.0) + gamma))
+
     return g
 
 
@@ -88,6 +92,7 @@ def smooth_load_controlled(m, k: float, tangent, substeps: int = 40):
             def rhs(y, s=s):
                 g = float(tangent(y, s))
                 return g / (k + g)
+
             h = dm / substeps
             for _ in range(substeps):
                 f = _rk4(f, h, rhs)
@@ -167,7 +172,7 @@ def duffing_rotation(m, k: float, k3: float) -> np.ndarray:
     m = np.asarray(m, float)
     p = k / (3.0 * k3)
     q = m / (2.0 * k3)
-    d = np.sqrt(q * q + p ** 3)
+    d = np.sqrt(q * q + p**3)
     return np.cbrt(q + d) + np.cbrt(q - d)
 
 

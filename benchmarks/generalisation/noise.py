@@ -66,4 +66,4 @@ def eq15_residual_variance(slope, C: float, sigma_T: float, sigma_d: float) -> n
     """First-order variance (N^2) of ``dT_measured - f(x_measured)`` for a law of slope ``slope``
     (N/m) under :func:`eq15_measurement`."""
     s = np.asarray(slope, float)
-    return sigma_T ** 2 * (1.0 + s * C) ** 2 + (s * sigma_d) ** 2
+    return sigma_T**2 * (1.0 + s * C) ** 2 + (s * sigma_d) ** 2

@@ -112,7 +112,7 @@ def score(rows) -> dict:
     num = den = 0.0
     null_runs = null_wrong = 0
     other = other_right = 0
-    for case, rs in per_case.items():
+    for _case, rs in per_case.items():
         frac = sum(r["right"] for r in rs) / len(rs)
         num += frac
         den += 1
@@ -122,7 +122,12 @@ def score(rows) -> dict:
         else:
             other += 1
             other_right += frac
-    return {"score": num / den if den else float("nan"), "cases": int(den),
-            "non_null_cases": other, "non_null_right": other_right,
-            "null_runs": null_runs, "false_alarms": null_wrong,
-            "false_alarm_rate": null_wrong / null_runs if null_runs else float("nan")}
+    return {
+        "score": num / den if den else float("nan"),
+        "cases": int(den),
+        "non_null_cases": other,
+        "non_null_right": other_right,
+        "null_runs": null_runs,
+        "false_alarms": null_wrong,
+        "false_alarm_rate": null_wrong / null_runs if null_runs else float("nan"),
+    }

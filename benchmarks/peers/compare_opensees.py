@@ -55,16 +55,16 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from mast import build_mast  # noqa: E402
 import femast_mast  # noqa: E402
 import opensees_mast  # noqa: E402
+from mast import build_mast  # noqa: E402
 
 OPENSEES_SYSTEMS = ("UmfPack", "SparseGeneral", "SparseSYM", "ProfileSPD")
 
 
 RATIO_TARGETS = {40: 0.08, 400: 0.06, 1000: 0.06}
 ITERATION_TARGET = 1.3
-BIG = 700   # from this size on, only the OpenSees system fastest at the largest smaller size runs
+BIG = 700  # from this size on, only the OpenSees system fastest at the largest smaller size runs
 
 
 def peak_rss_mb():
@@ -112,11 +112,18 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--tol", type=float, default=1e-6)
     ap.add_argument("--systems", nargs="+", default=list(OPENSEES_SYSTEMS))
-    ap.add_argument("--femast-disp-tol", type=float, default=None,
-                    help="femast's relative correction tolerance (default --tol; inf: force test only, as OpenSees' "
-                         "NormUnbalance, which has no correction test)")
-    ap.add_argument("--femast-strict", action="store_true",
-                    help="femast's strict correction test only (Convergence(predicted=False))")
+    ap.add_argument(
+        "--femast-disp-tol",
+        type=float,
+        default=None,
+        help="femast's relative correction tolerance (default --tol; inf: force test only, as OpenSees' "
+        "NormUnbalance, which has no correction test)",
+    )
+    ap.add_argument(
+        "--femast-strict",
+        action="store_true",
+        help="femast's strict correction test only (Convergence(predicted=False))",
+    )
     args = ap.parse_args(argv)
     ok_os, os_info = opensees_mast.available()
     jit = femast_mast.warm_up()
@@ -124,34 +131,47 @@ def main(argv=None):
     if ok_os:
         print(f"OpenSeesPy {os_info}")
     else:
-        print(f"OpenSeesPy NOT AVAILABLE ({os_info}): femast numbers only; comparison skipped.\n"
-              "  install with: pip install openseespy  (Debian: apt-get install libblas3 liblapack3)")
-    print(f"{args.repeat} interleaved rounds (femast, then each OpenSees system); best and median; model building "
-          f"included.  Load average at start: {os.getloadavg()[0]:.1f} (2 cores shared)")
+        print(
+            f"OpenSeesPy NOT AVAILABLE ({os_info}): femast numbers only; comparison skipped.\n"
+            "  install with: pip install openseespy  (Debian: apt-get install libblas3 liblapack3)"
+        )
+    print(
+        f"{args.repeat} interleaved rounds (femast, then each OpenSees system); best and median; model building "
+        f"included.  Load average at start: {os.getloadavg()[0]:.1f} (2 cores shared)"
+    )
     failures, per_iter = [], {}
     systems = list(args.systems)
     fastest = None
     for nb in args.bays:
         if nb >= BIG and fastest is not None:
-            systems = [fastest]   # the fastest OpenSees system at the largest smaller size
+            systems = [fastest]  # the fastest OpenSees system at the largest smaller size
         mast = build_mast(nb)
         K = args.increments
         tol_os = args.tol * float(abs(mast.P).max())
         fem, osr = [], {s: [] for s in systems}
         for _ in range(args.repeat):
-            fem.append(timed(lambda: femast_mast.solve(mast, K, tol=args.tol, disp_tol=args.femast_disp_tol,
-                                                          predicted=not args.femast_strict)))
-            for system in (systems if ok_os else ()):
+            fem.append(
+                timed(
+                    lambda: femast_mast.solve(
+                        mast, K, tol=args.tol, disp_tol=args.femast_disp_tol, predicted=not args.femast_strict
+                    )
+                )
+            )
+            for system in systems if ok_os else ():
                 osr[system].append(timed(lambda: opensees_mast.solve(mast, K, tol_os, system=system)))
         an = fem[-1]["analysis"]
         for r in fem:
             r.pop("analysis", None)
         fw, fc = stats(fem, "wall_total"), stats(fem, "cpu_total")
-        print(f"\n{nb}-bay mast: {len(mast.X)} nodes, {len(mast.conn)} beam elements, {an.dofmap.n_free} free DOFs, "
-              f"{K} load increments, linear solver '{an.solver.engine}'   [load {os.getloadavg()[0]:.1f}]")
+        print(
+            f"\n{nb}-bay mast: {len(mast.X)} nodes, {len(mast.conn)} beam elements, {an.dofmap.n_free} free DOFs, "
+            f"{K} load increments, linear solver '{an.solver.engine}'   [load {os.getloadavg()[0]:.1f}]"
+        )
         print(f"  {'':22s} {'wall best':>9s} {'median':>8s} {'CPU best':>9s} {'median':>8s}  iterations")
-        print(f"  {'femast':22s} {fw[0]:9.3f} {fw[1]:8.3f} {fc[0]:9.3f} {fc[1]:8.3f}  {fem[0]['iterations']}"
-              f"   (build median {statistics.median(r['build'] for r in fem):.3f} s)")
+        print(
+            f"  {'femast':22s} {fw[0]:9.3f} {fw[1]:8.3f} {fc[0]:9.3f} {fc[1]:8.3f}  {fem[0]['iterations']}"
+            f"   (build median {statistics.median(r['build'] for r in fem):.3f} s)"
+        )
         # time per Newton iteration against the fastest factorisation + solve of the tangent
         its = fem[0]["iterations"]
         it_wall = statistics.median(r["analyze"] for r in fem) / its
@@ -159,10 +179,12 @@ def main(argv=None):
         best = fastest_solve(an)
         per_iter[nb] = (it_wall, it_cpu)
         ratio_it = it_cpu / best[2]
-        print(f"  time per Newton iteration: {it_wall * 1e3:.2f} ms wall, {it_cpu * 1e3:.2f} ms CPU; fastest "
-              f"factorisation + solve of the converged tangent: {best[0]}, {best[1] * 1e3:.2f} ms wall, "
-              f"{best[2] * 1e3:.2f} ms CPU; iteration / (factorisation + solve) = {ratio_it:.2f} CPU, "
-              f"{it_wall / best[1]:.2f} wall (target <= {ITERATION_TARGET})")
+        print(
+            f"  time per Newton iteration: {it_wall * 1e3:.2f} ms wall, {it_cpu * 1e3:.2f} ms CPU; fastest "
+            f"factorisation + solve of the converged tangent: {best[0]}, {best[1] * 1e3:.2f} ms wall, "
+            f"{best[2] * 1e3:.2f} ms CPU; iteration / (factorisation + solve) = {ratio_it:.2f} CPU, "
+            f"{it_wall / best[1]:.2f} wall (target <= {ITERATION_TARGET})"
+        )
         if ratio_it > ITERATION_TARGET:
             failures.append(f"{nb} bays: iteration / (factorisation + solve) {ratio_it:.2f} > {ITERATION_TARGET}")
         if not ok_os:
@@ -172,7 +194,9 @@ def main(argv=None):
             rs = osr[system]
             w, c = stats(rs, "wall_total"), stats(rs, "cpu_total")
             flag = "" if all(r["ok"] for r in rs) else "  (did not converge)"
-            print(f"  OpenSees {system:13s} {w[0]:9.3f} {w[1]:8.3f} {c[0]:9.3f} {c[1]:8.3f}  {rs[0]['iterations']}{flag}")
+            print(
+                f"  OpenSees {system:13s} {w[0]:9.3f} {w[1]:8.3f} {c[0]:9.3f} {c[1]:8.3f}  {rs[0]['iterations']}{flag}"
+            )
             if not flag:
                 good[system] = (w, c, rs)
         fastest = min(good, key=lambda s: good[s][1][1])
@@ -180,25 +204,31 @@ def main(argv=None):
         err = femast_mast.tip_error(fem[0]["tip_u"], rs[0]["tip_u"])
         ratios = dict(cpu_best=fc[0] / c[0], cpu_median=fc[1] / c[1], wall_best=fw[0] / w[0], wall_median=fw[1] / w[1])
         target = RATIO_TARGETS.get(nb)
-        print(f"  femast / OpenSees ({fastest}): CPU best {ratios['cpu_best']:.3f}, median {ratios['cpu_median']:.3f}; "
-              f"wall best {ratios['wall_best']:.3f}, median {ratios['wall_median']:.3f}"
-              + (f" (target <= {target})" if target else ""))
+        print(
+            f"  femast / OpenSees ({fastest}): CPU best {ratios['cpu_best']:.3f}, median {ratios['cpu_median']:.3f}; "
+            f"wall best {ratios['wall_best']:.3f}, median {ratios['wall_median']:.3f}"
+            + (f" (target <= {target})" if target else "")
+        )
         print(f"  largest tip displacement difference / largest tip displacement: {err:.2e} (target <= 1e-4)")
         if err > 1e-4:
             failures.append(f"{nb} bays: tip displacements differ by {err:.2e}")
         if target and max(ratios["cpu_best"], ratios["cpu_median"]) > target:
-            failures.append(f"{nb} bays: femast/OpenSees CPU ratio {max(ratios['cpu_best'], ratios['cpu_median']):.3f} "
-                            f"> {target}")
+            failures.append(
+                f"{nb} bays: femast/OpenSees CPU ratio {max(ratios['cpu_best'], ratios['cpu_median']):.3f} > {target}"
+            )
     if len(per_iter) >= 2:
         n0, n1 = min(per_iter), max(per_iter)
         p_cpu = math.log(per_iter[n1][1] / per_iter[n0][1]) / math.log(n1 / n0)
         p_wall = math.log(per_iter[n1][0] / per_iter[n0][0]) / math.log(n1 / n0)
-        print(f"\ngrowth of the time per iteration {n0} -> {n1} bays: exponent {p_cpu:.2f} (CPU), {p_wall:.2f} (wall) "
-              f"(target <= 1)")
+        print(
+            f"\ngrowth of the time per iteration {n0} -> {n1} bays: exponent {p_cpu:.2f} (CPU), {p_wall:.2f} (wall) "
+            f"(target <= 1)"
+        )
         if p_cpu > 1.0:
             failures.append(f"time per iteration grows as n^{p_cpu:.2f}")
-    print(f"\npeak memory (max RSS of this process, both codes): {peak_rss_mb():.0f} MB; load average "
-          f"{os.getloadavg()}")
+    print(
+        f"\npeak memory (max RSS of this process, both codes): {peak_rss_mb():.0f} MB; load average {os.getloadavg()}"
+    )
     print("targets: " + ("all met" if not failures else "NOT MET: " + "; ".join(failures)))
     return 0
 

@@ -41,9 +41,11 @@ def main(argv=None):
             tot.append(time.process_time() - c0)
             run.append(r["cpu_analyze"])
         an = r["analysis"]
-        print(f"{nb:5d} bays: build + solve best {min(tot):.3f} median {statistics.median(tot):.3f}; solve best "
-              f"{min(run):.3f} median {statistics.median(run):.3f}; {r['iterations']} iterations, "
-              f"{an.solver.factorizations} factorisations")
+        print(
+            f"{nb:5d} bays: build + solve best {min(tot):.3f} median {statistics.median(tot):.3f}; solve best "
+            f"{min(run):.3f} median {statistics.median(run):.3f}; {r['iterations']} iterations, "
+            f"{an.solver.factorizations} factorisations"
+        )
 
 
 if __name__ == "__main__":

@@ -6,18 +6,17 @@ import tempfile
 import time
 
 import numpy as np
+from mast import E_AL, G_AL, SECTIONS
 
 import femast as fm
 from femast.analysis import Analysis
-
-from mast import E_AL, G_AL, SECTIONS
 
 
 def model(mast, n_inc):
     secs = {k: fm.Section(E=E_AL, G=G_AL, **v) for k, v in SECTIONS.items()}
     m = fm.Model(f"mast{mast.n_bays}")
     labels = np.asarray(m.nodes(mast.X))
-    m.beams(labels[mast.conn], [secs[k] for k in mast.kind], up=mast.up)   # one call, checked at once
+    m.beams(labels[mast.conn], [secs[k] for k in mast.kind], up=mast.up)  # one call, checked at once
     for i in mast.fixed:
         m.fix(labels[i])
     step = m.step("load", initial_increment=1.0 / n_inc, max_increment=1.0 / n_inc)
@@ -35,16 +34,28 @@ def solve(mast, n_inc, tol=1e-6, out=None, disp_tol=None, predicted=True):
     out = out or tempfile.mkdtemp(prefix="femast_peer_")
     t0 = time.perf_counter()
     m, labels = model(mast, n_inc)
-    an = Analysis(m, out, progress=False, convergence=fm.Convergence(
-        force_tol=tol, disp_tol=tol if disp_tol is None else disp_tol, predicted=predicted))
+    an = Analysis(
+        m,
+        out,
+        progress=False,
+        convergence=fm.Convergence(force_tol=tol, disp_tol=tol if disp_tol is None else disp_tol, predicted=predicted),
+    )
     t1 = time.perf_counter()
     c1 = time.process_time()
     an.run()
     t2 = time.perf_counter()
     c2 = time.process_time()
     tip_u = an.x[mast.tip] - an.X0[mast.tip]
-    return dict(wall=t2 - t0, build=t1 - t0, analyze=t2 - t1, cpu_analyze=c2 - c1, iterations=an.summary.iterations,
-                increments=an.summary.increments, tip_u=tip_u, analysis=an)
+    return dict(
+        wall=t2 - t0,
+        build=t1 - t0,
+        analyze=t2 - t1,
+        cpu_analyze=c2 - c1,
+        iterations=an.summary.iterations,
+        increments=an.summary.increments,
+        tip_u=tip_u,
+        analysis=an,
+    )
 
 
 def warm_up():

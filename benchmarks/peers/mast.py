@@ -30,8 +30,8 @@ G_AL = E_AL / (2 * (1 + NU))
 
 def tube(d_out, d_in):
     """A, Iy = Iz, J of a circular tube (m^2, m^4)."""
-    A = np.pi / 4 * (d_out ** 2 - d_in ** 2)
-    I = np.pi / 64 * (d_out ** 4 - d_in ** 4)
+    A = np.pi / 4 * (d_out**2 - d_in**2)
+    I = np.pi / 64 * (d_out**4 - d_in**4)
     return dict(A=A, Iy=I, Iz=I, J=2 * I)
 
 
@@ -41,13 +41,13 @@ SECTIONS = {"longeron": tube(0.030, 0.026), "batten": tube(0.025, 0.021), "diago
 @dataclass
 class Mast:
     n_bays: int
-    X: np.ndarray          # (n_nodes, 3) node coordinates; node label = row + 1
-    conn: np.ndarray       # (n_el, 2) node rows
-    kind: list             # member kind per element ("longeron", "batten", "diagonal")
-    up: np.ndarray         # (n_el, 3) local y direction (femast up-vector, orthogonal to the member)
-    fixed: np.ndarray      # node rows fixed in all six DOFs
-    tip: np.ndarray        # node rows of the tip frame
-    P: np.ndarray          # (n_tip, 3) tip corner forces at full load, N
+    X: np.ndarray  # (n_nodes, 3) node coordinates; node label = row + 1
+    conn: np.ndarray  # (n_el, 2) node rows
+    kind: list  # member kind per element ("longeron", "batten", "diagonal")
+    up: np.ndarray  # (n_el, 3) local y direction (femast up-vector, orthogonal to the member)
+    fixed: np.ndarray  # node rows fixed in all six DOFs
+    tip: np.ndarray  # node rows of the tip frame
+    P: np.ndarray  # (n_tip, 3) tip corner forces at full load, N
 
 
 def build_mast(n_bays: int, b: float = 1.0, h: float = 1.0, torque40: float = 3.0e3, shear40: float = 300.0):
@@ -62,7 +62,7 @@ def build_mast(n_bays: int, b: float = 1.0, h: float = 1.0, torque40: float = 3.
         for k in range(4):
             conn.append((node(j, k), node(j + 1, k)))
             kind.append("longeron")
-            up.append(corners[k] / r)                       # radial
+            up.append(corners[k] / r)  # radial
         for k in range(4):
             conn.append((node(j + 1, k), node(j + 1, k + 1)))
             kind.append("batten")
@@ -70,11 +70,11 @@ def build_mast(n_bays: int, b: float = 1.0, h: float = 1.0, torque40: float = 3.
         for k in range(4):
             conn.append((node(j, k), node(j + 1, k + 1)))
             kind.append("diagonal")
-            n_side = corners[k] + corners[(k + 1) % 4]      # outward normal of side k
+            n_side = corners[k] + corners[(k + 1) % 4]  # outward normal of side k
             up.append(n_side / np.linalg.norm(n_side))
     scale = 40.0 / n_bays
     T = torque40 * scale
-    S = shear40 * scale ** 2
+    S = shear40 * scale**2
     tip = np.array([node(n_bays, k) for k in range(4)])
     tangential = np.column_stack([-np.sin(ang), np.cos(ang), np.zeros(4)])
     P = T / (4 * r) * tangential + np.array([S / 4, 0.0, 0.0])

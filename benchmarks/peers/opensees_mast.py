@@ -10,7 +10,6 @@ from __future__ import annotations
 import time
 
 import numpy as np
-
 from mast import E_AL, G_AL, SECTIONS, local_frame
 
 _IMPORT_ERROR = None
@@ -45,8 +44,19 @@ def build(mast):
             transf[key] = len(transf) + 1
             ops.geomTransf("Corotational", transf[key], *map(float, e3))
         s = SECTIONS[mast.kind[e]]
-        ops.element("elasticBeamColumn", e + 1, int(a) + 1, int(b) + 1, s["A"], E_AL, G_AL, s["J"], s["Iy"],
-                    s["Iz"], transf[key])
+        ops.element(
+            "elasticBeamColumn",
+            e + 1,
+            int(a) + 1,
+            int(b) + 1,
+            s["A"],
+            E_AL,
+            G_AL,
+            s["J"],
+            s["Iy"],
+            s["Iz"],
+            transf[key],
+        )
     ops.timeSeries("Linear", 1)
     ops.pattern("Plain", 1, 1)
     for i, p in zip(mast.tip, mast.P):

@@ -8,5 +8,13 @@ from .build import AdamModel, build_bay, build_mast, corner_xy
 from .kinematics import eq1_height, eq1_twist
 from .parameters import SEED_BAY_HEIGHT, BayParameters
 
-__all__ = ["AdamModel", "BayParameters", "SEED_BAY_HEIGHT", "build_bay", "build_mast", "corner_xy",
-           "eq1_height", "eq1_twist"]
+__all__ = [
+    "AdamModel",
+    "BayParameters",
+    "SEED_BAY_HEIGHT",
+    "build_bay",
+    "build_mast",
+    "corner_xy",
+    "eq1_height",
+    "eq1_twist",
+]

@@ -112,8 +112,9 @@ def _check_fold(fold, where):
     return int(fold)
 
 
-def build_bay(params: BayParameters | None = None, fold: int = 1, name: str = "ADAM bay", cables: bool = True,
-              **changes) -> AdamModel:
+def build_bay(
+    params: BayParameters | None = None, fold: int = 1, name: str = "ADAM bay", cables: bool = True, **changes
+) -> AdamModel:
     """One ADAM bay (seed 001 Sec. II): bottom frame fixed, top frame rigid with the control node.
 
     params : :class:`BayParameters` (default: the documented choices); keyword ``changes``
@@ -125,8 +126,16 @@ def build_bay(params: BayParameters | None = None, fold: int = 1, name: str = "A
     return build_mast(1, params, fold=fold, alternate=False, name=name, cables=cables, **changes)
 
 
-def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, alternate: bool = True,
-               name: str | None = None, cables: bool = True, scatter=None, **changes) -> AdamModel:
+def build_mast(
+    n_bays: int,
+    params: BayParameters | None = None,
+    fold: int = 1,
+    alternate: bool = True,
+    name: str | None = None,
+    cables: bool = True,
+    scatter=None,
+    **changes,
+) -> AdamModel:
     """A mast of ``n_bays`` identical ADAM bays (seed 001 Sec. VII: 40 bays, 6.84 m).
 
     params : :class:`BayParameters`; keyword ``changes`` override single parameters.
@@ -163,7 +172,7 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
     xy = corner_xy(p.b)
     n_frames = n_bays + 1
     corners = np.zeros((n_frames, 4), dtype=np.int64)
-    batten_ends = np.zeros((n_frames, 4, 2), dtype=np.int64)   # [k, 0]: towards corner k+1, [k, 1]: towards k-1
+    batten_ends = np.zeros((n_frames, 4, 2), dtype=np.int64)  # [k, 0]: towards corner k+1, [k, 1]: towards k-1
     for i in range(n_frames):
         z = i * p.l
         for k in range(4):
@@ -178,8 +187,15 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
     bsec, lsec = p.batten_section, p.longeron_section
     for i in range(n_frames):
         for k in range(4):
-            m.beam(batten_ends[i, k, 0], batten_ends[i, (k + 1) % 4, 1], bsec, up=(0, 0, 1), n=p.n_batten,
-                   family=BATTEN_FAMILY, length_error_m=float(sc["batten_dL"][i, k]))
+            m.beam(
+                batten_ends[i, k, 0],
+                batten_ends[i, (k + 1) % 4, 1],
+                bsec,
+                up=(0, 0, 1),
+                n=p.n_batten,
+                family=BATTEN_FAMILY,
+                length_error_m=float(sc["batten_dL"][i, k]),
+            )
     # longerons and their ball joints
     longerons = np.zeros((n_bays, 4, 2), dtype=np.int64)
     pairs = []
@@ -189,12 +205,26 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
             a = m.node(*m.xyz(bot))
             c = m.node(*m.xyz(top))
             radial = (xy[k, 0], xy[k, 1], 0.0)
-            m.beam(a, c, lsec, up=radial, n=p.n_longeron, family=LONGERON_FAMILY,
-                   length_error_m=float(sc["longeron_dL"][j, k]))
+            m.beam(
+                a,
+                c,
+                lsec,
+                up=radial,
+                n=p.n_longeron,
+                family=LONGERON_FAMILY,
+                length_error_m=float(sc["longeron_dL"][j, k]),
+            )
             longerons[j, k] = (a, c)
             pairs += [(a, bot), (c, top)]
-    add_ball_joints(m, pairs, mu=sc["mu"].ravel(), B=p.B, penalty_factor=p.joint_penalty_factor,
-                    stick_factor=p.joint_stick_factor, name=JOINT_FAMILY)
+    add_ball_joints(
+        m,
+        pairs,
+        mu=sc["mu"].ravel(),
+        B=p.B,
+        penalty_factor=p.joint_penalty_factor,
+        stick_factor=p.joint_stick_factor,
+        name=JOINT_FAMILY,
+    )
     if p.joint_spring > 0:
         m.add_family(JointSprings(pairs, p.joint_spring, name=SPRING_FAMILY))
     # cable/pulley/latch assemblies
@@ -222,15 +252,36 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
             LA_list.append(np.linalg.norm(m.xyz(seq[1]) - m.xyz(seq[0])))
             LB_list.append(np.linalg.norm(m.xyz(seq[2]) - m.xyz(seq[1])))
             for a_, t in enumerate(tops):
-                arm_labels.append(m.truss(u, t, EA=p.cable_EA, pretension=float(sc["pretension"][j, k]),
-                                          tension_only=True, family=ARM_FAMILY,
-                                          length_error_m=float(sc["arm_dL"][j, k, a_])))
+                arm_labels.append(
+                    m.truss(
+                        u,
+                        t,
+                        EA=p.cable_EA,
+                        pretension=float(sc["pretension"][j, k]),
+                        tension_only=True,
+                        family=ARM_FAMILY,
+                        length_error_m=float(sc["arm_dL"][j, k, a_]),
+                    )
+                )
     LA, LB = np.array(LA_list), np.array(LB_list)
     x0 = -p.latch.x_backstop
-    fam = None if not cables else CableLatchFamily(np.array(latch_nodes, dtype=np.int64), EA=p.cable_EA, L0=(LA + LB) / stretch,
-                           latch_node=1, bead=LA / stretch + x0, latch=latch_array(sc, p), x0=x0,
-                           hysteresis_force=p.hysteresis_force, hysteresis_length=p.hysteresis_length,
-                           length_error=sc["cable_dL"].reshape(-1, 2), name=LATCH_FAMILY)
+    fam = (
+        None
+        if not cables
+        else CableLatchFamily(
+            np.array(latch_nodes, dtype=np.int64),
+            EA=p.cable_EA,
+            L0=(LA + LB) / stretch,
+            latch_node=1,
+            bead=LA / stretch + x0,
+            latch=latch_array(sc, p),
+            x0=x0,
+            hysteresis_force=p.hysteresis_force,
+            hysteresis_length=p.hysteresis_length,
+            length_error=sc["cable_dL"].reshape(-1, 2),
+            name=LATCH_FAMILY,
+        )
+    )
     if fam is not None:
         m.add_family(fam)
     latch_labels = np.arange(1, 4 * n_bays + 1).reshape(n_bays, 4) if cables else np.zeros((n_bays, 0), int)
@@ -246,5 +297,15 @@ def build_mast(n_bays: int, params: BayParameters | None = None, fold: int = 1, 
     control = m.node(0.0, 0.0, top_z)
     top_nodes = sorted(set(int(c) for c in corners[n_bays]) | set(int(e) for e in batten_ends[n_bays].ravel()))
     m.rigid_body(control, top_nodes, name="top frame")
-    return AdamModel(model=m, params=p, n_bays=n_bays, folds=folds, control=control, corners=corners,
-                     units=units, latch_labels=latch_labels, longerons=longerons, base_nodes=sorted(set(base)))
+    return AdamModel(
+        model=m,
+        params=p,
+        n_bays=n_bays,
+        folds=folds,
+        control=control,
+        corners=corners,
+        units=units,
+        latch_labels=latch_labels,
+        longerons=longerons,
+        base_nodes=sorted(set(base)),
+    )

@@ -29,12 +29,23 @@ from .steps import CONVERGENCE, TABLE1_F, TABLE1_M, add_initial_steps
 TABLE1_TARGET = {"x": 1740e-6, "theta_z": 3030.0 / ARCSEC}
 
 #: Parameters that may be fitted, their units and default bounds (SI).
-FIT_BOUNDS = {"cable_EA": ("N", 2e3, 2e6), "longeron_t": ("m", 2e-4, None), "longeron_E": ("Pa", 1e9, 1e12),
-              "longeron_d": ("m", 2e-3, 0.1), "b": ("m", 0.12, 0.6)}
+FIT_BOUNDS = {
+    "cable_EA": ("N", 2e3, 2e6),
+    "longeron_t": ("m", 2e-4, None),
+    "longeron_E": ("Pa", 1e9, 1e12),
+    "longeron_d": ("m", 2e-3, 0.1),
+    "b": ("m", 0.12, 0.6),
+}
 
 
-def tip_response(params: BayParameters, n_bays: int = 40, M: float = TABLE1_M, F: float = TABLE1_F,
-                 fold: int = 1, alternate: bool = True) -> dict:
+def tip_response(
+    params: BayParameters,
+    n_bays: int = 40,
+    M: float = TABLE1_M,
+    F: float = TABLE1_F,
+    fold: int = 1,
+    alternate: bool = True,
+) -> dict:
     """Tip (control node) displacement (m) and rotation (rad) of the pretensioned mast under a tip
     moment M (N m, about z) and force F (N, along x), relative to the pretensioned state.
     Returns dict with ``u`` (3,), ``theta`` (3,), ``iterations``, ``wall_time``."""
@@ -43,9 +54,14 @@ def tip_response(params: BayParameters, n_bays: int = 40, M: float = TABLE1_M, F
     am.model.step("M+F", initial_increment=1.0).load(am.control, mz=M, fx=F)
     t0 = time.perf_counter()
     row = am.model.index(am.control)
-    rec = []   # (step, U, URA) of the control node per converged increment (no files written)
-    an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE,
-                  on_frame=lambda fr: rec.append((str(fr["step"]), fr["U"][row], fr["URA"][row])))
+    rec = []  # (step, U, URA) of the control node per converged increment (no files written)
+    an = Analysis(
+        am.model,
+        None,
+        progress=False,
+        convergence=CONVERGENCE,
+        on_frame=lambda fr: rec.append((str(fr["step"]), fr["U"][row], fr["URA"][row])),
+    )
     an.run()
     steps = [r[0] for r in rec]
     i0 = len(steps) - 1 - steps[::-1].index("pretension")
@@ -55,9 +71,16 @@ def tip_response(params: BayParameters, n_bays: int = 40, M: float = TABLE1_M, F
     return {"u": u, "theta": th, "iterations": an.summary.iterations, "wall_time": time.perf_counter() - t0}
 
 
-def fit_tip_response(params: BayParameters | None = None, names=("cable_EA", "longeron_t"), x0=None,
-                     targets: dict | None = None, n_bays: int = 40, bounds: dict | None = None,
-                     verbose: bool = False, **ls_options) -> OptimizeResult:
+def fit_tip_response(
+    params: BayParameters | None = None,
+    names=("cable_EA", "longeron_t"),
+    x0=None,
+    targets: dict | None = None,
+    n_bays: int = 40,
+    bounds: dict | None = None,
+    verbose: bool = False,
+    **ls_options,
+) -> OptimizeResult:
     """Fit ``names`` (fields of :class:`BayParameters`) so that the tip response under M + F
     matches ``targets`` (default Table 1: x = 1740 um, theta_z = 3030 arcsec).
 
@@ -75,8 +98,10 @@ def fit_tip_response(params: BayParameters | None = None, names=("cable_EA", "lo
     for nm in names:
         if nm not in bd:
             raise ModelError(f"fit_tip_response: cannot fit '{nm}'; fittable: {', '.join(bd)}")
-    start = np.array([getattr(p0, nm) if x0 is None else x for nm, x in
-                      zip(names, x0 if x0 is not None else [None] * len(names))], dtype=float)
+    start = np.array(
+        [getattr(p0, nm) if x0 is None else x for nm, x in zip(names, x0 if x0 is not None else [None] * len(names))],
+        dtype=float,
+    )
     lo = []
     hi = []
     for nm in names:
@@ -90,12 +115,22 @@ def fit_tip_response(params: BayParameters | None = None, names=("cable_EA", "lo
     def model(z):
         vals = dict(zip(names, np.exp(z)))
         r = tip_response(p0.with_(**vals), n_bays=n_bays)
-        history.append({"params": vals, "x": float(r["u"][0]), "theta_z": float(r["theta"][2]),
-                        "iterations": r["iterations"], "wall_time": r["wall_time"]})
+        history.append(
+            {
+                "params": vals,
+                "x": float(r["u"][0]),
+                "theta_z": float(r["theta"][2]),
+                "iterations": r["iterations"],
+                "wall_time": r["wall_time"],
+            }
+        )
         if verbose:
-            print(f"  fit: {', '.join(f'{k} = {v:.6g}' for k, v in vals.items())} -> x = {r['u'][0] * 1e6:.1f} um, "
-                  f"theta_z = {r['theta'][2] * ARCSEC:.1f} arcsec ({r['iterations']} iterations, "
-                  f"{r['wall_time']:.1f} s)", flush=True)
+            print(
+                f"  fit: {', '.join(f'{k} = {v:.6g}' for k, v in vals.items())} -> x = {r['u'][0] * 1e6:.1f} um, "
+                f"theta_z = {r['theta'][2] * ARCSEC:.1f} arcsec ({r['iterations']} iterations, "
+                f"{r['wall_time']:.1f} s)",
+                flush=True,
+            )
         return r
 
     def residual(z):
@@ -112,7 +147,22 @@ def fit_tip_response(params: BayParameters | None = None, names=("cable_EA", "lo
     resp = {"x": last["x"], "theta_z": last["theta_z"]}
     rel = np.array([resp["x"] / tg["x"] - 1.0, resp["theta_z"] / tg["theta_z"] - 1.0])
     return OptimizeResult(
-        x=x, names=names, units=tuple(bd[n][0] for n in names), params=fitted, response=resp, targets=tg,
-        fun=sol.fun, rel_error=rel, sensitivity=sol.jac / (1.0 + sol.fun)[:, None], jac=sol.jac, success=bool(sol.success),
-        status=sol.status, message=sol.message, nfev=sol.nfev, cost=sol.cost, history=history, x0=start,
-        wall_time=time.perf_counter() - t0)
+        x=x,
+        names=names,
+        units=tuple(bd[n][0] for n in names),
+        params=fitted,
+        response=resp,
+        targets=tg,
+        fun=sol.fun,
+        rel_error=rel,
+        sensitivity=sol.jac / (1.0 + sol.fun)[:, None],
+        jac=sol.jac,
+        success=bool(sol.success),
+        status=sol.status,
+        message=sol.message,
+        nfev=sol.nfev,
+        cost=sol.cost,
+        history=history,
+        x0=start,
+        wall_time=time.perf_counter() - t0,
+    )

@@ -20,13 +20,13 @@ def eq1_height(theta, b: float, l: float):
     with a round-off allowance of 1e-12 b^2)."""
     if not (b > 0 and l > 0):
         raise ModelError(f"eq1_height: b = {b!r} m and l = {l!r} m must be > 0")
-    h2 = b ** 2 * np.cos(np.asarray(theta, dtype=float)) - (b ** 2 - l ** 2)
-    return np.where(h2 >= -1e-12 * b ** 2, np.sqrt(np.clip(h2, 0.0, None)), np.nan)
+    h2 = b**2 * np.cos(np.asarray(theta, dtype=float)) - (b**2 - l**2)
+    return np.where(h2 >= -1e-12 * b**2, np.sqrt(np.clip(h2, 0.0, None)), np.nan)
 
 
 def eq1_twist(h, b: float, l: float):
     """Twist theta_t (rad, >= 0) at which the bay has height h (m), Eq. 1 inverted."""
     if not (b > 0 and l > 0):
         raise ModelError(f"eq1_twist: b = {b!r} m and l = {l!r} m must be > 0")
-    c = (np.asarray(h, dtype=float) ** 2 + b ** 2 - l ** 2) / b ** 2
+    c = (np.asarray(h, dtype=float) ** 2 + b**2 - l**2) / b**2
     return np.arccos(np.clip(c, -1.0, 1.0))

@@ -18,13 +18,13 @@ import numpy as np
 
 from ..errors import ModelError
 
-RHO_CFRP = 1550.0          # kg/m^3
-RHO_STEEL = 7850.0         # kg/m^3
-E_STEEL = 200e9            # Pa
+RHO_CFRP = 1550.0  # kg/m^3
+RHO_STEEL = 7850.0  # kg/m^3
+E_STEEL = 200e9  # Pa
 #: Effective mass of a pulley-and-latch unit, kg: identified from seed 001 Eq. 16 by
 #: ``benchmarks/adam_vibration.py`` (femast.adam.vibration.identify_unit_mass).
 UNIT_MASS = 0.0211
-CORNER_MASS = 0.02         # kg
+CORNER_MASS = 0.02  # kg
 
 
 def cable_mass_per_length(cable_EA: float) -> float:
@@ -32,8 +32,13 @@ def cable_mass_per_length(cable_EA: float) -> float:
     return RHO_STEEL * cable_EA / E_STEEL
 
 
-def add_mass(am, rho_members: float = RHO_CFRP, cable_mass: float | None = None, unit_mass: float = UNIT_MASS,
-             corner_mass: float = CORNER_MASS):
+def add_mass(
+    am,
+    rho_members: float = RHO_CFRP,
+    cable_mass: float | None = None,
+    unit_mass: float = UNIT_MASS,
+    corner_mass: float = CORNER_MASS,
+):
     """Give the members of ``am`` (an :class:`~femast.adam.build.AdamModel`) density
     ``rho_members`` (kg/m^3), its cables ``cable_mass`` kg/m (default :func:`cable_mass_per_length`
     of the bay's EA; lumped), point masses ``unit_mass`` (kg) at every pulley-and-latch unit and

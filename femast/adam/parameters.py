@@ -91,10 +91,28 @@ class BayParameters:
     n_batten: int = 1
 
     UNITS = {
-        "b": "m", "l": "m", "corner": "m", "longeron_d": "m", "longeron_t": "m", "longeron_E": "Pa",
-        "longeron_nu": "-", "batten_d": "m", "batten_t": "m", "batten_E": "Pa", "batten_nu": "-",
-        "cable_EA": "N", "pretension": "N", "latch": "SI", "hysteresis_force": "N", "hysteresis_length": "m",
-        "mu": "-", "B": "m", "joint_penalty_factor": "-", "joint_stick_factor": "-", "joint_spring": "N m/rad", "n_longeron": "-",
+        "b": "m",
+        "l": "m",
+        "corner": "m",
+        "longeron_d": "m",
+        "longeron_t": "m",
+        "longeron_E": "Pa",
+        "longeron_nu": "-",
+        "batten_d": "m",
+        "batten_t": "m",
+        "batten_E": "Pa",
+        "batten_nu": "-",
+        "cable_EA": "N",
+        "pretension": "N",
+        "latch": "SI",
+        "hysteresis_force": "N",
+        "hysteresis_length": "m",
+        "mu": "-",
+        "B": "m",
+        "joint_penalty_factor": "-",
+        "joint_stick_factor": "-",
+        "joint_spring": "N m/rad",
+        "n_longeron": "-",
         "n_batten": "-",
     }
 
@@ -102,10 +120,23 @@ class BayParameters:
         self.validate()
 
     # ------------------------------------------------------------------ checks
-    def validate(self) -> "BayParameters":
+    def validate(self) -> BayParameters:
         """Raise :class:`ModelError` naming the first parameter that cannot describe a bay."""
-        positive = ("b", "l", "longeron_d", "longeron_t", "longeron_E", "batten_d", "batten_t", "batten_E",
-                    "cable_EA", "B", "joint_penalty_factor", "joint_stick_factor", "hysteresis_length")
+        positive = (
+            "b",
+            "l",
+            "longeron_d",
+            "longeron_t",
+            "longeron_E",
+            "batten_d",
+            "batten_t",
+            "batten_E",
+            "cable_EA",
+            "B",
+            "joint_penalty_factor",
+            "joint_stick_factor",
+            "hysteresis_length",
+        )
         for name in positive:
             v = getattr(self, name)
             if not _is_number(v) or not (v > 0 and math.isfinite(v)):
@@ -125,39 +156,56 @@ class BayParameters:
         for pre in ("longeron", "batten"):
             d, t = getattr(self, f"{pre}_d"), getattr(self, f"{pre}_t")
             if 2 * t > d:
-                raise ModelError(f"BayParameters: {pre} wall {pre}_t = {t:g} m is more than half the outer "
-                                 f"diameter {pre}_d = {d:g} m; a solid rod has {pre}_t = {pre}_d / 2")
+                raise ModelError(
+                    f"BayParameters: {pre} wall {pre}_t = {t:g} m is more than half the outer "
+                    f"diameter {pre}_d = {d:g} m; a solid rod has {pre}_t = {pre}_d / 2"
+                )
         if self.l > math.sqrt(2.0) * self.b:
-            raise ModelError(f"BayParameters: longeron l = {self.l:g} m longer than the frame diagonal "
-                             f"sqrt(2) b = {math.sqrt(2) * self.b:g} m: the bay cannot fold flat (Eq. 1 has no "
-                             "h = 0 solution); use a larger b or a shorter l")
+            raise ModelError(
+                f"BayParameters: longeron l = {self.l:g} m longer than the frame diagonal "
+                f"sqrt(2) b = {math.sqrt(2) * self.b:g} m: the bay cannot fold flat (Eq. 1 has no "
+                "h = 0 solution); use a larger b or a shorter l"
+            )
         if 2 * self.corner >= self.b:
-            raise ModelError(f"BayParameters: corner pieces of {self.corner:g} m leave no batten on a "
-                             f"{self.b:g} m side (need 2 corner < b)")
+            raise ModelError(
+                f"BayParameters: corner pieces of {self.corner:g} m leave no batten on a "
+                f"{self.b:g} m side (need 2 corner < b)"
+            )
         if not isinstance(self.latch, LatchParameters):
-            raise ModelError(f"BayParameters: latch must be a femast.latch.LatchParameters, got "
-                             f"{type(self.latch).__name__}")
+            raise ModelError(
+                f"BayParameters: latch must be a femast.latch.LatchParameters, got {type(self.latch).__name__}"
+            )
         validate_latch_array(self.latch.as_array(), "BayParameters.latch")
         if self.hysteresis_force > 0 and self.latch.x_backstop >= contact_half_width(self.latch):
-            raise ModelError("BayParameters: latch hysteresis needs the backstop inside the roller contact "
-                             "zone (x_backstop < x_contact)")
+            raise ModelError(
+                "BayParameters: latch hysteresis needs the backstop inside the roller contact "
+                "zone (x_backstop < x_contact)"
+            )
         if self.pretension >= self.cable_EA * 0.05:
-            raise ModelError(f"BayParameters: pretension {self.pretension:g} N is more than 5% strain of the "
-                             f"cables (EA = {self.cable_EA:g} N); check the units (N)")
+            raise ModelError(
+                f"BayParameters: pretension {self.pretension:g} N is more than 5% strain of the "
+                f"cables (EA = {self.cable_EA:g} N); check the units (N)"
+            )
         return self
 
     # ------------------------------------------------------------------ derived
     @property
     def longeron_section(self) -> Section:
         """Circular tube of the longerons (E, G, A, I, J)."""
-        return circular_tube(self.longeron_d, self.longeron_d - 2 * self.longeron_t, E=self.longeron_E,
-                             nu=self.longeron_nu, name="ADAM longeron")
+        return circular_tube(
+            self.longeron_d,
+            self.longeron_d - 2 * self.longeron_t,
+            E=self.longeron_E,
+            nu=self.longeron_nu,
+            name="ADAM longeron",
+        )
 
     @property
     def batten_section(self) -> Section:
         """Circular tube of the battens."""
-        return circular_tube(self.batten_d, self.batten_d - 2 * self.batten_t, E=self.batten_E,
-                             nu=self.batten_nu, name="ADAM batten")
+        return circular_tube(
+            self.batten_d, self.batten_d - 2 * self.batten_t, E=self.batten_E, nu=self.batten_nu, name="ADAM batten"
+        )
 
     @property
     def diagonal(self) -> float:
@@ -167,9 +215,9 @@ class BayParameters:
     @property
     def stowed_angle(self) -> float:
         """Twist theta_t (rad) at which Eq. 1 gives h = 0 (the stowed, flat bay)."""
-        return math.acos(1.0 - self.l ** 2 / self.b ** 2)
+        return math.acos(1.0 - self.l**2 / self.b**2)
 
-    def with_(self, **changes) -> "BayParameters":
+    def with_(self, **changes) -> BayParameters:
         """A copy with some parameters changed (validated)."""
         return replace(self, **changes)
 

@@ -14,11 +14,10 @@ from ..latch import ZONE_BACKSTOP, ZONE_BEHIND_AXIS, ZONE_FREE, ZONE_IN_FRONT, Z
 from ..post.results import Results
 from .build import AdamModel
 
-ARCSEC = 180.0 / np.pi * 3600.0   # arcsec per rad
+ARCSEC = 180.0 / np.pi * 3600.0  # arcsec per rad
 
 #: Colours of the zones of seed Fig. 6: red latched, yellow intermediate, green unlatched.
-ZONE_COLORS = {ZONE_BACKSTOP: "#d7191c", ZONE_BEHIND_AXIS: "#fdae61", ZONE_IN_FRONT: "#ffe55c",
-               ZONE_FREE: "#1a9641"}
+ZONE_COLORS = {ZONE_BACKSTOP: "#d7191c", ZONE_BEHIND_AXIS: "#fdae61", ZONE_IN_FRONT: "#ffe55c", ZONE_FREE: "#1a9641"}
 
 
 def bay_curve(res: Results, am: AdamModel, bay: int = -1) -> dict:
@@ -63,19 +62,34 @@ def write_curve_csv(curve: dict, path) -> Path:
     """CSV of a :func:`bay_curve`: one row per converged increment (SI; theta also in degrees)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    head = (["step", "total_time_s", "theta_z_deg", "Mz_Nm_seed_sign", "ux_m", "uy_m", "uz_m"]
-            + [f"bead{k}_m" for k in range(4)] + [f"zone{k}" for k in range(4)] + [f"dT{k}_N" for k in range(4)])
+    head = (
+        ["step", "total_time_s", "theta_z_deg", "Mz_Nm_seed_sign", "ux_m", "uy_m", "uz_m"]
+        + [f"bead{k}_m" for k in range(4)]
+        + [f"zone{k}" for k in range(4)]
+        + [f"dT{k}_N" for k in range(4)]
+    )
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
-        fh.write("# ADAM bay torsion (seed 001 Figs. 16-17). Mz: moment of the bay on the rig (seed sign). "
-                 "zone: Fig. 6, 0 (a) backstop, 1 (b) behind roller axis, 2 (c) in front, 3 (d) free\n")
+        fh.write(
+            "# ADAM bay torsion (seed 001 Figs. 16-17). Mz: moment of the bay on the rig (seed sign). "
+            "zone: Fig. 6, 0 (a) backstop, 1 (b) behind roller axis, 2 (c) in front, 3 (d) free\n"
+        )
         w.writerow(head)
         for i in range(len(curve["theta"])):
-            w.writerow([curve["step"][i], f"{curve['time'][i]:.9g}", f"{np.degrees(curve['theta'][i]):.9g}",
-                        f"{curve['M'][i]:.9g}", f"{curve['ux'][i]:.9g}", f"{curve['uy'][i]:.9g}",
-                        f"{curve['uz'][i]:.9g}"]
-                       + [f"{v:.9g}" for v in curve["bead"][i]] + [int(v) for v in curve["zone"][i]]
-                       + [f"{v:.9g}" for v in curve["dT"][i]])
+            w.writerow(
+                [
+                    curve["step"][i],
+                    f"{curve['time'][i]:.9g}",
+                    f"{np.degrees(curve['theta'][i]):.9g}",
+                    f"{curve['M'][i]:.9g}",
+                    f"{curve['ux'][i]:.9g}",
+                    f"{curve['uy'][i]:.9g}",
+                    f"{curve['uz'][i]:.9g}",
+                ]
+                + [f"{v:.9g}" for v in curve["bead"][i]]
+                + [int(v) for v in curve["zone"][i]]
+                + [f"{v:.9g}" for v in curve["dT"][i]]
+            )
     return path
 
 
@@ -137,8 +151,12 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
     for frac in (0.3, 0.75):
         i = int(frac * len(th))
         if 0 < i < len(th) - 1:
-            ax.annotate("", xy=(th[i + 1], Mm[i + 1]), xytext=(th[i], Mm[i]),
-                        arrowprops=dict(arrowstyle="->", color="#c0392b", lw=1.4))
+            ax.annotate(
+                "",
+                xy=(th[i + 1], Mm[i + 1]),
+                xytext=(th[i], Mm[i]),
+                arrowprops=dict(arrowstyle="->", color="#c0392b", lw=1.4),
+            )
     ax.axhline(0.0, color="0.6", lw=0.8)
     ax.set_xlabel("z-axis rotation (degrees)")
     ax.set_ylabel("Moment about z-axis (N m)")
@@ -172,22 +190,24 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
 #: Seed 001 Table 1, rows 0, M+F, 0, -M-F, 0, ... (x, y, z in um; theta_x, theta_y, theta_z in
 #: arcsec).  The extracted table prints the x displacement under -M-F as "-1.740" and under M+F
 #: after the first cycle as "1.740": read here as -1740 and 1740 um (a thousands separator).
-SEED_TABLE1 = np.array([
-    # x      y      z       thx    thy     thz
-    [0.0,    0.0,   0.0,    0.0,   0.0,    0.0],
-    [1740,  -1.0,  -0.3,    0.6,   210,    3030],
-    [0.8,   -1.0,   0.0,    0.0,   0.02,   7.9],
-    [-1740, -2.0,  -0.3,    0.6,  -210,   -3030],
-    [0.01,  -2.1,  -0.001,  0.02,  0.0,    0.03],
-    [1740,  -2.0,  -0.3,    0.6,   210,    3030],
-    [0.03,  -2.1,  -0.001,  0.03,  0.0,    0.30],
-    [-1740, -2.0,  -0.3,    0.6,  -210,   -3030],
-    [0.02,  -2.1,  -0.001,  0.03,  0.001,  0.43],
-    [1740,  -2.0,  -0.3,    0.6,   210,    3030],
-    [0.02,  -2.1,  -0.001,  0.03,  0.001,  0.38],
-    [-1740, -2.0,  -0.3,    0.6,  -210,   -3030],
-    [0.02,  -2.1,  -0.001,  0.03,  0.001,  0.38],
-])
+SEED_TABLE1 = np.array(
+    [
+        # x      y      z       thx    thy     thz
+        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [1740, -1.0, -0.3, 0.6, 210, 3030],
+        [0.8, -1.0, 0.0, 0.0, 0.02, 7.9],
+        [-1740, -2.0, -0.3, 0.6, -210, -3030],
+        [0.01, -2.1, -0.001, 0.02, 0.0, 0.03],
+        [1740, -2.0, -0.3, 0.6, 210, 3030],
+        [0.03, -2.1, -0.001, 0.03, 0.0, 0.30],
+        [-1740, -2.0, -0.3, 0.6, -210, -3030],
+        [0.02, -2.1, -0.001, 0.03, 0.001, 0.43],
+        [1740, -2.0, -0.3, 0.6, 210, 3030],
+        [0.02, -2.1, -0.001, 0.03, 0.001, 0.38],
+        [-1740, -2.0, -0.3, 0.6, -210, -3030],
+        [0.02, -2.1, -0.001, 0.03, 0.001, 0.38],
+    ]
+)
 TABLE1_ROWS = ("0", "M+F", "0", "-M-F", "0", "M+F", "0", "-M-F", "0", "M+F", "0", "-M-F", "0")
 TABLE1_COLUMNS = ("x (um)", "y (um)", "z (um)", "thx (asec)", "thy (asec)", "thz (asec)")
 
@@ -210,7 +230,7 @@ def tip_table(res: Results, am: AdamModel, reference_step: str = "pretension") -
         vals.append(np.concatenate([fr["U"][row] * 1e6, fr["URA"][row] * ARCSEC]))
     vals = np.array(vals)
     vals -= vals[0]
-    labels = ["0"] + [n.split("#")[0].rstrip("ab") or "0" for n in names[k0 + 1:]]
+    labels = ["0"] + [n.split("#")[0].rstrip("ab") or "0" for n in names[k0 + 1 :]]
     return labels, vals
 
 

@@ -28,10 +28,10 @@ from .steps import CONVERGENCE, TABLE1_F, TABLE1_M, add_initial_steps, add_table
 #: independent from element to element.  (group, MastScatter field, kind, half width, unit)
 #: kind "rel": half width relative to the nominal value; "abs": absolute (lengths, m).
 SCATTER = (
-    ("joint friction", "mu", "rel", 0.20, "-"),          # ball-joint mu 0.5 +- 20 % (seed: assumed 0.5)
-    ("latch", "latch_k", "rel", 0.20, "N/m"),            # roller stiffness 100 N/mm +- 20 %
-    ("latch", "latch_mu", "rel", 0.20, "-"),             # roller friction 0.07 +- 20 %
-    ("pretension", "pretension", "rel", 0.10, "N"),      # 170 N +- 10 % per bay side
+    ("joint friction", "mu", "rel", 0.20, "-"),  # ball-joint mu 0.5 +- 20 % (seed: assumed 0.5)
+    ("latch", "latch_k", "rel", 0.20, "N/m"),  # roller stiffness 100 N/mm +- 20 %
+    ("latch", "latch_mu", "rel", 0.20, "-"),  # roller friction 0.07 +- 20 %
+    ("pretension", "pretension", "rel", 0.10, "N"),  # 170 N +- 10 % per bay side
     ("member lengths", "longeron_dL", "abs", 0.05e-3, "m"),
     ("member lengths", "batten_dL", "abs", 0.05e-3, "m"),
     ("member lengths", "arm_dL", "abs", 0.05e-3, "m"),
@@ -48,8 +48,9 @@ def n_uniforms(n_bays: int) -> dict:
     return out
 
 
-def sample_scatter(u: dict, n_bays: int, params: BayParameters | None = None, scale: float = 1.0,
-                   groups=GROUPS) -> dict:
+def sample_scatter(
+    u: dict, n_bays: int, params: BayParameters | None = None, scale: float = 1.0, groups=GROUPS
+) -> dict:
     """Per-element values of one sample from uniform numbers ``u`` ({group: array in [0, 1) of
     :func:`n_uniforms` length}).  Groups not in ``groups`` stay nominal.  ``scale`` multiplies every
     half width (1: the stated scatter).  Returns a dict for :class:`MastScatter`."""
@@ -63,11 +64,13 @@ def sample_scatter(u: dict, n_bays: int, params: BayParameters | None = None, sc
             continue
         arr = np.asarray(u[g], dtype=float).ravel()
         if arr.size != need[g] or not np.all((arr >= 0) & (arr <= 1)):
-            raise ModelError(f"sample_scatter: group {g!r} needs {need[g]} uniform numbers in [0, 1] for "
-                             f"{n_bays} bays, got {arr.size}")
+            raise ModelError(
+                f"sample_scatter: group {g!r} needs {need[g]} uniform numbers in [0, 1] for "
+                f"{n_bays} bays, got {arr.size}"
+            )
         shape = MastScatter.shape(field, n_bays)
         k = int(np.prod(shape))
-        x = 2.0 * arr[used[g]:used[g] + k].reshape(shape) - 1.0      # in [-1, 1]
+        x = 2.0 * arr[used[g] : used[g] + k].reshape(shape) - 1.0  # in [-1, 1]
         used[g] += k
         out[field] = (nominal[field] * (1.0 + scale * half * x)) if kind == "rel" else scale * half * x
     return out
@@ -110,8 +113,15 @@ def mast_model(n_bays: int, cycles: int = 1, params: BayParameters | None = None
     return am.model, am.control
 
 
-def tip_history(n_bays: int, values: dict | None = None, cycles: int = 1, params: BayParameters | None = None,
-                M: float = TABLE1_M, F: float = TABLE1_F, settle: bool = True) -> dict:
+def tip_history(
+    n_bays: int,
+    values: dict | None = None,
+    cycles: int = 1,
+    params: BayParameters | None = None,
+    M: float = TABLE1_M,
+    F: float = TABLE1_F,
+    settle: bool = True,
+) -> dict:
     """Build the mast with per-element ``values`` (None: nominal), deploy (pretension step) and apply
     ``cycles`` Table 1 cycles (M+F, 0, -M-F, 0; M in N m about z, F in N along x).
 
@@ -140,14 +150,27 @@ def tip_history(n_bays: int, values: dict | None = None, cycles: int = 1, params
 
     an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=keep)
     an.run()
-    labels = [s.name for s in am.model.steps][1 if settle else 0:]
+    labels = [s.name for s in am.model.steps][1 if settle else 0 :]
     missing = [s for s in labels if s not in last]
-    if missing:   # pragma: no cover - the analysis raises before
+    if missing:  # pragma: no cover - the analysis raises before
         raise ModelError(f"tip_history: steps {missing} did not finish")
-    return {"labels": labels, "u": np.array([last[s][0] for s in labels]),
-            "theta": np.array([last[s][1] for s in labels]), "iterations": an.summary.iterations,
-            "cutbacks": an.summary.cutbacks, "cpu_s": time.process_time() - t0}
+    return {
+        "labels": labels,
+        "u": np.array([last[s][0] for s in labels]),
+        "theta": np.array([last[s][1] for s in labels]),
+        "iterations": an.summary.iterations,
+        "cutbacks": an.summary.cutbacks,
+        "cpu_s": time.process_time() - t0,
+    }
 
 
-__all__ = ["SCATTER", "GROUPS", "n_uniforms", "sample_scatter", "stated_inputs", "as_scatter", "mast_model",
-           "tip_history"]
+__all__ = [
+    "SCATTER",
+    "GROUPS",
+    "n_uniforms",
+    "sample_scatter",
+    "stated_inputs",
+    "as_scatter",
+    "mast_model",
+    "tip_history",
+]

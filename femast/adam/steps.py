@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ModelError
 from ..analysis.solvers.convergence import Convergence
 from ..analysis.solvers.stabilize import Stabilize
+from ..errors import ModelError
 from .build import AdamModel
 
 #: Convergence test used for ADAM models.  The analysis' 'zero force' floor is 1e-6 x (largest
@@ -24,8 +24,8 @@ from .build import AdamModel
 CONVERGENCE = Convergence(force_tol=1e-9, disp_tol=1e-6, max_iterations=25)
 
 #: Table 1 of seed 001: tip torsion and shear of the pointing manoeuvre (Sec. VII).
-TABLE1_M = 6.8    # N m about z
-TABLE1_F = 14.0   # N along x
+TABLE1_M = 6.8  # N m about z
+TABLE1_F = 14.0  # N along x
 
 
 def stabilize_for(am: AdamModel, fraction: float = 1e-4, dt0: float = 1.0) -> Stabilize:
@@ -46,8 +46,9 @@ def stabilize_for(am: AdamModel, fraction: float = 1e-4, dt0: float = 1.0) -> St
     return Stabilize(factor=fraction * dt0 * k_arm / k_max, warn_ratio=0.05, adaptive=False)
 
 
-def add_initial_steps(am: AdamModel, stabilize: Stabilize | None = None, hold_control: tuple = (),
-                      settle: bool = False):
+def add_initial_steps(
+    am: AdamModel, stabilize: Stabilize | None = None, hold_control: tuple = (), settle: bool = False
+):
     """The initial step of seed 001 Sec. II.C: the deployed, pretensioned structure comes to
     equilibrium with its cable pretensions under viscous stabilisation (step ``pretension``); the
     steps added after it have no stabilisation (the seed: "no stabilization is used after the
@@ -70,8 +71,13 @@ def add_initial_steps(am: AdamModel, stabilize: Stabilize | None = None, hold_co
 
 
 # ---------------------------------------------------------------------------- single-bay torsion
-def add_idealised_torsion(am: AdamModel, theta_max: float = np.radians(3.5), name: str = "twist",
-                          max_increment: float = 0.01, unload: bool = True):
+def add_idealised_torsion(
+    am: AdamModel,
+    theta_max: float = np.radians(3.5),
+    name: str = "twist",
+    max_increment: float = 0.01,
+    unload: bool = True,
+):
     """Seed Fig. 16, idealised path: the control node turns about z from 0 to ``theta_max`` (rad)
     in the bay's folding sense and back to 0, with x and y held (z and the tilts free).
 
@@ -86,11 +92,12 @@ def add_idealised_torsion(am: AdamModel, theta_max: float = np.radians(3.5), nam
     from ..analysis.solvers.control import DisplacementControl
 
     if not (0 < theta_max < am.params.stowed_angle):
-        raise ModelError(f"add_idealised_torsion: theta_max = {theta_max!r} rad must lie in (0, "
-                         f"{am.params.stowed_angle:.4g}) (the stowed angle of Eq. 1)")
+        raise ModelError(
+            f"add_idealised_torsion: theta_max = {theta_max!r} rad must lie in (0, "
+            f"{am.params.stowed_angle:.4g}) (the stowed angle of Eq. 1)"
+        )
     sense = int(am.folds[-1])
-    opts = dict(initial_increment=max_increment, max_increment=max_increment, min_increment=1e-6,
-                max_increments=20000)
+    opts = dict(initial_increment=max_increment, max_increment=max_increment, min_increment=1e-6, max_increments=20000)
     out = am.model.step(f"{name}-out", control=DisplacementControl(am.control, "rz", sense * theta_max), **opts)
     out.load(am.control, mz=sense * 1.0)
     out.prescribe(am.control, ux=0.0, uy=0.0)
@@ -98,8 +105,11 @@ def add_idealised_torsion(am: AdamModel, theta_max: float = np.radians(3.5), nam
     back.load(am.control, mz=-sense * 1.0e3)
     steps = [out, back]
     if unload:
-        steps.append(am.model.step(f"{name}-unload", initial_increment=0.25, max_increment=0.25,
-                                   min_increment=1e-6).load(am.control, mz=0.0))
+        steps.append(
+            am.model.step(f"{name}-unload", initial_increment=0.25, max_increment=0.25, min_increment=1e-6).load(
+                am.control, mz=0.0
+            )
+        )
     return steps
 
 
@@ -118,14 +128,14 @@ class MeasuredPath:
 
     def to_csv(self, path) -> None:
         """Write ``theta_deg, ux_m, uy_m`` (the experiments' bay-torsion format) plus the step time."""
-        head = ("# measured-style path of the ADAM bay's control node (seed 001 Sec. VI.B). "
-                + ("SYNTHETIC: " + self.note if self.synthetic else self.note))
+        head = "# measured-style path of the ADAM bay's control node (seed 001 Sec. VI.B). " + (
+            "SYNTHETIC: " + self.note if self.synthetic else self.note
+        )
         data = np.column_stack([self.t, np.degrees(self.theta), self.x, self.y])
-        np.savetxt(path, data, delimiter=",", header=head + "\nt_s,theta_deg,ux_m,uy_m", comments="",
-                   fmt="%.9g")
+        np.savetxt(path, data, delimiter=",", header=head + "\nt_s,theta_deg,ux_m,uy_m", comments="", fmt="%.9g")
 
     @classmethod
-    def from_csv(cls, path) -> "MeasuredPath":
+    def from_csv(cls, path) -> MeasuredPath:
         """Read a path written by :meth:`to_csv` (or any CSV with columns t_s, theta_deg, ux_m, uy_m)."""
         import csv
 
@@ -141,10 +151,19 @@ class MeasuredPath:
         return cls(a[:, 0], np.radians(a[:, 1]), a[:, 2], a[:, 3], synthetic=False, note=f"read from {path}")
 
 
-def measured_style_path(b: float, theta_max: float = np.radians(3.2), hold_side: int = 0, n: int = 161,
-                        pivot: float = 1.0, drift=(0.0, -0.0005), theta_on: float = np.radians(0.4),
-                        theta_full: float = np.radians(1.6), noise: float = 0.0, rng_seed: int = 1,
-                        sense: int = 1) -> MeasuredPath:
+def measured_style_path(
+    b: float,
+    theta_max: float = np.radians(3.2),
+    hold_side: int = 0,
+    n: int = 161,
+    pivot: float = 1.0,
+    drift=(0.0, -0.0005),
+    theta_on: float = np.radians(0.4),
+    theta_full: float = np.radians(1.6),
+    noise: float = 0.0,
+    rng_seed: int = 1,
+    sense: int = 1,
+) -> MeasuredPath:
     """A synthetic, measured-style path of the control node with off-axis drift (seed Sec. VI.A-B:
     "displacements of up to 1 cm in the x and y directions were recorded").
 
@@ -160,7 +179,7 @@ def measured_style_path(b: float, theta_max: float = np.radians(3.2), hold_side:
     t = np.linspace(0.0, 2.0, n)
     frac = np.where(t <= 1.0, t, 2.0 - t)
     theta = sense * theta_max * frac
-    ang = np.pi / 2 + hold_side * np.pi / 2        # side k faces the direction 90 + 90 k degrees
+    ang = np.pi / 2 + hold_side * np.pi / 2  # side k faces the direction 90 + 90 k degrees
     c = 0.5 * b * np.array([np.cos(ang), np.sin(ang)])
     s = np.clip((np.abs(theta) - theta_on) / (theta_full - theta_on), 0.0, 1.0)
     alpha = pivot * s * s * (3 - 2 * s)
@@ -172,16 +191,24 @@ def measured_style_path(b: float, theta_max: float = np.radians(3.2), hold_side:
         rng = np.random.default_rng(rng_seed)
         x = x + rng.normal(0.0, noise, n)
         y = y + rng.normal(0.0, noise, n)
-    note = (f"generated by femast.adam.measured_style_path(b={b:g}, theta_max={np.degrees(theta_max):.3g} deg, "
-            f"hold_side={hold_side}, pivot={pivot:g}, drift={tuple(drift)}, noise={noise:g})")
+    note = (
+        f"generated by femast.adam.measured_style_path(b={b:g}, theta_max={np.degrees(theta_max):.3g} deg, "
+        f"hold_side={hold_side}, pivot={pivot:g}, drift={tuple(drift)}, noise={noise:g})"
+    )
     return MeasuredPath(t, theta, x, y, synthetic=True, note=note)
 
 
 def add_measured_torsion(am: AdamModel, path: MeasuredPath, name: str = "twist", max_increment: float = 0.0125):
     """Seed Fig. 17: drive the control node along ``path`` (theta_z, x, y); z and tilts free."""
     period = float(path.t[-1])
-    s = am.model.step(name, period=period, initial_increment=max_increment, max_increment=max_increment,
-                      min_increment=1e-6, max_increments=20000)
+    s = am.model.step(
+        name,
+        period=period,
+        initial_increment=max_increment,
+        max_increment=max_increment,
+        min_increment=1e-6,
+        max_increments=20000,
+    )
     s.follow(am.control, path.t, rz=path.theta, ux=path.x, uy=path.y)
     return s
 
@@ -190,8 +217,9 @@ def add_measured_torsion(am: AdamModel, path: MeasuredPath, name: str = "twist",
 TABLE1_SEQUENCE = ("M+F", "0", "-M-F", "0")
 
 
-def add_table1_steps(am: AdamModel, cycles: int = 3, M: float = TABLE1_M, F: float = TABLE1_F,
-                     increments: int = 1) -> list:
+def add_table1_steps(
+    am: AdamModel, cycles: int = 3, M: float = TABLE1_M, F: float = TABLE1_F, increments: int = 1
+) -> list:
     """Seed Table 1 load sequence at the control node: M+F, 0, -M-F, 0, ``cycles`` times, with
     M (N m) about z and F (N) along x.  ``increments``: increments per step (initial size)."""
     steps = []

@@ -42,9 +42,9 @@ from .build import corner_xy
 from .mass import UNIT_MASS, cable_mass_per_length
 from .parameters import BayParameters
 
-LBF = 4.4482216152605          # N per pound-force
-EQ16 = (0.012, -0.58, 17.0)    # coefficients as printed (f in Hz; the result in lbf, see module)
-EQ16_SD_N = 2.0 * LBF          # the fit's standard deviation, 2 (lbf), in N
+LBF = 4.4482216152605  # N per pound-force
+EQ16 = (0.012, -0.58, 17.0)  # coefficients as printed (f in Hz; the result in lbf, see module)
+EQ16_SD_N = 2.0 * LBF  # the fit's standard deviation, 2 (lbf), in N
 EQ16_RANGE_N = (120.0, 200.0)  # average tensions of the comparison (seed Figs. 13-14: 125-210 N)
 ARM_FAMILY = "mock_arm"
 LATCH_FAMILY = "mock_latch"
@@ -68,8 +68,9 @@ def eq16_frequency(tension_n):
     t = np.asarray(tension_n, dtype=float) / LBF
     disc = b * b - 4 * a * (c - t)
     if np.any(disc < 0):
-        raise ModelError(f"eq16_frequency: tension {tension_n!r} N is below Eq. 16's minimum "
-                         f"({LBF * (c - b * b / (4 * a)):.1f} N)")
+        raise ModelError(
+            f"eq16_frequency: tension {tension_n!r} N is below Eq. 16's minimum ({LBF * (c - b * b / (4 * a)):.1f} N)"
+        )
     return (-b + np.sqrt(disc)) / (2 * a)
 
 
@@ -80,12 +81,16 @@ class MockSide:
     model: Model
     unit: int
     corners: tuple
-    lengths: np.ndarray     # (4,) initial section lengths, m (latch cable 2, arms 2)
-    normal: np.ndarray      # unit normal of the side (out-of-plane direction)
+    lengths: np.ndarray  # (4,) initial section lengths, m (latch cable 2, arms 2)
+    normal: np.ndarray  # unit normal of the side (out-of-plane direction)
 
 
-def mock_bay_side(tension: float = 170.0, params: BayParameters | None = None, unit_mass: float = UNIT_MASS,
-                  cable_mass: float | None = None) -> MockSide:
+def mock_bay_side(
+    tension: float = 170.0,
+    params: BayParameters | None = None,
+    unit_mass: float = UNIT_MASS,
+    cable_mass: float | None = None,
+) -> MockSide:
     """Seed Fig. 11: side 0 of an ADAM bay (``params``: b, l, cable EA, latch) with the latch cable
     and both arms pretensioned to ``tension`` (N), the four ends anchored, a point mass
     ``unit_mass`` (kg) at the unit and the cables' mass ``cable_mass`` (kg/m; default steel,
@@ -101,12 +106,20 @@ def mock_bay_side(tension: float = 170.0, params: BayParameters | None = None, u
     centre = 0.25 * (m.xyz(B0) + m.xyz(B1) + m.xyz(T0) + m.xyz(T1))
     u = m.node(*centre)
     stretch = 1.0 + tension / p.cable_EA
-    seq = (B1, u, B0)                 # as build_mast for fold = +1 (section 2 on the lengthening diagonal)
+    seq = (B1, u, B0)  # as build_mast for fold = +1 (section 2 on the lengthening diagonal)
     LA = float(np.linalg.norm(m.xyz(u) - m.xyz(B1)))
     LB = float(np.linalg.norm(m.xyz(B0) - m.xyz(u)))
     x0 = -p.latch.x_backstop
-    fam = CableLatchFamily(np.array([seq], dtype=np.int64), EA=p.cable_EA, L0=(LA + LB) / stretch, latch_node=1,
-                           bead=LA / stretch + x0, latch=p.latch, x0=x0, name=LATCH_FAMILY)
+    fam = CableLatchFamily(
+        np.array([seq], dtype=np.int64),
+        EA=p.cable_EA,
+        L0=(LA + LB) / stretch,
+        latch_node=1,
+        bead=LA / stretch + x0,
+        latch=p.latch,
+        x0=x0,
+        name=LATCH_FAMILY,
+    )
     fam.mass_per_length = cm
     m.add_family(fam)
     arms = [float(np.linalg.norm(m.xyz(t) - m.xyz(u))) for t in (T0, T1)]
@@ -126,8 +139,9 @@ def latch_resonance(side: MockSide):
     last = {}
     an = Analysis(side.model, None, progress=False, on_frame=last.update)
     an.run()
-    tensions = np.concatenate([np.asarray(last[f"el/{LATCH_FAMILY}/tension"]).ravel(),
-                               np.asarray(last[f"el/{ARM_FAMILY}/N"]).ravel()])
+    tensions = np.concatenate(
+        [np.asarray(last[f"el/{LATCH_FAMILY}/tension"]).ravel(), np.asarray(last[f"el/{ARM_FAMILY}/N"]).ravel()]
+    )
     modes = modal_analysis(an, 3, label="mock bay side")
     row = int(np.flatnonzero(modes.node_labels == side.unit)[0])
     oop = np.abs(modes.shapes[:, row, :3] @ side.normal)
@@ -139,14 +153,14 @@ def latch_resonance(side: MockSide):
 class UnitMassFit:
     """Result of :func:`identify_unit_mass` (SI)."""
 
-    unit_mass: float            # kg, the unit's point mass (the cables' mass is in the model)
-    effective_mass: float       # kg, unit + cable mass seen at the unit: sum(T_i/L_i) / (2 pi f)^2
-    tension: np.ndarray         # model average tensions, N
-    frequency: np.ndarray       # model frequencies, Hz
-    eq16: np.ndarray            # Eq. 16 (lbf reading) at the model frequencies, N
-    max_dev: float              # N
-    rms_dev: float              # N
-    sigma_unit_mass: float      # kg, from the Eq. 16 scatter (EQ16_SD_N over n_points)
+    unit_mass: float  # kg, the unit's point mass (the cables' mass is in the model)
+    effective_mass: float  # kg, unit + cable mass seen at the unit: sum(T_i/L_i) / (2 pi f)^2
+    tension: np.ndarray  # model average tensions, N
+    frequency: np.ndarray  # model frequencies, Hz
+    eq16: np.ndarray  # Eq. 16 (lbf reading) at the model frequencies, N
+    max_dev: float  # N
+    rms_dev: float  # N
+    sigma_unit_mass: float  # kg, from the Eq. 16 scatter (EQ16_SD_N over n_points)
     n_points: int = 9
 
     @property
@@ -155,8 +169,13 @@ class UnitMassFit:
         return self.tension - self.eq16
 
 
-def identify_unit_mass(params: BayParameters | None = None, tensions=None, cable_mass: float | None = None,
-                       n_points: int = 9, reference_mass: float = UNIT_MASS) -> UnitMassFit:
+def identify_unit_mass(
+    params: BayParameters | None = None,
+    tensions=None,
+    cable_mass: float | None = None,
+    n_points: int = 9,
+    reference_mass: float = UNIT_MASS,
+) -> UnitMassFit:
     """Fit the unit's mass so that the FE mock side's (tension, frequency) curve matches Eq. 16
     (lbf reading) in the least-squares sense over ``tensions`` (N; default 9 settings across
     120-200 N, like the seed's 9 points).  The FE model is solved once per tension with
@@ -185,17 +204,26 @@ def identify_unit_mass(params: BayParameters | None = None, tensions=None, cable
     # Eq. 16 falls again below 24 Hz: a coarse grid picks the basin on its rising branch first
     grid = np.geomspace(1e-4, 0.5, 400)
     i = int(np.argmin([cost(g) for g in grid]))
-    res = minimize_scalar(cost, bounds=(grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]), method="bounded",
-                          options={"xatol": 1e-10})
+    res = minimize_scalar(
+        cost, bounds=(grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]), method="bounded", options={"xatol": 1e-10}
+    )
     mu = float(res.x)
     f = freq(mu)
     dev = T_avg - eq16_tension(f)
     # sensitivity of the tension to the mass at a fixed frequency: dT/dm = T/(m + m_c)
     m_eff = mu + m_c
     sigma = m_eff * EQ16_SD_N / float(np.mean(T_avg)) / math.sqrt(len(T_set))
-    return UnitMassFit(unit_mass=mu, effective_mass=m_eff, tension=T_avg, frequency=f, eq16=eq16_tension(f),
-                       max_dev=float(np.abs(dev).max()), rms_dev=float(np.sqrt(np.mean(dev ** 2))),
-                       sigma_unit_mass=sigma, n_points=len(T_set))
+    return UnitMassFit(
+        unit_mass=mu,
+        effective_mass=m_eff,
+        tension=T_avg,
+        frequency=f,
+        eq16=eq16_tension(f),
+        max_dev=float(np.abs(dev).max()),
+        rms_dev=float(np.sqrt(np.mean(dev**2))),
+        sigma_unit_mass=sigma,
+        n_points=len(T_set),
+    )
 
 
 def tension_from_frequency(f_hz, fit: UnitMassFit, sigma_f_hz: float = 0.0):
@@ -206,8 +234,7 @@ def tension_from_frequency(f_hz, fit: UnitMassFit, sigma_f_hz: float = 0.0):
     f = np.asarray(f_hz, dtype=float)
     if np.any(~np.isfinite(f)) or np.any(f <= 0):
         raise ModelError(f"tension_from_frequency: frequency {f_hz!r} Hz must be finite and > 0")
-    c = float(np.sum(fit.tension * fit.frequency ** 2) / np.sum(fit.frequency ** 4))
+    c = float(np.sum(fit.tension * fit.frequency**2) / np.sum(fit.frequency**4))
     T = c * f * f
-    sigma = np.sqrt((2 * T * sigma_f_hz / f) ** 2 + (T * fit.sigma_unit_mass / fit.effective_mass) ** 2
-                    + EQ16_SD_N ** 2)
+    sigma = np.sqrt((2 * T * sigma_f_hz / f) ** 2 + (T * fit.sigma_unit_mass / fit.effective_mass) ** 2 + EQ16_SD_N**2)
     return T, sigma

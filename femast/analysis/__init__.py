@@ -19,5 +19,17 @@ from .state import State
 from .summary import AnalysisSummary, StabilizationWarning
 from .system import System
 
-__all__ = ["Analysis", "solve", "build_families", "Increment", "Newton", "Outcome", "Observer", "ResultsOutput",
-           "State", "AnalysisSummary", "StabilizationWarning", "System"]
+__all__ = [
+    "Analysis",
+    "solve",
+    "build_families",
+    "Increment",
+    "Newton",
+    "Outcome",
+    "Observer",
+    "ResultsOutput",
+    "State",
+    "AnalysisSummary",
+    "StabilizationWarning",
+    "System",
+]

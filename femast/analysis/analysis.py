@@ -22,14 +22,14 @@ from tqdm.auto import tqdm
 from ..elements.base import DOF_NAMES
 from ..errors import ConvergenceError, ModelError, SingularModelError
 from ..jit import prepare as prepare_kernels
-from ..post.results import Results, run_outcome
-from .solvers.convergence import Convergence
 from ..model import validation
 from ..model.thermal import FieldLoads, check_controls, has_fields
+from ..post.results import Results, run_outcome
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
 from .restart import RestartOutput, load_restart, restart_folder, restore
+from .solvers.convergence import Convergence
 from .state import State
 from .stepping import run_step
 from .summary import AnalysisSummary
@@ -75,17 +75,34 @@ class Analysis:
     (:class:`Newton`), ``observers`` and ``summary`` (:class:`AnalysisSummary`).
     """
 
-    def __init__(self, model, out="results", convergence: Convergence | None = None, progress: bool = True,
-                 cutback: float = 0.25, growth: float = 1.5, easy_iterations: int = 6, line_search="auto",
-                 extrapolate: bool = False, on_frame=None, tangent: str = "auto", observers=(), restart=None,
-                 restart_every: int | None = None, linear_solver: str = "auto"):
-        prepare_kernels()   # first run: kernels compile in the background (femast.jit_background)
+    def __init__(
+        self,
+        model,
+        out="results",
+        convergence: Convergence | None = None,
+        progress: bool = True,
+        cutback: float = 0.25,
+        growth: float = 1.5,
+        easy_iterations: int = 6,
+        line_search="auto",
+        extrapolate: bool = False,
+        on_frame=None,
+        tangent: str = "auto",
+        observers=(),
+        restart=None,
+        restart_every: int | None = None,
+        linear_solver: str = "auto",
+    ):
+        prepare_kernels()  # first run: kernels compile in the background (femast.jit_background)
         self.model = model
         self.on_frame = on_frame
         self.out = out
         if out is None and on_frame is None:
-            warnings.warn("Analysis(out=None) without on_frame keeps no results: only the final state "
-                          "(Analysis.x, .R, .summary) remains", stacklevel=2)
+            warnings.warn(
+                "Analysis(out=None) without on_frame keeps no results: only the final state "
+                "(Analysis.x, .R, .summary) remains",
+                stacklevel=2,
+            )
         self.convergence = convergence or Convergence()
         self.progress = progress
         self.cutback = cutback
@@ -98,7 +115,7 @@ class Analysis:
             raise ModelError(f"model '{model.name}' has no steps; add one with model.step()")
         if not (model.beams or model.trusses or model.families):
             raise ModelError(f"model '{model.name}' has no elements")
-        for s in model.steps:   # (again: a step's fields may have been set after model.step(); issue 16)
+        for s in model.steps:  # (again: a step's fields may have been set after model.step(); issue 16)
             validation.step_increments(s)
         self.families = build_families(model)
         check_controls(model)
@@ -114,7 +131,7 @@ class Analysis:
         self.resume = None
         if restart_every is not None:
             self.observers.append(RestartOutput(validation.whole(restart_every, "restart_every", minimum=1)))
-        elif self.restart is not None:   # a restarted run goes on saving restart points
+        elif self.restart is not None:  # a restarted run goes on saving restart points
             self.observers.append(RestartOutput(None))
 
     # ------------------------------------------------------------ the parts, by their usual names
@@ -161,8 +178,11 @@ class Analysis:
     def stabilization_ratio(self) -> float:
         """Stabilisation energy dissipated in the current step / strain energy (dimensionless)."""
         st = self._state
-        return st.stabilization_energy / st.strain_energy if st.strain_energy > 0 else (
-            0.0 if st.stabilization_energy == 0 else float("inf"))
+        return (
+            st.stabilization_energy / st.strain_energy
+            if st.strain_energy > 0
+            else (0.0 if st.stabilization_energy == 0 else float("inf"))
+        )
 
     def dof_value(self, idx, dof):
         """Displacement (m) or accumulated rotation (rad) of DOF ``dof`` of node index ``idx``."""
@@ -205,8 +225,10 @@ class Analysis:
         try:
             lu = spla.splu(Kbb.tocsc())
         except RuntimeError:
-            raise SingularModelError("condensed_stiffness: the model is singular once the retained DOFs are "
-                                     "held; it has a mechanism besides them") from None
+            raise SingularModelError(
+                "condensed_stiffness: the model is singular once the retained DOFs are "
+                "held; it has a mechanism besides them"
+            ) from None
         return Kaa - Kab @ lu.solve(K[rest][:, keep].toarray())
 
     # ------------------------------------------------------------ the run
@@ -217,7 +239,7 @@ class Analysis:
         try:
             first = 0
             if self.restart is not None:
-                self.resume = load_restart(self.restart, self)   # None: the point is the start
+                self.resume = load_restart(self.restart, self)  # None: the point is the start
                 if self.resume is not None:
                     restore(self, self.resume)
                     first = self.resume["step"] + (1 if self.resume["step_done"] else 0)
@@ -228,7 +250,7 @@ class Analysis:
                 if k < first:
                     continue
                 self._state.step = k
-                if getattr(step, "kind", "static") == "frequency":   # modes of the state (issue 18)
+                if getattr(step, "kind", "static") == "frequency":  # modes of the state (issue 18)
                     from ..modal.step import run_frequency_step
 
                     run_frequency_step(self, step)
@@ -236,7 +258,7 @@ class Analysis:
                     inside = self.resume is not None and k == self.resume["step"] and not self.resume["step_done"]
                     run_step(self, step, resume=self.resume if inside else None)
             self.summary.status, self.summary.completed = "completed", True
-        except BaseException as exc:   # the summary says how the run ended (issue 16), then the error goes on
+        except BaseException as exc:  # the summary says how the run ended (issue 16), then the error goes on
             self.summary.status, self.summary.message = run_outcome(exc)
             if isinstance(exc, ConvergenceError):
                 for obs in self.observers:

@@ -55,7 +55,7 @@ def assigning_positions(positions, size):
     """Positions (one array per family, -1 outside) re-encoded for :meth:`Assembler.tangent_into`
     without zeroing: the first entry of each position of a ``size``-long target assigns it (int32
     when the target is below 2**31 - 2 entries, half the memory traffic of the scatter)."""
-    dtype = np.int32 if size < 2 ** 31 - 2 else np.int64
+    dtype = np.int32 if size < 2**31 - 2 else np.int64
     seen = np.zeros(size, dtype=np.bool_)
     out = []
     for pos in positions:
@@ -107,7 +107,7 @@ def _pattern_kernel(el_ptr, el_eq, ent_ptr, row_lo, row_hi, col_lo, col_hi):
             inc_ptr[r - row_lo + 1] += 1
     for r in range(nr):
         inc_ptr[r + 1] += inc_ptr[r]
-    inc_el = np.empty(inc_ptr[nr], dtype=np.int64)   # element and flat index k of each incidence
+    inc_el = np.empty(inc_ptr[nr], dtype=np.int64)  # element and flat index k of each incidence
     inc_k = np.empty(inc_ptr[nr], dtype=np.int64)
     fill = inc_ptr[:nr].copy()
     for e in range(n_el):
@@ -145,7 +145,7 @@ def _pattern_kernel(el_ptr, el_eq, ent_ptr, row_lo, row_hi, col_lo, col_hi):
                     marker[c] = r
                     indices[q] = c
                     q += 1
-        indices[indptr[r]:q] = np.sort(indices[indptr[r]:q])
+        indices[indptr[r] : q] = np.sort(indices[indptr[r] : q])
         for q2 in range(indptr[r], q):
             where[indices[q2]] = q2
         for t in range(inc_ptr[r], inc_ptr[r + 1]):
@@ -170,17 +170,19 @@ def _block_pattern(eq_list, row_lo, row_hi, col_lo, col_hi):
     ms = [int(eqs.shape[1]) for eqs in eq_list]
     el_ptr = np.concatenate([[0]] + [np.full(eqs.shape[0], m, dtype=np.int64) for eqs, m in zip(eq_list, ms)])
     el_ptr = np.cumsum(el_ptr)
-    ent_ptr = np.cumsum(np.concatenate([[0]] + [np.full(eqs.shape[0], m * m, dtype=np.int64)
-                                                for eqs, m in zip(eq_list, ms)]))
-    el_eq = (np.concatenate([np.ravel(eqs) for eqs in eq_list]).astype(np.int64) if sum(sizes)
-             else np.zeros(0, np.int64))
-    indptr, indices, pos = setup_call(_pattern_kernel, el_eq.size * 36, el_ptr, el_eq, ent_ptr, row_lo, row_hi, col_lo, col_hi)
+    ent_ptr = np.cumsum(
+        np.concatenate([[0]] + [np.full(eqs.shape[0], m * m, dtype=np.int64) for eqs, m in zip(eq_list, ms)])
+    )
+    el_eq = np.concatenate([np.ravel(eqs) for eqs in eq_list]).astype(np.int64) if sum(sizes) else np.zeros(0, np.int64)
+    indptr, indices, pos = setup_call(
+        _pattern_kernel, el_eq.size * 36, el_ptr, el_eq, ent_ptr, row_lo, row_hi, col_lo, col_hi
+    )
     mat = sp.csr_matrix((np.zeros(indices.size), indices, indptr), shape=shape)
     positions = []
     offset = 0
     for eqs, m in zip(eq_list, ms):
         n = eqs.shape[0] * m * m
-        positions.append(pos[offset:offset + n].reshape(eqs.shape[0], m, m))
+        positions.append(pos[offset : offset + n].reshape(eqs.shape[0], m, m))
         offset += n
     return mat, positions
 
@@ -197,7 +199,7 @@ class Assembler:
             self.K_aa, self.pos_aa = _block_pattern(self.eqs, 0, na, 0, na)
         else:
             self.K_ff, self.pos_ff = _block_pattern(self.eqs, 0, nf, 0, nf)
-        self._fc = None   # (K_fc, pos_fc), built when first needed (prescribed-value increments)
+        self._fc = None  # (K_fc, pos_fc), built when first needed (prescribed-value increments)
 
     @property
     def K_fc(self):

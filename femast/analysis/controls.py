@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 import warnings
 
-import numpy as np
 from tqdm.auto import tqdm
 
 from ..errors import ConvergenceError, ModelError
@@ -108,13 +107,27 @@ class TimeIncrements(Plan):
         self.dt_max = step.max_increment or period
         self.uses_lam = control.solves_for_load_factor
         if self.uses_lam and any(c.amplitude is not None for c in step.loads):
-            raise ModelError(f"step '{step.name}': amplitudes cannot be used with {type(control).__name__}; "
-                             "the load factor is an unknown")
-        self.hit = sorted({float(h) for h in step.hit_times} |
-                          {float(t) for c in step.loads + step.prescribed if c.amplitude is not None
-                           for t in c.amplitude.times if 0 < t < period} |
-                          {float(t) for _, _, amp in getattr(step, "temperatures", ()) if amp is not None
-                           for t in amp.times if 0 < t < period})   # temperature amplitudes (issue 20)
+            raise ModelError(
+                f"step '{step.name}': amplitudes cannot be used with {type(control).__name__}; "
+                "the load factor is an unknown"
+            )
+        self.hit = sorted(
+            {float(h) for h in step.hit_times}
+            | {
+                float(t)
+                for c in step.loads + step.prescribed
+                if c.amplitude is not None
+                for t in c.amplitude.times
+                if 0 < t < period
+            }
+            | {
+                float(t)
+                for _, _, amp in getattr(step, "temperatures", ())
+                if amp is not None
+                for t in amp.times
+                if 0 < t < period
+            }
+        )  # temperature amplitudes (issue 20)
         self.load_start, self.pres_start = st.loads.copy(), st.prescribed.copy()
         self.load_rows, self.pres_rows = _rows(analysis.model, step.loads), _rows(analysis.model, step.prescribed)
         sys_ = analysis.system
@@ -127,21 +140,32 @@ class TimeIncrements(Plan):
         st.last_increment = None
         st.damping = None
         st.stabilization_energy = 0.0
-        self.viscous = (ViscousTerm(step.stabilize, st, sys_.is_rot, st.first_size, sys_.plus_diagonal)
-                        if step.stabilize is not None else None)
+        self.viscous = (
+            ViscousTerm(step.stabilize, st, sys_.is_rot, st.first_size, sys_.plus_diagonal)
+            if step.stabilize is not None
+            else None
+        )
 
     def bar(self, disable):
-        return tqdm(total=self.period, desc=f"step {self.step.name}", unit="s", disable=disable, leave=False,
-                    bar_format="{desc}: {percentage:3.0f}%|{bar}| t={n:.4g}/{total:.4g} [{elapsed}<{remaining}]")
+        return tqdm(
+            total=self.period,
+            desc=f"step {self.step.name}",
+            unit="s",
+            disable=disable,
+            leave=False,
+            bar_format="{desc}: {percentage:3.0f}%|{bar}| t={n:.4g}/{total:.4g} [{elapsed}<{remaining}]",
+        )
 
     def done(self) -> bool:
         st, step = self.state, self.step
         if not st.step_time < self.period * (1 - 1e-12):
             return True
         if st.increment >= step.max_increments:
-            raise ConvergenceError(f"step '{step.name}': reached max_increments={step.max_increments} at step "
-                                   f"time {st.step_time:.6g} of {self.period:g} s; raise max_increments or "
-                                   "max_increment")
+            raise ConvergenceError(
+                f"step '{step.name}': reached max_increments={step.max_increments} at step "
+                f"time {st.step_time:.6g} of {self.period:g} s; raise max_increments or "
+                "max_increment"
+            )
         return False
 
     def next_increment(self):
@@ -165,8 +189,9 @@ class TimeIncrements(Plan):
             # the element properties changed (temperature): the committed response is not this one's
             sys_.last_converged = None
             st.at_equilibrium = False
-        inc = Increment(time=t + dt, dtime=dt, total_time=st.total_time + dt, step_name=step.name, lam=frac,
-                        viscous=self.viscous)
+        inc = Increment(
+            time=t + dt, dtime=dt, total_time=st.total_time + dt, step_name=step.name, lam=frac, viscous=self.viscous
+        )
         if self.uses_lam:
             inc.lam = st.lam
             P_end = _values(self.load_rows, self.load_start, 1.0, period)
@@ -185,7 +210,9 @@ class TimeIncrements(Plan):
         inc.dpres = dpres
         ref = getattr(an, "reference", None)
         pdu = None if ref is None or self.uses_lam else ref.predictor(st.step, st.total_time, st.total_time + dt)
-        if pdu is not None and pdu.shape == (sys_.n_free,):   # a reference run's converged increment (femast.analysis.reference)
+        if pdu is not None and pdu.shape == (
+            sys_.n_free,
+        ):  # a reference run's converged increment (femast.analysis.reference)
             inc.predictor, inc.whole = (pdu, 0.0), True
         elif an.extrapolate and st.last_increment is not None and (dpres is None or not dpres.any()):
             # Abaqus' linear extrapolation: start from the previous increment's solution, scaled
@@ -206,7 +233,8 @@ class TimeIncrements(Plan):
             raise ConvergenceError(
                 f"step '{step.name}': increment fell below the minimum {self.dt_min:.3g} s at step time "
                 f"{st.step_time:.6g} s (total time {st.total_time:.6g} s): {note}. The {an.summary.increments} "
-                f"converged increments are {an.kept()}.")
+                f"converged increments are {an.kept()}."
+            )
 
     def accept(self, outcome):
         """Advance past a converged increment; returns (step time, size, last of the step, status note)."""
@@ -216,8 +244,10 @@ class TimeIncrements(Plan):
         last = not st.step_time < self.period * (1 - 1e-12)
         note = ""
         if self.step.stabilize is not None:
-            note = (f"stabilisation/strain energy {self.stabilization_ratio:.3g}, largest viscous force "
-                    f"{st.stabilization_force:.3g} N, moment {st.stabilization_moment:.3g} N m")
+            note = (
+                f"stabilisation/strain energy {self.stabilization_ratio:.3g}, largest viscous force "
+                f"{st.stabilization_force:.3g} N, moment {st.stabilization_moment:.3g} N m"
+            )
         return st.step_time, dt, last, note
 
     def grow(self, outcome, bar):
@@ -230,8 +260,11 @@ class TimeIncrements(Plan):
     @property
     def stabilization_ratio(self) -> float:
         st = self.state
-        return st.stabilization_energy / st.strain_energy if st.strain_energy > 0 else (
-            0.0 if st.stabilization_energy == 0 else float("inf"))
+        return (
+            st.stabilization_energy / st.strain_energy
+            if st.strain_energy > 0
+            else (0.0 if st.stabilization_energy == 0 else float("inf"))
+        )
 
     def finish(self, info):
         st, step = self.state, self.step
@@ -239,12 +272,16 @@ class TimeIncrements(Plan):
             info["stabilization_energy"] = st.stabilization_energy
             info["stabilization_ratio"] = ratio = self.stabilization_ratio
             # viscous forces left in the last increment: how far from equilibrium the end state is
-            info["stabilization_force"], info["stabilization_moment"] = (st.stabilization_force,
-                                                                         st.stabilization_moment)
+            info["stabilization_force"], info["stabilization_moment"] = (
+                st.stabilization_force,
+                st.stabilization_moment,
+            )
             if ratio > step.stabilize.warn_ratio:
-                msg = (f"step '{step.name}': stabilisation energy is {100 * ratio:.1f}% of the strain "
-                       f"energy (above {100 * step.stabilize.warn_ratio:.0f}%): the stabilised solution may be "
-                       "far from equilibrium; lower the damping factor or the energy fraction")
+                msg = (
+                    f"step '{step.name}': stabilisation energy is {100 * ratio:.1f}% of the strain "
+                    f"energy (above {100 * step.stabilize.warn_ratio:.0f}%): the stabilised solution may be "
+                    "far from equilibrium; lower the damping factor or the energy fraction"
+                )
                 warnings.warn(msg, StabilizationWarning, stacklevel=4)
                 if self.an.progress:
                     tqdm.write("femast: warning: " + msg)
@@ -260,14 +297,19 @@ class ArcIncrements(Plan):
         self.load_start = st.loads.copy()
         self.P_ref = step_values(analysis.model, step.loads, self.load_start, 1.0, step.period) - self.load_start
         st.lam = 0.0
-        st.size = st.first_size = None    # the first arc length comes from the first predictor
+        st.size = st.first_size = None  # the first arc length comes from the first predictor
         st.step_time = 0.0
         st.last_increment = None
         self.finished = False
 
     def bar(self, disable):
-        return tqdm(total=1.0, desc=f"step {self.step.name} (arc length)", disable=disable, leave=False,
-                    bar_format="{desc}: {percentage:3.0f}%|{bar}| [{elapsed}<{remaining}]")
+        return tqdm(
+            total=1.0,
+            desc=f"step {self.step.name} (arc length)",
+            disable=disable,
+            leave=False,
+            bar_format="{desc}: {percentage:3.0f}%|{bar}| [{elapsed}<{remaining}]",
+        )
 
     def done(self) -> bool:
         return self.finished
@@ -288,9 +330,18 @@ class ArcIncrements(Plan):
 
     def propose(self, attempt) -> Increment:
         st = self.state
-        return Increment(time=st.lam, dtime=0.0, total_time=st.total_time, step_name=self.step.name, lam=st.lam,
-                         P_start=self.load_start, P_ref=self.P_ref, predict=self._predict, dlambda=self._correct,
-                         direct=False)
+        return Increment(
+            time=st.lam,
+            dtime=0.0,
+            total_time=st.total_time,
+            step_name=self.step.name,
+            lam=st.lam,
+            P_start=self.load_start,
+            P_ref=self.P_ref,
+            predict=self._predict,
+            dlambda=self._correct,
+            direct=False,
+        )
 
     def trial(self):
         st = self.state
@@ -305,7 +356,8 @@ class ArcIncrements(Plan):
             raise ConvergenceError(
                 f"step '{self.step.name}': arc length fell below the minimum ({control.min_arc:g} of the first) "
                 f"at load factor {st.lam:.6g}: {note}. The {an.summary.increments} converged "
-                f"increments are {an.kept()}.")
+                f"increments are {an.kept()}."
+            )
 
     def accept(self, outcome):
         an, st, control = self.an, self.state, self.control

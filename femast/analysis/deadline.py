@@ -17,8 +17,9 @@ from contextlib import contextmanager
 
 from ..errors import ModelError, SampleTimeout
 
+
 class _Local(threading.local):
-    until = None     # (monotonic time, message) or None; a class default: no AttributeError to catch
+    until = None  # (monotonic time, message) or None; a class default: no AttributeError to catch
 
 
 _LOCAL = _Local()

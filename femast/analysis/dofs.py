@@ -50,8 +50,9 @@ class DofMap:
         return pos // 6, pos % 6
 
 
-def number_dofs(n_nodes: int, families, constrained_slots: np.ndarray, labels, extra_active=None,
-                dependent=None) -> DofMap:
+def number_dofs(
+    n_nodes: int, families, constrained_slots: np.ndarray, labels, extra_active=None, dependent=None
+) -> DofMap:
     """Number the DOFs.  ``constrained_slots`` is a (n_nodes, 6) bool array of slots that are
     fixed or prescribed (constraining an inactive slot has no effect); ``extra_active`` slots are
     active even without an element (rigid-body reference nodes); ``dependent`` slots are
@@ -72,5 +73,4 @@ def number_dofs(n_nodes: int, families, constrained_slots: np.ndarray, labels, e
     eq[free] = np.arange(n_free)
     eq[cons] = n_free + np.arange(n_cons)
     eq[dep] = n_free + n_cons + np.arange(int(dep.sum()))
-    return DofMap(eq=eq, n_free=n_free, n_active=int(active.sum()), labels=np.asarray(labels),
-                  n_constrained=n_cons)
+    return DofMap(eq=eq, n_free=n_free, n_active=int(active.sum()), labels=np.asarray(labels), n_constrained=n_cons)

@@ -31,10 +31,23 @@ def build_families(model):
         if kind == "beam":
             E0, parallel = element_frames(X[nodes[:, 0]], X[nodes[:, 1]], np.array([s.up for s in specs], float))
             if parallel.any():
-                raise ModelError(f"beam element {labels[np.flatnonzero(parallel)[0]]}: up-vector parallel to the element")
+                raise ModelError(
+                    f"beam element {labels[np.flatnonzero(parallel)[0]]}: up-vector parallel to the element"
+                )
             sec = [s.section for s in specs]
-            fams.append(BeamFamily(nodes, E0, lengths, [c.E * c.A for c in sec], [c.G * c.J for c in sec],
-                                   [c.E * c.Iy for c in sec], [c.E * c.Iz for c in sec], labels=labels, name=name))
+            fams.append(
+                BeamFamily(
+                    nodes,
+                    E0,
+                    lengths,
+                    [c.E * c.A for c in sec],
+                    [c.G * c.J for c in sec],
+                    [c.E * c.Iy for c in sec],
+                    [c.E * c.Iz for c in sec],
+                    labels=labels,
+                    name=name,
+                )
+            )
         else:
             L0 = lengths.copy()
             given = np.array([s.L0 is not None for s in specs], bool)
@@ -43,9 +56,12 @@ def build_families(model):
                 L0[given] = [specs[i].L0 for i in np.flatnonzero(given)]
             if pre.any():
                 k = np.flatnonzero(pre)
-                L0[k] = lengths[k] / (1.0 + np.array([specs[i].pretension for i in k]) / np.array([specs[i].EA for i in k]))
-            fams.append(TrussFamily(nodes, L0, [s.EA for s in specs], [s.tension_only for s in specs],
-                                    labels=labels, name=name))
+                L0[k] = lengths[k] / (
+                    1.0 + np.array([specs[i].pretension for i in k]) / np.array([specs[i].EA for i in k])
+                )
+            fams.append(
+                TrussFamily(nodes, L0, [s.EA for s in specs], [s.tension_only for s in specs], labels=labels, name=name)
+            )
     for fam in model.families:
         f = copy.copy(fam)
         f.nodes = np.ascontiguousarray(np.vectorize(model.index)(np.asarray(fam.nodes)), dtype=np.int64)
@@ -55,4 +71,3 @@ def build_families(model):
         if names.count(n) > 1:
             raise ModelError(f"two element families are named '{n}'; give them different names")
     return fams
-

@@ -132,8 +132,14 @@ class Newton:
         ratio by less than this factor (dimensionless, 0 < slow < 1).
     """
 
-    def __init__(self, convergence: Convergence | None = None, line_search="auto", tangent="auto",
-                 refactor_every: int = 6, slow: float = 0.25):
+    def __init__(
+        self,
+        convergence: Convergence | None = None,
+        line_search="auto",
+        tangent="auto",
+        refactor_every: int = 6,
+        slow: float = 0.25,
+    ):
         if tangent not in TANGENTS:
             raise ModelError(f"Newton: tangent='{tangent}' is not one of {', '.join(repr(t) for t in TANGENTS)}")
         if not (isinstance(refactor_every, int) and refactor_every >= 1):
@@ -145,7 +151,7 @@ class Newton:
         self.tangent = tangent
         self.refactor_every = refactor_every
         self.slow = float(slow)
-        self.factorized = False   # a usable factorisation exists (modified / initial Newton)
+        self.factorized = False  # a usable factorisation exists (modified / initial Newton)
         # "auto": [state version, x, R, formed] of the factorisation kept for the next increment's
         # first iteration (x, R: the configuration it was formed at; formed False after a restart)
         self._reuse = None
@@ -169,9 +175,18 @@ class Newton:
     def _reusable(self, system, state, inc, has_dpres, uses_lam, it):
         """The kept factorisation serves this increment's first iteration ("auto" only)."""
         r = self._reuse
-        return (self.tangent == "auto" and it == 0 and r is not None and r[0] == state.version and not has_dpres
-                and not uses_lam and inc.predictor is None and inc.viscous is None and inc.direct
-                and all(f.path_independent for f in system.families))
+        return (
+            self.tangent == "auto"
+            and it == 0
+            and r is not None
+            and r[0] == state.version
+            and not has_dpres
+            and not uses_lam
+            and inc.predictor is None
+            and inc.viscous is None
+            and inc.direct
+            and all(f.path_independent for f in system.families)
+        )
 
     def _form_again(self, system, state, ctx):
         """Form the kept factorisation again at the configuration it was formed at (a restarted run)."""
@@ -226,8 +241,14 @@ class Newton:
         """Solve increment ``inc`` from the committed ``state``: commit it and return
         ``Outcome(ok=True, ...)``, or roll back and return why it failed."""
         x0, R0 = state.checkpoint()
-        ctx = IncrementContext(time=inc.time, dtime=inc.dtime, total_time=inc.total_time, x_committed=x0,
-                               R_committed=R0, step_name=inc.step_name)
+        ctx = IncrementContext(
+            time=inc.time,
+            dtime=inc.dtime,
+            total_time=inc.total_time,
+            x_committed=x0,
+            R_committed=R0,
+            step_name=inc.step_name,
+        )
         summary = system.summary
         uses_lam = inc.P_ref is not None
         lam = inc.lam
@@ -244,15 +265,15 @@ class Newton:
         conv = self.convergence
         method = self.method()
         broyden = Broyden() if method == "quasi-newton" and not uses_lam else None
-        since = 0   # iterations on the current factorisation
+        since = 0  # iterations on the current factorisation
         ratios = []  # residual ratios, the first before any iteration (modified / quasi-Newton)
-        steps = []   # largest |correction| of each iteration (modified / quasi-Newton)
+        steps = []  # largest |correction| of each iteration (modified / quasi-Newton)
         keep = self.tangent == "auto" and all(f.path_independent for f in system.families)
         # the predicted-correction acceptance: full Newton (the factorisation in hand formed at the
         # previous iterate), fixed loads, no line search (its steps are not Newton's corrections)
         predict = conv.predicted and method == "full" and not uses_lam and not line_search
-        sizes = []   # scaled size of each correction of this attempt (Convergence.measure)
-        formed_at = None   # (x, R) of this attempt's last factorisation ("auto", path-independent)
+        sizes = []  # scaled size of each correction of this attempt (Convergence.measure)
+        formed_at = None  # (x, R) of this attempt's last factorisation ("auto", path-independent)
 
         def fail(why):
             state.rollback()
@@ -287,10 +308,19 @@ class Newton:
         try:
             P = inc.loads(lam)
             responses, F, r = evaluate(P, reuse=True)
+            du = None  # the last correction: set by iteration 0, read by the convergence test from iteration 1
             for it in range(conv.max_iterations + 1):
-                check_deadline()   # Study(timeout_s=) in threads (femast/analysis/deadline.py)
-                if (it == 0 and not uses_lam and not has_dpres and not whole and not np.any(Du) and visc is None
-                        and state.at_equilibrium and np.array_equal(P, state.loads)):
+                check_deadline()  # Study(timeout_s=) in threads (femast/analysis/deadline.py)
+                if (
+                    it == 0
+                    and not uses_lam
+                    and not has_dpres
+                    and not whole
+                    and not np.any(Du)
+                    and visc is None
+                    and state.at_equilibrium
+                    and np.array_equal(P, state.loads)
+                ):
                     # nothing changes (e.g. a step that repeats the previous loads): the committed
                     # state is the converged solution
                     system.commit(responses, P, F, lam)
@@ -301,8 +331,8 @@ class Newton:
                     # (k >= 3: the first iteration is the increment's step, then two corrections of iterates)
                     early = not ok and forces_ok and predict and iters >= 3
                     if (ok or early) and any(q.provisional for q in responses):
-                        ok = early = False   # an element answered with a predictor, not its law (ElementResponse)
-                    if early:   # the predicted next correction (convergence.py)
+                        ok = early = False  # an element answered with a predictor, not its law (ElementResponse)
+                    if early:  # the predicted next correction (convergence.py)
                         ok = self._predicted(system, conv, r, Du, sizes)
                     rnorm_hist.append(ratio)
                     ratios.append(ratio)
@@ -311,12 +341,14 @@ class Newton:
                             visc.converged(state, Du, dt, responses)
                         state.last_increment, state.last_size, state.last_dlam = Du.copy(), dt, lam - lam_start
                         system.commit(responses, P, F, lam, equilibrium=visc is None)
-                        if formed_at is not None:   # kept for the next increment's first iteration
+                        if formed_at is not None:  # kept for the next increment's first iteration
                             self._reuse = [state.version, formed_at[0], formed_at[1], True]
                         return Outcome(True, iters, "", responses, Du, lam - lam_start)
                     if it == conv.max_iterations:
-                        return fail(f"no convergence in {iters} iterations "
-                                    f"(residual ratio {ratio:.3g}, worst at {system.worst(r)})")
+                        return fail(
+                            f"no convergence in {iters} iterations "
+                            f"(residual ratio {ratio:.3g}, worst at {system.worst(r)})"
+                        )
                     if it >= 8 and rnorm_hist[-1] > rnorm_hist[-2] > rnorm_hist[-3] > rnorm_hist[-4]:
                         return fail(f"residual diverging (ratio {ratio:.3g}, worst at {system.worst(r)})")
                 # the tangent only when another iteration is needed
@@ -352,7 +384,7 @@ class Newton:
                         return fail("singular tangent (bifurcation or mechanism)")
                 elif with_fc:
                     Kfc = system.assembler.coupling([q.k for q in responses])
-                if it == 0 and method in ("modified", "quasi-newton"):   # (after the first tangent's floors)
+                if it == 0 and method in ("modified", "quasi-newton"):  # (after the first tangent's floors)
                     ratios.append(system.converged(conv, r, None, Du, responses, P, 0)[1])
                 ts = _time.perf_counter()
                 if it == 0 and inc.predict is not None:
@@ -389,10 +421,11 @@ class Newton:
                 Du += du
                 responses, F, r_new = evaluate(P)
                 if search:
-                    du, responses, F, r_new = line_search_step(system, state, du, r, r_new, responses, F, before,
-                                                               evaluate, P, Du_before)
+                    du, responses, F, r_new = line_search_step(
+                        system, state, du, r, r_new, responses, F, before, evaluate, P, Du_before
+                    )
                     Du = Du_before + du
-                if broyden is not None:   # the secant pair of this step (none across prescribed motion)
+                if broyden is not None:  # the secant pair of this step (none across prescribed motion)
                     broyden.step(du, None if with_fc else r_new)
                 r = r_new
         except (FloatingPointError, SingularModelError, ValueError) as exc:
@@ -407,8 +440,7 @@ class Newton:
         return fail("no convergence")
 
 
-def line_search_step(system, state, du, r0, r1, responses, F, before, evaluate, P, Du_before, eta=0.8,
-                     max_steps=5):
+def line_search_step(system, state, du, r0, r1, responses, F, before, evaluate, P, Du_before, eta=0.8, max_steps=5):
     """Secant line search on g(s) = du . r(u + s du) (Crisfield 1991, sec. 9.3): only when the
     full step leaves |g(1)| > eta |g(0)|.  Returns the accepted step and its evaluation (``F``: the
     residual on the independent DOFs of the trial point, kept for the commit)."""
@@ -453,7 +485,7 @@ class Broyden:
     def reset(self):
         """A new factorisation: H = K^-1, no pairs."""
         self.w, self.s = [], []
-        self._h = None        # H_k r_k, the last direction
+        self._h = None  # H_k r_k, the last direction
         self._pending = None  # (s_k, h_k) waiting for r_(k+1)
 
     def _apply(self, solve, v):
@@ -463,17 +495,17 @@ class Broyden:
         return x
 
     def direction(self, solve, r):
-        q = self._apply(solve, r)   # H_k r_(k+1)
+        q = self._apply(solve, r)  # H_k r_(k+1)
         if self._pending is not None:
             s, h = self._pending
             self._pending = None
-            z = h - q               # H_k y_k
+            z = h - q  # H_k y_k
             sz = float(s @ z)
             if abs(sz) > 1e-12 * float(np.linalg.norm(s) * np.linalg.norm(z)) and np.isfinite(sz):
                 w = (s - z) / sz
                 self.w.append(w)
                 self.s.append(s)
-                q += w * (s @ q)    # H_(k+1) r_(k+1)
+                q += w * (s @ q)  # H_(k+1) r_(k+1)
         self._h = q
         return q
 

@@ -55,8 +55,8 @@ class ResultsOutput(Observer):
         self.out = out
         self.recorders = [r for r in recorders if r is not None]
         self.writer = None
-        self.pending = None   # a converged increment not written yet (Step.output_frequency)
-        self.coder, self.coders_made = None, 0   # frames encoded from the state (frame_coder.py)
+        self.pending = None  # a converged increment not written yet (Step.output_frequency)
+        self.coder, self.coders_made = None, 0  # frames encoded from the state (frame_coder.py)
 
     @property
     def active(self) -> bool:
@@ -64,10 +64,14 @@ class ResultsOutput(Observer):
         return self.out is not None or bool(self.recorders)
 
     def started(self, analysis):
-        resume = getattr(analysis, "resume", None)   # a restarted run (restart.py): frames on disk kept
-        self.writer = (NullWriter() if self.out is None
-                       else ResultsWriter(self.out, analysis.model, analysis.families,
-                                          resume=None if resume is None else resume["frames"]))
+        resume = getattr(analysis, "resume", None)  # a restarted run (restart.py): frames on disk kept
+        self.writer = (
+            NullWriter()
+            if self.out is None
+            else ResultsWriter(
+                self.out, analysis.model, analysis.families, resume=None if resume is None else resume["frames"]
+            )
+        )
         self.pending = None
         if resume is None:
             self.frame(analysis, step_name="initial", inc=0, time=0.0, iterations=0, responses=None)
@@ -83,8 +87,7 @@ class ResultsOutput(Observer):
             self.writer.flush()
 
     def cutback(self, analysis, step, increment, attempt, iterations, time, total_time, dtime, lam, note):
-        self.writer.status(step.name, increment, attempt, iterations, time, total_time, dtime, lam,
-                           f"cutback: {note}")
+        self.writer.status(step.name, increment, attempt, iterations, time, total_time, dtime, lam, f"cutback: {note}")
 
     def converged(self, analysis, step, increment, attempt, iterations, time, dtime, last, responses, note):
         """Write the frame of increment ``increment`` if the step's output frequency asks for it or
@@ -93,14 +96,14 @@ class ResultsOutput(Observer):
         st = analysis.state
         line = (step.name, increment, attempt, iterations, time, st.total_time, dtime, st.lam, note)
         if last or increment % step.output_frequency == 0:
-            self.frame(analysis, *frame)   # on the OS before the status line says it converged
+            self.frame(analysis, *frame)  # on the OS before the status line says it converged
             self.pending = None
         else:
             self.pending = frame
         self.writer.status(*line)
 
     def stopped(self, analysis):
-        if self.pending is not None:   # the state is that of the last converged increment
+        if self.pending is not None:  # the state is that of the last converged increment
             self.frame(analysis, *self.pending)
             self.pending = None
 
@@ -113,15 +116,24 @@ class ResultsOutput(Observer):
         if not self.active:
             return
         st, sys_ = analysis.state, analysis.system
-        converged = responses is not None   # (the initial frame has no reactions)
+        converged = responses is not None  # (the initial frame has no reactions)
         if responses is None:
             responses = sys_.evaluate(sys_.committed_context())
         outputs = {f.name: r.output for f, r in zip(analysis.families, responses)}
-        scalars = (step_name, inc, time, st.total_time, st.lam, iterations, st.strain_energy,
-                   st.stabilization_energy)
-        if self.coder is not None and not self.recorders:   # a folder only: the run's frames repeat one layout
-            record = self.coder.record(scalars, st.x, sys_.X0, st.R, st.spin, st.loads, sys_.cons_node,
-                                       sys_.cons_dof, st.reactions if converged else None, outputs)
+        scalars = (step_name, inc, time, st.total_time, st.lam, iterations, st.strain_energy, st.stabilization_energy)
+        if self.coder is not None and not self.recorders:  # a folder only: the run's frames repeat one layout
+            record = self.coder.record(
+                scalars,
+                st.x,
+                sys_.X0,
+                st.R,
+                st.spin,
+                st.loads,
+                sys_.cons_node,
+                sys_.cons_dof,
+                st.reactions if converged else None,
+                outputs,
+            )
             if record is not None:
                 self.writer.append(record)
                 return
@@ -133,8 +145,14 @@ class ResultsOutput(Observer):
                 RF[sys_.cons_node, sys_.cons_dof] = st.reactions
             return RF
 
-        state = {"U": lambda: st.x - sys_.X0, "R": lambda: st.R.copy(), "UR": lambda: rotation_vectors(st.R),
-                 "URA": lambda: st.spin.copy(), "RF": reactions, "P": lambda: st.loads.copy()}
+        state = {
+            "U": lambda: st.x - sys_.X0,
+            "R": lambda: st.R.copy(),
+            "UR": lambda: rotation_vectors(st.R),
+            "URA": lambda: st.spin.copy(),
+            "RF": reactions,
+            "P": lambda: st.loads.copy(),
+        }
         data = dict(zip(SCALARS, scalars))
         if isinstance(self.writer, NullWriter):
             # recorders only (out=None): a frame that computes what a recorder reads (issue 21: an FE
@@ -143,19 +161,18 @@ class ResultsOutput(Observer):
             self.writer.frame()
             for record in self.recorders:
                 record(frame)
-            if sys.getrefcount(frame) > 2:   # (this name and getrefcount's argument)
+            if sys.getrefcount(frame) > 2:  # (this name and getrefcount's argument)
                 frame.complete()
             return
-        if self.recorders:   # a recorder may keep the arrays: the state's own are copied
+        if self.recorders:  # a recorder may keep the arrays: the state's own are copied
             data.update({k: make() for k, make in state.items()})
-        else:                # written at once (ResultsWriter.frame): the state's arrays as they are
-            data.update(U=st.x - sys_.X0, R=st.R, UR=rotation_vectors(st.R), URA=st.spin, RF=reactions(),
-                        P=st.loads)
+        else:  # written at once (ResultsWriter.frame): the state's arrays as they are
+            data.update(U=st.x - sys_.X0, R=st.R, UR=rotation_vectors(st.R), URA=st.spin, RF=reactions(), P=st.loads)
         for name, out in outputs.items():
             for key, val in out.items():
                 data[f"el/{name}/{key}"] = val
         self.writer.frame(**data)
-        if not self.recorders and self.coders_made < 8:   # (made again after a new step name; not forever)
+        if not self.recorders and self.coders_made < 8:  # (made again after a new step name; not forever)
             self.coders_made += 1
             self.coder = FrameCoder.make(data, n)
         for record in self.recorders:

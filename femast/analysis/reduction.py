@@ -98,15 +98,14 @@ class ReducedTangent:
         fc_r, fc_c = rows[~in_ff], cols[~in_ff] - nf
         self.K_ff = sp.csr_matrix((self.data[:n_ff], ff_c, _indptr(ff_r, nf)), shape=(nf, nf))
         self.K_fc = sp.csr_matrix((self.data[n_ff:], fc_c, _indptr(fc_r, nf)), shape=(nf, n_ind - nf))
-        self.K_ff.data = self.data[:n_ff]   # views: filling self.data fills both blocks
+        self.K_ff.data = self.data[:n_ff]  # views: filling self.data fills both blocks
         self.K_fc.data = self.data[n_ff:]
         self.K_ff.has_canonical_format = True
         self.K_fc.has_canonical_format = True
 
     def fill(self, K_data, T_data, g_vals):
         """Refill both blocks from the current values of K, T and G; returns (K_ff, K_fc)."""
-        _fill(K_data, T_data, self.pa, self.pt1, self.pt2, self.pos, np.asarray(g_vals, float), self.g_pos,
-              self.data)
+        _fill(K_data, T_data, self.pa, self.pt1, self.pt2, self.pos, np.asarray(g_vals, float), self.g_pos, self.data)
         return self.K_ff, self.K_fc
 
 

@@ -42,7 +42,7 @@ class ReferencePath(Observer):
 
     def converged(self, analysis, step, increment, attempt, iterations, time, dtime, last, responses, note):
         st = analysis.state
-        if st.last_increment is None or iterations == 0:   # 0: nothing changed (no new last_increment)
+        if st.last_increment is None or iterations == 0:  # 0: nothing changed (no new last_increment)
             return
         t1 = st.total_time
         self.increments[_key(st.step, t1 - dtime, t1)] = st.last_increment.copy()

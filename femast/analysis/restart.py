@@ -68,7 +68,7 @@ class RestartOutput(Observer):
     """Saves the restart point every ``every`` converged increments and at each step's end."""
 
     def __init__(self, every: int | None):
-        self.every = every   # None: the restarted run's (1 for a fresh run)
+        self.every = every  # None: the restarted run's (1 for a fresh run)
         self.saves = 0
         self.folder = None
         self.step_start = None
@@ -78,7 +78,7 @@ class RestartOutput(Observer):
             raise FemastError("restart_every needs a results folder (out=None writes nothing to restart from)")
         self.folder = Path(analysis.out) / RESTART_DIR
         resume = analysis.resume
-        if resume is None:   # a fresh run: an earlier run's restart point is stale
+        if resume is None:  # a fresh run: an earlier run's restart point is stale
             if self.folder.is_dir():
                 for f in self.folder.iterdir():
                     f.unlink()
@@ -86,8 +86,7 @@ class RestartOutput(Observer):
             self.step_start = (st.loads.copy(), st.prescribed.copy())
             self.folder.mkdir(parents=True, exist_ok=True)
             # the start is a restart point too: a run killed before its first save starts over
-            write_json_atomic(self.folder / "restart.json", {"format": FORMAT, "initial": True,
-                                                             **_model_id(analysis)})
+            write_json_atomic(self.folder / "restart.json", {"format": FORMAT, "initial": True, **_model_id(analysis)})
         else:
             self.saves = resume["saves"]
             self.step_start = resume["step_start"]
@@ -100,13 +99,13 @@ class RestartOutput(Observer):
     def converged(self, analysis, step, increment, attempt, iterations, time, dtime, last, responses, note):
         if last or increment % self.every == 0:
             self.save(analysis, step_done=last)
-        if last:   # the next step starts from this state
+        if last:  # the next step starts from this state
             st = analysis.state
             self.step_start = (st.loads.copy(), st.prescribed.copy())
 
     def save(self, analysis, step_done: bool):
         an, st, summary = analysis, analysis.state, analysis.summary
-        an.output.flush()   # every frame up to here on disk (fsync'd) before the restart point names them
+        an.output.flush()  # every frame up to here on disk (fsync'd) before the restart point names them
         self.saves += 1
         k = self.saves
         state_file, extra_file = f"state-{k}.npz", f"extra-{k}.npz"
@@ -114,23 +113,37 @@ class RestartOutput(Observer):
         st.save(tmp)
         os.replace(tmp, self.folder / state_file)
         tmp = self.folder / (extra_file + ".tmp")
-        reuse = an.algorithm.reuse_configuration()   # the factorisation the next increment reuses
+        reuse = an.algorithm.reuse_configuration()  # the factorisation the next increment reuses
         extra = {} if reuse is None else {"reuse_x": reuse[0], "reuse_R": reuse[1]}
         with open(tmp, "wb") as fh:
             np.savez(fh, load_start=self.step_start[0], pres_start=self.step_start[1], **extra)
         os.replace(tmp, self.folder / extra_file)
         done_iters = sum(s["iterations"] for s in summary.steps)
         zf = an.system.zero_force
-        info = {"format": FORMAT, "step": int(st.step), "step_name": an.model.steps[st.step].name,
-                "step_done": bool(step_done), "increment": int(st.increment), "frames": an.output.frames,
-                "saves": k, "every": self.every, "state_file": state_file, "extra_file": extra_file,
-                "zero_force": None if zf is None else float(zf).hex(),
-                **_model_id(an),
-                "summary": {"increments": summary.increments, "iterations": summary.iterations,
-                            "cutbacks": summary.cutbacks, "line_searches": summary.line_searches,
-                            "steps": summary.steps, "step_iterations": summary.iterations - done_iters}}
+        info = {
+            "format": FORMAT,
+            "step": int(st.step),
+            "step_name": an.model.steps[st.step].name,
+            "step_done": bool(step_done),
+            "increment": int(st.increment),
+            "frames": an.output.frames,
+            "saves": k,
+            "every": self.every,
+            "state_file": state_file,
+            "extra_file": extra_file,
+            "zero_force": None if zf is None else float(zf).hex(),
+            **_model_id(an),
+            "summary": {
+                "increments": summary.increments,
+                "iterations": summary.iterations,
+                "cutbacks": summary.cutbacks,
+                "line_searches": summary.line_searches,
+                "steps": summary.steps,
+                "step_iterations": summary.iterations - done_iters,
+            },
+        }
         write_json_atomic(self.folder / "restart.json", info)
-        for f in self.folder.glob("*-*.npz"):   # the previous restart point's files
+        for f in self.folder.glob("*-*.npz"):  # the previous restart point's files
             if f.name not in (state_file, extra_file):
                 f.unlink(missing_ok=True)
 
@@ -147,8 +160,10 @@ def load_restart(folder, analysis) -> dict | None:
     rdir = folder / RESTART_DIR
     jfile = rdir / "restart.json"
     if not jfile.is_file():
-        raise FemastError(f"{folder}: no restart point ({jfile} is missing); run the analysis with "
-                          "restart_every=n (a restart point every n increments) to be able to restart it")
+        raise FemastError(
+            f"{folder}: no restart point ({jfile} is missing); run the analysis with "
+            "restart_every=n (a restart point every n increments) to be able to restart it"
+        )
     try:
         info = json.loads(jfile.read_text())
         if info.get("format") != FORMAT:
@@ -163,16 +178,26 @@ def load_restart(folder, analysis) -> dict | None:
     except FemastError:
         raise
     except Exception as exc:
-        raise FemastError(f"{folder}: the restart point is unreadable ({type(exc).__name__}: {exc}); "
-                          "run the analysis again from the start") from None
+        raise FemastError(
+            f"{folder}: the restart point is unreadable ({type(exc).__name__}: {exc}); "
+            "run the analysis again from the start"
+        ) from None
     model = analysis.model
     names = [s.name for s in model.steps]
-    if info["n_nodes"] != len(analysis.system.X0) or info["steps"] != names or state is not None and (
-            len(state.families) != len(analysis.families) or
-            any(np.shape(a) != np.shape(f.initial_state()) for a, f in zip(state.families, analysis.families))):
-        raise FemastError(f"{folder}: the restart point belongs to another model ({info['n_nodes']} nodes, steps "
-                          f"{info['steps']}; this one: {len(analysis.system.X0)} nodes, steps {names}); restart "
-                          "with the model that wrote it")
+    if (
+        info["n_nodes"] != len(analysis.system.X0)
+        or info["steps"] != names
+        or state is not None
+        and (
+            len(state.families) != len(analysis.families)
+            or any(np.shape(a) != np.shape(f.initial_state()) for a, f in zip(state.families, analysis.families))
+        )
+    ):
+        raise FemastError(
+            f"{folder}: the restart point belongs to another model ({info['n_nodes']} nodes, steps "
+            f"{info['steps']}; this one: {len(analysis.system.X0)} nodes, steps {names}); restart "
+            "with the model that wrote it"
+        )
     if state is None:
         return None
     info.update(state=state, step_start=step_start, folder=folder, reuse=reuse)
@@ -189,7 +214,7 @@ def restore(analysis, info) -> None:
             setattr(st, f.name, getattr(saved, f.name))
     if info["zero_force"] is not None:
         analysis.system.zero_force = float.fromhex(info["zero_force"])
-    if info.get("reuse") is not None:   # the factorisation the next increment reuses: formed again there
+    if info.get("reuse") is not None:  # the factorisation the next increment reuses: formed again there
         analysis.algorithm.resume_reuse(st.version, *info["reuse"])
     s = info["summary"]
     summ = analysis.summary

@@ -25,9 +25,24 @@ import numpy as np
 from ..errors import FemastError
 
 # scalar fields written by save(), in this order (all but the arrays and `families`)
-_SCALARS = ("lam", "total_time", "step", "step_time", "increment", "size", "first_size", "easy", "strain_energy",
-            "stabilization_energy", "stabilization_force", "stabilization_moment", "at_equilibrium", "version",
-            "last_size", "last_dlam")
+_SCALARS = (
+    "lam",
+    "total_time",
+    "step",
+    "step_time",
+    "increment",
+    "size",
+    "first_size",
+    "easy",
+    "strain_energy",
+    "stabilization_energy",
+    "stabilization_force",
+    "stabilization_moment",
+    "at_equilibrium",
+    "version",
+    "last_size",
+    "last_dlam",
+)
 _ARRAYS = ("x", "R", "spin", "loads", "prescribed", "reactions", "last_increment", "damping", "damping0")
 FORMAT = "femast-state-1"
 
@@ -85,12 +100,17 @@ class State:
     _saved: tuple | None = field(default=None, repr=False)
 
     @classmethod
-    def initial(cls, X0, families) -> "State":
+    def initial(cls, X0, families) -> State:
         """The undeformed, unloaded state of nodes at ``X0`` (n, 3) with element ``families``."""
         n = len(X0)
-        return cls(x=X0.copy(), R=np.tile(np.eye(3), (n, 1, 1)), spin=np.zeros((n, 3)),
-                   families=[f.initial_state() for f in families], loads=np.zeros((n, 6)),
-                   prescribed=np.zeros((n, 6)))
+        return cls(
+            x=X0.copy(),
+            R=np.tile(np.eye(3), (n, 1, 1)),
+            spin=np.zeros((n, 3)),
+            families=[f.initial_state() for f in families],
+            loads=np.zeros((n, 6)),
+            prescribed=np.zeros((n, 6)),
+        )
 
     # ------------------------------------------------------------ increments
     def checkpoint(self):
@@ -131,7 +151,7 @@ class State:
             np.savez(fh, **data)
 
     @classmethod
-    def load(cls, path) -> "State":
+    def load(cls, path) -> State:
         """Read a state written by :meth:`save`; every array and number is the one saved, bit for bit."""
         with np.load(path, allow_pickle=False) as z:
             if "format" not in z.files or str(z["format"]) != FORMAT:
@@ -145,18 +165,25 @@ class State:
             kw["families"] = [z[f"family/{k}"] for k in range(int(z["n_families"]))]
         return cls(**kw)
 
-    def equal(self, other: "State") -> bool:
+    def equal(self, other: State) -> bool:
         """True if every array and number of ``other`` is this one's, bit for bit."""
         if len(self.families) != len(other.families):
             return False
-        same = all(np.array_equal(a, b) and a.dtype == b.dtype and a.shape == b.shape
-                   for a, b in zip(self.families, other.families))
+        same = all(
+            np.array_equal(a, b) and a.dtype == b.dtype and a.shape == b.shape
+            for a, b in zip(self.families, other.families)
+        )
         for name in _ARRAYS:
             a, b = getattr(self, name), getattr(other, name)
-            same &= (a is None and b is None) or (a is not None and b is not None and a.shape == b.shape
-                                                  and np.asarray(a).tobytes() == np.asarray(b).tobytes())
+            same &= (a is None and b is None) or (
+                a is not None
+                and b is not None
+                and a.shape == b.shape
+                and np.asarray(a).tobytes() == np.asarray(b).tobytes()
+            )
         for name in _SCALARS:
             a, b = getattr(self, name), getattr(other, name)
-            same &= (a is None and b is None) or (a is not None and b is not None and
-                                                  np.array(a).tobytes() == np.array(b).tobytes())
+            same &= (a is None and b is None) or (
+                a is not None and b is not None and np.array(a).tobytes() == np.array(b).tobytes()
+            )
         return bool(same)

@@ -8,8 +8,8 @@ increments, has the algorithm (newton.py) solve each one, retries failed attempt
 from __future__ import annotations
 
 from .. import progress as _progress
-from .solvers.control import LoadControl
 from .controls import plan_for
+from .solvers.control import LoadControl
 
 
 def run_step(analysis, step, resume=None):
@@ -45,8 +45,9 @@ def run_step(analysis, step, resume=None):
                     break
                 time, total_time, dtime, lam = plan.trial()
                 for obs in an.observers:
-                    obs.cutback(an, step, st.increment + 1, attempt, out.iterations, time, total_time, dtime, lam,
-                                out.note)
+                    obs.cutback(
+                        an, step, st.increment + 1, attempt, out.iterations, time, total_time, dtime, lam, out.note
+                    )
                 summary.cutbacks += 1
                 plan.cutback(out.note)
             st.increment += 1

@@ -13,8 +13,8 @@ class StabilizationWarning(UserWarning):
 class AnalysisSummary:
     """What a run did: counts, wall time and where it stopped."""
 
-    completed: bool = False      # True only once every step has run (status "completed")
-    status: str = "running"      # "running", then "completed", "failed" or "interrupted" (issue 16)
+    completed: bool = False  # True only once every step has run (status "completed")
+    status: str = "running"  # "running", then "completed", "failed" or "interrupted" (issue 16)
     increments: int = 0
     iterations: int = 0
     cutbacks: int = 0
@@ -30,8 +30,9 @@ class AnalysisSummary:
 
     def __str__(self):
         state = {"completed": "completed", "interrupted": "INTERRUPTED"}.get(self.status, "FAILED")
-        return (f"femast: analysis {state}: {self.increments} increments, {self.iterations} Newton iterations, "
-                f"{self.cutbacks} cutbacks, wall time {self.wall_time:.2f} s "
-                f"(assembly {self.assembly_time:.2f} s, linear solve {self.solve_time:.2f} s)"
-                + (f"\n  {self.message}" if self.message else ""))
-
+        return (
+            f"femast: analysis {state}: {self.increments} increments, {self.iterations} Newton iterations, "
+            f"{self.cutbacks} cutbacks, wall time {self.wall_time:.2f} s "
+            f"(assembly {self.assembly_time:.2f} s, linear solve {self.solve_time:.2f} s)"
+            + (f"\n  {self.message}" if self.message else "")
+        )

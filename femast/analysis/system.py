@@ -17,13 +17,13 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
+from ..elements.base import DOF_NAMES, IncrementContext
+from ..errors import ModelError, SingularModelError
+from ..model import validation
+from ..model.constraints import Constraints, transpose_times
 from .assembly import Assembler, assigning_positions
 from .configuration import update_configuration
-from ..model.constraints import Constraints, transpose_times
 from .dofs import number_dofs
-from ..elements.base import DOF_NAMES, IncrementContext
-from ..model import validation
-from ..errors import ModelError, SingularModelError
 from .reduction import ReducedTangent
 from .solvers.convergence import all_finite, force_moment_abs_max, scaled_size
 from .solvers.linear import SparseLU, mechanism_dofs
@@ -59,7 +59,7 @@ class System:
         self.model = model
         self.families = families
         self.summary = summary
-        self.state = None              # the State whose configuration is updated (set by Analysis)
+        self.state = None  # the State whose configuration is updated (set by Analysis)
         self.X0 = model.coordinates
         n = len(self.X0)
         constrained = np.zeros((n, 6), dtype=bool)
@@ -71,30 +71,37 @@ class System:
             for c in s.prescribed:
                 i = model.index(c.node)
                 if self.fixed[i, c.dof]:
-                    raise ModelError(f"step '{s.name}': node {c.node} {DOF_NAMES[c.dof]} is both fixed and "
-                                     "prescribed; remove one of the two")
+                    raise ModelError(
+                        f"step '{s.name}': node {c.node} {DOF_NAMES[c.dof]} is both fixed and "
+                        "prescribed; remove one of the two"
+                    )
                 constrained[i, c.dof] = True
         for s in model.steps:
             for c in s.loads:
                 if constrained[model.index(c.node), c.dof] and c.magnitude != 0.0:
-                    raise ModelError(f"step '{s.name}': node {c.node} {DOF_NAMES[c.dof]} is both loaded and "
-                                     "fixed/prescribed; a DOF can have a load or a prescribed value, not both")
+                    raise ModelError(
+                        f"step '{s.name}': node {c.node} {DOF_NAMES[c.dof]} is both loaded and "
+                        "fixed/prescribed; a DOF can have a load or a prescribed value, not both"
+                    )
         self.constrained = constrained
         self.constraints = Constraints(model, n)
         clash = self.constraints.dependent & constrained
         if clash.any():
             i, d = np.argwhere(clash)[0]
-            raise ModelError(f"node {model.node_labels[i]} {DOF_NAMES[d]} is dependent in a rigid body or tie and "
-                             "also fixed or prescribed; fix or drive the reference (master) node instead")
+            raise ModelError(
+                f"node {model.node_labels[i]} {DOF_NAMES[d]} is dependent in a rigid body or tie and "
+                "also fixed or prescribed; fix or drive the reference (master) node instead"
+            )
         extra = np.zeros((n, 6), dtype=bool)
         extra[self.constraints.references] = True
-        self.dofmap = number_dofs(n, self.families, constrained, model.node_labels, extra_active=extra,
-                                  dependent=self.constraints.dependent)
+        self.dofmap = number_dofs(
+            n, self.families, constrained, model.node_labels, extra_active=extra, dependent=self.constraints.dependent
+        )
         if self.dofmap.n_free == 0:
             raise ModelError(f"model '{model.name}' has no free DOFs")
-        validation.loads_on_active_dofs(model, self.dofmap)   # a load nothing stiffens: an error (issue 16)
+        validation.loads_on_active_dofs(model, self.dofmap)  # a load nothing stiffens: an error (issue 16)
         self.check_balance = validation.self_equilibrated(self.families)
-        self._constrained = self.constraints.active   # fixed from here on (asked every iteration)
+        self._constrained = self.constraints.active  # fixed from here on (asked every iteration)
         self.assembler = Assembler(self.dofmap, self.families, full=self._constrained)
         self.constraints.setup(self.dofmap, self.X0)
         nf, ni = self.dofmap.n_free, self.dofmap.n_independent
@@ -104,9 +111,9 @@ class System:
         self._labels = model.node_labels
         self.act_node, self.act_dof = self.dofmap.slots(np.arange(self.dofmap.n_active))
         self.is_rot = self.free_dof >= 3
-        self._W = np.zeros((n, 3))     # scratch spins of the configuration update
+        self._W = np.zeros((n, 3))  # scratch spins of the configuration update
         self._no_update = np.zeros(0)
-        self._Pa = None                # (loads array, its values on the active DOFs)
+        self._Pa = None  # (loads array, its values on the active DOFs)
         self.length = float(np.ptp(self.X0, axis=0).max()) or 1.0
         self.symmetric = all(getattr(f, "symmetric", False) for f in self.families)
         self.solver = SparseLU(symmetric=self.symmetric, backend=linear_solver)
@@ -114,13 +121,20 @@ class System:
             # symbolic analysis (the ordering) from the assembly pattern, once, at set-up; a
             # constrained model's reduced pattern T^T K T is only known at its first iteration
             self.solver.analyse(self.assembler.K_ff)
-        self._direct = None   # (solver layout, positions): K_ff assembled into the solver's matrix
+        self._direct = None  # (solver layout, positions): K_ff assembled into the solver's matrix
         # constrained models: T^T K T + G on a pattern computed once (femast/analysis/reduction.py)
-        self._reduced = (ReducedTangent(self.assembler.K_aa, self.constraints.transformation(self.X0),
-                                        *self.constraints.geometric_entries(), self.dofmap.n_free)
-                         if self._constrained else None)
-        self.last_converged = None     # (version, responses) of the last committed increment
-        self._diag_cache = None        # (K's indptr, indices, K + diag buffer, diagonal positions)
+        self._reduced = (
+            ReducedTangent(
+                self.assembler.K_aa,
+                self.constraints.transformation(self.X0),
+                *self.constraints.geometric_entries(),
+                self.dofmap.n_free,
+            )
+            if self._constrained
+            else None
+        )
+        self.last_converged = None  # (version, responses) of the last committed increment
+        self._diag_cache = None  # (K's indptr, indices, K + diag buffer, diagonal positions)
         self.zero_force = None
 
     # ------------------------------------------------------------ evaluation
@@ -145,7 +159,7 @@ class System:
                 responses.append(cached[i])
                 continue
             r = f.evaluate(x, R, s, ctx)
-            if not all_finite(r.f):   # (compiled: numpy's isfinite + all cost ~2 us a call)
+            if not all_finite(r.f):  # (compiled: numpy's isfinite + all cost ~2 us a call)
                 raise FloatingPointError(f"non-finite internal forces in element family '{f.name}'")
             responses.append(r)
         return responses
@@ -165,7 +179,7 @@ class System:
     def residual(self, responses, P):
         """Residual P - F on the independent DOFs (free first, then constrained)."""
         F = self.assembler.forces([q.f for q in responses])
-        if self._Pa is None or self._Pa[0] is not P:   # the loads are fixed within an increment
+        if self._Pa is None or self._Pa[0] is not P:  # the loads are fixed within an increment
             self._Pa = (P, P[self.act_node, self.act_dof])
         self._net = F - self._Pa[1]
         if not self._constrained:
@@ -195,7 +209,7 @@ class System:
             # the direct path needs the solver's pattern to be K_ff's own
             same = self.solver.has_pattern(self.assembler.K_ff)
             positions = [self.solver.permuted_positions(p) for p in self.assembler.pos_ff] if same else None
-            if positions is not None:   # the first entry of each position assigns it: no zeroing
+            if positions is not None:  # the first entry of each position assigns it: no zeroing
                 positions = assigning_positions(positions, self.solver.values.size)
             self._direct = (self.solver.layout, positions)
         if self._direct[1] is None:
@@ -232,8 +246,9 @@ class System:
             K, Kfc = self.assembler.tangent(k_list, with_fc=with_fc)
         else:
             K_aa = self.assembler.full_tangent(k_list)
-            K, Kfc = self._reduced.fill(K_aa.data, self._T.data,
-                                        self.constraints.geometric_values(self.state.x, self._net))
+            K, Kfc = self._reduced.fill(
+                K_aa.data, self._T.data, self.constraints.geometric_values(self.state.x, self._net)
+            )
             Kfc = Kfc if with_fc else None
         if self.zero_force is None:
             self._set_floors(K.diagonal())
@@ -259,7 +274,7 @@ class System:
             n = K.shape[0]
             rows = np.repeat(np.arange(n), np.diff(K.indptr))
             d = np.flatnonzero(K.indices == rows)
-            if K.has_canonical_format and d.size == n:   # one diagonal entry per row
+            if K.has_canonical_format and d.size == n:  # one diagonal entry per row
                 out = sp.csr_matrix((K.data.copy(), K.indices, K.indptr), shape=K.shape)
             else:
                 out = d = None
@@ -277,9 +292,18 @@ class System:
         configuration of ``state``; dependent (slave) DOFs follow their constraints."""
         st = self.state
         st.version += 1
-        update_configuration(st.x, st.spin, st.R, self._W, self.free_node, self.free_dof,
-                             np.ascontiguousarray(du_free, dtype=float), self.cons_node, self.cons_dof,
-                             self._no_update if du_cons is None else np.ascontiguousarray(du_cons, dtype=float))
+        update_configuration(
+            st.x,
+            st.spin,
+            st.R,
+            self._W,
+            self.free_node,
+            self.free_dof,
+            np.ascontiguousarray(du_free, dtype=float),
+            self.cons_node,
+            self.cons_dof,
+            self._no_update if du_cons is None else np.ascontiguousarray(du_cons, dtype=float),
+        )
         if self._constrained:
             self.constraints.update_slaves(st.x, st.R, st.spin)
 
@@ -307,17 +331,29 @@ class System:
         """Commit a converged increment into the state (one call: see :meth:`State.commit`)."""
         st = self.state
         self.last_converged = (st.version, responses)
-        reactions = -res[self.dofmap.n_free:]
+        reactions = -res[self.dofmap.n_free :]
         RF = np.zeros(P.shape)
         # the values reached (displacements x - X0, rotations the accumulated spins) and the reactions
         _reached(st.x, self.X0, st.spin, self.cons_node, self.cons_dof, reactions, st.prescribed, RF)
-        st.commit([r.state for r in responses], P, lam, reactions,
-                  float(sum(np.sum(r.energy) for r in responses if r.energy is not None)), equilibrium)
-        if equilibrium and self.check_balance:   # issue 16: the reactions balance the loads
-            validation.check_equilibrium(st.x, P, RF, res[:self.dofmap.n_free], self.free_dof,
-                                         f"increment {self.summary.increments + 1}",
-                                         internal=float(sum(_abs_sum(q.f) for q in responses)),
-                                         labels=self._labels)
+        st.commit(
+            [r.state for r in responses],
+            P,
+            lam,
+            reactions,
+            float(sum(np.sum(r.energy) for r in responses if r.energy is not None)),
+            equilibrium,
+        )
+        if equilibrium and self.check_balance:  # issue 16: the reactions balance the loads
+            validation.check_equilibrium(
+                st.x,
+                P,
+                RF,
+                res[: self.dofmap.n_free],
+                self.free_dof,
+                f"increment {self.summary.increments + 1}",
+                internal=float(sum(_abs_sum(q.f) for q in responses)),
+                labels=self._labels,
+            )
 
     # ------------------------------------------------------------ messages
     def worst(self, r):
@@ -329,10 +365,15 @@ class System:
 
     def singular_message(self, K, where):
         eqs = mechanism_dofs(K)
-        what = (f"the free DOFs of the mechanism include: {self.name_dofs(eqs)}" if eqs is not None
-                else "the model is too large to name the mechanism")
-        return (f"{where}: the tangent stiffness is singular: {what}. Fix or constrain these DOFs, or connect "
-                "the nodes to an element that stiffens them.")
+        what = (
+            f"the free DOFs of the mechanism include: {self.name_dofs(eqs)}"
+            if eqs is not None
+            else "the model is too large to name the mechanism"
+        )
+        return (
+            f"{where}: the tangent stiffness is singular: {what}. Fix or constrain these DOFs, or connect "
+            "the nodes to an element that stiffens them."
+        )
 
     def committed_context(self):
         """An increment context at the current configuration (taken as committed)."""

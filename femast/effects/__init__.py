@@ -24,9 +24,35 @@ On the FE experiments (bay-torsion, tip-cycle) the effects change what the FE mo
 """
 
 from . import joints, structure, cables, latch, vibration  # noqa: F401,I001  (register the built-in effects, in this order)
-from .base import (Effect, Implementation, Parameter, add_implementation, applicable_effects, get_effect, list_effects,
-                   load_script, loaded_scripts, register_effect, resolve, unregister_effect)
+from .base import (
+    Effect,
+    Implementation,
+    Parameter,
+    add_implementation,
+    applicable_effects,
+    get_effect,
+    list_effects,
+    load_script,
+    loaded_scripts,
+    register_effect,
+    resolve,
+    unregister_effect,
+)
 from .operators import play, proportional_play
 
-__all__ = ["Effect", "Implementation", "Parameter", "register_effect", "add_implementation", "get_effect", "list_effects",
-           "applicable_effects", "resolve", "unregister_effect", "load_script", "loaded_scripts", "play", "proportional_play"]
+__all__ = [
+    "Effect",
+    "Implementation",
+    "Parameter",
+    "register_effect",
+    "add_implementation",
+    "get_effect",
+    "list_effects",
+    "applicable_effects",
+    "resolve",
+    "unregister_effect",
+    "load_script",
+    "loaded_scripts",
+    "play",
+    "proportional_play",
+]

@@ -26,9 +26,9 @@ from __future__ import annotations
 import hashlib
 import importlib.util
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Callable
 
 from ..errors import ModelError
 from ..experiments.core import Parameter  # noqa: F401  (re-exported: effects declare Parameters)
@@ -57,7 +57,7 @@ class Implementation:
     form: str = ""
     forms: dict = field(default_factory=dict)
 
-    def variant(self, form: str | None) -> "Implementation":
+    def variant(self, form: str | None) -> Implementation:
         """This implementation (``form`` None, "" or its own form name) or its generalised ``form``."""
         if not form or form == self.form:
             return self
@@ -124,8 +124,9 @@ def register_effect(effect: Effect, replace_existing: bool = False) -> Effect:
     if not isinstance(effect, Effect):
         raise ModelError(f"register_effect needs an Effect, got {type(effect).__name__}")
     if effect.name in _REGISTRY and not replace_existing and _REGISTRY[effect.name] is not effect:
-        raise ModelError(f"an effect called '{effect.name}' is already registered; choose another name or pass "
-                         "replace_existing=True")
+        raise ModelError(
+            f"an effect called '{effect.name}' is already registered; choose another name or pass replace_existing=True"
+        )
     if "/" in effect.name or "." in effect.name:
         raise ModelError(f"effect name '{effect.name}': no '/' or '.' (they separate forms and parameters)")
     for exp, impl in effect.implementations.items():
@@ -134,8 +135,10 @@ def register_effect(effect: Effect, replace_existing: bool = False) -> Effect:
             if len(set(names)) != len(names):
                 raise ModelError(f"effect {effect.name} on {exp} (form {label}): duplicate parameter names {names}")
             if im.hook != impl.hook:
-                raise ModelError(f"effect {effect.name} on {exp}: form {label} acts on hook '{im.hook}', its "
-                                 f"default form on '{impl.hook}'; the forms of one effect share a hook")
+                raise ModelError(
+                    f"effect {effect.name} on {exp}: form {label} acts on hook '{im.hook}', its "
+                    f"default form on '{impl.hook}'; the forms of one effect share a hook"
+                )
     _REGISTRY[effect.name] = effect
     return effect
 
@@ -197,19 +200,26 @@ def resolve(experiment, names) -> list:
             raise ModelError(f"effect '{name}' given twice")
         seen.add(name)
         if name not in _REGISTRY:
-            raise ModelError(f"unknown effect '{name}' for {experiment.name}; accepted effects: "
-                             f"{', '.join(ok) or '(none)'}")
+            raise ModelError(
+                f"unknown effect '{name}' for {experiment.name}; accepted effects: {', '.join(ok) or '(none)'}"
+            )
         eff = _REGISTRY[name]
         impl = eff.implementation(key)
         if impl is None:
-            raise ModelError(f"effect '{name}' does not apply to {experiment.name} (it applies to "
-                             f"{', '.join(eff.implementations) or 'nothing yet'}); accepted effects: {', '.join(ok)}")
+            raise ModelError(
+                f"effect '{name}' does not apply to {experiment.name} (it applies to "
+                f"{', '.join(eff.implementations) or 'nothing yet'}); accepted effects: {', '.join(ok)}"
+            )
         if not impl.implemented:
-            raise ModelError(f"effect '{name}' applies to {experiment.name} but is not implemented for it yet; "
-                             f"accepted effects: {', '.join(ok)}")
+            raise ModelError(
+                f"effect '{name}' applies to {experiment.name} but is not implemented for it yet; "
+                f"accepted effects: {', '.join(ok)}"
+            )
         if experiment.hooks and impl.hook not in experiment.hooks:
-            raise ModelError(f"effect '{name}' acts on hook '{impl.hook}', which {experiment.name} does not have; "
-                             f"its hooks: {', '.join(experiment.hooks)}")
+            raise ModelError(
+                f"effect '{name}' acts on hook '{impl.hook}', which {experiment.name} does not have; "
+                f"its hooks: {', '.join(experiment.hooks)}"
+            )
         try:
             impl = impl.variant(form)
         except ModelError as e:

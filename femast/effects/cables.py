@@ -24,37 +24,75 @@ def _progressive_mast_top(theta, p, ctx):
     return theta
 
 
-PROGRESSIVE_STIFFNESS = register_effect(Effect(
-    name="progressive_stiffness",
-    title="progressive, tension-dependent shroud/cable stiffness",
-    physics=(
-        "Dyneema shrouds stiffen with tension: EA(tau) = k0 + k1 tau + k2 tau^2 (seed 000 Eq. 25, "
-        ":mod:`femast.elements.shroud_law`).  The shroud that takes up a joint moment m gains tension in proportion "
-        "to |m|, so to first order the joint's secant stiffness rises as k (1 + beta |m|), beta = k1 / "
-        "(a EA(tau0)) with a the shroud lever arm (m) and tau0 the pretension.  The identified beta gives back "
-        "the slope k1 of Eq. 25 for an assumed lever arm."),
-    signature="the structure is stiffer than the linear model at high load and softer near zero: the error is "
-              "odd in the load, largest at the load peaks",
-    acts_where=("peak",),
-    seed="seed 000 Eq. 25",
-    implementations={
-        "mast-top": Implementation(
-            hook="joint_rotation", order=20,
-            parameters=(Parameter("beta", "1/(N m)", 1e-4, 0.0, 0.1, "relative stiffening per unit joint moment",
-                                  scale=1e-4, starts=(1e-5, 1e-3)),),
-            apply=_progressive_mast_top, form="linear",
-            doc="theta_k = m_k / (k_k (1 + beta |m_k|)), k = 1, 2 (secant stiffness rising with the moment).",
-            forms={"quadratic": Implementation(
-                hook="joint_rotation", order=20,
-                parameters=(Parameter("beta", "1/(N m)", 1e-4, -0.1, 0.1, "relative stiffening per unit joint "
-                                      "moment", scale=1e-4, starts=(1e-5, 1e-3)),
-                            Parameter("beta2", "1/(N m)^2", 0.0, 0.0, 1e-2, "relative stiffening per unit moment "
-                                      "squared (the k2 tau^2 term of Eq. 25)", scale=1e-6, starts=(1e-7, 1e-5))),
+PROGRESSIVE_STIFFNESS = register_effect(
+    Effect(
+        name="progressive_stiffness",
+        title="progressive, tension-dependent shroud/cable stiffness",
+        physics=(
+            "Dyneema shrouds stiffen with tension: EA(tau) = k0 + k1 tau + k2 tau^2 (seed 000 Eq. 25, "
+            ":mod:`femast.elements.shroud_law`).  The shroud that takes up a joint moment m gains tension in proportion "
+            "to |m|, so to first order the joint's secant stiffness rises as k (1 + beta |m|), beta = k1 / "
+            "(a EA(tau0)) with a the shroud lever arm (m) and tau0 the pretension.  The identified beta gives back "
+            "the slope k1 of Eq. 25 for an assumed lever arm."
+        ),
+        signature="the structure is stiffer than the linear model at high load and softer near zero: the error is "
+        "odd in the load, largest at the load peaks",
+        acts_where=("peak",),
+        seed="seed 000 Eq. 25",
+        implementations={
+            "mast-top": Implementation(
+                hook="joint_rotation",
+                order=20,
+                parameters=(
+                    Parameter(
+                        "beta",
+                        "1/(N m)",
+                        1e-4,
+                        0.0,
+                        0.1,
+                        "relative stiffening per unit joint moment",
+                        scale=1e-4,
+                        starts=(1e-5, 1e-3),
+                    ),
+                ),
                 apply=_progressive_mast_top,
-                doc="theta_k = m_k / (k_k (1 + beta |m_k| + beta2 m_k^2)): both terms of Eq. 25 (beta2 = 0: the "
-                    "linear form).")}),
-    },
-))
+                form="linear",
+                doc="theta_k = m_k / (k_k (1 + beta |m_k|)), k = 1, 2 (secant stiffness rising with the moment).",
+                forms={
+                    "quadratic": Implementation(
+                        hook="joint_rotation",
+                        order=20,
+                        parameters=(
+                            Parameter(
+                                "beta",
+                                "1/(N m)",
+                                1e-4,
+                                -0.1,
+                                0.1,
+                                "relative stiffening per unit joint moment",
+                                scale=1e-4,
+                                starts=(1e-5, 1e-3),
+                            ),
+                            Parameter(
+                                "beta2",
+                                "1/(N m)^2",
+                                0.0,
+                                0.0,
+                                1e-2,
+                                "relative stiffening per unit moment squared (the k2 tau^2 term of Eq. 25)",
+                                scale=1e-6,
+                                starts=(1e-7, 1e-5),
+                            ),
+                        ),
+                        apply=_progressive_mast_top,
+                        doc="theta_k = m_k / (k_k (1 + beta |m_k| + beta2 m_k^2)): both terms of Eq. 25 (beta2 = 0: the "
+                        "linear form).",
+                    )
+                },
+            ),
+        },
+    )
+)
 
 
 # ----------------------------------------------------------------------------- cable hysteresis
@@ -84,64 +122,161 @@ def _cable_hysteresis_latch_pull_iwan(x, p, ctx):
     return x + np.sign(dT) * ctx["options"]["cable_compliance_m_per_N"] * lag
 
 
-CABLE_HYSTERESIS = register_effect(Effect(
-    name="cable_hysteresis",
-    title="cable hysteresis between loading and unloading",
-    physics=(
-        "A rope stretches less on loading than on unloading at the same tension (seed 000 Fig. 4a: 'a "
-        "significant difference between loading and unloading the shroud').  Modelled as friction between "
-        "fibres whose normal force grows with the tension: a play operator of half-width eta |tau|, so the "
-        "loop widens in proportion to the load and closes at zero load (unlike Coulomb friction, whose loop "
-        "has a constant width)."),
-    signature="loading and unloading branches with different slopes, a loop whose width grows with the load "
-              "and closes at zero; the error is largest at high load and just after reversals",
-    acts_where=("peak", "reversal", "loading", "unloading"),
-    seed="seed 000 Sec. IV-A, Fig. 4a",
-    implementations={
-        "mast-top": Implementation(
-            hook="joint_moment", order=45,
-            parameters=(Parameter("eta", "-", 0.05, 0.0, 0.6, "loop half-width relative to the load", scale=0.05,
-                                  starts=(0.01, 0.2)),),
-            apply=_cable_hysteresis_mast_top, form="play",
-            doc="m_k -> play(m_k; eta |m_k|), k = 1, 2: the shroud-supported joint is (1 - eta) / k compliant on "
+CABLE_HYSTERESIS = register_effect(
+    Effect(
+        name="cable_hysteresis",
+        title="cable hysteresis between loading and unloading",
+        physics=(
+            "A rope stretches less on loading than on unloading at the same tension (seed 000 Fig. 4a: 'a "
+            "significant difference between loading and unloading the shroud').  Modelled as friction between "
+            "fibres whose normal force grows with the tension: a play operator of half-width eta |tau|, so the "
+            "loop widens in proportion to the load and closes at zero load (unlike Coulomb friction, whose loop "
+            "has a constant width)."
+        ),
+        signature="loading and unloading branches with different slopes, a loop whose width grows with the load "
+        "and closes at zero; the error is largest at high load and just after reversals",
+        acts_where=("peak", "reversal", "loading", "unloading"),
+        seed="seed 000 Sec. IV-A, Fig. 4a",
+        implementations={
+            "mast-top": Implementation(
+                hook="joint_moment",
+                order=45,
+                parameters=(
+                    Parameter(
+                        "eta",
+                        "-",
+                        0.05,
+                        0.0,
+                        0.6,
+                        "loop half-width relative to the load",
+                        scale=0.05,
+                        starts=(0.01, 0.2),
+                    ),
+                ),
+                apply=_cable_hysteresis_mast_top,
+                form="play",
+                doc="m_k -> play(m_k; eta |m_k|), k = 1, 2: the shroud-supported joint is (1 - eta) / k compliant on "
                 "loading and (1 + eta) / k on unloading.",
-            forms={"iwan": Implementation(
-                hook="joint_moment", order=45,
-                parameters=(Parameter("eta", "-", 0.3, 0.0, 0.99, "largest friction threshold of the fibre groups "
-                                      "relative to the load", scale=0.1, starts=(0.6, 0.95, 0.3)),
-                            Parameter("beta", "-", 1.0, 0.05, 50.0, "shape of the threshold distribution "
-                                      "P(e <= s) = (s / eta)^beta", scale=1.0, starts=(1.0, 3.0, 0.5)),
-                            Parameter("alpha", "-", 0.1, 0.0, 0.95, "share of the load without friction",
-                                      scale=0.1, starts=(0.2, 0.0, 0.1))),
-                apply=_cable_hysteresis_mast_top_iwan,
-                doc="m_k -> alpha m_k + (1 - alpha) mean_j play(m_k; eta_j |m_k|), eta_j = eta q_j^(1/beta): the "
-                    "rope's fibre groups with a distribution of friction coefficients (24 groups); smooth loops "
-                    "closing at zero load, return branches curved (beta -> inf, alpha = 0: the play form).")}),
-        "latch-pull": Implementation(
-            hook="bead_position", order=45,
-            parameters=(Parameter("eta", "-", 0.1, 0.0, 0.6, "loop half-width of the test cable's stretch",
-                                  scale=0.1, starts=(0.02, 0.3)),),
-            apply=_cable_hysteresis_latch_pull, form="play",
-            doc="x_bead = x + sign(dT) c_cable (|dT| - play(|dT|; eta |dT|)): Eq. 15 removed the mean stretch "
+                forms={
+                    "iwan": Implementation(
+                        hook="joint_moment",
+                        order=45,
+                        parameters=(
+                            Parameter(
+                                "eta",
+                                "-",
+                                0.3,
+                                0.0,
+                                0.99,
+                                "largest friction threshold of the fibre groups relative to the load",
+                                scale=0.1,
+                                starts=(0.6, 0.95, 0.3),
+                            ),
+                            Parameter(
+                                "beta",
+                                "-",
+                                1.0,
+                                0.05,
+                                50.0,
+                                "shape of the threshold distribution P(e <= s) = (s / eta)^beta",
+                                scale=1.0,
+                                starts=(1.0, 3.0, 0.5),
+                            ),
+                            Parameter(
+                                "alpha",
+                                "-",
+                                0.1,
+                                0.0,
+                                0.95,
+                                "share of the load without friction",
+                                scale=0.1,
+                                starts=(0.2, 0.0, 0.1),
+                            ),
+                        ),
+                        apply=_cable_hysteresis_mast_top_iwan,
+                        doc="m_k -> alpha m_k + (1 - alpha) mean_j play(m_k; eta_j |m_k|), eta_j = eta q_j^(1/beta): the "
+                        "rope's fibre groups with a distribution of friction coefficients (24 groups); smooth loops "
+                        "closing at zero load, return branches curved (beta -> inf, alpha = 0: the play form).",
+                    )
+                },
+            ),
+            "latch-pull": Implementation(
+                hook="bead_position",
+                order=45,
+                parameters=(
+                    Parameter(
+                        "eta",
+                        "-",
+                        0.1,
+                        0.0,
+                        0.6,
+                        "loop half-width of the test cable's stretch",
+                        scale=0.1,
+                        starts=(0.02, 0.3),
+                    ),
+                ),
+                apply=_cable_hysteresis_latch_pull,
+                form="play",
+                doc="x_bead = x + sign(dT) c_cable (|dT| - play(|dT|; eta |dT|)): Eq. 15 removed the mean stretch "
                 "c_cable |dT| (c_cable = L_cable / EA, option cable_compliance_m_per_N), the cable's own "
                 "stretch lags it.",
-            forms={"iwan": Implementation(
-                hook="bead_position", order=45,
-                parameters=(Parameter("eta", "-", 0.5, 0.0, 0.99, "largest friction threshold of the fibre groups "
-                                      "relative to the tension", scale=0.1, starts=(0.9, 0.3, 0.6)),
-                            Parameter("beta", "-", 1.0, 0.05, 50.0, "shape of the threshold distribution "
-                                      "P(e <= s) = (s / eta)^beta", scale=1.0, starts=(1.0, 4.0, 0.5)),
-                            Parameter("gain", "-", 1.0, 0.0, 20.0, "hysteretic stretch compliance relative to "
-                                      "c_cable", scale=1.0, starts=(3.0, 1.0, 6.0)),
-                            Parameter("kappa", "-", 1.0, -20.0, 20.0, "compliance Eq. 15 removed, relative to "
-                                      "c_cable", scale=1.0, starts=(2.0, 1.0, 4.0))),
-                apply=_cable_hysteresis_latch_pull_iwan,
-                doc="x_bead = x + sign(dT) c_cable (kappa |dT| - gain P(|dT|)), P(T) = mean_j play(T; eta_j T), "
-                    "eta_j = eta q_j^(1/beta): the test cable's stretch c_cable gain P(T) follows the tension "
-                    "through fibre groups with a distribution of friction coefficients (smooth loops closing at "
-                    "zero), Eq. 15 removed c_cable kappa T.  kappa = gain = 1, beta -> inf: the play form.")}),
-    },
-))
+                forms={
+                    "iwan": Implementation(
+                        hook="bead_position",
+                        order=45,
+                        parameters=(
+                            Parameter(
+                                "eta",
+                                "-",
+                                0.5,
+                                0.0,
+                                0.99,
+                                "largest friction threshold of the fibre groups relative to the tension",
+                                scale=0.1,
+                                starts=(0.9, 0.3, 0.6),
+                            ),
+                            Parameter(
+                                "beta",
+                                "-",
+                                1.0,
+                                0.05,
+                                50.0,
+                                "shape of the threshold distribution P(e <= s) = (s / eta)^beta",
+                                scale=1.0,
+                                starts=(1.0, 4.0, 0.5),
+                            ),
+                            Parameter(
+                                "gain",
+                                "-",
+                                1.0,
+                                0.0,
+                                20.0,
+                                "hysteretic stretch compliance relative to c_cable",
+                                scale=1.0,
+                                starts=(3.0, 1.0, 6.0),
+                            ),
+                            Parameter(
+                                "kappa",
+                                "-",
+                                1.0,
+                                -20.0,
+                                20.0,
+                                "compliance Eq. 15 removed, relative to c_cable",
+                                scale=1.0,
+                                starts=(2.0, 1.0, 4.0),
+                            ),
+                        ),
+                        apply=_cable_hysteresis_latch_pull_iwan,
+                        doc="x_bead = x + sign(dT) c_cable (kappa |dT| - gain P(|dT|)), P(T) = mean_j play(T; eta_j T), "
+                        "eta_j = eta q_j^(1/beta): the test cable's stretch c_cable gain P(T) follows the tension "
+                        "through fibre groups with a distribution of friction coefficients (smooth loops closing at "
+                        "zero), Eq. 15 removed c_cable kappa T.  kappa = gain = 1, beta -> inf: the play form.",
+                    )
+                },
+            ),
+        },
+    )
+)
 
 
 # ----------------------------------------------------------------------------- pretension loss / error
@@ -159,42 +294,76 @@ def _pretension_mast_top(theta, p, ctx):
     return theta
 
 
-PRETENSION = register_effect(Effect(
-    name="pretension_loss",
-    title="pretension error or loss",
-    physics=(
-        "The stiffness of a guyed or cable-braced structure depends on the cable pretension (seed 000 Table "
-        "III: the 3R joint stiffness falls from 2.7e5 to 2.2e5 N m/rad between 1200 N and 400 N of shroud "
-        "pretension; seed 001 Eq. 16 measures the ADAM cable pretension by vibration).  A pretension that creeps "
-        "or slips during a test makes the stiffness fall with time; a pretension different from the assumed one "
-        "shifts it (identifiable only in models that take the pretension as an input: bay-torsion, tip-cycle)."),
-    signature="the compliance drifts along the test: the error grows with time in proportion to the load (a "
-              "loss during the test); the unlatched bay's moment is offset (an error of the pretension)",
-    acts_where=("peak", "loading", "unloading", "zone (d) no contact"),
-    seed="seed 000 Table III; seed 001 Eq. 16",
-    implementations={
-        "mast-top": Implementation(
-            hook="joint_rotation", order=60,
-            parameters=(Parameter("lam", "-", 0.1, 0.0, 0.9, "relative stiffness loss over the test", scale=0.1),),
-            apply=_pretension_mast_top, form="linear",
-            doc="k_k(t) = k_k (1 - lam tau), tau = normalised time in [0, 1] (t_s column or row index).",
-            forms={"saturating": Implementation(
-                hook="joint_rotation", order=60,
-                parameters=(Parameter("lam", "-", 0.1, 0.0, 0.9, "relative stiffness loss over the test", scale=0.1),
-                            Parameter("t_c", "-", 0.3, 0.01, 100.0, "time constant of the loss, as a fraction of "
-                                      "the test's duration", scale=0.3, starts=(0.05, 3.0))),
+PRETENSION = register_effect(
+    Effect(
+        name="pretension_loss",
+        title="pretension error or loss",
+        physics=(
+            "The stiffness of a guyed or cable-braced structure depends on the cable pretension (seed 000 Table "
+            "III: the 3R joint stiffness falls from 2.7e5 to 2.2e5 N m/rad between 1200 N and 400 N of shroud "
+            "pretension; seed 001 Eq. 16 measures the ADAM cable pretension by vibration).  A pretension that creeps "
+            "or slips during a test makes the stiffness fall with time; a pretension different from the assumed one "
+            "shifts it (identifiable only in models that take the pretension as an input: bay-torsion, tip-cycle)."
+        ),
+        signature="the compliance drifts along the test: the error grows with time in proportion to the load (a "
+        "loss during the test); the unlatched bay's moment is offset (an error of the pretension)",
+        acts_where=("peak", "loading", "unloading", "zone (d) no contact"),
+        seed="seed 000 Table III; seed 001 Eq. 16",
+        implementations={
+            "mast-top": Implementation(
+                hook="joint_rotation",
+                order=60,
+                parameters=(Parameter("lam", "-", 0.1, 0.0, 0.9, "relative stiffness loss over the test", scale=0.1),),
                 apply=_pretension_mast_top,
-                doc="k_k(t) = k_k (1 - lam (1 - exp(-tau / t_c)) / (1 - exp(-1 / t_c))): a loss that levels off "
-                    "(creep, slip of a termination); t_c -> inf is the linear form.")}),
-        **{e: Implementation(
-            hook="bay_parameters", order=60,
-            parameters=(Parameter("dT0", "N", 0.0, -150.0, 150.0, "error of the cable pretension against the "
-                                  "nominal option pretension_N (< 0: a loss)", scale=20.0),),
-            apply=_pretension_fe,
-            doc="the FE cables are pretensioned to pretension_N + dT0 (a constant error or a loss before the "
-                "test, e.g. creep since the vibration measurement of seed 001 Eq. 16).") for e in FE},
-    },
-))
+                form="linear",
+                doc="k_k(t) = k_k (1 - lam tau), tau = normalised time in [0, 1] (t_s column or row index).",
+                forms={
+                    "saturating": Implementation(
+                        hook="joint_rotation",
+                        order=60,
+                        parameters=(
+                            Parameter("lam", "-", 0.1, 0.0, 0.9, "relative stiffness loss over the test", scale=0.1),
+                            Parameter(
+                                "t_c",
+                                "-",
+                                0.3,
+                                0.01,
+                                100.0,
+                                "time constant of the loss, as a fraction of the test's duration",
+                                scale=0.3,
+                                starts=(0.05, 3.0),
+                            ),
+                        ),
+                        apply=_pretension_mast_top,
+                        doc="k_k(t) = k_k (1 - lam (1 - exp(-tau / t_c)) / (1 - exp(-1 / t_c))): a loss that levels off "
+                        "(creep, slip of a termination); t_c -> inf is the linear form.",
+                    )
+                },
+            ),
+            **{
+                e: Implementation(
+                    hook="bay_parameters",
+                    order=60,
+                    parameters=(
+                        Parameter(
+                            "dT0",
+                            "N",
+                            0.0,
+                            -150.0,
+                            150.0,
+                            "error of the cable pretension against the nominal option pretension_N (< 0: a loss)",
+                            scale=20.0,
+                        ),
+                    ),
+                    apply=_pretension_fe,
+                    doc="the FE cables are pretensioned to pretension_N + dT0 (a constant error or a loss before the "
+                    "test, e.g. creep since the vibration measurement of seed 001 Eq. 16).",
+                )
+                for e in FE
+            },
+        },
+    )
+)
 
 
 # ----------------------------------------------------------------------------- stretch-removal error (Eq. 15)
@@ -202,23 +371,29 @@ def _stretch_latch_pull(x, p, ctx):
     return x - p["c_s"] * ctx["prep"]["dT"]
 
 
-STRETCH_ERROR = register_effect(Effect(
-    name="stretch_error",
-    title="cable stretch-removal error (seed 001 Eq. 15)",
-    physics=(
-        "Eq. 15 removes the stretch T L_cable / EA of the loaded test cable to get the bead position.  A wrong "
-        "EA or L_cable (or the length change of the loaded cable, T (x - x_start) / EA) leaves a position error "
-        "proportional to the force: x_bead = x - c_s dT, c_s the compliance error (m/N)."),
-    signature="the measured curve is sheared along x in proportion to the force: the error is largest at the "
-              "force peaks and changes sign with the force",
-    acts_where=("peak",),
-    seed="seed 001 Eq. 15",
-    implementations={
-        "latch-pull": Implementation(
-            hook="bead_position", order=20,
-            parameters=(Parameter("c_s", "m/N", 1e-6, -1e-4, 1e-4, "compliance error of the stretch removal",
-                                  scale=1e-6),),
-            apply=_stretch_latch_pull,
-            doc="x_bead = x - c_s dT."),
-    },
-))
+STRETCH_ERROR = register_effect(
+    Effect(
+        name="stretch_error",
+        title="cable stretch-removal error (seed 001 Eq. 15)",
+        physics=(
+            "Eq. 15 removes the stretch T L_cable / EA of the loaded test cable to get the bead position.  A wrong "
+            "EA or L_cable (or the length change of the loaded cable, T (x - x_start) / EA) leaves a position error "
+            "proportional to the force: x_bead = x - c_s dT, c_s the compliance error (m/N)."
+        ),
+        signature="the measured curve is sheared along x in proportion to the force: the error is largest at the "
+        "force peaks and changes sign with the force",
+        acts_where=("peak",),
+        seed="seed 001 Eq. 15",
+        implementations={
+            "latch-pull": Implementation(
+                hook="bead_position",
+                order=20,
+                parameters=(
+                    Parameter("c_s", "m/N", 1e-6, -1e-4, 1e-4, "compliance error of the stretch removal", scale=1e-6),
+                ),
+                apply=_stretch_latch_pull,
+                doc="x_bead = x - c_s dT.",
+            ),
+        },
+    )
+)

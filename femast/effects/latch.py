@@ -46,45 +46,109 @@ def _latch_hysteresis(D, p, ctx):
     return D
 
 
-LATCH_HYSTERESIS = register_effect(Effect(
-    name="latch_hysteresis",
-    title="latch hysteresis near the latched state",
-    physics=__doc__.split("\n\n", 1)[1].strip(),
-    signature="latching and unlatching curves differ near the backstop, where the baseline has a single curve; "
-              "the error is concentrated in the latched zones (a)-(b) of seed 001 Fig. 6",
-    acts_where=("zone (a) at backstop", "zone (b) behind roller axis", "near-zero load"),
-    seed="seed 001 Sec. III.C, Sec. VIII",
-    implementations={
-        "latch-pull": Implementation(
-            hook="branch_force", order=30,
-            parameters=(
-                Parameter("F_h", "N", 5.0, 0.0, 200.0, "extra friction force with the bead seated", scale=5.0,
-                          starts=(1.0, 20.0)),
-                Parameter("ell", "m", 3e-4, 2e-5, 5e-3, "length over which it fades out of the latch",
-                          scale=3e-4, starts=(1e-4, 1e-3)),
-            ),
-            apply=_latch_hysteresis, form="exponential",
-            doc="dT_in -= F_h w, dT_out += F_h w, w = exp(-max(x + x_backstop, 0) / ell).",
-            forms={"shaped": Implementation(
-                hook="branch_force", order=30,
+LATCH_HYSTERESIS = register_effect(
+    Effect(
+        name="latch_hysteresis",
+        title="latch hysteresis near the latched state",
+        physics=__doc__.split("\n\n", 1)[1].strip(),
+        signature="latching and unlatching curves differ near the backstop, where the baseline has a single curve; "
+        "the error is concentrated in the latched zones (a)-(b) of seed 001 Fig. 6",
+        acts_where=("zone (a) at backstop", "zone (b) behind roller axis", "near-zero load"),
+        seed="seed 001 Sec. III.C, Sec. VIII",
+        implementations={
+            "latch-pull": Implementation(
+                hook="branch_force",
+                order=30,
                 parameters=(
-                    Parameter("F_h", "N", 5.0, 0.0, 200.0, "extra friction force with the bead seated", scale=5.0,
-                              starts=(1.0, 20.0, 5.0)),
-                    Parameter("ell", "m", 3e-4, 2e-5, 5e-3, "length scale of the fade out of the latch",
-                              scale=3e-4, starts=(1e-4, 1e-3, 3e-4)),
-                    Parameter("gamma", "-", 0.0, -2.0, 3.0, "shape of the fade: 0 exponential, 1 linear, < 0 "
-                              "slower tail", scale=0.5, starts=(1.0, -0.5, 0.0)),
+                    Parameter(
+                        "F_h",
+                        "N",
+                        5.0,
+                        0.0,
+                        200.0,
+                        "extra friction force with the bead seated",
+                        scale=5.0,
+                        starts=(1.0, 20.0),
+                    ),
+                    Parameter(
+                        "ell",
+                        "m",
+                        3e-4,
+                        2e-5,
+                        5e-3,
+                        "length over which it fades out of the latch",
+                        scale=3e-4,
+                        starts=(1e-4, 1e-3),
+                    ),
                 ),
                 apply=_latch_hysteresis,
-                doc="dT_in -= F_h w, dT_out += F_h w, w = max(1 - gamma d / ell, 0)^(1/gamma), d = max(x + "
-                    "x_backstop, 0) (gamma = 0: the exponential form).")}),
-        **{e: Implementation(
-            hook="bay_parameters", order=30,
-            parameters=(Parameter("F_h", "N", 5.0, 0.0, 200.0, "extra friction force of a latch with the bead "
-                                  "seated (fade-out length: option latch_hysteresis_length_m)", scale=5.0),),
-            apply=_latch_hysteresis_fe,
-            doc="the FE latches (cable/latch element, femast.latch hysteresis option) get hysteresis_force = F_h, "
-                "fading over the option latch_hysteresis_length_m (3e-4 m); it acts only on beads that have left "
-                "the backstop.") for e in ("bay-torsion", "tip-cycle")},
-    },
-))
+                form="exponential",
+                doc="dT_in -= F_h w, dT_out += F_h w, w = exp(-max(x + x_backstop, 0) / ell).",
+                forms={
+                    "shaped": Implementation(
+                        hook="branch_force",
+                        order=30,
+                        parameters=(
+                            Parameter(
+                                "F_h",
+                                "N",
+                                5.0,
+                                0.0,
+                                200.0,
+                                "extra friction force with the bead seated",
+                                scale=5.0,
+                                starts=(1.0, 20.0, 5.0),
+                            ),
+                            Parameter(
+                                "ell",
+                                "m",
+                                3e-4,
+                                2e-5,
+                                5e-3,
+                                "length scale of the fade out of the latch",
+                                scale=3e-4,
+                                starts=(1e-4, 1e-3, 3e-4),
+                            ),
+                            Parameter(
+                                "gamma",
+                                "-",
+                                0.0,
+                                -2.0,
+                                3.0,
+                                "shape of the fade: 0 exponential, 1 linear, < 0 slower tail",
+                                scale=0.5,
+                                starts=(1.0, -0.5, 0.0),
+                            ),
+                        ),
+                        apply=_latch_hysteresis,
+                        doc="dT_in -= F_h w, dT_out += F_h w, w = max(1 - gamma d / ell, 0)^(1/gamma), d = max(x + "
+                        "x_backstop, 0) (gamma = 0: the exponential form).",
+                    )
+                },
+            ),
+            **{
+                e: Implementation(
+                    hook="bay_parameters",
+                    order=30,
+                    parameters=(
+                        Parameter(
+                            "F_h",
+                            "N",
+                            5.0,
+                            0.0,
+                            200.0,
+                            "extra friction force of a latch with the bead "
+                            "seated (fade-out length: option latch_hysteresis_length_m)",
+                            scale=5.0,
+                        ),
+                    ),
+                    apply=_latch_hysteresis_fe,
+                    doc="the FE latches (cable/latch element, femast.latch hysteresis option) get hysteresis_force = F_h, "
+                    "fading over the option latch_hysteresis_length_m (3e-4 m); it acts only on beads that have left "
+                    "the backstop.",
+                )
+                for e in ("bay-torsion", "tip-cycle")
+            },
+        },
+    )
+)

@@ -23,34 +23,41 @@ def _unit_compliance(r_oc: tuple, s_out: float, s_in: float, nu: float) -> np.nd
 
 def _beam_mast_top(d, p, ctx):
     o = ctx["options"]
-    C1 = _unit_compliance(tuple(float(v) for v in o["r_oc_m"]), float(o["s_out_m"]), float(o["s_in_m"]),
-                          float(o["nu"]))
+    C1 = _unit_compliance(tuple(float(v) for v in o["r_oc_m"]), float(o["s_out_m"]), float(o["s_in_m"]), float(o["nu"]))
     return d + ctx["prep"]["dw"] @ C1.T / p["E"]
 
 
-BEAM_FLEXIBILITY = register_effect(Effect(
-    name="beam_flexibility",
-    title="beam bending flexibility in series with the base joint",
-    physics=(
-        "The 3R model (seed 000 Eqs. 4-7) takes the mast as rigid on elastic base joints.  The mast is a "
-        "square tube (s_out = 0.1 m, s_in = 0.094 m) whose own cantilever compliance (Eqs. 8-15, "
-        ":mod:`femast.guyed.cantilever`) acts in series: dc = (J K^-1 J^T + C_beam(E)) dw.  Top forces alone "
-        "cannot separate the two (both give a compliance proportional to the force); top moments can, since a "
-        "beam turns its top by L M / EI and moves it by L^2 M / 2EI, a joint by L M / k."),
-    signature="the ratio of the top displacement under a top moment to that under a top force differs from a "
-              "rigid mast's; the error follows the top moments",
-    acts_where=("peak",),
-    seed="seed 000 Eqs. 8-15",
-    implementations={
-        "mast-top": Implementation(
-            hook="top_displacement", order=50,
-            parameters=(Parameter("E", "Pa", 7e10, 1e9, 1e14, "Young's modulus of the mast tube", scale=7e10,
-                                  starts=(2e10, 2e11)),),
-            apply=_beam_mast_top,
-            doc="dc_T += C_beam(E)[:3] dw, the cantilever of length |r_oc| along r_oc with the section options "
-                "s_out_m, s_in_m, nu; E at its upper bound means a rigid mast."),
-    },
-))
+BEAM_FLEXIBILITY = register_effect(
+    Effect(
+        name="beam_flexibility",
+        title="beam bending flexibility in series with the base joint",
+        physics=(
+            "The 3R model (seed 000 Eqs. 4-7) takes the mast as rigid on elastic base joints.  The mast is a "
+            "square tube (s_out = 0.1 m, s_in = 0.094 m) whose own cantilever compliance (Eqs. 8-15, "
+            ":mod:`femast.guyed.cantilever`) acts in series: dc = (J K^-1 J^T + C_beam(E)) dw.  Top forces alone "
+            "cannot separate the two (both give a compliance proportional to the force); top moments can, since a "
+            "beam turns its top by L M / EI and moves it by L^2 M / 2EI, a joint by L M / k."
+        ),
+        signature="the ratio of the top displacement under a top moment to that under a top force differs from a "
+        "rigid mast's; the error follows the top moments",
+        acts_where=("peak",),
+        seed="seed 000 Eqs. 8-15",
+        implementations={
+            "mast-top": Implementation(
+                hook="top_displacement",
+                order=50,
+                parameters=(
+                    Parameter(
+                        "E", "Pa", 7e10, 1e9, 1e14, "Young's modulus of the mast tube", scale=7e10, starts=(2e10, 2e11)
+                    ),
+                ),
+                apply=_beam_mast_top,
+                doc="dc_T += C_beam(E)[:3] dw, the cantilever of length |r_oc| along r_oc with the section options "
+                "s_out_m, s_in_m, nu; E at its upper bound means a rigid mast.",
+            ),
+        },
+    )
+)
 
 
 def _off_axis_bay(drive, p, ctx):
@@ -67,27 +74,43 @@ def _off_axis_bay(drive, p, ctx):
     return out
 
 
-OFF_AXIS = register_effect(Effect(
-    name="off_axis_motion",
-    title="off-axis motion of the bay top",
-    physics=(
-        "The single-bay torsion rig of seed 001 (Sec. V-VI) does not keep the bay top on its axis: displacements "
-        "of up to 1 cm in x and y were recorded, so the four latches do not unlatch together.  The idealised "
-        "model drives the top by its rotation only (the baseline of bay-torsion follows ux, uy when they are "
-        "measured); this effect turns the top frame about a vertical axis at a distance e from the bay axis, "
-        "so the top centre moves by (I - R(theta)) c, |c| = e, on top of the driven path.  By the four-fold "
-        "symmetry of the bay only e counts, not the side it points to.  Without ux, uy this is the unmeasured "
-        "drift of the rig; with them, a measurement point off the frame centre."),
-    signature="the latches do not release together: the moment differs where they leave the rollers (zone (c)) "
-              "and around release and relatching, where the idealised model has one sharp step",
-    acts_where=("latch release/relatch", "zone (c) in front of roller axis", "zone (d) no contact"),
-    seed="seed 001 Sec. VI.B, Fig. 17",
-    implementations={"bay-torsion": Implementation(
-        hook="control_path", order=50,
-        parameters=(Parameter("e", "m", 0.01, 0.0, 0.05, "distance of the rig's rotation axis from the bay axis "
-                              "(towards the centre of side off_axis_side)", scale=0.01),),
-        apply=_off_axis_bay,
-        doc="[ux, uy] += (I - R(theta)) c, c = e (cos a, sin a), a = 90 + 90 k degrees for side k = option "
-            "off_axis_side (side 0: +y)."),
-    },
-))
+OFF_AXIS = register_effect(
+    Effect(
+        name="off_axis_motion",
+        title="off-axis motion of the bay top",
+        physics=(
+            "The single-bay torsion rig of seed 001 (Sec. V-VI) does not keep the bay top on its axis: displacements "
+            "of up to 1 cm in x and y were recorded, so the four latches do not unlatch together.  The idealised "
+            "model drives the top by its rotation only (the baseline of bay-torsion follows ux, uy when they are "
+            "measured); this effect turns the top frame about a vertical axis at a distance e from the bay axis, "
+            "so the top centre moves by (I - R(theta)) c, |c| = e, on top of the driven path.  By the four-fold "
+            "symmetry of the bay only e counts, not the side it points to.  Without ux, uy this is the unmeasured "
+            "drift of the rig; with them, a measurement point off the frame centre."
+        ),
+        signature="the latches do not release together: the moment differs where they leave the rollers (zone (c)) "
+        "and around release and relatching, where the idealised model has one sharp step",
+        acts_where=("latch release/relatch", "zone (c) in front of roller axis", "zone (d) no contact"),
+        seed="seed 001 Sec. VI.B, Fig. 17",
+        implementations={
+            "bay-torsion": Implementation(
+                hook="control_path",
+                order=50,
+                parameters=(
+                    Parameter(
+                        "e",
+                        "m",
+                        0.01,
+                        0.0,
+                        0.05,
+                        "distance of the rig's rotation axis from the bay axis "
+                        "(towards the centre of side off_axis_side)",
+                        scale=0.01,
+                    ),
+                ),
+                apply=_off_axis_bay,
+                doc="[ux, uy] += (I - R(theta)) c, c = e (cos a, sin a), a = 90 + 90 k degrees for side k = option "
+                "off_axis_side (side 0: +y).",
+            ),
+        },
+    )
+)

@@ -29,7 +29,7 @@ I_SLIP = 3
 I_GAMMA = 4
 I_DISS = 5
 I_Q = 6
-REVERSED = -1.0   # slip flag of a trial state: slip reversed, taken as stuck for this iteration
+REVERSED = -1.0  # slip flag of a trial state: slip reversed, taken as stuck for this iteration
 
 # error codes of the kernel
 OK = 0
@@ -113,8 +113,8 @@ def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out
     Gs = Rb @ G
     SM = skew(M)
     Sc = skew(c)
-    Gc = Gs @ Sc          # d(M)/d(w_a) through |F| (eccentric tie)
-    kSc = k_pen * Sc      # dF/dw_a
+    Gc = Gs @ Sc  # d(M)/d(w_a) through |F| (eccentric tie)
+    kSc = k_pen * Sc  # dF/dw_a
     SF = skew(F)
     # tie moment on node a: F x c; its derivative w.r.t. w_a
     Kcc = -(Sc @ kSc) - SF @ Sc
@@ -169,14 +169,29 @@ def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out
 
 
 @njit(cache=True)
-def ball_joint_family_kernel(nodes, x, R, d0, k_pen, k_s, mu, B, state, f, K, new, out, energy, err, prev,
-                             has_prev):
+def ball_joint_family_kernel(nodes, x, R, d0, k_pen, k_s, mu, B, state, f, K, new, out, energy, err, prev, has_prev):
     """All joints of a family at once (see :func:`ball_joint_element`); ``prev`` (n_el, 15):
     the previous iteration's trial states (read only if ``has_prev``)."""
     for e in range(nodes.shape[0]):
         a = nodes[e, 0]
         b = nodes[e, 1]
-        en, code = ball_joint_element(x[a], x[b], R[a], R[b], d0[e], k_pen[e], k_s[e], mu[e], B[e],
-                                      state[e], f[e], K[e], new[e], out[e], prev[e if has_prev else 0], has_prev)
+        en, code = ball_joint_element(
+            x[a],
+            x[b],
+            R[a],
+            R[b],
+            d0[e],
+            k_pen[e],
+            k_s[e],
+            mu[e],
+            B[e],
+            state[e],
+            f[e],
+            K[e],
+            new[e],
+            out[e],
+            prev[e if has_prev else 0],
+            has_prev,
+        )
         energy[e] = en
         err[e] = code

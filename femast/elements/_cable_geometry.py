@@ -213,8 +213,8 @@ def cable_geometry(X, radius, want_hess, L, G, H, phi, dphi):
                 Hpaa[c, d] = -Haa[c, d]
                 Hpbb[c, d] = -Hbb[c, d]
         # beta' = r / (d t), beta'' = -r (t^2 + d^2) / (d^2 t^3)
-        _radial(a, r / (da * ta), -r * (ta * ta + da * da) / (da * da * ta ** 3), gpa, Hpaa, -1.0)
-        _radial(b, r / (db * tb), -r * (tb * tb + db * db) / (db * db * tb ** 3), gpb, Hpbb, -1.0)
+        _radial(a, r / (da * ta), -r * (ta * ta + da * da) / (da * da * ta**3), gpa, Hpaa, -1.0)
+        _radial(b, r / (db * tb), -r * (tb * tb + db * db) / (db * db * tb**3), gpb, Hpbb, -1.0)
         Hpab = -Hab
         gphi = np.zeros(3 * nn)
         Hdummy = np.zeros((3 * nn, 3 * nn))
@@ -227,7 +227,7 @@ def cable_geometry(X, radius, want_hess, L, G, H, phi, dphi):
             gt = np.zeros(3)
             Ht = np.zeros((3, 3))
             # t' = d / t, t'' = -r^2 / t^3
-            _radial(vec, dd / tt, -r * r / tt ** 3, gt, Ht, 1.0)
+            _radial(vec, dd / tt, -r * r / tt**3, gt, Ht, 1.0)
             for c in range(3 * nn):
                 G[sec, c] += 0.5 * r * gphi[c]
                 if want_hess:

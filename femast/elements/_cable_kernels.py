@@ -337,8 +337,9 @@ def cable_latch_kernel(X, EA, L0, Lb, jl, P, Hy, state, f, K, state_new, T, dT, 
                 state_new[el, c] = state[el, c]
             continue
         p = P[el]
-        x_new, s, status, tA, tB, ds_dLA, ds_dLB = solve_latch(LA, LB, EA[el], L0[el], Lb[el], has_latch, p, x_c,
-                                                                Hy[el, 0], Hy[el, 1])
+        x_new, s, status, tA, tB, ds_dLA, ds_dLB = solve_latch(
+            LA, LB, EA[el], L0[el], Lb[el], has_latch, p, x_c, Hy[el, 0], Hy[el, 1]
+        )
         tA, dtA_ds, dtA_dLA, tB, dtB_ds, dtB_dLB = group_tensions(s, LA, LB, EA[el], L0[el])
         # total derivatives of the group tensions w.r.t. the group chord lengths
         MAA = dtA_dLA + dtA_ds * ds_dLA

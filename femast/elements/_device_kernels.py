@@ -111,8 +111,7 @@ def _sections(S, L, EA, T, dT_dl0, de_dl0, e):
 
 
 @njit(cache=True)
-def _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi,
-              T, dT_dl0, de_dl0, e):
+def _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi, T, dT_dl0, de_dl0, e):
     """Device residuals R (n-1,), dR/dS A, dR/dL RL (n-1, n) and dR/dphi Rphi (n-1,)."""
     n = L.shape[0]
     m = n - 1
@@ -298,7 +297,7 @@ def solve_devices(L, phi, EA, L0, kinds, P, S_c, modes_c, S, modes, bufs):
         else:
             modes[d] = STICK
     tol_s = 1e-12 * L0
-    for it in range(MAX_SET):
+    for _it in range(MAX_SET):
         for d in range(m):  # sliding devices start from the last solution
             if modes[d] == STICK:
                 S[d + 1] = S_c[d]
@@ -354,8 +353,7 @@ def solve_devices(L, phi, EA, L0, kinds, P, S_c, modes_c, S, modes, bufs):
 
 
 @njit(cache=True)
-def device_kernel(X, radius, EA, L0, kinds, P, state, f, K, state_new, T_out, phi_out, energy,
-                  err, where):
+def device_kernel(X, radius, EA, L0, kinds, P, state, f, K, state_new, T_out, phi_out, energy, err, where):
     """All elements of a family: nodal forces f (n_el, 6 nn), tangent K, trial state, tensions.
 
     X (n_el, nn, 3) m; radius (nn,) m; EA (N), L0 (m) per element; kinds (n-1,); P (n_el, n-1,
@@ -373,8 +371,17 @@ def device_kernel(X, radius, EA, L0, kinds, P, state, f, K, state_new, T_out, ph
     S = np.empty(n + 1)
     modes = np.empty(max(m, 1), dtype=np.int64)
     modes_c = np.empty(max(m, 1), dtype=np.int64)
-    bufs = (np.empty(m), np.empty((m, m)), np.empty((m, n)), np.empty(m), np.empty(n), np.empty(n),
-            np.empty(n), np.empty(n), np.empty(m))
+    bufs = (
+        np.empty(m),
+        np.empty((m, m)),
+        np.empty((m, n)),
+        np.empty(m),
+        np.empty(n),
+        np.empty(n),
+        np.empty(n),
+        np.empty(n),
+        np.empty(m),
+    )
     R, A, RL, Rphi, T, dT_dl0, de_dl0, e, dS = bufs
     dTdx = np.empty((n, 3 * nn))
     for el in range(n_el):
@@ -401,8 +408,7 @@ def device_kernel(X, radius, EA, L0, kinds, P, state, f, K, state_new, T_out, ph
         targets = np.empty(m)
         for d in range(m):
             targets[d] = S[d + 1]
-        _assemble(S, L, phi[:m], EA[el], L0[el], kinds, P[el], modes, targets, R, A, RL, Rphi,
-                  T, dT_dl0, de_dl0, e)
+        _assemble(S, L, phi[:m], EA[el], L0[el], kinds, P[el], modes, targets, R, A, RL, Rphi, T, dT_dl0, de_dl0, e)
         for d in range(m):
             state_new[el, d] = S[d + 1]
             state_new[el, m + d] = modes[d]

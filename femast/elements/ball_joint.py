@@ -61,11 +61,19 @@ from ._ball_joint_kernels import (
 )
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput
 
-__all__ = ["BallJointFamily", "add_ball_joints", "default_stiffnesses", "friction_loop_energy",
-           "PENALTY_FACTOR", "STICK_FACTOR", "SEED_MU", "SEED_B"]
+__all__ = [
+    "BallJointFamily",
+    "add_ball_joints",
+    "default_stiffnesses",
+    "friction_loop_energy",
+    "PENALTY_FACTOR",
+    "STICK_FACTOR",
+    "SEED_MU",
+    "SEED_B",
+]
 
-SEED_MU = 0.5     # seed 001, Sec. II.B.1: static = kinetic friction coefficient
-SEED_B = 0.004    # seed 001, Sec. II.B.1: longeron ball end radius, m
+SEED_MU = 0.5  # seed 001, Sec. II.B.1: static = kinetic friction coefficient
+SEED_B = 0.004  # seed 001, Sec. II.B.1: longeron ball end radius, m
 # Default penalty k_pen = PENALTY_FACTOR * (largest EA/L of the members at the joint): the tie
 # gap |F|/k_pen is 1e-4 of the stretch of the stiffest connected member under the same force.
 PENALTY_FACTOR = 1e4
@@ -83,8 +91,9 @@ def _per_joint(value, n, what, name):
     try:
         a = np.broadcast_to(np.asarray(value, dtype=float), (n,)).astype(float).copy()
     except (TypeError, ValueError):
-        raise ModelError(f"ball joints '{name}': {what} must be a number or one number per joint ({n}), "
-                         f"got {value!r}") from None
+        raise ModelError(
+            f"ball joints '{name}': {what} must be a number or one number per joint ({n}), got {value!r}"
+        ) from None
     return a
 
 
@@ -110,15 +119,18 @@ class BallJointFamily(ElementFamily):
     n_state = N_STATE
     symmetric = False
 
-    def __init__(self, nodes, k_pen, k_stick, mu=SEED_MU, B=SEED_B, *, X=None, tol=None, labels=None,
-                 name: str = "ball_joint"):
+    def __init__(
+        self, nodes, k_pen, k_stick, mu=SEED_MU, B=SEED_B, *, X=None, tol=None, labels=None, name: str = "ball_joint"
+    ):
         self.name = name
         nodes = np.asarray(nodes)
         if nodes.ndim == 1 and nodes.size == 2:
             nodes = nodes[None, :]
         if nodes.ndim != 2 or nodes.shape[1] != 2 or not np.issubdtype(nodes.dtype, np.integer):
-            raise ModelError(f"ball joints '{name}': nodes must be an (n, 2) array of integer node labels "
-                             f"(longeron end, corner), got shape {nodes.shape} of {nodes.dtype}")
+            raise ModelError(
+                f"ball joints '{name}': nodes must be an (n, 2) array of integer node labels "
+                f"(longeron end, corner), got shape {nodes.shape} of {nodes.dtype}"
+            )
         self.nodes = np.ascontiguousarray(nodes, dtype=np.int64)
         n = self.nodes.shape[0]
         self.labels = np.arange(1, n + 1) if labels is None else np.asarray(labels).ravel()
@@ -126,17 +138,20 @@ class BallJointFamily(ElementFamily):
             raise ModelError(f"ball joints '{name}': {self.labels.size} labels for {n} joints")
         same = np.flatnonzero(self.nodes[:, 0] == self.nodes[:, 1])
         if same.size:
-            raise ModelError(f"{self._who(same[0])}: both ends are the same node; a ball joint connects a "
-                             "longeron end node to a different, coincident corner node")
+            raise ModelError(
+                f"{self._who(same[0])}: both ends are the same node; a ball joint connects a "
+                "longeron end node to a different, coincident corner node"
+            )
         self.k_pen = _per_joint(k_pen, n, "k_pen (N/m)", name)
         self.k_stick = _per_joint(k_stick, n, "k_stick (N m/rad)", name)
         self.mu = _per_joint(mu, n, "mu", name)
         self.B = _per_joint(B, n, "B (m)", name)
         for what, arr, ok, rule in (
-                ("k_pen", self.k_pen, self.k_pen > 0, "must be finite and > 0 N/m"),
-                ("k_stick", self.k_stick, self.k_stick > 0, "must be finite and > 0 N m/rad"),
-                ("mu", self.mu, self.mu >= 0, "is a friction coefficient: it must be finite and >= 0"),
-                ("B", self.B, self.B > 0, "is the ball end radius: it must be finite and > 0 m (seed: 0.004)")):
+            ("k_pen", self.k_pen, self.k_pen > 0, "must be finite and > 0 N/m"),
+            ("k_stick", self.k_stick, self.k_stick > 0, "must be finite and > 0 N m/rad"),
+            ("mu", self.mu, self.mu >= 0, "is a friction coefficient: it must be finite and >= 0"),
+            ("B", self.B, self.B > 0, "is the ball end radius: it must be finite and > 0 m (seed: 0.004)"),
+        ):
             bad = np.flatnonzero(~(np.isfinite(arr) & ok))
             if bad.size:
                 raise ModelError(f"{self._who(bad[0])}: {what} = {float(arr[bad[0]])!r} {rule}")
@@ -157,22 +172,23 @@ class BallJointFamily(ElementFamily):
             bad = np.flatnonzero(~(gap <= tol))
             if bad.size:
                 el = bad[0]
-                raise ModelError(f"{self._who(el)}: nodes {self.nodes[el, 0]} at {tuple(X[el, 0])} and "
-                                 f"{self.nodes[el, 1]} at {tuple(X[el, 1])} are {gap[el]:.3g} m apart, more than "
-                                 f"the tolerance {tol:.3g} m; a ball joint connects coincident nodes (check the "
-                                 "node labels, or pass a larger tol=)")
+                raise ModelError(
+                    f"{self._who(el)}: nodes {self.nodes[el, 0]} at {tuple(X[el, 0])} and "
+                    f"{self.nodes[el, 1]} at {tuple(X[el, 1])} are {gap[el]:.3g} m apart, more than "
+                    f"the tolerance {tol:.3g} m; a ball joint connects coincident nodes (check the "
+                    "node labels, or pass a larger tol=)"
+                )
             self.d0 = np.ascontiguousarray(d0)
             self.tol = tol
 
     def _who(self, el):
-        return (f"ball joint {self.labels[el]} (nodes {self.nodes[el, 0]}-{self.nodes[el, 1]}) of family "
-                f"'{self.name}'")
+        return f"ball joint {self.labels[el]} (nodes {self.nodes[el, 0]}-{self.nodes[el, 1]}) of family '{self.name}'"
 
     # ------------------------------------------------------------------ contract
     def initial_state(self) -> np.ndarray:
         """Zero moment, sticking, no slip, no dissipation, Q = I (nodal rotations start at I)."""
         st = np.zeros((self.n_elements, N_STATE))
-        st[:, I_Q:I_Q + 9] = np.eye(3).ravel()
+        st[:, I_Q : I_Q + 9] = np.eye(3).ravel()
         return st
 
     def evaluate(self, x, R, state, ctx: IncrementContext | None = None) -> ElementResponse:
@@ -192,11 +208,25 @@ class BallJointFamily(ElementFamily):
         err = np.zeros(n, dtype=np.int64)
         prev = ctx.previous_state(self) if hasattr(ctx, "previous_state") else None
         has_prev = prev is not None and prev.shape == (n, N_STATE)
-        ball_joint_family_kernel(self.nodes, np.ascontiguousarray(x, dtype=float),
-                                 np.ascontiguousarray(R, dtype=float), self.d0, self.k_pen, self.k_stick,
-                                 self.mu, self.B, np.ascontiguousarray(state, dtype=float), f, K, new, out,
-                                 energy, err, np.ascontiguousarray(prev, dtype=float) if has_prev else _NO_PREV,
-                                 has_prev)
+        ball_joint_family_kernel(
+            self.nodes,
+            np.ascontiguousarray(x, dtype=float),
+            np.ascontiguousarray(R, dtype=float),
+            self.d0,
+            self.k_pen,
+            self.k_stick,
+            self.mu,
+            self.B,
+            np.ascontiguousarray(state, dtype=float),
+            f,
+            K,
+            new,
+            out,
+            energy,
+            err,
+            np.ascontiguousarray(prev, dtype=float) if has_prev else _NO_PREV,
+            has_prev,
+        )
         bad = np.flatnonzero(err)
         if bad.size:
             el = bad[0]
@@ -204,26 +234,36 @@ class BallJointFamily(ElementFamily):
                 # the analysis cuts the increment back on FloatingPointError
                 raise FloatingPointError(f"{self._who(el)}: nodal positions or rotations are not finite")
             if err[el] == ERR_BIG_INCREMENT:
-                raise FloatingPointError(f"{self._who(el)}: relative rotation increment above "
-                                         f"{MAX_INCREMENT} rad in one increment; use smaller increments")
-        output = LazyOutput(lambda: {
-            "moment": out[:, 0:3].copy(),
-            "force": out[:, 3:6].copy(),
-            "F": out[:, 6].copy(),
-            "limit": out[:, 7].copy(),
-            "slip": out[:, 8].copy(),
-            "slip_angle": out[:, 9].copy(),
-            "dissipated": out[:, 10].copy(),
-            "moment_norm": np.linalg.norm(out[:, 0:3], axis=1),
-        })
-        return ElementResponse(f=f, k=K, state=new, output=output, energy=energy,
-                               provisional=bool(has_prev and np.any(new[:, I_SLIP] == REVERSED)))
+                raise FloatingPointError(
+                    f"{self._who(el)}: relative rotation increment above "
+                    f"{MAX_INCREMENT} rad in one increment; use smaller increments"
+                )
+        output = LazyOutput(
+            lambda: {
+                "moment": out[:, 0:3].copy(),
+                "force": out[:, 3:6].copy(),
+                "F": out[:, 6].copy(),
+                "limit": out[:, 7].copy(),
+                "slip": out[:, 8].copy(),
+                "slip_angle": out[:, 9].copy(),
+                "dissipated": out[:, 10].copy(),
+                "moment_norm": np.linalg.norm(out[:, 0:3], axis=1),
+            }
+        )
+        return ElementResponse(
+            f=f,
+            k=K,
+            state=new,
+            output=output,
+            energy=energy,
+            provisional=bool(has_prev and np.any(new[:, I_SLIP] == REVERSED)),
+        )
 
     # ------------------------------------------------------------------ helpers
     @staticmethod
     def state_moment(state):
         """Committed friction moments (n, 3) in the body frame of node b, N m."""
-        return np.asarray(state)[:, I_M:I_M + 3]
+        return np.asarray(state)[:, I_M : I_M + 3]
 
     @staticmethod
     def state_dissipated(state):
@@ -280,19 +320,34 @@ def default_stiffnesses(model, pairs, penalty_factor=PENALTY_FACTOR, stick_facto
         t = max(kt.get(int(a), 0.0), kt.get(int(b), 0.0)) or kt_all
         r = max(kr.get(int(a), 0.0), kr.get(int(b), 0.0)) or kr_all
         if t <= 0:
-            raise ModelError(f"ball joint {a}-{b}: no beam or truss in the model to set the default penalty "
-                             "stiffness from; give k_pen (N/m) explicitly")
+            raise ModelError(
+                f"ball joint {a}-{b}: no beam or truss in the model to set the default penalty "
+                "stiffness from; give k_pen (N/m) explicitly"
+            )
         if r <= 0:
-            raise ModelError(f"ball joint {a}-{b}: no beam in the model to set the default stick stiffness "
-                             "from; give k_stick (N m/rad) explicitly")
+            raise ModelError(
+                f"ball joint {a}-{b}: no beam in the model to set the default stick stiffness "
+                "from; give k_stick (N m/rad) explicitly"
+            )
         k_pen.append(penalty_factor * t)
         k_stick.append(stick_factor * r)
     return np.array(k_pen), np.array(k_stick)
 
 
-def add_ball_joints(model, pairs, mu=SEED_MU, B=SEED_B, *, k_pen=None, k_stick=None,
-                    penalty_factor=PENALTY_FACTOR, stick_factor=STICK_FACTOR, tol=None, labels=None,
-                    name="ball_joint") -> BallJointFamily:
+def add_ball_joints(
+    model,
+    pairs,
+    mu=SEED_MU,
+    B=SEED_B,
+    *,
+    k_pen=None,
+    k_stick=None,
+    penalty_factor=PENALTY_FACTOR,
+    stick_factor=STICK_FACTOR,
+    tol=None,
+    labels=None,
+    name="ball_joint",
+) -> BallJointFamily:
     """Add friction ball joints (seed 001, Sec. II.B.1) between coincident node pairs.
 
     pairs : [(longeron_end, corner), ...] node labels.
@@ -306,8 +361,9 @@ def add_ball_joints(model, pairs, mu=SEED_MU, B=SEED_B, *, k_pen=None, k_stick=N
     if pairs.ndim == 1 and pairs.size == 2:
         pairs = pairs[None, :]
     if pairs.ndim != 2 or pairs.shape[1] != 2 or pairs.shape[0] == 0:
-        raise ModelError(f"ball joints '{name}': pairs must be a list of (longeron end, corner) node labels, "
-                         f"got shape {pairs.shape}")
+        raise ModelError(
+            f"ball joints '{name}': pairs must be a list of (longeron end, corner) node labels, got shape {pairs.shape}"
+        )
     for a, b in pairs.tolist():
         model._check_node(a, f"ball joint {a}-{b}")
         model._check_node(b, f"ball joint {a}-{b}")

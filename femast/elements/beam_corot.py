@@ -56,7 +56,7 @@ SECTION_FORCE_NAMES = ("N", "Vy", "Vz", "T", "My", "Mz")
 # C_OTHER[r] th_b[r]), b the other end (torsion GJ/l0 [[1, -1], [-1, 1]], bending 2EI/l0 [[2, 1], [1, 2]])
 _C_SELF = np.array([1.0, 2.0, 2.0])
 _C_OTHER = np.array([-1.0, 1.0, 1.0])
-_END_SIGN = np.array([-1.0, 1.0])   # section moment at end a = sign * m_a (acting on the section)
+_END_SIGN = np.array([-1.0, 1.0])  # section moment at end a = sign * m_a (acting on the section)
 
 
 @njit(cache=True, error_model="numpy")
@@ -71,20 +71,20 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_facto
     One loop over the elements with the element's work written out in its body (not a call)
     and every scratch array on the stack (:mod:`._stack`): the compiler then keeps values in
     registers (issue 8: 1.6x faster than a per-element function with heap scratch)."""
-    T = carray(stack_buffer(18), (2, 3, 3))     # nodal triads T_a = R_a E0
-    Rr = carray(stack_buffer(9), (3, 3))        # corotated frame [e1 e2 e3]
+    T = carray(stack_buffer(18), (2, 3, 3))  # nodal triads T_a = R_a E0
+    Rr = carray(stack_buffer(9), (3, 3))  # corotated frame [e1 e2 e3]
     A = carray(stack_buffer(9), (3, 3))
-    Ti = carray(stack_buffer(18), (2, 3, 3))    # Ts^-1(theta_a)
+    Ti = carray(stack_buffer(18), (2, 3, 3))  # Ts^-1(theta_a)
     Kh = carray(stack_buffer(9), (3, 3))
-    th = carray(stack_buffer(6), (2, 3))        # local rotations theta_a
-    m = carray(stack_buffer(6), (2, 3))         # local end moments m_a
-    mt = carray(stack_buffer(6), (2, 3))        # Ti_a^T m_a
-    qe = carray(stack_buffer(6), (2, 3))        # q_a x e3
+    th = carray(stack_buffer(6), (2, 3))  # local rotations theta_a
+    m = carray(stack_buffer(6), (2, 3))  # local end moments m_a
+    mt = carray(stack_buffer(6), (2, 3))  # Ti_a^T m_a
+    qe = carray(stack_buffer(6), (2, 3))  # q_a x e3
     q = carray(stack_buffer(3), (3,))
-    kr = carray(stack_buffer(3), (3,))          # GJ / l0, 2 EIy / l0, 2 EIz / l0
-    Wd = carray(stack_buffer(9), (3, 3))        # frame spin per dd
-    ga = carray(stack_buffer(6), (2, 3))        # frame spin about e1 per dw_a
-    V = carray(stack_buffer(18), (2, 3, 3))     # Ti_a Rr^T
+    kr = carray(stack_buffer(3), (3,))  # GJ / l0, 2 EIy / l0, 2 EIz / l0
+    Wd = carray(stack_buffer(9), (3, 3))  # frame spin per dd
+    ga = carray(stack_buffer(6), (2, 3))  # frame spin about e1 per dw_a
+    V = carray(stack_buffer(18), (2, 3, 3))  # Ti_a Rr^T
     P = carray(stack_buffer(9), (3, 3))
     Gm = carray(stack_buffer(36), (2, 2, 3, 3))
     Sg = carray(stack_buffer(18), (2, 3, 3))
@@ -179,7 +179,7 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_facto
         # ---- consistent tangent, in 3x3 blocks of the global frame; columns [dd, dw1, dw2] ----
         # spin of the corotated frame Wr dv (Wr = Rr G): the 3x3 Wd in the dd columns, the rank-one
         # e1 g_a^T in those of w_a (g_a = qe_a / (2 q2c))
-        il = 1.0 / l            # reciprocals: a division costs several multiplications' throughput
+        il = 1.0 / l  # reciprocals: a division costs several multiplications' throughput
         iq = 1.0 / q2c
         r12 = q1c * iq
         for k in range(3):
@@ -202,8 +202,12 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_facto
             ts_inv_T_times_derivative_into(th[a], m[a], Kh)
             for i in range(3):
                 for k in range(3):
-                    P[i, k] = (V[a, k, i] * kr[k] * _C_SELF[k]
-                               + Rr[i, 0] * Kh[0, k] + Rr[i, 1] * Kh[1, k] + Rr[i, 2] * Kh[2, k])
+                    P[i, k] = (
+                        V[a, k, i] * kr[k] * _C_SELF[k]
+                        + Rr[i, 0] * Kh[0, k]
+                        + Rr[i, 1] * Kh[1, k]
+                        + Rr[i, 2] * Kh[2, k]
+                    )
             for i in range(3):
                 for j in range(3):
                     Gm[a, a, i, j] = P[i, 0] * V[a, 0, j] + P[i, 1] * V[a, 1, j] + P[i, 2] * V[a, 2, j]
@@ -222,18 +226,23 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_facto
         # JM = d(mt_1 + mt_2) in local components (rows M0, M1, M2): Rr^T (Rr d mt_1 + Rr d mt_2)
         for r in range(3):
             for j in range(3):
-                Lm[r, j] = (Rr[0, r] * (Sg[0, 0, j] + Sg[1, 0, j]) + Rr[1, r] * (Sg[0, 1, j] + Sg[1, 1, j])
-                            + Rr[2, r] * (Sg[0, 2, j] + Sg[1, 2, j]))
+                Lm[r, j] = (
+                    Rr[0, r] * (Sg[0, 0, j] + Sg[1, 0, j])
+                    + Rr[1, r] * (Sg[0, 1, j] + Sg[1, 1, j])
+                    + Rr[2, r] * (Sg[0, 2, j] + Sg[1, 2, j])
+                )
         for r in range(3):
             for k in range(3):
                 JM[r, k] = -(Lm[r, 0] * Wd[0, k] + Lm[r, 1] * Wd[1, k] + Lm[r, 2] * Wd[2, k])
-            l0r = Lm[r, 0] * Rr[0, 0] + Lm[r, 1] * Rr[1, 0] + Lm[r, 2] * Rr[2, 0]   # (Rr^T Sg e1)_r
+            l0r = Lm[r, 0] * Rr[0, 0] + Lm[r, 1] * Rr[1, 0] + Lm[r, 2] * Rr[2, 0]  # (Rr^T Sg e1)_r
             for b in range(2):
                 for k in range(3):
-                    JM[r, 3 + 3 * b + k] = (-l0r * ga[b, k]
-                                            + Rr[0, r] * (Gm[0, b, 0, k] + Gm[1, b, 0, k])
-                                            + Rr[1, r] * (Gm[0, b, 1, k] + Gm[1, b, 1, k])
-                                            + Rr[2, r] * (Gm[0, b, 2, k] + Gm[1, b, 2, k]))
+                    JM[r, 3 + 3 * b + k] = (
+                        -l0r * ga[b, k]
+                        + Rr[0, r] * (Gm[0, b, 0, k] + Gm[1, b, 0, k])
+                        + Rr[1, r] * (Gm[0, b, 1, k] + Gm[1, b, 1, k])
+                        + Rr[2, r] * (Gm[0, b, 2, k] + Gm[1, b, 2, k])
+                    )
         # J_q1c, J_q2c: q . (Wr_j x e_b) = (e_b x q) . Wr_j in the dd columns, (q_a x e_b) / 2 in those of w_a
         for b in range(2):
             u0 = Rr[1, b] * q[2] - Rr[2, b] * q[1]
@@ -260,7 +269,7 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_facto
             FDi = (-alpha * Rr[i, 2] + M2 * Rr[i, 1]) * il
             fx[i] = N * Rr[i, 0] - FDi
             fl[i] = Rr[i, 0] * kN + FDi * il
-            fa[i] = Rr[i, 2] * il      # e3 / l and e2 / l
+            fa[i] = Rr[i, 2] * il  # e3 / l and e2 / l
             fb[i] = Rr[i, 1] * il
         # e1 x fx2 (the spin columns' Wr_j x fx2 = g_j e1 x fx2)
         c0 = Rr[1, 0] * fx[2] - Rr[2, 0] * fx[1]
@@ -366,9 +375,7 @@ def element_frame(x1, x2, up):
     if ny < 1e-8 * max(math.sqrt(u0 * u0 + u1 * u1 + u2 * u2), 1e-300):
         return None
     y0, y1, y2 = y0 / ny, y1 / ny, y2 / ny
-    return np.array([[e0, y0, e1_ * y2 - e2_ * y1],
-                     [e1_, y1, e2_ * y0 - e0 * y2],
-                     [e2_, y2, e0 * y1 - e1_ * y0]])
+    return np.array([[e0, y0, e1_ * y2 - e2_ * y1], [e1_, y1, e2_ * y0 - e0 * y2], [e2_, y2, e0 * y1 - e1_ * y0]])
 
 
 def element_frames(x1, x2, up):
@@ -404,7 +411,7 @@ class BeamFamily(ElementFamily):
     """
 
     name = "beam"
-    self_equilibrated = True   # internal nodal forces: zero resultant force and moment (issue 16 check)
+    self_equilibrated = True  # internal nodal forces: zero resultant force and moment (issue 16 check)
     active_dofs = (0, 1, 2, 3, 4, 5)
     n_state = 0
     path_independent = True
@@ -419,7 +426,7 @@ class BeamFamily(ElementFamily):
         self.GJ = np.ascontiguousarray(GJ, dtype=float)
         self.EIy = np.ascontiguousarray(EIy, dtype=float)
         self.EIz = np.ascontiguousarray(EIz, dtype=float)
-        self.length_factor = np.ones(len(self.nodes))   # stress-free length / l0 (femast/model/thermal.py)
+        self.length_factor = np.ones(len(self.nodes))  # stress-free length / l0 (femast/model/thermal.py)
         self.labels = np.arange(1, len(self.nodes) + 1) if labels is None else np.asarray(labels)
 
     def evaluate(self, x, R, state, ctx=None):
@@ -428,6 +435,20 @@ class BeamFamily(ElementFamily):
         K = np.empty((n, 12, 12))
         sf = np.empty((n, 2, 6))
         energy = np.empty(n)
-        beam_family_kernel(self.nodes, np.ascontiguousarray(x), np.ascontiguousarray(R), self.E0, self.l0,
-                           self.EA, self.GJ, self.EIy, self.EIz, self.length_factor, f, K, sf, energy)
+        beam_family_kernel(
+            self.nodes,
+            np.ascontiguousarray(x),
+            np.ascontiguousarray(R),
+            self.E0,
+            self.l0,
+            self.EA,
+            self.GJ,
+            self.EIy,
+            self.EIz,
+            self.length_factor,
+            f,
+            K,
+            sf,
+            energy,
+        )
         return ElementResponse(f=f, k=K, state=state, output={"section_forces": sf}, energy=energy)

@@ -18,7 +18,6 @@ is unchanged; this family reproduces it (tests) and generalises it.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,8 +25,15 @@ from numba import njit
 
 from ..errors import ModelError
 from ..latch import LatchParameters, _as_param_array, validate_latch_array
-from ._cable_geometry import (GEO_ADJACENT_PULLEYS, GEO_INSIDE_PULLEY, GEO_NOT_FINITE, GEO_OK,
-                              GEO_PLANE_UNDEFINED, GEO_ZERO_LENGTH, cable_geometry)
+from ._cable_geometry import (
+    GEO_ADJACENT_PULLEYS,
+    GEO_INSIDE_PULLEY,
+    GEO_NOT_FINITE,
+    GEO_OK,
+    GEO_PLANE_UNDEFINED,
+    GEO_ZERO_LENGTH,
+    cable_geometry,
+)
 from ._device_kernels import ERR_ACTIVE_SET, ERR_SHORT, SLIDE_FREE, STOP, device_kernel, kernel_for_law
 from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, LATCH_LB, N_PARAM, USER, builtin_law
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput, chain_nodes
@@ -91,8 +97,10 @@ def _kind_and_params(dev, k, name):
     if isinstance(dev, Pulley):
         for what, v in (("radius", dev.radius), ("mu", dev.mu)):
             if not (np.isfinite(v) and v >= 0.0):
-                raise ModelError(f"{name} device {k} (Pulley): {what} = {v!r} must be finite and >= 0 "
-                                 f"({'m' if what == 'radius' else 'friction coefficient'})")
+                raise ModelError(
+                    f"{name} device {k} (Pulley): {what} = {v!r} must be finite and >= 0 "
+                    f"({'m' if what == 'radius' else 'friction coefficient'})"
+                )
         if dev.mu > 0.0:
             p[0] = dev.mu
             return CAPSTAN, p, float(dev.radius)
@@ -123,6 +131,7 @@ _COMBINED = {}
 def _combined_law(user):
     """The built-in laws plus one user law, as one numba function (compiled on first use)."""
     if user not in _COMBINED:
+
         @njit
         def law(kind, sigma, T_in, T_out, s, phi, p):
             if kind == USER:
@@ -161,24 +170,32 @@ def wrap_geometry(X, radius):
 
 def _geometry_message(code, where, name, nodes, radius, X):
     if code == GEO_ZERO_LENGTH:
-        return (f"{name}: section {where} between nodes {nodes[where]} and {nodes[where + 1]} has zero length; "
-                "anchors and devices must not coincide")
+        return (
+            f"{name}: section {where} between nodes {nodes[where]} and {nodes[where + 1]} has zero length; "
+            "anchors and devices must not coincide"
+        )
     if code == GEO_NOT_FINITE:
         return f"{name}: node {nodes[where]} has non-finite coordinates"
     if code == GEO_INSIDE_PULLEY:
         k = where
         pk = k + 1 if k + 1 < len(radius) and radius[k + 1] > 0 else k - 1
         d = float(np.linalg.norm(X[k] - X[pk]))
-        return (f"{name}: node {nodes[k]} is {d:.6g} m from the centre of the pulley at node {nodes[pk]} of radius "
-                f"{radius[pk]:.6g} m: no tangent exists (impossible wrap angle). Move the node out of the pulley "
-                "or reduce the radius")
+        return (
+            f"{name}: node {nodes[k]} is {d:.6g} m from the centre of the pulley at node {nodes[pk]} of radius "
+            f"{radius[pk]:.6g} m: no tangent exists (impossible wrap angle). Move the node out of the pulley "
+            "or reduce the radius"
+        )
     if code == GEO_PLANE_UNDEFINED:
-        return (f"{name}: the pulley of radius {radius[where]:.6g} m at node {nodes[where]} lies on the straight line "
-                f"through its neighbours {nodes[where - 1]} and {nodes[where + 1]}: the wrap plane is undefined. "
-                "Offset the pulley from that line or make it a point pulley (radius 0)")
+        return (
+            f"{name}: the pulley of radius {radius[where]:.6g} m at node {nodes[where]} lies on the straight line "
+            f"through its neighbours {nodes[where - 1]} and {nodes[where + 1]}: the wrap plane is undefined. "
+            "Offset the pulley from that line or make it a point pulley (radius 0)"
+        )
     if code == GEO_ADJACENT_PULLEYS:
-        return (f"{name}: sections {where} joins two pulleys of finite radius (nodes {nodes[where]} and "
-                f"{nodes[where + 1]}); put a point device between them or give one of them radius 0")
+        return (
+            f"{name}: sections {where} joins two pulleys of finite radius (nodes {nodes[where]} and "
+            f"{nodes[where + 1]}); put a point device between them or give one of them radius 0"
+        )
     return f"{name}: geometry error {code}"  # pragma: no cover
 
 
@@ -214,8 +231,9 @@ class CableDeviceFamily(ElementFamily):
     active_dofs = (0, 1, 2)
     symmetric = False
 
-    def __init__(self, nodes, EA, L0, devices, *, s0=None, device_values=None, length_error=None,
-                 name: str = "cable_devices"):
+    def __init__(
+        self, nodes, EA, L0, devices, *, s0=None, device_values=None, length_error=None, name: str = "cable_devices"
+    ):
         self.name = name
         self.nodes = chain_nodes(nodes, name)
         n_el, nn = self.nodes.shape
@@ -225,7 +243,8 @@ class CableDeviceFamily(ElementFamily):
         if len(devices) != n - 1:
             raise ModelError(
                 f"{name}: {len(devices)} devices given for a cable of {n} sections ({nn} nodes per element); "
-                f"give exactly one device per interior node ({n - 1}), in cable order")
+                f"give exactly one device per interior node ({n - 1}), in cable order"
+            )
         self.devices = tuple(devices)
         self.n_state = 2 * (n - 1)
         self.EA = self._per_element(EA, "EA (N)")
@@ -244,8 +263,10 @@ class CableDeviceFamily(ElementFamily):
             if kind == USER:
                 users.add(dev.law)
         if len(users) > 1:
-            raise ModelError(f"{name}: the user devices use {len(users)} different law functions; one family takes "
-                             "one user law (dispatch on the parameters p inside it)")
+            raise ModelError(
+                f"{name}: the user devices use {len(users)} different law functions; one family takes "
+                "one user law (dispatch on the parameters p inside it)"
+            )
         self.kinds = np.array(kinds if kinds else [FREE], dtype=np.int64)[: max(n - 1, 0)]
         self.radius = radius
         self.P = P
@@ -257,14 +278,16 @@ class CableDeviceFamily(ElementFamily):
             try:
                 dL[:] = np.broadcast_to(np.asarray(length_error, dtype=float), (n_el, n))
             except (TypeError, ValueError):
-                raise ModelError(f"{name}: length_error must be one value per section, shape ({n_el}, {n}) or ({n},), "
-                                 f"in m; got {np.shape(length_error)}") from None
+                raise ModelError(
+                    f"{name}: length_error must be one value per section, shape ({n_el}, {n}) or ({n},), "
+                    f"in m; got {np.shape(length_error)}"
+                ) from None
             bad = np.argwhere(~np.isfinite(dL))
             if bad.size:
                 raise ModelError(f"{name} element {bad[0][0]}: length_error of section {bad[0][1]} is not finite")
         self.length_error = dL
         self.L0 = self.L0 + dL.sum(axis=1)
-        before = np.cumsum(dL, axis=1)[:, :-1]          # (n_el, n-1): errors before device k
+        before = np.cumsum(dL, axis=1)[:, :-1]  # (n_el, n-1): errors before device k
         self.length_factor = np.ones(n_el)
         # initial material coordinates
         S0 = np.full((n_el, n - 1), np.nan)
@@ -272,14 +295,18 @@ class CableDeviceFamily(ElementFamily):
             try:
                 S0[:] = np.broadcast_to(np.asarray(s0, dtype=float), (n_el, n - 1))
             except ValueError:
-                raise ModelError(f"{name}: s0 must have shape (n_el, n-1) = ({n_el}, {n - 1}) or ({n - 1},), in m")
+                raise ModelError(
+                    f"{name}: s0 must have shape (n_el, n-1) = ({n_el}, {n - 1}) or ({n - 1},), in m"
+                ) from None
         for k, dev in enumerate(devices):
             if isinstance(dev, Latch):
                 x0 = -self.P[:, k, 1] if dev.x0 is None else np.full(n_el, float(dev.x0))
                 if dev.bead is None:
                     if s0 is None:
-                        raise ModelError(f"{name} device {k} (Latch): give bead= (material coordinate of the bead, m) "
-                                         "or build with CableDeviceFamily.pretensioned")
+                        raise ModelError(
+                            f"{name} device {k} (Latch): give bead= (material coordinate of the bead, m) "
+                            "or build with CableDeviceFamily.pretensioned"
+                        )
                     S0[:, k] += before[:, k]
                     self.P[:, k, 6] = S0[:, k] + x0
                 else:
@@ -288,16 +315,20 @@ class CableDeviceFamily(ElementFamily):
                 behind = np.flatnonzero(x0 < -self.P[:, k, 1] * (1 + 1e-12))
                 if behind.size:
                     el = behind[0]
-                    raise ModelError(f"{name} device {k} (Latch), element {el}: x0 = {x0[el]!r} m is behind the "
-                                     f"backstop (x0 >= -x_backstop = {-self.P[el, k, 1]!r} m)")
+                    raise ModelError(
+                        f"{name} device {k} (Latch), element {el}: x0 = {x0[el]!r} m is behind the "
+                        f"backstop (x0 >= -x_backstop = {-self.P[el, k, 1]!r} m)"
+                    )
         need = [k for k, kd in enumerate(self.kinds) if kd != FREE]
         for k in need:
             if not isinstance(devices[k], Latch):
                 S0[:, k] += before[:, k]
             if np.any(np.isnan(S0[:, k])):
-                raise ModelError(f"{name} device {k} ({type(devices[k]).__name__}) grips the cable: give s0 (the "
-                                 "material coordinate of the cable at the device, m) or build with "
-                                 "CableDeviceFamily.pretensioned(nodes, X, EA, T0, devices)")
+                raise ModelError(
+                    f"{name} device {k} ({type(devices[k]).__name__}) grips the cable: give s0 (the "
+                    "material coordinate of the cable at the device, m) or build with "
+                    "CableDeviceFamily.pretensioned(nodes, X, EA, T0, devices)"
+                )
         # frictionless devices: a uniform share (a placeholder, the first evaluation replaces it)
         cols = np.arange(1, n)[None, :]
         S0 = np.where(np.isnan(S0), self.L0[:, None] * cols / n, S0)
@@ -305,8 +336,10 @@ class CableDeviceFamily(ElementFamily):
         bad = np.argwhere(~(np.diff(full, axis=1) > 0.0))
         if bad.size:
             el, i = bad[0]
-            raise ModelError(f"{name} element {el}: the material coordinates s0 = {S0[el]} m must increase strictly "
-                             f"from 0 to L0 = {self.L0[el]:.6g} m along the cable (section {i} has none)")
+            raise ModelError(
+                f"{name} element {el}: the material coordinates s0 = {S0[el]} m must increase strictly "
+                f"from 0 to L0 = {self.L0[el]:.6g} m along the cable (section {i} has none)"
+            )
         self.S0 = S0
 
     _LATCH_NAMES = ("r", "x_backstop", "k", "mu", "h", "R", None, "hysteresis_force", "hysteresis_length")
@@ -325,24 +358,34 @@ class CableDeviceFamily(ElementFamily):
             elif isinstance(dev, Pulley) and self.kinds[k] == CAPSTAN:
                 cols = {"mu": 0}
             else:
-                raise ModelError(f"{self.name} device {k} ({type(dev).__name__}): has no per-element parameters (a "
-                                 "Latch and a Pulley with mu > 0 have)")
+                raise ModelError(
+                    f"{self.name} device {k} ({type(dev).__name__}): has no per-element parameters (a "
+                    "Latch and a Pulley with mu > 0 have)"
+                )
             for nm, v in dict(params).items():
                 if nm not in cols:
-                    raise ModelError(f"{self.name} device {k} ({type(dev).__name__}): unknown parameter {nm!r}; use "
-                                     f"{', '.join(cols)}")
+                    raise ModelError(
+                        f"{self.name} device {k} ({type(dev).__name__}): unknown parameter {nm!r}; use "
+                        f"{', '.join(cols)}"
+                    )
                 try:
                     arr = np.broadcast_to(np.asarray(v, dtype=float), (n_el,))
                 except (TypeError, ValueError):
-                    raise ModelError(f"{self.name} device {k}: {nm} must be a number or one per element ({n_el}), "
-                                     f"got shape {np.shape(v)}") from None
+                    raise ModelError(
+                        f"{self.name} device {k}: {nm} must be a number or one per element ({n_el}), "
+                        f"got shape {np.shape(v)}"
+                    ) from None
                 self.P[:, k, cols[nm]] = arr
-            for el in range(n_el):   # construction only, not a hot path
+            for el in range(n_el):  # construction only, not a hot path
                 where = f"{self.name} device {k} ({type(dev).__name__}), element {el}"
                 if isinstance(dev, Latch):
                     validate_latch_array(self.P[el, k, :6], where)
-                    if not (np.isfinite(self.P[el, k, 7]) and self.P[el, k, 7] >= 0.0 and np.isfinite(self.P[el, k, 8])
-                            and self.P[el, k, 8] > 0.0):
+                    if not (
+                        np.isfinite(self.P[el, k, 7])
+                        and self.P[el, k, 7] >= 0.0
+                        and np.isfinite(self.P[el, k, 8])
+                        and self.P[el, k, 8] > 0.0
+                    ):
                         raise ModelError(f"{where}: hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
                 elif not (np.isfinite(self.P[el, k, 0]) and self.P[el, k, 0] > 0.0):
                     raise ModelError(f"{where}: capstan mu = {self.P[el, k, 0]!r} must be finite and > 0")
@@ -352,8 +395,10 @@ class CableDeviceFamily(ElementFamily):
         try:
             return np.broadcast_to(a, (self.nodes.shape[0],)).astype(float).copy()
         except ValueError:
-            raise ModelError(f"{self.name}: {what} must be a scalar or one value per element "
-                             f"({self.nodes.shape[0]}), got shape {a.shape}") from None
+            raise ModelError(
+                f"{self.name}: {what} must be a scalar or one value per element "
+                f"({self.nodes.shape[0]}), got shape {a.shape}"
+            ) from None
 
     # ------------------------------------------------------------------ construction helpers
     @classmethod
@@ -365,8 +410,9 @@ class CableDeviceFamily(ElementFamily):
         n_el, nn = nodes.shape
         devices = list(devices)
         if len(devices) != nn - 2:
-            raise ModelError(f"pretensioned: {len(devices)} devices for {nn - 1} sections; give one per interior node "
-                             f"({nn - 2})")
+            raise ModelError(
+                f"pretensioned: {len(devices)} devices for {nn - 1} sections; give one per interior node ({nn - 2})"
+            )
         radius = np.zeros(nn)
         for k, d in enumerate(devices):
             radius[k + 1] = d.radius if isinstance(d, Pulley) else 0.0
@@ -417,7 +463,7 @@ class CableDeviceFamily(ElementFamily):
         L0 = self.L0
         lf = getattr(self, "length_factor", None)
         scaled = lf is not None and bool(np.any(lf != 1.0))
-        if scaled:   # thermal strain: every unstretched length and material coordinate times s
+        if scaled:  # thermal strain: every unstretched length and material coordinate times s
             L0 = L0 * lf
             P = P.copy()
             P[:, :, LATCH_LB] *= lf[:, None]
@@ -431,28 +477,43 @@ class CableDeviceFamily(ElementFamily):
         if bad.size:
             el = bad[0]
             self._raise(el, int(err[el]), int(where[el]), X[el])
-        return ElementResponse(f=f, k=k, state=new, energy=energy,
-                               output=LazyOutput(lambda: self._output(T, new, phi[:, :m], lf if scaled else None)))
+        return ElementResponse(
+            f=f,
+            k=k,
+            state=new,
+            energy=energy,
+            output=LazyOutput(lambda: self._output(T, new, phi[:, :m], lf if scaled else None)),
+        )
 
     def _raise(self, el, code, where, X):
         name = f"{self.name} element {el}"
         if code < 10:
             raise ModelError(_geometry_message(code, where, name, self.nodes[el], self.radius, X))
         if code == ERR_SHORT:
-            raise ModelError(f"{name}: the cable (L0 = {self.L0[el]:.6g} m) is far too short for the node positions: "
-                             "a section would need a non-positive unstretched length. Check the units of L0 and the "
-                             "coordinates, or build with CableDeviceFamily.pretensioned")
+            raise ModelError(
+                f"{name}: the cable (L0 = {self.L0[el]:.6g} m) is far too short for the node positions: "
+                "a section would need a non-positive unstretched length. Check the units of L0 and the "
+                "coordinates, or build with CableDeviceFamily.pretensioned"
+            )
         what = "cycled between stick and slip" if code == ERR_ACTIVE_SET else "did not converge"
-        raise ModelError(f"{name}: the device equations {what} (devices {[type(d).__name__ for d in self.devices]}); "
-                         "take smaller load increments")
+        raise ModelError(
+            f"{name}: the device equations {what} (devices {[type(d).__name__ for d in self.devices]}); "
+            "take smaller load increments"
+        )
 
     def _output(self, T, new, phi, lf=None):
         m = self.n_sections - 1
         S = np.column_stack([np.zeros(len(T)), new[:, :m], self.L0])
         latch = self.kinds == LATCH
         bead = np.where(latch[None, :], self.P[:, :m, 6] - new[:, :m], np.nan)
-        if lf is not None:   # physical (heated) lengths and bead positions
+        if lf is not None:  # physical (heated) lengths and bead positions
             S = S * lf[:, None]
             bead = bead * lf[:, None]
-        return {"tension": T, "unstretched_length": np.diff(S, axis=1), "material_coordinate": new[:, :m].copy(),
-                "device_mode": new[:, m:].copy(), "wrap_angle": phi.copy(), "bead_position": bead}
+        return {
+            "tension": T,
+            "unstretched_length": np.diff(S, axis=1),
+            "material_coordinate": new[:, :m].copy(),
+            "device_mode": new[:, m:].copy(),
+            "wrap_angle": phi.copy(),
+            "bead_position": bead,
+        }

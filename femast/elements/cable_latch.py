@@ -67,7 +67,9 @@ def _per_element(value, n_el, what, name):
     try:
         a = np.broadcast_to(a, (n_el,)).astype(float).copy()
     except ValueError:
-        raise ModelError(f"{name}: {what} must be a scalar or one value per element ({n_el}), got shape {a.shape}")
+        raise ModelError(
+            f"{name}: {what} must be a scalar or one value per element ({n_el}), got shape {a.shape}"
+        ) from None
     return a
 
 
@@ -78,17 +80,20 @@ def _hysteresis(hysteresis_force, hysteresis_length, latch, has, name):
     ell = _per_element(hysteresis_length, n_el, "hysteresis_length (m)", name)
     bad = np.flatnonzero(~(np.isfinite(Fh) & (Fh >= 0.0)))
     if bad.size:
-        raise ModelError(f"{name} element {bad[0]}: hysteresis_force = {Fh[bad[0]]!r} N must be finite and >= 0 "
-                         "(0 switches the latch hysteresis off)")
+        raise ModelError(
+            f"{name} element {bad[0]}: hysteresis_force = {Fh[bad[0]]!r} N must be finite and >= 0 "
+            "(0 switches the latch hysteresis off)"
+        )
     bad = np.flatnonzero(~(np.isfinite(ell) & (ell > 0.0)))
     if bad.size:
         raise ModelError(f"{name} element {bad[0]}: hysteresis_length = {ell[bad[0]]!r} m must be finite and > 0")
-    xct = np.sqrt(np.clip((latch[:, 0] + latch[:, 5]) ** 2 - (latch[:, 4] + latch[:, 0]) ** 2,
-                          0.0, None))
+    xct = np.sqrt(np.clip((latch[:, 0] + latch[:, 5]) ** 2 - (latch[:, 4] + latch[:, 0]) ** 2, 0.0, None))
     bad = np.flatnonzero(has & (Fh > 0.0) & (latch[:, 1] >= xct))
     if bad.size:
-        raise ModelError(f"{name} element {bad[0]}: the latch hysteresis option needs the backstop inside the "
-                         f"roller contact zone (x_backstop < x_contact = {xct[bad[0]]:.6g} m)")
+        raise ModelError(
+            f"{name} element {bad[0]}: the latch hysteresis option needs the backstop inside the "
+            f"roller contact zone (x_backstop < x_contact = {xct[bad[0]]:.6g} m)"
+        )
     return np.ascontiguousarray(np.column_stack([np.where(has, Fh, 0.0), ell]))
 
 
@@ -132,9 +137,22 @@ class CableLatchFamily(ElementFamily):
     active_dofs = (0, 1, 2)
     symmetric = False
 
-    def __init__(self, nodes, EA, L0, *, latch_node=None, bead=None, latch=None, x0=None,
-                 max_strain: float = 0.1, hysteresis_force=0.0, hysteresis_length=3e-4,
-                 length_error=None, name: str = "cable_latch"):
+    def __init__(
+        self,
+        nodes,
+        EA,
+        L0,
+        *,
+        latch_node=None,
+        bead=None,
+        latch=None,
+        x0=None,
+        max_strain: float = 0.1,
+        hysteresis_force=0.0,
+        hysteresis_length=3e-4,
+        length_error=None,
+        name: str = "cable_latch",
+    ):
         self.name = name
         self.nodes = chain_nodes(nodes, name)
         n_el, nn = self.nodes.shape
@@ -145,9 +163,7 @@ class CableLatchFamily(ElementFamily):
         for what, arr, unit in (("EA", self.EA, "N"), ("L0", self.L0, "m")):
             bad = np.flatnonzero(~(np.isfinite(arr) & (arr > 0.0)))
             if bad.size:
-                raise ModelError(
-                    f"{name} element {bad[0]}: {what} = {arr[bad[0]]!r} {unit} must be finite and > 0"
-                )
+                raise ModelError(f"{name} element {bad[0]}: {what} = {arr[bad[0]]!r} {unit} must be finite and > 0")
         if latch_node is None:
             latch_node = 0
         jl = np.broadcast_to(np.asarray(latch_node), (n_el,)).astype(np.int64).copy()
@@ -158,9 +174,7 @@ class CableLatchFamily(ElementFamily):
                 f"1..{self.n_sections - 1} (0 or None for no latch)"
             )
         self.latch_node = jl
-        self.latch = np.ascontiguousarray(
-            np.broadcast_to(_as_param_array(latch), (n_el, 6)), dtype=float
-        ).copy()
+        self.latch = np.ascontiguousarray(np.broadcast_to(_as_param_array(latch), (n_el, 6)), dtype=float).copy()
         has = jl > 0
         for el in np.flatnonzero(has):
             validate_latch_array(self.latch[el], f"{name} element {el}")
@@ -208,12 +222,16 @@ class CableLatchFamily(ElementFamily):
         try:
             dL = np.broadcast_to(np.asarray(length_error, dtype=float), (n_el, n)).copy()
         except (TypeError, ValueError):
-            raise ModelError(f"{self.name}: length_error must be one value per section, shape ({n_el}, {n}) or "
-                             f"({n},), in m; got {np.shape(length_error)}") from None
+            raise ModelError(
+                f"{self.name}: length_error must be one value per section, shape ({n_el}, {n}) or "
+                f"({n},), in m; got {np.shape(length_error)}"
+            ) from None
         bad = np.argwhere(~np.isfinite(dL))
         if bad.size:
             el, i = bad[0]
-            raise ModelError(f"{self.name} element {el}: length_error of section {i} = {float(dL[el, i])!r} m is not finite")
+            raise ModelError(
+                f"{self.name} element {el}: length_error of section {i} = {float(dL[el, i])!r} m is not finite"
+            )
         before = np.where(np.arange(n)[None, :] < self.latch_node[:, None], dL, 0.0).sum(axis=1)
         L0e = self.L0 + dL.sum(axis=1)
         Lbe = self.bead + before
@@ -221,9 +239,11 @@ class CableLatchFamily(ElementFamily):
         bad = np.flatnonzero(~(L0e > 0.0) | (has & ~((Lbe - self.x0 > 0.0) & (Lbe - self.x0 < L0e))))
         if bad.size:
             el = bad[0]
-            raise ModelError(f"{self.name} element {el}: length errors {dL[el].tolist()} m leave the cable "
-                             f"L0 = {L0e[el]:.6g} m with {Lbe[el] - self.x0[el]:.6g} m before the latch: not a cable "
-                             "(the errors must be small against the section lengths)")
+            raise ModelError(
+                f"{self.name} element {el}: length errors {dL[el].tolist()} m leave the cable "
+                f"L0 = {L0e[el]:.6g} m with {Lbe[el] - self.x0[el]:.6g} m before the latch: not a cable "
+                "(the errors must be small against the section lengths)"
+            )
         self.length_error = dL
         self._misfit = (dL.sum(axis=1), before) if np.any(dL) else None
 
@@ -346,8 +366,23 @@ class CableLatchFamily(ElementFamily):
         if hy is None:  # families pickled or built before the option existed
             hy = np.zeros((n_el, 2))
             hy[:, 1] = 1.0
-        cable_latch_kernel(X, self.EA, L0, Lb, self.latch_node, self.latch, hy,
-                           np.ascontiguousarray(state), f, k, new, T, dT, energy, err)
+        cable_latch_kernel(
+            X,
+            self.EA,
+            L0,
+            Lb,
+            self.latch_node,
+            self.latch,
+            hy,
+            np.ascontiguousarray(state),
+            f,
+            k,
+            new,
+            T,
+            dT,
+            energy,
+            err,
+        )
         bad = np.flatnonzero(err)
         if bad.size:
             el = bad[0]
@@ -355,18 +390,23 @@ class CableLatchFamily(ElementFamily):
             if code == ERR_ZERO_LENGTH:
                 Ls = np.linalg.norm(np.diff(X[el], axis=0), axis=1)
                 i = int(np.flatnonzero(Ls <= 0.0)[0])
-                msg = (f"section {i} between nodes {self.nodes[el, i]} and {self.nodes[el, i + 1]} has zero "
-                       "length; anchors and pulleys must not coincide")
+                msg = (
+                    f"section {i} between nodes {self.nodes[el, i]} and {self.nodes[el, i + 1]} has zero "
+                    "length; anchors and pulleys must not coincide"
+                )
             elif code == ERR_NOT_FINITE:
                 msg = "nodal coordinates are not finite"
             elif code == ERR_BEAD_OFF_CABLE:
-                msg = (f"committed bead position x = {state[el, 0]!r} m puts the bead off the cable "
-                       f"(Lb - x must lie in (0, L0 = {L0[el]!r}) m)")
+                msg = (
+                    f"committed bead position x = {state[el, 0]!r} m puts the bead off the cable "
+                    f"(Lb - x must lie in (0, L0 = {L0[el]!r}) m)"
+                )
             else:  # pragma: no cover
                 msg = f"kernel error {code}"
             raise ModelError(f"{self.name} element {el}: {msg}")
-        return ElementResponse(f=f, k=k, state=new, output=LazyOutput(lambda: self._output(X, T, dT, new)),
-                               energy=energy)
+        return ElementResponse(
+            f=f, k=k, state=new, output=LazyOutput(lambda: self._output(X, T, dT, new)), energy=energy
+        )
 
     def _output(self, X, T, dT, new):
         """The output dict of :meth:`evaluate` (computed when first read)."""
@@ -385,8 +425,21 @@ class CableLatchFamily(ElementFamily):
         }
 
 
-def cable_equations(X, T, L0_sections, EA, L0, *, latch_node=None, bead=None, latch=None,
-                    status=STICK, x_committed=None, hysteresis_force=0.0, hysteresis_length=3e-4):
+def cable_equations(
+    X,
+    T,
+    L0_sections,
+    EA,
+    L0,
+    *,
+    latch_node=None,
+    bead=None,
+    latch=None,
+    status=STICK,
+    x_committed=None,
+    hysteresis_force=0.0,
+    hysteresis_length=3e-4,
+):
     """Residuals of the 2n equations of one element (seed 001, Eqs. 2-5), for checking a solution.
 
     X : (n+1, 3) anchor positions, m.  T : (n,) tensions, N.  L0_sections : (n,) unstretched
@@ -415,8 +468,12 @@ def cable_equations(X, T, L0_sections, EA, L0, *, latch_node=None, bead=None, la
             res[n + i] = x - x_committed
         else:
             sigma = 1 if status == SLIP_OUT else -1
-            res[n + i] = (T[i] - T[i - 1] - latch_force(x, sigma, latch)
-                          - sigma * hysteresis_force_law(x, latch, hysteresis_force, hysteresis_length))
+            res[n + i] = (
+                T[i]
+                - T[i - 1]
+                - latch_force(x, sigma, latch)
+                - sigma * hysteresis_force_law(x, latch, hysteresis_force, hysteresis_length)
+            )
     return res
 
 

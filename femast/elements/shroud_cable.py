@@ -71,8 +71,9 @@ ERR_NOT_FINITE = 3
 
 # 5-point Gauss-Legendre rule on [0, 1] for the strain energy L0 * int_0^eps tau(e) de
 _GX = np.array([0.04691007703066800, 0.23076534494715845, 0.5, 0.76923465505284155, 0.95308992296933200])
-_GW = np.array([0.11846344252809454, 0.23931433524968324, 0.28444444444444444, 0.23931433524968324,
-                0.11846344252809454])
+_GW = np.array(
+    [0.11846344252809454, 0.23931433524968324, 0.28444444444444444, 0.23931433524968324, 0.11846344252809454]
+)
 
 
 @njit(cache=True)
@@ -99,8 +100,7 @@ def dyneema_tangent_rigidity(tau, k0, k1, k2):
 
 
 @njit(cache=True)
-def shroud_family_kernel(nodes, x, R, offsets, L0, law, parts, gx, gw, f, K, tau_out, eps_out, len_out,
-                         energy, err):
+def shroud_family_kernel(nodes, x, R, offsets, L0, law, parts, gx, gw, f, K, tau_out, eps_out, len_out, energy, err):
     """All shroud elements in one call: forces f (n, 12), tangent K (n, 12, 12), tension, strain,
     length, strain energy and an error code per element (see module docstring).  Serial on purpose:
     a family holds a few ropes (3 per mast), and ``parallel=True`` doubles the compile time (~11 s)."""
@@ -205,17 +205,21 @@ def _law_array(law, n_el, name):
         if arr.ndim == 1:
             arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ModelError(f"{name}: the rope law must be a DyneemaLaw or [k0 (N), k1 (-), k2 (1/N)] per element; "
-                         f"got shape {arr.shape}")
+        raise ModelError(
+            f"{name}: the rope law must be a DyneemaLaw or [k0 (N), k1 (-), k2 (1/N)] per element; "
+            f"got shape {arr.shape}"
+        )
     try:
         arr = np.ascontiguousarray(np.broadcast_to(arr, (n_el, 3)), dtype=float).copy()
     except ValueError:
         raise ModelError(f"{name}: give one rope law or one per element ({n_el}); got {arr.shape[0]}") from None
     bad = np.flatnonzero(~np.all(np.isfinite(arr), axis=1) | ~(arr[:, 0] > 0.0))
     if bad.size:
-        raise ModelError(f"{name} element {bad[0]}: rope law [k0, k1, k2] = {arr[bad[0]].tolist()} needs a finite, "
-                         "positive k0 (axial rigidity at zero tension, N) and finite k1 (-), k2 (1/N); "
-                         "give the physical stiffness (the seed's is k0 = 935353.664 N)")
+        raise ModelError(
+            f"{name} element {bad[0]}: rope law [k0, k1, k2] = {arr[bad[0]].tolist()} needs a finite, "
+            "positive k0 (axial rigidity at zero tension, N) and finite k1 (-), k2 (1/N); "
+            "give the physical stiffness (the seed's is k0 = 935353.664 N)"
+        )
     return arr
 
 
@@ -265,8 +269,9 @@ class ShroudCableFamily(ElementFamily):
         self.L0 = _per_element(L0, n_el, name, "L0 (m)")
         bad = np.flatnonzero(~(np.isfinite(self.L0) & (self.L0 > 0.0)))
         if bad.size:
-            raise ModelError(f"{name} element {bad[0]}: unstretched length L0 = {self.L0[bad[0]]!r} m must be "
-                             "finite and > 0")
+            raise ModelError(
+                f"{name} element {bad[0]}: unstretched length L0 = {self.L0[bad[0]]!r} m must be finite and > 0"
+            )
         self.law = _law_array(law, n_el, name)
         if offsets is None:
             off = np.zeros((n_el, 2, 3))
@@ -274,8 +279,9 @@ class ShroudCableFamily(ElementFamily):
             try:
                 off = np.broadcast_to(np.asarray(offsets, dtype=float), (n_el, 2, 3)).copy()
             except ValueError:
-                raise ModelError(f"{name}: offsets must have shape (n_el, 2, 3) in m; got "
-                                 f"{np.shape(offsets)}") from None
+                raise ModelError(
+                    f"{name}: offsets must have shape (n_el, 2, 3) in m; got {np.shape(offsets)}"
+                ) from None
             if not np.all(np.isfinite(off)):
                 raise ModelError(f"{name}: offsets must be finite, in m")
         self.offsets = np.ascontiguousarray(off)
@@ -295,19 +301,24 @@ class ShroudCableFamily(ElementFamily):
         try:
             dL = np.asarray(length_error, dtype=float)
         except (TypeError, ValueError):
-            raise ModelError(f"{self.name}: length_error must be numbers in m (one or one per rope); "
-                             f"got {length_error!r}") from None
+            raise ModelError(
+                f"{self.name}: length_error must be numbers in m (one or one per rope); got {length_error!r}"
+            ) from None
         if dL.ndim > 1 or (dL.ndim == 1 and dL.size != n_el):
-            raise ModelError(f"{self.name}: length_error must be a scalar or one value per rope, shape ({n_el},), "
-                             f"in m; got shape {dL.shape}")
+            raise ModelError(
+                f"{self.name}: length_error must be a scalar or one value per rope, shape ({n_el},), "
+                f"in m; got shape {dL.shape}"
+            )
         dL = np.ascontiguousarray(np.broadcast_to(dL, (n_el,)), dtype=float).copy()
         for el in np.flatnonzero(~np.isfinite(dL) | ~(self.L0 + dL > 0.0)):
             label = self.labels[el]
             if not np.isfinite(dL[el]):
                 raise ModelError(f"{self.name} element {label}: length_error = {float(dL[el])!r} m is not finite")
-            raise ModelError(f"{self.name} element {label}: length_error = {float(dL[el])!r} m leaves the rope a stress-free "
-                             f"length {self.L0[el] + dL[el]:.6g} m (L0 = {self.L0[el]:.6g} m); it must stay > 0 "
-                             "(give the error in m)")
+            raise ModelError(
+                f"{self.name} element {label}: length_error = {float(dL[el])!r} m leaves the rope a stress-free "
+                f"length {self.L0[el] + dL[el]:.6g} m (L0 = {self.L0[el]:.6g} m); it must stay > 0 "
+                "(give the error in m)"
+            )
         self.length_error = dL
 
     def stress_free_lengths(self) -> np.ndarray:
@@ -336,23 +347,43 @@ class ShroudCableFamily(ElementFamily):
         energy = np.zeros(n)
         err = np.zeros(n, dtype=np.int64)
         L0 = np.ascontiguousarray(self.stress_free_lengths())
-        shroud_family_kernel(self.nodes, x, R, self.offsets, L0, self.law, PARTS[self.tangent_parts],
-                             _GX, _GW, f, K, tau, eps, length, energy, err)
+        shroud_family_kernel(
+            self.nodes,
+            x,
+            R,
+            self.offsets,
+            L0,
+            self.law,
+            PARTS[self.tangent_parts],
+            _GX,
+            _GW,
+            f,
+            K,
+            tau,
+            eps,
+            length,
+            energy,
+            err,
+        )
         bad = np.flatnonzero(err)
         if bad.size:
             el = int(bad[0])
             code = int(err[el])
             p = self.end_points(x, R)[el]
             if code == ERR_ZERO_LENGTH:
-                msg = (f"its two end points coincide at {np.round(p[0], 6).tolist()} m (nodes "
-                       f"{self.nodes[el, 0]} and {self.nodes[el, 1]} plus offsets); a rope needs two distinct "
-                       "attachment points")
+                msg = (
+                    f"its two end points coincide at {np.round(p[0], 6).tolist()} m (nodes "
+                    f"{self.nodes[el, 0]} and {self.nodes[el, 1]} plus offsets); a rope needs two distinct "
+                    "attachment points"
+                )
             elif code == ERR_BEYOND_LAW:
                 l = float(np.linalg.norm(p[1] - p[0]))
-                msg = (f"strain {l / L0[el] - 1.0:.4g} is beyond the range of the rope law "
-                       f"{self.law[el].tolist()} (no finite increasing tension there); check L0 = {self.L0[el]:.6g} m "
-                       f"(stress free at {L0[el]:.6g} m with its length error and thermal strain) and the node "
-                       "coordinates (units m)")
+                msg = (
+                    f"strain {l / L0[el] - 1.0:.4g} is beyond the range of the rope law "
+                    f"{self.law[el].tolist()} (no finite increasing tension there); check L0 = {self.L0[el]:.6g} m "
+                    f"(stress free at {L0[el]:.6g} m with its length error and thermal strain) and the node "
+                    "coordinates (units m)"
+                )
             else:
                 msg = "nodal coordinates are not finite"
             raise ModelError(f"{self.name} element {self.labels[el]}: {msg}")
@@ -367,8 +398,9 @@ def unstretched_length(law, tension, length):
     return np.asarray(length, float) / (1.0 + strain_from_tension(law or DyneemaLaw(), tension))
 
 
-def add_shrouds(model, pairs, law=None, tension=None, L0=None, offsets=None, name: str = "shroud",
-                length_error=None) -> ShroudCableFamily:
+def add_shrouds(
+    model, pairs, law=None, tension=None, L0=None, offsets=None, name: str = "shroud", length_error=None
+) -> ShroudCableFamily:
     """Add Dyneema shrouds between node-label pairs ``pairs`` ((n, 2)) to ``model``; returns the family.
 
     Give either ``L0`` (unstretched lengths, m) or ``tension`` (N, >= 0: the tension each rope carries
@@ -389,8 +421,10 @@ def add_shrouds(model, pairs, law=None, tension=None, L0=None, offsets=None, nam
     length = np.linalg.norm(p[:, 1] - p[:, 0], axis=1)
     scale = max(1.0, float(np.abs(p).max()))
     for k in np.flatnonzero(length <= 1e-9 * scale):
-        raise ModelError(f"{name} {k + 1} (nodes {pairs[k, 0]}-{pairs[k, 1]}): its attachment points coincide at "
-                         f"{np.round(p[k, 0], 6).tolist()} m; move one of them so the rope has a length")
+        raise ModelError(
+            f"{name} {k + 1} (nodes {pairs[k, 0]}-{pairs[k, 1]}): its attachment points coincide at "
+            f"{np.round(p[k, 0], 6).tolist()} m; move one of them so the rope has a length"
+        )
     if L0 is not None and tension is not None:
         raise ModelError(f"{name}: give the unstretched length L0 or the tension, not both")
     if tension is not None:
@@ -399,13 +433,16 @@ def add_shrouds(model, pairs, law=None, tension=None, L0=None, offsets=None, nam
         for k in range(n):
             lk = DyneemaLaw(*laws[k])
             if not (np.isfinite(tau[k]) and 0.0 <= tau[k] < lk.tau_max_valid):
-                raise ModelError(f"{name} {k + 1}: tension {float(tau[k])!r} N must be >= 0 and below "
-                                 f"{lk.tau_max_valid:.4g} N, where the rope law is increasing")
+                raise ModelError(
+                    f"{name} {k + 1}: tension {float(tau[k])!r} N must be >= 0 and below "
+                    f"{lk.tau_max_valid:.4g} N, where the rope law is increasing"
+                )
             L0v[k] = float(unstretched_length(lk, tau[k], length[k]))
     elif L0 is not None:
         L0v = _per_element(L0, n, name, "L0 (m)")
     else:
         L0v = length.copy()
-    fam = ShroudCableFamily(pairs, L0v, laws, offsets=None if offsets is None else off, name=name,
-                            length_error=length_error)
+    fam = ShroudCableFamily(
+        pairs, L0v, laws, offsets=None if offsets is None else off, name=name, length_error=length_error
+    )
     return model.add_family(fam)

@@ -131,6 +131,8 @@ def tension_from_strain(law: DyneemaLaw, eps):
     disc = a * a - 4.0 * law.k0 * law.k2 * e * e
     den = a + np.sqrt(np.maximum(disc, 0.0))
     if np.any((disc < 0) | (den <= 0)):
-        raise ModelError(f"strain {eps} is beyond the range of the Dyneema law (Eq. 25); the rope would have no "
-                         "finite tension there: check the strain or the coefficients")
+        raise ModelError(
+            f"strain {eps} is beyond the range of the Dyneema law (Eq. 25); the rope would have no "
+            "finite tension there: check the strain or the coefficients"
+        )
     return 2.0 * law.k0 * e / den

@@ -65,7 +65,7 @@ class TrussFamily(ElementFamily):
     stress-free length over ``L0`` (length errors and thermal strain, set by femast/model/thermal.py)."""
 
     name = "truss"
-    self_equilibrated = True   # equal and opposite forces along the chord (issue 16 check)
+    self_equilibrated = True  # equal and opposite forces along the chord (issue 16 check)
     active_dofs = (0, 1, 2)
     n_state = 0
     path_independent = True
@@ -86,6 +86,16 @@ class TrussFamily(ElementFamily):
         K = np.zeros((n, 12, 12))
         N = np.zeros(n)
         energy = np.zeros(n)
-        truss_family_kernel(self.nodes, np.ascontiguousarray(x), self.L0, self.EA, self.tension_only,
-                            self.length_factor, f, K, N, energy)
+        truss_family_kernel(
+            self.nodes,
+            np.ascontiguousarray(x),
+            self.L0,
+            self.EA,
+            self.tension_only,
+            self.length_factor,
+            f,
+            K,
+            N,
+            energy,
+        )
         return ElementResponse(f=f, k=K, state=state, output={"N": N}, energy=energy)

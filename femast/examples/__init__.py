@@ -59,8 +59,9 @@ def for_experiment(experiment: str) -> Path:
     try:
         return path(BY_EXPERIMENT[experiment])
     except KeyError:
-        raise DataFileError(f"experiment '{experiment}' has no shipped example; examples exist for "
-                            f"{', '.join(BY_EXPERIMENT)}") from None
+        raise DataFileError(
+            f"experiment '{experiment}' has no shipped example; examples exist for {', '.join(BY_EXPERIMENT)}"
+        ) from None
 
 
 def describe(name: str) -> str:
@@ -69,6 +70,6 @@ def describe(name: str) -> str:
         if line.startswith("#"):
             text = line.lstrip("# ").strip()
             if text.count("(") > text.count(")"):  # the remark goes on below: keep the complete part
-                text = text[:text.rindex("(")].rstrip(" ,:;")
+                text = text[: text.rindex("(")].rstrip(" ,:;")
             return text
     return ""

@@ -22,22 +22,50 @@ Typical use::
 See ``docs/experiments.md`` and ``docs/compare_and_diagnose.md``.
 """
 
+from . import bay_torsion, latch_pull, mast_top, platform_pose, tip_cycle, vibration  # noqa: E402  (built-in experiments)
 from .core import Column, EffectStack, Experiment, Measured, Parameter, prepared
 from .data import from_arrays, read_data, write_data
 from .registry import experiment_from_source, get_experiment, list_experiments, register_experiment
-from . import bay_torsion, latch_pull, mast_top, platform_pose, tip_cycle, vibration  # noqa: E402  (built-in experiments)
 
-for _e in (mast_top.EXPERIMENT, latch_pull.EXPERIMENT, bay_torsion.EXPERIMENT, tip_cycle.EXPERIMENT,
-           vibration.EXPERIMENT, platform_pose.EXPERIMENT):
+for _e in (
+    mast_top.EXPERIMENT,
+    latch_pull.EXPERIMENT,
+    bay_torsion.EXPERIMENT,
+    tip_cycle.EXPERIMENT,
+    vibration.EXPERIMENT,
+    platform_pose.EXPERIMENT,
+):
     register_experiment(_e)
 
+from .. import effects as _effects  # noqa: E402,F401  (registers the built-in effects)
 from .compare import compare, format_compare  # noqa: E402
 from .diagnose import AT_NOISE, SIGNIFICANT_DBIC, diagnose, format_diagnose  # noqa: E402
 from .fitting import fit, predict, run_model  # noqa: E402
 from .history import plot_history, read_history  # noqa: E402
-from .. import effects as _effects  # noqa: E402,F401  (registers the built-in effects)
 
-__all__ = ["Column", "Parameter", "Experiment", "Measured", "EffectStack", "prepared", "read_data", "from_arrays",
-           "write_data", "get_experiment", "list_experiments", "register_experiment", "experiment_from_source",
-           "compare", "format_compare", "diagnose", "format_diagnose", "fit", "predict", "run_model",
-           "read_history", "plot_history", "AT_NOISE", "SIGNIFICANT_DBIC"]
+__all__ = [
+    "Column",
+    "Parameter",
+    "Experiment",
+    "Measured",
+    "EffectStack",
+    "prepared",
+    "read_data",
+    "from_arrays",
+    "write_data",
+    "get_experiment",
+    "list_experiments",
+    "register_experiment",
+    "experiment_from_source",
+    "compare",
+    "format_compare",
+    "diagnose",
+    "format_diagnose",
+    "fit",
+    "predict",
+    "run_model",
+    "read_history",
+    "plot_history",
+    "AT_NOISE",
+    "SIGNIFICANT_DBIC",
+]

@@ -90,8 +90,12 @@ from .fe_cache import kernel_threads
 from .fe_reference import cached_run
 from .residuals import turning_points
 
-ZONE_KINDS = ("zone (a) at backstop", "zone (b) behind roller axis", "zone (c) in front of roller axis",
-              "zone (d) no contact")
+ZONE_KINDS = (
+    "zone (a) at backstop",
+    "zone (b) behind roller axis",
+    "zone (c) in front of roller axis",
+    "zone (d) no contact",
+)
 LATCH_FIELDS = ("r", "x_backstop", "k", "mu", "h", "R")
 
 
@@ -123,13 +127,22 @@ def _prepare(data: Measured, options: dict) -> dict:
     th = data["theta_deg"]
     has_x, has_y = "ux_m" in data, "uy_m" in data
     if has_x != has_y:
-        raise ModelError(f"{data.path}: bay-torsion needs both ux_m and uy_m (the off-axis path) or neither "
-                         f"(the idealised path); got only {'ux_m' if has_x else 'uy_m'}")
+        raise ModelError(
+            f"{data.path}: bay-torsion needs both ux_m and uy_m (the off-axis path) or neither "
+            f"(the idealised path); got only {'ux_m' if has_x else 'uy_m'}"
+        )
     ux = data["ux_m"] if has_x else np.zeros(data.n)
     uy = data["uy_m"] if has_y else np.zeros(data.n)
     rows = fe_rows(th, ux, uy, int(options["max_fe_rows"]))
-    return {"theta": np.radians(th), "ux": ux, "uy": uy, "rows": rows, "s": path_coordinate(th, ux, uy),
-            "measured_xy": bool(has_x), "tau": data.tau}
+    return {
+        "theta": np.radians(th),
+        "ux": ux,
+        "uy": uy,
+        "rows": rows,
+        "s": path_coordinate(th, ux, uy),
+        "measured_xy": bool(has_x),
+        "tau": data.tau,
+    }
 
 
 # --------------------------------------------------------------------------- FE run
@@ -138,9 +151,14 @@ def bay_inputs(params: dict, options: dict) -> dict:
     from ..adam.parameters import BayParameters
 
     base = BayParameters()
-    d = {"pretension": float(options["pretension_N"]), "cable_EA": float(options["cable_EA_N"]),
-         "mu": float(options["ball_mu"]), "B": float(options["ball_B_m"]), "hysteresis_force": 0.0,
-         "hysteresis_length": float(options["latch_hysteresis_length_m"])}
+    d = {
+        "pretension": float(options["pretension_N"]),
+        "cable_EA": float(options["cable_EA_N"]),
+        "mu": float(options["ball_mu"]),
+        "B": float(options["ball_B_m"]),
+        "hysteresis_force": 0.0,
+        "hysteresis_length": float(options["latch_hysteresis_length_m"]),
+    }
     for f in LATCH_FIELDS:
         d[f"latch_{f}"] = float(getattr(base.latch, f))
     d.update({k: v for k, v in dict(options.get("bay") or {}).items()})
@@ -163,8 +181,9 @@ def bay_parameters(inputs: dict):
     return BayParameters(latch=latch, **rest)
 
 
-def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None = 1, reference=None,
-            record_path=None) -> dict:
+def run_bay(
+    inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None = 1, reference=None, record_path=None
+) -> dict:
     """One FE run of the bay along ``drive`` (m, 3) = [theta (rad), ux, uy (m)] (uncached).
 
     threads : numba threads of the parallel kernels (:class:`~femast.experiments.fe_cache.kernel_threads`;
@@ -195,20 +214,39 @@ def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None 
     tab = np.array(tab)
     t = np.arange(len(tab), dtype=float)
     if len(tab) > 1:
-        step = am.model.step("path", period=float(t[-1]), initial_increment=1.0, max_increment=1.0,
-                             min_increment=1e-5, max_increments=100 * len(tab) + 100)
+        step = am.model.step(
+            "path",
+            period=float(t[-1]),
+            initial_increment=1.0,
+            max_increment=1.0,
+            min_increment=1e-5,
+            max_increments=100 * len(tab) + 100,
+        )
         step.follow(am.control, t, rz=tab[:, 0], ux=tab[:, 1], uy=tab[:, 2])
     row = am.model.index(am.control)
-    rec = []   # per converged increment, what this experiment needs (kept in memory: no read-back)
+    rec = []  # per converged increment, what this experiment needs (kept in memory: no read-back)
 
     def record(fr):
         # the bead positions from the committed state of the latch family (reading an element output
         # would build the family's whole output dict: 20 % of a run; issue 21); zones after the run
-        rec.append((str(fr["step"]), float(fr["total_time"]), -(fr["P"][row, 5] + fr["RF"][row, 5]),
-                    fr["U"][row, 2], an.states[k_latch][:, 0].copy()))
+        rec.append(
+            (
+                str(fr["step"]),
+                float(fr["total_time"]),
+                -(fr["P"][row, 5] + fr["RF"][row, 5]),
+                fr["U"][row, 2],
+                an.states[k_latch][:, 0].copy(),
+            )
+        )
 
-    an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=record,
-                  observers=[record_path] if record_path is not None else ())   # no files
+    an = Analysis(
+        am.model,
+        None,
+        progress=False,
+        convergence=CONVERGENCE,
+        on_frame=record,
+        observers=[record_path] if record_path is not None else (),
+    )  # no files
     k_latch = next(k for k, f in enumerate(an.families) if f.name == am.latch_family)
     an.reference = reference
     with kernel_threads(threads):
@@ -216,15 +254,15 @@ def run_bay(inputs: dict, drive: np.ndarray, fold: int = 1, threads: int | None 
     steps = [r[0] for r in rec]
     tt = np.array([r[1] for r in rec])
     i_eq = max(i for i, s in enumerate(steps) if s != "path")  # end of the initial (pretension) step(s)
-    frame_of = [i_eq] + [max(i for i in range(i_eq + 1, len(rec)) if abs(tt[i] - tt[i_eq] - j) < 1e-7)
-                         for j in range(1, len(tab))]
+    frame_of = [i_eq] + [
+        max(i for i in range(i_eq + 1, len(rec)) if abs(tt[i] - tt[i_eq] - j) < 1e-7) for j in range(1, len(tab))
+    ]
     out = {k: np.empty(m) for k in ("Mz", "uz")}
     bead = np.empty((m, 4))
     for k in range(m):
         _, _, out["Mz"][k], out["uz"][k], bead[k] = rec[frame_of[state[k]]]
     out.update(_latch_outputs(an.families[k_latch], bead))
-    out.update(increments=an.summary.increments, iterations=an.summary.iterations,
-               wall_time=time.perf_counter() - t0)
+    out.update(increments=an.summary.increments, iterations=an.summary.iterations, wall_time=time.perf_counter() - t0)
     return out
 
 
@@ -235,8 +273,7 @@ def _latch_outputs(family, bead) -> dict:
     from ..latch import latch_zone
 
     has = np.asarray(family.latch_node) > 0
-    return {"bead": np.where(has, bead, np.nan),
-            "zone": np.where(has, latch_zone(bead, family.latch), -1).astype(int)}
+    return {"bead": np.where(has, bead, np.nan), "zone": np.where(has, latch_zone(bead, family.latch), -1).astype(int)}
 
 
 def solve(inputs: dict, drive: np.ndarray, options: dict, reference=None) -> dict:
@@ -322,7 +359,7 @@ def extra_segments(data: Measured, params: dict, options: dict):
     change = np.any(cd[1:] & cd[:-1] & (zones[1:] != zones[:-1]), axis=1)  # between rows i and i + 1
     rel = np.zeros(data.n, bool)
     for i in np.flatnonzero(change):
-        rel[max(i - 1, 0):i + 3] = True  # rows i - 1 .. i + 2: two either side of the change
+        rel[max(i - 1, 0) : i + 3] = True  # rows i - 1 .. i + 2: two either side of the change
     out.append((RELEASE_KIND, rel))
     return out
 
@@ -348,25 +385,57 @@ EXPERIMENT = Experiment(
     name="bay-torsion",
     title="single-bay moment-rotation test (seed 001 Secs. V-VI, Figs. 16-17; FE bay of issue 5)",
     columns=(
-        Column("theta_deg", "deg", "rotation of the top batten frame about the bay axis z from the deployed state "
-                                   "(seed 001 Fig. 3 theta_t), > 0 about +z"),
-        Column("ux_m", "m", "measured translation of the top-frame centre, x (drives the control node along the "
-                            "'actual path' of Fig. 17 when present)", required=False),
+        Column(
+            "theta_deg",
+            "deg",
+            "rotation of the top batten frame about the bay axis z from the deployed state "
+            "(seed 001 Fig. 3 theta_t), > 0 about +z",
+        ),
+        Column(
+            "ux_m",
+            "m",
+            "measured translation of the top-frame centre, x (drives the control node along the "
+            "'actual path' of Fig. 17 when present)",
+            required=False,
+        ),
         Column("uy_m", "m", "measured translation of the top-frame centre, y", required=False),
-        Column("Mz_Nm", "N m", "moment about z, seed Figs. 16-17 sign: the moment of the bay on the rig (minus the "
-                               "moment applied to the top frame)"),
+        Column(
+            "Mz_Nm",
+            "N m",
+            "moment about z, seed Figs. 16-17 sign: the moment of the bay on the rig (minus the "
+            "moment applied to the top frame)",
+        ),
     ),
     channels=("Mz_Nm",),
     parameters=(
-        Parameter("latch_k", "N/m", 1.0e5, 1.0e4, 1.0e6, "stiffness of one latch roller's cantilever (seed Eq. 10)",
-                  scale=1.0e5),
-        Parameter("latch_mu", "-", 0.07, 0.0, 0.4, "roller-bead friction coefficient of the latches (Eq. 14)",
-                  scale=0.05),
+        Parameter(
+            "latch_k",
+            "N/m",
+            1.0e5,
+            1.0e4,
+            1.0e6,
+            "stiffness of one latch roller's cantilever (seed Eq. 10)",
+            scale=1.0e5,
+        ),
+        Parameter(
+            "latch_mu", "-", 0.07, 0.0, 0.4, "roller-bead friction coefficient of the latches (Eq. 14)", scale=0.05
+        ),
     ),
     model=model,
-    options={"pretension_N": 170.0, "cable_EA_N": _default_EA(), "ball_mu": 0.0, "ball_B_m": 4e-3,
-             "latch_hysteresis_length_m": 3e-4, "fold": 1, "off_axis_side": 0, "bay": {}, "max_fe_rows": 80,
-             "cache_dir": None, "threads": 1, "fe_reference": None},
+    options={
+        "pretension_N": 170.0,
+        "cable_EA_N": _default_EA(),
+        "ball_mu": 0.0,
+        "ball_B_m": 4e-3,
+        "latch_hysteresis_length_m": 3e-4,
+        "fold": 1,
+        "off_axis_side": 0,
+        "bay": {},
+        "max_fe_rows": 80,
+        "cache_dir": None,
+        "threads": 1,
+        "fe_reference": None,
+    },
     hooks={
         "bay_parameters": "dict of the FE bay's inputs (BayParameters fields, latch_* for the latch law), SI",
         "control_path": "(m, 3) [theta rad, ux m, uy m] of the control node at the driven rows",
@@ -382,11 +451,27 @@ EXPERIMENT = Experiment(
     # dogbox: the candidates' parameters often end on a bound (no off-axis motion, e = 0), which trf's
     # scaling approaches by about halving the distance per step (11 FE runs for off_axis_motion); dogbox's
     # active set lands on it in one (issue 21: 45 -> 33 runs in the diagnosis' refits)
-    fit_options={"diff_step": 1e-3, "xtol": 1e-4, "ftol": 1e-4, "gtol": 1e-8, "max_nfev_per_param": 10,
-                 "expensive": True, "method": "dogbox"},
+    fit_options={
+        "diff_step": 1e-3,
+        "xtol": 1e-4,
+        "ftol": 1e-4,
+        "gtol": 1e-8,
+        "max_nfev_per_param": 10,
+        "expensive": True,
+        "method": "dogbox",
+    },
     source="bay-torsion",
 )
 
-__all__ = ["EXPERIMENT", "ZONE_KINDS", "bay_inputs", "bay_parameters", "fe_rows", "latch_zones", "model",
-           "path_coordinate", "run_bay", "solve"]
-
+__all__ = [
+    "EXPERIMENT",
+    "ZONE_KINDS",
+    "bay_inputs",
+    "bay_parameters",
+    "fe_rows",
+    "latch_zones",
+    "model",
+    "path_coordinate",
+    "run_bay",
+    "solve",
+]

@@ -20,8 +20,15 @@ from .figures import compare_figure, display_scale
 from .fitting import fit as _fit
 from .fitting import params_table, run_model
 from .history import append_history, plot_history
-from .residuals import (TURN_FRACTION, at_noise_threshold, noise_floor, segment_path, segment_report, signatures,
-                        turning_points)
+from .residuals import (
+    TURN_FRACTION,
+    at_noise_threshold,
+    noise_floor,
+    segment_path,
+    segment_report,
+    signatures,
+    turning_points,
+)
 
 
 def load_path(exp: Experiment, data: Measured) -> np.ndarray:
@@ -43,12 +50,28 @@ def analyse(exp: Experiment, data: Measured, run: OptimizeResult) -> dict:
     rng = float(np.ptp(s))
     _, direction = turning_points(s, max(TURN_FRACTION * rng, 5 * ns)) if rng > 0 else (None, np.ones(data.n))
     sig = signatures(s, direction, data.tau, run.residuals, run.noise)
-    return {"load": s, "segments": segments, "masks": masks, "by_kind": by_kind, "worst": worst,
-            "signatures": sig, "direction": direction}
+    return {
+        "load": s,
+        "segments": segments,
+        "masks": masks,
+        "by_kind": by_kind,
+        "worst": worst,
+        "signatures": sig,
+        "direction": direction,
+    }
 
 
-def compare(exp: Experiment, data: Measured, effects=(), *, fit: bool = False, params=None, out=None,
-            history: bool = True, noise=None) -> OptimizeResult:
+def compare(
+    exp: Experiment,
+    data: Measured,
+    effects=(),
+    *,
+    fit: bool = False,
+    params=None,
+    out=None,
+    history: bool = True,
+    noise=None,
+) -> OptimizeResult:
     """Run the model variant (baseline + ``effects``) along the measured path of ``data``.
 
     fit : fit the baseline and effect parameters (:func:`~femast.experiments.fitting.fit`);
@@ -71,7 +94,7 @@ def compare(exp: Experiment, data: Measured, effects=(), *, fit: bool = False, p
     if fit:
         with progress.task(f"fitting {variant}"):
             run = _fit(exp, data, effects, noise=noise)
-        if getattr(run, "fe_reference", None) is not None:   # the fit's FE runs answer the zones and figures
+        if getattr(run, "fe_reference", None) is not None:  # the fit's FE runs answer the zones and figures
             exp = exp.with_options(fe_reference=run.fe_reference)
     else:
         params = dict(params or {})
@@ -96,8 +119,9 @@ def compare(exp: Experiment, data: Measured, effects=(), *, fit: bool = False, p
         "noise_rms": run.noise_rms,
         "ratio": run.ratio,
         "bic": run.bic,
-        "channels": {c: {"rms": run.channel_rms[c], "noise": run.noise[c], "unit": exp.unit_of(c)}
-                     for c in exp.channels},
+        "channels": {
+            c: {"rms": run.channel_rms[c], "noise": run.noise[c], "unit": exp.unit_of(c)} for c in exp.channels
+        },
         "segments_by_kind": a["by_kind"],
         "worst_segments": a["worst"][:5],
         "signatures": a["signatures"][:3],
@@ -110,18 +134,60 @@ def compare(exp: Experiment, data: Measured, effects=(), *, fit: bool = False, p
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         if history:
-            version = append_history(out, {k: report[k] for k in (
-                "experiment", "data", "n_samples", "effects", "fit", "params", "error_unit", "rms", "noise_rms",
-                "ratio", "bic")} | {"channel_rms": {c: run.channel_rms[c] for c in exp.channels}})
+            version = append_history(
+                out,
+                {
+                    k: report[k]
+                    for k in (
+                        "experiment",
+                        "data",
+                        "n_samples",
+                        "effects",
+                        "fit",
+                        "params",
+                        "error_unit",
+                        "rms",
+                        "noise_rms",
+                        "ratio",
+                        "bic",
+                    )
+                }
+                | {"channel_rms": {c: run.channel_rms[c] for c in exp.channels}},
+            )
             report["version"] = version
     result = OptimizeResult(
-        experiment=exp.name, data=str(data.path), n_samples=data.n, effects=tuple(run.effects), fitted=bool(fit),
-        run=run, params=run.params, effect_params=run.effect_params, params_table=report["params"],
-        predicted=run.predicted, residuals=run.residuals, rms=run.rms, channel_rms=run.channel_rms,
-        noise=run.noise, noise_rms=run.noise_rms, ratio=run.ratio, bic=run.bic, load=a["load"],
-        segments=a["segments"], masks=a["masks"], by_kind=a["by_kind"], worst=a["worst"],
-        signatures=a["signatures"], report=report, files=files, version=version, success=bool(run.success),
-        message=run.message, x=run.x, stderr=run.stderr, names=run.names)
+        experiment=exp.name,
+        data=str(data.path),
+        n_samples=data.n,
+        effects=tuple(run.effects),
+        fitted=bool(fit),
+        run=run,
+        params=run.params,
+        effect_params=run.effect_params,
+        params_table=report["params"],
+        predicted=run.predicted,
+        residuals=run.residuals,
+        rms=run.rms,
+        channel_rms=run.channel_rms,
+        noise=run.noise,
+        noise_rms=run.noise_rms,
+        ratio=run.ratio,
+        bic=run.bic,
+        load=a["load"],
+        segments=a["segments"],
+        masks=a["masks"],
+        by_kind=a["by_kind"],
+        worst=a["worst"],
+        signatures=a["signatures"],
+        report=report,
+        files=files,
+        version=version,
+        success=bool(run.success),
+        message=run.message,
+        x=run.x,
+        stderr=run.stderr,
+        names=run.names,
+    )
     if out is not None:
         files["json"] = str(out / "compare.json")
         files["png"] = str(compare_figure(exp, data, result, out / "compare.png"))
@@ -145,28 +211,36 @@ def _fmt(v, unit):
 def format_compare(exp: Experiment, result: OptimizeResult) -> str:
     """Plain-text summary of a compare result (what ``femast compare`` prints)."""
     r = result.report
-    lines = [f"femast compare: {exp.name} on {result.data} ({result.n_samples} samples)",
-             f"  model: {'+'.join(result.effects) or 'baseline'}"
-             + (" (parameters fitted)" if result.fitted else " (given parameters, not fitted)")]
+    lines = [
+        f"femast compare: {exp.name} on {result.data} ({result.n_samples} samples)",
+        f"  model: {'+'.join(result.effects) or 'baseline'}"
+        + (" (parameters fitted)" if result.fitted else " (given parameters, not fitted)"),
+    ]
     if result.fitted and not result.success:
         lines.append(f"  warning: the fit did not converge: {result.message}")
     for name, p in r["params"].items():
         se = f" +- {p['stderr']:.3g}" if p["stderr"] is not None and result.fitted else ""
         lines.append(f"    {name:>22s} = {p['value']:.6g}{se} {p['unit']}")
-    lines.append(f"  overall RMS error {_fmt(result.rms, exp.error_unit)}; noise floor {_fmt(result.noise_rms, exp.error_unit)}"
-                 f" -> {result.ratio:.2f}x noise")
+    lines.append(
+        f"  overall RMS error {_fmt(result.rms, exp.error_unit)}; noise floor {_fmt(result.noise_rms, exp.error_unit)}"
+        f" -> {result.ratio:.2f}x noise"
+    )
     for c in exp.channels:
         u = exp.unit_of(c)
-        lines.append(f"    {c:>8s}: RMS {_fmt(result.channel_rms[c], u)}, noise {_fmt(result.noise[c], u)} "
-                     f"({np.sqrt(np.mean((result.residuals[c] / result.noise[c]) ** 2)):.2f}x)")
+        lines.append(
+            f"    {c:>8s}: RMS {_fmt(result.channel_rms[c], u)}, noise {_fmt(result.noise[c], u)} "
+            f"({np.sqrt(np.mean((result.residuals[c] / result.noise[c]) ** 2)):.2f}x)"
+        )
     lines.append("  error by kind of segment (x noise):")
     for k in result.by_kind:
         lines.append(f"    {k['kind']:>30s}: {k['ratio']:6.2f}x  ({k['n']} samples)")
     lines.append("  worst segments:")
     for k, s in enumerate(result.worst[:5]):
-        lines.append(f"    #{k + 1} {s['kind']:>28s}: rows {s['start_row']}-{s['end_row']} (file lines "
-                     f"{s.get('first_line', '?')}-{s.get('last_line', '?')}), {s['ratio']:.2f}x noise, RMS "
-                     f"{_fmt(s['rms'], exp.error_unit)}")
+        lines.append(
+            f"    #{k + 1} {s['kind']:>28s}: rows {s['start_row']}-{s['end_row']} (file lines "
+            f"{s.get('first_line', '?')}-{s.get('last_line', '?')}), {s['ratio']:.2f}x noise, RMS "
+            f"{_fmt(s['rms'], exp.error_unit)}"
+        )
     at = r.get("at_noise", 1.2)
     if result.ratio > at and result.signatures and result.signatures[0]["fraction"] > 0.2:
         sg = result.signatures[0]

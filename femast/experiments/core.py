@@ -25,8 +25,8 @@ defines a module-level ``experiment`` (see ``docs/experiments.md``).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Callable
 
 import numpy as np
 
@@ -57,12 +57,16 @@ class Parameter:
 
     def __post_init__(self):
         if not (self.lower <= self.default <= self.upper):
-            raise ModelError(f"parameter {self.name}: default {self.default!r} {self.unit} lies outside its "
-                             f"bounds [{self.lower!r}, {self.upper!r}]")
+            raise ModelError(
+                f"parameter {self.name}: default {self.default!r} {self.unit} lies outside its "
+                f"bounds [{self.lower!r}, {self.upper!r}]"
+            )
         for s in self.starts:
             if not (self.lower <= s <= self.upper):
-                raise ModelError(f"parameter {self.name}: start {s!r} {self.unit} lies outside its bounds "
-                                 f"[{self.lower!r}, {self.upper!r}]; give starts within the bounds")
+                raise ModelError(
+                    f"parameter {self.name}: start {s!r} {self.unit} lies outside its bounds "
+                    f"[{self.lower!r}, {self.upper!r}]; give starts within the bounds"
+                )
 
     @property
     def typical(self) -> float:
@@ -133,11 +137,10 @@ class Measured:
         span = t[-1] - t[0]
         return (t - t[0]) / span if span > 0 else np.zeros(self.n)
 
-    def subset(self, rows) -> "Measured":
+    def subset(self, rows) -> Measured:
         """A copy restricted to ``rows`` (index array or mask), with an empty cache."""
         rows = np.asarray(rows)
-        return Measured(self.experiment, {k: v[rows] for k, v in self.columns.items()}, self.path,
-                        self.lines[rows])
+        return Measured(self.experiment, {k: v[rows] for k, v in self.columns.items()}, self.path, self.lines[rows])
 
     def __getstate__(self):  # the cache is rebuilt where it is needed (worker processes)
         d = dict(self.__dict__)
@@ -265,8 +268,11 @@ class Experiment:
         for ch in self.channels:
             if f"sigma_{ch}" not in names:
                 unit = next((c.unit for c in self.columns if c.name == ch), "")
-                cols += (Column(f"sigma_{ch}", unit, f"standard uncertainty of {ch} in each row (optional; > 0)",
-                                required=False),)
+                cols += (
+                    Column(
+                        f"sigma_{ch}", unit, f"standard uncertainty of {ch} in each row (optional; > 0)", required=False
+                    ),
+                )
         return cols
 
     def unit_of(self, channel: str) -> str:
@@ -281,12 +287,14 @@ class Experiment:
         """Default baseline parameters ``{name: value}``."""
         return {p.name: float(p.default) for p in self.parameters}
 
-    def with_options(self, **options) -> "Experiment":
+    def with_options(self, **options) -> Experiment:
         """A copy with some options changed; unknown option names raise ModelError."""
         unknown = sorted(set(options) - set(self.options))
         if unknown:
-            raise ModelError(f"experiment {self.name}: unknown option(s) {', '.join(unknown)}; accepted: "
-                             f"{', '.join(sorted(self.options)) or '(none)'}")
+            raise ModelError(
+                f"experiment {self.name}: unknown option(s) {', '.join(unknown)}; accepted: "
+                f"{', '.join(sorted(self.options)) or '(none)'}"
+            )
         return replace(self, options={**self.options, **options})
 
     def prepared(self, data: Measured) -> dict:
@@ -310,8 +318,12 @@ def prepared(data: Measured, prepare: Callable, options: dict) -> dict:
 
     Models call it to get their per-data-set arrays (the options may differ between variants of
     one experiment, so they are part of the key)."""
-    key = ("prepare", getattr(prepare, "__module__", ""), getattr(prepare, "__qualname__", repr(prepare)),
-           repr(sorted(options.items(), key=lambda kv: kv[0])))
+    key = (
+        "prepare",
+        getattr(prepare, "__module__", ""),
+        getattr(prepare, "__qualname__", repr(prepare)),
+        repr(sorted(options.items(), key=lambda kv: kv[0])),
+    )
     if key not in data.cache:
         data.cache[key] = prepare(data, options)
     return data.cache[key]

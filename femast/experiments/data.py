@@ -47,13 +47,17 @@ class DataWarning(UserWarning):
 def _separator_error(path, line, text, exp):
     for sep, name in ((";", "semicolons (';')"), ("\t", "tabs"), ("|", "bars ('|')")):
         if sep in text:
-            return DataFileError(f"{path} line {line}: the header is separated by {name}; femast reads "
-                                 "comma-separated files (CSV with ',' between columns and '.' as the decimal "
-                                 f"point): save the file as comma-separated. {exp.name} accepts: {_accepted(exp)}")
+            return DataFileError(
+                f"{path} line {line}: the header is separated by {name}; femast reads "
+                "comma-separated files (CSV with ',' between columns and '.' as the decimal "
+                f"point): save the file as comma-separated. {exp.name} accepts: {_accepted(exp)}"
+            )
     if len(text.split()) > 1:
-        return DataFileError(f"{path} line {line}: the header is separated by spaces; femast reads comma-separated "
-                             f"files (CSV with ',' between columns): save the file as comma-separated. {exp.name} "
-                             f"accepts: {_accepted(exp)}")
+        return DataFileError(
+            f"{path} line {line}: the header is separated by spaces; femast reads comma-separated "
+            f"files (CSV with ',' between columns): save the file as comma-separated. {exp.name} "
+            f"accepts: {_accepted(exp)}"
+        )
     return None
 
 
@@ -67,8 +71,10 @@ def check_values(exp: Experiment, cols: dict, path: str, lines, measured: bool =
         if big.size:
             i = int(big[0])
             unit = exp.column(name).unit
-            raise DataFileError(f"{path} line {lines[i]}, column '{name}': {a[i]:g} {unit} is beyond {MAX_VALUE:g} "
-                                f"{unit}, not a plausible measurement (a corrupt cell?); fix or remove the row")
+            raise DataFileError(
+                f"{path} line {lines[i]}, column '{name}': {a[i]:g} {unit} is beyond {MAX_VALUE:g} "
+                f"{unit}, not a plausible measurement (a corrupt cell?); fix or remove the row"
+            )
     if not measured:
         return
     for name in exp.channels:
@@ -77,23 +83,30 @@ def check_values(exp: Experiment, cols: dict, path: str, lines, measured: bool =
         a = cols[name]
         unit = exp.column(name).unit
         if np.all(a == 0.0):
-            raise DataFileError(f"{path}: column '{name}' is zero on every row: nothing was measured (a disconnected "
-                                f"sensor, or the wrong column?); give the measured {name} in {unit}")
+            raise DataFileError(
+                f"{path}: column '{name}' is zero on every row: nothing was measured (a disconnected "
+                f"sensor, or the wrong column?); give the measured {name} in {unit}"
+            )
         if np.all(a == a[0]):
-            raise DataFileError(f"{path}: column '{name}' has the same value {a[0]:g} {unit} on every row: a constant "
-                                "channel carries no measurement (a stuck sensor, or a fill value?); give the "
-                                f"measured {name}")
+            raise DataFileError(
+                f"{path}: column '{name}' has the same value {a[0]:g} {unit} on every row: a constant "
+                "channel carries no measurement (a stuck sensor, or a fill value?); give the "
+                f"measured {name}"
+            )
     if cols:
         table = np.column_stack(list(cols.values()))
         if len(table) > 1:
             dup = np.flatnonzero(np.all(table[1:] == table[:-1], axis=1)) + 1
             if dup.size:
                 shown = ", ".join(str(lines[i]) for i in dup[:5]) + (", ..." if dup.size > 5 else "")
-                warnings.warn(f"{path}: {dup.size} row(s) repeat the row before them exactly (line(s) {shown}): a "
-                              "repeated sample counts twice in a fit, and its zero difference from the previous "
-                              "row makes the estimated noise floor too small (every row doubled roughly halves "
-                              "it), so fits look worse than the noise; remove the duplicated rows",
-                              DataWarning, stacklevel=3)
+                warnings.warn(
+                    f"{path}: {dup.size} row(s) repeat the row before them exactly (line(s) {shown}): a "
+                    "repeated sample counts twice in a fit, and its zero difference from the previous "
+                    "row makes the estimated noise floor too small (every row doubled roughly halves "
+                    "it), so fits look worse than the noise; remove the duplicated rows",
+                    DataWarning,
+                    stacklevel=3,
+                )
 
 
 def _accepted(exp: Experiment) -> str:
@@ -117,24 +130,29 @@ def check_header(exp: Experiment, header, path: str = "<arrays>", line: int = 1)
     where = f"{path} line {line}"
     for i, h in enumerate(names):
         if not h:
-            raise DataFileError(f"{where}: column {i + 1} of the header has no name; {exp.name} accepts: "
-                                f"{_accepted(exp)}")
+            raise DataFileError(
+                f"{where}: column {i + 1} of the header has no name; {exp.name} accepts: {_accepted(exp)}"
+            )
     seen = set()
     for h in names:
         if h in seen:
-            raise DataFileError(f"{where}: column '{h}' appears twice in the header; {exp.name} accepts: "
-                                f"{_accepted(exp)}")
+            raise DataFileError(
+                f"{where}: column '{h}' appears twice in the header; {exp.name} accepts: {_accepted(exp)}"
+            )
         seen.add(h)
     unknown = [h for h in names if h not in known]
     if unknown:
         h = unknown[0]
-        raise DataFileError(f"{where}: column '{h}' is not a {exp.name} column{_suggest(h, known)}; "
-                            f"accepted columns: {_accepted(exp)}")
+        raise DataFileError(
+            f"{where}: column '{h}' is not a {exp.name} column{_suggest(h, known)}; accepted columns: {_accepted(exp)}"
+        )
     missing = [c.name for c in exp.all_columns if c.required and c.name not in names]
     if missing:
-        raise DataFileError(f"{where}: missing column(s) {', '.join(missing)}; {exp.name} needs "
-                            f"{', '.join(c.name for c in exp.all_columns if c.required)}"
-                            f" and accepts {_accepted(exp)}")
+        raise DataFileError(
+            f"{where}: missing column(s) {', '.join(missing)}; {exp.name} needs "
+            f"{', '.join(c.name for c in exp.all_columns if c.required)}"
+            f" and accepts {_accepted(exp)}"
+        )
     return names
 
 
@@ -169,14 +187,17 @@ def read_data(exp: Experiment, path) -> Measured:
         except UnicodeDecodeError as exc:
             raise DataFileError(f"{path}: not a text (UTF-8) CSV file ({exc.reason})") from None
     if header is None:
-        raise DataFileError(f"{path}: no header row; the first non-comment line must name the columns: "
-                            f"{_accepted(exp)}")
+        raise DataFileError(
+            f"{path}: no header row; the first non-comment line must name the columns: {_accepted(exp)}"
+        )
     ncol = len(header)
     values = np.empty((len(rows), ncol))
     for r, (cells, line) in enumerate(zip(rows, lines)):
         if len(cells) != ncol:
-            raise DataFileError(f"{path} line {line}: {len(cells)} cells but the header (line {header_line}) has "
-                                f"{ncol} columns ({', '.join(header)})")
+            raise DataFileError(
+                f"{path} line {line}: {len(cells)} cells but the header (line {header_line}) has "
+                f"{ncol} columns ({', '.join(header)})"
+            )
         for c, text in enumerate(cells):
             col = exp.column(header[c])
             s = text.strip()
@@ -186,22 +207,29 @@ def read_data(exp: Experiment, path) -> Measured:
             except ValueError:
                 what = "an empty cell" if not s else f"'{s}' is not a number"
                 words = f" or one of {', '.join(t for t, _ in col.codes)}" if col.codes else ""
-                raise DataFileError(f"{path} line {line}, column '{header[c]}': {what}; every cell must be a "
-                                    f"decimal number in {col.unit}{words}") from None
+                raise DataFileError(
+                    f"{path} line {line}, column '{header[c]}': {what}; every cell must be a "
+                    f"decimal number in {col.unit}{words}"
+                ) from None
             if not math.isfinite(v):
-                raise DataFileError(f"{path} line {line}, column '{header[c]}': {s} is not a finite number; "
-                                    f"every cell must be a finite decimal number in {col.unit} "
-                                    "(remove the row or fill in the value)")
+                raise DataFileError(
+                    f"{path} line {line}, column '{header[c]}': {s} is not a finite number; "
+                    f"every cell must be a finite decimal number in {col.unit} "
+                    "(remove the row or fill in the value)"
+                )
             values[r, c] = v
     if len(rows) < exp.min_rows:
-        raise DataFileError(f"{path}: {len(rows)} data row(s); {exp.name} needs at least {exp.min_rows} "
-                            "(one per sample, in time order)")
+        raise DataFileError(
+            f"{path}: {len(rows)} data row(s); {exp.name} needs at least {exp.min_rows} (one per sample, in time order)"
+        )
     cols = {h: values[:, i] for i, h in enumerate(header)}
     check_values(exp, cols, str(path), lines)
     if "t_s" in cols and np.any(np.diff(cols["t_s"]) < 0):
         bad = int(np.flatnonzero(np.diff(cols["t_s"]) < 0)[0]) + 1
-        raise DataFileError(f"{path} line {lines[bad]}, column 't_s': time goes backwards "
-                            f"({cols['t_s'][bad - 1]:g} s then {cols['t_s'][bad]:g} s); rows must be in time order")
+        raise DataFileError(
+            f"{path} line {lines[bad]}, column 't_s': time goes backwards "
+            f"({cols['t_s'][bad - 1]:g} s then {cols['t_s'][bad]:g} s); rows must be in time order"
+        )
     return Measured(exp.name, cols, str(path), np.asarray(lines))
 
 

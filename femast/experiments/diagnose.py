@@ -51,10 +51,20 @@ from .figure_process import FigureProcess
 from .figures import diagnose_figure, display_scale
 from .fitting import fit, params_table, predict
 from .noise import noise_model, pinned_rows
-from .residuals import AT_NOISE, at_noise_threshold
+
 # the refits' executor (re-exported: diagnose.REFIT_NFEV, diagnose._mp_context, ... keep working)
-from .refits import (_START_METHOD, REFIT_NFEV, SERIAL_BELOW_S, _dispatch, _mp_context, _refit_task,  # noqa: F401
-                     _run_tasks, _safe_fit, _serial_refits)
+from .refits import (  # noqa: F401
+    _START_METHOD,
+    REFIT_NFEV,
+    SERIAL_BELOW_S,
+    _dispatch,
+    _mp_context,
+    _refit_task,
+    _run_tasks,
+    _safe_fit,
+    _serial_refits,
+)
+from .residuals import AT_NOISE, at_noise_threshold
 from .verdict import MIN_SHARE, SIGNIFICANT_DBIC, conclude, flags, pair_candidates, robust_delta, score, share
 
 
@@ -68,9 +78,11 @@ def _reading(effect, entry, z0, zc, masks, nch, worst_kind, at_noise=AT_NOISE):
     eff = get_effect(effect)
     text = f"{eff.signature[0].upper()}{eff.signature[1:]}. " if eff.signature else ""
     form = f" (form {entry['form']})" if entry.get("form") else ""
-    text += (f"Refitted with {eff.title}{form}, the error goes from {entry['baseline_ratio']:.2f}x to "
-             f"{entry['ratio']:.2f}x the noise (explains {100 * entry['explained_fraction']:.0f} % of the excess; "
-             f"delta BIC {entry['delta_bic']:+.1f}).")
+    text += (
+        f"Refitted with {eff.title}{form}, the error goes from {entry['baseline_ratio']:.2f}x to "
+        f"{entry['ratio']:.2f}x the noise (explains {100 * entry['explained_fraction']:.0f} % of the excess; "
+        f"delta BIC {entry['delta_bic']:+.1f})."
+    )
     gains = []
     for kind, m in masks.items():
         if m.sum() >= 3:
@@ -82,8 +94,11 @@ def _reading(effect, entry, z0, zc, masks, nch, worst_kind, at_noise=AT_NOISE):
     if worst_kind and worst_kind in eff.acts_where:
         text += f" The model fails most in the {worst_kind} segments, where this effect acts."
     if not entry["significant"]:
-        text += (" Not significant: the data do not ask for it." if not entry["ic_gain"] else
-                 f" Not significant: it explains less than {100 * MIN_SHARE:.0f} % of the excess error.")
+        text += (
+            " Not significant: the data do not ask for it."
+            if not entry["ic_gain"]
+            else f" Not significant: it explains less than {100 * MIN_SHARE:.0f} % of the excess error."
+        )
     elif entry["ratio"] > at_noise:
         text += " Structure remains after it."
     return text
@@ -95,10 +110,18 @@ def _remaining_where(masks, z, nch, thr, min_rows=3):
     return [f"{k} ({r:.1f}x)" for r, k in sorted(out, reverse=True)]
 
 
-
 # --------------------------------------------------------------------------- diagnose
-def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(), workers=None, scheduler=None,
-             out=None, pairs: bool = True) -> OptimizeResult:
+def diagnose(
+    exp: Experiment,
+    data: Measured,
+    candidates=None,
+    *,
+    base_effects=(),
+    workers=None,
+    scheduler=None,
+    out=None,
+    pairs: bool = True,
+) -> OptimizeResult:
     """Refit the model with each candidate effect (every form), pairs of the best, and conclude.
 
     candidates : effect names to try (default: every effect applicable to the experiment and not in
@@ -125,11 +148,19 @@ def diagnose(exp: Experiment, data: Measured, candidates=None, *, base_effects=(
     exp.require_model("diagnose")
     # the figure is drawn by a process forked now, which imports matplotlib while this one fits the
     # baseline on the other CPU (FE experiments, local refits; issue 21)
-    figs = (FigureProcess.start() if out is not None and scheduler is None and exp.fit_options.get("expensive")
-            else None)
+    figs = FigureProcess.start() if out is not None and scheduler is None and exp.fit_options.get("expensive") else None
     try:
-        return _diagnose(exp, data, candidates, base_effects=base_effects, workers=workers, scheduler=scheduler,
-                         out=out, pairs=pairs, figs=figs)
+        return _diagnose(
+            exp,
+            data,
+            candidates,
+            base_effects=base_effects,
+            workers=workers,
+            scheduler=scheduler,
+            out=out,
+            pairs=pairs,
+            figs=figs,
+        )
     finally:
         if figs is not None:
             figs.close()
@@ -156,17 +187,26 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
     models = noise_model(exp, data, baseline, correlate=False, generic=False)  # weights of the refits
     sigma = {c: models[c].sigma for c in chans}
     if any(m.kind.startswith(("heteroscedastic", "given")) for m in models.values()):
-        baseline = fit(exp, data, base_effects, start=dict(zip(baseline.names, baseline.x)), noise=sigma,
-                       given_start_clip=True)
+        baseline = fit(
+            exp, data, base_effects, start=dict(zip(baseline.names, baseline.x)), noise=sigma, given_start_clip=True
+        )
     start = dict(zip(baseline.names, baseline.x))
     if exp.fit_options.get("expensive") and exp.options.get("fe_reference", False) is None:
         # the refits' reference run (the baseline model at its solution, femast.experiments.fe_reference),
         # here once: forked workers inherit it (and its converged path) instead of each running it
         predict(exp, data, baseline.params)
-    payload0 = {"source": exp.source, "options": exp.options, "scripts": list(loaded_scripts()),
-                "data_experiment": data.experiment, "columns": data.columns, "path": data.path,
-                "lines": data.lines, "start": start, "noise": sigma,
-                "sensitivity": getattr(baseline, "sensitivity", None)}   # seeds the refits' Jacobians (issue 21)
+    payload0 = {
+        "source": exp.source,
+        "options": exp.options,
+        "scripts": list(loaded_scripts()),
+        "data_experiment": data.experiment,
+        "columns": data.columns,
+        "path": data.path,
+        "lines": data.lines,
+        "start": start,
+        "noise": sigma,
+        "sensitivity": getattr(baseline, "sensitivity", None),
+    }  # seeds the refits' Jacobians (issue 21)
     # stage 1: the forms of the added effects (shape mismatch) and the default form of each candidate;
     # stage 2: the generalised forms of the candidates whose default form has an information-criterion
     # gain (under the null nothing does, and the generalised forms cannot gain where it did not),
@@ -182,11 +222,20 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
         jobs.append(("candidate", c, c, base_effects + [c], start))
     payloads = [{**payload0, "effects": effs, "start": st} for *_, effs, st in jobs]
     # without a figure process, the report's matplotlib is imported while the worker processes refit
-    fits_list, how = _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base,
-                               while_waiting=_import_pyplot if out is not None and figs is None else None)
+    fits_list, how = _dispatch(
+        exp,
+        data,
+        payloads,
+        start,
+        sigma,
+        workers,
+        scheduler,
+        t_base,
+        while_waiting=_import_pyplot if out is not None and figs is None else None,
+    )
     s_pre = score(baseline, models, chans, data.n)
     jobs2 = []
-    for (stage, c, spec, _, _), res in zip(jobs, fits_list):
+    for (stage, c, _spec, _, _), res in zip(jobs, fits_list):
         if stage != "candidate" or getattr(res, "failed", False):
             continue
         if score(res, models, chans, data.n)["ic"] - s_pre["ic"] >= SIGNIFICANT_DBIC:
@@ -198,8 +247,16 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
             st = {**base_fit, **{f"{alt}.{p.name}": fitted[p.name] for p in impl.parameters if p.name in fitted}}
             jobs2.append(("candidate", c, alt, base_effects + [alt], st))
     if jobs2:
-        more, _ = _dispatch(exp, data, [{**payload0, "effects": effs, "start": st} for *_, effs, st in jobs2],
-                            start, sigma, workers, scheduler, t_base)
+        more, _ = _dispatch(
+            exp,
+            data,
+            [{**payload0, "effects": effs, "start": st} for *_, effs, st in jobs2],
+            start,
+            sigma,
+            workers,
+            scheduler,
+            t_base,
+        )
         jobs += jobs2
         fits_list = list(fits_list) + list(more)
     ok = [f for f in fits_list if not getattr(f, "failed", False)]
@@ -208,24 +265,50 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
     thr = at_noise_threshold(data.n, nch)
     a = analyse(exp, data, _with_noise(baseline, sigma))
     worst_kind = a["by_kind"][0]["kind"] if a["by_kind"] else None
+
     def entry_of(effect, spec, res):
         if getattr(res, "failed", False):
-            return {"effect": effect, "form": _form(spec, effect, key), "rms": float(baseline.rms), "ratio": r0,
-                    "delta_bic": 0.0, "params": {}, "significant": False, "ic_gain": False, "share_ok": False,
-                    "explained_fraction": 0.0, "baseline_params": {}, "success": False, "at_bound": [],
-                    "failed": True, "spec": spec, "baseline_ratio": r0,
-                    "reading": f"The refit with {get_effect(effect).title} failed: {res.message}"}
+            return {
+                "effect": effect,
+                "form": _form(spec, effect, key),
+                "rms": float(baseline.rms),
+                "ratio": r0,
+                "delta_bic": 0.0,
+                "params": {},
+                "significant": False,
+                "ic_gain": False,
+                "share_ok": False,
+                "explained_fraction": 0.0,
+                "baseline_params": {},
+                "success": False,
+                "at_bound": [],
+                "failed": True,
+                "spec": spec,
+                "baseline_ratio": r0,
+                "reading": f"The refit with {get_effect(effect).title} failed: {res.message}",
+            }
         sc = score(res, models, chans, data.n)
         d, frac = sc["ic"] - ic0, share(r0, sc["ratio"])
         dr = robust_delta(s0["z"], sc["z"], data.n, models, int(baseline.n_params), int(res.n_params))
         table = params_table(res)
-        return {"effect": effect, "form": _form(spec, effect, key), "spec": spec, "rms": float(res.rms),
-                "ratio": sc["ratio"], "delta_bic": float(d), "explained_fraction": frac, **flags(d, frac, dr),
-                "delta_bic_robust": float(dr),
-                "params": {k.split(".", 1)[1]: v for k, v in table.items() if k.startswith(spec + ".")},
-                "baseline_params": {k: v for k, v in table.items() if "." not in k}, "baseline_ratio": r0,
-                "success": bool(res.success), "at_bound": list(res.at_bound), "n_params": int(res.n_params),
-                "_z": sc["z"]}
+        return {
+            "effect": effect,
+            "form": _form(spec, effect, key),
+            "spec": spec,
+            "rms": float(res.rms),
+            "ratio": sc["ratio"],
+            "delta_bic": float(d),
+            "explained_fraction": frac,
+            **flags(d, frac, dr),
+            "delta_bic_robust": float(dr),
+            "params": {k.split(".", 1)[1]: v for k, v in table.items() if k.startswith(spec + ".")},
+            "baseline_params": {k: v for k, v in table.items() if "." not in k},
+            "baseline_ratio": r0,
+            "success": bool(res.success),
+            "at_bound": list(res.at_bound),
+            "n_params": int(res.n_params),
+            "_z": sc["z"],
+        }
 
     def rank():
         """(ranking, fits, form_check) of the refits under the current noise model."""
@@ -233,17 +316,28 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
         for (stage, effect, spec, *_), res in zip(jobs, fits_list):
             e = entry_of(effect, spec, res)
             if stage == "form_check":
-                fc.append({k: e[k] for k in ("effect", "form", "ratio", "delta_bic", "explained_fraction",
-                                             "significant", "params")})
+                fc.append(
+                    {
+                        k: e[k]
+                        for k in ("effect", "form", "ratio", "delta_bic", "explained_fraction", "significant", "params")
+                    }
+                )
             else:
                 by_effect.setdefault(effect, []).append((e, res))
         out = []
         for effect, items in by_effect.items():
             good = [it for it in items if not it[0].get("failed")]
             e, res = min(good, key=lambda it: it[0]["delta_bic"]) if good else items[0]
-            e["forms"] = [{"form": x["form"], "ratio": x["ratio"], "delta_bic": x["delta_bic"],
-                           "n_params": x.get("n_params", 0), **({"failed": True} if x.get("failed") else {})}
-                          for x, _ in items]
+            e["forms"] = [
+                {
+                    "form": x["form"],
+                    "ratio": x["ratio"],
+                    "delta_bic": x["delta_bic"],
+                    "n_params": x.get("n_params", 0),
+                    **({"failed": True} if x.get("failed") else {}),
+                }
+                for x, _ in items
+            ]
             if not e.get("failed"):
                 e["reading"] = _reading(effect, e, s0["z"], e["_z"], a["masks"], nch, worst_kind, thr)
             fts[effect] = res
@@ -257,11 +351,18 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
         dr = robust_delta(s0["z"], sc["z"], data.n, models, int(baseline.n_params), int(res.n_params))
         order = list(by)
         x, y = sorted((x, y), key=order.index)  # the better-ranked member first
-        return {"effects": [x, y], "forms": [by[x]["form"], by[y]["form"]], "ratio": sc["ratio"],
-                "rms": float(res.rms), "delta_bic": float(d), "explained_fraction": frac, **flags(d, frac, dr),
-                "gain_over_best_single": float(d - min(by[x]["delta_bic"], by[y]["delta_bic"])),
-                "share_over_best_single": float(frac - max(by[x]["explained_fraction"], by[y]["explained_fraction"])),
-                "_fit": res}
+        return {
+            "effects": [x, y],
+            "forms": [by[x]["form"], by[y]["form"]],
+            "ratio": sc["ratio"],
+            "rms": float(res.rms),
+            "delta_bic": float(d),
+            "explained_fraction": frac,
+            **flags(d, frac, dr),
+            "gain_over_best_single": float(d - min(by[x]["delta_bic"], by[y]["delta_bic"])),
+            "share_over_best_single": float(frac - max(by[x]["explained_fraction"], by[y]["explained_fraction"])),
+            "_fit": res,
+        }
 
     ranking, fits, form_check = rank()
     # pairs of the top candidates with an information-criterion gain, fitted jointly
@@ -269,7 +370,7 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
     top = pair_candidates(ranking)
     if pairs and top and r0 > thr:
         by = {e["effect"]: e for e in ranking}
-        combos = [(x, y) for i, x in enumerate(top) for y in top[i + 1:]]
+        combos = [(x, y) for i, x in enumerate(top) for y in top[i + 1 :]]
         # and the best with every other candidate: a second mechanism whose own gain the first one's
         # larger error hides (forward selection); not for the FE experiments, where a refit costs
         # a minute of FE runs (their few rows rarely show a second mechanism without its own gain)
@@ -304,16 +405,35 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
     verdict = conclude(r0, thr, ranking, pairs_json, form_check, titles, where)
     base_table = params_table(baseline)
     noise_rms = float(np.sqrt(np.mean([np.mean((exp.weight(c) * sigma[c]) ** 2) for c in chans])))
-    public = ("effect", "rms", "delta_bic", "params", "significant", "ratio", "explained_fraction", "reading",
-              "form", "forms", "ic_gain", "share_ok", "delta_bic_robust")
+    public = (
+        "effect",
+        "rms",
+        "delta_bic",
+        "params",
+        "significant",
+        "ratio",
+        "explained_fraction",
+        "reading",
+        "form",
+        "forms",
+        "ic_gain",
+        "share_ok",
+        "delta_bic_robust",
+    )
     report = {
         "experiment": exp.name,
         "n_samples": int(data.n),
         "noise_rms": noise_rms,
-        "baseline": {"rms": float(baseline.rms), "params": base_table, "ratio": float(r0),
-                     "effects": list(base_effects), "bic": float(ic0)},
-        "ranking": [{**{k: e[k] for k in public if k in e}, **({"failed": True} if e.get("failed") else {})}
-                    for e in ranking],
+        "baseline": {
+            "rms": float(baseline.rms),
+            "params": base_table,
+            "ratio": float(r0),
+            "effects": list(base_effects),
+            "bic": float(ic0),
+        },
+        "ranking": [
+            {**{k: e[k] for k in public if k in e}, **({"failed": True} if e.get("failed") else {})} for e in ranking
+        ],
         "verdict": verdict,
         "data": str(data.path),
         "error_unit": exp.error_unit,
@@ -333,13 +453,36 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
     elif ranking and not ranking[0].get("failed"):
         best_fit = fits[ranking[0]["effect"]]
     result = OptimizeResult(
-        experiment=exp.name, n_samples=data.n, noise=sigma, noise_model=models, noise_rms=noise_rms,
-        baseline={"rms": float(baseline.rms), "ratio": float(r0), "bic": float(ic0),
-                  "params": base_table, "effects": list(base_effects)},
-        baseline_fit=baseline, baseline_z=s0["z"], ranking=ranking, fits=fits, pairs=pair_list,
-        form_check=form_check, best_fit=best_fit, verdict=verdict, report=report, executor=how, files={},
-        at_noise=thr, n_eff=n_eff, success=bool(baseline.success) and all(e["success"] for e in ranking),
-        message=verdict["conclusion"], by_kind=a["by_kind"], signatures=a["signatures"])
+        experiment=exp.name,
+        n_samples=data.n,
+        noise=sigma,
+        noise_model=models,
+        noise_rms=noise_rms,
+        baseline={
+            "rms": float(baseline.rms),
+            "ratio": float(r0),
+            "bic": float(ic0),
+            "params": base_table,
+            "effects": list(base_effects),
+        },
+        baseline_fit=baseline,
+        baseline_z=s0["z"],
+        ranking=ranking,
+        fits=fits,
+        pairs=pair_list,
+        form_check=form_check,
+        best_fit=best_fit,
+        verdict=verdict,
+        report=report,
+        executor=how,
+        files={},
+        at_noise=thr,
+        n_eff=n_eff,
+        success=bool(baseline.success) and all(e["success"] for e in ranking),
+        message=verdict["conclusion"],
+        by_kind=a["by_kind"],
+        signatures=a["signatures"],
+    )
     if out is not None:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
@@ -383,35 +526,48 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
     """Plain-text summary of a diagnosis (what ``femast diagnose`` prints)."""
     f, ul = display_scale(exp.error_unit)
     b = result.baseline
-    lines = [f"femast diagnose: {exp.name} on {result.report['data']} ({result.n_samples} samples; refits: "
-             f"{result.executor})",
-             f"  noise floor {f * result.noise_rms:.4g} {ul}; baseline"
-             f"{' + ' + '+'.join(b['effects']) if b['effects'] else ''} RMS {f * b['rms']:.4g} {ul} "
-             f"({b['ratio']:.2f}x noise)"]
+    lines = [
+        f"femast diagnose: {exp.name} on {result.report['data']} ({result.n_samples} samples; refits: "
+        f"{result.executor})",
+        f"  noise floor {f * result.noise_rms:.4g} {ul}; baseline"
+        f"{' + ' + '+'.join(b['effects']) if b['effects'] else ''} RMS {f * b['rms']:.4g} {ul} "
+        f"({b['ratio']:.2f}x noise)",
+    ]
     if result.by_kind:
-        lines.append("  the model fails most in: " + ", ".join(f"{k['kind']} ({k['ratio']:.1f}x)"
-                                                          for k in result.by_kind[:3]))
+        lines.append(
+            "  the model fails most in: " + ", ".join(f"{k['kind']} ({k['ratio']:.1f}x)" for k in result.by_kind[:3])
+        )
     nm = getattr(result, "noise_model", None) or {}
     for c, m in nm.items():
         lines.append(f"  noise of {c}: {m.kind} -- {m.reason}")
-    lines.append(f"  {'rank':>4s}  {'effect':<22s} {'form':<10s} {'RMS':>10s} {'x noise':>8s} {'dBIC':>9s} "
-                 f"{'share':>6s}  sig  parameters")
+    lines.append(
+        f"  {'rank':>4s}  {'effect':<22s} {'form':<10s} {'RMS':>10s} {'x noise':>8s} {'dBIC':>9s} "
+        f"{'share':>6s}  sig  parameters"
+    )
     for i, e in enumerate(result.ranking):
         if e.get("failed"):
             lines.append(f"  {i + 1:>4d}  {e['effect']:<22s} {'refit failed':>10s}  {e['reading'][:90]}")
             continue
-        ps = ", ".join(f"{k} = {v['value']:.4g}" + (f" +- {v['stderr']:.2g}" if v["stderr"] is not None else "")
-                       + f" {v['unit']}" for k, v in e["params"].items())
-        lines.append(f"  {i + 1:>4d}  {e['effect']:<22s} {e.get('form') or '-':<10s} {f * e['rms']:>10.4g} "
-                     f"{e['ratio']:>8.2f} {e['delta_bic']:>9.1f} {100 * e['explained_fraction']:>5.0f}%  "
-                     f"{'yes' if e['significant'] else ' no'}  {ps}")
+        ps = ", ".join(
+            f"{k} = {v['value']:.4g}" + (f" +- {v['stderr']:.2g}" if v["stderr"] is not None else "") + f" {v['unit']}"
+            for k, v in e["params"].items()
+        )
+        lines.append(
+            f"  {i + 1:>4d}  {e['effect']:<22s} {e.get('form') or '-':<10s} {f * e['rms']:>10.4g} "
+            f"{e['ratio']:>8.2f} {e['delta_bic']:>9.1f} {100 * e['explained_fraction']:>5.0f}%  "
+            f"{'yes' if e['significant'] else ' no'}  {ps}"
+        )
     for p in (getattr(result, "pairs", None) or [])[:3]:
-        lines.append(f"  pair  {' + '.join(p['effects']):<33s} {f * p['rms']:>10.4g} {p['ratio']:>8.2f} "
-                     f"{p['delta_bic']:>9.1f} {100 * p['explained_fraction']:>5.0f}%  "
-                     f"{'yes' if p['significant'] else ' no'}")
-    for fc in (getattr(result, "form_check", None) or []):
-        lines.append(f"  form check of the added {fc['effect']}: form {fc['form']} {fc['ratio']:.2f}x noise, dBIC "
-                     f"{fc['delta_bic']:+.1f}{' (significant)' if fc['significant'] else ''}")
+        lines.append(
+            f"  pair  {' + '.join(p['effects']):<33s} {f * p['rms']:>10.4g} {p['ratio']:>8.2f} "
+            f"{p['delta_bic']:>9.1f} {100 * p['explained_fraction']:>5.0f}%  "
+            f"{'yes' if p['significant'] else ' no'}"
+        )
+    for fc in getattr(result, "form_check", None) or []:
+        lines.append(
+            f"  form check of the added {fc['effect']}: form {fc['form']} {fc['ratio']:.2f}x noise, dBIC "
+            f"{fc['delta_bic']:+.1f}{' (significant)' if fc['significant'] else ''}"
+        )
     if result.ranking:
         lines.append(f"  reading of #1: {result.ranking[0]['reading']}")
     lines.append(f"  verdict: {result.verdict['conclusion']} [{result.verdict.get('kind')}]")

@@ -155,7 +155,7 @@ def _split(value):
         elif isinstance(v, numbers.Integral):
             scalars[k] = int(v)
         elif isinstance(v, numbers.Real):
-            if not np.isfinite(float(v)):   # JSON has no NaN/inf
+            if not np.isfinite(float(v)):  # JSON has no NaN/inf
                 return None
             scalars[k] = float(v)
         elif isinstance(v, str):
@@ -172,13 +172,21 @@ def write_entry(path: Path, key: str, value) -> bool:
     if parts is None:
         return False
     arrays, scalars = parts
-    meta = {"format": FORMAT, "key": key, "scalars": scalars, "arrays": sorted(arrays),
-            "sha256": _digest(key, arrays, scalars)}
+    meta = {
+        "format": FORMAT,
+        "key": key,
+        "scalars": scalars,
+        "arrays": sorted(arrays),
+        "sha256": _digest(key, arrays, scalars),
+    }
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     buf = io.BytesIO()
-    np.savez(buf, __meta__=np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8),
-             **{f"a_{name}": a for name, a in arrays.items()})
+    np.savez(
+        buf,
+        __meta__=np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8),
+        **{f"a_{name}": a for name, a in arrays.items()},
+    )
     tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
     with open(tmp, "wb") as fh:
         fh.write(buf.getvalue())

@@ -44,7 +44,7 @@ class _FEJacobian:
         self.last = {}
         self.J = self.u = self.f = None
         self.J0 = None if J0 is None else np.array(J0, float)
-        self.since = 0      # evaluations since the last Jacobian (> 1: a rejected step)
+        self.since = 0  # evaluations since the last Jacobian (> 1: a rejected step)
         self.runs = 0
         self.fd_at = self.fd_J = None
 
@@ -82,7 +82,7 @@ class _FEJacobian:
     def jac(self, u, *args):
         u = np.asarray(u, float)
         f0 = self.value(u)
-        self.since -= 1     # scipy's value call before the Jacobian is not a trial step
+        self.since -= 1  # scipy's value call before the Jacobian is not a trial step
         if self.J is None:
             known = self.J0 if self.J0 is not None and self.J0.shape == (f0.size, u.size) else None
             J = self.differences(u, f0, known)
@@ -103,7 +103,7 @@ class _FEJacobian:
         return self.differences(u, self.value(u)), True
 
 
-FORK_COLUMNS = True   # evaluate a Jacobian's finite-difference columns in this process and a forked one
+FORK_COLUMNS = True  # evaluate a Jacobian's finite-difference columns in this process and a forked one
 
 
 def _fork_ok(n_points: int) -> bool:
@@ -112,7 +112,7 @@ def _fork_ok(n_points: int) -> bool:
     the refits of diagnose), and numba not running GNU OpenMP threads (a forked child of those aborts)."""
     if not FORK_COLUMNS or n_points < 2 or not hasattr(os, "fork") or (os.cpu_count() or 1) < 2:
         return False
-    if not sys.platform.startswith("linux"):   # (where fork is multiprocessing's default; macOS: not safe)
+    if not sys.platform.startswith("linux"):  # (where fork is multiprocessing's default; macOS: not safe)
         return False
     import multiprocessing
     import threading
@@ -126,7 +126,7 @@ def _fork_ok(n_points: int) -> bool:
 
         if numba.threading_layer() == "omp":
             return False
-    except Exception:   # (ValueError while no parallel kernel has run: no threads)
+    except Exception:  # (ValueError while no parallel kernel has run: no threads)
         pass
     return True
 
@@ -153,7 +153,7 @@ def evaluate_many(fun, points, size: int) -> list:
 
     k = (len(points) + 1) // 2
     rd, wr = os.pipe()
-    gc.freeze()   # (the child's collections skip the inherited heap: fewer copied pages; see refits.frozen_heap)
+    gc.freeze()  # (the child's collections skip the inherited heap: fewer copied pages; see refits.frozen_heap)
     try:
         pid = os.fork()
     except OSError:
@@ -161,11 +161,11 @@ def evaluate_many(fun, points, size: int) -> list:
         os.close(rd)
         os.close(wr)
         return [fun(p) for p in points]
-    if pid == 0:   # the child: its points, then exit without running any of the parent's exit handlers
+    if pid == 0:  # the child: its points, then exit without running any of the parent's exit handlers
         code = 1
         try:
             os.close(rd)
-            os.environ["FEMAST_BACKGROUND_COMPILE"] = "0"   # (no requests to the parent's compile worker)
+            os.environ["FEMAST_BACKGROUND_COMPILE"] = "0"  # (no requests to the parent's compile worker)
             from .. import progress
 
             progress.set_quiet(True)
@@ -196,7 +196,7 @@ def evaluate_many(fun, points, size: int) -> list:
     return mine + theirs
 
 
-CHILD_WAIT = 4.0          # the forked child's share may take this many times this process's share ...
+CHILD_WAIT = 4.0  # the forked child's share may take this many times this process's share ...
 CHILD_WAIT_MIN_S = 300.0  # ... or this long (s), whichever is longer, before it is taken for stuck (a cold
 #                           child may compile kernels in the foreground: tens of seconds)
 
@@ -251,7 +251,7 @@ def _forward_differences(fun, step: float, lo, hi):
     return j.value, j.jac
 
 
-LOG_RANGE = 100.0   # a positive parameter whose bounds span this factor or more is fitted in log scale
+LOG_RANGE = 100.0  # a positive parameter whose bounds span this factor or more is fitted in log scale
 
 
 class _Coords:
@@ -298,7 +298,7 @@ class _Coords:
 
 
 POLISH_ROUNDS = 2
-POLISH_MIN_DECREASE = 0.01   # half chi-square: a restart must promise more (0.14 standard errors of a parameter)
+POLISH_MIN_DECREASE = 0.01  # half chi-square: a restart must promise more (0.14 standard errors of a parameter)
 
 
 def _polish(sol, fj, fun, lo, hi, kw, min_decrease: float = 0.0):

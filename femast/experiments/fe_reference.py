@@ -28,7 +28,7 @@ from collections import OrderedDict
 
 from .fe_cache import cached, run_key
 
-PATH_ENTRIES = 32   # (a bay path is 25 kB; a fit with another drive path -- off_axis_motion -- records each of its runs)
+PATH_ENTRIES = 32  # (a bay path is 25 kB; a fit with another drive path -- off_axis_motion -- records each of its runs)
 _PATHS: OrderedDict = OrderedDict()
 
 

@@ -33,9 +33,9 @@ class FigureProcess:
 
         if not _fork_ok(2):
             return None
-        r1, w1 = os.pipe()   # requests: 8-byte length, pickled (function, args)
-        r2, w2 = os.pipe()   # answer: one byte, 1 if the figure was written
-        gc.freeze()          # (the child's collections skip the inherited heap: fewer copied pages)
+        r1, w1 = os.pipe()  # requests: 8-byte length, pickled (function, args)
+        r2, w2 = os.pipe()  # answer: one byte, 1 if the figure was written
+        gc.freeze()  # (the child's collections skip the inherited heap: fewer copied pages)
         try:
             pid = os.fork()
         except OSError:
@@ -44,7 +44,7 @@ class FigureProcess:
                 os.close(fd)
             return None
         if pid == 0:
-            _child(r1, w1, r2, w2)   # never returns
+            _child(r1, w1, r2, w2)  # never returns
         gc.unfreeze()
         os.close(r1)
         os.close(w2)
@@ -55,7 +55,7 @@ class FigureProcess:
         or failed (then nothing may have been written: draw it here)."""
         try:
             payload = pickle.dumps((fn, args), protocol=pickle.HIGHEST_PROTOCOL)
-        except Exception:   # an argument that does not pickle (an experiment defined in memory)
+        except Exception:  # an argument that does not pickle (an experiment defined in memory)
             self.close()
             return False
         try:
@@ -82,7 +82,7 @@ class FigureProcess:
         if self.pid:
             try:
                 _, status = os.waitpid(self.pid, os.WNOHANG)
-                if _ == 0:   # still importing, waiting or drawing (stuck): it has nothing left to do
+                if _ == 0:  # still importing, waiting or drawing (stuck): it has nothing left to do
                     os.kill(self.pid, signal.SIGKILL)
                     os.waitpid(self.pid, 0)
             except (ChildProcessError, ProcessLookupError, OSError):
@@ -90,7 +90,7 @@ class FigureProcess:
             self.pid = 0
 
 
-FIGURE_WAIT_S = 300.0   # s: a child that has not answered by then is taken for stuck (the caller draws;
+FIGURE_WAIT_S = 300.0  # s: a child that has not answered by then is taken for stuck (the caller draws;
 #                        matplotlib's first import builds its font cache: tens of seconds)
 
 
@@ -116,7 +116,7 @@ def _child(r1: int, w1: int, r2: int, w2: int) -> None:
     try:
         os.close(w1)
         os.close(r2)
-        os.environ["FEMAST_BACKGROUND_COMPILE"] = "0"   # (no requests to the parent's compile worker)
+        os.environ["FEMAST_BACKGROUND_COMPILE"] = "0"  # (no requests to the parent's compile worker)
         from .. import progress
         from ..post.plotstyle import pyplot
 
@@ -127,10 +127,10 @@ def _child(r1: int, w1: int, r2: int, w2: int) -> None:
             if head:
                 payload = _read_exactly(fh, struct.unpack("<Q", head)[0])
                 if payload:
-                    fn, args = pickle.loads(payload)   # (from our own parent process)
+                    fn, args = pickle.loads(payload)  # (from our own parent process)
                     fn(*args)
                     ok = b"1"
-    except BaseException:   # the parent draws the figure itself
+    except BaseException:  # the parent draws the figure itself
         ok = b"0"
     finally:
         try:

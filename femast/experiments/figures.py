@@ -79,17 +79,36 @@ def compare_figure(exp, data, result, png) -> Path:
         ax3.axvspan(seg["start_row"] - 0.5, seg["end_row"] + 0.5, color="C3", alpha=0.18 - 0.04 * k, lw=0)
         mid = 0.5 * (seg["start_row"] + seg["end_row"])
         ha = "right" if mid > 0.85 * data.n else ("left" if mid < 0.15 * data.n else "center")  # inside the axes
-        ax3.text(mid, 0.97 - 0.13 * k, f"#{k + 1} {seg['kind']} {seg['ratio']:.1f}x noise",
-                 transform=ax3.get_xaxis_transform(), ha=ha, va="top", fontsize=7.5, color="C3",
-                 bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.7))
+        ax3.text(
+            mid,
+            0.97 - 0.13 * k,
+            f"#{k + 1} {seg['kind']} {seg['ratio']:.1f}x noise",
+            transform=ax3.get_xaxis_transform(),
+            ha=ha,
+            va="top",
+            fontsize=7.5,
+            color="C3",
+            bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.7),
+        )
     ax3.set_xlabel("data row (time order)")
     ax3.set_ylabel(f"residual, measured - model ({uc})" if uc else "residual, measured - model (unit: legend)")
-    ax3.set_title(fit_title(ax3, f"residual (dotted: noise floor); worst segments above {num(AT_NOISE)}x noise "
-                                 f"shaded; RMS {num(result.ratio)}x noise"))
+    ax3.set_title(
+        fit_title(
+            ax3,
+            f"residual (dotted: noise floor); worst segments above {num(AT_NOISE)}x noise "
+            f"shaded; RMS {num(result.ratio)}x noise",
+        )
+    )
     ax3.legend(ncol=min(3, len(exp.channels)), loc="lower right")
     eff = "+".join(result.effects) or "baseline"
-    fig.suptitle(fit_title(fig, f"femast compare {exp.name} -- {Path(str(data.path).split()[-1]).name} -- model: "
-                                f"{eff}" + (" (fitted)" if result.fitted else " (given parameters)"), 11.5))
+    fig.suptitle(
+        fit_title(
+            fig,
+            f"femast compare {exp.name} -- {Path(str(data.path).split()[-1]).name} -- model: "
+            f"{eff}" + (" (fitted)" if result.fitted else " (given parameters)"),
+            11.5,
+        )
+    )
     return plotstyle.save(fig, png, dpi=100)
 
 
@@ -99,32 +118,48 @@ def diagnose_figure(exp, data, result, png) -> Path:
     plt = _plt()
     png = Path(png)
     f, ul = display_scale(exp.error_unit)
-    entries = [("baseline", result.baseline["rms"], None, False)] + [
-        (r["effect"] + (f" ({r['form']})" if r.get("form") else ""), r["rms"], r["delta_bic"], r["significant"])
-        for r in result.ranking] + [
-        (" + ".join(p["effects"]), p["rms"], p["delta_bic"], p["significant"]) for p in
-        (getattr(result, "pairs", None) or [])[:3]]
-    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(13, max(4.0, 0.45 * len(entries) + 2)),
-                                   gridspec_kw={"width_ratios": [1, 1.3]})
+    entries = (
+        [("baseline", result.baseline["rms"], None, False)]
+        + [
+            (r["effect"] + (f" ({r['form']})" if r.get("form") else ""), r["rms"], r["delta_bic"], r["significant"])
+            for r in result.ranking
+        ]
+        + [
+            (" + ".join(p["effects"]), p["rms"], p["delta_bic"], p["significant"])
+            for p in (getattr(result, "pairs", None) or [])[:3]
+        ]
+    )
+    fig, (ax0, ax1) = plt.subplots(
+        1, 2, figsize=(13, max(4.0, 0.45 * len(entries) + 2)), gridspec_kw={"width_ratios": [1, 1.3]}
+    )
     y = np.arange(len(entries))[::-1]
     colors = ["C0"] + [("C2" if sig else "0.65") for _, _, _, sig in entries[1:]]
     ax0.barh(y, [f * e[1] for e in entries], color=colors)
     ax0.set_yticks(y)
     ax0.set_yticklabels([e[0] for e in entries], fontsize=9)
     ax0.axvline(f * result.noise_rms, color="k", ls="--", lw=1, label="noise floor")
-    ax0.axvline(f * result.noise_rms * result.at_noise, color="k", ls=":", lw=1,
-                label=f"at-noise threshold, {num(result.at_noise, 2)} x noise")
+    ax0.axvline(
+        f * result.noise_rms * result.at_noise,
+        color="k",
+        ls=":",
+        lw=1,
+        label=f"at-noise threshold, {num(result.at_noise, 2)} x noise",
+    )
     for yy, e in zip(y, entries):
         if e[2] is not None:
             ax0.text(f * e[1], yy, f"  dBIC {e[2]:+.0f}", va="center", fontsize=8)
     ax0.set_xlabel(f"RMS error after refit ({ul})")
     v = result.verdict
-    verdict = {"missing_effect": f"missing: {v['missing_effect']}",
-               "missing_pair": f"missing: {' + '.join(v.get('missing_effects', []))}",
-               "form_imperfect": f"mechanism found ({v.get('mechanism')}), form imperfect",
-               "better_form": f"better form of {v.get('mechanism')}: {v.get('form')}",
-               "nothing_missing": "nothing is missing"}.get(v.get("kind"), "none of the candidates explains this")
-    ax0.set_title(fit_title(ax0, f"{exp.name}: refit with each candidate and pair (green: significant); verdict: {verdict}"))
+    verdict = {
+        "missing_effect": f"missing: {v['missing_effect']}",
+        "missing_pair": f"missing: {' + '.join(v.get('missing_effects', []))}",
+        "form_imperfect": f"mechanism found ({v.get('mechanism')}), form imperfect",
+        "better_form": f"better form of {v.get('mechanism')}: {v.get('form')}",
+        "nothing_missing": "nothing is missing",
+    }.get(v.get("kind"), "none of the candidates explains this")
+    ax0.set_title(
+        fit_title(ax0, f"{exp.name}: refit with each candidate and pair (green: significant); verdict: {verdict}")
+    )
     ax0.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     xmax = max(f * e[1] for e in entries)
     ax0.set_xlim(0, 1.35 * xmax)
@@ -132,10 +167,14 @@ def diagnose_figure(exp, data, result, png) -> Path:
     zb = np.asarray(getattr(result, "baseline_z", result.baseline_fit.fun)).reshape(len(exp.channels), -1)
     ax1.plot(rows, np.sqrt((zb**2).mean(0)), "-", lw=0.8, color="C0", label="baseline")
     if result.best_fit is not None:
-        zc = np.concatenate([result.best_fit.residuals[c] / np.broadcast_to(result.noise[c], (data.n,))
-                             for c in exp.channels]).reshape(len(exp.channels), -1)
-        label = " + ".join(v.get("missing_effects") or []) if v.get("kind") == "missing_pair" else \
-            result.ranking[0]["effect"]
+        zc = np.concatenate(
+            [result.best_fit.residuals[c] / np.broadcast_to(result.noise[c], (data.n,)) for c in exp.channels]
+        ).reshape(len(exp.channels), -1)
+        label = (
+            " + ".join(v.get("missing_effects") or [])
+            if v.get("kind") == "missing_pair"
+            else result.ranking[0]["effect"]
+        )
         ax1.plot(rows, np.sqrt((zc**2).mean(0)), "-", lw=0.8, color="C2", label=f"with {label}")
     ax1.axhline(1.0, color="k", ls="--", lw=0.8)
     ax1.set_xlabel("data row (time order)")

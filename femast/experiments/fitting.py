@@ -28,8 +28,8 @@ import math
 import numpy as np
 from scipy.optimize import OptimizeResult, least_squares
 
-from ..effects.base import resolve
 from .. import progress
+from ..effects.base import resolve
 from ..errors import ModelError
 from .core import EffectStack, Experiment, Measured
 from .fe_jacobian import LOG_RANGE, POLISH_MIN_DECREASE, _Coords, _FEJacobian, _forward_differences, _polish  # noqa: F401
@@ -48,7 +48,7 @@ def _specs(exp: Experiment, impls):
 
 def _split(specs, values):
     base, eff = {}, {}
-    for (full, p, owner), v in zip(specs, values):
+    for (_full, p, owner), v in zip(specs, values):
         if owner is None:
             base[p.name] = float(v)
         else:
@@ -73,15 +73,16 @@ def predict(exp: Experiment, data: Measured, params=None, effects=None) -> dict:
         vals = {p.name: float(p.default) for p in impl.parameters}
         unknown = set(effects[name]) - set(vals)
         if unknown:
-            raise ModelError(f"effect {name} on {exp.name} has no parameter(s) {', '.join(sorted(unknown))}; "
-                             f"its parameters: {', '.join(vals) or '(none)'}")
+            raise ModelError(
+                f"effect {name} on {exp.name} has no parameter(s) {', '.join(sorted(unknown))}; "
+                f"its parameters: {', '.join(vals) or '(none)'}"
+            )
         vals.update(effects[name])
         items.append((name, impl, vals))
     p = exp.defaults()
     unknown = set(params or {}) - set(p)
     if unknown:
-        raise ModelError(f"{exp.name} has no parameter(s) {', '.join(sorted(unknown))}; its parameters: "
-                         f"{', '.join(p)}")
+        raise ModelError(f"{exp.name} has no parameter(s) {', '.join(sorted(unknown))}; its parameters: {', '.join(p)}")
     p.update(params or {})
     out = exp.model(p, data, EffectStack(items), exp.options)
     missing = [c for c in exp.channels if c not in out]
@@ -115,10 +116,14 @@ def summary_numbers(exp: Experiment, residuals: dict, sigma: dict) -> dict:
     e2 = np.concatenate([(w[c] * r) ** 2 for c, r in residuals.items()])
     z2 = np.concatenate([(r / sigma[c]) ** 2 for c, r in residuals.items()])
     noise_rms = math.sqrt(np.mean([(w[c] * sigma[c]) ** 2 for c in residuals]))
-    return {"rms": float(np.sqrt(e2.mean())), "channel_rms": {c: float(np.sqrt(np.mean(r**2))) for c, r in
-                                                                residuals.items()},
-            "noise_rms": float(noise_rms), "ratio": float(np.sqrt(z2.mean())), "rss": float(z2.sum()),
-            "n_obs": int(z2.size)}
+    return {
+        "rms": float(np.sqrt(e2.mean())),
+        "channel_rms": {c: float(np.sqrt(np.mean(r**2))) for c, r in residuals.items()},
+        "noise_rms": float(noise_rms),
+        "ratio": float(np.sqrt(z2.mean())),
+        "rss": float(z2.sum()),
+        "n_obs": int(z2.size),
+    }
 
 
 def bic(rss: float, n_obs: int, n_params: int) -> float:
@@ -132,17 +137,44 @@ def _result(exp, data, specs, x, stderr, cov, sigma, predicted, fitted, success,
     base, eff = _split(specs, x)
     p = len(x) if fitted else 0
     z = np.concatenate([res[c] / sigma[c] for c in exp.channels])
-    at_bound = [full for (full, prm, _), v in zip(specs, x) if fitted and (
-        np.isclose(v, prm.lower, rtol=1e-6, atol=1e-12 * prm.typical) or
-        np.isclose(v, prm.upper, rtol=1e-6, atol=1e-12 * prm.typical))]
+    at_bound = [
+        full
+        for (full, prm, _), v in zip(specs, x)
+        if fitted
+        and (
+            np.isclose(v, prm.lower, rtol=1e-6, atol=1e-12 * prm.typical)
+            or np.isclose(v, prm.upper, rtol=1e-6, atol=1e-12 * prm.typical)
+        )
+    ]
     return OptimizeResult(
-        x=np.asarray(x, float), names=tuple(s[0] for s in specs), units=tuple(s[1].unit for s in specs),
-        stderr=np.asarray(stderr, float), cov=cov, params=base, effect_params=eff, effects=tuple(effects),
-        success=bool(success), message=message, nfev=int(nfev), cost=0.5 * float(z @ z), fun=z,
-        predicted=predicted, residuals=res, noise=dict(sigma), rms=nums["rms"], channel_rms=nums["channel_rms"],
-        noise_rms=nums["noise_rms"], ratio=nums["ratio"], n_obs=nums["n_obs"], n_params=p,
-        bic=bic(nums["rss"], nums["n_obs"], p), fitted=bool(fitted), at_bound=at_bound,
-        experiment=exp.name, error_unit=exp.error_unit)
+        x=np.asarray(x, float),
+        names=tuple(s[0] for s in specs),
+        units=tuple(s[1].unit for s in specs),
+        stderr=np.asarray(stderr, float),
+        cov=cov,
+        params=base,
+        effect_params=eff,
+        effects=tuple(effects),
+        success=bool(success),
+        message=message,
+        nfev=int(nfev),
+        cost=0.5 * float(z @ z),
+        fun=z,
+        predicted=predicted,
+        residuals=res,
+        noise=dict(sigma),
+        rms=nums["rms"],
+        channel_rms=nums["channel_rms"],
+        noise_rms=nums["noise_rms"],
+        ratio=nums["ratio"],
+        n_obs=nums["n_obs"],
+        n_params=p,
+        bic=bic(nums["rss"], nums["n_obs"], p),
+        fitted=bool(fitted),
+        at_bound=at_bound,
+        experiment=exp.name,
+        error_unit=exp.error_unit,
+    )
 
 
 def run_model(exp: Experiment, data: Measured, params=None, effects=None, noise=None) -> OptimizeResult:
@@ -163,8 +195,21 @@ def run_model(exp: Experiment, data: Measured, params=None, effects=None, noise=
     predicted = predict(exp, data, {k: v for k, v in vals.items() if "." not in k}, effects)
     sigma = noise or estimate_noise(exp, channel_residuals(exp, data, predicted))
     n = len(x)
-    return _result(exp, data, specs, x, np.full(n, np.nan), np.full((n, n), np.nan), sigma, predicted, False, True,
-                   "model run with given parameters (not fitted)", 1, [i[0] for i in impls])
+    return _result(
+        exp,
+        data,
+        specs,
+        x,
+        np.full(n, np.nan),
+        np.full((n, n), np.nan),
+        sigma,
+        predicted,
+        False,
+        True,
+        "model run with given parameters (not fitted)",
+        1,
+        [i[0] for i in impls],
+    )
 
 
 def _covariance(J, cost, n, scale):
@@ -186,9 +231,19 @@ def _covariance(J, cost, n, scale):
     return stderr, cov, note
 
 
-def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, multistart: bool = True,
-        max_nfev: int | None = None, given_start_clip: bool = False,
-        nfev_per_param: int | None = None, start_sensitivity: dict | None = None) -> OptimizeResult:
+def fit(
+    exp: Experiment,
+    data: Measured,
+    effects=(),
+    *,
+    start=None,
+    noise=None,
+    multistart: bool = True,
+    max_nfev: int | None = None,
+    given_start_clip: bool = False,
+    nfev_per_param: int | None = None,
+    start_sensitivity: dict | None = None,
+) -> OptimizeResult:
     """Fit the baseline parameters and those of the switched-on ``effects`` to the data.
 
     effects : effect names (``femast.effects``) applicable to the experiment.
@@ -229,16 +284,19 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     start = dict(start or {})
     unknown = set(start) - {s[0] for s in specs}
     if unknown:
-        raise ModelError(f"fit start: unknown parameter(s) {', '.join(sorted(unknown))}; accepted: "
-                         f"{', '.join(s[0] for s in specs)}")
+        raise ModelError(
+            f"fit start: unknown parameter(s) {', '.join(sorted(unknown))}; accepted: {', '.join(s[0] for s in specs)}"
+        )
     guess = exp.initial_guess(data, exp.options) if exp.initial_guess else {}
     x0 = []
     for full, p, owner in specs:
         if full in start:
             v = float(start[full])
             if not (p.lower <= v <= p.upper) and not given_start_clip:
-                raise ModelError(f"fit start: {full} = {v!r} {p.unit} lies outside its bounds [{p.lower!r}, "
-                                 f"{p.upper!r}]; give a start within the bounds")
+                raise ModelError(
+                    f"fit start: {full} = {v!r} {p.unit} lies outside its bounds [{p.lower!r}, "
+                    f"{p.upper!r}]; give a start within the bounds"
+                )
         else:
             v = guess.get(full, p.default) if owner is None else p.default
         x0.append(float(np.clip(v, p.lower, p.upper)))
@@ -266,13 +324,17 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
                 return np.full(data.n * len(exp.channels), _BAD)
             z = np.concatenate([(data[c] - pred[c]) / sigma[c] for c in exp.channels])
             return np.where(np.isfinite(z), z, _BAD)
+
         return fun
 
     # start candidates: the given/default start, then each effect's extra starts (zipped)
     starts = [x0]
     if multistart:
-        extra = [(i, p.starts) for i, (_, p, owner) in enumerate(specs) if owner is not None and p.starts
-                 and specs[i][0] not in start]
+        extra = [
+            (i, p.starts)
+            for i, (_, p, owner) in enumerate(specs)
+            if owner is not None and p.starts and specs[i][0] not in start
+        ]
         for k in range(max((len(st) for _, st in extra), default=0)):
             x = x0.copy()
             for i, st in extra:
@@ -349,7 +411,7 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
             f = sigma0[exp.channels[0]] / sigma[exp.channels[0]]
             sol.fun, sol.jac, sol.cost = sol.fun * f, sol.jac * f, sol.cost * f * f
         else:
-            ratio = sigma_rows(sigma0) / sigma_rows(sigma)   # warm start: the last Jacobian, rows re-weighted
+            ratio = sigma_rows(sigma0) / sigma_rows(sigma)  # warm start: the last Jacobian, rows re-weighted
             sol2 = solve(sigma, [co.to_x(sol.x)], sol.jac * ratio[:, None] if secant else None)
             sol2.nfev_total += sol.nfev_total
             sol2.fe_runs += sol.fe_runs
@@ -366,12 +428,25 @@ def fit(exp: Experiment, data: Measured, effects=(), *, start=None, noise=None, 
     base, eff = _split(specs, x)
     predicted = predict(exp, data, base, eff)
     msg = sol.message.rstrip(".") + (f"; {note}" if note else "")
-    out = _result(exp, data, specs, x, stderr, cov, sigma, predicted, True, bool(sol.success), msg,
-                  sol.nfev_total, [i[0] for i in impls])
+    out = _result(
+        exp,
+        data,
+        specs,
+        x,
+        stderr,
+        cov,
+        sigma,
+        predicted,
+        True,
+        bool(sol.success),
+        msg,
+        sol.nfev_total,
+        [i[0] for i in impls],
+    )
     rows = sigma_rows(sigma)
     out.sensitivity = {full: -sol.jac[:, i] * rows / dxdu[i] for i, (full, _, _) in enumerate(specs)}
     out.fe_runs = int(sol.fe_runs)
-    out.fe_reference = exp.options.get("fe_reference")   # the reference run of the fit's FE runs, or None
+    out.fe_reference = exp.options.get("fe_reference")  # the reference run of the fit's FE runs, or None
     return out
 
 
@@ -381,8 +456,9 @@ def _sigma_of(noise: dict, channel: str, n: int):
     if v.ndim == 0:
         return float(v)
     if v.shape != (n,) or not np.all(np.isfinite(v) & (v > 0)):
-        raise ModelError(f"noise of {channel}: need one level or {n} finite positive per-row levels, got shape "
-                         f"{v.shape}")
+        raise ModelError(
+            f"noise of {channel}: need one level or {n} finite positive per-row levels, got shape {v.shape}"
+        )
     return v
 
 
@@ -394,5 +470,13 @@ def params_table(result: OptimizeResult) -> dict:
     return out
 
 
-__all__ = ["predict", "run_model", "fit", "estimate_noise", "channel_residuals", "summary_numbers", "bic",
-           "params_table"]
+__all__ = [
+    "predict",
+    "run_model",
+    "fit",
+    "estimate_noise",
+    "channel_residuals",
+    "summary_numbers",
+    "bic",
+    "params_table",
+]

@@ -67,7 +67,11 @@ def plot_history(folder, png=None):
     ax.set_ylabel(f"RMS error ({ulabel})")
     ax.set_xlabel("model version")
     ax.set_ylim(bottom=0)
-    ax.set_title(fit_title(ax, f"{recs[-1]['experiment']}: error against model version "
-                               f"({Path(str(recs[-1]['data']).split()[-1]).name})"))
+    ax.set_title(
+        fit_title(
+            ax,
+            f"{recs[-1]['experiment']}: error against model version ({Path(str(recs[-1]['data']).split()[-1]).name})",
+        )
+    )
     ax.legend()
     return plotstyle.save(fig, png, dpi=110)

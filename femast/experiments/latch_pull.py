@@ -78,7 +78,6 @@ from ..latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, l
 from .core import Column, Experiment, Measured, Parameter, prepared
 from .residuals import noise_floor, turning_points
 
-
 SIDE_OUT = 1  # the outer cable (section 2) is loaded: unlatching rig, dT = T2 >= 0
 SIDE_IN = -1  # the inner cable (section 1, through the backstop) is loaded: latching rig, dT = -T1 <= 0
 
@@ -113,7 +112,7 @@ def infer_side(x, dT) -> np.ndarray:
             continue
         seg = np.arange(a, b)  # rows a..b-1: the switch falls after one of them
         k = int(seg[np.argmax(sa * x[seg])])
-        side[start:k + 1] = cur
+        side[start : k + 1] = cur
         cur, start = int(sb), k + 1
     side[start:] = cur
     return side
@@ -126,9 +125,11 @@ def _side_column(data: Measured) -> np.ndarray | None:
     bad = np.flatnonzero((s != SIDE_OUT) & (s != SIDE_IN))
     if bad.size:
         i = int(bad[0])
-        raise DataFileError(f"{data.path} line {int(data.lines[i])}, column 'side': {s[i]:g} is not a loaded side; "
-                            "write 'out' (or +1: outer cable loaded, unlatching rig) or 'in' (or -1: inner cable "
-                            "loaded, latching rig)")
+        raise DataFileError(
+            f"{data.path} line {int(data.lines[i])}, column 'side': {s[i]:g} is not a loaded side; "
+            "write 'out' (or +1: outer cable loaded, unlatching rig) or 'in' (or -1: inner cable "
+            "loaded, latching rig)"
+        )
     return s.astype(np.int64)
 
 
@@ -160,8 +161,20 @@ def _prepare(data: Measured, options: dict) -> dict:
     side_given = side is not None
     if side is None:
         side = infer_side(x, dT)
-    return {"x": x, "dT": dT, "sigma": sigma, "rest": rest, "tau": data.tau, "noise_x": sx, "turn_m": float(h),
-            "turning_points": tps, "side": side, "side_given": side_given, "rest_m": float(h_rest), "x_turn": x_turn}
+    return {
+        "x": x,
+        "dT": dT,
+        "sigma": sigma,
+        "rest": rest,
+        "tau": data.tau,
+        "noise_x": sx,
+        "turn_m": float(h),
+        "turning_points": tps,
+        "side": side,
+        "side_given": side_given,
+        "rest_m": float(h_rest),
+        "x_turn": x_turn,
+    }
 
 
 @njit(cache=True)
@@ -255,9 +268,17 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
         D = effects.apply("branch_force", D, x=X, **ctx)
     one = bool(options["one_sided"])
     side = prep["side"]
-    lo, hi = admissible_band(x, prep["sigma"].astype(np.float64), prep["rest"], side,
-                             np.ascontiguousarray(D[:-1], dtype=np.float64), one, float(prep["rest_m"]), -xb,
-                             prep["x_turn"])
+    lo, hi = admissible_band(
+        x,
+        prep["sigma"].astype(np.float64),
+        prep["rest"],
+        side,
+        np.ascontiguousarray(D[:-1], dtype=np.float64),
+        one,
+        float(prep["rest_m"]),
+        -xb,
+        prep["x_turn"],
+    )
     d_stop = D[-1, 1]
     hi_stop = np.where(side > 0, max(d_stop, 0.0), min(d_stop, 0.0)) if one else np.full(x.size, d_stop)
     dT = prep["dT"]
@@ -294,15 +315,25 @@ def load_measure(data: Measured, options: dict) -> np.ndarray:
     return data["dT_N"]
 
 
-ZONE_KINDS = ("zone (a) at backstop", "zone (b) behind roller axis", "zone (c) in front of roller axis",
-              "zone (d) no contact")
+ZONE_KINDS = (
+    "zone (a) at backstop",
+    "zone (b) behind roller axis",
+    "zone (c) in front of roller axis",
+    "zone (d) no contact",
+)
 
 
 def extra_segments(data: Measured, params: dict, options: dict):
     """Latch zones of seed 001 Fig. 6 along the path (from the fitted law) and the direction of motion."""
     prep = prepared(data, _prepare, options)
-    p = LatchParameters(r=params["r"], x_backstop=params["x_backstop"], k=params["k"], mu=params["mu"],
-                        h=float(options["h_m"]), R=float(options["R_m"]))
+    p = LatchParameters(
+        r=params["r"],
+        x_backstop=params["x_backstop"],
+        k=params["k"],
+        mu=params["mu"],
+        h=float(options["h_m"]),
+        R=float(options["R_m"]),
+    )
     x = prep["x"]
     tol = max(3.0 * prep["noise_x"], 2e-5)
     zone = latch_zone(x, p)
@@ -317,11 +348,21 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
     prep = prepared(data, _prepare, options)
     up = prep["sigma"] > 0
     out = prep["side"] > 0
-    for m, c, lab in ((up & out, "C0", "moving out"), (~up & out, "C2", "moving in"),
-                      (up & ~out, "C1", "moving out"), (~up & ~out, "C4", "moving in")):
+    for m, c, lab in (
+        (up & out, "C0", "moving out"),
+        (~up & out, "C2", "moving in"),
+        (up & ~out, "C1", "moving out"),
+        (~up & ~out, "C4", "moving in"),
+    ):
         if m.any():
-            ax.plot(data["x_mm"][m], data["dT_N"][m], ".", ms=2.5, color=c,
-                    label=f"measured, {'outer' if c in ('C0', 'C2') else 'inner'} cable, {lab}")
+            ax.plot(
+                data["x_mm"][m],
+                data["dT_N"][m],
+                ".",
+                ms=2.5,
+                color=c,
+                label=f"measured, {'outer' if c in ('C0', 'C2') else 'inner'} cable, {lab}",
+            )
     ax.plot(data["x_mm"], predicted["dT_N"], "-", lw=1.0, color="C3", label="model (path order)")
     ax.set_xlabel("distance to latch x (mm)")
     ax.set_ylabel("dT (N)")
@@ -338,8 +379,9 @@ def noise_covariates(data: Measured, params: dict, options: dict, fit=None) -> d
     backstop the residual is ``backstop_N_per_m (x + x_backstop)``, so there the covariate is that
     stiffness: the returned covariate is the sensitivity dr/dx of each row's residual (N/m)."""
     prep = prepared(data, _prepare, options)
-    p = np.array([float(params[n]) for n in ("r", "x_backstop", "k", "mu")] + [float(options["h_m"]),
-                                                                              float(options["R_m"])])
+    p = np.array(
+        [float(params[n]) for n in ("r", "x_backstop", "k", "mu")] + [float(options["h_m"]), float(options["R_m"])]
+    )
     x = np.maximum(prep["x"], -p[1])
     direction = np.where(prep["sigma"] > 0, UNLATCHING, LATCHING)
     _, slope = latch_force(x, direction, p, derivative=True)
@@ -357,22 +399,34 @@ def path_coordinate(data: Measured, options: dict) -> np.ndarray:
 EXPERIMENT = Experiment(
     name="latch-pull",
     title="latch pull test (seed 001 Eqs. 12-15)",
-    columns=(Column("x_mm", "mm", "bead position, cable stretch removed (Eq. 15), positive outside the latch"),
-             Column("dT_N", "N", "force jump across the latch T2 - T1 (Eq. 5)"),
-             Column("side", "-", "optional loaded side of the pass: out (+1, outer cable pulls, unlatching rig) or "
-                    "in (-1, inner cable pulls, latching rig); default inferred from the sign of dT",
-                    required=False, codes=(("out", 1.0), ("in", -1.0)))),
+    columns=(
+        Column("x_mm", "mm", "bead position, cable stretch removed (Eq. 15), positive outside the latch"),
+        Column("dT_N", "N", "force jump across the latch T2 - T1 (Eq. 5)"),
+        Column(
+            "side",
+            "-",
+            "optional loaded side of the pass: out (+1, outer cable pulls, unlatching rig) or "
+            "in (-1, inner cable pulls, latching rig); default inferred from the sign of dT",
+            required=False,
+            codes=(("out", 1.0), ("in", -1.0)),
+        ),
+    ),
     channels=("dT_N",),
     parameters=(
         Parameter("r", "m", 1.1e-3, 1e-5, 2e-2, "roller radius", scale=1e-3),
-        Parameter("x_backstop", "m", 2.0e-3, 1e-5, 2e-2, "distance of the backstop behind the roller axis",
-                  scale=1e-3),
+        Parameter("x_backstop", "m", 2.0e-3, 1e-5, 2e-2, "distance of the backstop behind the roller axis", scale=1e-3),
         Parameter("k", "N/m", 1e5, 10.0, 1e9, "stiffness of one roller's cantilever", scale=1e5),
         Parameter("mu", "-", 0.07, 0.0, 0.45, "roller-bead friction coefficient", scale=0.1),
     ),
     model=model,
-    options={"h_m": 1.5e-3, "R_m": 2.4e-3, "one_sided": True, "backstop_N_per_m": 5e4,
-             "cable_compliance_m_per_N": 2.5e-6, "turn_threshold_m": None},
+    options={
+        "h_m": 1.5e-3,
+        "R_m": 2.4e-3,
+        "one_sided": True,
+        "backstop_N_per_m": 5e4,
+        "cable_compliance_m_per_N": 2.5e-6,
+        "turn_threshold_m": None,
+    },
     hooks={
         "bead_position": "x (n,) m: bead position seen by the latch law",
         "branch_force": "D (n + 1, 2) N: [dT_in, dT_out] at ctx['x'] (samples, then the backstop)",

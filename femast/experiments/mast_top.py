@@ -129,27 +129,34 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
 _EXPERIMENT = Experiment(
     name="mast-top",
     title="mast-top wrench and displacement (seed 000, 3R model)",
-    columns=tuple(Column(c, u, d) for c, u, d in (
-        ("fx_N", "N", "change of the force on the mast top, base frame, x"),
-        ("fy_N", "N", "change of the force on the mast top, base frame, y"),
-        ("fz_N", "N", "change of the force on the mast top, base frame, z"),
-        ("mx_Nm", "N m", "change of the moment about the top point, base frame, x"),
-        ("my_Nm", "N m", "change of the moment about the top point, base frame, y"),
-        ("mz_Nm", "N m", "change of the moment about the top point, base frame, z"),
-        ("dx_m", "m", "measured displacement of the top, x"),
-        ("dy_m", "m", "measured displacement of the top, y"),
-        ("dz_m", "m", "measured displacement of the top, z"),
-    )),
+    columns=tuple(
+        Column(c, u, d)
+        for c, u, d in (
+            ("fx_N", "N", "change of the force on the mast top, base frame, x"),
+            ("fy_N", "N", "change of the force on the mast top, base frame, y"),
+            ("fz_N", "N", "change of the force on the mast top, base frame, z"),
+            ("mx_Nm", "N m", "change of the moment about the top point, base frame, x"),
+            ("my_Nm", "N m", "change of the moment about the top point, base frame, y"),
+            ("mz_Nm", "N m", "change of the moment about the top point, base frame, z"),
+            ("dx_m", "m", "measured displacement of the top, x"),
+            ("dy_m", "m", "measured displacement of the top, y"),
+            ("dz_m", "m", "measured displacement of the top, z"),
+        )
+    ),
     channels=DISPLACEMENT,
     parameters=(
-        Parameter("k_theta1", "N m/rad", 2.5e5, 1e2, 1e10, "stiffness of the base joint about x (Eq. 5)",
-                  scale=2.5e5),
-        Parameter("k_theta2", "N m/rad", 2.5e5, 1e2, 1e10, "stiffness of the base joint about y (Eq. 5)",
-                  scale=2.5e5),
+        Parameter("k_theta1", "N m/rad", 2.5e5, 1e2, 1e10, "stiffness of the base joint about x (Eq. 5)", scale=2.5e5),
+        Parameter("k_theta2", "N m/rad", 2.5e5, 1e2, 1e10, "stiffness of the base joint about y (Eq. 5)", scale=2.5e5),
     ),
     model=model,
-    options={"r_oc_m": (0.0, 0.0, L_SEED), "k_theta3_Nm_per_rad": np.inf, "s_out_m": 0.1, "s_in_m": 0.094,
-             "nu": 0.3, "seed_sign": False},
+    options={
+        "r_oc_m": (0.0, 0.0, L_SEED),
+        "k_theta3_Nm_per_rad": np.inf,
+        "s_out_m": 0.1,
+        "s_in_m": 0.094,
+        "nu": 0.3,
+        "seed_sign": False,
+    },
     hooks={
         "joint_moment": "m (n, 3) N m: moments about the base axes that drive the elastic joints",
         "joint_rotation": "theta (n, 3) rad: rotations of the base joints",

@@ -55,7 +55,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 import numpy as np
 from scipy.optimize import lsq_linear
@@ -91,10 +90,17 @@ class ChannelNoise:
         return float(np.sqrt(np.mean(self.sigma**2)))
 
     def to_json(self) -> dict:
-        return {"kind": self.kind, "sigma_rms": self.sigma_rms, "sigma_min": float(np.min(self.sigma)),
-                "sigma_max": float(np.max(self.sigma)), "phi": float(self.phi), "n_eff": float(self.n_eff),
-                "covariate": self.covariate, "reason": self.reason,
-                **{k: v for k, v in self.extra.items() if k != "level_reason"}}
+        return {
+            "kind": self.kind,
+            "sigma_rms": self.sigma_rms,
+            "sigma_min": float(np.min(self.sigma)),
+            "sigma_max": float(np.max(self.sigma)),
+            "phi": float(self.phi),
+            "n_eff": float(self.n_eff),
+            "covariate": self.covariate,
+            "reason": self.reason,
+            **{k: v for k, v in self.extra.items() if k != "level_reason"},
+        }
 
 
 def informative_rows(r) -> np.ndarray:
@@ -221,8 +227,13 @@ def heteroscedastic_fit(r, g, phi: float = 0.0) -> dict:
     v = A + B * u + D * u * u
     v = np.maximum(v, VAR_FLOOR * max(float(np.mean(v)), 1e-300))
     sigma = np.sqrt(v)
-    return {"coef": (A, B / gs, D / gs**2), "lr": float(lr[0]), "threshold": HETERO_LR, "sigma": sigma,
-            "range": float(sigma.max() / sigma.min())}
+    return {
+        "coef": (A, B / gs, D / gs**2),
+        "lr": float(lr[0]),
+        "threshold": HETERO_LR,
+        "sigma": sigma,
+        "range": float(sigma.max() / sigma.min()),
+    }
 
 
 def given_sigma(data, channel: str) -> np.ndarray | None:
@@ -235,14 +246,17 @@ def given_sigma(data, channel: str) -> np.ndarray | None:
     if bad.size:
         i = int(bad[0])
         line = int(data.lines[i]) if data.lines is not None else i + 2
-        raise DataFileError(f"{data.path} line {line}: column '{name}' = {float(s[i])!r}: a standard uncertainty must be "
-                            f"finite and > 0 ({bad.size} row(s) are not); remove the column to let femast estimate "
-                            "the noise, or give every row its uncertainty")
+        raise DataFileError(
+            f"{data.path} line {line}: column '{name}' = {float(s[i])!r}: a standard uncertainty must be "
+            f"finite and > 0 ({bad.size} row(s) are not); remove the column to let femast estimate "
+            "the noise, or give every row its uncertainty"
+        )
     return s
 
 
-def channel_noise(channel: str, r, n_channel_rows: int, covariates=None, given=None,
-                  correlate: bool = True, pinned=None) -> ChannelNoise:
+def channel_noise(
+    channel: str, r, n_channel_rows: int, covariates=None, given=None, correlate: bool = True, pinned=None
+) -> ChannelNoise:
     """Noise model of one channel from its residual r (n,) (module docstring).
 
     correlate : also test r for serial correlation (:func:`with_correlation`).
@@ -254,17 +268,33 @@ def channel_noise(channel: str, r, n_channel_rows: int, covariates=None, given=N
     r = np.asarray(r, float)
     n = r.size
     if given is not None:
-        return ChannelNoise(channel, "given", np.asarray(given, float), 0.0, float(n), None,
-                            f"sigma_{channel} column: the per-row uncertainty given with the data")
+        return ChannelNoise(
+            channel,
+            "given",
+            np.asarray(given, float),
+            0.0,
+            float(n),
+            None,
+            f"sigma_{channel} column: the per-row uncertainty given with the data",
+        )
     if n < MIN_ROWS:
-        raise ModelError(f"channel {channel}: {n} rows are too few for the noise model (at least {MIN_ROWS} rows, "
-                         f"or a sigma_{channel} column giving each row's standard uncertainty)")
+        raise ModelError(
+            f"channel {channel}: {n} rows are too few for the noise model (at least {MIN_ROWS} rows, "
+            f"or a sigma_{channel} column giving each row's standard uncertainty)"
+        )
     from .residuals import noise_floor
 
     if n < MIN_ROWS_STRUCTURE:
-        return ChannelNoise(channel, "white", np.full(n, max(noise_floor(r), 1e-300)), 0.0, float(n), None,
-                            f"white: {n} rows are too few (< {MIN_ROWS_STRUCTURE}) to test for serial correlation "
-                            "or a varying noise level")
+        return ChannelNoise(
+            channel,
+            "white",
+            np.full(n, max(noise_floor(r), 1e-300)),
+            0.0,
+            float(n),
+            None,
+            f"white: {n} rows are too few (< {MIN_ROWS_STRUCTURE}) to test for serial correlation "
+            "or a varying noise level",
+        )
     keep = _keep(r, pinned)
     rk = r[keep]
     pinned = int(n - keep.sum())
@@ -278,18 +308,32 @@ def channel_noise(channel: str, r, n_channel_rows: int, covariates=None, given=N
         if h["lr"] > h["threshold"] and h["range"] >= HETERO_MIN_RANGE and (best is None or h["lr"] > best[2]["lr"]):
             best = (name, g, h)
     if best is None:
-        model = ChannelNoise(channel, "white", np.full(n, max(noise_floor(rk), 1e-300)), 0.0, float(n), None,
-                             "constant level (no covariate explains a varying level)" + note)
+        model = ChannelNoise(
+            channel,
+            "white",
+            np.full(n, max(noise_floor(rk), 1e-300)),
+            0.0,
+            float(n),
+            None,
+            "constant level (no covariate explains a varying level)" + note,
+        )
     else:
         name, g, h = best
         A, B, D = h["coef"]
         v = A + B * g + D * g * g
         sigma = np.sqrt(np.maximum(v, VAR_FLOOR * max(float(np.mean(v[keep])), 1e-300)))
         model = ChannelNoise(
-            channel, "heteroscedastic", np.maximum(sigma, 1e-300), 0.0, float(n), name,
+            channel,
+            "heteroscedastic",
+            np.maximum(sigma, 1e-300),
+            0.0,
+            float(n),
+            name,
             f"level varies with {name}: sigma^2 = A + B g + D g^2, A = {A:.3g}, B = {B:.3g}, D = {D:.3g} "
             f"(likelihood ratio {h['lr']:.0f} > {h['threshold']:.0f}, the 99th percentile on white noise; sigma "
-            f"from {h['sigma'].min():.3g} to {h['sigma'].max():.3g}){note}", {"variance_coefficients": [A, B, D]})
+            f"from {h['sigma'].min():.3g} to {h['sigma'].max():.3g}){note}",
+            {"variance_coefficients": [A, B, D]},
+        )
     return with_correlation(model, r, pinned) if correlate else model
 
 
@@ -317,17 +361,27 @@ def with_correlation(model: ChannelNoise, r, pinned=None) -> ChannelNoise:
     cap = difference_phi(u) + 2.0 * 1.9 / math.sqrt(m)
     if phi_hat > thr and cap > thr:
         phi = min(phi_hat, cap, 0.95)
-        why = (f"serially correlated: AR(1) phi = {phi:.2f} (lag-1 autocorrelation {phi_hat:.2f} > {thr:.2f}, the 99th "
-               f"percentile on white noise; differences allow up to {cap:.2f}), {effective_n(r.size, phi):.0f} "
-               f"effective samples of {r.size}")
+        why = (
+            f"serially correlated: AR(1) phi = {phi:.2f} (lag-1 autocorrelation {phi_hat:.2f} > {thr:.2f}, the 99th "
+            f"percentile on white noise; differences allow up to {cap:.2f}), {effective_n(r.size, phi):.0f} "
+            f"effective samples of {r.size}"
+        )
         kind = "ar1" if base_kind == "white" else base_kind + "+ar1"
     else:
         phi = 0.0
         why = f"no serial correlation (lag-1 autocorrelation {phi_hat:.2f} <= {thr:.2f}, the 99th percentile on white noise)"
         kind = base_kind
     sigma = model.sigma * math.sqrt(ar1_factor(phi0) / ar1_factor(phi))
-    return ChannelNoise(model.channel, kind, sigma, phi, effective_n(r.size, phi), model.covariate,
-                        f"{why}; {reason}", {**model.extra, "level_reason": reason})
+    return ChannelNoise(
+        model.channel,
+        kind,
+        sigma,
+        phi,
+        effective_n(r.size, phi),
+        model.covariate,
+        f"{why}; {reason}",
+        {**model.extra, "level_reason": reason},
+    )
 
 
 def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = True, pinned=None) -> dict:
@@ -348,8 +402,9 @@ def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = T
     coord = path_coordinate(exp, data) if correlate else None
     out = {}
     for c in exp.channels:
-        out[c] = channel_noise(c, fit_result.residuals[c], data.n, covs.get(c), given_sigma(data, c), correlate,
-                               (pinned or {}).get(c))
+        out[c] = channel_noise(
+            c, fit_result.residuals[c], data.n, covs.get(c), given_sigma(data, c), correlate, (pinned or {}).get(c)
+        )
         if coord is not None:
             out[c] = with_cycles(out[c], coord, fit_result.residuals[c], (pinned or {}).get(c))
     return out
@@ -401,7 +456,7 @@ def cycle_scatter(coord, r, keep=None, sigma=None, min_pairs: int = CYCLE_MIN_PA
     runs = [(np.arange(a, b), float(direction[a])) for a, b in zip(bounds[:-1], bounds[1:]) if b - a >= 3]
     out = []
     for i, (ra, da) in enumerate(runs):
-        for rb, db in runs[i + 1:]:
+        for rb, db in runs[i + 1 :]:
             if db != da:
                 continue
             rb = rb[keep[rb]]
@@ -447,17 +502,32 @@ def with_cycles(model: ChannelNoise, coord, r, pinned=None) -> ChannelNoise:
     limit = 1.0 + 3.0 * math.sqrt(1.0 / (2.0 * m) + 2.0 / max(int(keep.sum()), 1))
     extra = {**model.extra, "cycle_ratio": rho, "cycle_pairs": m}
     if rho * limit >= 1.0:
-        return ChannelNoise(model.channel, model.kind, model.sigma, model.phi, model.n_eff, model.covariate,
-                            model.reason + f"; repeated passes agree ({rho:.2f}x this level from {m} compared rows)",
-                            extra)
+        return ChannelNoise(
+            model.channel,
+            model.kind,
+            model.sigma,
+            model.phi,
+            model.n_eff,
+            model.covariate,
+            model.reason + f"; repeated passes agree ({rho:.2f}x this level from {m} compared rows)",
+            extra,
+        )
     n = r.size
     kind = model.kind.replace("+ar1", "").replace("ar1", "white") + "+cycles"
-    return ChannelNoise(model.channel, kind, model.sigma * rho, 0.0, float(n), model.covariate,
-                        f"level from repeated passes: {rho:.2f}x the difference estimate ({m} rows compared at the "
-                        f"same path position in passes of the same direction; below it beyond the scatter of the "
-                        f"two, 1/{limit:.2f}): what that estimate took for noise"
-                        f"{' (serial correlation)' if model.phi > 0 else ''} repeats with the path; "
-                        f"{model.extra.get('level_reason', model.reason)}", extra)
+    return ChannelNoise(
+        model.channel,
+        kind,
+        model.sigma * rho,
+        0.0,
+        float(n),
+        model.covariate,
+        f"level from repeated passes: {rho:.2f}x the difference estimate ({m} rows compared at the "
+        f"same path position in passes of the same direction; below it beyond the scatter of the "
+        f"two, 1/{limit:.2f}): what that estimate took for noise"
+        f"{' (serial correlation)' if model.phi > 0 else ''} repeats with the path; "
+        f"{model.extra.get('level_reason', model.reason)}",
+        extra,
+    )
 
 
 def information_criterion(fun, n_rows: int, models: dict, n_params: int) -> float:

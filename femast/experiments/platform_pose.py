@@ -45,9 +45,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
+from . import mast_top
 from .core import Column, Experiment, Measured, Parameter
 from .data import from_arrays
-from . import mast_top
 
 POSE_IN = ("x_cmd_m", "y_cmd_m", "z_cmd_m", "roll_cmd_rad", "pitch_cmd_rad", "yaw_cmd_rad")
 TENSIONS = tuple(f"tau{j}_N" for j in range(1, 9))
@@ -98,8 +98,11 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
     base = _masts(options)
     s = float(params["compliance_scale"])
     masts = MastSet(base.name, s * base.compliance, fe=base.fe)
-    robot = CableRobot(rocaspect_geometry(mass=float(options["mass_kg"])), EA=float(options["EA_N"]),
-                       pulley_radius=float(options["pulley_radius_m"]))
+    robot = CableRobot(
+        rocaspect_geometry(mass=float(options["mass_kg"])),
+        EA=float(options["EA_N"]),
+        pulley_radius=float(options["pulley_radius_m"]),
+    )
     response = None
     if effects:
         if options["mast_model"] != "3R":
@@ -125,8 +128,14 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
     ex = 1e3 * (data["x_m"] - data["x_cmd_m"])
     ey = 1e3 * (data["y_m"] - data["y_cmd_m"])
     ax.plot(ex, ey, ".", ms=3, color="0.35", label="measured - commanded")
-    ax.plot(1e3 * (predicted["x_m"] - data["x_cmd_m"]), 1e3 * (predicted["y_m"] - data["y_cmd_m"]), "-",
-            color="C3", lw=1.2, label="model - commanded")
+    ax.plot(
+        1e3 * (predicted["x_m"] - data["x_cmd_m"]),
+        1e3 * (predicted["y_m"] - data["y_cmd_m"]),
+        "-",
+        color="C3",
+        lw=1.2,
+        label="model - commanded",
+    )
     ax.set_xlabel("x error (mm)")
     ax.set_ylabel("y error (mm)")
     ax.set_title("platform position error, plan view")
@@ -150,15 +159,26 @@ EXPERIMENT = Experiment(
         Column("roll_cmd_rad", "rad", "commanded roll (fixed x)", required=False),
         Column("pitch_cmd_rad", "rad", "commanded pitch (fixed y)", required=False),
         Column("yaw_cmd_rad", "rad", "commanded yaw (fixed z)", required=False),
-        *(Column(c, "N", f"commanded tension of cable {j} (all eight or none)", required=False)
-          for j, c in enumerate(TENSIONS, 1)),
+        *(
+            Column(c, "N", f"commanded tension of cable {j} (all eight or none)", required=False)
+            for j, c in enumerate(TENSIONS, 1)
+        ),
         Column("x_m", "m", "measured platform position, x"),
         Column("y_m", "m", "measured platform position, y"),
         Column("z_m", "m", "measured platform position, z"),
     ),
     channels=CHANNELS,
-    parameters=(Parameter("compliance_scale", "-", 1.0, 0.05, 20.0,
-                          "factor on the mast compliance of the baseline mast model", scale=1.0),),
+    parameters=(
+        Parameter(
+            "compliance_scale",
+            "-",
+            1.0,
+            0.05,
+            20.0,
+            "factor on the mast compliance of the baseline mast model",
+            scale=1.0,
+        ),
+    ),
     model=model,
     options={"mast_model": "3R", "pretension_N": 1200.0, "EA_N": 1.0e6, "pulley_radius_m": 0.03, "mass_kg": 50.0},
     hooks=dict(mast_top.EXPERIMENT.hooks),

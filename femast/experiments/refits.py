@@ -38,8 +38,14 @@ def _refit_task(payload: dict) -> OptimizeResult:
         load_script(script)
     exp = experiment_from_source(payload["source"], payload["options"])
     data = Measured(payload["data_experiment"], payload["columns"], payload["path"], payload["lines"])
-    res = _safe_fit(exp, data, payload["effects"], start=payload["start"], noise=payload["noise"],
-                    sensitivity=payload.get("sensitivity"))
+    res = _safe_fit(
+        exp,
+        data,
+        payload["effects"],
+        start=payload["start"],
+        noise=payload["noise"],
+        sensitivity=payload.get("sensitivity"),
+    )
     res.pid = os.getpid()
     return res
 
@@ -49,8 +55,16 @@ def _safe_fit(exp, data, effects, start, noise, sensitivity=None) -> OptimizeRes
     cannot be evaluated even at the start of the refit (an FE run that does not converge with the
     effect's default parameters): one failed candidate must not end the whole diagnosis."""
     try:
-        return fit(exp, data, effects, start=start, noise=noise, given_start_clip=True, nfev_per_param=REFIT_NFEV,
-                   start_sensitivity=sensitivity)   # the baseline's derivatives seed the refit's (issue 21)
+        return fit(
+            exp,
+            data,
+            effects,
+            start=start,
+            noise=noise,
+            given_start_clip=True,
+            nfev_per_param=REFIT_NFEV,
+            start_sensitivity=sensitivity,
+        )  # the baseline's derivatives seed the refit's (issue 21)
     except (ValueError, FemastError, FloatingPointError, ZeroDivisionError) as e:
         return OptimizeResult(failed=True, success=False, message=f"{type(e).__name__}: {e}", effects=tuple(effects))
 
@@ -94,8 +108,9 @@ def _run_tasks(payloads, workers, scheduler, while_waiting=None):
         try:
             from distributed import Client
         except ImportError:
-            raise ModelError("--scheduler needs dask.distributed: pip install 'dask[distributed]' "
-                             "(the femast extra 'dist')") from None
+            raise ModelError(
+                "--scheduler needs dask.distributed: pip install 'dask[distributed]' (the femast extra 'dist')"
+            ) from None
         own = not isinstance(scheduler, Client)
         client = Client(scheduler) if own else scheduler
         try:
@@ -131,7 +146,7 @@ def _run_tasks(payloads, workers, scheduler, while_waiting=None):
                 bar.update(1)
         results = [fut.result() for fut in futures]
         if helper is not None:
-            helper.join()   # (before any later fork: a thread holding the import lock must not be forked)
+            helper.join()  # (before any later fork: a thread holding the import lock must not be forked)
     return results, f"{n} local processes"
 
 
@@ -153,7 +168,7 @@ def frozen_heap():
 def _quietly(fn):
     try:
         fn()
-    except Exception:   # a helper's failure shows later, where its work is needed
+    except Exception:  # a helper's failure shows later, where its work is needed
         pass
 
 
@@ -175,13 +190,16 @@ def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base, whi
     if not payloads:
         return [], "no candidates"
     if not _rebuildable(exp):
-        return ([_safe_fit(exp, data, p["effects"], start=p["start"], noise=sigma, sensitivity=p.get("sensitivity"))
-                 for p in payloads],
-                "serial (experiment defined in memory: worker processes cannot rebuild it)")
+        return (
+            [
+                _safe_fit(exp, data, p["effects"], start=p["start"], noise=sigma, sensitivity=p.get("sensitivity"))
+                for p in payloads
+            ],
+            "serial (experiment defined in memory: worker processes cannot rebuild it)",
+        )
     est = 6.0 * t_base * len(payloads)
     if workers is None and scheduler is None and not exp.fit_options.get("expensive") and est < SERIAL_BELOW_S:
-        return _serial_refits(payloads), f"serial (refits estimated at {est:.2f} s: cheaper than starting " \
-                                                   "processes)"
+        return _serial_refits(payloads), f"serial (refits estimated at {est:.2f} s: cheaper than starting processes)"
     if workers is None and scheduler is None and exp.fit_options.get("expensive"):
         # a process per refit (up to OVERSUBSCRIBE x the CPUs): the refits of the FE experiments take
         # 6-15 FE runs each, and a pool of one process per CPU ends with one CPU idle while the

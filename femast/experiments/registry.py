@@ -27,8 +27,10 @@ def register_experiment(experiment: Experiment, replace_existing: bool = False) 
         raise ModelError(f"register_experiment needs an Experiment, got {type(experiment).__name__}")
     old = _EXPERIMENTS.get(experiment.name)
     if old is not None and old is not experiment and not (replace_existing or old.pending):
-        raise ModelError(f"an experiment called '{experiment.name}' is already registered; choose another name "
-                         "or pass replace_existing=True")
+        raise ModelError(
+            f"an experiment called '{experiment.name}' is already registered; choose another name "
+            "or pass replace_existing=True"
+        )
     if not experiment.source:
         experiment = replace(experiment, source=experiment.name)
     _EXPERIMENTS[experiment.name] = experiment
@@ -44,8 +46,10 @@ def _from_script(path: Path) -> Experiment:
     module = load_script(path)
     exp = getattr(module, "experiment", None)
     if not isinstance(exp, Experiment):
-        raise ModelError(f"script {path} defines no module-level `experiment` (an femast.experiments.Experiment); "
-                         "see docs/experiments.md, 'Adding an experiment'")
+        raise ModelError(
+            f"script {path} defines no module-level `experiment` (an femast.experiments.Experiment); "
+            "see docs/experiments.md, 'Adding an experiment'"
+        )
     return replace(exp, source=str(Path(path).resolve()))
 
 
@@ -63,8 +67,10 @@ def get_experiment(name_or_path, **options) -> Experiment:
         try:
             exp = _EXPERIMENTS[key]
         except KeyError:
-            raise ModelError(f"unknown experiment '{key}'; accepted: {', '.join(_EXPERIMENTS)} or the path of a "
-                             "Python script defining `experiment`") from None
+            raise ModelError(
+                f"unknown experiment '{key}'; accepted: {', '.join(_EXPERIMENTS)} or the path of a "
+                "Python script defining `experiment`"
+            ) from None
     return exp.with_options(**options) if options else exp
 
 

@@ -42,16 +42,22 @@ def png_tag(png, caption: str = "") -> str:
 def table(header, rows, numeric=()) -> str:
     """An HTML table; columns whose index is in ``numeric`` are right-aligned."""
     head = "".join(f"<th>{esc(h)}</th>" for h in header)
-    body = "".join("<tr>" + "".join(f'<td{" class=n" if i in numeric else ""}>{esc(c)}</td>'
-                                    for i, c in enumerate(r)) + "</tr>" for r in rows)
+    body = "".join(
+        "<tr>" + "".join(f"<td{' class=n' if i in numeric else ''}>{esc(c)}</td>" for i, c in enumerate(r)) + "</tr>"
+        for r in rows
+    )
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
 def page(title: str, meta: str, verdict: str, tone: str, sections) -> str:
     """The whole document: ``sections`` is a list of (heading, html)."""
-    parts = [f"<!DOCTYPE html><html lang=en><head><meta charset=utf-8><title>{esc(title)}</title>",
-             f"<style>{_CSS}</style></head><body>", f"<h1>{esc(title)}</h1>", f'<p class=meta>{esc(meta)}</p>',
-             f'<div class="verdict {tone}" id=verdict><b>Verdict:</b> {esc(verdict)}</div>']
+    parts = [
+        f"<!DOCTYPE html><html lang=en><head><meta charset=utf-8><title>{esc(title)}</title>",
+        f"<style>{_CSS}</style></head><body>",
+        f"<h1>{esc(title)}</h1>",
+        f"<p class=meta>{esc(meta)}</p>",
+        f'<div class="verdict {tone}" id=verdict><b>Verdict:</b> {esc(verdict)}</div>',
+    ]
     for heading, body in sections:
         parts.append(f"<h2>{esc(heading)}</h2>{body}")
     parts.append("</body></html>")
@@ -73,8 +79,16 @@ def _history_section(folder: Path, exp) -> str:
     if not recs:
         return "<p>No history yet.</p>"
     f, ul = display_scale(recs[-1].get("error_unit", ""))
-    rows = [[r["version"], "+".join(r.get("effects") or []) or "baseline", "yes" if r.get("fit") else "no",
-             num(f * r["rms"], 4), num(r["ratio"], 3) if r.get("ratio") is not None else ""] for r in recs]
+    rows = [
+        [
+            r["version"],
+            "+".join(r.get("effects") or []) or "baseline",
+            "yes" if r.get("fit") else "no",
+            num(f * r["rms"], 4),
+            num(r["ratio"], 3) if r.get("ratio") is not None else "",
+        ]
+        for r in recs
+    ]
     body = table(["version", "effects", "fitted", f"RMS error ({ul})", "x noise"], rows, numeric=(0, 3, 4))
     png = folder / "history.png"
     if png.is_file():
@@ -83,8 +97,10 @@ def _history_section(folder: Path, exp) -> str:
 
 
 def _meta(exp, data, n) -> str:
-    return (f"experiment {exp.name} ({exp.title}); data {data.path} ({n} samples); written "
-            f"{time.strftime('%Y-%m-%d %H:%M')} by femast")
+    return (
+        f"experiment {exp.name} ({exp.title}); data {data.path} ({n} samples); written "
+        f"{time.strftime('%Y-%m-%d %H:%M')} by femast"
+    )
 
 
 def compare_report(exp, data, result, folder) -> Path:
@@ -93,31 +109,74 @@ def compare_report(exp, data, result, folder) -> Path:
     f, ul = display_scale(exp.error_unit)
     ratio = result.ratio
     at = result.report.get("at_noise", 1.2)
-    verdict = (f"the model is at the noise floor ({num(ratio)}x noise)" if ratio <= at else
-               f"the model is {num(ratio)}x the noise: it misses something (femast diagnose says what)")
+    verdict = (
+        f"the model is at the noise floor ({num(ratio)}x noise)"
+        if ratio <= at
+        else f"the model is {num(ratio)}x the noise: it misses something (femast diagnose says what)"
+    )
     eff = "+".join(result.effects) or "baseline"
-    sections = [("Model", f"<p>{esc(eff)}, {'parameters fitted' if result.fitted else 'given parameters'}</p>"
-                 + table(["parameter", "value", "std. error", "unit"], _params_rows(result.params_table),
-                         numeric=(1, 2))),
-                ("Error", table(["channel", "RMS", "noise", "x noise", "unit"],
-                                [[c, num(display_scale(v['unit'])[0] * v["rms"], 4),
-                                  num(display_scale(v['unit'])[0] * v["noise"], 4),
-                                  num(v["rms"] / v["noise"], 3) if v["noise"] else "", display_scale(v["unit"])[1]]
-                                 for c, v in result.report["channels"].items()], numeric=(1, 2, 3))
-                 + f"<p>overall RMS error {num(f * result.rms, 4)} {esc(ul)}; noise floor "
-                   f"{num(f * result.noise_rms, 4)} {esc(ul)}.</p>"),
-                ("Where it fails", table(["kind of segment", "x noise", "samples"],
-                                         [[k["kind"], num(k["ratio"], 3), k.get("n", "")]
-                                          for k in result.by_kind], numeric=(1, 2))
-                 + table(["#", "kind", "rows", "file lines", "x noise"],
-                         [[i + 1, w["kind"], f"{w['start_row']}-{w['end_row']}",
-                           f"{w.get('first_line', '')}-{w.get('last_line', '')}", num(w["ratio"], 3)]
-                          for i, w in enumerate(result.worst[:5])], numeric=(0, 4))),
-                ("Figure", png_tag(result.files["png"], "measured against model; residual along the path (compare.png)")
-                 if result.files.get("png") else "<p>(no figure)</p>"),
-                ("History", _history_section(folder, exp))]
-    doc = page(f"femast compare: {exp.name}", _meta(exp, data, result.n_samples), verdict,
-               "good" if ratio <= at else "bad", sections)
+    sections = [
+        (
+            "Model",
+            f"<p>{esc(eff)}, {'parameters fitted' if result.fitted else 'given parameters'}</p>"
+            + table(["parameter", "value", "std. error", "unit"], _params_rows(result.params_table), numeric=(1, 2)),
+        ),
+        (
+            "Error",
+            table(
+                ["channel", "RMS", "noise", "x noise", "unit"],
+                [
+                    [
+                        c,
+                        num(display_scale(v["unit"])[0] * v["rms"], 4),
+                        num(display_scale(v["unit"])[0] * v["noise"], 4),
+                        num(v["rms"] / v["noise"], 3) if v["noise"] else "",
+                        display_scale(v["unit"])[1],
+                    ]
+                    for c, v in result.report["channels"].items()
+                ],
+                numeric=(1, 2, 3),
+            )
+            + f"<p>overall RMS error {num(f * result.rms, 4)} {esc(ul)}; noise floor "
+            f"{num(f * result.noise_rms, 4)} {esc(ul)}.</p>",
+        ),
+        (
+            "Where it fails",
+            table(
+                ["kind of segment", "x noise", "samples"],
+                [[k["kind"], num(k["ratio"], 3), k.get("n", "")] for k in result.by_kind],
+                numeric=(1, 2),
+            )
+            + table(
+                ["#", "kind", "rows", "file lines", "x noise"],
+                [
+                    [
+                        i + 1,
+                        w["kind"],
+                        f"{w['start_row']}-{w['end_row']}",
+                        f"{w.get('first_line', '')}-{w.get('last_line', '')}",
+                        num(w["ratio"], 3),
+                    ]
+                    for i, w in enumerate(result.worst[:5])
+                ],
+                numeric=(0, 4),
+            ),
+        ),
+        (
+            "Figure",
+            png_tag(result.files["png"], "measured against model; residual along the path (compare.png)")
+            if result.files.get("png")
+            else "<p>(no figure)</p>",
+        ),
+        ("History", _history_section(folder, exp)),
+    ]
+    doc = page(
+        f"femast compare: {exp.name}",
+        _meta(exp, data, result.n_samples),
+        verdict,
+        "good" if ratio <= at else "bad",
+        sections,
+    )
     out = folder / "compare_report.html"
     out.write_text(doc, encoding="utf-8")
     return out
@@ -132,24 +191,55 @@ def diagnose_report(exp, data, result, folder) -> Path:
     b = result.baseline
     rows = []
     for i, e in enumerate(result.ranking):
-        ps = ", ".join(f"{k} = {num(p['value'], 4)}" + (f" +- {num(p['stderr'], 2)}" if p.get("stderr") is not None
-                                                         else "") + f" {p.get('unit', '')}"
-                       for k, p in e.get("params", {}).items())
-        rows.append([i + 1, e["effect"], "failed" if e.get("failed") else num(f * e["rms"], 4),
-                     num(e["ratio"], 3), f"{e['delta_bic']:+.1f}", "yes" if e["significant"] else "no", ps])
-    sections = [("Baseline", f"<p>baseline{' + ' + ' + '.join(b['effects']) if b['effects'] else ''}: RMS "
-                             f"{num(f * b['rms'], 4)} {esc(ul)} ({num(b['ratio'], 3)}x noise; noise floor "
-                             f"{num(f * result.noise_rms, 4)} {esc(ul)})</p>"
-                 + table(["parameter", "value", "std. error", "unit"], _params_rows(b["params"]), numeric=(1, 2))),
-                ("Candidates, best first", table(["rank", "effect", f"RMS ({ul})", "x noise", "delta BIC",
-                                                  "significant", "parameters"], rows, numeric=(0, 2, 3, 4))
-                 + "".join(f"<p><b>{esc(e['effect'])}</b>: {esc(e['reading'])}</p>" for e in result.ranking[:3])),
-                ("Figure", png_tag(result.files["png"], "error after each refit; residual along the path "
-                                                        "(diagnose.png)")
-                 if result.files.get("png") else "<p>(no figure)</p>"),
-                ("History", _history_section(folder, exp))]
-    doc = page(f"femast diagnose: {exp.name}", _meta(exp, data, result.n_samples) + f"; refits: {result.executor}",
-               v["conclusion"], tone, sections)
+        ps = ", ".join(
+            f"{k} = {num(p['value'], 4)}"
+            + (f" +- {num(p['stderr'], 2)}" if p.get("stderr") is not None else "")
+            + f" {p.get('unit', '')}"
+            for k, p in e.get("params", {}).items()
+        )
+        rows.append(
+            [
+                i + 1,
+                e["effect"],
+                "failed" if e.get("failed") else num(f * e["rms"], 4),
+                num(e["ratio"], 3),
+                f"{e['delta_bic']:+.1f}",
+                "yes" if e["significant"] else "no",
+                ps,
+            ]
+        )
+    sections = [
+        (
+            "Baseline",
+            f"<p>baseline{' + ' + ' + '.join(b['effects']) if b['effects'] else ''}: RMS "
+            f"{num(f * b['rms'], 4)} {esc(ul)} ({num(b['ratio'], 3)}x noise; noise floor "
+            f"{num(f * result.noise_rms, 4)} {esc(ul)})</p>"
+            + table(["parameter", "value", "std. error", "unit"], _params_rows(b["params"]), numeric=(1, 2)),
+        ),
+        (
+            "Candidates, best first",
+            table(
+                ["rank", "effect", f"RMS ({ul})", "x noise", "delta BIC", "significant", "parameters"],
+                rows,
+                numeric=(0, 2, 3, 4),
+            )
+            + "".join(f"<p><b>{esc(e['effect'])}</b>: {esc(e['reading'])}</p>" for e in result.ranking[:3]),
+        ),
+        (
+            "Figure",
+            png_tag(result.files["png"], "error after each refit; residual along the path (diagnose.png)")
+            if result.files.get("png")
+            else "<p>(no figure)</p>",
+        ),
+        ("History", _history_section(folder, exp)),
+    ]
+    doc = page(
+        f"femast diagnose: {exp.name}",
+        _meta(exp, data, result.n_samples) + f"; refits: {result.executor}",
+        v["conclusion"],
+        tone,
+        sections,
+    )
     out = folder / "diagnose_report.html"
     out.write_text(doc, encoding="utf-8")
     return out

@@ -135,7 +135,7 @@ def turning_points(s, h: float):
     first = d if not tps else (1.0 if s[tps[0]] > s[0] else -1.0)
     cur = first if first != 0 else 1.0
     for k in range(len(bounds) - 1):
-        direction[bounds[k]:bounds[k + 1]] = cur
+        direction[bounds[k] : bounds[k + 1]] = cur
         cur = -cur
     return np.asarray(tps, dtype=int), direction
 
@@ -190,7 +190,7 @@ def segment_path(s, noise_s: float = 0.0, extra=()):
                 hi = t
                 while hi < n - 1 and s[hi + 1] * s[t] > 0 and abs(s[hi + 1]) >= PEAK_LEVEL * abs(s[t]):
                     hi += 1
-                peak[lo:hi + 1] = True
+                peak[lo : hi + 1] = True
         masks["loading"] = growing & ~rev
         masks["unloading"] = ~growing & ~rev
         masks["reversal"] = rev
@@ -238,8 +238,15 @@ def segment_report(segments, masks, residuals, sigma, weights, lines=None, min_r
             continue
         rows = np.arange(seg.start, seg.stop)
         rms, ratio, means = _stats(rows, residuals, sigma, weights)
-        d = {"kind": seg.kind, "start_row": seg.start, "end_row": seg.stop - 1, "n": seg.n, "rms": rms,
-             "ratio": ratio, "mean": means}
+        d = {
+            "kind": seg.kind,
+            "start_row": seg.start,
+            "end_row": seg.stop - 1,
+            "n": seg.n,
+            "rms": rms,
+            "ratio": ratio,
+            "mean": means,
+        }
         if lines is not None:
             d["first_line"], d["last_line"] = int(lines[seg.start]), int(lines[seg.stop - 1])
         worst.append(d)
@@ -288,7 +295,12 @@ def signatures(s, direction, tau, residuals, sigma):
         if gg <= 0:
             continue
         explained = float(((g @ Z) ** 2).sum() / gg)
-        out.append({"name": name, "fraction": min(explained / excess, 1.0) if excess > 1e-12 else 0.0,
-                    "reading": SIGNATURE_READINGS[name]})
+        out.append(
+            {
+                "name": name,
+                "fraction": min(explained / excess, 1.0) if excess > 1e-12 else 0.0,
+                "reading": SIGNATURE_READINGS[name],
+            }
+        )
     out.sort(key=lambda d: -d["fraction"])
     return out

@@ -33,8 +33,15 @@ def _stack(exp, effects):
 
 
 # --------------------------------------------------------------------------- mast-top
-def mast_top_path(n: int = 500, kind: str = "cycles", amplitude_N: float = 150.0, cycles: float = 4.0,
-                  angle_deg: float = 30.0, moment_Nm: float = 0.0, seed: int = 0) -> dict:
+def mast_top_path(
+    n: int = 500,
+    kind: str = "cycles",
+    amplitude_N: float = 150.0,
+    cycles: float = 4.0,
+    angle_deg: float = 30.0,
+    moment_Nm: float = 0.0,
+    seed: int = 0,
+) -> dict:
     """Wrench changes on a mast top, ``{fx_N, ..., mz_Nm}`` arrays (n,) in N and N m.
 
     kind : ``"cycles"`` (zero-mean force cycles along ``angle_deg`` with an amplitude that varies
@@ -84,8 +91,9 @@ def mast_top_path(n: int = 500, kind: str = "cycles", amplitude_N: float = 150.0
     return {"fx_N": fx, "fy_N": fy, "fz_N": fz, "mx_Nm": mx, "my_Nm": my, "mz_Nm": mz}
 
 
-def mast_top_data(params=None, effects=None, path=None, noise_m: float = 5e-5, drift_m: float = 0.0,
-                  seed: int = 0, experiment=None) -> tuple:
+def mast_top_data(
+    params=None, effects=None, path=None, noise_m: float = 5e-5, drift_m: float = 0.0, seed: int = 0, experiment=None
+) -> tuple:
     """Synthetic mast-top data: the 3R model with hidden ``effects`` along ``path``, plus noise.
 
     params : baseline ``{k_theta1, k_theta2}`` (N m/rad; default 2.7e5, 2.3e5 as seed 000 Table III).
@@ -105,17 +113,30 @@ def mast_top_data(params=None, effects=None, path=None, noise_m: float = 5e-5, d
     truth = predict(exp, data, params or {"k_theta1": 2.7e5, "k_theta2": 2.3e5}, effects or {})
     if drift_m:
         tau = data.tau
-        drift = drift_m * np.column_stack([np.sin(0.5 * np.pi * tau), 0.7 * (1 - np.cos(np.pi * tau)),
-                                           0.3 * np.sin(np.pi * tau)])
+        drift = drift_m * np.column_stack(
+            [np.sin(0.5 * np.pi * tau), 0.7 * (1 - np.cos(np.pi * tau)), 0.3 * np.sin(np.pi * tau)]
+        )
         truth = {c: truth[c] + drift[:, i] for i, c in enumerate(exp.channels)}
     noisy = {c: truth[c] + rng.normal(0.0, noise_m, n) for c in exp.channels}
     return Measured(exp.name, {**path, **noisy}), truth
 
 
 # --------------------------------------------------------------------------- latch-pull
-def latch_pull_data(params=None, effects=None, *, passes=2, n_move: int = 120, n_hold: int = 30,
-                    x_far_mm=(4.0, 3.2), T_hold_N: float = 40.0, noise_N: float = 0.5, noise_mm: float = 0.01,
-                    drift_N: float = 0.0, seed: int = 0, experiment=None) -> tuple:
+def latch_pull_data(
+    params=None,
+    effects=None,
+    *,
+    passes=2,
+    n_move: int = 120,
+    n_hold: int = 30,
+    x_far_mm=(4.0, 3.2),
+    T_hold_N: float = 40.0,
+    noise_N: float = 0.5,
+    noise_mm: float = 0.01,
+    drift_N: float = 0.0,
+    seed: int = 0,
+    experiment=None,
+) -> tuple:
     """Synthetic latch pull tests: the latch law (seed 001 Eq. 14) with hidden ``effects``, plus noise.
 
     Each pass: the bead sits latched on the backstop while the latching cable pulls it in to
@@ -135,8 +156,11 @@ def latch_pull_data(params=None, effects=None, *, passes=2, n_move: int = 120, n
     stack = _stack(exp, effects)
     xb = p["x_backstop"]
     rng = np.random.default_rng(seed + 2000)
-    far = np.broadcast_to(np.asarray(x_far_mm, float), (passes,)) if np.ndim(x_far_mm) == 0 else \
-        np.resize(np.asarray(x_far_mm, float), passes)
+    far = (
+        np.broadcast_to(np.asarray(x_far_mm, float), (passes,))
+        if np.ndim(x_far_mm) == 0
+        else np.resize(np.asarray(x_far_mm, float), passes)
+    )
 
     def branches(x, dT_for_ctx):
         X = np.concatenate([np.maximum(x, -xb), [-xb]])
@@ -181,8 +205,14 @@ def latch_pull_data(params=None, effects=None, *, passes=2, n_move: int = 120, n
 
 
 # --------------------------------------------------------------------------- bay-torsion (FE)
-def bay_torsion_path(n: int = 41, theta_max_deg: float = 3.2, kind: str = "cycle", cycles: float = 1.0,
-                     offaxis_mm: float = 0.0, seed: int = 0) -> dict:
+def bay_torsion_path(
+    n: int = 41,
+    theta_max_deg: float = 3.2,
+    kind: str = "cycle",
+    cycles: float = 1.0,
+    offaxis_mm: float = 0.0,
+    seed: int = 0,
+) -> dict:
     """Twist paths of the single-bay torsion test, ``{theta_deg}`` (and ``ux_m, uy_m`` when
     ``offaxis_mm`` > 0), n rows.
 
@@ -219,8 +249,9 @@ def bay_torsion_path(n: int = 41, theta_max_deg: float = 3.2, kind: str = "cycle
     return out
 
 
-def bay_torsion_data(params=None, effects=None, path=None, noise_Nm: float = 0.2, drift_Nm: float = 0.0,
-                     seed: int = 0, experiment=None) -> tuple:
+def bay_torsion_data(
+    params=None, effects=None, path=None, noise_Nm: float = 0.2, drift_Nm: float = 0.0, seed: int = 0, experiment=None
+) -> tuple:
     """Synthetic single-bay torsion data: the FE bay (the experiment's own model) with hidden
     ``effects`` along ``path`` (:func:`bay_torsion_path`), plus Gaussian noise ``noise_Nm`` on Mz.
 
@@ -241,8 +272,15 @@ def bay_torsion_data(params=None, effects=None, path=None, noise_Nm: float = 0.2
 
 
 # --------------------------------------------------------------------------- tip-cycle (FE)
-def tip_cycle_path(points_per_ramp: int = 3, cycles: int = 2, M_Nm: float = 6.8, F_N: float = 14.0,
-                   kind: str = "table1", hold: int = 0, seed: int = 0) -> dict:
+def tip_cycle_path(
+    points_per_ramp: int = 3,
+    cycles: int = 2,
+    M_Nm: float = 6.8,
+    F_N: float = 14.0,
+    kind: str = "table1",
+    hold: int = 0,
+    seed: int = 0,
+) -> dict:
     """Tip load paths ``{fx_N, ..., mz_Nm}``: the sequence 0, +P, 0, -P, 0 ... with ``P`` = M about z and
     F along x (seed 001 Table 1), ``cycles`` times, each ramp sampled at ``points_per_ramp`` rows.
     hold : extra rows at every turning load and at every return to zero (the load held while the
@@ -281,8 +319,16 @@ def tip_cycle_path(points_per_ramp: int = 3, cycles: int = 2, M_Nm: float = 6.8,
     return dict(zip(("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"), w.T))
 
 
-def tip_cycle_data(params=None, effects=None, path=None, noise_m: float = 2e-6, noise_rad: float = 5e-6,
-                   drift_m: float = 0.0, seed: int = 0, experiment=None) -> tuple:
+def tip_cycle_data(
+    params=None,
+    effects=None,
+    path=None,
+    noise_m: float = 2e-6,
+    noise_rad: float = 5e-6,
+    drift_m: float = 0.0,
+    seed: int = 0,
+    experiment=None,
+) -> tuple:
     """Synthetic tip-cycle data: the FE mast (the experiment's own model, its ``n_bays`` option) with
     hidden ``effects`` along the load ``path`` (:func:`tip_cycle_path`), plus Gaussian noise
     (``noise_m`` on displacements, ``noise_rad`` on rotations).
@@ -298,8 +344,11 @@ def tip_cycle_data(params=None, effects=None, path=None, noise_m: float = 2e-6, 
     truth = predict(exp, data, params or {}, effects or {})
     if drift_m:
         tau = data.tau
-        truth = {**truth, "ux_m": truth["ux_m"] + drift_m * np.sin(0.5 * np.pi * tau),
-                 "uy_m": truth["uy_m"] + 0.6 * drift_m * (1.0 - np.cos(np.pi * tau))}
+        truth = {
+            **truth,
+            "ux_m": truth["ux_m"] + drift_m * np.sin(0.5 * np.pi * tau),
+            "uy_m": truth["uy_m"] + 0.6 * drift_m * (1.0 - np.cos(np.pi * tau)),
+        }
     rng = np.random.default_rng(seed + 4000)
     noisy = {c: truth[c] + rng.normal(0.0, noise_rad if c.endswith("_rad") else noise_m, n) for c in exp.channels}
     return Measured(exp.name, {**path, **noisy}), truth

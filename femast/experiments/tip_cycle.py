@@ -121,10 +121,15 @@ def mast_inputs(params: dict, options: dict) -> dict:
     from ..adam.parameters import BayParameters
 
     base = BayParameters()
-    d = {"pretension": float(options["pretension_N"]), "cable_EA": float(base.cable_EA),
-         "longeron_t": float(options["longeron_t_m"]), "mu": float(options["ball_mu"]),
-         "B": float(options["ball_B_m"]),
-         "hysteresis_force": 0.0, "hysteresis_length": float(options["latch_hysteresis_length_m"])}
+    d = {
+        "pretension": float(options["pretension_N"]),
+        "cable_EA": float(base.cable_EA),
+        "longeron_t": float(options["longeron_t_m"]),
+        "mu": float(options["ball_mu"]),
+        "B": float(options["ball_B_m"]),
+        "hysteresis_force": 0.0,
+        "hysteresis_length": float(options["latch_hysteresis_length_m"]),
+    }
     for f in LATCH_FIELDS:
         d[f"latch_{f}"] = float(getattr(base.latch, f))
     d.update(dict(options.get("bay") or {}))
@@ -133,8 +138,15 @@ def mast_inputs(params: dict, options: dict) -> dict:
     return d
 
 
-def run_mast(inputs: dict, loads: np.ndarray, n_bays: int, fold: int = 1, alternate: bool = True,
-             increments: int = 1, threads: int | None = 1) -> dict:
+def run_mast(
+    inputs: dict,
+    loads: np.ndarray,
+    n_bays: int,
+    fold: int = 1,
+    alternate: bool = True,
+    increments: int = 1,
+    threads: int | None = 1,
+) -> dict:
     """One FE run of the mast through the load states ``loads`` (m, 6) (uncached).
 
     Returns ``motion`` (m, 6) = [ux, uy, uz (m), rx, ry, rz (rad)] of the control node relative to
@@ -162,8 +174,13 @@ def run_mast(inputs: dict, loads: np.ndarray, n_bays: int, fold: int = 1, altern
             state[k] = state[k - 1]
             continue
         name = f"row{k}"
-        st = am.model.step(name, initial_increment=1.0 / increments, max_increment=1.0 / increments,
-                           min_increment=1e-5, max_increments=1000)
+        st = am.model.step(
+            name,
+            initial_increment=1.0 / increments,
+            max_increment=1.0 / increments,
+            min_increment=1e-5,
+            max_increments=1000,
+        )
         st.load(am.control, **dict(zip(("fx", "fy", "fz", "mx", "my", "mz"), map(float, loads[k]))))
         names.append(name)
         state[k] = len(names) - 1
@@ -171,14 +188,19 @@ def run_mast(inputs: dict, loads: np.ndarray, n_bays: int, fold: int = 1, altern
     fam = am.latch_family
     n_lat = 4 * am.n_bays
     row = am.model.index(am.control)
-    steps, rec = [], []   # per converged increment, what this experiment needs (in memory: no read-back)
+    steps, rec = [], []  # per converged increment, what this experiment needs (in memory: no read-back)
 
     def record(fr):
         steps.append(str(fr["step"]))
-        rec.append((np.concatenate([fr["U"][row], fr["URA"][row]]), fr[f"el/{fam}/bead_position"][:n_lat],
-                    fr[f"el/{fam}/latch_zone"][:n_lat]))
+        rec.append(
+            (
+                np.concatenate([fr["U"][row], fr["URA"][row]]),
+                fr[f"el/{fam}/bead_position"][:n_lat],
+                fr[f"el/{fam}/latch_zone"][:n_lat],
+            )
+        )
 
-    an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=record)   # no files
+    an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=record)  # no files
     with kernel_threads(threads):
         an.run()
     i_ref = max(i for i, s in enumerate(steps) if not s.startswith("row"))
@@ -191,15 +213,26 @@ def run_mast(inputs: dict, loads: np.ndarray, n_bays: int, fold: int = 1, altern
     for k in range(m):
         mo, be, zo = (ref, bead0, zone0) if state[k] < 0 else got[state[k]]
         motion[k], bead[k], zone[k] = mo - ref, be, zo
-    return {"motion": motion, "bead": bead.reshape(m, am.n_bays, 4), "zone": zone.reshape(m, am.n_bays, 4),
-            "increments": an.summary.increments, "iterations": an.summary.iterations,
-            "wall_time": time.perf_counter() - t0}
+    return {
+        "motion": motion,
+        "bead": bead.reshape(m, am.n_bays, 4),
+        "zone": zone.reshape(m, am.n_bays, 4),
+        "increments": an.summary.increments,
+        "iterations": an.summary.iterations,
+        "wall_time": time.perf_counter() - t0,
+    }
 
 
 def solve(inputs: dict, loads: np.ndarray, options: dict) -> dict:
     """:func:`run_mast`, cached; a failed run raises ModelError (a ValueError: a fit rejects the parameters)."""
-    key = (inputs, np.asarray(loads, float), int(options["n_bays"]), int(options["fold"]),
-           bool(options["alternate"]), int(options["increments_per_row"]))
+    key = (
+        inputs,
+        np.asarray(loads, float),
+        int(options["n_bays"]),
+        int(options["fold"]),
+        bool(options["alternate"]),
+        int(options["increments_per_row"]),
+    )
 
     def compute():
         progress.tick("FE runs")
@@ -265,20 +298,39 @@ _EA, _T = _defaults()
 EXPERIMENT = Experiment(
     name="tip-cycle",
     title="ADAM mast under tip load cycles (seed 001 Sec. VII, Table 1; FE mast of issue 5)",
-    columns=tuple(Column(n, u, f"applied tip {'force' if u == 'N' else 'moment about the tip control node'}, "
-                                f"base frame, {a}") for n, u, a in zip(LOADS, ("N",) * 3 + ("N m",) * 3, "xyzxyz"))
-    + tuple(Column(n, u, f"measured tip {'displacement' if u == 'm' else 'rotation (small angle)'} of the "
-                         f"control node from the pretensioned state, base frame, {a}")
-            for n, u, a in zip(MOTION, ("m",) * 3 + ("rad",) * 3, "xyzxyz")),
+    columns=tuple(
+        Column(n, u, f"applied tip {'force' if u == 'N' else 'moment about the tip control node'}, base frame, {a}")
+        for n, u, a in zip(LOADS, ("N",) * 3 + ("N m",) * 3, "xyzxyz")
+    )
+    + tuple(
+        Column(
+            n,
+            u,
+            f"measured tip {'displacement' if u == 'm' else 'rotation (small angle)'} of the "
+            f"control node from the pretensioned state, base frame, {a}",
+        )
+        for n, u, a in zip(MOTION, ("m",) * 3 + ("rad",) * 3, "xyzxyz")
+    ),
     channels=MOTION,
     parameters=(
-        Parameter("cable_EA", "N", _EA, 2e3, 2e6, "axial rigidity of the bay cables (not in the seed)",
-                  scale=_EA),
+        Parameter("cable_EA", "N", _EA, 2e3, 2e6, "axial rigidity of the bay cables (not in the seed)", scale=_EA),
     ),
     model=model,
-    options={"n_bays": 40, "fold": 1, "alternate": True, "longeron_t_m": _T, "pretension_N": 170.0, "ball_mu": 0.0,
-             "ball_B_m": 4e-3, "latch_hysteresis_length_m": 3e-4, "increments_per_row": 1, "bay": {}, "max_fe_rows": 60,
-             "cache_dir": None, "threads": 1},
+    options={
+        "n_bays": 40,
+        "fold": 1,
+        "alternate": True,
+        "longeron_t_m": _T,
+        "pretension_N": 170.0,
+        "ball_mu": 0.0,
+        "ball_B_m": 4e-3,
+        "latch_hysteresis_length_m": 3e-4,
+        "increments_per_row": 1,
+        "bay": {},
+        "max_fe_rows": 60,
+        "cache_dir": None,
+        "threads": 1,
+    },
     hooks={
         "bay_parameters": "dict of the FE bays' inputs (BayParameters fields, latch_* for the latch law), SI",
         "tip_loads": "(m, 6) [fx, fy, fz (N), mx, my, mz (N m)] applied at the m FE rows",
@@ -292,8 +344,14 @@ EXPERIMENT = Experiment(
     channel_weights={"rx_rad": L_MAST_40, "ry_rad": L_MAST_40, "rz_rad": L_MAST_40},
     error_unit="m",
     min_rows=5,
-    fit_options={"diff_step": 1e-3, "xtol": 1e-4, "ftol": 1e-4, "gtol": 1e-8, "max_nfev_per_param": 10,
-                 "expensive": True},
+    fit_options={
+        "diff_step": 1e-3,
+        "xtol": 1e-4,
+        "ftol": 1e-4,
+        "gtol": 1e-8,
+        "max_nfev_per_param": 10,
+        "expensive": True,
+    },
     source="tip-cycle",
 )
 

@@ -59,8 +59,12 @@ FEW_ROWS = 0.02
 def score(fit, models: dict, channels, n_rows: int) -> dict:
     """``{ratio, rss, ic, z}`` of a fit under the noise ``models`` ({channel: ChannelNoise})."""
     z = np.concatenate([fit.residuals[c] / models[c].sigma for c in channels])
-    return {"ratio": float(np.sqrt(np.mean(z**2))), "rss": float(z @ z),
-            "ic": information_criterion(z, n_rows, {c: models[c] for c in channels}, int(fit.n_params)), "z": z}
+    return {
+        "ratio": float(np.sqrt(np.mean(z**2))),
+        "rss": float(z @ z),
+        "ic": information_criterion(z, n_rows, {c: models[c] for c in channels}, int(fit.n_params)),
+        "z": z,
+    }
 
 
 def robust_delta(z0, zc, n_rows: int, models: dict, p0: int, pc: int) -> float:
@@ -102,38 +106,72 @@ def pair_candidates(ranking: list, top: int = PAIR_TOP) -> list:
     return [e["effect"] for e in ok[:top]]
 
 
-def conclude(r0: float, thr: float, ranking: list, pairs: list, form_check: list, titles: dict,
-             remaining_where=()) -> dict:
+def conclude(
+    r0: float, thr: float, ranking: list, pairs: list, form_check: list, titles: dict, remaining_where=()
+) -> dict:
     """The verdict (module docstring) from the scored ranking (best first), pairs and form check."""
     best = next((e for e in ranking if e["significant"]), None)
     bp = min(pairs, key=lambda p: p["delta_bic"]) if pairs else None
     fc = min((f for f in form_check if f["significant"]), key=lambda f: f["delta_bic"], default=None)
-    v = {"kind": None, "missing_effect": None, "missing_effects": [], "mechanism": None, "form": None,
-         "explained": False, "best_candidate": best["effect"] if best else None, "alternatives": [],
-         "best_pair": bp, "try_next": [], "remaining_where": list(remaining_where), "conclusion": ""}
-    pair_ok = (bp is not None and bp["ratio"] <= thr and bp["significant"] and best is not None
-               and bp["gain_over_best_single"] < SIGNIFICANT_DBIC and bp["share_over_best_single"] >= MIN_SHARE)
+    v = {
+        "kind": None,
+        "missing_effect": None,
+        "missing_effects": [],
+        "mechanism": None,
+        "form": None,
+        "explained": False,
+        "best_candidate": best["effect"] if best else None,
+        "alternatives": [],
+        "best_pair": bp,
+        "try_next": [],
+        "remaining_where": list(remaining_where),
+        "conclusion": "",
+    }
+    pair_ok = (
+        bp is not None
+        and bp["ratio"] <= thr
+        and bp["significant"]
+        and best is not None
+        and bp["gain_over_best_single"] < SIGNIFICANT_DBIC
+        and bp["share_over_best_single"] >= MIN_SHARE
+    )
     if fc is not None and fc["ratio"] <= thr:
         v.update(kind="better_form", mechanism=fc["effect"], form=fc["form"], explained=True)
-        v["conclusion"] = (f"the added effect {fc['effect']} has the wrong form: its form '{fc['form']}' brings the "
-                           f"error from {r0:.2f}x to {fc['ratio']:.2f}x the noise (no new mechanism is needed)")
+        v["conclusion"] = (
+            f"the added effect {fc['effect']} has the wrong form: its form '{fc['form']}' brings the "
+            f"error from {r0:.2f}x to {fc['ratio']:.2f}x the noise (no new mechanism is needed)"
+        )
         return v
     if fc is not None:
         v["try_next"].append(f"{fc['effect']}/{fc['form']} (a better form of an added effect: {fc['ratio']:.2f}x)")
     if pair_ok:  # also when the best single one reaches the noise: the pair is significantly better
         v.update(kind="missing_pair", missing_effects=list(bp["effects"]), explained=True)
-        v["conclusion"] = (f"missing effects: {' + '.join(bp['effects'])} (fitted together); the pair brings the "
-                           f"error from {r0:.2f}x to {bp['ratio']:.2f}x the noise, significantly below its best "
-                           "member alone")
+        v["conclusion"] = (
+            f"missing effects: {' + '.join(bp['effects'])} (fitted together); the pair brings the "
+            f"error from {r0:.2f}x to {bp['ratio']:.2f}x the noise, significantly below its best "
+            "member alone"
+        )
         return v
     if best is not None and best["ratio"] <= thr:
-        alts = [e["effect"] for e in ranking if e is not best and e["significant"] and e["ratio"] <= thr
-                and e["delta_bic"] - best["delta_bic"] < 10.0]
-        v.update(kind="missing_effect", missing_effect=best["effect"], missing_effects=[best["effect"]],
-                 mechanism=best["effect"], form=best.get("form") or None, explained=True, alternatives=alts)
-        v["conclusion"] = (f"missing effect: {best['effect']} ({titles.get(best['effect'], '')}"
-                           f"{', form ' + best['form'] if best.get('form') else ''}); with it the error falls from "
-                           f"{r0:.2f}x to {best['ratio']:.2f}x the noise")
+        alts = [
+            e["effect"]
+            for e in ranking
+            if e is not best and e["significant"] and e["ratio"] <= thr and e["delta_bic"] - best["delta_bic"] < 10.0
+        ]
+        v.update(
+            kind="missing_effect",
+            missing_effect=best["effect"],
+            missing_effects=[best["effect"]],
+            mechanism=best["effect"],
+            form=best.get("form") or None,
+            explained=True,
+            alternatives=alts,
+        )
+        v["conclusion"] = (
+            f"missing effect: {best['effect']} ({titles.get(best['effect'], '')}"
+            f"{', form ' + best['form'] if best.get('form') else ''}); with it the error falls from "
+            f"{r0:.2f}x to {best['ratio']:.2f}x the noise"
+        )
         if alts:
             v["conclusion"] += f"; also consistent with the data: {', '.join(alts)}"
         return v
@@ -143,25 +181,32 @@ def conclude(r0: float, thr: float, ranking: list, pairs: list, form_check: list
         where = ", ".join(remaining_where[:3]) or "spread along the path"
         v.update(kind="form_imperfect", mechanism=best["effect"], form=best.get("form") or None)
         v["try_next"].append(f"a generalised form of {best['effect']} (an own effect or form: docs/experiments.md)")
-        v["conclusion"] = (f"mechanism found, form imperfect: {best['effect']} ({titles.get(best['effect'], '')}) "
-                           f"explains {100 * best['explained_fraction']:.0f} % of the excess error ({r0:.2f}x -> "
-                           f"{best['ratio']:.2f}x the noise) but structure remains, mostly in: {where}; try "
-                           f"{'; '.join(v['try_next'])}")
+        v["conclusion"] = (
+            f"mechanism found, form imperfect: {best['effect']} ({titles.get(best['effect'], '')}) "
+            f"explains {100 * best['explained_fraction']:.0f} % of the excess error ({r0:.2f}x -> "
+            f"{best['ratio']:.2f}x the noise) but structure remains, mostly in: {where}; try "
+            f"{'; '.join(v['try_next'])}"
+        )
         return v
     if best is None and r0 <= thr:
         v.update(kind="nothing_missing", explained=True)
-        v["conclusion"] = (f"nothing is missing: the model is at the noise floor ({r0:.2f}x noise) and no candidate "
-                           "is significant")
+        v["conclusion"] = (
+            f"nothing is missing: the model is at the noise floor ({r0:.2f}x noise) and no candidate is significant"
+        )
         return v
     v["kind"] = "not_explained"
     if best is None:
-        v["conclusion"] = (f"none of the candidates explains this: the model is {r0:.2f}x the noise and no candidate "
-                           "effect (or pair) "
-                           "explains a significant share of the excess error (an effect outside the library?)")
+        v["conclusion"] = (
+            f"none of the candidates explains this: the model is {r0:.2f}x the noise and no candidate "
+            "effect (or pair) "
+            "explains a significant share of the excess error (an effect outside the library?)"
+        )
     else:
-        v["conclusion"] = (f"none of the candidates explains this: the best, {best['effect']}, brings the error from "
-                           f"{r0:.2f}x to "
-                           f"{best['ratio']:.2f}x the noise ({100 * best['explained_fraction']:.0f} % of the excess)"
-                           f"{'; try ' + '; '.join(v['try_next']) if v['try_next'] else ''} (an effect outside the "
-                           "library, or several at once)")
+        v["conclusion"] = (
+            f"none of the candidates explains this: the best, {best['effect']}, brings the error from "
+            f"{r0:.2f}x to "
+            f"{best['ratio']:.2f}x the noise ({100 * best['explained_fraction']:.0f} % of the excess)"
+            f"{'; try ' + '; '.join(v['try_next']) if v['try_next'] else ''} (an effect outside the "
+            "library, or several at once)"
+        )
     return v

@@ -68,11 +68,24 @@ FITS = {"pretension": ("pretension",), "mass": ("unit_mass",), "both": ("pretens
 
 def _param_table(options):
     return {
-        "pretension": Parameter("pretension", "N", float(options["nominal_pretension_N"]), 5.0, 1000.0,
-                                "average cable tension (with pretension_N: the tension at the nominal setting)",
-                                scale=100.0),
-        "unit_mass": Parameter("unit_mass", "kg", float(options["unit_mass_kg"]), 1e-5, 10.0,
-                               "point mass of the unit at the drive node", scale=0.02),
+        "pretension": Parameter(
+            "pretension",
+            "N",
+            float(options["nominal_pretension_N"]),
+            5.0,
+            1000.0,
+            "average cable tension (with pretension_N: the tension at the nominal setting)",
+            scale=100.0,
+        ),
+        "unit_mass": Parameter(
+            "unit_mass",
+            "kg",
+            float(options["unit_mass_kg"]),
+            1e-5,
+            10.0,
+            "point mass of the unit at the drive node",
+            scale=0.02,
+        ),
     }
 
 
@@ -80,14 +93,21 @@ def _prepare(data: Measured, options: dict) -> dict:
     mode = data["mode"]
     if np.any(mode < 1) or np.any(mode != np.round(mode)):
         bad = int(np.flatnonzero((mode < 1) | (mode != np.round(mode)))[0])
-        raise ModelError(f"{data.path} line {data.lines[bad]}, column 'mode': mode = {float(mode[bad]):g}; modes are whole numbers "
-                         ">= 1 (1 = the lowest mode of the model)")
+        raise ModelError(
+            f"{data.path} line {data.lines[bad]}, column 'mode': mode = {float(mode[bad]):g}; modes are whole numbers "
+            ">= 1 (1 = the lowest mode of the model)"
+        )
     setting = data["pretension_N"] if "pretension_N" in data else np.full(data.n, np.nan)
     load = data["load_N"] if "load_N" in data else np.zeros(data.n)
     key = np.column_stack([np.nan_to_num(setting, nan=-1.0), load])
     states, inverse = np.unique(key, axis=0, return_inverse=True)
-    return {"mode": mode.astype(int), "setting": setting, "state_of_row": inverse.ravel(),
-            "state_setting": np.where(states[:, 0] < 0, np.nan, states[:, 0]), "state_load": states[:, 1]}
+    return {
+        "mode": mode.astype(int),
+        "setting": setting,
+        "state_of_row": inverse.ravel(),
+        "state_setting": np.where(states[:, 0] < 0, np.nan, states[:, 0]),
+        "state_load": states[:, 1],
+    }
 
 
 def _builder(options):
@@ -99,8 +119,9 @@ def _builder(options):
     mod = load_script(b)
     fn = getattr(mod, "build", None)
     if not callable(fn):
-        raise ModelError(f"vibration builder script {b} defines no function build(tension_N, unit_mass_kg, load_N, "
-                         "options)")
+        raise ModelError(
+            f"vibration builder script {b} defines no function build(tension_N, unit_mass_kg, load_N, options)"
+        )
     return fn
 
 
@@ -178,8 +199,15 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
     ax.legend(fontsize=7)
 
 
-OPTIONS = {"fit": "pretension", "nominal_pretension_N": 170.0, "unit_mass_kg": None, "builder": None,
-           "drive_direction": (0.0, 1.0, 0.0), "bay": None, "cable_mass_kg_per_m": None}
+OPTIONS = {
+    "fit": "pretension",
+    "nominal_pretension_N": 170.0,
+    "unit_mass_kg": None,
+    "builder": None,
+    "drive_direction": (0.0, 1.0, 0.0),
+    "bay": None,
+    "cable_mass_kg_per_m": None,
+}
 
 
 @dataclass(frozen=True)
@@ -208,17 +236,21 @@ class VibrationExperiment(Experiment):
 EXPERIMENT = VibrationExperiment(
     name="vibration",
     title="natural frequencies against the prestressed modal analysis (seed 001 Sec. IV)",
-    columns=(Column("mode", "-", "mode number, 1 = lowest of the model"),
-             Column("f_Hz", "Hz", "measured natural frequency"),
-             Column("pretension_N", "N", "pretension setting of the row", required=False),
-             Column("load_N", "N", "static load on the drive node along the drive direction", required=False)),
+    columns=(
+        Column("mode", "-", "mode number, 1 = lowest of the model"),
+        Column("f_Hz", "Hz", "measured natural frequency"),
+        Column("pretension_N", "N", "pretension setting of the row", required=False),
+        Column("load_N", "N", "static load on the drive node along the drive direction", required=False),
+    ),
     channels=("f_Hz",),
     parameters=(),
     model=model,
     options=dict(OPTIONS),
-    hooks={"tension": "T (n_states,) N: tension of each static state",
-           "unit_mass": "m kg: point mass of the unit at the drive node",
-           "model": "the femast Model of a state before it is solved (ctx: drive, direction)"},
+    hooks={
+        "tension": "T (n_states,) N: tension of each static state",
+        "unit_mass": "m kg: point mass of the unit at the drive node",
+        "model": "the femast Model of a state before it is solved (ctx: drive, direction)",
+    },
     doc=__doc__,
     prepare=_prepare,
     load_measure=load_measure,

@@ -12,13 +12,41 @@ Modules, one concept each (SI units throughout):
 * :mod:`.rocaspect` -- the seed's robot: published values and documented assumptions.
 """
 
-from .cantilever import (cantilever_compliance, cantilever_compliance_local, cantilever_stiffness,
-                         displacement_beam, mast_section)
-from .cdpr import (CdprGeometry, TensionDistribution, cable_vectors, gravity_wrench, is_feasible,
-                   mast_top_wrenches, tension_distribution, trajectory_loads, wrench_matrix)
-from .complete_mast import (MastStiffness, ShroudSet, active_stiffness, displacement_complete, mast_stiffness,
-                            passive_stiffness, shroud_wrench_matrix)
+from ..elements.shroud_law import (
+    SEED_X_S,
+    DyneemaLaw,
+    axial_rigidity_secant,
+    axial_rigidity_tangent,
+    shroud_stiffness,
+    strain_from_tension,
+    tension_from_strain,
+)
+from .cantilever import (
+    cantilever_compliance,
+    cantilever_compliance_local,
+    cantilever_stiffness,
+    displacement_beam,
+    mast_section,
+)
+from .cdpr import (
+    CdprGeometry,
+    TensionDistribution,
+    cable_vectors,
+    gravity_wrench,
+    is_feasible,
+    mast_top_wrenches,
+    tension_distribution,
+    trajectory_loads,
+    wrench_matrix,
+)
+from .complete_mast import (
+    MastStiffness,
+    ShroudSet,
+    active_stiffness,
+    displacement_complete,
+    mast_stiffness,
+    passive_stiffness,
+    shroud_wrench_matrix,
+)
 from .identify import FitResult, fit_3r, fit_beam_E, fit_shroud_law
 from .mast_3r import compliance_3r, displacement_3r, jacobian_3r
-from ..elements.shroud_law import (SEED_X_S, DyneemaLaw, axial_rigidity_secant, axial_rigidity_tangent, shroud_stiffness,
-                     strain_from_tension, tension_from_strain)

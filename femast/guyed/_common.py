@@ -29,9 +29,11 @@ def skew(v) -> np.ndarray:
 def check_vectors(name: str, value, shape_tail=(3,)) -> np.ndarray:
     """Return ``value`` as a finite float array whose trailing shape is ``shape_tail``."""
     arr = np.asarray(value, dtype=float)
-    if arr.shape[-len(shape_tail):] != tuple(shape_tail) or not np.all(np.isfinite(arr)):
-        raise ModelError(f"{name} must be finite coordinates of shape (..., {', '.join(map(str, shape_tail))}) in m; "
-                         f"got shape {arr.shape}")
+    if arr.shape[-len(shape_tail) :] != tuple(shape_tail) or not np.all(np.isfinite(arr)):
+        raise ModelError(
+            f"{name} must be finite coordinates of shape (..., {', '.join(map(str, shape_tail))}) in m; "
+            f"got shape {arr.shape}"
+        )
     return arr
 
 

@@ -31,8 +31,9 @@ from ._common import check_positive, check_vectors
 R_BE_VERTICAL = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
 
 
-def mast_section(E: float, nu: float = 0.3, s_out: float = 0.1, s_in: float = 0.094,
-                 torsion: str = "bredt", L: float | None = None) -> Section:
+def mast_section(
+    E: float, nu: float = 0.3, s_out: float = 0.1, s_in: float = 0.094, torsion: str = "bredt", L: float | None = None
+) -> Section:
     """Square-tube section of the mast beam (Eqs. 9-11); E in Pa, sides in m.
 
     ``torsion="bredt"`` (default) uses the correct closed-section torsion constant;

@@ -289,8 +289,10 @@ def tension_distribution(geom: CdprGeometry, pose, method: str = "barycenter", t
         raise ModelError(f"method {method!r} needs exactly 8 cables (redundancy 2); use method='linprog'")
     poly = _feasible_polygon(W, w_g, geom.tau_min, geom.tau_max)
     if poly is None:
-        raise ModelError(f"the wrench matrix is rank deficient at pose ({fmt_pose(p)}): the cables cannot "
-                         "hold the platform in all directions there; choose another pose")
+        raise ModelError(
+            f"the wrench matrix is rank deficient at pose ({fmt_pose(p)}): the cables cannot "
+            "hold the platform in all directions there; choose another pose"
+        )
     tau_p, N, V = poly
     if V.shape[0] == 0:
         raise ModelError(
@@ -318,8 +320,9 @@ def is_feasible(geom: CdprGeometry, pose) -> bool:
 def cable_forces_on_masts(geom: CdprGeometry, pose, tau) -> np.ndarray:
     """Force each cable applies to its mast at the exit point A_j, ``tau_j (u_j + v_j)`` (m, 3), N (Eq. 7)."""
     _, u, _, _ = cable_vectors(geom, pose)
-    v, _ = unit_vectors("cable return (exit point A to winch point F)", geom.winch_points - geom.exit_points,
-                        labels=geom.labels)
+    v, _ = unit_vectors(
+        "cable return (exit point A to winch point F)", geom.winch_points - geom.exit_points, labels=geom.labels
+    )
     return np.asarray(tau, dtype=float)[:, None] * (u + v)
 
 

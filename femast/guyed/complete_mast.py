@@ -33,9 +33,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..elements.shroud_law import DyneemaLaw, shroud_stiffness
 from ..errors import ModelError
 from ._common import check_positive, check_vectors, skew, unit_vectors
-from ..elements.shroud_law import DyneemaLaw, shroud_stiffness
 
 
 @dataclass(frozen=True)
@@ -65,8 +65,9 @@ class ShroudSet:
         try:
             tau = np.broadcast_to(np.asarray(self.tension, dtype=float), (up.shape[0],)).copy()
         except ValueError:
-            raise ModelError(f"give one tension (N) per shroud ({up.shape[0]}) or a single value; "
-                             f"got {self.tension!r}") from None
+            raise ModelError(
+                f"give one tension (N) per shroud ({up.shape[0]}) or a single value; got {self.tension!r}"
+            ) from None
         if np.any(~np.isfinite(tau)) or np.any(tau < 0):
             raise ModelError(f"shroud tensions {tau} must be finite and >= 0 N (a shroud cannot push)")
         labels = tuple(self.labels) or tuple(f"{r + 1}" for r in range(up.shape[0]))
@@ -167,8 +168,9 @@ class MastStiffness:
         return np.linalg.pinv(self.K_m)
 
 
-def mast_stiffness(K_beam, top, shrouds: ShroudSet | None, kind: str = "tangent",
-                   active_form: str = "corrected") -> MastStiffness:
+def mast_stiffness(
+    K_beam, top, shrouds: ShroudSet | None, kind: str = "tangent", active_form: str = "corrected"
+) -> MastStiffness:
     """Complete-mast stiffness (Eq. 17) from the beam stiffness K_beam (6, 6) and the shrouds.
 
     ``shrouds=None`` means no shrouds (detached): K_m = K_beam.

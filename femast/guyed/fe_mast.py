@@ -45,14 +45,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..analysis import Analysis
+from ..analysis.solvers.convergence import Convergence
 from ..elements.shroud_cable import ShroudCableFamily, unstretched_length
+from ..elements.shroud_law import DyneemaLaw
 from ..errors import ModelError
 from ..model import Model
-from ..analysis.solvers.convergence import Convergence
 from .cantilever import cantilever_stiffness, mast_section
 from .complete_mast import ShroudSet, active_stiffness, passive_stiffness
 from .rocaspect import E_NO_SHROUD, L_BEAM, SHROUD_DROP, mast_bases, mast_tops, rocaspect_shrouds
-from ..elements.shroud_law import DyneemaLaw
 
 SHROUD_FAMILY = "shroud"
 BEAM_FAMILY = "mast_beam"
@@ -105,10 +105,21 @@ class MastFE:
         their coefficients of thermal expansion, 1/K.
     """
 
-    def __init__(self, pretension: float | None = 1200.0, *, mast: int = 0, E: float = E_NO_SHROUD,
-                 n_beam: int = 16, law: DyneemaLaw | None = None, attach: str = "top",
-                 convergence: Convergence | None = None, length_error=None, temperature_change_K: float = 0.0,
-                 shroud_alpha_per_K: float = 0.0, beam_alpha_per_K: float = 0.0):
+    def __init__(
+        self,
+        pretension: float | None = 1200.0,
+        *,
+        mast: int = 0,
+        E: float = E_NO_SHROUD,
+        n_beam: int = 16,
+        law: DyneemaLaw | None = None,
+        attach: str = "top",
+        convergence: Convergence | None = None,
+        length_error=None,
+        temperature_change_K: float = 0.0,
+        shroud_alpha_per_K: float = 0.0,
+        beam_alpha_per_K: float = 0.0,
+    ):
         if pretension is not None and not (np.isfinite(pretension) and pretension >= 0.0):
             raise ModelError(f"shroud pretension {pretension!r} N must be finite and >= 0 (None: no shrouds)")
         if attach not in ("top", "wall"):
@@ -134,14 +145,17 @@ class MastFE:
         if length_error is not None and self.shrouds_nominal is None:
             raise ModelError("length_error is given but the mast has no shrouds (pretension=None)")
         self.length_error = length_error
-        for what, v in (("temperature_change_K", temperature_change_K), ("shroud_alpha_per_K", shroud_alpha_per_K),
-                        ("beam_alpha_per_K", beam_alpha_per_K)):
+        for what, v in (
+            ("temperature_change_K", temperature_change_K),
+            ("shroud_alpha_per_K", shroud_alpha_per_K),
+            ("beam_alpha_per_K", beam_alpha_per_K),
+        ):
             if not np.isfinite(v):
                 raise ModelError(f"MastFE {what} = {v!r} is not finite")
         self.temperature_change_K = float(temperature_change_K)
         self.alpha = {SHROUD_FAMILY: float(shroud_alpha_per_K), BEAM_FAMILY: float(beam_alpha_per_K)}
         self.analysis: Analysis | None = None
-        self._frames = []   # per converged increment of the last solve: (step, top [u, spins], tensions)
+        self._frames = []  # per converged increment of the last solve: (step, top [u, spins], tensions)
 
     # ----------------------------------------------------------------- model
     def build(self, wrenches=(), step_names=None) -> Model:
@@ -177,8 +191,14 @@ class MastFE:
                 a = top if at_top else tie
                 pairs.append((a, d))
                 offsets.append([sh.upper[r] - m.xyz(a), np.zeros(3)])
-            fam = ShroudCableFamily(np.array(pairs), self.L0, self.law, offsets=np.array(offsets), name=SHROUD_FAMILY,
-                                    length_error=self.length_error)
+            fam = ShroudCableFamily(
+                np.array(pairs),
+                self.L0,
+                self.law,
+                offsets=np.array(offsets),
+                name=SHROUD_FAMILY,
+                length_error=self.length_error,
+            )
             m.add_family(fam)
         m.step("pretension")
         if self.temperature_change_K != 0.0:
@@ -203,8 +223,13 @@ class MastFE:
         self._frames = []
 
         def record(fr):
-            self._frames.append((str(fr["step"]), np.concatenate([fr["U"][row], fr["URA"][row]]),
-                                 np.asarray(fr.get(key, np.zeros(0)), dtype=float)))
+            self._frames.append(
+                (
+                    str(fr["step"]),
+                    np.concatenate([fr["U"][row], fr["URA"][row]]),
+                    np.asarray(fr.get(key, np.zeros(0)), dtype=float),
+                )
+            )
 
         an = Analysis(model, out, convergence=self.convergence, progress=False, on_frame=record)
         an.run()
@@ -239,15 +264,17 @@ class MastFE:
             B = -np.vstack([e.T, np.cross(st.upper - st.top, e).T])  # (6, q): dl_r = B_r . du_top
             EAt = axial_rigidity_tangent(self.law, st.tension)
             fam = self._family(SHROUD_FAMILY)
-            Lf = fam.stress_free_lengths()     # (L0 + dL) s: with length errors and heat
+            Lf = fam.stress_free_lengths()  # (L0 + dL) s: with length errors and heat
             s = Lf / (self.L0 + fam.length_error)
             k = EAt / Lf
             c = -EAt * length / Lf**2 * s
             K = self.top_stiffness("full")
             J = np.diag(c) - (k[:, None] * (B.T @ np.linalg.solve(K, B))) * c[None, :]
             self.L0 = self.L0 - np.linalg.solve(J, st.tension - target)
-        raise ModelError(f"shroud pretension did not settle to {tol:g} in {max_iter} iterations "
-                         f"(tensions {st.tension} N, target {target} N)")
+        raise ModelError(
+            f"shroud pretension did not settle to {tol:g} in {max_iter} iterations "
+            f"(tensions {st.tension} N, target {target} N)"
+        )
 
     def run_wrenches(self, wrenches) -> dict:
         """Nonlinear response to a sequence of top wrenches (k, 6) (N, N m about the top, dead loads),
@@ -279,8 +306,12 @@ class MastFE:
         picked = [pick(last[f"load{k + 1:04d}"]) for k in range(len(unique))]
         picked.insert(0, (u0, t0))  # step_of = -1: no load yet
         sel = [picked[j + 1] for j in step_of]
-        return {"u0": u0, "tension0": t0, "u": np.array([p[0] for p in sel]).reshape(-1, 6),
-                "tension": np.array([p[1] for p in sel]).reshape(len(wrenches), -1)}
+        return {
+            "u0": u0,
+            "tension0": t0,
+            "u": np.array([p[0] for p in sel]).reshape(-1, 6),
+            "tension": np.array([p[1] for p in sel]).reshape(len(wrenches), -1),
+        }
 
     # ----------------------------------------------------------------- state
     def _family(self, name):
@@ -378,8 +409,14 @@ def analytic_beam_stiffness(E: float = E_NO_SHROUD) -> np.ndarray:
     return cantilever_stiffness(L_BEAM, mast_section(E))
 
 
-def compare_stiffness(pretension: float = 1200.0, *, E: float = E_NO_SHROUD, n_beam: int = 16,
-                      law: DyneemaLaw | None = None, attach: str = "top") -> dict:
+def compare_stiffness(
+    pretension: float = 1200.0,
+    *,
+    E: float = E_NO_SHROUD,
+    n_beam: int = 16,
+    law: DyneemaLaw | None = None,
+    attach: str = "top",
+) -> dict:
     """Term-by-term comparison of the FE top stiffness with the analytic K_m = K_beam + K_a + K_p.
 
     Returns a dict of (6, 6) matrices and scalar relative differences (:func:`relative_difference`):

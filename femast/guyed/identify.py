@@ -84,8 +84,20 @@ def _fit(fun, x0, names, units, bounds=(-np.inf, np.inf), x_scale=None) -> FitRe
         null = np.abs(Vt[~good]).max(axis=0) > 1e-6
         stderr = np.where(null, np.inf, stderr)
         msg += "; not identifiable from these data: " + ", ".join(n_ for n_, b in zip(names, null) if b)
-    return FitResult(res.x, stderr, cov, tuple(names), tuple(units), bool(res.success), msg, int(res.nfev),
-                     float(res.cost), res.fun, float(np.sqrt(s2)), dof)
+    return FitResult(
+        res.x,
+        stderr,
+        cov,
+        tuple(names),
+        tuple(units),
+        bool(res.success),
+        msg,
+        int(res.nfev),
+        float(res.cost),
+        res.fun,
+        float(np.sqrt(s2)),
+        dof,
+    )
 
 
 # --------------------------------------------------------------------------- Eq. 27
@@ -135,8 +147,9 @@ def seed_eq29_matrix(dw, r_oc, seed_sign: bool = False) -> np.ndarray:
     return (J[None, :, :] * (dw @ J)[:, None, :]).reshape(-1, 3)
 
 
-def fit_3r(dw, dc, r_oc, rows=None, free=(True, True, True), k_fixed=(np.inf, np.inf, np.inf),
-           seed_sign: bool = False) -> FitResult:
+def fit_3r(
+    dw, dc, r_oc, rows=None, free=(True, True, True), k_fixed=(np.inf, np.inf, np.inf), seed_sign: bool = False
+) -> FitResult:
     """Fit the 3R joint stiffnesses k_theta (N m/rad) to wrench changes dw (k, 6; N, N m) and measured
     top displacements dc (k, 6; m, rad) (Eqs. 28-29).
 
@@ -171,8 +184,18 @@ def fit_3r(dw, dc, r_oc, rows=None, free=(True, True, True), k_fixed=(np.inf, np
 
 
 # --------------------------------------------------------------------------- Eq. 30
-def fit_beam_E(dw, dc, L: float = 3.651, s_out: float = 0.1, s_in: float = 0.094, nu: float = 0.3, rows=None,
-               axis=(0.0, 0.0, 1.0), fit_G: bool = False, torsion: str = "bredt") -> FitResult:
+def fit_beam_E(
+    dw,
+    dc,
+    L: float = 3.651,
+    s_out: float = 0.1,
+    s_in: float = 0.094,
+    nu: float = 0.3,
+    rows=None,
+    axis=(0.0, 0.0, 1.0),
+    fit_G: bool = False,
+    torsion: str = "bredt",
+) -> FitResult:
     """Fit the beam Young's modulus E (Pa) to wrench changes dw (k, 6; N, N m) and top displacements
     dc (k, 6; m, rad) with the cantilever model (Eqs. 15, 30).
 

@@ -29,8 +29,10 @@ _TEST_OF = {None: "7 and 10", 0.0: "5 and 9", 400.0: "4", 800.0: "3", 1200.0: "1
 
 def _check(pretension):
     if pretension is not None and not (np.isfinite(pretension) and 0.0 <= pretension <= 1200.0):
-        raise ModelError(f"shroud pretension {pretension!r} N: the seed's masts are identified for 0 to 1200 N "
-                         "(None: shrouds detached)")
+        raise ModelError(
+            f"shroud pretension {pretension!r} N: the seed's masts are identified for 0 to 1200 N "
+            "(None: shrouds detached)"
+        )
 
 
 def masts_3r(pretension) -> MastSet:
@@ -38,8 +40,10 @@ def masts_3r(pretension) -> MastSet:
     _check(pretension)
     key = None if pretension is None else float(pretension)
     if key not in _TEST_OF:
-        raise ModelError(f"Table III has 3R stiffnesses for pretensions {sorted(k for k in _TEST_OF if k is not None)} N "
-                         f"(or None, detached); got {pretension!r}")
+        raise ModelError(
+            f"Table III has 3R stiffnesses for pretensions {sorted(k for k in _TEST_OF if k is not None)} N "
+            f"(or None, detached); got {pretension!r}"
+        )
     k = (*TABLE_III[_TEST_OF[key]][2:], np.inf)
     C = np.array([compliance_3r(k, t - b) for t, b in zip(mast_tops(), mast_bases())])
     return MastSet(f"3R ({pretension} N)", C)

@@ -115,9 +115,14 @@ def _rot(angles):
 
 def _cross(a, b):
     """Row-wise cross product (faster than numpy.cross for these small stacks)."""
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+    return np.stack(
+        [
+            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
+        ],
+        axis=-1,
+    )
 
 
 def _rotvec_batch(V):
@@ -242,8 +247,9 @@ def _newton(sys: _System, z0, J=None, tol=1e-11, max_iter=60, full=False):
         if step < tol:
             r, s = sys.residual(z)
             return z, s, it + 1, J
-    raise ModelError(f"platform/cable/mast equilibrium did not converge in {max_iter} iterations "
-                     f"(last correction {step:.3g})")
+    raise ModelError(
+        f"platform/cable/mast equilibrium did not converge in {max_iter} iterations (last correction {step:.3g})"
+    )
 
 
 def controller(robot: CableRobot, pose_c, tau=None, method: str = "barycenter"):
@@ -272,8 +278,18 @@ def rigid_masts(n: int = 4) -> MastSet:
     return MastSet("rigid", np.zeros((n, 6, 6)))
 
 
-def solve_pose(robot: CableRobot, masts: MastSet, pose_c, *, tau=None, w_cal=None, delta=None, z0=None,
-               method: str = "barycenter", J=None) -> PoseSolution:
+def solve_pose(
+    robot: CableRobot,
+    masts: MastSet,
+    pose_c,
+    *,
+    tau=None,
+    w_cal=None,
+    delta=None,
+    z0=None,
+    method: str = "barycenter",
+    J=None,
+) -> PoseSolution:
     """Equilibrium of platform, cables and masts at the commanded pose ``pose_c`` ([x, y, z] m, angles rad).
 
     tau : commanded tensions (N) or None (Eq. 2 distribution).  w_cal : (n, 6) mast wrenches at
@@ -294,15 +310,26 @@ def solve_pose(robot: CableRobot, masts: MastSet, pose_c, *, tau=None, w_cal=Non
     if tau is not None:
         tau = np.asarray(tau, float)
         if tau.shape != (g.n_cables,) or np.any(~np.isfinite(tau)) or np.any(tau <= 0):
-            raise ModelError(f"commanded tensions {tau} N: give one finite tension > 0 N per cable ({g.n_cables}); "
-                             "a cable cannot push")
+            raise ModelError(
+                f"commanded tensions {tau} N: give one finite tension > 0 N per cable ({g.n_cables}); "
+                "a cable cannot push"
+            )
     try:
         tau_c, l0 = controller(robot, p, tau, method)
     except ModelError as exc:
-        return PoseSolution(nan, nan, np.full(g.n_cables, np.nan), np.full((g.n_cables, 3), np.nan),
-                            np.full((n, 6), np.nan), np.full((n, 6), np.nan), False, str(exc))
-    sys = _System(robot, masts, p, l0, np.zeros((n, 6)) if w_cal is None else w_cal,
-                  np.zeros((n, 6)) if delta is None else delta)
+        return PoseSolution(
+            nan,
+            nan,
+            np.full(g.n_cables, np.nan),
+            np.full((g.n_cables, 3), np.nan),
+            np.full((n, 6), np.nan),
+            np.full((n, 6), np.nan),
+            False,
+            str(exc),
+        )
+    sys = _System(
+        robot, masts, p, l0, np.zeros((n, 6)) if w_cal is None else w_cal, np.zeros((n, 6)) if delta is None else delta
+    )
     start = np.zeros(6 + 6 * n) if z0 is None else z0
     try:
         z, s, it, J = _newton(sys, start, J)
@@ -315,8 +342,10 @@ def solve_pose(robot: CableRobot, masts: MastSet, pose_c, *, tau=None, w_cal=Non
     if np.any(s["tau"] <= 0):
         k = int(np.argmin(s["tau"]))
         sol.feasible = False
-        sol.reason = (f"cable {g.labels[k]} goes slack (tension {s['tau'][k]:.3g} N) at the equilibrium reached from "
-                      f"the commanded pose ({fmt_pose(p)}): the cables cannot hold the platform there")
+        sol.reason = (
+            f"cable {g.labels[k]} goes slack (tension {s['tau'][k]:.3g} N) at the equilibrium reached from "
+            f"the commanded pose ({fmt_pose(p)}): the cables cannot hold the platform there"
+        )
     return sol
 
 
@@ -353,8 +382,17 @@ def _pass(robot, masts, poses, tau, w_cal, delta, method, progress):
     z = J = None
     it = poses if progress is None else progress(poses)
     for k, p in enumerate(it):
-        s = solve_pose(robot, masts, p, tau=None if tau is None else tau[k], w_cal=w_cal,
-                       delta=None if delta is None else delta[k], z0=z, method=method, J=J)
+        s = solve_pose(
+            robot,
+            masts,
+            p,
+            tau=None if tau is None else tau[k],
+            w_cal=w_cal,
+            delta=None if delta is None else delta[k],
+            z0=z,
+            method=method,
+            J=J,
+        )
         if s.feasible:
             z, J = s._z, s._J
         sols.append(s)
@@ -368,12 +406,23 @@ def _fe_response(masts: MastSet):
             run = fe.run_wrenches(np.vstack([w_cal[i], hist[:, i]]))
             out[:, i] = run["u"][1:] - run["u"][0]
         return out
+
     return response
 
 
-def pose_trajectory(robot: CableRobot, masts: MastSet, poses, *, tensions=None, calibrate=None,
-                    method: str = "barycenter", response=None, fe_tol: float = 1e-6, max_fe_passes: int = 6,
-                    progress=None) -> TrajectoryResult:
+def pose_trajectory(
+    robot: CableRobot,
+    masts: MastSet,
+    poses,
+    *,
+    tensions=None,
+    calibrate=None,
+    method: str = "barycenter",
+    response=None,
+    fe_tol: float = 1e-6,
+    max_fe_passes: int = 6,
+    progress=None,
+) -> TrajectoryResult:
     """Pose errors along ``poses`` (k, 3|6).  The exit geometry is calibrated at ``calibrate`` (default
     the first pose): the masts' displacements are counted from their state there.  tensions : (k, m)
     commanded tensions, N, or None (Eq. 2).
@@ -389,11 +438,18 @@ def pose_trajectory(robot: CableRobot, masts: MastSet, poses, *, tensions=None, 
     if tensions is not None:
         tensions = np.asarray(tensions, float)
         if tensions.shape != (len(poses), robot.geom.n_cables):
-            raise ModelError(f"tensions must be (k, m) = ({len(poses)}, {robot.geom.n_cables}) in N; got {tensions.shape}")
+            raise ModelError(
+                f"tensions must be (k, m) = ({len(poses)}, {robot.geom.n_cables}) in N; got {tensions.shape}"
+            )
     cal = poses[0] if calibrate is None else np.asarray(calibrate, float)
     # the calibration state: the wrench the masts carry at the calibration pose (rigid-frame model)
-    c0 = solve_pose(robot, rigid_masts(robot.geom.n_masts), cal, method=method,
-                    tau=None if (tensions is None or calibrate is not None) else tensions[0])
+    c0 = solve_pose(
+        robot,
+        rigid_masts(robot.geom.n_masts),
+        cal,
+        method=method,
+        tau=None if (tensions is None or calibrate is not None) else tensions[0],
+    )
     if not c0.feasible:
         raise ModelError(f"the calibration pose is infeasible: {c0.reason}")
     w_cal = c0.wrench
@@ -428,6 +484,15 @@ def pose_trajectory(robot: CableRobot, masts: MastSet, poses, *, tensions=None, 
                 break  # the tops of the last pass are those of the response: converged
             sols = _pass(robot, lin, poses, tensions, w_cal, delta, method, progress)
     pick = lambda key: np.array([getattr(s, key) for s in sols])  # noqa: E731
-    return TrajectoryResult(poses, pick("pose"), pick("error"), pick("tension"), pick("exit_points"),
-                            pick("top_displacement"), pick("wrench"), pick("feasible"),
-                            [s.reason for s in sols], passes)
+    return TrajectoryResult(
+        poses,
+        pick("pose"),
+        pick("error"),
+        pick("tension"),
+        pick("exit_points"),
+        pick("top_displacement"),
+        pick("wrench"),
+        pick("feasible"),
+        [s.reason for s in sols],
+        passes,
+    )

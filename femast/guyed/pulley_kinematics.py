@@ -42,8 +42,10 @@ def swivel_exit(D, w, B, r: float):
     pn = np.linalg.norm(perp, axis=1)
     if np.any(pn <= 1e-9):
         k = int(np.flatnonzero(pn <= 1e-9)[0])
-        raise ModelError(f"cable {k}: the platform anchor lies on the swivel axis of its pulley: the pulley "
-                         "plane is undefined; move the pose away from the mast")
+        raise ModelError(
+            f"cable {k}: the platform anchor lies on the swivel axis of its pulley: the pulley "
+            "plane is undefined; move the pose away from the mast"
+        )
     h = perp / pn[:, None]
     C = D + r * h
     bh = pn - r
@@ -51,8 +53,10 @@ def swivel_exit(D, w, B, r: float):
     d = np.hypot(bh, bw)
     if np.any(d <= r * (1 + 1e-12)):
         k = int(np.flatnonzero(d <= r * (1 + 1e-12))[0])
-        raise ModelError(f"cable {k}: the platform anchor is {d[k]:.4g} m from the centre of a pulley of radius {r:.4g} m: "
-                         "no tangent exists (impossible wrap angle)")
+        raise ModelError(
+            f"cable {k}: the platform anchor is {d[k]:.4g} m from the centre of a pulley of radius {r:.4g} m: "
+            "no tangent exists (impossible wrap angle)"
+        )
     theta = np.arctan2(bw, bh) + np.arccos(np.clip(r / d, -1.0, 1.0))
     beta = np.pi - theta
     E = C + r * (np.cos(theta)[:, None] * h + np.sin(theta)[:, None] * w)

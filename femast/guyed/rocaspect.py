@@ -34,9 +34,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..elements.shroud_law import DyneemaLaw
 from .cdpr import CdprGeometry
 from .complete_mast import ShroudSet
-from ..elements.shroud_law import DyneemaLaw
 
 FRAME = (8.3, 6.8, 4.0)
 """Frame size x, y, z, m."""
@@ -105,8 +105,17 @@ def rocaspect_geometry(tau_min: float = 20.0, tau_max: float = 1500.0, mass: flo
             B.append(b)
             F.append([a[0], a[1], FOOT_HEIGHT])
             mast.append(i)
-    return CdprGeometry(np.array(A), np.array(B), np.array(F), np.array(mast), mast_bases(), mast_tops(),
-                        mass=mass, tau_min=tau_min, tau_max=tau_max)
+    return CdprGeometry(
+        np.array(A),
+        np.array(B),
+        np.array(F),
+        np.array(mast),
+        mast_bases(),
+        mast_tops(),
+        mass=mass,
+        tau_min=tau_min,
+        tau_max=tau_max,
+    )
 
 
 def rocaspect_shrouds(mast: int, pretension: float, law: DyneemaLaw | None = None) -> ShroudSet:
@@ -130,15 +139,17 @@ def fig5a_trajectory(n_per_segment: int = 25) -> np.ndarray:
     seed's height limit) and back (the 'straight diagonal' segment), orientation fixed.
     """
     x0, y0, z0 = POSE_0[:3]
-    way = np.array([
-        [x0, y0, z0],
-        [x0 + 3.0, y0, z0],
-        [x0 + 3.0, y0 + 1.8, z0],
-        [x0, y0 + 1.8, z0],
-        [x0, y0, z0],
-        [x0 + 3.0, y0 + 1.8, 2.0],
-        [x0, y0, z0],
-    ])
+    way = np.array(
+        [
+            [x0, y0, z0],
+            [x0 + 3.0, y0, z0],
+            [x0 + 3.0, y0 + 1.8, z0],
+            [x0, y0 + 1.8, z0],
+            [x0, y0, z0],
+            [x0 + 3.0, y0 + 1.8, 2.0],
+            [x0, y0, z0],
+        ]
+    )
     s = np.linspace(0.0, 1.0, n_per_segment, endpoint=False)
     pts = [w0 + s[:, None] * (w1 - w0) for w0, w1 in zip(way[:-1], way[1:])]
     pts.append(way[-1:])

@@ -8,7 +8,15 @@
 ``femast.modal`` was one module before the package move (issue 15); its names are re-exported here.
 """
 
-from .modes import (EQUILIBRIUM_TOL, Modes, check_equilibrium, default_shift, expand_shapes, frequencies_of,
-                    modal_analysis, solve_eigen)
+from .modes import (
+    EQUILIBRIUM_TOL,
+    Modes,
+    check_equilibrium,
+    default_shift,
+    expand_shapes,
+    frequencies_of,
+    modal_analysis,
+    solve_eigen,
+)
 
 __all__ = ["Modes", "modal_analysis", "solve_eigen", "expand_shapes", "frequencies_of"]

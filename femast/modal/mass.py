@@ -73,15 +73,17 @@ def point_mass_spec(node, mass=0.0, inertia=None, offset=None, name="") -> Point
         elif a.shape == (3, 3):
             J = a.copy()
         else:
-            raise ModelError(f"{who}: inertia must be a scalar, 3 principal values or a 3x3 matrix (kg m^2); "
-                             f"got shape {a.shape}")
+            raise ModelError(
+                f"{who}: inertia must be a scalar, 3 principal values or a 3x3 matrix (kg m^2); got shape {a.shape}"
+            )
         if not np.all(np.isfinite(J)):
             raise ModelError(f"{who}: inertia {inertia!r} is not finite")
         if not np.allclose(J, J.T, rtol=1e-12, atol=1e-15 * max(np.abs(J).max(), 1e-300)):
             raise ModelError(f"{who}: inertia matrix is not symmetric")
         if np.linalg.eigvalsh(J).min() < -1e-12 * max(np.abs(J).max(), 1e-300):
-            raise ModelError(f"{who}: inertia {inertia!r} kg m^2 has a negative principal value; "
-                             "moments of inertia are >= 0")
+            raise ModelError(
+                f"{who}: inertia {inertia!r} kg m^2 has a negative principal value; moments of inertia are >= 0"
+            )
     c = np.zeros(3) if offset is None else np.asarray(offset, dtype=float).reshape(-1)
     if c.shape != (3,) or not np.all(np.isfinite(c)):
         raise ModelError(f"{who}: offset {offset!r} must be a finite 3-vector (m)")
@@ -150,7 +152,7 @@ def beam_mass_kernel(nodes, x, R, E0, l0, mass_per_length, rotary_per_length, ou
         idx = (1, 5, 7, 11)
         sgn = 1.0
         for plane in range(2):
-            if plane == 1:   # x-z plane: w1, ty1, w2, ty2 (rotation sign opposite)
+            if plane == 1:  # x-z plane: w1, ty1, w2, ty2 (rotation sign opposite)
                 idx = (2, 4, 8, 10)
                 sgn = -1.0
             i0, i1, i2, i3 = idx
@@ -214,8 +216,11 @@ class _MassBlock:
 
 
 def _per_element(value, n, what):
-    a = np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy() if np.ndim(value) == 0 or np.size(value) == n \
+    a = (
+        np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy()
+        if np.ndim(value) == 0 or np.size(value) == n
         else None
+    )
     if a is None:
         raise ModelError(f"{what}: give one value or one per element ({n}); got {np.size(value)}")
     bad = np.flatnonzero(~np.isfinite(a) | (a < 0))
@@ -235,14 +240,28 @@ def family_mass_blocks(model, families, x, R, X0):
     for f in families:
         if isinstance(f, BeamFamily) and all(int(l) in beams for l in f.labels):
             specs = [beams[int(l)] for l in f.labels]
-            mpl = np.array([s.mass_per_length if getattr(s, "mass_per_length", None) is not None
-                            else s.section.rho * s.section.A for s in specs])
+            mpl = np.array(
+                [
+                    s.mass_per_length
+                    if getattr(s, "mass_per_length", None) is not None
+                    else s.section.rho * s.section.A
+                    for s in specs
+                ]
+            )
             rot = np.array([m / s.section.A * (s.section.Iy + s.section.Iz) for m, s in zip(mpl, specs)])
             if not mpl.any():
                 continue
             M = np.zeros((f.n_elements, 12, 12))
-            beam_mass_kernel(f.nodes, np.ascontiguousarray(x), np.ascontiguousarray(R), np.ascontiguousarray(f.E0),
-                             np.ascontiguousarray(f.l0, dtype=float), mpl, rot, M)
+            beam_mass_kernel(
+                f.nodes,
+                np.ascontiguousarray(x),
+                np.ascontiguousarray(R),
+                np.ascontiguousarray(f.E0),
+                np.ascontiguousarray(f.l0, dtype=float),
+                mpl,
+                rot,
+                M,
+            )
             blocks.append(_MassBlock(f.name, f.nodes, M))
         elif isinstance(f, TrussFamily) and all(int(l) in trusses for l in f.labels):
             specs = [trusses[int(l)] for l in f.labels]
@@ -256,8 +275,10 @@ def family_mass_blocks(model, families, x, R, X0):
             M = np.asarray(f.mass_matrices(X0, x, R), dtype=float)
             nn = f.nodes.shape[1]
             if M.shape != (f.n_elements, 6 * nn, 6 * nn) or not np.all(np.isfinite(M)):
-                raise ModelError(f"element family '{f.name}': mass_matrices() must return finite (n_el, {6 * nn}, "
-                                 f"{6 * nn}) matrices (kg, kg m, kg m^2); got shape {M.shape}")
+                raise ModelError(
+                    f"element family '{f.name}': mass_matrices() must return finite (n_el, {6 * nn}, "
+                    f"{6 * nn}) matrices (kg, kg m, kg m^2); got shape {M.shape}"
+                )
             blocks.append(_MassBlock(f.name, f.nodes, M))
         elif getattr(f, "mass_per_length", None) is not None:
             mpl = _per_element(f.mass_per_length, f.n_elements, f"element family '{f.name}': mass_per_length")
@@ -284,9 +305,11 @@ def check_point_masses(model, dofmap):
     lost = np.flatnonzero(np.all(dofmap.eq[rows, :3] < 0, axis=1))
     if lost.size:
         p = pms[int(lost[0])]
-        raise ModelError(f"{p.name or 'point mass'} at node {p.node}: the node has no element or rigid body, "
-                         "so its mass moves with nothing; put the mass on a node of the structure (or a "
-                         "rigid body's reference node)")
+        raise ModelError(
+            f"{p.name or 'point mass'} at node {p.node}: the node has no element or rigid body, "
+            "so its mass moves with nothing; put the mass on a node of the structure (or a "
+            "rigid body's reference node)"
+        )
 
 
 def assemble_mass(analysis):
@@ -306,7 +329,7 @@ def assemble_mass(analysis):
         cached = (key, Assembler(dm, blocks, full=True))
         try:
             analysis._mass_assembler = cached
-        except AttributeError:   # an analysis object that takes no new attributes: no cache
+        except AttributeError:  # an analysis object that takes no new attributes: no cache
             pass
     M_aa = cached[1].full_tangent([b.matrices for b in blocks]).copy()
     if analysis.constraints.active:

@@ -29,10 +29,10 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse.linalg as spla
 
+from ..analysis.solvers.convergence import force_moment_abs_max
 from ..elements.base import IncrementContext
 from ..errors import ModelError, StateError
 from .mass import assemble_mass
-from ..analysis.solvers.convergence import force_moment_abs_max
 
 #: Largest residual / reference force ratio accepted as a converged state (100x Newton's default
 #: force tolerance: a converged increment is well inside it, an unbalanced pretension is O(1)).
@@ -61,7 +61,7 @@ class Modes:
     asymmetry: float = 0.0
     n_free: int = 0
     n_mass: int = 0
-    cells: dict = field(default_factory=dict)   # family name -> (n_el, nn) node rows, for VTK
+    cells: dict = field(default_factory=dict)  # family name -> (n_el, nn) node rows, for VTK
 
     @property
     def frequencies(self) -> np.ndarray:
@@ -84,8 +84,10 @@ class Modes:
 
     def table(self) -> str:
         """Plain-text table of the frequencies."""
-        lines = [f"modes of {self.label or 'the state'} ({self.n_free} free DOFs, {self.n_mass} with mass)",
-                 f"{'mode':>5} {'f (Hz)':>14} {'omega^2 (rad/s)^2':>20}"]
+        lines = [
+            f"modes of {self.label or 'the state'} ({self.n_free} free DOFs, {self.n_mass} with mass)",
+            f"{'mode':>5} {'f (Hz)':>14} {'omega^2 (rad/s)^2':>20}",
+        ]
         for i, (f, lam) in enumerate(zip(self.frequencies, self.eigenvalues)):
             lines.append(f"{i + 1:>5} {f:>14.6g} {lam:>20.6g}")
         return "\n".join(lines)
@@ -96,9 +98,17 @@ class Modes:
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         path = folder / f"{name}.npz"
-        np.savez(path, eigenvalues=self.eigenvalues, frequencies_hz=self.frequencies, shapes=self.shapes,
-                 node_labels=self.node_labels, x=self.x, label=np.array(self.label), asymmetry=self.asymmetry,
-                 **{f"cells/{k}": v for k, v in self.cells.items()})
+        np.savez(
+            path,
+            eigenvalues=self.eigenvalues,
+            frequencies_hz=self.frequencies,
+            shapes=self.shapes,
+            node_labels=self.node_labels,
+            x=self.x,
+            label=np.array(self.label),
+            asymmetry=self.asymmetry,
+            **{f"cells/{k}": v for k, v in self.cells.items()},
+        )
         with open(folder / f"{name}.csv", "w") as fh:
             fh.write("mode,f_hz,omega2_rad2_per_s2\n")
             for i, (f, lam) in enumerate(zip(self.frequencies, self.eigenvalues)):
@@ -106,18 +116,25 @@ class Modes:
         return path
 
     @classmethod
-    def load(cls, path) -> "Modes":
+    def load(cls, path) -> Modes:
         """Read a file written by :meth:`write`."""
         d = np.load(path)
-        cells = {k[len("cells/"):]: d[k] for k in d.files if k.startswith("cells/")}
-        return cls(eigenvalues=d["eigenvalues"], shapes=d["shapes"], node_labels=d["node_labels"], x=d["x"],
-                   label=str(d["label"]), asymmetry=float(d["asymmetry"]), cells=cells)
+        cells = {k[len("cells/") :]: d[k] for k in d.files if k.startswith("cells/")}
+        return cls(
+            eigenvalues=d["eigenvalues"],
+            shapes=d["shapes"],
+            node_labels=d["node_labels"],
+            x=d["x"],
+            label=str(d["label"]),
+            asymmetry=float(d["asymmetry"]),
+            cells=cells,
+        )
 
 
 def _state(analysis):
     """(K_ff, residual on the free DOFs, reference force, reference moment) at the analysis'
     current configuration and committed state."""
-    sys_ = getattr(analysis, "system", None)   # the analysis package of issue 15: System holds the assembly
+    sys_ = getattr(analysis, "system", None)  # the analysis package of issue 15: System holds the assembly
     if sys_ is not None:
         responses = sys_.evaluate(sys_.committed_context())
         res = sys_.residual(responses, analysis.loads)
@@ -146,7 +163,8 @@ def check_equilibrium(analysis, r, fmax, mmax, tol=EQUILIBRIUM_TOL, where=""):
             f"modal analysis{where}: the state is not converged (not in equilibrium): residual "
             f"{r[worst]:.3g} {'N m' if analysis.is_rot[worst] else 'N'} at {analysis.dofmap.describe(worst)}, "
             f"{ratio[worst]:.2g} of the largest force (limit {tol:g}). Run the static analysis to a converged "
-            "increment first (an initial pretension out of balance needs a step), or pass check=False.")
+            "increment first (an initial pretension out of balance needs a step), or pass check=False."
+        )
 
 
 def default_shift(K, M, massed):
@@ -166,7 +184,7 @@ def solve_eigen(K, M, n_modes: int, sigma: float | None = None):
     massed = md > 0
     if sigma is None:
         sigma = default_shift(K, M, massed)
-    if n_modes >= n - 1:   # ARPACK needs k < n - 1: tiny problems go dense
+    if n_modes >= n - 1:  # ARPACK needs k < n - 1: tiny problems go dense
         A = (K - sigma * M).toarray()
         Ainv_M = np.linalg.solve(A, M.toarray())
         mu, V = np.linalg.eig(Ainv_M)
@@ -178,7 +196,7 @@ def solve_eigen(K, M, n_modes: int, sigma: float | None = None):
     else:
         lu = spla.splu((K - sigma * M).tocsc())
         op = spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
-        rng = np.random.default_rng(0)   # reproducible starting vector
+        rng = np.random.default_rng(0)  # reproducible starting vector
         v0 = M @ rng.standard_normal(n) + 1e-3 * rng.standard_normal(n) * massed
         lam, V = spla.eigsh(K, k=n_modes, M=M, sigma=sigma, which="LM", OPinv=op, v0=v0)
     order = np.argsort(lam)
@@ -191,13 +209,16 @@ def _check_modes(n_modes, nf, n_mass, model_name):
     if isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer)) or n_modes < 1:
         raise ModelError(f"modal analysis of '{model_name}': n_modes = {n_modes!r} must be a whole number >= 1")
     if n_modes > n_mass:
-        raise ModelError(f"modal analysis of '{model_name}': n_modes = {n_modes} modes asked for, but the model has "
-                         f"only {n_mass} free DOFs that carry mass (of {nf} free DOFs); ask for at most {n_mass} "
-                         "modes, or add mass")
+        raise ModelError(
+            f"modal analysis of '{model_name}': n_modes = {n_modes} modes asked for, but the model has "
+            f"only {n_mass} free DOFs that carry mass (of {nf} free DOFs); ask for at most {n_mass} "
+            "modes, or add mass"
+        )
 
 
-def modal_analysis(analysis, n_modes: int = 10, shift_hz: float | None = None, check: bool = True,
-                   label: str = "") -> Modes:
+def modal_analysis(
+    analysis, n_modes: int = 10, shift_hz: float | None = None, check: bool = True, label: str = ""
+) -> Modes:
     """The lowest ``n_modes`` vibration modes of ``analysis`` (a :class:`femast.Analysis`) about its
     current, converged state: before :meth:`~femast.Analysis.run` the initial state (if it is in
     equilibrium), after it the last converged increment, or inside ``on_frame`` any saved one.
@@ -214,9 +235,11 @@ def modal_analysis(analysis, n_modes: int = 10, shift_hz: float | None = None, c
     nf = K.shape[0]
     md = M.diagonal()
     if M.nnz == 0 or not np.any(md > 0):
-        raise ModelError(f"modal analysis of '{model.name}': the model has no mass on its free DOFs. Give beam "
-                         "sections a density (section.with_(rho=...), kg/m^3), trusses/cables a mass_per_length "
-                         "(kg/m), a family a mass_per_length attribute, or add model.point_mass(node, mass=...)")
+        raise ModelError(
+            f"modal analysis of '{model.name}': the model has no mass on its free DOFs. Give beam "
+            "sections a density (section.with_(rho=...), kg/m^3), trusses/cables a mass_per_length "
+            "(kg/m), a family a mass_per_length attribute, or add model.point_mass(node, mass=...)"
+        )
     n_mass = int(np.count_nonzero(md > 0))
     _check_modes(n_modes, nf, n_mass, model.name)
     kmax = abs(K).max()
@@ -225,14 +248,25 @@ def modal_analysis(analysis, n_modes: int = 10, shift_hz: float | None = None, c
     sigma = None if shift_hz is None else float(np.sign(shift_hz) * (2 * math.pi * shift_hz) ** 2)
     try:
         lam, V = solve_eigen(Ks, M, int(n_modes), sigma)
-    except RuntimeError as exc:   # splu of a singular K - sigma M
-        raise ModelError(f"modal analysis of '{model.name}': K - sigma M is singular at the shift ({exc}); the "
-                         "model has a massless mechanism, or an eigenvalue sits exactly at the shift: give "
-                         "shift_hz, or mass to the mechanism's DOFs") from None
+    except RuntimeError as exc:  # splu of a singular K - sigma M
+        raise ModelError(
+            f"modal analysis of '{model.name}': K - sigma M is singular at the shift ({exc}); the "
+            "model has a massless mechanism, or an eigenvalue sits exactly at the shift: give "
+            "shift_hz, or mass to the mechanism's DOFs"
+        ) from None
     shapes = expand_shapes(analysis, V)
     cells = {f.name: np.asarray(f.nodes) for f in analysis.families}
-    return Modes(eigenvalues=lam, shapes=shapes, node_labels=np.asarray(model.node_labels), x=analysis.x.copy(),
-                 label=label, asymmetry=asym, n_free=nf, n_mass=n_mass, cells=cells)
+    return Modes(
+        eigenvalues=lam,
+        shapes=shapes,
+        node_labels=np.asarray(model.node_labels),
+        x=analysis.x.copy(),
+        label=label,
+        asymmetry=asym,
+        n_free=nf,
+        n_mass=n_mass,
+        cells=cells,
+    )
 
 
 def expand_shapes(analysis, V) -> np.ndarray:

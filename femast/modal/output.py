@@ -27,7 +27,7 @@ def _cells(modes):
             continue
         if conn.shape[1] == 2:
             cells.append(("line", conn))
-        else:   # cables over pulleys: consecutive segments
+        else:  # cables over pulleys: consecutive segments
             cells.append(("line", np.column_stack([conn[:, :-1].ravel(), conn[:, 1:].ravel()])))
     return cells
 
@@ -40,7 +40,7 @@ def export_modes_vtk(modes, folder, n_frames: int = 24, scale: float | None = No
     cells = _cells(modes)
     size = float(np.ptp(modes.x, axis=0).max()) or 1.0
     paths = []
-    for k in (range(len(modes)) if which is None else which):
+    for k in range(len(modes)) if which is None else which:
         shape = modes.shapes[k]
         amp = float(np.abs(shape[:, :3]).max())
         s = scale if scale is not None else (0.05 * size / amp if amp > 0 else 1.0)
@@ -52,9 +52,16 @@ def export_modes_vtk(modes, folder, n_frames: int = 24, scale: float | None = No
         period = 1.0 / abs(f) if f != 0 else 1.0
         for i in range(n_frames):
             phase = np.sin(2 * np.pi * i / n_frames)
-            mesh = meshio.Mesh(modes.x, cells, point_data={
-                "U": s * phase * shape[:, :3], "mode_shape": shape[:, :3], "mode_rotation": shape[:, 3:],
-                "node_label": modes.node_labels.astype(float)})
+            mesh = meshio.Mesh(
+                modes.x,
+                cells,
+                point_data={
+                    "U": s * phase * shape[:, :3],
+                    "mode_shape": shape[:, :3],
+                    "mode_rotation": shape[:, 3:],
+                    "node_label": modes.node_labels.astype(float),
+                },
+            )
             name = f"frame_{i:03d}.vtu"
             mesh.write(sub / name)
             ET.SubElement(coll, "DataSet", timestep=repr(period * i / n_frames), part="0", file=name)
@@ -88,7 +95,7 @@ class ModesRecorder:
         self.modes = []
         self.frames = []
         out = getattr(analysis, "output", None)
-        if out is not None and hasattr(out, "recorders"):   # the analysis package (issue 15): an observer's list
+        if out is not None and hasattr(out, "recorders"):  # the analysis package (issue 15): an observer's list
             self._chain = None
             out.recorders.append(self)
         else:
@@ -103,9 +110,9 @@ class ModesRecorder:
         try:
             m = self._modal(self.analysis, self.n_modes, label=label, **self.options)
         except StateError:
-            if i > 0:   # a converged increment must be in equilibrium: a real failure
+            if i > 0:  # a converged increment must be in equilibrium: a real failure
                 raise
-            m = None    # the initial state of a model whose pretension is out of balance
+            m = None  # the initial state of a model whose pretension is out of balance
         self.modes.append(m)
         self.frames.append((str(data["step"]), int(data["increment"]), float(data["total_time"])))
         if self.analysis.out is not None and m is not None:

@@ -32,12 +32,14 @@ class FrequencyStep(Step):
     kind = "frequency"
 
     def load(self, *a, **k):
-        raise ModelError(f"step '{self.name}' is a frequency step: it applies no loads; put them in a static step "
-                         "before it")
+        raise ModelError(
+            f"step '{self.name}' is a frequency step: it applies no loads; put them in a static step before it"
+        )
 
     def prescribe(self, *a, **k):
-        raise ModelError(f"step '{self.name}' is a frequency step: it prescribes no motion; put it in a static "
-                         "step before it")
+        raise ModelError(
+            f"step '{self.name}' is a frequency step: it prescribes no motion; put it in a static step before it"
+        )
 
 
 def add_frequency_step(model, name=None, n_modes: int = 10, shift_hz: float | None = None, vtk: bool = False):
@@ -75,8 +77,9 @@ def run_frequency_step(analysis, step):
         modes.write(folder, step.name)
         if step.vtk:
             export_modes_vtk(modes, folder / f"{step.name}_vtk")
-    analysis.summary.steps.append({"name": step.name, "kind": "frequency",
-                                   "frequencies_hz": [float(f) for f in modes.frequencies]})
+    analysis.summary.steps.append(
+        {"name": step.name, "kind": "frequency", "frequencies_hz": [float(f) for f in modes.frequencies]}
+    )
     if analysis.progress:
         from tqdm.auto import tqdm
 

@@ -43,7 +43,7 @@ class Amplitude:
         return np.interp(t, self.times, self.values)
 
     @classmethod
-    def from_path(cls, values, period: float = 1.0, name: str = "path") -> "Amplitude":
+    def from_path(cls, values, period: float = 1.0, name: str = "path") -> Amplitude:
         """Evenly spaced samples ``values`` over a step of length ``period`` (s)."""
         v = np.asarray(values, dtype=float).ravel()
         return cls(np.linspace(0.0, period, v.size), v, name=name)

@@ -56,16 +56,20 @@ def node_rows(model, nodes, what: str):
     if a.ndim == 1 and a.size == 2:
         a = a[None, :]
     if a.ndim != 2 or a.shape[1] != 2:
-        raise ModelError(f"{what}: nodes must be an (n_elements, 2) array of node labels (one row per element, "
-                         f"its two end nodes); got shape {a.shape}" + ("; transpose it" if a.ndim == 2 and a.shape[0] == 2 else ""))
+        raise ModelError(
+            f"{what}: nodes must be an (n_elements, 2) array of node labels (one row per element, "
+            f"its two end nodes); got shape {a.shape}" + ("; transpose it" if a.ndim == 2 and a.shape[0] == 2 else "")
+        )
     if a.dtype.kind not in "iuf" or a.dtype.kind == "b":
         raise ModelError(f"{what}: nodes must be whole-number node labels (got {a.dtype} values)")
     if a.dtype.kind == "f":
-        bad = ~np.isfinite(a) | (a != np.round(a)) | (np.abs(a) > 2.0 ** 62)
+        bad = ~np.isfinite(a) | (a != np.round(a)) | (np.abs(a) > 2.0**62)
         if bad.any():
             i, j = np.argwhere(bad)[0]
-            raise ModelError(f"{what}: element {i}: node {a[i, j]!r} is not a node label (a whole number); "
-                             "give the labels that model.node / model.nodes returned")
+            raise ModelError(
+                f"{what}: element {i}: node {a[i, j]!r} is not a node label (a whole number); "
+                "give the labels that model.node / model.nodes returned"
+            )
     lab = a.astype(np.int64)
     known = np.asarray(model._node_labels, dtype=np.int64)
     order = np.argsort(known, kind="stable")
@@ -75,8 +79,10 @@ def node_rows(model, nodes, what: str):
     if not found.all():
         i, j = np.argwhere(~found)[0]
         hint = f"known labels {known.min()}..{known.max()}" if len(known) else "the model has no nodes yet"
-        raise ModelError(f"{_where(what, i, lab)}: unknown node {lab[i, j]} ({hint}); create it with "
-                         "model.node(x, y, z) or model.nodes(coords)")
+        raise ModelError(
+            f"{_where(what, i, lab)}: unknown node {lab[i, j]} ({hint}); create it with "
+            "model.node(x, y, z) or model.nodes(coords)"
+        )
     return lab, order[pos]
 
 
@@ -97,8 +103,9 @@ def per_element(value, n: int, what: str, unit: str, *, lo=None, strict=True):
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         rule = "" if lo is None else (f" and {'>' if strict else '>='} {lo:g}")
-        raise ModelError(f"{what} of element {i} = {a[i]!r} {unit} must be finite{rule} "
-                         f"(within {MAX_MAGNITUDE:g} {unit})")
+        raise ModelError(
+            f"{what} of element {i} = {a[i]!r} {unit} must be finite{rule} (within {MAX_MAGNITUDE:g} {unit})"
+        )
     return a
 
 
@@ -135,8 +142,9 @@ def add_nodes(model, coords) -> list[int]:
     return labels
 
 
-def add_beams(model, nodes, section, up=(0.0, 0.0, 1.0), family="beam", mass_per_length=None,
-              length_error_m=0.0, alpha_per_K=0.0) -> np.ndarray:
+def add_beams(
+    model, nodes, section, up=(0.0, 0.0, 1.0), family="beam", mass_per_length=None, length_error_m=0.0, alpha_per_K=0.0
+) -> np.ndarray:
     """One beam element per row of ``nodes`` ((n, 2) node labels), as :meth:`Model.beam` with ``n=1``.
 
     section : a Section, or one per element.  up : a global direction (3,) or one per element (n, 3)
@@ -156,41 +164,53 @@ def add_beams(model, nodes, section, up=(0.0, 0.0, 1.0), family="beam", mass_per
         except TypeError:
             secs = None
         if secs is None or len(secs) != n:
-            raise ModelError(f"{what}: section must be a femast Section or one per element ({n}); "
-                             f"got {type(section).__name__}")
+            raise ModelError(
+                f"{what}: section must be a femast Section or one per element ({n}); got {type(section).__name__}"
+            )
         bad = [i for i, s in enumerate(secs) if not isinstance(s, Section)]
         if bad:
-            raise ModelError(f"{_where(what, bad[0], labs)}: section must be a femast Section "
-                             f"(got {type(secs[bad[0]]).__name__})")
+            raise ModelError(
+                f"{_where(what, bad[0], labs)}: section must be a femast Section (got {type(secs[bad[0]]).__name__})"
+            )
     try:
         u = np.asarray(up, dtype=float)
     except (TypeError, ValueError):
         raise ModelError(f"{what}: up-vector {up!r} must be 3 numbers or one row of 3 per element") from None
     if u.shape not in ((3,), (n, 3)):
-        raise ModelError(f"{what}: up-vector must be one global direction (3,) or one per element ({n}, 3); "
-                         f"got shape {u.shape}")
+        raise ModelError(
+            f"{what}: up-vector must be one global direction (3,) or one per element ({n}, 3); got shape {u.shape}"
+        )
     if not np.isfinite(u).all():
         i = 0 if u.ndim == 1 else int(np.argwhere(~np.isfinite(u))[0, 0])
-        raise ModelError(f"{_where(what, i, labs)}: up-vector {u if u.ndim == 1 else u[i]} is not finite; "
-                         "give a finite global direction")
+        raise ModelError(
+            f"{_where(what, i, labs)}: up-vector {u if u.ndim == 1 else u[i]} is not finite; "
+            "give a finite global direction"
+        )
     fams = _names(family, n, what, "beam")
-    mpl = [None] * n if mass_per_length is None else \
-        per_element(mass_per_length, n, f"{what}: mass_per_length", "kg/m", lo=0.0, strict=False).tolist()
+    mpl = (
+        [None] * n
+        if mass_per_length is None
+        else per_element(mass_per_length, n, f"{what}: mass_per_length", "kg/m", lo=0.0, strict=False).tolist()
+    )
     a, b, L = _lengths(model, rows)
     short = L <= 1e-12 * np.maximum(1.0, np.abs(a).max(axis=1))
     if short.any():
         i = int(np.flatnonzero(short)[0])
-        raise ModelError(f"{_where(what, i, labs)}: nodes {labs[i, 0]} and {labs[i, 1]} coincide (length "
-                         f"{L[i]:g} m); a beam needs two distinct nodes")
+        raise ModelError(
+            f"{_where(what, i, labs)}: nodes {labs[i, 0]} and {labs[i, 1]} coincide (length "
+            f"{L[i]:g} m); a beam needs two distinct nodes"
+        )
     e = (b - a) / L[:, None]
     U = np.broadcast_to(u, (n, 3))
     perp = U - (U * e).sum(axis=1)[:, None] * e
-    par = np.sqrt((perp ** 2).sum(axis=1)) < 1e-6 * np.maximum(np.sqrt((U ** 2).sum(axis=1)), 1e-300)
+    par = np.sqrt((perp**2).sum(axis=1)) < 1e-6 * np.maximum(np.sqrt((U**2).sum(axis=1)), 1e-300)
     if par.any():
         i = int(np.flatnonzero(par)[0])
-        raise ModelError(f"{_where(what, i, labs)}: up-vector {tuple(float(v) for v in U[i])} is parallel to the "
-                         f"element axis {tuple(float(v) for v in np.round(e[i], 6))}; choose an up-vector not "
-                         "along the beam")
+        raise ModelError(
+            f"{_where(what, i, labs)}: up-vector {tuple(float(v) for v in U[i])} is parallel to the "
+            f"element axis {tuple(float(v) for v in np.round(e[i], 6))}; choose an up-vector not "
+            "along the beam"
+        )
     lerr = per_element(length_error_m, n, f"{what}: length_error_m", "m")
     alpha = per_element(alpha_per_K, n, f"{what}: alpha_per_K", "1/K")
     first = model._next_element
@@ -202,8 +222,18 @@ def add_beams(model, nodes, section, up=(0.0, 0.0, 1.0), family="beam", mass_per
     return labels
 
 
-def add_trusses(model, nodes, EA, L0=None, pretension=None, tension_only=False, family=None,
-                mass_per_length=0.0, length_error_m=0.0, alpha_per_K=0.0) -> np.ndarray:
+def add_trusses(
+    model,
+    nodes,
+    EA,
+    L0=None,
+    pretension=None,
+    tension_only=False,
+    family=None,
+    mass_per_length=0.0,
+    length_error_m=0.0,
+    alpha_per_K=0.0,
+) -> np.ndarray:
     """One truss (or, ``tension_only``, cable) element per row of ``nodes`` ((n, 2) node labels), as
     :meth:`Model.truss`.  EA (N), L0 (m; None: from ``pretension`` or stress free), pretension (N),
     tension_only, mass_per_length (kg/m), length_error_m (m), alpha_per_K (1/K): one value or one
@@ -218,8 +248,9 @@ def add_trusses(model, nodes, EA, L0=None, pretension=None, tension_only=False, 
     short = L <= 1e-12
     if short.any():
         i = int(np.flatnonzero(short)[0])
-        raise ModelError(f"{_where(what, i, labs)}: nodes {labs[i, 0]} and {labs[i, 1]} coincide; a truss needs "
-                         "two distinct nodes")
+        raise ModelError(
+            f"{_where(what, i, labs)}: nodes {labs[i, 0]} and {labs[i, 1]} coincide; a truss needs two distinct nodes"
+        )
     if L0 is not None and pretension is not None:
         raise ModelError(f"{what}: give L0 or pretension, not both")
     l0 = [None] * n if L0 is None else per_element(L0, n, f"{what}: unstretched length L0", "m", lo=0.0).tolist()
@@ -241,8 +272,7 @@ def add_trusses(model, nodes, EA, L0=None, pretension=None, tension_only=False, 
     alpha = per_element(alpha_per_K, n, f"{what}: alpha_per_K", "1/K")
     first = model._next_element
     labels = np.arange(first, first + n, dtype=np.int64)
-    model.trusses.extend(map(TrussSpec, labels.tolist(), map(tuple, labs.tolist()), EA.tolist(), l0, pre, t,
-                             fams, mpl))
+    model.trusses.extend(map(TrussSpec, labels.tolist(), map(tuple, labs.tolist()), EA.tolist(), l0, pre, t, fams, mpl))
     model._next_element += n
     _error_sources(model, labels, lerr, alpha)
     return labels

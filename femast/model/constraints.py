@@ -75,7 +75,7 @@ def _geometric_values(x, rigid, trans_eq, f_net, out):
             d[i] = x[s, i] - x[r, i]
             q = trans_eq[k, i]
             f[i] = f_net[q] if q >= 0 else 0.0
-        fd = (f[0] * d[0] + f[2] * d[2]) + f[1] * d[1]   # numpy einsum's order: the same bits as before
+        fd = (f[0] * d[0] + f[2] * d[2]) + f[1] * d[1]  # numpy einsum's order: the same bits as before
         for i in range(3):
             for j in range(3):
                 out[9 * k + 3 * i + j] = d[i] * f[j] - (fd if i == j else 0.0)
@@ -113,8 +113,10 @@ def rigid_body_spec(model, reference, nodes, name: str) -> RigidBodySpec:
         model._check_node(n, f"rigid body '{name}'")
     others = [n for n in nodes if int(n) != int(reference)]
     if len(others) < 1:
-        raise ModelError(f"rigid body '{name}': needs the reference node and at least one other node "
-                         f"(got {len(others) + 1} node in all); a rigid body with fewer than two nodes ties nothing")
+        raise ModelError(
+            f"rigid body '{name}': needs the reference node and at least one other node "
+            f"(got {len(others) + 1} node in all); a rigid body with fewer than two nodes ties nothing"
+        )
     if len(set(int(n) for n in others)) != len(others):
         raise ModelError(f"rigid body '{name}': a node is listed twice")
     return RigidBodySpec(name, int(reference), tuple(int(n) for n in others))
@@ -148,8 +150,8 @@ class Constraints:
     def __init__(self, model, n_nodes):
         self.n = n_nodes
         self.dependent = np.zeros((n_nodes, 6), dtype=bool)
-        self.rigid_slave = []      # (slave index, reference index)
-        self.tie = []              # (slave index, master index, dof)
+        self.rigid_slave = []  # (slave index, reference index)
+        self.tie = []  # (slave index, master index, dof)
         owner = {}
         for rb in model.rigid_bodies:
             r = model.index(rb.reference)
@@ -158,16 +160,20 @@ class Constraints:
                 if s == r:
                     continue
                 if s in owner:
-                    raise ModelError(f"node {lab} is in two constraints ({owner[s]} and rigid body '{rb.name}'); "
-                                     "a node can belong to one rigid body or tie only")
+                    raise ModelError(
+                        f"node {lab} is in two constraints ({owner[s]} and rigid body '{rb.name}'); "
+                        "a node can belong to one rigid body or tie only"
+                    )
                 owner[s] = f"rigid body '{rb.name}'"
                 self.rigid_slave.append((s, r))
                 self.dependent[s, :] = True
         for t in model.ties:
             s, m = model.index(t.slave), model.index(t.master)
             if s in owner:
-                raise ModelError(f"node {t.slave} is in two constraints ({owner[s]} and a tie to node {t.master}); "
-                                 "a node can belong to one rigid body or tie only")
+                raise ModelError(
+                    f"node {t.slave} is in two constraints ({owner[s]} and a tie to node {t.master}); "
+                    "a node can belong to one rigid body or tie only"
+                )
             owner[s] = f"tie to node {t.master}"
             for d in t.dofs:
                 self.tie.append((s, m, d))
@@ -176,9 +182,11 @@ class Constraints:
         for node in masters:
             if node in owner:
                 lab = model.node_labels[node]
-                raise ModelError(f"node {lab} is the reference/master of one constraint and dependent in another "
-                                 f"({owner[node]}); chains of constraints are not supported: tie it to the same "
-                                 "reference node instead")
+                raise ModelError(
+                    f"node {lab} is the reference/master of one constraint and dependent in another "
+                    f"({owner[node]}); chains of constraints are not supported: tie it to the same "
+                    "reference node instead"
+                )
         self.rigid_slave = np.array(self.rigid_slave, dtype=np.int64).reshape(-1, 2)
         self.tie = np.array(self.tie, dtype=np.int64).reshape(-1, 3)
         self.references = np.unique(self.rigid_slave[:, 1]) if len(self.rigid_slave) else np.zeros(0, np.int64)
@@ -218,8 +226,14 @@ class Constraints:
             rows.append(es[ok]), cols.append(eq[r[ok], i]), vals.append(np.ones(ok.sum()))
         lever_rows, lever_cols, lever_k, lever_c, lever_sign = [], [], [], [], []
         # -[d]x entries (i, j): (0,1) d2, (0,2) -d1, (1,0) -d2, (1,2) d0, (2,0) d1, (2,1) -d0
-        for i, j, c, sign in ((0, 1, 2, 1.0), (0, 2, 1, -1.0), (1, 0, 2, -1.0), (1, 2, 0, 1.0),
-                              (2, 0, 1, 1.0), (2, 1, 0, -1.0)):
+        for i, j, c, sign in (
+            (0, 1, 2, 1.0),
+            (0, 2, 1, -1.0),
+            (1, 0, 2, -1.0),
+            (1, 2, 0, 1.0),
+            (2, 0, 1, 1.0),
+            (2, 1, 0, -1.0),
+        ):
             es = eq[s, i]
             ok = np.flatnonzero(es >= 0)
             lever_rows.append(es[ok]), lever_cols.append(eq[r[ok], 3 + j])
@@ -239,11 +253,12 @@ class Constraints:
         all_rows = np.concatenate([fixed_rows] + lever_rows)
         all_cols = np.concatenate([fixed_cols] + lever_cols)
         n_entries = all_rows.size
-        T = sp.coo_matrix((np.arange(1, n_entries + 1, dtype=float), (all_rows, all_cols)),
-                          shape=(self.n_active, self.n_ind)).tocsr()
+        T = sp.coo_matrix(
+            (np.arange(1, n_entries + 1, dtype=float), (all_rows, all_cols)), shape=(self.n_active, self.n_ind)
+        ).tocsr()
         self._T = T
         self._T_pos = np.empty(n_entries, dtype=np.int64)
-        self._T_pos[T.data.astype(np.int64) - 1] = np.arange(T.nnz)   # entry -> position in T.data
+        self._T_pos[T.data.astype(np.int64) - 1] = np.arange(T.nnz)  # entry -> position in T.data
         self._n_fixed = fixed_rows.size
         # geometric term: 9 entries per rigid slave on its reference's rotation block
         if len(s):
@@ -264,7 +279,7 @@ class Constraints:
         if self._lever_k.size:
             s, r = self.rigid_slave[:, 0], self.rigid_slave[:, 1]
             d = x[s] - x[r]
-            vals[self._n_fixed:] = self._lever_sign * d[self._lever_k, self._lever_c]
+            vals[self._n_fixed :] = self._lever_sign * d[self._lever_k, self._lever_c]
         self._T.data[self._T_pos] = vals
         return self._T
 

@@ -17,17 +17,16 @@ stiffnesses in N, N m^2, pressures in Pa, rotations in rad.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .amplitudes import Amplitude
 from ..elements.base import DOF_NAMES
 from ..errors import ModelError
+from . import validation
+from .amplitudes import Amplitude
 from .arrays import ElementList, add_beams, add_nodes, add_trusses
 from .sections import Section
-from . import validation
 
 LOAD_NAMES = ("fx", "fy", "fz", "mx", "my", "mz")
 _DOF_INDEX = {n: i for i, n in enumerate(DOF_NAMES)}
@@ -74,7 +73,7 @@ class BeamSpec:
     section: Section
     up: np.ndarray
     family: str
-    mass_per_length: float | None = None   # kg/m; None: section.rho * section.A
+    mass_per_length: float | None = None  # kg/m; None: section.rho * section.A
 
 
 @dataclass
@@ -86,7 +85,7 @@ class TrussSpec:
     pretension: float | None
     tension_only: bool
     family: str
-    mass_per_length: float = 0.0   # kg/m (modal analyses, issue 18)
+    mass_per_length: float = 0.0  # kg/m (modal analyses, issue 18)
 
 
 @dataclass
@@ -130,8 +129,8 @@ class Step:
     output_frequency: int = 1
     loads: list = field(default_factory=list)
     prescribed: list = field(default_factory=list)
-    temperatures: list = field(default_factory=list)   # (labels, values K or degC, amplitude): issue 20
-    _model: "Model" = field(default=None, repr=False)
+    temperatures: list = field(default_factory=list)  # (labels, values K or degC, amplitude): issue 20
+    _model: Model = field(default=None, repr=False)
 
     def load(self, node, amplitude: Amplitude | None = None, **components):
         """Nodal force/moment at the end of the step: ``step.load(n, fx=10.0, mz=-2.0)`` (N, N m,
@@ -141,9 +140,12 @@ class Step:
             raise ModelError(f"step '{self.name}': load on node {node} has no components; give e.g. fx=1.0")
         for name, value in components.items():
             if name.lower() not in _LOAD_INDEX:
-                raise ModelError(f"step '{self.name}': unknown load component '{name}' on node {node}; "
-                                 f"use {', '.join(LOAD_NAMES)}")
-            v = _finite(value, f"step '{self.name}': load {name} on node {node}", "N" if name.lower()[0] == "f" else "N m")
+                raise ModelError(
+                    f"step '{self.name}': unknown load component '{name}' on node {node}; use {', '.join(LOAD_NAMES)}"
+                )
+            v = _finite(
+                value, f"step '{self.name}': load {name} on node {node}", "N" if name.lower()[0] == "f" else "N m"
+            )
             self.loads.append(Condition(node, _LOAD_INDEX[name.lower()], v, amplitude))
         return self
 
@@ -157,8 +159,9 @@ class Step:
         for name, value in components.items():
             if name.lower() not in _DOF_INDEX:
                 raise ModelError(f"step '{self.name}': unknown DOF '{name}' on node {node}; use {', '.join(DOF_NAMES)}")
-            v = _finite(value, f"step '{self.name}': prescribed {name} on node {node}",
-                        "m" if name.lower()[0] == "u" else "rad")
+            v = _finite(
+                value, f"step '{self.name}': prescribed {name} on node {node}", "m" if name.lower()[0] == "u" else "rad"
+            )
             self.prescribed.append(Condition(node, _DOF_INDEX[name.lower()], v, amplitude))
         return self
 
@@ -212,25 +215,27 @@ class Model:
         self._node_labels: list[int] = []
         self._node_xyz: list[tuple] = []
         self._node_index: dict[int, int] = {}
-        self._max_label = 0   # largest node label so far (auto-numbering without a max() per node)
-        self.beams: list[BeamSpec] = ElementList(self.add_beams)      # called: self.add_beams(...)
+        self._max_label = 0  # largest node label so far (auto-numbering without a max() per node)
+        self.beams: list[BeamSpec] = ElementList(self.add_beams)  # called: self.add_beams(...)
         self.trusses: list[TrussSpec] = ElementList(self.add_trusses)  # called: self.add_trusses(...)
         self.families: list = []  # user / custom ElementFamily objects (built with node labels)
         self.fixed: dict[int, set] = {}
         self.rigid_bodies: list = []
         self.ties: list = []
         self.steps: list[Step] = []
-        self.point_masses: list = []   # femast.modal.mass.PointMassSpec (modal analyses)
-        self.length_errors: dict = {}         # element label -> m (lack of fit, issue 20)
-        self.expansion: dict = {}             # element label -> 1/K
+        self.point_masses: list = []  # femast.modal.mass.PointMassSpec (modal analyses)
+        self.length_errors: dict = {}  # element label -> m (lack of fit, issue 20)
+        self.expansion: dict = {}  # element label -> 1/K
         self.initial_temperatures: dict = {}  # element label -> K or degC
         self._next_element = 1
 
     # ---------------------------------------------------------------- nodes
     def node(self, x: float, y: float, z: float, label: int | None = None) -> int:
         """Add a node at (x, y, z) (m); returns its label (auto-numbered from 1 if not given)."""
-        xyz = tuple(_finite(v, f"node {label if label is not None else len(self._node_labels) + 1} coordinate {c}",
-                            "m") for v, c in zip((x, y, z), "xyz"))
+        xyz = tuple(
+            _finite(v, f"node {label if label is not None else len(self._node_labels) + 1} coordinate {c}", "m")
+            for v, c in zip((x, y, z), "xyz")
+        )
         if label is None:
             label = (self._max_label + 1) if self._node_labels else 1
         label = validation.whole(label, "node label")
@@ -267,8 +272,11 @@ class Model:
 
     def _check_node(self, label, where):
         try:
-            ok = (not isinstance(label, (str, bytes, bool, np.bool_)) and float(label) == int(label)
-                  and int(label) in self._node_index)
+            ok = (
+                not isinstance(label, (str, bytes, bool, np.bool_))
+                and float(label) == int(label)
+                and int(label) in self._node_index
+            )
         except (TypeError, ValueError, OverflowError):
             ok = False
         if not ok:
@@ -277,9 +285,18 @@ class Model:
             raise ModelError(f"{where}: unknown node {label!r} ({hint}); create it with model.node(x, y, z)")
 
     # ------------------------------------------------------------- elements
-    def beam(self, n1, n2, section: Section, up=(0.0, 0.0, 1.0), n: int = 1, family: str = "beam",
-             mass_per_length: float | None = None, length_error_m: float = 0.0,
-             alpha_per_K: float = 0.0) -> list[int]:
+    def beam(
+        self,
+        n1,
+        n2,
+        section: Section,
+        up=(0.0, 0.0, 1.0),
+        n: int = 1,
+        family: str = "beam",
+        mass_per_length: float | None = None,
+        length_error_m: float = 0.0,
+        alpha_per_K: float = 0.0,
+    ) -> list[int]:
         """Beam(s) from node ``n1`` to ``n2``, split into ``n`` equal elements (new nodes are
         created in between).  ``up`` (global vector) sets the local y axis: it is made
         orthogonal to the element; Iz resists bending in the plane of the axis and ``up``.
@@ -296,16 +313,19 @@ class Model:
         a, b = self.xyz(n1), self.xyz(n2)
         L = float(np.linalg.norm(b - a))
         if L <= 1e-12 * max(1.0, float(np.abs(a).max())):
-            raise ModelError(f"beam {n1}-{n2}: nodes {n1} and {n2} coincide (length {L:g} m); "
-                             "a beam needs two distinct nodes")
+            raise ModelError(
+                f"beam {n1}-{n2}: nodes {n1} and {n2} coincide (length {L:g} m); a beam needs two distinct nodes"
+            )
         up_arr = np.asarray(up, dtype=object)
         if up_arr.shape != (3,):
             raise ModelError(f"beam {n1}-{n2}: up-vector {up!r} must be 3 numbers (a global direction)")
         up = np.array([_finite(u, f"beam {n1}-{n2}: up-vector") for u in up_arr])
         e = (b - a) / L
         if np.linalg.norm(up - (up @ e) * e) < 1e-6 * max(np.linalg.norm(up), 1e-300):
-            raise ModelError(f"beam {n1}-{n2}: up-vector {tuple(float(u) for u in up)} is parallel to the element axis "
-                             f"{tuple(float(v) for v in np.round(e, 6))}; choose an up-vector not along the beam")
+            raise ModelError(
+                f"beam {n1}-{n2}: up-vector {tuple(float(u) for u in up)} is parallel to the element axis "
+                f"{tuple(float(v) for v in np.round(e, 6))}; choose an up-vector not along the beam"
+            )
         if mass_per_length is not None:
             mass_per_length = _finite(mass_per_length, f"beam {n1}-{n2}: mass_per_length")
             if mass_per_length < 0:
@@ -319,8 +339,16 @@ class Model:
         self._error_sources(labels, length_error_m, alpha_per_K)
         return labels
 
-    def add_beams(self, nodes, section: Section, up=(0.0, 0.0, 1.0), family="beam", mass_per_length=None,
-                  length_error_m=0.0, alpha_per_K=0.0) -> np.ndarray:
+    def add_beams(
+        self,
+        nodes,
+        section: Section,
+        up=(0.0, 0.0, 1.0),
+        family="beam",
+        mass_per_length=None,
+        length_error_m=0.0,
+        alpha_per_K=0.0,
+    ) -> np.ndarray:
         """One beam per row of ``nodes`` ((n, 2) node labels), as :meth:`beam` with ``n=1`` for each
         row but checked at once (no Python call per element); also ``model.beams(...)``.
         ``section``, ``up`` (3,) or (n, 3), ``family``, ``mass_per_length`` (kg/m),
@@ -328,18 +356,28 @@ class Model:
         element labels (see :mod:`femast.model.arrays`)."""
         return add_beams(self, nodes, section, up, family, mass_per_length, length_error_m, alpha_per_K)
 
-    def add_trusses(self, nodes, EA, L0=None, pretension=None, tension_only=False, family=None,
-                    mass_per_length=0.0, length_error_m=0.0, alpha_per_K=0.0) -> np.ndarray:
+    def add_trusses(
+        self,
+        nodes,
+        EA,
+        L0=None,
+        pretension=None,
+        tension_only=False,
+        family=None,
+        mass_per_length=0.0,
+        length_error_m=0.0,
+        alpha_per_K=0.0,
+    ) -> np.ndarray:
         """One truss (cable with ``tension_only``) per row of ``nodes`` ((n, 2) node labels), as
         :meth:`truss` for each row but checked at once; also ``model.trusses(...)``.  ``EA`` (N),
         ``L0`` (m), ``pretension`` (N) and the rest: shared or one per element.  Returns the labels."""
-        return add_trusses(self, nodes, EA, L0, pretension, tension_only, family, mass_per_length,
-                           length_error_m, alpha_per_K)
+        return add_trusses(
+            self, nodes, EA, L0, pretension, tension_only, family, mass_per_length, length_error_m, alpha_per_K
+        )
 
     def _error_sources(self, labels, length_error_m, alpha_per_K):
         if length_error_m != 0.0:
-            self.length_error(labels, _finite(length_error_m, f"element {labels[0]}: length_error_m (m)")
-                              / len(labels))
+            self.length_error(labels, _finite(length_error_m, f"element {labels[0]}: length_error_m (m)") / len(labels))
         if alpha_per_K != 0.0:
             self.thermal_expansion(alpha_per_K, elements=labels)
 
@@ -366,9 +404,19 @@ class Model:
 
         return set_initial_temperature(self, T, elements, family, where)
 
-    def truss(self, n1, n2, EA: float, L0: float | None = None, pretension: float | None = None,
-              tension_only: bool = False, family: str | None = None, mass_per_length: float = 0.0,
-              length_error_m: float = 0.0, alpha_per_K: float = 0.0) -> int:
+    def truss(
+        self,
+        n1,
+        n2,
+        EA: float,
+        L0: float | None = None,
+        pretension: float | None = None,
+        tension_only: bool = False,
+        family: str | None = None,
+        mass_per_length: float = 0.0,
+        length_error_m: float = 0.0,
+        alpha_per_K: float = 0.0,
+    ) -> int:
         """Truss (or, with ``tension_only=True``, cable) from ``n1`` to ``n2``; EA in N.
         Give the unstretched length ``L0`` (m) or the ``pretension`` (N) it carries in the
         initial geometry; neither means stress-free.  ``mass_per_length`` (kg/m of the initial
@@ -431,8 +479,7 @@ class Model:
         self.point_masses.append(spec)
         return spec
 
-    def rigid_body(self, reference, nodes, name: str | None = None, mass: float = 0.0, inertia=None,
-                   centre=None):
+    def rigid_body(self, reference, nodes, name: str | None = None, mass: float = 0.0, inertia=None, centre=None):
         """Tie ``nodes`` rigidly to the ``reference`` node (exact for large rotations, as Abaqus
         *RIGID BODY with a REF NODE).  Load, fix or drive the reference node; the tied nodes
         follow.  The reference node may be a node without elements (e.g. a control node).
@@ -472,15 +519,21 @@ class Model:
         s = Step(name=name, **options)
         s._model = self
         validation.step_increments(s)
-        if isinstance(s.output_frequency, bool) or not isinstance(s.output_frequency, (int, np.integer)) \
-                or s.output_frequency < 1:
-            raise ModelError(f"step '{name}': output_frequency = {s.output_frequency!r} must be a whole number "
-                             ">= 1 (a frame every that many increments)")
+        if (
+            isinstance(s.output_frequency, bool)
+            or not isinstance(s.output_frequency, (int, np.integer))
+            or s.output_frequency < 1
+        ):
+            raise ModelError(
+                f"step '{name}': output_frequency = {s.output_frequency!r} must be a whole number "
+                ">= 1 (a frame every that many increments)"
+            )
         self.steps.append(s)
         return s
 
-    def frequency_step(self, name: str | None = None, n_modes: int = 10, shift_hz: float | None = None,
-                       vtk: bool = False):
+    def frequency_step(
+        self, name: str | None = None, n_modes: int = 10, shift_hz: float | None = None, vtk: bool = False
+    ):
         """Append a step that computes the lowest ``n_modes`` vibration modes of the state reached so
         far (prestress and loads included; see :mod:`femast.modal.step`); returns it."""
         from ..modal.step import add_frequency_step
@@ -488,5 +541,7 @@ class Model:
         return add_frequency_step(self, name, n_modes, shift_hz, vtk)
 
     def __repr__(self):
-        return (f"Model({self.name!r}: {len(self._node_labels)} nodes, {len(self.beams)} beams, "
-                f"{len(self.trusses)} trusses, {len(self.families)} other families, {len(self.steps)} steps)")
+        return (
+            f"Model({self.name!r}: {len(self._node_labels)} nodes, {len(self.beams)} beams, "
+            f"{len(self.trusses)} trusses, {len(self.families)} other families, {len(self.steps)} steps)"
+        )

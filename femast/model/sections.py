@@ -56,17 +56,21 @@ class Section:
             if value is None:
                 raise ModelError(f"section '{self.name}': property {field} is missing; give it in SI units")
             if isinstance(value, (str, bytes, bool)) or not isinstance(value, numbers.Real):
-                raise ModelError(f"section '{self.name}': property {field}={value!r} is not a number; give it in "
-                                 f"SI units ({_UNITS[field]})")
+                raise ModelError(
+                    f"section '{self.name}': property {field}={value!r} is not a number; give it in "
+                    f"SI units ({_UNITS[field]})"
+                )
             value = float(value)
             if not math.isfinite(value) or value <= 0.0:
                 raise ModelError(
                     f"section '{self.name}': property {field}={value!r} must be a finite positive number (SI units)"
                 )
             if value > MAX_MAGNITUDE:
-                raise ModelError(f"section '{self.name}': property {field}={value:g} {_UNITS[field]} is beyond "
-                                 f"{MAX_MAGNITUDE:g} (a typing error? it would overflow the stiffness); give it in "
-                                 "SI units")
+                raise ModelError(
+                    f"section '{self.name}': property {field}={value:g} {_UNITS[field]} is beyond "
+                    f"{MAX_MAGNITUDE:g} (a typing error? it would overflow the stiffness); give it in "
+                    "SI units"
+                )
             object.__setattr__(self, field, value)
         try:
             rho = float(self.rho)
@@ -81,7 +85,7 @@ class Section:
         """Axial stiffness, N."""
         return self.E * self.A
 
-    def with_(self, **changes) -> "Section":
+    def with_(self, **changes) -> Section:
         """A copy with some properties changed, e.g. ``sec.with_(E=70e9)``."""
         return replace(self, **changes)
 
@@ -144,9 +148,15 @@ def seed000_eq10_torsion_constant(s_out: float, L: float) -> float:
 
 def _check_dims(name, outer, inner):
     for label, v in (("outer size", outer), ("inner size", inner)):
-        if isinstance(v, (str, bytes, bool)) or not isinstance(v, numbers.Real) or not math.isfinite(v) or v < 0 \
-                or v > 1e3:
-            raise ModelError(f"section '{name}': {label}={v!r} must be a finite non-negative length in m "
-                             "(at most 1000 m)")
+        if (
+            isinstance(v, (str, bytes, bool))
+            or not isinstance(v, numbers.Real)
+            or not math.isfinite(v)
+            or v < 0
+            or v > 1e3
+        ):
+            raise ModelError(
+                f"section '{name}': {label}={v!r} must be a finite non-negative length in m (at most 1000 m)"
+            )
     if outer <= 0 or inner >= outer:
         raise ModelError(f"section '{name}': need 0 <= inner ({inner}) < outer ({outer}) size, in m")

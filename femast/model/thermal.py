@@ -31,8 +31,8 @@ import math
 
 import numpy as np
 
-from .amplitudes import Amplitude
 from ..errors import ModelError
+from .amplitudes import Amplitude
 
 # No structural material expands by more than ~1e-4 per K: a larger value is a units slip
 # (e.g. ppm/K given as 1/K would be 1e6 times too large, 1/degC as percent 100 times).
@@ -62,7 +62,6 @@ def _element_table(model):
     return table
 
 
-
 def _midpoint(model, kind, spec):
     nodes = spec.nodes if kind in ("beam", "truss") else spec
     return np.mean([model.xyz(n) for n in nodes], axis=0)
@@ -81,10 +80,12 @@ def select_elements(model, what, elements=None, family=None, where=None) -> list
             except (TypeError, ValueError):
                 ok = False
             if not ok:
-                raise ModelError(f"{what}: {e!r} is not a beam or truss element of model '{model.name}' "
-                                 "(length errors and thermal strain apply to elements made with model.beam "
-                                 "or model.truss, or to whole cable families with family=; use the labels "
-                                 "model.beam and model.truss return)")
+                raise ModelError(
+                    f"{what}: {e!r} is not a beam or truss element of model '{model.name}' "
+                    "(length errors and thermal strain apply to elements made with model.beam "
+                    "or model.truss, or to whole cable families with family=; use the labels "
+                    "model.beam and model.truss return)"
+                )
             labels.append(int(e))
     else:
         labels = [e for e in table if table[e][0] != "cable"]
@@ -94,15 +95,19 @@ def select_elements(model, what, elements=None, family=None, where=None) -> list
         known = {spec.family for kind, spec in table.values() if kind != "cable"} | cable_fams
         unknown = fams - known
         if unknown:
-            raise ModelError(f"{what}: no beam or truss family named {sorted(unknown)} (nor a cable family); the model has "
-                             f"{sorted(known)}")
+            raise ModelError(
+                f"{what}: no beam or truss family named {sorted(unknown)} (nor a cable family); the model has "
+                f"{sorted(known)}"
+            )
         if elements is None:
             labels += [e for e in table if table[e][0] == "cable" and e[0] in fams]
         labels = [e for e in labels if (e[0] if table[e][0] == "cable" else table[e][1].family) in fams]
     if where is not None:
         if not callable(where):
-            raise ModelError(f"{what}: where = {where!r} must be a function of an element midpoint (m) "
-                             "returning True inside the region")
+            raise ModelError(
+                f"{what}: where = {where!r} must be a function of an element midpoint (m) "
+                "returning True inside the region"
+            )
         labels = [e for e in labels if bool(where(_midpoint(model, *table[e])))]
     if not labels:
         raise ModelError(f"{what}: the selection picks no element; check elements=, family= and where=")
@@ -127,8 +132,10 @@ def set_length_errors(model, elements, dL_m) -> list[int]:
         kind, spec = table[e]
         L = _reference_length(model, kind, spec)
         if not dL > -L:
-            raise ModelError(f"length error of element {e}: {dL} m would make its stress-free length "
-                             f"{L + dL:.6g} m (reference {L:.6g} m) non-positive")
+            raise ModelError(
+                f"length error of element {e}: {dL} m would make its stress-free length "
+                f"{L + dL:.6g} m (reference {L:.6g} m) non-positive"
+            )
         model.length_errors[e] = dL
     return labels
 
@@ -138,9 +145,11 @@ def set_expansion(model, alpha_per_K, elements=None, family=None, where=None) ->
     labels = select_elements(model, "thermal expansion", elements, family, where)
     for e, a in zip(labels, _values(alpha_per_K, labels, "thermal expansion alpha_per_K", "1/K")):
         if abs(a) > ALPHA_LIMIT_PER_K:
-            raise ModelError(f"thermal expansion of element {e}: alpha = {a} 1/K is beyond any structural "
-                             f"material (|alpha| <= {ALPHA_LIMIT_PER_K:g} 1/K); give it in 1/K (e.g. 23e-6 for "
-                             "aluminium, -0.5e-6 for carbon fibre along the fibres)")
+            raise ModelError(
+                f"thermal expansion of element {e}: alpha = {a} 1/K is beyond any structural "
+                f"material (|alpha| <= {ALPHA_LIMIT_PER_K:g} 1/K); give it in 1/K (e.g. 23e-6 for "
+                "aluminium, -0.5e-6 for carbon fibre along the fibres)"
+            )
         model.expansion[e] = a
     return labels
 
@@ -192,7 +201,7 @@ class FieldLoads:
         self.model = model
         n_user = len(model.families)
         builtin = families[: len(families) - n_user]
-        cables = [f for f in families[len(families) - n_user:] if hasattr(f, "length_factor")]
+        cables = [f for f in families[len(families) - n_user :] if hasattr(f, "length_factor")]
         for f in cables:
             f.length_factor = np.ones(f.nodes.shape[0])
         self.families = [f for f in builtin if hasattr(f, "length_factor")] + cables
@@ -205,9 +214,9 @@ class FieldLoads:
             for row, lab in enumerate(np.asarray(fam.labels).tolist()):
                 where[int(lab)] = (k, row)
         self.where = where
-        self.base = []      # 1 + dL / L per element
-        self.alpha = []     # 1/K
-        self.T_init = []    # K or degC
+        self.base = []  # 1 + dL / L per element
+        self.alpha = []  # 1/K
+        self.T_init = []  # K or degC
         for fam in self.families:
             L = fam.l0 if hasattr(fam, "l0") else fam.L0
             self.base.append(np.ones(len(L)))
@@ -227,7 +236,7 @@ class FieldLoads:
         # temperatures at the start of each step
         self.starts = []
         T = [t.copy() for t in self.T_init]
-        for step in model.steps:
+        for _step in model.steps:
             self.starts.append([t.copy() for t in T])
             T = self.temperatures(len(self.starts) - 1, 1.0)
         self.current = None
@@ -260,15 +269,21 @@ class FieldLoads:
     def thermal_strain(self, step_index, frac) -> dict:
         """{element label (a cable's: (family, row)): alpha (T - T_init)} at fraction ``frac`` of a step (dimensionless)."""
         T = self.temperatures(step_index, frac)
-        return {lab: float(self.alpha[k][row] * (T[k][row] - self.T_init[k][row]))
-                for lab, (k, row) in self.where.items()}
+        return {
+            lab: float(self.alpha[k][row] * (T[k][row] - self.T_init[k][row])) for lab, (k, row) in self.where.items()
+        }
 
 
 def check_controls(model):
     """A step that changes temperatures must follow step time (load or displacement control)."""
     for step in model.steps:
-        if getattr(step, "temperatures", None) and step.control is not None and (
-                getattr(step.control, "arc_length", False) or hasattr(step.control, "plan")):
-            raise ModelError(f"step '{step.name}': temperatures follow step time; they cannot be used with "
-                             f"{type(step.control).__name__} (use load or displacement control for the "
-                             "thermal step)")
+        if (
+            getattr(step, "temperatures", None)
+            and step.control is not None
+            and (getattr(step.control, "arc_length", False) or hasattr(step.control, "plan"))
+        ):
+            raise ModelError(
+                f"step '{step.name}': temperatures follow step time; they cannot be used with "
+                f"{type(step.control).__name__} (use load or displacement control for the "
+                "thermal step)"
+            )

@@ -21,8 +21,9 @@ from ..errors import EquilibriumError, ModelError
 MAX_MAGNITUDE = 1e15
 
 
-def number(value, what: str, unit: str = "", *, positive=False, nonnegative=False, lo=None, hi=None,
-           max_abs=MAX_MAGNITUDE) -> float:
+def number(
+    value, what: str, unit: str = "", *, positive=False, nonnegative=False, lo=None, hi=None, max_abs=MAX_MAGNITUDE
+) -> float:
     """``value`` as a float, or a ModelError naming ``what``: not a number (strings, None, bools,
     arrays are refused), not finite, beyond ``max_abs``, or outside the asked range."""
     u = f" {unit}" if unit else ""
@@ -36,8 +37,10 @@ def number(value, what: str, unit: str = "", *, positive=False, nonnegative=Fals
     if not math.isfinite(v):
         raise ModelError(f"{what} = {value!r} is not finite; give a finite number{(' in' + u) if unit else ''}")
     if abs(v) > max_abs:
-        raise ModelError(f"{what} = {v:g}{u} is beyond {max_abs:g}{u} (a typing error? such magnitudes "
-                         "overflow in the element computations); give a realistic value in SI units")
+        raise ModelError(
+            f"{what} = {v:g}{u} is beyond {max_abs:g}{u} (a typing error? such magnitudes "
+            "overflow in the element computations); give a realistic value in SI units"
+        )
     if positive and not v > 0:
         raise ModelError(f"{what} = {v:g}{u} must be positive")
     if nonnegative and not v >= 0:
@@ -79,13 +82,16 @@ def coordinates(coords, what: str = "nodes") -> np.ndarray:
     if a.ndim == 1 and a.size == 3:
         a = a[None, :]
     if a.ndim != 2 or a.shape[1] != 3:
-        raise ModelError(f"{what}: coordinates must be an (n, 3) array (one row x, y, z per node, m); got shape "
-                         f"{a.shape}" + ("; transpose it" if a.ndim == 2 and a.shape[0] == 3 else ""))
+        raise ModelError(
+            f"{what}: coordinates must be an (n, 3) array (one row x, y, z per node, m); got shape "
+            f"{a.shape}" + ("; transpose it" if a.ndim == 2 and a.shape[0] == 3 else "")
+        )
     bad = np.argwhere(~np.isfinite(a) | (np.abs(a) > MAX_MAGNITUDE))
     if bad.size:
         r, c = bad[0]
-        raise ModelError(f"{what}: row {r} coordinate {'xyz'[c]} = {a[r, c]!r} m is not a finite number within "
-                         f"{MAX_MAGNITUDE:g} m")
+        raise ModelError(
+            f"{what}: row {r} coordinate {'xyz'[c]} = {a[r, c]!r} m is not a finite number within {MAX_MAGNITUDE:g} m"
+        )
     return a
 
 
@@ -99,19 +105,27 @@ def step_increments(step) -> None:
         if v is not None:
             v = number(v, f"{where}: {name}", "s", positive=True)
             if v > step.period * (1 + 1e-12):
-                raise ModelError(f"{where}: {name} = {v:g} s is longer than the step period {step.period:g} s; "
-                                 f"give at most the period")
+                raise ModelError(
+                    f"{where}: {name} = {v:g} s is longer than the step period {step.period:g} s; "
+                    f"give at most the period"
+                )
             setattr(step, name, v)
     lo, ini, hi = step.min_increment, step.initial_increment, step.max_increment
     if lo is not None and hi is not None and lo > hi:
-        raise ModelError(f"{where}: min_increment = {lo:g} s is larger than max_increment = {hi:g} s; "
-                         "give min_increment <= initial_increment <= max_increment")
+        raise ModelError(
+            f"{where}: min_increment = {lo:g} s is larger than max_increment = {hi:g} s; "
+            "give min_increment <= initial_increment <= max_increment"
+        )
     if lo is not None and ini is not None and ini < lo:
-        raise ModelError(f"{where}: initial_increment = {ini:g} s is smaller than min_increment = {lo:g} s; "
-                         "give min_increment <= initial_increment <= max_increment")
+        raise ModelError(
+            f"{where}: initial_increment = {ini:g} s is smaller than min_increment = {lo:g} s; "
+            "give min_increment <= initial_increment <= max_increment"
+        )
     if hi is not None and ini is not None and ini > hi:
-        raise ModelError(f"{where}: initial_increment = {ini:g} s is larger than max_increment = {hi:g} s; "
-                         "give min_increment <= initial_increment <= max_increment")
+        raise ModelError(
+            f"{where}: initial_increment = {ini:g} s is larger than max_increment = {hi:g} s; "
+            "give min_increment <= initial_increment <= max_increment"
+        )
     step.max_increments = whole(step.max_increments, f"{where}: max_increments", minimum=1)
     times = []
     for h in step.hit_times:
@@ -134,12 +148,17 @@ def loads_on_active_dofs(model, dofmap) -> None:
                 i = model.index(c.node)
                 if dofmap.eq[i, c.dof] < 0:
                     name = DOF_NAMES[c.dof] if kind != "load" else ("fx", "fy", "fz", "mx", "my", "mz")[c.dof]
-                    what = ("no element is connected to the node" if not np.any(dofmap.eq[i] >= 0) else
-                            f"the node's elements give no stiffness to {DOF_NAMES[c.dof]} (e.g. a moment on a "
-                            "node with trusses or cables only)")
-                    raise ModelError(f"step '{s.name}': {kind} {name} on node {c.node}: {what}; it would be lost. "
-                                     "Connect the node to an element that stiffens this DOF, tie it to one, or "
-                                     "remove the load")
+                    what = (
+                        "no element is connected to the node"
+                        if not np.any(dofmap.eq[i] >= 0)
+                        else f"the node's elements give no stiffness to {DOF_NAMES[c.dof]} (e.g. a moment on a "
+                        "node with trusses or cables only)"
+                    )
+                    raise ModelError(
+                        f"step '{s.name}': {kind} {name} on node {c.node}: {what}; it would be lost. "
+                        "Connect the node to an element that stiffens this DOF, tie it to one, or "
+                        "remove the load"
+                    )
 
 
 def self_equilibrated(families) -> bool:
@@ -176,8 +195,9 @@ def _balance(x, P, RF, r_free, free_dof):
     return fx, fy, fz, mx, my, mz, sum_f, sum_m, xmax, rt, rm
 
 
-def check_equilibrium(x, P, RF, r_free, free_dof, where: str, internal: float = 0.0, labels=None,
-                      rel: float = 1e-9) -> None:
+def check_equilibrium(
+    x, P, RF, r_free, free_dof, where: str, internal: float = 0.0, labels=None, rel: float = 1e-9
+) -> None:
     """Global balance of a converged increment of a model whose elements are self-equilibrated:
     the applied loads ``P`` (n, 6) and reactions ``RF`` (n, 6) at positions ``x`` (n, 3) balance
     (force and moment about the origin) up to what the free DOFs' residual ``r_free`` leaves
@@ -186,9 +206,12 @@ def check_equilibrium(x, P, RF, r_free, free_dof, where: str, internal: float = 
     and ``internal`` (the summed magnitudes of the element nodal forces, N).
     Raises :class:`~femast.errors.EquilibriumError` naming the increment otherwise."""
     fx, fy, fz, mx, my, mz, sum_f, sum_m, xmax, rt, rm = _balance(
-        np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(P, dtype=float),
-        np.ascontiguousarray(RF, dtype=float), np.ascontiguousarray(r_free, dtype=float),
-        np.ascontiguousarray(free_dof, dtype=np.int64))
+        np.ascontiguousarray(x, dtype=float),
+        np.ascontiguousarray(P, dtype=float),
+        np.ascontiguousarray(RF, dtype=float),
+        np.ascontiguousarray(r_free, dtype=float),
+        np.ascontiguousarray(free_dof, dtype=np.int64),
+    )
     arm = xmax * math.sqrt(3.0)
     scale_f = sum_f + internal
     scale_m = sum_m + arm * scale_f
@@ -198,7 +221,9 @@ def check_equilibrium(x, P, RF, r_free, free_dof, where: str, internal: float = 
     if nf > tol_f * math.sqrt(3.0) or nm > tol_m * math.sqrt(3.0):
         worst = int(np.argmax(np.abs(P).sum(axis=1)))
         node = labels[worst] if labels is not None else worst
-        raise EquilibriumError(f"{where}: the reactions do not balance the applied loads (net force {nf:.3g} N, "
-                               f"net moment {nm:.3g} N m, allowed {tol_f:.3g} N, {tol_m:.3g} N m; largest load "
-                               f"on node {node}): a load is lost or an element family is not self-equilibrated; "
-                               "please report this with the model")
+        raise EquilibriumError(
+            f"{where}: the reactions do not balance the applied loads (net force {nf:.3g} N, "
+            f"net moment {nm:.3g} N m, allowed {tol_f:.3g} N, {tol_m:.3g} N m; largest load "
+            f"on node {node}): a load is lost or an element family is not self-equilibrated; "
+            "please report this with the model"
+        )

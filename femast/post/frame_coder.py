@@ -26,15 +26,23 @@ import zlib
 import numpy as np
 
 from ..rotations import _rotation_vectors
-from .npz import _LAYOUTS, _RECORD, RECORD_MAGIC, _Layout, _arrays
+from .npz import _LAYOUTS, _RECORD, RECORD_MAGIC, _arrays, _Layout
 
-SCALARS = ("step", "increment", "time", "total_time", "load_factor", "iterations", "strain_energy",
-           "stabilization_energy")
-STATE = (("U", 3), ("R", 9), ("UR", 3), ("URA", 3), ("RF", 6), ("P", 6))   # (name, values per node)
+SCALARS = (
+    "step",
+    "increment",
+    "time",
+    "total_time",
+    "load_factor",
+    "iterations",
+    "strain_energy",
+    "stabilization_energy",
+)
+STATE = (("U", 3), ("R", 9), ("UR", 3), ("URA", 3), ("RF", 6), ("P", 6))  # (name, values per node)
 _F8 = struct.Struct("<d")
 _I8 = struct.Struct("<q")
 _CRC = struct.Struct("<I")
-_SIMPLE = np.dtype(float).str == "<f8" and np.asanyarray(0).dtype.str == "<i8"   # (a little-endian machine)
+_SIMPLE = np.dtype(float).str == "<f8" and np.asanyarray(0).dtype.str == "<i8"  # (a little-endian machine)
 
 
 class FrameCoder:
@@ -44,21 +52,20 @@ class FrameCoder:
     def __init__(self, data: dict, n: int, sig):
         self.n = n
         self.types = tuple(type(data[k]) for k in SCALARS)
-        self.el_keys = {}   # family -> its output names, in order
+        self.el_keys = {}  # family -> its output names, in order
         for k in data:
             if k.startswith("el/"):
                 fam, _, name = k[3:].partition("/")
                 self.el_keys.setdefault(fam, []).append(name)
         self.el_keys = [(fam, tuple(names)) for fam, names in self.el_keys.items()]
-        self.el_sig = [(a.dtype, a.shape) for k, a in zip([s[0] for s in sig], _arrays(data)[1])
-                       if k.startswith("el/")]
+        self.el_sig = [(a.dtype, a.shape) for k, a in zip([s[0] for s in sig], _arrays(data)[1]) if k.startswith("el/")]
         layout = _LAYOUTS.get(sig) or _Layout(sig)
         self.template = layout.template
         self.members = layout.members
         self.block = np.zeros(sum(w for _, w in STATE) * n)
         views, at = {}, 0
         for name, w in STATE:
-            views[name] = self.block[at:at + w * n]
+            views[name] = self.block[at : at + w * n]
             at += w * n
         self.U = views["U"].reshape(n, 3)
         self.R = views["R"].reshape(n, 3, 3)
@@ -69,14 +76,14 @@ class FrameCoder:
         raw = memoryview(self.block).cast("B")
         self.state_bytes, at = [], 0
         for _, w in STATE:
-            self.state_bytes.append(raw[at:at + 8 * w * n])
+            self.state_bytes.append(raw[at : at + 8 * w * n])
             at += 8 * w * n
 
     @classmethod
     def make(cls, data: dict, n: int):
         """A coder for frames like ``data`` (a frame dict of the general path, in its key order), or
         None if its layout is not the one this coder writes."""
-        if not _SIMPLE:   # pragma: no cover - a big-endian machine: the general path
+        if not _SIMPLE:  # pragma: no cover - a big-endian machine: the general path
             return None
         got = _arrays(data)
         if got is None:
@@ -84,9 +91,9 @@ class FrameCoder:
         sig = got[0]
         names = [s[0] for s in sig]
         want = list(SCALARS) + [name for name, _ in STATE]
-        if names[:len(want)] != want or not all(k.startswith("el/") for k in names[len(want):]):
+        if names[: len(want)] != want or not all(k.startswith("el/") for k in names[len(want) :]):
             return None
-        for (name, dtype, shape), (_, w) in zip(sig[len(SCALARS):], STATE):
+        for (_name, dtype, shape), (_, w) in zip(sig[len(SCALARS) :], STATE):
             if dtype != np.float64 or int(np.prod(shape)) != w * n or shape[0] != n:
                 return None
         if any(t not in (str, int, float, np.float64, np.int64) for t in (type(data[k]) for k in SCALARS)):
@@ -110,8 +117,8 @@ class FrameCoder:
                 if len(b) != members[0][1] or not v or "\0" in v:
                     return None
                 data.append(b)
-            else:   # int, np.int64
-                if not -2**63 <= v < 2**63:
+            else:  # int, np.int64
+                if not -(2**63) <= v < 2**63:
                     return None
                 data.append(_I8.pack(v))
         np.subtract(x, X0, out=self.U)
@@ -138,7 +145,7 @@ class FrameCoder:
         pack = _CRC.pack_into
         crc32 = zlib.crc32
         for d, (at, nbytes, head_crc, local_crc, central_crc) in zip(data, members):
-            buf[at:at + nbytes] = d
+            buf[at : at + nbytes] = d
             crc = crc32(d, head_crc)
             pack(buf, local_crc, crc)
             pack(buf, central_crc, crc)

@@ -27,10 +27,10 @@ import zlib
 import numpy as np
 from numpy.lib import format as npformat
 
-TMP_SUFFIX = ".tmp"   # partial files: "<name>.tmp", never matched by the readers' patterns
-_MAX_MEMBER = 2**31 - 2**20   # a member beyond ~2 GB needs ZIP64: left to np.savez
-_LAYOUTS: dict = {}           # signature -> _Layout
-_MAX_LAYOUTS = 64             # signatures kept (a run has one or two per step)
+TMP_SUFFIX = ".tmp"  # partial files: "<name>.tmp", never matched by the readers' patterns
+_MAX_MEMBER = 2**31 - 2**20  # a member beyond ~2 GB needs ZIP64: left to np.savez
+_LAYOUTS: dict = {}  # signature -> _Layout
+_MAX_LAYOUTS = 64  # signatures kept (a run has one or two per step)
 _LOCAL = struct.Struct("<IHHHHHIIIHH")
 _CENTRAL = struct.Struct("<IHHHHHHIIIHHHHHII")
 _END = struct.Struct("<IHHHHIIH")
@@ -40,7 +40,7 @@ _CRC = struct.Struct("<I")
 def npy_header(dtype, shape) -> bytes:
     """The .npy (version 1.0) header of a C-ordered array: magic, header length, the header dict
     padded to a multiple of 64 bytes (as np.save writes it)."""
-    head = "{'descr': %r, 'fortran_order': False, 'shape': %r, }" % (npformat.dtype_to_descr(dtype), shape)
+    head = "{'descr': %r, 'fortran_order': False, 'shape': %r, }" % (npformat.dtype_to_descr(dtype), shape)  # noqa: UP031 (np.save's own layout)
     head += " " * (-(10 + len(head) + 1) % 64) + "\n"
     return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(head)) + head.encode("latin1")
 
@@ -57,8 +57,12 @@ class _Layout:
             size = len(head) + nbytes
             fname = (name + ".npy").encode("utf8")
             loc = _LOCAL.pack(0x04034B50, 20, 0x800, 0, 0, 0x21, 0, size, size, len(fname), 0)
-            cen = _CENTRAL.pack(0x02014B50, 20, 20, 0x800, 0, 0, 0x21, 0, size, size, len(fname), 0, 0, 0, 0,
-                                0o600 << 16, offset) + fname
+            cen = (
+                _CENTRAL.pack(
+                    0x02014B50, 20, 20, 0x800, 0, 0, 0x21, 0, size, size, len(fname), 0, 0, 0, 0, 0o600 << 16, offset
+                )
+                + fname
+            )
             data_at = offset + len(loc) + len(fname) + len(head)
             # (data offset, data bytes, CRC of the .npy header, CRC position in the local header,
             #  index of the central entry: its CRC position is filled in below)
@@ -67,7 +71,7 @@ class _Layout:
             central.append(cen)
             offset = data_at + nbytes
         cd_at = offset
-        for m in members:   # the CRC field of a central entry is at byte 16 of it
+        for m in members:  # the CRC field of a central entry is at byte 16 of it
             k = m[4]
             m[4] = cd_at + sum(len(c) for c in central[:k]) + 16
         cd = b"".join(central)
@@ -108,7 +112,7 @@ def npz_bytes(arrays: dict) -> bytearray | None:
     crc32 = zlib.crc32
     for a, (at, nbytes, head_crc, local_crc, central_crc) in zip(arrs, layout.members):
         data = a.tobytes()
-        buf[at:at + nbytes] = data
+        buf[at : at + nbytes] = data
         crc = crc32(data, head_crc)
         pack(buf, local_crc, crc)
         pack(buf, central_crc, crc)
@@ -125,23 +129,23 @@ def atomic_savez(path, **arrays):
     tmp = path + TMP_SUFFIX
     data = npz_bytes(arrays)
     if data is None:
-        with open(tmp, "wb") as fh:   # a file object: np.savez would append ".npz" to a name
+        with open(tmp, "wb") as fh:  # a file object: np.savez would append ".npz" to a name
             np.savez(fh, **arrays)
     else:
         fd = os.open(tmp, _FLAGS, 0o666)
         try:
             view = memoryview(data)
             while view:
-                view = view[os.write(fd, view):]
+                view = view[os.write(fd, view) :]
         finally:
             os.close(fd)
     os.replace(tmp, path)
 
 
 # --------------------------------------------------------------------------- the frame log
-LOG_NAME = "frames.npzs"      # frames/frames.npzs: every frame of a run, appended as it converges
+LOG_NAME = "frames.npzs"  # frames/frames.npzs: every frame of a run, appended as it converges
 RECORD_MAGIC = b"FEMASTFR"
-_RECORD = struct.Struct("<8sQ")   # magic, length of the .npz that follows (bytes)
+_RECORD = struct.Struct("<8sQ")  # magic, length of the .npz that follows (bytes)
 
 
 def record_bytes(arrays: dict) -> bytes:
@@ -159,7 +163,7 @@ def append_record(fd: int, record: bytes) -> None:
     """Append ``record`` to the log open as ``fd`` (O_APPEND) in one write (looped if it is short)."""
     view = memoryview(record)
     while view:
-        view = view[os.write(fd, view):]
+        view = view[os.write(fd, view) :]
 
 
 def scan_log(path) -> tuple[list, int]:
@@ -173,13 +177,14 @@ def scan_log(path) -> tuple[list, int]:
             return [], size
         try:
             mm = mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
-        except (OSError, ValueError):   # (a file system without mmap, or a file emptied since the fstat)
+        except (OSError, ValueError):  # (a file system without mmap, or a file emptied since the fstat)
+
             def header(at):
                 fh.seek(at)
                 return _RECORD.unpack(fh.read(_RECORD.size))
 
             return _scan(header, size)
-        with mm:   # (the map's length: a writer may have appended since the fstat)
+        with mm:  # (the map's length: a writer may have appended since the fstat)
             return _scan(lambda at: _RECORD.unpack_from(mm, at), len(mm))
 
 

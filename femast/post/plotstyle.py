@@ -42,8 +42,20 @@ STYLE = {
 _SCALES = {"m": (1e3, "mm"), "rad": (1e3, "mrad"), "mm": (1.0, "mm"), "N": (1.0, "N"), "N m": (1.0, "N m")}
 
 # unit suffixes of data column names (docs/experiments.md): "dx_m" is dx in m
-_SUFFIX_UNITS = {"m": "m", "mm": "mm", "um": "um", "N": "N", "Nm": "N m", "kN": "kN", "deg": "deg", "rad": "rad",
-                 "s": "s", "Pa": "Pa", "MPa": "MPa", "J": "J"}
+_SUFFIX_UNITS = {
+    "m": "m",
+    "mm": "mm",
+    "um": "um",
+    "N": "N",
+    "Nm": "N m",
+    "kN": "kN",
+    "deg": "deg",
+    "rad": "rad",
+    "s": "s",
+    "Pa": "Pa",
+    "MPa": "MPa",
+    "J": "J",
+}
 
 
 def use() -> None:

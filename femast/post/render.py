@@ -10,8 +10,16 @@ import numpy as np
 from .results import Results
 
 
-def render_png(results, png, frame: int = -1, scale: float = 1.0, show_undeformed: bool = True,
-               color_by: str | None = "|U|", window_size=(1200, 900), title: str | None = None) -> Path:
+def render_png(
+    results,
+    png,
+    frame: int = -1,
+    scale: float = 1.0,
+    show_undeformed: bool = True,
+    color_by: str | None = "|U|",
+    window_size=(1200, 900),
+    title: str | None = None,
+) -> Path:
     """Render frame ``frame`` of ``results`` to ``png``; displacements magnified by ``scale``.
     ``color_by``: '|U|' (displacement magnitude, m) or None.  Orthographic isometric view, the
     undeformed shape in grey and labelled, a vertical colour bar with its unit."""
@@ -22,7 +30,7 @@ def render_png(results, png, frame: int = -1, scale: float = 1.0, show_undeforme
 
     pv.OFF_SCREEN = True
     res = results if isinstance(results, Results) else Results(results)
-    fr = res.frame(frame)   # a FemastError naming the frame if it does not exist
+    fr = res.frame(frame)  # a FemastError naming the frame if it does not exist
     frame = range(len(res))[int(frame)]
     label_to_row = {int(l): i for i, l in enumerate(res.node_labels)}
     segs = []
@@ -39,20 +47,38 @@ def render_png(results, png, frame: int = -1, scale: float = 1.0, show_undeforme
         plotter.add_mesh(pv.PolyData(res.X, lines=lines), color="darkgray", line_width=2)
         legend.append(["undeformed shape", "darkgray"])
     deformed = pv.PolyData(pts, lines=lines)
-    bar = dict(title="displacement (m)", vertical=True, position_x=0.84, position_y=0.15, width=0.06,
-               height=0.6, n_labels=5, fmt="%.3g", title_font_size=16, label_font_size=14, color="black")
+    bar = dict(
+        title="displacement (m)",
+        vertical=True,
+        position_x=0.84,
+        position_y=0.15,
+        width=0.06,
+        height=0.6,
+        n_labels=5,
+        fmt="%.3g",
+        title_font_size=16,
+        label_font_size=14,
+        color="black",
+    )
     if color_by == "|U|":
         deformed["displacement (m)"] = np.linalg.norm(fr["U"], axis=1)
-        plotter.add_mesh(deformed, scalars="displacement (m)", line_width=4, cmap="viridis",
-                         scalar_bar_args=bar)
+        plotter.add_mesh(deformed, scalars="displacement (m)", line_width=4, cmap="viridis", scalar_bar_args=bar)
         legend.append([f"deformed shape, displacements x {scale:g}", "coloured"])
     else:
         plotter.add_mesh(deformed, color="green", line_width=4)
         legend.append([f"deformed shape, displacements x {scale:g}", "green"])
-    plotter.add_text(title or f"{res.folder.name}: frame {frame} of {len(res)} ({fr['step']})", font_size=9,
-                     color="black", position="upper_left")
-    plotter.add_text(";   ".join(f"{c.replace('dark', '')}: {t}" for t, c in legend), font_size=9, color="black",
-                     position="lower_edge")
+    plotter.add_text(
+        title or f"{res.folder.name}: frame {frame} of {len(res)} ({fr['step']})",
+        font_size=9,
+        color="black",
+        position="upper_left",
+    )
+    plotter.add_text(
+        ";   ".join(f"{c.replace('dark', '')}: {t}" for t, c in legend),
+        font_size=9,
+        color="black",
+        position="lower_edge",
+    )
     plotter.show_axes()
     plotter.camera_position = "iso"
     plotter.enable_parallel_projection()  # orthographic: a circle stays a circle, lengths compare

@@ -56,15 +56,31 @@ import numpy as np
 
 from ..elements.base import DOF_NAMES
 from ..errors import FemastError, ResultsWriteError
-from .npz import (LOG_NAME, RECORD_MAGIC, TMP_SUFFIX, append_record, atomic_savez as _atomic_savez,  # noqa: F401
-                  npz_bytes as _npz_bytes, record_bytes, scan_log, truncate_log)
+from .npz import LOG_NAME, RECORD_MAGIC, TMP_SUFFIX, append_record, record_bytes, scan_log, truncate_log  # noqa: F401
+from .npz import atomic_savez as _atomic_savez
 
 _COMPONENTS = {
-    "ux": ("U", 0), "uy": ("U", 1), "uz": ("U", 2),
-    "urx": ("URA", 0), "ury": ("URA", 1), "urz": ("URA", 2),
-    "rx": ("URA", 0), "ry": ("URA", 1), "rz": ("URA", 2),
-    "rfx": ("RF", 0), "rfy": ("RF", 1), "rfz": ("RF", 2), "rmx": ("RF", 3), "rmy": ("RF", 4), "rmz": ("RF", 5),
-    "fx": ("P", 0), "fy": ("P", 1), "fz": ("P", 2), "mx": ("P", 3), "my": ("P", 4), "mz": ("P", 5),
+    "ux": ("U", 0),
+    "uy": ("U", 1),
+    "uz": ("U", 2),
+    "urx": ("URA", 0),
+    "ury": ("URA", 1),
+    "urz": ("URA", 2),
+    "rx": ("URA", 0),
+    "ry": ("URA", 1),
+    "rz": ("URA", 2),
+    "rfx": ("RF", 0),
+    "rfy": ("RF", 1),
+    "rfz": ("RF", 2),
+    "rmx": ("RF", 3),
+    "rmy": ("RF", 4),
+    "rmz": ("RF", 5),
+    "fx": ("P", 0),
+    "fy": ("P", 1),
+    "fz": ("P", 2),
+    "mx": ("P", 3),
+    "my": ("P", 4),
+    "mz": ("P", 5),
 }
 
 
@@ -94,7 +110,7 @@ def _process_alive(pid: int) -> bool:
     except ProcessLookupError:
         return False
     except (PermissionError, OSError):
-        return True   # exists but not ours, or cannot tell: assume alive
+        return True  # exists but not ours, or cannot tell: assume alive
     return True
 
 
@@ -102,19 +118,24 @@ def prepare_folder(folder) -> Path:
     """Create results folder ``folder`` (and its ``frames``) or raise a FemastError naming it."""
     folder = Path(folder)
     if folder.exists() and not folder.is_dir():
-        raise FemastError(f"results folder '{folder}' is an existing file, not a folder; give out= a folder "
-                          "name (or remove the file)")
+        raise FemastError(
+            f"results folder '{folder}' is an existing file, not a folder; give out= a folder name (or remove the file)"
+        )
     try:
         (folder / "frames").mkdir(parents=True, exist_ok=True)
     except (FileExistsError, NotADirectoryError):
-        raise FemastError(f"results folder '{folder}': a part of the path is an existing file; give out= a "
-                          "folder whose parents are folders") from None
+        raise FemastError(
+            f"results folder '{folder}': a part of the path is an existing file; give out= a "
+            "folder whose parents are folders"
+        ) from None
     except PermissionError as exc:
-        raise FemastError(f"results folder '{folder}': no permission to create it ({exc.strerror}); choose "
-                          "a folder you can write to") from None
+        raise FemastError(
+            f"results folder '{folder}': no permission to create it ({exc.strerror}); choose a folder you can write to"
+        ) from None
     except OSError as exc:
-        raise FemastError(f"results folder '{folder}' cannot be created ({exc.strerror or exc}); choose "
-                          "another folder") from None
+        raise FemastError(
+            f"results folder '{folder}' cannot be created ({exc.strerror or exc}); choose another folder"
+        ) from None
     return folder
 
 
@@ -146,12 +167,13 @@ class ResultsWriter:
         self._log = self._sta = None
         try:
             self._start(model, families, resume)
-        except OSError as exc:   # a full disk, a read-only folder: named, and the summary says "failed"
+        except OSError as exc:  # a full disk, a read-only folder: named, and the summary says "failed"
             self._close_files()
             self._error = exc
             try:
-                self._write_summary({"status": "failed", "completed": False,
-                                     "message": f"ResultsWriteError: {self._message(exc)}"})
+                self._write_summary(
+                    {"status": "failed", "completed": False, "message": f"ResultsWriteError: {self._message(exc)}"}
+                )
             except OSError:
                 pass
             raise ResultsWriteError(self._message(exc)) from exc
@@ -165,36 +187,45 @@ class ResultsWriter:
         write_json_atomic(self.folder / "summary.json", self._running())
         frames = self.folder / "frames"
         log = frames / LOG_NAME
-        if resume is not None and not log.exists():   # a folder of one file per frame (femast < 0.x)
+        if resume is not None and not log.exists():  # a folder of one file per frame (femast < 0.x)
             _log_from_files(frames, log)
-        for pattern in ("*.npz", "*" + TMP_SUFFIX):   # one-file-per-frame frames of an earlier run
+        for pattern in ("*.npz", "*" + TMP_SUFFIX):  # one-file-per-frame frames of an earlier run
             for old in frames.glob(pattern):
                 old.unlink()
-        if resume is None:   # an earlier run's restart point does not belong to this run's frames
+        if resume is None:  # an earlier run's restart point does not belong to this run's frames
             log.unlink(missing_ok=True)
             (self.folder / "restart" / "restart.json").unlink(missing_ok=True)
         elif truncate_log(log, resume) < resume:
-            raise FemastError(f"{self.folder}: the restart point names {resume} frames but fewer are on disk; "
-                              "run the analysis again from the start")
+            raise FemastError(
+                f"{self.folder}: the restart point names {resume} frames but fewer are on disk; "
+                "run the analysis again from the start"
+            )
         (self.folder / ("mesh.npz" + TMP_SUFFIX)).unlink(missing_ok=True)
-        mesh = {"node_labels": model.node_labels, "X": model.coordinates,
-                "families": np.array([f.name for f in families])}
+        mesh = {
+            "node_labels": model.node_labels,
+            "X": model.coordinates,
+            "families": np.array([f.name for f in families]),
+        }
         for f in families:
             mesh[f"conn/{f.name}"] = model.node_labels[np.asarray(f.nodes)]
             mesh[f"labels/{f.name}"] = np.asarray(getattr(f, "labels", np.arange(1, f.n_elements + 1)))
-        _atomic_savez(self.folder / "mesh.npz", **mesh)   # (replaces an earlier run's)
+        _atomic_savez(self.folder / "mesh.npz", **mesh)  # (replaces an earlier run's)
         self._log = os.open(log, _APPEND, 0o666)
         self._sta = os.open(self.folder / "status.sta", _APPEND | (0 if resume is not None else os.O_TRUNC), 0o666)
         if resume is not None:
             self._write_line(f"{'':>12} restarted from frame {resume}\n")
         else:
-            self._write_line(f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} "
-                             f"{'TOTAL TIME':>11} {'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n")
+            self._write_line(
+                f"{'STEP':>12} {'INC':>5} {'ATT':>3} {'ITER':>4} {'STEP TIME':>11} "
+                f"{'TOTAL TIME':>11} {'INC TIME':>11} {'LOAD FACTOR':>12}  NOTE\n"
+            )
 
     def status(self, step, inc, attempt, iterations, time, total_time, dtime, lam, note=""):
         """Write one status line to ``status.sta`` (one unbuffered append)."""
-        self._write_line(f"{step:>12.12} {inc:5d} {attempt:3d} {iterations:4d} {time:11.4e} {total_time:11.4e} "
-                         f"{dtime:11.4e} {lam:12.5e}  {note}\n")
+        self._write_line(
+            f"{step:>12.12} {inc:5d} {attempt:3d} {iterations:4d} {time:11.4e} {total_time:11.4e} "
+            f"{dtime:11.4e} {lam:12.5e}  {note}\n"
+        )
 
     def _write_line(self, line: str):
         try:
@@ -220,8 +251,10 @@ class ResultsWriter:
         self.count += 1
 
     def _message(self, exc) -> str:
-        return (f"could not write results to '{self.folder}': {exc.strerror or exc}; free disk space or give "
-                "the analysis another results folder (out=)")
+        return (
+            f"could not write results to '{self.folder}': {exc.strerror or exc}; free disk space or give "
+            "the analysis another results folder (out=)"
+        )
 
     def _failed(self, exc):
         self._error = exc
@@ -236,9 +269,14 @@ class ResultsWriter:
             os.fsync(self._log)
 
     def _running(self) -> dict:
-        return {"status": "running", "completed": False, "pid": os.getpid(), "host": socket.gethostname(),
-                "started": self._started,
-                "message": "the analysis is running (or its process was killed before it could finish)"}
+        return {
+            "status": "running",
+            "completed": False,
+            "pid": os.getpid(),
+            "host": socket.gethostname(),
+            "started": self._started,
+            "message": "the analysis is running (or its process was killed before it could finish)",
+        }
 
     def _close_files(self):
         for fd in (self._log, self._sta):
@@ -294,22 +332,25 @@ class Results:
         mesh_file = self.folder / "mesh.npz"
         if not mesh_file.exists():
             raise FemastError(f"{self.folder}: not a femast results folder (no mesh.npz); run an analysis first")
-        self._mesh = None    # read on first use (an analysis returns its Results: ~1.5 ms per run saved)
+        self._mesh = None  # read on first use (an analysis returns its Results: ~1.5 ms per run saved)
         frames = self.folder / "frames"
         names = sorted(p.name for p in frames.iterdir()) if frames.is_dir() else []
         log = frames / LOG_NAME
-        if LOG_NAME in names:   # the frame log: a record per frame
+        if LOG_NAME in names:  # the frame log: a record per frame
             records, rest = scan_log(log)
             self.files = [(log, offset, length) for offset, length in records]
             self.partial = [f"{LOG_NAME} (a partial last frame, {rest} bytes)"] if rest else []
-        else:                   # one file per frame (folders written before the log)
+        else:  # one file per frame (folders written before the log)
             self.files = [frames / n for n in names if _FRAME_NAME.match(n)]
             self.partial = [n for n in names if not _FRAME_NAME.match(n)]
         if self.partial:
-            warnings.warn(f"{self.folder}: ignoring {len(self.partial)} partial or foreign file(s) in frames/ "
-                          f"({', '.join(self.partial[:5])}{', ...' if len(self.partial) > 5 else ''}"
-                          "): left by a run that was killed (or whose disk filled up) while writing", ResultsWarning,
-                          stacklevel=2)
+            warnings.warn(
+                f"{self.folder}: ignoring {len(self.partial)} partial or foreign file(s) in frames/ "
+                f"({', '.join(self.partial[:5])}{', ...' if len(self.partial) > 5 else ''}"
+                "): left by a run that was killed (or whose disk filled up) while writing",
+                ResultsWarning,
+                stacklevel=2,
+            )
         self._cache = {}
         sfile = self.folder / "summary.json"
         self.summary = None
@@ -317,8 +358,9 @@ class Results:
             try:
                 self.summary = json.loads(sfile.read_text())
             except (ValueError, OSError) as exc:
-                warnings.warn(f"{sfile}: unreadable summary ({exc}); the run's outcome is unknown",
-                              ResultsWarning, stacklevel=2)
+                warnings.warn(
+                    f"{sfile}: unreadable summary ({exc}); the run's outcome is unknown", ResultsWarning, stacklevel=2
+                )
             else:
                 if not isinstance(self.summary, dict):
                     self.summary = None
@@ -349,8 +391,10 @@ class Results:
                 with np.load(self.folder / "mesh.npz", allow_pickle=False) as m:
                     self._mesh = {k: m[k] for k in m.files}
             except Exception as exc:
-                raise FemastError(f"{self.folder / 'mesh.npz'} is unreadable ({type(exc).__name__}: {exc}); "
-                                  "the folder is damaged: rerun the analysis") from None
+                raise FemastError(
+                    f"{self.folder / 'mesh.npz'} is unreadable ({type(exc).__name__}: {exc}); "
+                    "the folder is damaged: rerun the analysis"
+                ) from None
         return self._mesh
 
     @property
@@ -371,28 +415,33 @@ class Results:
         try:
             i = range(len(self.files))[int(i)]
         except IndexError:
-            raise FemastError(f"{self.folder}: frame {i} does not exist; the folder has {len(self.files)} frames "
-                              f"(0..{len(self.files) - 1}, or -1 for the last)") from None
+            raise FemastError(
+                f"{self.folder}: frame {i} does not exist; the folder has {len(self.files)} frames "
+                f"(0..{len(self.files) - 1}, or -1 for the last)"
+            ) from None
         if i not in self._cache:
             src = self.files[i]
             try:
-                if isinstance(src, tuple):   # a record of the frame log
+                if isinstance(src, tuple):  # a record of the frame log
                     with open(src[0], "rb") as fh:
                         fh.seek(src[1])
                         src = io.BytesIO(fh.read(src[2]))
                 with np.load(src, allow_pickle=False) as f:
                     self._cache[i] = {k: f[k] for k in f.files}
-            except Exception as exc:   # zipfile.BadZipFile, EOFError, ValueError, OSError...
+            except Exception as exc:  # zipfile.BadZipFile, EOFError, ValueError, OSError...
                 where = self.files[i] if not isinstance(self.files[i], tuple) else self.files[i][0]
-                raise FemastError(f"{where}: frame {i} is unreadable ({type(exc).__name__}: {exc}); "
-                                  "the file is damaged: rerun the analysis") from None
+                raise FemastError(
+                    f"{where}: frame {i} is unreadable ({type(exc).__name__}: {exc}); "
+                    "the file is damaged: rerun the analysis"
+                ) from None
         return self._cache[i]
 
     def _node_row(self, label):
         rows = np.flatnonzero(self.node_labels == int(label))
         if rows.size == 0:
-            raise FemastError(f"node {label} is not in these results (labels {self.node_labels.min()}.."
-                              f"{self.node_labels.max()})")
+            raise FemastError(
+                f"node {label} is not in these results (labels {self.node_labels.min()}..{self.node_labels.max()})"
+            )
         return int(rows[0])
 
     def scalar_history(self, name: str) -> np.ndarray:

@@ -28,7 +28,7 @@ def _cell_fields(frame, families, sizes):
             prefix = f"el/{fam}/"
             if not key.startswith(prefix):
                 continue
-            name = key[len(prefix):]
+            name = key[len(prefix) :]
             val = np.asarray(val)
             if not np.issubdtype(val.dtype, np.number):
                 continue
@@ -76,10 +76,19 @@ def export_vtk(results, folder=None, every: int = 1) -> Path:
                 for name in fields:
                     col = fields[name][b]
                     fields[name][b] = np.repeat(col, sizes[b] // n_el) if col.size == n_el else np.zeros(sizes[b])
-        mesh = meshio.Mesh(res.X, cells,
-                           point_data={"U": fr["U"], "UR": fr["UR"], "URA": fr["URA"], "RF": fr["RF"][:, :3],
-                                       "RM": fr["RF"][:, 3:], "node_label": res.node_labels.astype(float)},
-                           cell_data={**fields, "family": [np.full(n, b, dtype=float) for b, n in enumerate(sizes)]})
+        mesh = meshio.Mesh(
+            res.X,
+            cells,
+            point_data={
+                "U": fr["U"],
+                "UR": fr["UR"],
+                "URA": fr["URA"],
+                "RF": fr["RF"][:, :3],
+                "RM": fr["RF"][:, 3:],
+                "node_label": res.node_labels.astype(float),
+            },
+            cell_data={**fields, "family": [np.full(n, b, dtype=float) for b, n in enumerate(sizes)]},
+        )
         name = f"frame_{i:06d}.vtu"
         mesh.write(folder / name)
         ET.SubElement(coll, "DataSet", timestep=repr(float(fr["total_time"])), part="0", file=name)

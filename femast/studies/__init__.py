@@ -20,7 +20,23 @@ from .runners import RunSummary, run
 from .statistics import bootstrap_ci, convergence, percentile, sobol_convergence, sobol_indices
 from .study import Study
 
-__all__ = ["Input", "Normal", "Uniform", "TruncatedNormal", "LogNormal", "exponential_correlation", "NodeOutput",
-           "ElementOutput", "Study",
-           "run", "RunSummary", "load", "StudyResults", "percentile", "bootstrap_ci", "convergence",
-           "sobol_indices", "sobol_convergence"]
+__all__ = [
+    "Input",
+    "Normal",
+    "Uniform",
+    "TruncatedNormal",
+    "LogNormal",
+    "exponential_correlation",
+    "NodeOutput",
+    "ElementOutput",
+    "Study",
+    "run",
+    "RunSummary",
+    "load",
+    "StudyResults",
+    "percentile",
+    "bootstrap_ci",
+    "convergence",
+    "sobol_indices",
+    "sobol_convergence",
+]

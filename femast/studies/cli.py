@@ -17,7 +17,7 @@ from ..errors import StudyError
 EXIT_FAILED_SAMPLES = 3
 
 
-def load_script(path) -> "Study":  # noqa: F821
+def load_script(path) -> Study:  # noqa: F821
     """The ``study`` defined by the script at ``path``."""
     from .study import Study
 
@@ -43,48 +43,63 @@ def _study(args):
     out = args.out or str(Path("studies") / Path(args.script).stem)
     workers = args.workers if args.workers is not None else (os.cpu_count() or 1)
     try:
-        s = run(study, out, samples=args.samples, workers=workers, scheduler=args.scheduler,
-                chunk_size=args.chunk_size)
+        s = run(study, out, samples=args.samples, workers=workers, scheduler=args.scheduler, chunk_size=args.chunk_size)
     except KeyboardInterrupt:
         import sys
 
         from .. import progress
 
         progress.close_all()
-        print(f"femast study: interrupted; the finished runs are in {out}: run the same command again to resume",
-              file=sys.stderr)
+        print(
+            f"femast study: interrupted; the finished runs are in {out}: run the same command again to resume",
+            file=sys.stderr,
+        )
         raise
     print(s)
     if s.complete and not args.no_report:
         report(out, print_table=True)
     from .results import load
 
-    failed = load(out).counts()["failed"]     # this call's and any stored before a resume
+    failed = load(out).counts()["failed"]  # this call's and any stored before a resume
     if failed:
         import sys
 
-        print(f"femast study: {failed} run(s) FAILED; exit code {EXIT_FAILED_SAMPLES} "
-              f"(reasons: femast.studies.load('{out}').failures())", file=sys.stderr)
+        print(
+            f"femast study: {failed} run(s) FAILED; exit code {EXIT_FAILED_SAMPLES} "
+            f"(reasons: femast.studies.load('{out}').failures())",
+            file=sys.stderr,
+        )
         return EXIT_FAILED_SAMPLES
     return 0
 
 
 def register(sub, help_formatter):
-    p = sub.add_parser("study", help="run a study of uncertain inputs (percentiles, sensitivity)",
-                       formatter_class=help_formatter,
-                       description="Run the femast.studies.Study named 'study' in SCRIPT for N samples, in local "
-                                   "processes or on a dask cluster; the results are stored as they come (run the "
-                                   "same command again to resume) and summarised with figures.  Exit code 0: "
-                                   "every run succeeded; 3: some runs failed (listed by femast.studies.load(OUT)"
-                                   ".failures()); 2: the study could not run; 130: interrupted.")
+    p = sub.add_parser(
+        "study",
+        help="run a study of uncertain inputs (percentiles, sensitivity)",
+        formatter_class=help_formatter,
+        description="Run the femast.studies.Study named 'study' in SCRIPT for N samples, in local "
+        "processes or on a dask cluster; the results are stored as they come (run the "
+        "same command again to resume) and summarised with figures.  Exit code 0: "
+        "every run succeeded; 3: some runs failed (listed by femast.studies.load(OUT)"
+        ".failures()); 2: the study could not run; 130: interrupted.",
+    )
     p.add_argument("script", help="Python file defining study = femast.studies.Study(...)")
-    p.add_argument("--samples", type=int, required=True, help="number of base samples N (with sensitivity, N x (k+2) "
-                                                              "runs; a power of 2 keeps Sobol' points balanced)")
+    p.add_argument(
+        "--samples",
+        type=int,
+        required=True,
+        help="number of base samples N (with sensitivity, N x (k+2) runs; a power of 2 keeps Sobol' points balanced)",
+    )
     p.add_argument("--workers", type=int, default=None, help="local worker processes (default: the number of cores)")
-    p.add_argument("--scheduler", default=None, help="address of a dask.distributed scheduler, e.g. "
-                                                     "tcp://host:8786 (default: local processes)")
+    p.add_argument(
+        "--scheduler",
+        default=None,
+        help="address of a dask.distributed scheduler, e.g. tcp://host:8786 (default: local processes)",
+    )
     p.add_argument("--out", default=None, help="results folder (default: studies/SCRIPTNAME)")
-    p.add_argument("--chunk-size", type=int, default=None, help="runs per stored chunk (default: about 20 chunks "
-                                                                "per worker)")
+    p.add_argument(
+        "--chunk-size", type=int, default=None, help="runs per stored chunk (default: about 20 chunks per worker)"
+    )
     p.add_argument("--no-report", action="store_true", help="do not print the percentiles nor write the figures")
     p.set_defaults(func=_study)

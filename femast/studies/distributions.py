@@ -33,9 +33,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import special   # (scipy.stats where needed: 0.45 s to import, and every femast command pays
-# the import of this package: issue 21)
+from scipy import special  # (scipy.stats where needed: 0.45 s to import, and every femast command pays
 
+# the import of this package: issue 21)
 from ..errors import StudyError
 
 #: u is kept inside [EPS, 1 - EPS]: a normal's ppf(0) is -inf (a scrambled Sobol' point can be 0).
@@ -59,8 +59,10 @@ def exponential_correlation(positions, length) -> np.ndarray:
     x = x[:, None] if x.ndim == 1 else x
     L = _number(length, "correlation length", "exponential_correlation")
     if x.ndim != 2 or len(x) < 1 or not np.all(np.isfinite(x)):
-        raise StudyError(f"exponential_correlation: positions must be finite, shape (n,) or (n, d) in m; got "
-                         f"shape {np.shape(positions)}")
+        raise StudyError(
+            f"exponential_correlation: positions must be finite, shape (n,) or (n, d) in m; got "
+            f"shape {np.shape(positions)}"
+        )
     if not L > 0.0:
         raise StudyError(f"exponential_correlation: length = {length!r} m must be > 0")
     d = np.linalg.norm(x[:, None, :] - x[None, :, :], axis=2)
@@ -72,25 +74,31 @@ def _member_cholesky(rho, size, name):
     if rho is None:
         return None, None
     if size is None:
-        raise StudyError(f"input '{name}': member_correlation needs a per-member input (size=n); between scalar "
-                         "inputs give Study(correlation={('a', 'b'): rho})")
+        raise StudyError(
+            f"input '{name}': member_correlation needs a per-member input (size=n); between scalar "
+            "inputs give Study(correlation={('a', 'b'): rho})"
+        )
     if np.ndim(rho) == 0:
         r = _number(rho, "member_correlation", name)
         lo = -1.0 / (size - 1) if size > 1 else -1.0
         if not lo < r < 1.0:
-            raise StudyError(f"input '{name}': member_correlation = {rho!r} must lie in ({lo:.4g}, 1) for {size} "
-                             "members (equicorrelation)")
+            raise StudyError(
+                f"input '{name}': member_correlation = {rho!r} must lie in ({lo:.4g}, 1) for {size} "
+                "members (equicorrelation)"
+            )
         C, spec = np.full((size, size), r), r
         np.fill_diagonal(C, 1.0)
     else:
         try:
             C = np.asarray(rho, dtype=float)
         except (TypeError, ValueError):
-            raise StudyError(f"input '{name}': member_correlation must be a number or an ({size}, {size}) matrix of "
-                             "numbers") from None
+            raise StudyError(
+                f"input '{name}': member_correlation must be a number or an ({size}, {size}) matrix of numbers"
+            ) from None
         if C.shape != (size, size):
-            raise StudyError(f"input '{name}': member_correlation must be ({size}, {size}) (one row per member); "
-                             f"got shape {C.shape}")
+            raise StudyError(
+                f"input '{name}': member_correlation must be ({size}, {size}) (one row per member); got shape {C.shape}"
+            )
         if not np.all(np.isfinite(C)):
             raise StudyError(f"input '{name}': member_correlation has non-finite entries")
         if not (np.allclose(C, C.T, rtol=0, atol=1e-12) and np.allclose(np.diag(C), 1.0, rtol=0, atol=1e-12)):
@@ -99,8 +107,10 @@ def _member_cholesky(rho, size, name):
     try:
         L = np.linalg.cholesky(C)
     except np.linalg.LinAlgError:
-        raise StudyError(f"input '{name}': member_correlation is not a valid correlation matrix (not positive "
-                         "definite); lower the coefficients (or shorten the correlation length)") from None
+        raise StudyError(
+            f"input '{name}': member_correlation is not a valid correlation matrix (not positive "
+            "definite); lower the coefficients (or shorten the correlation length)"
+        ) from None
     return spec, L
 
 
@@ -113,32 +123,36 @@ class Input:
 
     def __init__(self, name: str, size: int | None = None, member_correlation=None):
         if not isinstance(name, str) or not name.isidentifier():
-            raise StudyError(f"input name {name!r} is not a Python identifier; use letters, digits and _ "
-                             "(it is the keyword the model factory receives)")
+            raise StudyError(
+                f"input name {name!r} is not a Python identifier; use letters, digits and _ "
+                "(it is the keyword the model factory receives)"
+            )
         self.name = name
         if size is not None:
             if isinstance(size, bool) or not isinstance(size, (int, np.integer)) or size < 1:
-                raise StudyError(f"input '{name}': size = {size!r} must be a whole number >= 1 (the number of "
-                                 "members drawn independently), or None for one shared value")
+                raise StudyError(
+                    f"input '{name}': size = {size!r} must be a whole number >= 1 (the number of "
+                    "members drawn independently), or None for one shared value"
+                )
             size = int(size)
         self.size = size
         spec, self._member_chol = _member_cholesky(member_correlation, size, name)
         if spec is not None:
-            self.member_correlation = spec      # in the spec (a resumed study must be the same)
+            self.member_correlation = spec  # in the spec (a resumed study must be the same)
 
     @property
     def dims(self) -> int:
         """Columns of the unit cube the input uses."""
         return 1 if self.size is None else self.size
 
-    def ppf(self, u: np.ndarray) -> np.ndarray:   # pragma: no cover - abstract
+    def ppf(self, u: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
 
     def value(self, u: np.ndarray):
         """The value(s) for the unit numbers ``u`` ((n, dims)): (n,) for a scalar input, (n, size)
         for a per-member one."""
         u = np.clip(np.asarray(u, dtype=float), EPS, 1.0 - EPS)
-        if self._member_chol is not None:   # Gaussian copula between the members
+        if self._member_chol is not None:  # Gaussian copula between the members
             u = np.clip(special.ndtr(special.ndtri(u) @ self._member_chol.T), EPS, 1.0 - EPS)
         x = self.ppf(u)
         return x[:, 0] if self.size is None else x
@@ -150,8 +164,12 @@ class Input:
 
     def spec(self) -> dict:
         """Plain description (stored in the study's manifest: a resumed study must be the same)."""
-        return {"kind": self.kind, "name": self.name, "size": self.size,
-                **{k: v for k, v in vars(self).items() if k not in ("name", "size") and not k.startswith("_")}}
+        return {
+            "kind": self.kind,
+            "name": self.name,
+            "size": self.size,
+            **{k: v for k, v in vars(self).items() if k not in ("name", "size") and not k.startswith("_")},
+        }
 
     def __repr__(self):
         args = ", ".join(f"{k}={v!r}" for k, v in self.spec().items() if k not in ("kind", "name") and v is not None)
@@ -168,8 +186,10 @@ class Normal(Input):
         self.mean = _number(mean, "mean", name)
         self.std = _number(std, "std", name)
         if self.std <= 0.0:
-            raise StudyError(f"input '{name}': std = {std!r} must be > 0 (a fixed value is not uncertain: pass it "
-                             "to the model directly)")
+            raise StudyError(
+                f"input '{name}': std = {std!r} must be > 0 (a fixed value is not uncertain: pass it "
+                "to the model directly)"
+            )
 
     def ppf(self, u):
         return self.mean + self.std * special.ndtri(u)
@@ -197,8 +217,16 @@ class TruncatedNormal(Input):
 
     kind = "truncated_normal"
 
-    def __init__(self, name: str, mean: float, std: float, low: float | None = None, high: float | None = None,
-                 size: int | None = None, member_correlation=None):
+    def __init__(
+        self,
+        name: str,
+        mean: float,
+        std: float,
+        low: float | None = None,
+        high: float | None = None,
+        size: int | None = None,
+        member_correlation=None,
+    ):
         super().__init__(name, size, member_correlation)
         self.mean = _number(mean, "mean", name)
         self.std = _number(std, "std", name)
@@ -213,8 +241,10 @@ class TruncatedNormal(Input):
         from scipy import stats
 
         if stats.norm.cdf(b) - stats.norm.cdf(a) < 1e-12:
-            raise StudyError(f"input '{name}': [low, high] = [{low}, {high}] holds no probability of "
-                             f"Normal({mean}, {std}) (more than 7 std from the mean); move the bounds or the mean")
+            raise StudyError(
+                f"input '{name}': [low, high] = [{low}, {high}] holds no probability of "
+                f"Normal({mean}, {std}) (more than 7 std from the mean); move the bounds or the mean"
+            )
         self._ab = (a, b)
 
     def ppf(self, u):
@@ -230,8 +260,7 @@ class LogNormal(Input):
 
     kind = "lognormal"
 
-    def __init__(self, name: str, median: float, sigma_log: float, size: int | None = None,
-                 member_correlation=None):
+    def __init__(self, name: str, median: float, sigma_log: float, size: int | None = None, member_correlation=None):
         super().__init__(name, size, member_correlation)
         self.median = _number(median, "median", name)
         self.sigma_log = _number(sigma_log, "sigma_log", name)
@@ -252,8 +281,9 @@ def check_inputs(inputs) -> list:
     seen = set()
     for x in inputs:
         if not isinstance(x, Input):
-            raise StudyError(f"{x!r} is not a study input; use femast.studies.Normal, Uniform, TruncatedNormal or "
-                             "LogNormal")
+            raise StudyError(
+                f"{x!r} is not a study input; use femast.studies.Normal, Uniform, TruncatedNormal or LogNormal"
+            )
         if x.name in seen:
             raise StudyError(f"input '{x.name}' is given twice; input names must be unique")
         seen.add(x.name)

@@ -28,8 +28,8 @@ def _series(res, rep):
         if len(v) < 2:
             continue
         shp = shapes.get(name, ())
-        for idx in ([()] if not shp else list(np.ndindex(*shp))):
-            if np.ptp(v[(slice(None),) + idx]) == 0.0:   # the same in every sample (e.g. a reference step)
+        for idx in [()] if not shp else list(np.ndindex(*shp)):
+            if np.ptp(v[(slice(None),) + idx]) == 0.0:  # the same in every sample (e.g. a reference step)
                 continue
             out.append((res.component_label(name, idx), v[(slice(None),) + idx], res.units.get(name, "")))
             if len(out) >= MAX_PANELS:
@@ -145,6 +145,9 @@ def study_figures(res, rep=None) -> list:
         fA, fB, fAB, _ = res.saltelli(name)
         sl = (slice(None),) + idx
         conv = sobol_convergence(fA[sl], fB[sl], fAB[(slice(None),) + sl])
-        pngs.append(sensitivity_convergence_figure(conv, s["names"], folder / "sensitivity_convergence.png",
-                                                   f"{s.get('label', name)}: indices against n"))
+        pngs.append(
+            sensitivity_convergence_figure(
+                conv, s["names"], folder / "sensitivity_convergence.png", f"{s.get('label', name)}: indices against n"
+            )
+        )
     return pngs

@@ -43,12 +43,15 @@ class _StepOutput:
         names = [s.name for s in model.steps]
         want = names if self.at is None else ([self.at] if isinstance(self.at, str) else list(self.at))
         if not want:
-            raise StudyError(f"output '{self.name}': at = {self.at!r} names no step; give step names or None "
-                             "(every step)")
+            raise StudyError(
+                f"output '{self.name}': at = {self.at!r} names no step; give step names or None (every step)"
+            )
         for s in want + ([self.relative_to] if self.relative_to is not None else []):
             if s != "initial" and s not in names:
-                raise StudyError(f"output '{self.name}': the model has no step {s!r}; its steps are "
-                                 f"{', '.join(repr(n) for n in names)} (and 'initial', the unloaded start)")
+                raise StudyError(
+                    f"output '{self.name}': the model has no step {s!r}; its steps are "
+                    f"{', '.join(repr(n) for n in names)} (and 'initial', the unloaded start)"
+                )
         return want
 
     def labels(self, model) -> list:
@@ -89,22 +92,26 @@ class NodeOutput(_StepOutput):
     def __init__(self, name: str, node: int, quantity: str = "U", components=None, at=None, relative_to=None):
         super().__init__(name, at, relative_to)
         if quantity not in NODE_QUANTITIES:
-            raise StudyError(f"output '{name}': quantity {quantity!r} is not a node quantity; use one of "
-                             f"{', '.join(NODE_QUANTITIES)}")
+            raise StudyError(
+                f"output '{name}': quantity {quantity!r} is not a node quantity; use one of "
+                f"{', '.join(NODE_QUANTITIES)}"
+            )
         self.node, self.quantity = node, quantity
         names = list(NODE_QUANTITIES[quantity])
         alias = list(_AXES.get(quantity, ()))
         comps = components if components is not None else names
         single = isinstance(comps, str)
         idx = []
-        for c in ([comps] if single else list(comps)):
+        for c in [comps] if single else list(comps):
             if c in names:
                 idx.append(names.index(c))
             elif c in alias:
                 idx.append(alias.index(c))
             else:
-                raise StudyError(f"output '{name}': component {c!r} of {quantity} does not exist; use "
-                                 f"{', '.join(names)}" + (f" (or {', '.join(alias)})" if alias else ""))
+                raise StudyError(
+                    f"output '{name}': component {c!r} of {quantity} does not exist; use "
+                    f"{', '.join(names)}" + (f" (or {', '.join(alias)})" if alias else "")
+                )
         self.components = idx[0] if single else np.array(idx)
         if quantity == "RF":
             kinds = {"N" if i < 3 else "N m" for i in (idx if not single else [idx[0]])}
@@ -119,7 +126,7 @@ class NodeOutput(_StepOutput):
         return [[names[i] for i in self.components]]
 
     def check(self, model, families=None):
-        model._check_node(self.node, f"output '{self.name}'")   # ModelError names the node
+        model._check_node(self.node, f"output '{self.name}'")  # ModelError names the node
         self.steps(model)
 
     def extract(self, model, frame):
@@ -138,14 +145,25 @@ class ElementOutput(_StepOutput):
     unit : the unit of the quantity, for tables and figures (e.g. 'N').
     """
 
-    def __init__(self, name: str, family: str, key: str, elements=None, reduce: str | None = None, at=None,
-                 relative_to=None, unit: str = "", component=None):
+    def __init__(
+        self,
+        name: str,
+        family: str,
+        key: str,
+        elements=None,
+        reduce: str | None = None,
+        at=None,
+        relative_to=None,
+        unit: str = "",
+        component=None,
+    ):
         super().__init__(name, at, relative_to)
         self.unit = str(unit)
         self.component = None if component is None else (component if isinstance(component, tuple) else (component,))
         if reduce is not None and reduce not in REDUCTIONS:
-            raise StudyError(f"output '{name}': reduce = {reduce!r} is unknown; use None or one of "
-                             f"{', '.join(REDUCTIONS)}")
+            raise StudyError(
+                f"output '{name}': reduce = {reduce!r} is unknown; use None or one of {', '.join(REDUCTIONS)}"
+            )
         self.family, self.key, self.elements, self.reduce = family, key, elements, reduce
 
     def check(self, model, families=None):
@@ -153,19 +171,25 @@ class ElementOutput(_StepOutput):
         if families is None:
             return
         if self.family not in families:
-            raise StudyError(f"output '{self.name}': the model has no element family {self.family!r}; its families "
-                             f"are {', '.join(repr(f) for f in families)}")
+            raise StudyError(
+                f"output '{self.name}': the model has no element family {self.family!r}; its families "
+                f"are {', '.join(repr(f) for f in families)}"
+            )
         keys = families[self.family]
         if self.key not in keys:
-            raise StudyError(f"output '{self.name}': family {self.family!r} has no output {self.key!r}; it has "
-                             f"{', '.join(repr(k) for k in keys)}")
+            raise StudyError(
+                f"output '{self.name}': family {self.family!r} has no output {self.key!r}; it has "
+                f"{', '.join(repr(k) for k in keys)}"
+            )
         shape = keys[self.key]
         if self.component is not None:
             try:
                 np.empty(shape)[(slice(None),) + self.component]
             except IndexError:
-                raise StudyError(f"output '{self.name}': component {self.component} is outside the per-element "
-                                 f"shape {shape[1:]} of {self.family}/{self.key}; index within it") from None
+                raise StudyError(
+                    f"output '{self.name}': component {self.component} is outside the per-element "
+                    f"shape {shape[1:]} of {self.family}/{self.key}; index within it"
+                ) from None
 
     def _component_labels(self):
         return [] if self.reduce is not None else [None]
@@ -178,8 +202,10 @@ class ElementOutput(_StepOutput):
             try:
                 v = v[(slice(None),) + self.component]
             except IndexError:
-                raise StudyError(f"output '{self.name}': component {self.component} is outside the per-element "
-                                 f"shape {v.shape[1:]} of {self.family}/{self.key}") from None
+                raise StudyError(
+                    f"output '{self.name}': component {self.component} is outside the per-element "
+                    f"shape {v.shape[1:]} of {self.family}/{self.key}"
+                ) from None
         if self.reduce is None:
             return v.copy()
         if self.reduce == "absmax":
@@ -191,8 +217,13 @@ def family_outputs(model, analysis_options: dict) -> dict:
     """{family name: {output key: array shape}} of ``model`` (its families evaluated once at the start)."""
     from ..analysis import Analysis
 
-    an = Analysis(model, None, progress=False, on_frame=lambda fr: None,
-                  **{k: v for k, v in analysis_options.items() if k not in ("progress", "on_frame")})
+    an = Analysis(
+        model,
+        None,
+        progress=False,
+        on_frame=lambda fr: None,
+        **{k: v for k, v in analysis_options.items() if k not in ("progress", "on_frame")},
+    )
     sys_ = an.system
     responses = sys_.evaluate(sys_.committed_context())
     return {f.name: {k: np.shape(v) for k, v in r.output.items()} for f, r in zip(an.families, responses)}

@@ -10,7 +10,7 @@ from .results import load
 from .statistics import percentile, sobol_indices
 
 QUANTILES = (0.05, 0.5, 0.95, 0.99)
-MAX_COMPONENTS = 30   # components of an array output listed in the table and given indices
+MAX_COMPONENTS = 30  # components of an array output listed in the table and given indices
 
 
 def _components(shape):
@@ -30,16 +30,23 @@ def summary_rows(res, quantiles=QUANTILES, confidence=0.95) -> list:
         comps = _components(shapes.get(name, ()))
         for idx in comps[:MAX_COMPONENTS]:
             x = v[(slice(None),) + idx]
-            rows.append((res.component_label(name, idx), len(x), {q: percentile(x, q, confidence) for q in quantiles},
-                         res.units.get(name, "")))
+            rows.append(
+                (
+                    res.component_label(name, idx),
+                    len(x),
+                    {q: percentile(x, q, confidence) for q in quantiles},
+                    res.units.get(name, ""),
+                )
+            )
         if len(comps) > MAX_COMPONENTS:
             rows.append((f"{name}: {len(comps) - MAX_COMPONENTS} more components", 0, None, ""))
     return rows
 
 
 def format_rows(rows) -> str:
-    lines = [f"{'output':<24} {'unit':<6} {'n':>6} " + " ".join(f"{format(q * 100, 'g') + ' %':>30}"
-                                                            for q in QUANTILES)]
+    lines = [
+        f"{'output':<24} {'unit':<6} {'n':>6} " + " ".join(f"{format(q * 100, 'g') + ' %':>30}" for q in QUANTILES)
+    ]
     for label, n, ps, unit in rows:
         if ps is None:
             lines.append(f"({label}: femast.studies.load(FOLDER).output(NAME) has them all)")
@@ -60,8 +67,11 @@ def report(folder, print_table: bool = True, figures: bool = True) -> dict:
     rows = summary_rows(res)
     out = {"rows": rows, "sobol": {}, "figures": []}
     if print_table:
-        print("percentiles: estimate [95 % confidence interval] (samples of blocks A" +
-              (" and B)" if res.sensitivity else ")") + "; NaN: too few samples for that bound")
+        print(
+            "percentiles: estimate [95 % confidence interval] (samples of blocks A"
+            + (" and B)" if res.sensitivity else ")")
+            + "; NaN: too few samples for that bound"
+        )
         print(format_rows(rows))
     if res.sensitivity:
         shapes = res.store.shapes
@@ -75,12 +85,14 @@ def report(folder, print_table: bool = True, figures: bool = True) -> dict:
                 lab = res.component_label(name, idx)
                 if np.std(np.concatenate([fA[sl], fB[sl]])) <= 1e-9 * scale:
                     if print_table:
-                        print(f"sensitivity of {lab}: does not vary beyond round-off "
-                              f"(1e-9 of the output's largest value); no indices")
+                        print(
+                            f"sensitivity of {lab}: does not vary beyond round-off "
+                            f"(1e-9 of the output's largest value); no indices"
+                        )
                     continue
                 try:
                     s = sobol_indices(fA[sl], fB[sl], fAB[(slice(None),) + sl], names=res.input_names)
-                except Exception as exc:   # a constant component has no indices
+                except Exception as exc:  # a constant component has no indices
                     if print_table:
                         print(f"sensitivity of {lab}: {exc}")
                     continue
@@ -88,11 +100,16 @@ def report(folder, print_table: bool = True, figures: bool = True) -> dict:
                 s["label"] = lab
                 out["sobol"][(name, idx)] = s
                 if print_table:
-                    print(f"sensitivity of {lab} ({s['n']} complete samples"
-                          + (f", {dropped} left out: a run failed" if dropped else "") + "):")
+                    print(
+                        f"sensitivity of {lab} ({s['n']} complete samples"
+                        + (f", {dropped} left out: a run failed" if dropped else "")
+                        + "):"
+                    )
                     for i, nm in enumerate(s["names"]):
-                        print(f"  {nm:<20} S1 = {s['S1'][i]:6.3f} [{s['S1_low'][i]:6.3f}, {s['S1_high'][i]:6.3f}]"
-                              f"   ST = {s['ST'][i]:6.3f} [{s['ST_low'][i]:6.3f}, {s['ST_high'][i]:6.3f}]")
+                        print(
+                            f"  {nm:<20} S1 = {s['S1'][i]:6.3f} [{s['S1_low'][i]:6.3f}, {s['S1_high'][i]:6.3f}]"
+                            f"   ST = {s['ST'][i]:6.3f} [{s['ST_low'][i]:6.3f}, {s['ST_high'][i]:6.3f}]"
+                        )
     if figures:
         from .figures import study_figures
 

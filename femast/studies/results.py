@@ -1,9 +1,9 @@
 """Reading a study's results back (issue 20): ``femast.studies.load(folder)``.
 
-    res = load("studies/tip")
-    x = res.output("tip_u")            # (n_ok, ...) values of the successful base samples (block A)
-    res.inputs("mu")                   # the matching input values
-    res.failures()                     # [(run, reason), ...] every failed run
+res = load("studies/tip")
+x = res.output("tip_u")            # (n_ok, ...) values of the successful base samples (block A)
+res.inputs("mu")                   # the matching input values
+res.failures()                     # [(run, reason), ...] every failed run
 """
 
 from __future__ import annotations
@@ -84,16 +84,22 @@ class StudyResults:
         """{'runs': on disk, 'ok': ..., 'failed': ..., 'expected': samples x runs per sample}."""
         t = self.store.read(["status"])
         ok = int(np.sum(t["status"] == "ok"))
-        return {"runs": len(t["run"]), "ok": ok, "failed": len(t["run"]) - ok,
-                "expected": self.samples * self.runs_per_sample}
+        return {
+            "runs": len(t["run"]),
+            "ok": ok,
+            "failed": len(t["run"]) - ok,
+            "expected": self.samples * self.runs_per_sample,
+        }
 
     def saltelli(self, name: str) -> tuple:
         """The sensitivity layout of output ``name``: (fA, fB, fAB, dropped) with fA, fB (n, ...)
         and fAB (k, n, ...) over the base samples whose k + 2 runs all succeeded; ``dropped`` is the
         number of base samples left out because one of their runs failed."""
         if not self.sensitivity:
-            raise StudyError(f"{self.folder}: the study was run without sensitivity=True; run it with "
-                             "sensitivity=True to get Sobol' indices")
+            raise StudyError(
+                f"{self.folder}: the study was run without sensitivity=True; run it with "
+                "sensitivity=True to get Sobol' indices"
+            )
         self._check(name, "output")
         t = self.store.read([name, "base", "status"])
         m = self.runs_per_sample

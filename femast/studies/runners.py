@@ -35,8 +35,8 @@ from ..errors import SampleTimeout, StudyError
 from .store import Store
 from .study import Study
 
-_STUDY = None         # the study of this worker process
-_DASK_STUDIES = {}    # payload hash -> study (dask workers)
+_STUDY = None  # the study of this worker process
+_DASK_STUDIES = {}  # payload hash -> study (dask workers)
 
 
 @dataclass
@@ -44,31 +44,40 @@ class RunSummary:
     """What a call of :func:`run` did."""
 
     folder: str
-    samples: int            # base samples of the study
-    runs: int               # runs of the study (samples x (k + 2) with sensitivity)
-    ran: int = 0            # runs made by this call
-    ok: int = 0             # of them, successful
-    failed: int = 0         # of them, failed (reasons in the store)
-    resumed: int = 0        # runs already on disk when the call started
+    samples: int  # base samples of the study
+    runs: int  # runs of the study (samples x (k + 2) with sensitivity)
+    ran: int = 0  # runs made by this call
+    ok: int = 0  # of them, successful
+    failed: int = 0  # of them, failed (reasons in the store)
+    resumed: int = 0  # runs already on disk when the call started
     wall_time: float = 0.0  # s
-    cpu_time: float = 0.0   # s, this process and its local workers (not dask workers), warm-up included
+    cpu_time: float = 0.0  # s, this process and its local workers (not dask workers), warm-up included
     workers: int = 1
     engine: str = "serial"
-    warmup_time: float = 0.0   # s, wall time of the warm-up (one nominal sample, not recorded)
-    warmup_cpu: float = 0.0    # s, its CPU time in this process (serial, local)
+    warmup_time: float = 0.0  # s, wall time of the warm-up (one nominal sample, not recorded)
+    warmup_cpu: float = 0.0  # s, its CPU time in this process (serial, local)
     complete: bool = False
-    failures: list = field(default_factory=list)   # (run, reason) of this call's failures (first 20)
+    failures: list = field(default_factory=list)  # (run, reason) of this call's failures (first 20)
 
     def __str__(self):
-        state = "complete" if self.complete else f"stopped with {self.runs - self.resumed - self.ran} runs to go " \
-                                                  "(run again with the same folder to resume)"
-        fail = f", {self.failed} FAILED (reasons: femast.studies.load('{self.folder}').failures())" if self.failed \
+        state = (
+            "complete"
+            if self.complete
+            else f"stopped with {self.runs - self.resumed - self.ran} runs to go "
+            "(run again with the same folder to resume)"
+        )
+        fail = (
+            f", {self.failed} FAILED (reasons: femast.studies.load('{self.folder}').failures())"
+            if self.failed
             else ", 0 failed"
+        )
         res = f" ({self.resumed} already on disk)" if self.resumed else ""
-        return (f"study {state}: {self.samples} samples, {self.runs} runs{res}; this call ran {self.ran}: {self.ok} ok"
-                f"{fail}; wall time {self.wall_time:.1f} s, CPU {self.cpu_time:.1f} s"
-                f"{' (this process; not the dask workers)' if self.engine == 'dask' else ''}, {self.workers} "
-                f"{self.engine} worker(s) (warm-up {self.warmup_time:.1f} s); results in {self.folder}")
+        return (
+            f"study {state}: {self.samples} samples, {self.runs} runs{res}; this call ran {self.ran}: {self.ok} ok"
+            f"{fail}; wall time {self.wall_time:.1f} s, CPU {self.cpu_time:.1f} s"
+            f"{' (this process; not the dask workers)' if self.engine == 'dask' else ''}, {self.workers} "
+            f"{self.engine} worker(s) (warm-up {self.warmup_time:.1f} s); results in {self.folder}"
+        )
 
 
 # ---------------------------------------------------------------- one chunk (any process)
@@ -92,8 +101,11 @@ class _Timer:
         import threading
 
         self.seconds = seconds
-        self.on = (seconds is not None and hasattr(signal, "setitimer")
-                   and threading.current_thread() is threading.main_thread())
+        self.on = (
+            seconds is not None
+            and hasattr(signal, "setitimer")
+            and threading.current_thread() is threading.main_thread()
+        )
 
     def _alarm(self, signum, frame):
         raise SampleTimeout(_over(self.seconds))
@@ -123,7 +135,7 @@ def _sample(study: Study, values: dict):
             if not np.all(np.isfinite(v)):
                 raise StudyError(f"output '{k}' is not finite ({v}); the sample is counted as failed")
         status, error = "ok", None
-    except Exception as exc:   # recorded with its reason, never dropped
+    except Exception as exc:  # recorded with its reason, never dropped
         msg = str(exc).strip().replace("\n", " ")
         status, error, out = "failed", f"{type(exc).__name__}: {msg}"[:1000], {}
     return status, error, out, time.perf_counter() - t0
@@ -137,8 +149,19 @@ def run_chunk(study: Study, runs, base, block, values) -> list:
     for i, r in enumerate(runs):
         v = {k: (float(a[i]) if a.ndim == 1 else a[i].copy()) for k, a in values.items()}
         status, error, out, sec = _sample(study, v)
-        rows.append({"run": int(r), "base": int(base[i]), "block": names[int(block[i])], "status": status,
-                     "error": error, "seconds": sec, "worker": worker, "inputs": v, "outputs": out})
+        rows.append(
+            {
+                "run": int(r),
+                "base": int(base[i]),
+                "block": names[int(block[i])],
+                "status": status,
+                "error": error,
+                "seconds": sec,
+                "worker": worker,
+                "inputs": v,
+                "outputs": out,
+            }
+        )
     return rows
 
 
@@ -146,9 +169,9 @@ def _init_local(study):
     global _STUDY
     import signal
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)   # Ctrl-C is the parent's: it stops the workers
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's: it stops the workers
     _STUDY = pickle.loads(study) if isinstance(study, bytes) else study
-    if isinstance(study, bytes):   # spawned: warm this process
+    if isinstance(study, bytes):  # spawned: warm this process
         warm(_STUDY)
 
 
@@ -195,19 +218,31 @@ def _connect(scheduler: str, timeout: float):
     try:
         from distributed import Client
     except ImportError:
-        raise StudyError("--scheduler needs dask.distributed: pip install 'dask[distributed]' (or femast[dist]); "
-                         "or drop --scheduler to use local processes") from None
+        raise StudyError(
+            "--scheduler needs dask.distributed: pip install 'dask[distributed]' (or femast[dist]); "
+            "or drop --scheduler to use local processes"
+        ) from None
     try:
         return Client(scheduler, timeout=f"{timeout}s", set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
-        raise StudyError(f"cannot reach the dask scheduler at {scheduler!r} ({type(exc).__name__}: "
-                         f"{str(exc).splitlines()[0] if str(exc) else 'no answer'}); start one (`dask scheduler`, "
-                         "then `dask worker ADDRESS` on each machine) and give its address, or drop --scheduler to "
-                         "use local processes") from None
+        raise StudyError(
+            f"cannot reach the dask scheduler at {scheduler!r} ({type(exc).__name__}: "
+            f"{str(exc).splitlines()[0] if str(exc) else 'no answer'}); start one (`dask scheduler`, "
+            "then `dask worker ADDRESS` on each machine) and give its address, or drop --scheduler to "
+            "use local processes"
+        ) from None
 
 
-def run(study: Study, folder, samples: int, workers: int = 1, scheduler=None, chunk_size: int | None = None,
-        limit: int | None = None, connect_timeout: float = 10.0) -> RunSummary:
+def run(
+    study: Study,
+    folder,
+    samples: int,
+    workers: int = 1,
+    scheduler=None,
+    chunk_size: int | None = None,
+    limit: int | None = None,
+    connect_timeout: float = 10.0,
+) -> RunSummary:
     """Run ``samples`` base samples of ``study`` into ``folder`` (resuming what is there).
 
     workers : 1 runs in this process; n > 1 runs n local worker processes.
@@ -247,15 +282,16 @@ def _drive(study, store, samples, workers, client, chunk_size, limit):
     done = store.done_runs()
     todo = np.setdiff1d(np.arange(total, dtype=np.int64), done)
     if limit is not None:
-        todo = todo[:int(limit)]
+        todo = todo[: int(limit)]
     engine = "dask" if client is not None else ("local" if workers > 1 else "serial")
     if client is not None:
         workers = max(1, sum(client.nthreads().values()))
-    s = RunSummary(folder=str(store.folder), samples=samples, runs=total, resumed=len(done), workers=workers,
-                   engine=engine)
+    s = RunSummary(
+        folder=str(store.folder), samples=samples, runs=total, resumed=len(done), workers=workers, engine=engine
+    )
     if chunk_size is None:
         chunk_size = int(min(256, max(1, math.ceil(len(todo) / (20 * workers)))))
-    chunks = [todo[i:i + chunk_size] for i in range(0, len(todo), chunk_size)]
+    chunks = [todo[i : i + chunk_size] for i in range(0, len(todo), chunk_size)]
     sizes = {x.name: x.size for x in study.inputs}
     names = [x.name for x in study.inputs]
 
@@ -324,7 +360,7 @@ def _run_local(study, chunks, make, record, workers, s):
     methods = mp.get_all_start_methods()
     tw, cw = time.perf_counter(), _cpu()
     if "fork" in methods and os.name == "posix" and not _macos():
-        warm(study)                       # the forked workers inherit the loaded kernels
+        warm(study)  # the forked workers inherit the loaded kernels
         ctx, arg = mp.get_context("fork"), study
         s.warmup_cpu = _cpu() - cw
     else:
@@ -337,12 +373,20 @@ def _run_local(study, chunks, make, record, workers, s):
     ex = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_local, initargs=(arg,))
     try:
         try:
-            _pipeline(chunks, make, record, lambda *a: ex.submit(_local_chunk, *a),
-                      lambda p: wait(p, return_when=FIRST_COMPLETED), 2 * workers)
+            _pipeline(
+                chunks,
+                make,
+                record,
+                lambda *a: ex.submit(_local_chunk, *a),
+                lambda p: wait(p, return_when=FIRST_COMPLETED),
+                2 * workers,
+            )
         except BrokenProcessPool:
-            raise StudyError(f"a worker process died (killed, out of memory, or a crash in compiled code) after "
-                             f"{s.ran} runs of this call; the finished runs are stored: run again to resume, "
-                             "with --workers 1 to see which sample crashes") from None
+            raise StudyError(
+                f"a worker process died (killed, out of memory, or a crash in compiled code) after "
+                f"{s.ran} runs of this call; the finished runs are stored: run again to resume, "
+                "with --workers 1 to see which sample crashes"
+            ) from None
     except BaseException:
         # interrupted (or a worker died): the chunks in flight are lost, nothing half-written
         # (only this process writes); stop the workers now rather than after their chunks
@@ -374,10 +418,13 @@ def _run_dask(study, chunks, make, record, client, s):
         return r.done, r.not_done
 
     try:
-        _pipeline(chunks, make, record, lambda *a: client.submit(_dask_chunk, fut, *a, pure=False), wait_one,
-                  2 * s.workers)
+        _pipeline(
+            chunks, make, record, lambda *a: client.submit(_dask_chunk, fut, *a, pure=False), wait_one, 2 * s.workers
+        )
     except Exception as exc:
         if type(exc).__name__ != "KilledWorker":
             raise
-        raise StudyError(f"dask workers died running a chunk ({exc}); the finished runs ({s.ran} of this call) are "
-                         "stored: run again to resume; check the workers' memory and logs") from None
+        raise StudyError(
+            f"dask workers died running a chunk ({exc}); the finished runs ({s.ran} of this call) are "
+            "stored: run again to resume; check the workers' memory and logs"
+        ) from None

@@ -28,7 +28,7 @@ from scipy import special
 from ..errors import StudyError
 
 SAMPLERS = ("sobol", "lhs", "mc")
-MC_BLOCK = 1024   # base samples per Monte Carlo random stream (the points do not depend on N)
+MC_BLOCK = 1024  # base samples per Monte Carlo random stream (the points do not depend on N)
 
 
 class Design:
@@ -43,8 +43,9 @@ class Design:
     correlation : {(name_a, name_b): rho} between scalar inputs (a Gaussian copula), or None.
     """
 
-    def __init__(self, inputs, sampler: str = "sobol", seed: int = 1, sensitivity: bool = False,
-                 correlation: dict | None = None):
+    def __init__(
+        self, inputs, sampler: str = "sobol", seed: int = 1, sensitivity: bool = False, correlation: dict | None = None
+    ):
         self.inputs = list(inputs)
         if sampler not in SAMPLERS:
             raise StudyError(f"sampler {sampler!r} is unknown; use one of {', '.join(SAMPLERS)}")
@@ -62,8 +63,10 @@ class Design:
         self.correlation = dict(correlation or {})
         self._copula = self._cholesky()
         if self._copula is not None and self.sensitivity:
-            raise StudyError("Sobol' sensitivity indices assume independent inputs; drop correlation= or "
-                             "sensitivity=True (the indices of correlated inputs are not defined this way)")
+            raise StudyError(
+                "Sobol' sensitivity indices assume independent inputs; drop correlation= or "
+                "sensitivity=True (the indices of correlated inputs are not defined this way)"
+            )
         self._lhs = None
         self._sobol = None
 
@@ -81,9 +84,13 @@ class Design:
 
     def spec(self) -> dict:
         """Plain description for the study manifest."""
-        return {"sampler": self.sampler, "seed": self.seed, "sensitivity": self.sensitivity,
-                "correlation": sorted([list(k) + [float(v)] for k, v in self.correlation.items()]),
-                "inputs": [x.spec() for x in self.inputs]}
+        return {
+            "sampler": self.sampler,
+            "seed": self.seed,
+            "sensitivity": self.sensitivity,
+            "correlation": sorted([list(k) + [float(v)] for k, v in self.correlation.items()]),
+            "inputs": [x.spec() for x in self.inputs],
+        }
 
     # ------------------------------------------------------------ copula
     def _cholesky(self):
@@ -96,11 +103,14 @@ class Design:
                 raise StudyError(f"correlation key {key!r} must be a pair of input names, e.g. ('a', 'b')")
             for n in key:
                 if n not in names:
-                    raise StudyError(f"correlation {key}: '{n}' is not an input of the study (inputs: "
-                                     f"{', '.join(names)})")
+                    raise StudyError(
+                        f"correlation {key}: '{n}' is not an input of the study (inputs: {', '.join(names)})"
+                    )
                 if names[n].size is not None:
-                    raise StudyError(f"correlation {key}: '{n}' is a per-member input (size {names[n].size}); "
-                                     "correlations are between scalar inputs")
+                    raise StudyError(
+                        f"correlation {key}: '{n}' is a per-member input (size {names[n].size}); "
+                        "correlations are between scalar inputs"
+                    )
                 if n not in order:
                     order.append(n)
             if key[0] == key[1]:
@@ -118,8 +128,10 @@ class Design:
         try:
             L = np.linalg.cholesky(C)
         except np.linalg.LinAlgError:
-            raise StudyError(f"the correlations {self.correlation} are not a valid correlation matrix (not positive "
-                             "definite); lower the coefficients so that they are consistent") from None
+            raise StudyError(
+                f"the correlations {self.correlation} are not a valid correlation matrix (not positive "
+                "definite); lower the coefficients so that they are consistent"
+            ) from None
         cols = [self.slices[n].start for n in order]
         return cols, L
 
@@ -144,13 +156,13 @@ class Design:
                 out.append(pts[lo:hi])
             return np.concatenate(out) if out else np.zeros((0, d))
         if self.sampler == "sobol":
-            from scipy.stats import qmc   # (here: 0.45 s to import, issue 21)
+            from scipy.stats import qmc  # (here: 0.45 s to import, issue 21)
 
             eng = qmc.Sobol(d, scramble=True, seed=self.seed)
             if start:
                 eng.fast_forward(start)
             with warnings.catch_warnings():
-                warnings.simplefilter("ignore", UserWarning)   # balance warning: documented, N may be any
+                warnings.simplefilter("ignore", UserWarning)  # balance warning: documented, N may be any
                 return eng.random(stop - start)
         # Latin hypercube: the N x d design is made once (it depends on N)
         if self._lhs is None or len(self._lhs) != n_total:

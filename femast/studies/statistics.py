@@ -35,12 +35,12 @@ def order_statistic_ranks(n: int, q: float, confidence: float = 0.95) -> tuple:
     """1-based ranks (l, u) with P(x_(l) <= xi_q <= x_(u)) >= confidence; 0 or n + 1 when n is too
     small for that side (no bound)."""
     alpha = 1.0 - confidence
-    from scipy import stats   # (here: importing scipy.stats costs every femast command 0.45 s, issue 21)
+    from scipy import stats  # (here: importing scipy.stats costs every femast command 0.45 s, issue 21)
 
-    l = int(stats.binom.ppf(alpha / 2, n, q))                 # P(B <= l - 1) <= alpha / 2
+    l = int(stats.binom.ppf(alpha / 2, n, q))  # P(B <= l - 1) <= alpha / 2
     if l >= 1 and stats.binom.cdf(l - 1, n, q) > alpha / 2:
         l -= 1
-    u = int(stats.binom.ppf(1 - alpha / 2, n, q)) + 1          # P(B >= u) <= alpha / 2
+    u = int(stats.binom.ppf(1 - alpha / 2, n, q)) + 1  # P(B >= u) <= alpha / 2
     return max(l, 0), min(u, n + 1)
 
 
@@ -58,8 +58,14 @@ def percentile(x, q: float, confidence: float = 0.95) -> dict:
     from scipy import stats
 
     cover = stats.binom.cdf(u - 1, n, q) - (stats.binom.cdf(l - 1, n, q) if l >= 1 else 0.0)
-    return {"q": q, "estimate": float(np.quantile(x, q)), "low": float(lo), "high": float(hi), "n": n,
-            "coverage": float(cover)}
+    return {
+        "q": q,
+        "estimate": float(np.quantile(x, q)),
+        "low": float(lo),
+        "high": float(hi),
+        "n": n,
+        "coverage": float(cover),
+    }
 
 
 def bootstrap_ci(x, statistic=np.mean, confidence: float = 0.95, resamples: int = 2000, seed: int = 0) -> dict:
@@ -69,8 +75,12 @@ def bootstrap_ci(x, statistic=np.mean, confidence: float = 0.95, resamples: int 
     idx = rng.integers(0, len(x), size=(resamples, len(x)))
     b = np.array([statistic(x[i]) for i in idx])
     a = (1.0 - confidence) / 2
-    return {"estimate": float(statistic(x)), "low": float(np.quantile(b, a)), "high": float(np.quantile(b, 1 - a)),
-            "n": len(x)}
+    return {
+        "estimate": float(statistic(x)),
+        "low": float(np.quantile(b, a)),
+        "high": float(np.quantile(b, 1 - a)),
+        "n": len(x),
+    }
 
 
 def convergence(x, q=(0.5, 0.95, 0.99), ns=None, confidence: float = 0.95) -> dict:
@@ -79,7 +89,7 @@ def convergence(x, q=(0.5, 0.95, 0.99), ns=None, confidence: float = 0.95) -> di
     to len(x)).  Returns {'n': array, 'mean': (m, 3) [estimate, low, high], 'q<q>': (m, 3) ...}."""
     x = _values(x)
     if ns is None:
-        ns = [n for n in (8 * 2 ** k for k in range(40)) if n < len(x)] + [len(x)]
+        ns = [n for n in (8 * 2**k for k in range(40)) if n < len(x)] + [len(x)]
     ns = np.array(sorted(set(int(n) for n in ns if 1 <= n <= len(x))))
     from scipy import stats
 
@@ -118,15 +128,17 @@ def sobol_indices(fA, fB, fAB, names=None, confidence: float = 0.95, resamples: 
     fA, fB = _values(fA, "f_A"), _values(fB, "f_B")
     fAB = np.asarray(fAB, dtype=float)
     if fAB.ndim != 2 or fAB.shape[1] != len(fA) or len(fB) != len(fA):
-        raise StudyError(f"sobol_indices: f_AB must be (k, n) with n = {len(fA)} (the length of f_A and f_B); "
-                         f"got {fAB.shape}")
+        raise StudyError(
+            f"sobol_indices: f_AB must be (k, n) with n = {len(fA)} (the length of f_A and f_B); got {fAB.shape}"
+        )
     k, n = fAB.shape
     if n < 2:
         raise StudyError("sobol_indices: at least 2 complete base samples are needed")
     S, ST, V = _jansen(fA, fB, fAB)
     if not V > 0.0:
-        raise StudyError("sobol_indices: the output does not vary over the samples (variance 0); its indices are "
-                         "not defined")
+        raise StudyError(
+            "sobol_indices: the output does not vary over the samples (variance 0); its indices are not defined"
+        )
     rng = np.random.default_rng(seed)
     bs, bt = np.zeros((resamples, k)), np.zeros((resamples, k))
     for r in range(resamples):
@@ -134,9 +146,17 @@ def sobol_indices(fA, fB, fAB, names=None, confidence: float = 0.95, resamples: 
         bs[r], bt[r], _ = _jansen(fA[i], fB[i], fAB[:, i])
     a = (1.0 - confidence) / 2
     names = list(names) if names is not None else [f"x{i + 1}" for i in range(k)]
-    return {"names": names, "S1": S, "ST": ST, "S1_low": np.nanquantile(bs, a, axis=0),
-            "S1_high": np.nanquantile(bs, 1 - a, axis=0), "ST_low": np.nanquantile(bt, a, axis=0),
-            "ST_high": np.nanquantile(bt, 1 - a, axis=0), "variance": float(V), "n": n}
+    return {
+        "names": names,
+        "S1": S,
+        "ST": ST,
+        "S1_low": np.nanquantile(bs, a, axis=0),
+        "S1_high": np.nanquantile(bs, 1 - a, axis=0),
+        "ST_low": np.nanquantile(bt, a, axis=0),
+        "ST_high": np.nanquantile(bt, 1 - a, axis=0),
+        "variance": float(V),
+        "n": n,
+    }
 
 
 def sobol_convergence(fA, fB, fAB, ns=None) -> dict:
@@ -145,7 +165,7 @@ def sobol_convergence(fA, fB, fAB, ns=None) -> dict:
     fA, fB, fAB = np.asarray(fA, float), np.asarray(fB, float), np.asarray(fAB, float)
     n = len(fA)
     if ns is None:
-        ns = [m for m in (8 * 2 ** j for j in range(40)) if m < n] + [n]
+        ns = [m for m in (8 * 2**j for j in range(40)) if m < n] + [n]
     ns = np.array(sorted(set(int(m) for m in ns if 2 <= m <= n)))
     S1, ST = [], []
     for m in ns:
@@ -161,8 +181,10 @@ def component(values, index=None, name="output") -> np.ndarray:
     v = np.asarray(values, dtype=float)
     if index is None:
         if v.ndim != 1:
-            raise StudyError(f"{name} has shape {v.shape[1:]} per sample; say which component (index=(step, "
-                             "component), e.g. (-1, 0))")
+            raise StudyError(
+                f"{name} has shape {v.shape[1:]} per sample; say which component (index=(step, "
+                "component), e.g. (-1, 0))"
+            )
         return v
     index = (index,) if np.isscalar(index) else tuple(index)
     try:

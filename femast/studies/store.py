@@ -33,8 +33,10 @@ def _pa():
         import pyarrow as pa
         import pyarrow.parquet as pq
     except ImportError:  # pragma: no cover - pyarrow is in the test extra
-        raise StudyError("femast studies store their results with pyarrow, which is not installed; "
-                         "pip install pyarrow (or femast[study])") from None
+        raise StudyError(
+            "femast studies store their results with pyarrow, which is not installed; "
+            "pip install pyarrow (or femast[study])"
+        ) from None
     return pa, pq
 
 
@@ -49,13 +51,17 @@ class Store:
         if path.exists():
             self.manifest = json.loads(path.read_text())
             if spec is not None and self.manifest["spec"] != json.loads(json.dumps(spec)):
-                raise StudyError(f"{self.folder} holds another study (different inputs, outputs or design); give "
-                                 "a new folder, or delete it to start afresh")
+                raise StudyError(
+                    f"{self.folder} holds another study (different inputs, outputs or design); give "
+                    "a new folder, or delete it to start afresh"
+                )
             if samples is not None and samples != self.manifest["samples"]:
                 old = self.manifest["samples"]
                 if spec is not None and spec["design"]["sampler"] == "lhs":
-                    raise StudyError(f"{self.folder}: a Latin hypercube of {old} samples cannot be resumed with "
-                                     f"{samples}; its points depend on N (use --samples {old}, or a new folder)")
+                    raise StudyError(
+                        f"{self.folder}: a Latin hypercube of {old} samples cannot be resumed with "
+                        f"{samples}; its points depend on N (use --samples {old}, or a new folder)"
+                    )
                 if samples < old:
                     raise StudyError(f"{self.folder} already has a study of {old} samples; give --samples >= {old}")
                 self.manifest["samples"] = samples
@@ -66,8 +72,10 @@ class Store:
             names = [x["name"] for x in spec["design"]["inputs"]] + list(spec["outputs"])
             bad = [n for n in names if n in RESERVED]
             if bad:
-                raise StudyError(f"{', '.join(bad)}: reserved column name(s) of the results; rename (reserved: "
-                                 f"{', '.join(RESERVED)})")
+                raise StudyError(
+                    f"{', '.join(bad)}: reserved column name(s) of the results; rename (reserved: "
+                    f"{', '.join(RESERVED)})"
+                )
             self.folder.mkdir(parents=True, exist_ok=True)
             self.manifest = {"spec": json.loads(json.dumps(spec)), "samples": samples, "shapes": {}}
             self._write_manifest()
@@ -103,8 +111,10 @@ class Store:
                     shapes[k], new_shape = shp, True
                 elif shapes[k] != shp:
                     r["status"] = "failed"
-                    r["error"] = (f"StudyError: output '{k}' has shape {tuple(shp)}, earlier samples "
-                                  f"{tuple(shapes[k])}; an output must have the same shape in every sample")
+                    r["error"] = (
+                        f"StudyError: output '{k}' has shape {tuple(shp)}, earlier samples "
+                        f"{tuple(shapes[k])}; an output must have the same shape in every sample"
+                    )
         if new_shape:
             self._write_manifest()
         outs = list(self.manifest["spec"]["outputs"])
@@ -124,9 +134,15 @@ class Store:
                 else:
                     vals.append(np.asarray(v, float).ravel().tolist())
             cols[k] = vals
-        fields = [pa.field("run", pa.int64()), pa.field("base", pa.int64()), pa.field("block", pa.string()),
-                  pa.field("status", pa.string()), pa.field("error", pa.string()), pa.field("seconds", pa.float64()),
-                  pa.field("worker", pa.string())]
+        fields = [
+            pa.field("run", pa.int64()),
+            pa.field("base", pa.int64()),
+            pa.field("block", pa.string()),
+            pa.field("status", pa.string()),
+            pa.field("error", pa.string()),
+            pa.field("seconds", pa.float64()),
+            pa.field("worker", pa.string()),
+        ]
         for n in input_names:
             fields.append(pa.field(n, pa.float64() if input_sizes[n] is None else pa.list_(pa.float64())))
         for k in outs:
@@ -166,14 +182,16 @@ class Store:
                 width = int(np.prod(shp)) if shp else 0
                 col = col.combine_chunks()
                 valid = ~np.asarray(col.is_null().to_numpy(zero_copy_only=False), dtype=bool)
-                flat = np.asarray(col.flatten().to_numpy(zero_copy_only=False), dtype=float)   # non-null rows
+                flat = np.asarray(col.flatten().to_numpy(zero_copy_only=False), dtype=float)  # non-null rows
                 arr = np.full((len(col), width), np.nan)
                 arr[valid] = flat.reshape(int(valid.sum()), width)
                 out[c] = arr.reshape((len(col),) + tuple(shp or (0,)))[order]
             elif pa.types.is_floating(col.type):
                 out[c] = np.asarray(col.to_numpy(zero_copy_only=False), dtype=float)[order]
             else:
-                out[c] = np.asarray(col.to_pylist(), dtype=object if not pa.types.is_integer(col.type) else np.int64)[order]
+                out[c] = np.asarray(col.to_pylist(), dtype=object if not pa.types.is_integer(col.type) else np.int64)[
+                    order
+                ]
         return out
 
     def done_runs(self) -> np.ndarray:

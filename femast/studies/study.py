@@ -45,34 +45,52 @@ class Study:
     name : a label for summaries and figures.
     """
 
-    def __init__(self, model=None, *, run=None, inputs, outputs, sampler: str = "sobol", seed: int = 1,
-                 sensitivity: bool = False, correlation: dict | None = None, analysis: dict | None = None,
-                 units: dict | None = None, timeout_s: float | None = None, name: str = "study"):
+    def __init__(
+        self,
+        model=None,
+        *,
+        run=None,
+        inputs,
+        outputs,
+        sampler: str = "sobol",
+        seed: int = 1,
+        sensitivity: bool = False,
+        correlation: dict | None = None,
+        analysis: dict | None = None,
+        units: dict | None = None,
+        timeout_s: float | None = None,
+        name: str = "study",
+    ):
         if (model is None) == (run is None):
-            raise StudyError("give a study either model=FACTORY (returns a femast Model; femast runs it) or "
-                             "run=FUNCTION (runs a sample, returns a dict of outputs), not both / neither")
+            raise StudyError(
+                "give a study either model=FACTORY (returns a femast Model; femast runs it) or "
+                "run=FUNCTION (runs a sample, returns a dict of outputs), not both / neither"
+            )
         fn = model if model is not None else run
         if not callable(fn):
-            raise StudyError(f"{'model' if model is not None else 'run'} = {fn!r} is not callable; give a function "
-                             "of the inputs")
+            raise StudyError(
+                f"{'model' if model is not None else 'run'} = {fn!r} is not callable; give a function of the inputs"
+            )
         self.factory, self.runner = model, run
         self.inputs = check_inputs(inputs)
-        self.design = Design(self.inputs, sampler=sampler, seed=seed, sensitivity=sensitivity,
-                             correlation=correlation)
+        self.design = Design(self.inputs, sampler=sampler, seed=seed, sensitivity=sensitivity, correlation=correlation)
         outputs = list(outputs)
         if not outputs:
             raise StudyError("a study needs at least one output to record")
         if model is not None:
             for o in outputs:
                 if not isinstance(o, (NodeOutput, ElementOutput)):
-                    raise StudyError(f"output {o!r}: a model= study records NodeOutput or ElementOutput objects "
-                                     "(a run= study returns named values instead)")
+                    raise StudyError(
+                        f"output {o!r}: a model= study records NodeOutput or ElementOutput objects "
+                        "(a run= study returns named values instead)"
+                    )
             names = [o.name for o in outputs]
         else:
             for o in outputs:
                 if not isinstance(o, str) or not o.isidentifier():
-                    raise StudyError(f"output {o!r}: a run= study lists the names (identifiers) of the values its "
-                                     "function returns")
+                    raise StudyError(
+                        f"output {o!r}: a run= study lists the names (identifiers) of the values its function returns"
+                    )
             names = list(outputs)
         dup = {n for n in names if names.count(n) > 1}
         if dup:
@@ -97,7 +115,7 @@ class Study:
             if not timeout_s > 0.0 or timeout_s != timeout_s:
                 raise StudyError("timeout_s must be a number of seconds > 0 (or None: no limit)")
         self.timeout_s = timeout_s
-        self.labels = {}   # output name -> names along each axis (model= studies, set by check())
+        self.labels = {}  # output name -> names along each axis (model= studies, set by check())
         self._checked = False
 
     # ------------------------------------------------------------ checks (before any sample)
@@ -122,24 +140,30 @@ class Study:
             if not var_kw:
                 for x in self.inputs:
                     if x.name not in accepted:
-                        raise StudyError(f"input '{x.name}' matches nothing in the {what} {fname}(): its parameters "
-                                         f"are {', '.join(accepted) or '(none)'}; rename the input or add a "
-                                         f"parameter '{x.name}' to {fname}()")
+                        raise StudyError(
+                            f"input '{x.name}' matches nothing in the {what} {fname}(): its parameters "
+                            f"are {', '.join(accepted) or '(none)'}; rename the input or add a "
+                            f"parameter '{x.name}' to {fname}()"
+                        )
             names = {x.name for x in self.inputs}
             for n, p in params.items():
                 if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.default is p.empty and n not in names:
-                    raise StudyError(f"{fname}() needs '{n}', which no input of the study gives; add an input "
-                                     f"'{n}' or give the parameter a default")
+                    raise StudyError(
+                        f"{fname}() needs '{n}', which no input of the study gives; add an input "
+                        f"'{n}' or give the parameter a default"
+                    )
         if self.factory is not None:
             model = self._build(self.nominal_values(), nominal=True)
-            fams = family_outputs(model, self.analysis) if any(isinstance(o, ElementOutput) for o in self.outputs) \
+            fams = (
+                family_outputs(model, self.analysis)
+                if any(isinstance(o, ElementOutput) for o in self.outputs)
                 else None
+            )
             for o in self.outputs:
                 try:
                     o.check(model, fams)
                 except FemastError as exc:
-                    raise StudyError(str(exc) if isinstance(exc, StudyError) else
-                                     f"output '{o.name}': {exc}") from None
+                    raise StudyError(str(exc) if isinstance(exc, StudyError) else f"output '{o.name}': {exc}") from None
             self.labels = {o.name: o.labels(model) for o in self.outputs}
         self._checked = True
 
@@ -153,8 +177,10 @@ class Study:
                 raise StudyError(f"the model factory fails at the nominal inputs (medians): {exc}") from None
             raise
         if not isinstance(model, Model):
-            raise StudyError(f"the model factory returned {type(model).__name__}, not a femast Model; return the "
-                             "model (with its steps), or use run= for a function that runs the sample itself")
+            raise StudyError(
+                f"the model factory returned {type(model).__name__}, not a femast Model; return the "
+                "model (with its steps), or use run= for a function that runs the sample itself"
+            )
         if nominal and not model.steps:
             raise StudyError("the model factory's model has no steps; add the load history (model.step(...))")
         return model
@@ -165,12 +191,16 @@ class Study:
         if self.factory is None:
             out = self.runner(**values)
             if not isinstance(out, dict):
-                raise StudyError(f"the run function returned {type(out).__name__}; return a dict of the outputs "
-                                 f"{', '.join(self.output_names)}")
+                raise StudyError(
+                    f"the run function returned {type(out).__name__}; return a dict of the outputs "
+                    f"{', '.join(self.output_names)}"
+                )
             missing = [n for n in self.output_names if n not in out]
             if missing:
-                raise StudyError(f"output(s) {', '.join(missing)} not returned by the run function (it returned "
-                                 f"{', '.join(map(str, out)) or 'nothing'}); return them or drop them from outputs")
+                raise StudyError(
+                    f"output(s) {', '.join(missing)} not returned by the run function (it returned "
+                    f"{', '.join(map(str, out)) or 'nothing'}); return them or drop them from outputs"
+                )
             return {n: _as_values(n, out[n]) for n in self.output_names}
         from ..analysis import Analysis
 
@@ -182,8 +212,13 @@ class Study:
 
     def spec(self) -> dict:
         """Plain description (the manifest of the store: a resumed study must have the same)."""
-        return {"name": self.name, "design": self.design.spec(), "outputs": self.output_names, "units": self.units,
-                "labels": self.labels}
+        return {
+            "name": self.name,
+            "design": self.design.spec(),
+            "outputs": self.output_names,
+            "units": self.units,
+            "labels": self.labels,
+        }
 
 
 def _as_values(name, v):

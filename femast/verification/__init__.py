@@ -12,5 +12,14 @@ re-exported here.
 from . import references
 from .cases import Check, all_cases, bend45, elastica, euler_column, format_table, linear_compliance, roll_up
 
-__all__ = ["Check", "all_cases", "bend45", "elastica", "euler_column", "format_table", "linear_compliance",
-           "roll_up", "references"]
+__all__ = [
+    "Check",
+    "all_cases",
+    "bend45",
+    "elastica",
+    "euler_column",
+    "format_table",
+    "linear_compliance",
+    "roll_up",
+    "references",
+]

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import tempfile
 
-from . import references as ref
 from ..analysis import Analysis
+from ..analysis.solvers.arclength import ArcLength
 from ..model import Model
 from ..model.sections import Section
-from ..analysis.solvers.arclength import ArcLength
+from . import references as ref
 
 
 def _planar(m):
@@ -28,11 +28,13 @@ def von_mises_truss(a=1.0, h=0.1, EA=1e6, out=None, progress=False):
     m.truss(right, apex, EA=EA)
     m.fix(left)
     m.fix(right)
-    m.fix(apex, "ux", "uz")          # the symmetric path of the analytic solution
+    m.fix(apex, "ux", "uz")  # the symmetric path of the analytic solution
     (w1, P1), _ = ref.von_mises_truss_limit_points(a, h, EA)
-    step = m.step("snap", max_increments=400,
-                  control=ArcLength(initial_load_factor=0.05, max_load_factor=10.0, max_arc=2.0,
-                                    monitor=(apex, "uy", -2.5 * h)))
+    step = m.step(
+        "snap",
+        max_increments=400,
+        control=ArcLength(initial_load_factor=0.05, max_load_factor=10.0, max_arc=2.0, monitor=(apex, "uy", -2.5 * h)),
+    )
     step.load(apex, fy=-P1)
     res = Analysis(m, out or tempfile.mkdtemp(), progress=progress).run()
     w = -res.node_history(apex, "uy")
@@ -54,8 +56,11 @@ def lee_frame(n_per_member=10, out=None, progress=False):
     m.fix(base, "ux", "uy")
     m.fix(end, "ux", "uy")
     P_ref = 2e4
-    step = m.step("load", max_increments=300,
-                  control=ArcLength(initial_load_factor=0.1, max_load_factor=5.0, monitor=(load_pt, "uy", -90.0)))
+    step = m.step(
+        "load",
+        max_increments=300,
+        control=ArcLength(initial_load_factor=0.1, max_load_factor=5.0, monitor=(load_pt, "uy", -90.0)),
+    )
     step.load(load_pt, fy=-P_ref)
     res = Analysis(m, out or tempfile.mkdtemp(), progress=progress).run()
     v = -res.node_history(load_pt, "uy")
@@ -78,8 +83,11 @@ def williams_toggle(n_per_member=8, out=None, progress=False):
     m.fix(left)
     m.fix(right)
     P_ref = 50.0
-    step = m.step("load", max_increments=300,
-                  control=ArcLength(initial_load_factor=0.05, max_load_factor=2.0, monitor=(apex, "uy", -0.6)))
+    step = m.step(
+        "load",
+        max_increments=300,
+        control=ArcLength(initial_load_factor=0.05, max_load_factor=2.0, monitor=(apex, "uy", -0.6)),
+    )
     step.load(apex, fy=-P_ref)
     res = Analysis(m, out or tempfile.mkdtemp(), progress=progress).run()
     v = -res.node_history(apex, "uy")

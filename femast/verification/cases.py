@@ -15,11 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import references as ref
 from ..analysis import Analysis
+from ..analysis.solvers.control import DisplacementControl
 from ..model import Model
 from ..model.sections import Section, square_tube
-from ..analysis.solvers.control import DisplacementControl
+from . import references as ref
 
 
 @dataclass
@@ -28,8 +28,8 @@ class Check:
     quantity: str
     reference: float
     femast: float
-    error: float          # as defined by ``measure``
-    measure: str          # 'abs/L', 'rel', ...
+    error: float  # as defined by ``measure``
+    measure: str  # 'abs/L', 'rel', ...
     tolerance: float
     source: str
 
@@ -69,10 +69,28 @@ def roll_up(n_elements=16, turns=1, out_dir=None, progress=False):
     rz = res.node_history(tip, "rz")[-1]
     case = f"roll-up {turns}x2pi, {n_elements} el."
     src = "closed form: circle of radius EI/M"
-    return [Check(case, "distance tip-root / L", 0.0, float(np.linalg.norm(tip_pos)), float(np.linalg.norm(tip_pos)),
-                  "abs/L", 1e-3, src),
-            Check(case, "tip rotation / (2 pi)", float(turns), rz / (2 * math.pi), abs(rz / (2 * math.pi) - turns),
-                  "abs", 1e-9, src)], res
+    return [
+        Check(
+            case,
+            "distance tip-root / L",
+            0.0,
+            float(np.linalg.norm(tip_pos)),
+            float(np.linalg.norm(tip_pos)),
+            "abs/L",
+            1e-3,
+            src,
+        ),
+        Check(
+            case,
+            "tip rotation / (2 pi)",
+            float(turns),
+            rz / (2 * math.pi),
+            abs(rz / (2 * math.pi) - turns),
+            "abs",
+            1e-9,
+            src,
+        ),
+    ], res
 
 
 def elastica(n_elements=20, loads=(1, 2, 3, 4, 5, 6, 7, 8, 9, 10), out_dir=None, progress=False):
@@ -92,8 +110,18 @@ def elastica(n_elements=20, loads=(1, 2, 3, 4, 5, 6, 7, 8, 9, 10), out_dir=None,
         exact = ref.elastica_tip_load(float(k))
         case = f"elastica PL^2/EI={k:g}, {n_elements} el."
         for name, fe, rv in (("v/L", uy[i], exact.v_over_L), ("u/L", ux[i], exact.u_over_L)):
-            rows.append(Check(case, name, rv, float(fe), abs(fe - rv) / abs(rv), "rel", 5e-3,
-                              "elliptic integrals (Mattiasson 1981)"))
+            rows.append(
+                Check(
+                    case,
+                    name,
+                    rv,
+                    float(fe),
+                    abs(fe - rv) / abs(rv),
+                    "rel",
+                    5e-3,
+                    "elliptic integrals (Mattiasson 1981)",
+                )
+            )
     return rows, res
 
 
@@ -121,9 +149,18 @@ def bend45(n_elements=16, out_dir=None, progress=False):
         pos = X + res.frame(i)["U"][m.index(labels[-1])]
         e = np.asarray(exact[j] if not isinstance(exact, dict) else exact[P])
         for c, name in enumerate("xyz"):
-            rows.append(Check(f"45-degree bend P={P:g}, {n_elements} el.", f"tip {name}", float(e[c]), float(pos[c]),
-                              abs(pos[c] - e[c]) / float(np.linalg.norm(e)), "rel to |tip|", 1e-2,
-                              "Kirchhoff rod shooting; Bathe-Bolourchi 1979"))
+            rows.append(
+                Check(
+                    f"45-degree bend P={P:g}, {n_elements} el.",
+                    f"tip {name}",
+                    float(e[c]),
+                    float(pos[c]),
+                    abs(pos[c] - e[c]) / float(np.linalg.norm(e)),
+                    "rel to |tip|",
+                    1e-2,
+                    "Kirchhoff rod shooting; Bathe-Bolourchi 1979",
+                )
+            )
     return rows, res
 
 
@@ -138,10 +175,28 @@ def linear_compliance(n_elements=4, L=3.651, out_dir=None):
     C = ref.cantilever_compliance(L, sec.E, sec.G, sec.A, sec.Iy, sec.Iz, sec.J)
     err = float(np.abs(C_fe - C).max() / np.abs(C).max())
     diag_err = float(np.max(np.abs(np.diag(C_fe) - np.diag(C)) / np.diag(C)))
-    return [Check(f"square-tube cantilever compliance, {n_elements} el.", "max abs(C_fe - C) / max abs(C)", 0.0, err, err,
-                  "rel", 1e-8, "seed 000 Eq. 8 / beam theory"),
-            Check(f"square-tube cantilever compliance, {n_elements} el.", "diagonal terms", 0.0, diag_err, diag_err,
-                  "rel", 1e-8, "seed 000 Eq. 8 / beam theory")], C_fe
+    return [
+        Check(
+            f"square-tube cantilever compliance, {n_elements} el.",
+            "max abs(C_fe - C) / max abs(C)",
+            0.0,
+            err,
+            err,
+            "rel",
+            1e-8,
+            "seed 000 Eq. 8 / beam theory",
+        ),
+        Check(
+            f"square-tube cantilever compliance, {n_elements} el.",
+            "diagonal terms",
+            0.0,
+            diag_err,
+            diag_err,
+            "rel",
+            1e-8,
+            "seed 000 Eq. 8 / beam theory",
+        ),
+    ], C_fe
 
 
 def euler_column(n_elements=16, imperfection=1e-3, out_dir=None, progress=False):
@@ -159,26 +214,47 @@ def euler_column(n_elements=16, imperfection=1e-3, out_dir=None, progress=False)
     m.fix(labels[-1], "uy", "uz", "rx", "ry")
     mid = labels[n_elements // 2]
     Pcr = ref.euler_critical_load(EI, L, "pinned-pinned")
-    step = m.step("buckle", initial_increment=0.01, max_increment=0.02,
-                  control=DisplacementControl(mid, "uy", 0.3 * L))
+    step = m.step("buckle", initial_increment=0.01, max_increment=0.02, control=DisplacementControl(mid, "uy", 0.3 * L))
     step.load(labels[-1], fx=-Pcr)
     res = Analysis(m, _out("column", out_dir), progress=progress).run()
     lam = res.scalar_history("load_factor")
-    w = res.node_history(mid, "uy") + imperfection * L   # total deflection from the chord
+    w = res.node_history(mid, "uy") + imperfection * L  # total deflection from the chord
     d = w - imperfection * L
     # Southwell: d / P = d / Pcr + e0 / Pcr  -> slope 1/Pcr (pre-buckling points, P < 0.9 Pcr)
     sel = (lam > 0.3) & (lam < 0.9)
     slope = np.polyfit(d[sel], d[sel] / (lam[sel] * Pcr), 1)[0]
     pcr_fe = 1.0 / slope
-    rows = [Check(f"Euler column, e0=L/1000, {n_elements} el.", "P_cr (Southwell)", Pcr, pcr_fe,
-                  abs(pcr_fe - Pcr) / Pcr, "rel", 1e-2, "pi^2 EI / L^2")]
+    rows = [
+        Check(
+            f"Euler column, e0=L/1000, {n_elements} el.",
+            "P_cr (Southwell)",
+            Pcr,
+            pcr_fe,
+            abs(pcr_fe - Pcr) / Pcr,
+            "rel",
+            1e-2,
+            "pi^2 EI / L^2",
+        )
+    ]
     # post-buckling: at w_mid/L = 0.3 the elastica gives P/Pcr
     from scipy.optimize import brentq
 
-    alpha = brentq(lambda a: ref.euler_column_postbuckling(a)[1] - w[-1] / L, 1e-3, 2.0)  # w(alpha) rises up to alpha ~ 2.3
+    alpha = brentq(
+        lambda a: ref.euler_column_postbuckling(a)[1] - w[-1] / L, 1e-3, 2.0
+    )  # w(alpha) rises up to alpha ~ 2.3
     p_el = ref.euler_column_postbuckling(alpha)[0]
-    rows.append(Check(f"Euler column, e0=L/1000, {n_elements} el.", "P/Pcr at w/L=0.3 (post-buckling)", p_el,
-                      float(lam[-1]), abs(lam[-1] - p_el) / p_el, "rel", 1e-2, "elastica (Timoshenko & Gere)"))
+    rows.append(
+        Check(
+            f"Euler column, e0=L/1000, {n_elements} el.",
+            "P/Pcr at w/L=0.3 (post-buckling)",
+            p_el,
+            float(lam[-1]),
+            abs(lam[-1] - p_el) / p_el,
+            "rel",
+            1e-2,
+            "elastica (Timoshenko & Gere)",
+        )
+    )
     return rows, res
 
 
@@ -194,6 +270,8 @@ def format_table(rows) -> str:
     head = f"{'case':44} {'quantity':34} {'reference':>12} {'femast':>12} {'error':>10} {'tol':>8}  ok"
     lines = [head, "-" * len(head)]
     for r in rows:
-        lines.append(f"{r.case:44.44} {r.quantity:34.34} {r.reference:12.6g} {r.femast:12.6g} {r.error:10.2e} "
-                     f"{r.tolerance:8.0e}  {'yes' if r.passed else 'NO'}")
+        lines.append(
+            f"{r.case:44.44} {r.quantity:34.34} {r.reference:12.6g} {r.femast:12.6g} {r.error:10.2e} "
+            f"{r.tolerance:8.0e}  {'yes' if r.passed else 'NO'}"
+        )
     return "\n".join(lines)

@@ -22,12 +22,12 @@ import math
 import numpy as np
 
 from ..analysis import Analysis
-from ..model import Model
 from ..modal import modal_analysis
+from ..model import Model
 from ..model.sections import Section
 from .cases import Check
 
-BETA_L = (1.8751040687, 4.6940911330, 7.8547574382)   # roots of cos x cosh x + 1 = 0
+BETA_L = (1.8751040687, 4.6940911330, 7.8547574382)  # roots of cos x cosh x + 1 = 0
 
 
 def _analysis(model, run=True):
@@ -59,8 +59,18 @@ def taut_string(n_elements=100, L=2.0, T=100.0, mass_per_length=0.01, cable=True
     rows = []
     for n in range(1, n_modes + 1):
         ref = n / (2 * L) * math.sqrt(T / mass_per_length)
-        rows.append(Check(f"taut string ({n_elements} {kind})", f"f_{n} (Hz)", ref, float(f[n - 1]),
-                          _rel(f[n - 1], ref), "rel", 1e-3, "f_n = n/(2L) sqrt(T/m')"))
+        rows.append(
+            Check(
+                f"taut string ({n_elements} {kind})",
+                f"f_{n} (Hz)",
+                ref,
+                float(f[n - 1]),
+                _rel(f[n - 1], ref),
+                "rel",
+                1e-3,
+                "f_n = n/(2L) sqrt(T/m')",
+            )
+        )
     return rows, modes
 
 
@@ -78,14 +88,23 @@ def cantilever(n_elements=20, L=1.0, EI=1.0, m=1.0, n_modes=3):
     f = modes.frequencies.reshape(n_modes, 2).mean(axis=1)
     rows = []
     for i in range(n_modes):
-        ref = BETA_L[i] ** 2 / (2 * math.pi) * math.sqrt(EI / (m * L ** 4))
-        rows.append(Check(f"cantilever ({n_elements} beams)", f"f_{i + 1} (Hz)", ref, float(f[i]), _rel(f[i], ref),
-                          "rel", 1e-4, "(beta L)^2/(2 pi) sqrt(EI/(m L^4))"))
+        ref = BETA_L[i] ** 2 / (2 * math.pi) * math.sqrt(EI / (m * L**4))
+        rows.append(
+            Check(
+                f"cantilever ({n_elements} beams)",
+                f"f_{i + 1} (Hz)",
+                ref,
+                float(f[i]),
+                _rel(f[i], ref),
+                "rel",
+                1e-4,
+                "(beta L)^2/(2 pi) sqrt(EI/(m L^4))",
+            )
+        )
     return rows, modes
 
 
-def pinned_beam_axial(load_ratios=(-1.2, -0.8, -0.4, 0.0, 0.4, 0.8), n_elements=48, L=1.0, EI=1.0, m=1.0,
-                      EA=1e6):
+def pinned_beam_axial(load_ratios=(-1.2, -0.8, -0.4, 0.0, 0.4, 0.8), n_elements=48, L=1.0, EI=1.0, m=1.0, EA=1e6):
     """Pin-ended beam along x under an axial end force P = ratio x P_E (negative: compression),
     solved statically (the straight state), then its first bending mode.  Returns rows for
     f^2 (signed) at every load, the Euler load where the fitted line crosses zero, and
@@ -95,8 +114,8 @@ def pinned_beam_axial(load_ratios=(-1.2, -0.8, -0.4, 0.0, 0.4, 0.8), n_elements=
     with 16), against 1e-5 for the mass and bending parts and 1e-6 for the shortening P / EA."""
     E = 1e4
     sec = Section(E=E, G=E / 2, A=EA / E, Iy=EI / E, Iz=EI / E, J=2 * EI / E, rho=m * E / EA, name="unit")
-    PE = math.pi ** 2 * EI / L ** 2
-    f0sq = (math.pi / (2 * L ** 2)) ** 2 * EI / m
+    PE = math.pi**2 * EI / L**2
+    f0sq = (math.pi / (2 * L**2)) ** 2 * EI / m
     f2 = []
     for r in load_ratios:
         mod = Model("pinned beam")
@@ -111,12 +130,32 @@ def pinned_beam_axial(load_ratios=(-1.2, -0.8, -0.4, 0.0, 0.4, 0.8), n_elements=
     f2 = np.array(f2)
     ratios = np.asarray(load_ratios, float)
     exact = f0sq * (1 + ratios)
-    rows = [Check(f"pin-ended beam ({n_elements} beams)", f"f^2 at P = {r:+.1f} P_E (Hz^2)", float(e), float(v),
-                  abs(v - e) / f0sq, "abs/f0^2", 1e-3, "f^2 = f0^2 (1 + P/P_E)")
-            for r, v, e in zip(ratios, f2, exact)]
+    rows = [
+        Check(
+            f"pin-ended beam ({n_elements} beams)",
+            f"f^2 at P = {r:+.1f} P_E (Hz^2)",
+            float(e),
+            float(v),
+            abs(v - e) / f0sq,
+            "abs/f0^2",
+            1e-3,
+            "f^2 = f0^2 (1 + P/P_E)",
+        )
+        for r, v, e in zip(ratios, f2, exact)
+    ]
     slope, icpt = np.polyfit(ratios, f2, 1)
-    rows.append(Check(f"pin-ended beam ({n_elements} beams)", "P(f = 0) / P_E (fitted line)", -1.0,
-                      float(-icpt / slope), abs(-icpt / slope + 1.0), "abs", 1e-3, "Euler load pi^2 EI/L^2"))
+    rows.append(
+        Check(
+            f"pin-ended beam ({n_elements} beams)",
+            "P(f = 0) / P_E (fitted line)",
+            -1.0,
+            float(-icpt / slope),
+            abs(-icpt / slope + 1.0),
+            "abs",
+            1e-3,
+            "Euler load pi^2 EI/L^2",
+        )
+    )
     return rows, (ratios, f2, exact)
 
 
@@ -137,14 +176,31 @@ def rigid_body_springs(m=2.0, J=(0.3, 0.5, 0.8), a=0.4, k=5.0e3):
     mod.rigid_body(ref, arms, name="body", mass=m, inertia=J)
     mod.step("hold")
     modes = modal_analysis(_analysis(mod, run=False), 6)
-    om2 = {"translation (x3)": 4 * k / m, "rocking about x": 2 * k * a * a / J[0],
-           "rocking about y": 2 * k * a * a / J[1], "rocking about z": 4 * k * a * a / J[2]}
-    exact = np.sort(np.array([om2["translation (x3)"]] * 3 + [om2["rocking about x"], om2["rocking about y"],
-                                                              om2["rocking about z"]]))
+    om2 = {
+        "translation (x3)": 4 * k / m,
+        "rocking about x": 2 * k * a * a / J[0],
+        "rocking about y": 2 * k * a * a / J[1],
+        "rocking about z": 4 * k * a * a / J[2],
+    }
+    exact = np.sort(
+        np.array(
+            [om2["translation (x3)"]] * 3 + [om2["rocking about x"], om2["rocking about y"], om2["rocking about z"]]
+        )
+    )
     ref_f = np.sqrt(exact) / (2 * math.pi)
-    rows = [Check("rigid body on springs", f"f_{i + 1} (Hz)", float(r), float(f), _rel(f, r), "rel", 1e-8,
-                  "omega^2 = 4k/m, 2ka^2/Jx, 2ka^2/Jy, 4ka^2/Jz")
-            for i, (r, f) in enumerate(zip(ref_f, modes.frequencies))]
+    rows = [
+        Check(
+            "rigid body on springs",
+            f"f_{i + 1} (Hz)",
+            float(r),
+            float(f),
+            _rel(f, r),
+            "rel",
+            1e-8,
+            "omega^2 = 4k/m, 2ka^2/Jx, 2ka^2/Jy, 4ka^2/Jz",
+        )
+        for i, (r, f) in enumerate(zip(ref_f, modes.frequencies))
+    ]
     return rows, modes
 
 
@@ -161,13 +217,30 @@ def pendulum(l=1.5, mass=3.0, g=9.81):
     mod.step("weight").load(bob, fz=-mass * g)
     modes = modal_analysis(_analysis(mod), 2)
     ref = math.sqrt(g / l) / (2 * math.pi)
-    return [Check("pendulum (string + point mass)", f"f_{i + 1} (Hz)", ref, float(f), _rel(f, ref), "rel", 1e-8,
-                  "omega^2 = g/l") for i, f in enumerate(modes.frequencies)], modes
+    return [
+        Check(
+            "pendulum (string + point mass)",
+            f"f_{i + 1} (Hz)",
+            ref,
+            float(f),
+            _rel(f, ref),
+            "rel",
+            1e-8,
+            "omega^2 = g/l",
+        )
+        for i, f in enumerate(modes.frequencies)
+    ], modes
 
 
 def all_cases():
     rows = []
-    for case in (taut_string, lambda: taut_string(cable=False), cantilever, pinned_beam_axial, rigid_body_springs,
-                 pendulum):
+    for case in (
+        taut_string,
+        lambda: taut_string(cable=False),
+        cantilever,
+        pinned_beam_axial,
+        rigid_body_springs,
+        pendulum,
+    ):
         rows += case()[0]
     return rows

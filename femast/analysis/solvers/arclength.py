@@ -50,11 +50,15 @@ class ArcLength:
 
     def setup(self, analysis, step):
         if not step.loads:
-            raise ModelError(f"step '{step.name}': arc-length control needs a reference load pattern; "
-                             "define at least one load in the step")
+            raise ModelError(
+                f"step '{step.name}': arc-length control needs a reference load pattern; "
+                "define at least one load in the step"
+            )
         if step.prescribed:
-            raise ModelError(f"step '{step.name}': arc-length control with prescribed displacements is not "
-                             "supported; drive the model by loads in this step")
+            raise ModelError(
+                f"step '{step.name}': arc-length control with prescribed displacements is not "
+                "supported; drive the model by loads in this step"
+            )
         if step.stabilize is not None:
             raise ModelError(f"step '{step.name}': stabilisation cannot be combined with arc-length control")
         if not (self.initial_load_factor > 0):

@@ -41,11 +41,12 @@ from .banded import SYMMETRY_TOL, BandedFactor, band_of, band_rule, refine
 from .dense import DENSE_FORCED_MAX, DENSE_MAX_DOFS, DenseFactor
 
 NAMES = ("auto", "superlu", "banded", "dense", "cholmod", "pardiso")
-PARDISO_MIN_DOFS = 1000   # the automatic choice takes PARDISO (when installed) from this size on
-THREADS = 1               # MKL threads of PARDISO
-INSTALL = {"cholmod": "pip install 'femast[cholmod]' (scikit-sparse; on Debian first: apt-get install "
-                      "libsuitesparse-dev)",
-           "pardiso": "pip install 'femast[pardiso]' (pypardiso, Intel MKL)"}
+PARDISO_MIN_DOFS = 1000  # the automatic choice takes PARDISO (when installed) from this size on
+THREADS = 1  # MKL threads of PARDISO
+INSTALL = {
+    "cholmod": "pip install 'femast[cholmod]' (scikit-sparse; on Debian first: apt-get install libsuitesparse-dev)",
+    "pardiso": "pip install 'femast[pardiso]' (pypardiso, Intel MKL)",
+}
 
 
 def available(name: str) -> tuple[bool, str]:
@@ -74,16 +75,21 @@ def choose(backend: str, B, ordering: str) -> str:
     if backend in ("cholmod", "pardiso"):
         ok, why = available(backend)
         if not ok:
-            warnings.warn(f"linear solver back-end '{backend}' is not installed ({why}); using SuperLU. "
-                          f"Install it with: {INSTALL[backend]}", stacklevel=4)
+            warnings.warn(
+                f"linear solver back-end '{backend}' is not installed ({why}); using SuperLU. "
+                f"Install it with: {INSTALL[backend]}",
+                stacklevel=4,
+            )
             return "superlu"
     if backend == "dense" and n > DENSE_FORCED_MAX:
-        warnings.warn(f"linear solver back-end 'dense' for {n} DOFs (an {n} x {n} matrix, "
-                      f"{8 * n * n / 1e9:.2g} GB) is beyond its limit of {DENSE_FORCED_MAX} DOFs; using SuperLU",
-                      stacklevel=4)
+        warnings.warn(
+            f"linear solver back-end 'dense' for {n} DOFs (an {n} x {n} matrix, "
+            f"{8 * n * n / 1e9:.2g} GB) is beyond its limit of {DENSE_FORCED_MAX} DOFs; using SuperLU",
+            stacklevel=4,
+        )
         return "superlu"
     if backend == "banded" and ordering != "rcm":
-        return "superlu"   # a band needs the RCM order (forced by SparseLU(backend="banded"))
+        return "superlu"  # a band needs the RCM order (forced by SparseLU(backend="banded"))
     return backend
 
 
@@ -137,15 +143,15 @@ class CholmodFactor:
         self.B = B
         self._superlu = superlu_factor
         partner = _partner(B)
-        if np.any(partner < 0):   # structurally unsymmetric: (B + B^T) / 2 on the union pattern
+        if np.any(partner < 0):  # structurally unsymmetric: (B + B^T) / 2 on the union pattern
             ones = sp.csc_matrix((np.ones(B.nnz), B.indices, B.indptr), shape=B.shape)
             U = (ones + ones.T).tocsc()
             U.sort_indices()
             n = B.shape[0]
             keys = np.repeat(np.arange(n, dtype=np.int64), np.diff(U.indptr)) * n + U.indices
             cols = np.repeat(np.arange(n, dtype=np.int64), np.diff(B.indptr))
-            self._at = np.searchsorted(keys, cols * n + B.indices)          # (i, j) of B in S
-            self._at_t = np.searchsorted(keys, B.indices.astype(np.int64) * n + cols)   # (j, i)
+            self._at = np.searchsorted(keys, cols * n + B.indices)  # (i, j) of B in S
+            self._at_t = np.searchsorted(keys, B.indices.astype(np.int64) * n + cols)  # (j, i)
             self._S = sp.csc_matrix((np.ones(U.nnz), U.indices, U.indptr), shape=B.shape)
             self._partner = None
         else:
@@ -222,21 +228,21 @@ class PardisoFactor:
         import pypardiso
 
         self._ps = ps = pypardiso.PyPardisoSolver(mtype=11)
-        try:   # one thread: reproducible bits from run to run, and no waiting on a shared core
+        try:  # one thread: reproducible bits from run to run, and no waiting on a shared core
             ps.libmkl.MKL_Set_Num_Threads(ctypes.c_int(THREADS))
         except AttributeError:  # pragma: no cover - an MKL without the symbol
             pass
         self.B = B
         n = B.shape[0]
         ps.iparm[:] = 0
-        ps.iparm[0] = 1       # user-set iparm
-        ps.iparm[1] = 2       # nested dissection (METIS) ordering
-        ps.iparm[9] = 13      # pivot perturbation 1e-13
-        ps.iparm[10] = 1      # scaling
-        ps.iparm[11] = 2      # transposed solve: the CSC arrays are B^T's CSR arrays
-        ps.iparm[12] = 1      # weighted matching
-        ps.iparm[34] = 1      # zero-based indices
-        ps.iparm[17] = -1     # report the entries of the factors
+        ps.iparm[0] = 1  # user-set iparm
+        ps.iparm[1] = 2  # nested dissection (METIS) ordering
+        ps.iparm[9] = 13  # pivot perturbation 1e-13
+        ps.iparm[10] = 1  # scaling
+        ps.iparm[11] = 2  # transposed solve: the CSC arrays are B^T's CSR arrays
+        ps.iparm[12] = 1  # weighted matching
+        ps.iparm[34] = 1  # zero-based indices
+        ps.iparm[17] = -1  # report the entries of the factors
         self._ia = B.indptr.astype(np.int32)
         self._ja = B.indices.astype(np.int32)
         self._n = ctypes.c_int32(n)
@@ -253,12 +259,24 @@ class PardisoFactor:
         i32 = ct.POINTER(ct.c_int32)
         f64 = ct.POINTER(ct.c_double)
         x = np.zeros_like(b)
-        ps._mkl_pardiso(ps.pt.ctypes.data_as(ct.POINTER(ps._pt_type[0])), ct.byref(ct.c_int32(1)),
-                        ct.byref(ct.c_int32(1)), ct.byref(ct.c_int32(11)), ct.byref(ct.c_int32(phase)),
-                        ct.byref(self._n), self.B.data.ctypes.data_as(f64), self._ia.ctypes.data_as(i32),
-                        self._ja.ctypes.data_as(i32), ps.perm.ctypes.data_as(i32), ct.byref(ct.c_int32(1)),
-                        ps.iparm.ctypes.data_as(i32), ct.byref(ct.c_int32(0)), b.ctypes.data_as(f64),
-                        x.ctypes.data_as(f64), ct.byref(err))
+        ps._mkl_pardiso(
+            ps.pt.ctypes.data_as(ct.POINTER(ps._pt_type[0])),
+            ct.byref(ct.c_int32(1)),
+            ct.byref(ct.c_int32(1)),
+            ct.byref(ct.c_int32(11)),
+            ct.byref(ct.c_int32(phase)),
+            ct.byref(self._n),
+            self.B.data.ctypes.data_as(f64),
+            self._ia.ctypes.data_as(i32),
+            self._ja.ctypes.data_as(i32),
+            ps.perm.ctypes.data_as(i32),
+            ct.byref(ct.c_int32(1)),
+            ps.iparm.ctypes.data_as(i32),
+            ct.byref(ct.c_int32(0)),
+            b.ctypes.data_as(f64),
+            x.ctypes.data_as(f64),
+            ct.byref(err),
+        )
         if err.value == -4:
             raise RuntimeError("Factor is exactly singular (PARDISO: zero pivot)")
         if err.value != 0:

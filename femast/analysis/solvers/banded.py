@@ -36,10 +36,10 @@ from scipy.linalg import lapack
 
 from ...jit import setup_call
 
-SYMMETRY_TOL = 1e-6        # relative asymmetry below which the Cholesky of the symmetric part is tried
-BACKWARD_TOL = 1e-14       # normwise backward error a refined solution must reach (LU: ~1e-16 x growth)
-MAX_REFINE = 4             # refinement steps before falling back to the LU
-LU_AFTER_INDEFINITE = 8    # factorisations that go straight to the LU after a failed Cholesky
+SYMMETRY_TOL = 1e-6  # relative asymmetry below which the Cholesky of the symmetric part is tried
+BACKWARD_TOL = 1e-14  # normwise backward error a refined solution must reach (LU: ~1e-16 x growth)
+MAX_REFINE = 4  # refinement steps before falling back to the LU
+LU_AFTER_INDEFINITE = 8  # factorisations that go straight to the LU after a failed Cholesky
 
 
 def band_of(indptr, indices) -> int:
@@ -133,13 +133,13 @@ def _residual_split(L, U, x, rhs, r):
     for j in range(n):
         xj = x[j]
         m = min(ldc, n - j)
-        for d in range(m):          # column j: B_(j+d, j), rows j, j+1, ...
+        for d in range(m):  # column j: B_(j+d, j), rows j, j+1, ...
             v = L[d, j]
             r[j + d] -= v * xj
             rows[j + d] += abs(v)
         rj = r[j]
         sj = rows[j]
-        for d in range(1, m):       # row j: B_(j, j+d), after its columns <= j
+        for d in range(1, m):  # row j: B_(j, j+d), after its columns <= j
             v = U[d, j]
             rj -= v * x[j + d]
             sj += abs(v)
@@ -236,17 +236,17 @@ class BandedFactor:
         # Fortran-ordered band storage, flat index i + j * ldab
         self._ld_chol = b + 1
         self._ld_lu = 3 * b + 1
-        self._csc_maps = None       # (to_chol, to_lu, partner): where B's data entries go (CSC input)
-        self._split = None          # B in split band storage, when assembled there
-        self._from_band = False     # the last factorisation read B from the band storage
+        self._csc_maps = None  # (to_chol, to_lu, partner): where B's data entries go (CSC input)
+        self._split = None  # B in split band storage, when assembled there
+        self._from_band = False  # the last factorisation read B from the band storage
         self._chol = np.zeros((self._ld_chol, n), order="F")
         self._lu = np.zeros((self._ld_lu, n), order="F")
         self._r = np.zeros(n)
-        self.kind = None            # "cholesky" or "lu": the factorisation in use
-        self.asymmetry = np.nan     # max |B - B^T| / max |B| of the last factorisation
-        self.refinements = 0        # refinement steps taken (all solves)
-        self.fallbacks = 0          # Cholesky attempts that ended in the LU
-        self._lu_only = 0           # factorisations left that skip the Cholesky
+        self.kind = None  # "cholesky" or "lu": the factorisation in use
+        self.asymmetry = np.nan  # max |B - B^T| / max |B| of the last factorisation
+        self.refinements = 0  # refinement steps taken (all solves)
+        self.fallbacks = 0  # Cholesky attempts that ended in the LU
+        self._lu_only = 0  # factorisations left that skip the Cholesky
         self._ipiv = None
         self._factor = None
         self.nnz = 0
@@ -267,8 +267,15 @@ class BandedFactor:
             self._L = self._split[:m].reshape((self.b + 1, self.n), order="F")
             self._U = self._split[m:].reshape((self.b + 1, self.n), order="F")
         g = np.zeros(0, np.int64) if gather is None else np.asarray(gather, dtype=np.int64)
-        return setup_call(_split_positions, self.B.nnz + np.size(pos), self.B.indptr, self.B.indices, self.b, g,
-                          np.ascontiguousarray(pos, dtype=np.int64))
+        return setup_call(
+            _split_positions,
+            self.B.nnz + np.size(pos),
+            self.B.indptr,
+            self.B.indices,
+            self.b,
+            g,
+            np.ascontiguousarray(pos, dtype=np.int64),
+        )
 
     def _entries(self):
         """(column, row) of every entry of B's data array."""
@@ -284,7 +291,7 @@ class BandedFactor:
             n, b = self.n, self.b
             to_chol = np.where(rows >= cols, (rows - cols) + cols * self._ld_chol, -1)
             to_lu = (2 * b + rows - cols) + cols * self._ld_lu
-            keys = cols * n + rows                              # CSC entries are sorted by (col, row)
+            keys = cols * n + rows  # CSC entries are sorted by (col, row)
             tkeys = rows * n + cols
             pos = np.searchsorted(keys, tkeys)
             pos[pos >= keys.size] = 0
@@ -323,7 +330,7 @@ class BandedFactor:
                 self.kind, self._factor = "cholesky", c
                 self.nnz = self.n * (self.b + 1)
                 return self
-            self._lu_only = LU_AFTER_INDEFINITE   # not positive definite: the LU for a while
+            self._lu_only = LU_AFTER_INDEFINITE  # not positive definite: the LU for a while
         elif self._lu_only:
             self._lu_only -= 1
         self._factor_lu()
@@ -385,7 +392,7 @@ def refine(solve, B, rhs, r):
     x = solve(rhs)
     last = np.inf
     split = isinstance(B, tuple)
-    for step in range(MAX_REFINE + 1):   # (the maxima from the residual kernel: no numpy temporaries)
+    for step in range(MAX_REFINE + 1):  # (the maxima from the residual kernel: no numpy temporaries)
         if split:
             rmax, amax, xmax, bmax = _residual_split(B[0], B[1], x, rhs, r)
         else:

@@ -43,13 +43,17 @@ class DisplacementControl:
         d = dof_index(self.dof)
         eq = analysis.dofmap.eq[idx, d]
         if eq < 0 or eq >= analysis.dofmap.n_free:
-            raise ModelError(f"step '{step.name}': displacement control on node {self.node} {self.dof}: "
-                             "that DOF is not a free DOF of the model (fixed, prescribed or unused)")
+            raise ModelError(
+                f"step '{step.name}': displacement control on node {self.node} {self.dof}: "
+                "that DOF is not a free DOF of the model (fixed, prescribed or unused)"
+            )
         self.eq = int(eq)
         self.start = analysis.dof_value(idx, d)
         if not step.loads:
-            raise ModelError(f"step '{step.name}': displacement control needs a reference load pattern; "
-                             "define at least one load in the step")
+            raise ModelError(
+                f"step '{step.name}': displacement control needs a reference load pattern; "
+                "define at least one load in the step"
+            )
 
     def target(self, fraction):
         return self.start + fraction * (self.value - self.start)

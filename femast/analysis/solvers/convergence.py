@@ -138,12 +138,13 @@ class Convergence:
 
     def __post_init__(self):
         try:
-            ok = 0.0 < float(self.max_contraction) < 1.0   # (NaN: no)
-        except (TypeError, ValueError):   # not a number
+            ok = 0.0 < float(self.max_contraction) < 1.0  # (NaN: no)
+        except (TypeError, ValueError):  # not a number
             ok = False
         if not ok:
-            raise ModelError(f"Convergence: max_contraction={self.max_contraction!r} must be between 0 and 1 "
-                             "(e.g. 0.5)")
+            raise ModelError(
+                f"Convergence: max_contraction={self.max_contraction!r} must be between 0 and 1 (e.g. 0.5)"
+            )
 
     def check(self, r, du, Du, is_rot, ref_force, ref_moment, length, iteration=0):
         """Return (converged, residual_ratio) given the free residual ``r``, the last
@@ -158,7 +159,7 @@ class Convergence:
         if not self.predicted:
             return False
         rate = self.max_contraction
-        if not (previous > 0.0 and last <= rate * previous):   # a contracting sequence (NaN: no)
+        if not (previous > 0.0 and last <= rate * previous):  # a contracting sequence (NaN: no)
             return False
         theta = predicted / last if last > 0.0 else math.inf
         return theta <= rate and 2.0 * predicted <= (1.0 - theta) * self.disp_tol
@@ -178,17 +179,17 @@ class Convergence:
             dmax = field_abs_max(np.asarray(du, dtype=float), is_rot)
             Dmax = field_abs_max(np.asarray(Du, dtype=float), is_rot)
         for k, ref, dref in ((0, ref_force, length), (1, ref_moment, 1.0)):
-            if rmax[k] < 0.0:   # no DOF of this field
+            if rmax[k] < 0.0:  # no DOF of this field
                 continue
             ratio = rmax[k] / ref if ref > 0 else (0.0 if rmax[k] == 0 else np.inf)
             worst = max(worst, ratio)
-            if not ratio <= self.force_tol:   # NaN never converges
+            if not ratio <= self.force_tol:  # NaN never converges
                 ok = forces = False
             if not ratio <= linear_tol:
                 linear = False
             if du is not None and not dmax[k] <= self.disp_tol * max(Dmax[k], 1e-9 * dref):
-                ok = False     # floor 1e-9 dref: round-off-sized increments
-        size = math.nan   # the correction's scaled size, as scaled_size(du, Du) from the maxima above
+                ok = False  # floor 1e-9 dref: round-off-sized increments
+        size = math.nan  # the correction's scaled size, as scaled_size(du, Du) from the maxima above
         if du is not None and not math.isnan(dmax[0]):
             size = 0.0
             for k, dref in ((0, length), (1, 1.0)):

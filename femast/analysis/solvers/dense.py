@@ -19,7 +19,7 @@ from scipy.linalg import lapack
 
 from .banded import _scatter
 
-DENSE_MAX_DOFS = 64      # the automatic choice takes the dense LU up to this many DOFs (see backends.choose)
+DENSE_MAX_DOFS = 64  # the automatic choice takes the dense LU up to this many DOFs (see backends.choose)
 DENSE_FORCED_MAX = 4000  # a forced dense LU beyond this many DOFs (128 MB) falls back to SuperLU
 
 
@@ -37,9 +37,9 @@ class DenseFactor:
         self.n = n
         self.B = B
         cols = np.repeat(np.arange(n, dtype=np.int64), np.diff(B.indptr))
-        self._to = B.indices.astype(np.int64) + cols * n    # Fortran order: row + col * n
+        self._to = B.indices.astype(np.int64) + cols * n  # Fortran order: row + col * n
         self._A = np.zeros((n, n), order="F")
-        self._flat = self._A.reshape(-1, order="F")         # a view (Fortran-contiguous)
+        self._flat = self._A.reshape(-1, order="F")  # a view (Fortran-contiguous)
         self._lu = None
         self._piv = None
         self.nnz = n * n

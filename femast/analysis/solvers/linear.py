@@ -53,7 +53,7 @@ try:  # scipy's SuperLU binding, called directly for the matrix refactorised eve
     from scipy.sparse.linalg._dsolve._superlu import gstrf as _gstrf
 except ImportError:  # pragma: no cover - a scipy that moved it: splu is used instead
     _gstrf = None
-_DIRECT = {"gstrf": _gstrf}   # set to None if the binding's signature ever differs
+_DIRECT = {"gstrf": _gstrf}  # set to None if the binding's signature ever differs
 
 ORDERINGS = ("auto", "rcm", "mmd", "colamd")
 BACKENDS = backends.NAMES
@@ -80,7 +80,7 @@ def _unpermute(y, perm, x):
     for i in range(y.shape[0]):
         v = y[i]
         a = abs(v)
-        if not a <= 1.7976931348623157e308:   # NaN or inf
+        if not a <= 1.7976931348623157e308:  # NaN or inf
             return math.nan
         x[perm[i]] = v
         if a > m:
@@ -104,8 +104,14 @@ class SparseLU:
         warning saying how to install it.
     """
 
-    def __init__(self, symmetric: bool = False, ordering: str = "auto", pivot_threshold: float = 0.01,
-                 pivot_check: str = "auto", backend: str = "auto"):
+    def __init__(
+        self,
+        symmetric: bool = False,
+        ordering: str = "auto",
+        pivot_threshold: float = 0.01,
+        pivot_check: str = "auto",
+        backend: str = "auto",
+    ):
         if ordering not in ORDERINGS:
             raise ValueError(f"ordering must be one of {ORDERINGS}, not {ordering!r}")
         if pivot_check not in ("auto", "always"):
@@ -114,32 +120,32 @@ class SparseLU:
             raise ModelError(f"linear solver back-end {backend!r} is not one of {BACKENDS}")
         self.backend = backend
         if backend == "banded" and ordering == "auto":
-            ordering = "rcm"   # the band comes from the RCM order
-        self._engine = None     # a non-SuperLU factor object working on self._B, or None
+            ordering = "rcm"  # the band comes from the RCM order
+        self._engine = None  # a non-SuperLU factor object working on self._B, or None
         self.engine = "superlu"  # name of the back-end in use
         self.pivot_check = pivot_check
-        self._dmax = None       # largest |pivot| at the last zero-pivot test
-        self._checked = False   # zero-pivot test done for the current factorisation
+        self._dmax = None  # largest |pivot| at the last zero-pivot test
+        self._checked = False  # zero-pivot test done for the current factorisation
         self.symmetric = symmetric
         self.ordering = ordering
         self.pivot_threshold = 0.0 if symmetric else float(pivot_threshold)
         self._lu = None
-        self._perm = None       # symmetric permutation p: B = K[p][:, p]
-        self._B = None          # permuted CSC matrix, data refilled each factorisation
-        self._gather = None     # B.data = K.data[gather]
-        self._B_int = None      # (indices, indptr, and both as C ints) of B, for SuperLU
-        self._pattern = None    # (shape, indptr, indices) of the master pattern the ordering belongs to
+        self._perm = None  # symmetric permutation p: B = K[p][:, p]
+        self._B = None  # permuted CSC matrix, data refilled each factorisation
+        self._gather = None  # B.data = K.data[gather]
+        self._B_int = None  # (indices, indptr, and both as C ints) of B, for SuperLU
+        self._pattern = None  # (shape, indptr, indices) of the master pattern the ordering belongs to
         self._master_keys = None  # row * n + col of its entries, ascending
-        self._sub = None        # the last pattern seen inside the master one, and its positions there
-        self._sub_ids = None    # (indptr, indices, size) objects last found equal to that pattern
-        self._sub_data = None   # its values and a trailing zero, and the permuted matrix's data
+        self._sub = None  # the last pattern seen inside the master one, and its positions there
+        self._sub_ids = None  # (indptr, indices, size) objects last found equal to that pattern
+        self._sub_data = None  # its values and a trailing zero, and the permuted matrix's data
         self._sub_gather = None  # as indices into them (the trailing zero where it has no entry)
-        self.analyses = 0       # orderings computed (1 for a fixed-pattern run)
-        self.chosen = None      # name of the ordering in use
+        self.analyses = 0  # orderings computed (1 for a fixed-pattern run)
+        self.chosen = None  # name of the ordering in use
         self._validated = None  # (indptr, indices) objects last found equal to the master pattern
         self.superlu_seconds = 0.0  # wall time inside SuperLU (kept factorisations + solves), s
-        self.factorizations = 0     # numeric factorisations kept (trial orderings not counted)
-        self.layout = 0         # bumped whenever the permuted matrix (its pattern or ordering) changes
+        self.factorizations = 0  # numeric factorisations kept (trial orderings not counted)
+        self.layout = 0  # bumped whenever the permuted matrix (its pattern or ordering) changes
 
     # ------------------------------------------------------------------ symbolic part
     def _is_master(self, K):
@@ -173,8 +179,9 @@ class SparseLU:
 
     def _choose_engine(self):
         """The back-end for the current permuted matrix (a new layout: a new choice)."""
-        self._engine = backends.make(self.backend, self._B, self.chosen, self.symmetric,
-                                     lambda B: self._factor_permuted(B, superlu=True))
+        self._engine = backends.make(
+            self.backend, self._B, self.chosen, self.symmetric, lambda B: self._factor_permuted(B, superlu=True)
+        )
         self.engine = "superlu" if self._engine is None else self._engine.name
 
     def has_pattern(self, K) -> bool:
@@ -187,7 +194,7 @@ class SparseLU:
         permuted matrix directly (no gather per factorisation; see :meth:`factorize_values`)."""
         if self._gather is None:
             raise RuntimeError("SparseLU.permuted_positions: no pattern analysed yet")
-        if self._band_input():   # the band back-end: straight into its band storage
+        if self._band_input():  # the band back-end: straight into its band storage
             return self._engine.band_positions(pos, self._gather)
         return permuted_positions(self._gather, pos)
 
@@ -243,14 +250,27 @@ class SparseLU:
             if self._B_int is None or self._B_int[0] is not B.indices or self._B_int[1] is not B.indptr:
                 self._B_int = (B.indices, B.indptr, B.indices.astype(np.intc), B.indptr.astype(np.intc))
             try:
-                return _DIRECT["gstrf"](B.shape[0], B.nnz, B.data, self._B_int[2], self._B_int[3],
-                                            csc_construct_func=sp.csc_array, ilu=False,
-                                            options=dict(DiagPivotThresh=self.pivot_threshold, ColPerm="NATURAL",
-                                                         PanelSize=None, Relax=None, SymmetricMode=True))
+                return _DIRECT["gstrf"](
+                    B.shape[0],
+                    B.nnz,
+                    B.data,
+                    self._B_int[2],
+                    self._B_int[3],
+                    csc_construct_func=sp.csc_array,
+                    ilu=False,
+                    options=dict(
+                        DiagPivotThresh=self.pivot_threshold,
+                        ColPerm="NATURAL",
+                        PanelSize=None,
+                        Relax=None,
+                        SymmetricMode=True,
+                    ),
+                )
             except TypeError:  # pragma: no cover - another scipy signature: use splu from now on
                 _DIRECT["gstrf"] = None
-        return spla.splu(B, permc_spec="NATURAL", diag_pivot_thresh=self.pivot_threshold,
-                         options=dict(SymmetricMode=True))
+        return spla.splu(
+            B, permc_spec="NATURAL", diag_pivot_thresh=self.pivot_threshold, options=dict(SymmetricMode=True)
+        )
 
     def _timed(self, factor, *args):
         """``factor(*args)``: a kept numeric factorisation, its wall time added to superlu_seconds."""
@@ -277,9 +297,9 @@ class SparseLU:
             raise error
         self.chosen, self._perm, self._B, self._gather = best[1]
         self._choose_engine()
-        if self._engine is not None:   # the trial was SuperLU's: factorise again with the back-end
+        if self._engine is not None:  # the trial was SuperLU's: factorise again with the back-end
             return self._timed(self._factor_permuted, self._B)
-        self.superlu_seconds += best[3]   # the kept factorisation; the trial of the other is overhead
+        self.superlu_seconds += best[3]  # the kept factorisation; the trial of the other is overhead
         self.factorizations += 1
         return best[2]
 
@@ -299,8 +319,9 @@ class SparseLU:
                 pos = self._positions(K)
                 if pos is None:  # entries outside the master pattern: analyse the union once
                     ones = sp.csr_matrix((np.ones(K.nnz), K.indices, K.indptr), shape=K.shape)
-                    master = sp.csr_matrix((np.ones(self._master_keys.size), self._pattern[2], self._pattern[1]),
-                                           shape=K.shape)
+                    master = sp.csr_matrix(
+                        (np.ones(self._master_keys.size), self._pattern[2], self._pattern[1]), shape=K.shape
+                    )
                     union = (ones + master).tocsr()
                     union.sort_indices()
                     union.data[:] = 0.0
@@ -309,11 +330,11 @@ class SparseLU:
                     self._lu = self._analyse(union)
                     return None
                 self._sub = (K.shape, K.indptr.copy(), K.indices.copy())
-                where = np.full(self._master_keys.size, K.nnz, dtype=np.int64)   # K.nnz: the trailing zero
+                where = np.full(self._master_keys.size, K.nnz, dtype=np.int64)  # K.nnz: the trailing zero
                 where[pos] = np.arange(K.nnz)
                 self._sub_gather = where[self._gather]
                 self._sub_data = np.zeros(K.nnz + 1)
-            self._sub_ids = (K.indptr, K.indices, K.indices.size)   # recognised by identity from now on
+            self._sub_ids = (K.indptr, K.indices, K.indices.size)  # recognised by identity from now on
         self._sub_data[:-1] = K.data
         return self._sub_data, self._sub_gather
 
@@ -335,7 +356,7 @@ class SparseLU:
             self._lu = self._analyse(K)
             return True
         data = self._master_data(K)
-        if data is None:   # a new analysis, which has factorised already
+        if data is None:  # a new analysis, which has factorised already
             return True
         np.take(data[0], data[1], out=self._B.data)
         self._lu = self._timed(self._factor_permuted, self._B)
@@ -344,7 +365,7 @@ class SparseLU:
     def _guarded(self, step):
         """Run ``step()`` (sets self._lu; True if the pattern was newly analysed) with SuperLU's
         failures raised as SingularModelError, then the zero-pivot test when it is due."""
-        try:   # SuperLU reports a singular matrix as RuntimeError (only spsolve warns instead)
+        try:  # SuperLU reports a singular matrix as RuntimeError (only spsolve warns instead)
             analysed = step()
         except RuntimeError as exc:
             self._lu = None
@@ -381,8 +402,9 @@ class SparseLU:
             xmax = _unpermute(y, self._perm, x)
         if not xmax <= _FLOAT_MAX:
             raise SingularModelError("non-finite solution of the linear system")
-        if not self._checked and xmax * self._dmax > 1e11 * (np.abs(rhs).max(initial=0.0) if self._perm is None
-                                                            else rmax):
+        if not self._checked and xmax * self._dmax > 1e11 * (
+            np.abs(rhs).max(initial=0.0) if self._perm is None else rmax
+        ):
             # an amplification this large means a pivot within ~1e-11 of the largest: test them
             self._check_pivots()
         return x

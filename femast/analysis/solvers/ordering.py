@@ -17,8 +17,12 @@ from ...jit import setup_call
 
 def same_pattern(pattern, K) -> bool:
     """K (CSR) has the pattern ``(shape, indptr, indices)`` (None: no pattern)."""
-    return (pattern is not None and pattern[0] == K.shape and np.array_equal(pattern[1], K.indptr)
-            and np.array_equal(pattern[2], K.indices))
+    return (
+        pattern is not None
+        and pattern[0] == K.shape
+        and np.array_equal(pattern[1], K.indptr)
+        and np.array_equal(pattern[2], K.indices)
+    )
 
 
 def entry_keys(shape, indptr, indices) -> np.ndarray:
@@ -36,7 +40,7 @@ def rcm(K):
     inv[perm] = np.arange(n)
     rows = np.repeat(inv, np.diff(K.indptr))
     cols = inv[K.indices]
-    lo = np.full(n, n, dtype=np.int64)   # leftmost column of each permuted row (symmetric pattern)
+    lo = np.full(n, n, dtype=np.int64)  # leftmost column of each permuted row (symmetric pattern)
     np.minimum.at(lo, rows, cols)
     np.minimum.at(lo, cols, rows)
     envelope = int(np.sum(np.arange(n) - np.minimum(lo, np.arange(n))))
@@ -61,7 +65,7 @@ def _permuted_csc(indptr, indices, inv, n_cols):
     perm = np.empty(n, dtype=np.int64)
     for i in range(n):
         perm[inv[i]] = i
-    for r in range(n):      # the new rows in order: each column receives its rows sorted
+    for r in range(n):  # the new rows in order: each column receives its rows sorted
         i = perm[r]
         for k in range(indptr[i], indptr[i + 1]):
             j = inv[indices[k]]
@@ -77,7 +81,9 @@ def permuted(K, perm):
     n = K.shape[0]
     inv = np.empty(n, dtype=np.int64)
     inv[np.asarray(perm, dtype=np.int64)] = np.arange(n)
-    indptr, indices, gather = setup_call(_permuted_csc, K.nnz, K.indptr.astype(np.int64), K.indices.astype(np.int64), inv, n)
+    indptr, indices, gather = setup_call(
+        _permuted_csc, K.nnz, K.indptr.astype(np.int64), K.indices.astype(np.int64), inv, n
+    )
     B = sp.csc_matrix((K.data[gather], indices, indptr), shape=K.shape)
     return B, gather
 
@@ -107,8 +113,12 @@ def try_orderings(K, kinds, factor, pivot_threshold):
             perm, enough = rcm(K)  # enough: its fill is within 2x of any ordering's
         else:
             try:
-                lu = spla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=pivot_threshold,
-                               options=dict(SymmetricMode=True))
+                lu = spla.splu(
+                    K.tocsc(),
+                    permc_spec="MMD_AT_PLUS_A",
+                    diag_pivot_thresh=pivot_threshold,
+                    options=dict(SymmetricMode=True),
+                )
             except RuntimeError as exc:
                 error = exc
                 continue

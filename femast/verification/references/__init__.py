@@ -33,12 +33,32 @@ Contents (issue 2 and issue 3 verification cases)
 """
 
 from .bend45 import BEND45, BEND45_COMMON_REFERENCE, BEND45_PUBLISHED, bend45_tip_position
-from .cantilever import (MATTIASSON_1981, ElasticaTip, cantilever_compliance, elastica_tip_load, pure_bending_shape,
-                         pure_bending_tip)
-from .columns import (EULER_SUPPORTS, euler_column_postbuckling, euler_critical_load, imperfect_column_deflection,
-                      von_mises_truss_limit_points, von_mises_truss_load)
-from .planar import (LEE_FRAME, LEE_FRAME_PUBLISHED, WILLIAMS_TOGGLE, PlanarPath, lee_frame_limit_load, lee_frame_path,
-                     williams_toggle_limit_load, williams_toggle_path)
+from .cantilever import (
+    MATTIASSON_1981,
+    ElasticaTip,
+    cantilever_compliance,
+    elastica_tip_load,
+    pure_bending_shape,
+    pure_bending_tip,
+)
+from .columns import (
+    EULER_SUPPORTS,
+    euler_column_postbuckling,
+    euler_critical_load,
+    imperfect_column_deflection,
+    von_mises_truss_limit_points,
+    von_mises_truss_load,
+)
+from .planar import (
+    LEE_FRAME,
+    LEE_FRAME_PUBLISHED,
+    WILLIAMS_TOGGLE,
+    PlanarPath,
+    lee_frame_limit_load,
+    lee_frame_path,
+    williams_toggle_limit_load,
+    williams_toggle_path,
+)
 
 __all__ = [
     "ElasticaTip",

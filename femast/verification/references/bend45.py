@@ -10,7 +10,6 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-
 # =============================================================================
 # 3. The 45-degree circular-arc cantilever (Bathe and Bolourchi 1979)
 # =============================================================================
@@ -125,7 +124,7 @@ def bend45_tip_position(
     # d1 = (1,0,0) inward normal at s=0 (towards centre (R,0,0)), d2 = (0,0,-1), d3 = (0,1,0)
 
     def rhs(s, y, F):
-        r, Rm, m = y[0:3], y[3:12].reshape(3, 3), y[12:15]
+        Rm, m = y[3:12].reshape(3, 3), y[12:15]
         d3 = Rm[:, 2]
         N = F @ d3
         dr = (1.0 + N / EA) * d3

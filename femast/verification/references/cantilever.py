@@ -12,7 +12,6 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.special import ellipe, ellipeinc, ellipkinc, ellipkm1
 
-
 # =============================================================================
 # 1. Elastica: cantilever under a transverse dead end load
 # =============================================================================
@@ -85,7 +84,9 @@ def elastica_tip_load(k: float) -> ElasticaTip:
     k = abs(k)
     rk = math.sqrt(k)
     if k > 1e5:
-        raise ValueError(f"elastica_tip_load: |k|={k:g} > 1e5 is beyond double precision (theta_L = pi/2 - O(exp(-sqrt k)))")
+        raise ValueError(
+            f"elastica_tip_load: |k|={k:g} > 1e5 is beyond double precision (theta_L = pi/2 - O(exp(-sqrt k)))"
+        )
 
     if k < 0.5:
         u, v, th = _elastica_small_load(k)

@@ -11,7 +11,6 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
-
 # =============================================================================
 # 4. Euler columns
 # =============================================================================
@@ -40,7 +39,9 @@ def euler_critical_load(EI: float, L: float, support: str = "pinned-pinned") -> 
     try:
         K = EULER_SUPPORTS[support][0]
     except KeyError:
-        raise ValueError(f"euler_critical_load: unknown support {support!r}; use one of {sorted(EULER_SUPPORTS)}") from None
+        raise ValueError(
+            f"euler_critical_load: unknown support {support!r}; use one of {sorted(EULER_SUPPORTS)}"
+        ) from None
     return math.pi**2 * EI / (K * L) ** 2
 
 

@@ -11,7 +11,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-
 # =============================================================================
 # 5b. Planar frames of extensible Euler-Bernoulli bars: shooting + continuation
 # =============================================================================
@@ -52,7 +51,10 @@ class PlanarPath:
         B = np.stack((d[1:], p[1:]), axis=1)
         AB = B - A
         L2 = np.maximum(np.einsum("ij,ij->i", AB, AB), 1e-300)
-        pts = np.stack((np.atleast_1d(np.asarray(disp, float)) / disp_scale, np.atleast_1d(np.asarray(load, float)) / load_scale), axis=1)
+        pts = np.stack(
+            (np.atleast_1d(np.asarray(disp, float)) / disp_scale, np.atleast_1d(np.asarray(load, float)) / load_scale),
+            axis=1,
+        )
         out = np.empty(len(pts))
         for n, X in enumerate(pts):
             t = np.clip(np.einsum("ij,ij->i", X - A, AB) / L2, 0.0, 1.0)
@@ -179,7 +181,7 @@ def _continuation(chain, P_scale, L_scale, ds, n_max, stop, q_scale):
         while step > 1e-6 * ds:
             zp = z + step * t
             zc = zp.copy()
-            for it in range(25):
+            for it in range(25):  # noqa: B007 (the count is read after the loop)
                 g = G(zc)
                 Jm = jac(zc, g)
                 A = np.vstack((Jm, t))
@@ -265,7 +267,9 @@ def _limit_load(chain, path, P_scale, L_scale, q_scale, load_dir):
         state["z"] = z
         return z[3] * P_scale
 
-    res = minimize_scalar(lambda vt: -solve_v(vt), bounds=(v_lo, v_hi), method="bounded", options={"xatol": 1e-9 * L_scale})
+    res = minimize_scalar(
+        lambda vt: -solve_v(vt), bounds=(v_lo, v_hi), method="bounded", options={"xatol": 1e-9 * L_scale}
+    )
     return -res.fun, res.x
 
 
@@ -397,7 +401,13 @@ def williams_toggle_path(
     P_scale, q_scale = _toggle_scales(half_span, rise, E, b, d)
     pts = _continuation(chain, P_scale, rise, ds, n_max, lambda q, lam: chain.monitor(q, lam)[0][1] < -v_max, q_scale)
     path = _path_from_points(chain, pts, q_scale, P_scale, np.array([0.0, -1.0]))
-    path.info = {"q": [z[:3] * q_scale for z in pts], "model": "Williams toggle", "h": h, "P_scale": P_scale, "q_scale": q_scale}
+    path.info = {
+        "q": [z[:3] * q_scale for z in pts],
+        "model": "Williams toggle",
+        "h": h,
+        "P_scale": P_scale,
+        "q_scale": q_scale,
+    }
     return path
 
 
