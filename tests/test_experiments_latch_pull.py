@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from femast.experiments import AT_NOISE, compare, diagnose, from_arrays, get_experiment, predict, run_model
-from femast.experiments.synthetic import latch_pull_data
+from femast.experiments.rigs.synthetic import latch_pull_data
 from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
 
 EXP = get_experiment("latch-pull")

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from femast.experiments import AT_NOISE, compare, diagnose, get_experiment, predict, run_model
-from femast.experiments.synthetic import mast_top_data, mast_top_path
+from femast.experiments.rigs.synthetic import mast_top_data, mast_top_path
 from femast.guyed.mast_3r import displacement_3r
 
 EXP = get_experiment("mast-top")

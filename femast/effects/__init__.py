@@ -27,7 +27,6 @@ from . import joints, structure, cables, latch, vibration  # noqa: F401,I001  (r
 from .base import (
     Effect,
     Implementation,
-    Parameter,
     add_implementation,
     applicable_effects,
     get_effect,
@@ -39,6 +38,7 @@ from .base import (
     unregister_effect,
 )
 from .operators import play, proportional_play
+from .parameters import Parameter
 
 __all__ = [
     "Effect",

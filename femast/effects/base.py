@@ -31,7 +31,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import ModelError
-from ..experiments.core import Parameter  # noqa: F401  (re-exported: effects declare Parameters)
+from .parameters import Parameter  # noqa: F401  (re-exported: effects declare Parameters)
 
 
 @dataclass(frozen=True)

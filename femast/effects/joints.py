@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiments.core import Parameter
 from .base import Effect, Implementation, register_effect
 from .operators import iwan, jenkins, play
+from .parameters import Parameter
 
 FE = ("bay-torsion", "tip-cycle")
 

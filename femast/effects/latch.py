@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiments.core import Parameter
 from .base import Effect, Implementation, register_effect
+from .parameters import Parameter
 
 
 def _latch_hysteresis_fe(bay, p, ctx):

@@ -7,9 +7,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..experiments.core import Parameter
 from ..guyed.cantilever import cantilever_compliance, mast_section
 from .base import Effect, Implementation, register_effect
+from .parameters import Parameter
 
 
 @lru_cache(maxsize=64)

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiments.core import Parameter
 from .base import Effect, Implementation, add_implementation, list_effects, register_effect
+from .parameters import Parameter
 
 
 def _loss(T, p, ctx):

@@ -16,64 +16,20 @@ It returns a dict ``{channel: (n,) array}`` with one predicted value per row for
 ``experiment.channels``, in the units of the channel's column name.  Everything else (fits,
 noise floor, segmentation, ranking of effects, figures, history) is generic.
 
-Built-in experiments live in :mod:`femast.experiments.mast_top`,
-:mod:`femast.experiments.latch_pull`, :mod:`femast.experiments.bay_torsion` and
-:mod:`femast.experiments.tip_cycle` (FE models); a user adds one from a Python script that
-defines a module-level ``experiment`` (see ``docs/experiments.md``).
+The built-in experiments are rigs written against this contract, one module each in
+:mod:`femast.experiments.rigs`; a user adds one from a Python script that defines a module-level
+``experiment`` (see ``docs/experiments.md``).
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..effects.parameters import Parameter  # noqa: F401  (re-exported: experiments declare Parameters)
 from ..errors import ModelError
-
-
-@dataclass(frozen=True)
-class Parameter:
-    """A fittable parameter of a model or of an effect.
-
-    name : identifier (used in JSON reports and as ``params[name]``).
-    unit : its SI unit as text ("N m/rad", "m", "-").
-    default : value used without ``--fit`` and as the start of a fit.
-    lower, upper : bounds of the fit (same unit).
-    doc : one line of physics.
-    scale : typical magnitude, used to scale the fit (default ``|default|`` or 1).
-    starts : extra start values tried by the fit (multi-start for non-convex effects).
-    """
-
-    name: str
-    unit: str
-    default: float
-    lower: float = -math.inf
-    upper: float = math.inf
-    doc: str = ""
-    scale: float | None = None
-    starts: tuple = ()
-
-    def __post_init__(self):
-        if not (self.lower <= self.default <= self.upper):
-            raise ModelError(
-                f"parameter {self.name}: default {self.default!r} {self.unit} lies outside its "
-                f"bounds [{self.lower!r}, {self.upper!r}]"
-            )
-        for s in self.starts:
-            if not (self.lower <= s <= self.upper):
-                raise ModelError(
-                    f"parameter {self.name}: start {s!r} {self.unit} lies outside its bounds "
-                    f"[{self.lower!r}, {self.upper!r}]; give starts within the bounds"
-                )
-
-    @property
-    def typical(self) -> float:
-        """Magnitude used to scale the fit, in the parameter's unit."""
-        if self.scale:
-            return float(self.scale)
-        return abs(float(self.default)) or 1.0
 
 
 @dataclass(frozen=True)

@@ -83,12 +83,11 @@ import time
 
 import numpy as np
 
-from .. import progress
-from ..errors import ConvergenceError, FemastError, ModelError
-from .core import Column, Experiment, Measured, Parameter, prepared
-from .fe_cache import kernel_threads
-from .fe_reference import cached_run
-from .residuals import turning_points
+from femast import progress
+from femast.errors import ConvergenceError, FemastError, ModelError
+from femast.experiments import Column, Experiment, Measured, Parameter, prepared, turning_points
+from femast.experiments.fe_cache import kernel_threads
+from femast.experiments.fe_reference import cached_run
 
 ZONE_KINDS = (
     "zone (a) at backstop",
@@ -148,7 +147,7 @@ def _prepare(data: Measured, options: dict) -> dict:
 # --------------------------------------------------------------------------- FE run
 def bay_inputs(params: dict, options: dict) -> dict:
     """The dict passed through the ``bay_parameters`` hook: baseline inputs of the FE bay (SI)."""
-    from ..adam.parameters import BayParameters
+    from femast.adam.parameters import BayParameters
 
     base = BayParameters()
     d = {
@@ -170,8 +169,8 @@ def bay_inputs(params: dict, options: dict) -> dict:
 
 def bay_parameters(inputs: dict):
     """:class:`~femast.adam.BayParameters` from a ``bay_parameters`` hook dict (validated)."""
-    from ..adam.parameters import BayParameters
-    from ..latch import LatchParameters
+    from femast.adam.parameters import BayParameters
+    from femast.latch import LatchParameters
 
     latch = LatchParameters(**{f: float(inputs[f"latch_{f}"]) for f in LATCH_FIELDS})
     rest = {k: v for k, v in inputs.items() if not k.startswith("latch_")}
@@ -194,9 +193,9 @@ def run_bay(
     Returns ``Mz`` (m,) N m (seed sign), ``zone`` and ``bead`` (m) (m, 4) of the four latches,
     ``uz`` (m,), ``increments``, ``iterations``, ``wall_time``.  (The latches' tension jumps ``dT``
     are no longer recorded: they were not used, and reading any element output costs 20 % of a run.)"""
-    from ..adam import build_bay
-    from ..adam.steps import CONVERGENCE, add_initial_steps
-    from ..analysis import Analysis
+    from femast.adam import build_bay
+    from femast.adam.steps import CONVERGENCE, add_initial_steps
+    from femast.analysis import Analysis
 
     t0 = time.perf_counter()
     am = build_bay(bay_parameters(inputs), fold=int(fold))
@@ -270,7 +269,7 @@ def _latch_outputs(family, bead) -> dict:
     """``bead`` (m) and ``zone`` (seed Fig. 6) of the latches at the driven rows from their committed
     bead positions (rows, elements), as the latch family's outputs ``bead_position`` and
     ``latch_zone`` give them (NaN and -1 for an element without a latch)."""
-    from ..latch import latch_zone
+    from femast.latch import latch_zone
 
     has = np.asarray(family.latch_node) > 0
     return {"bead": np.where(has, bead, np.nan), "zone": np.where(has, latch_zone(bead, family.latch), -1).astype(int)}
@@ -333,9 +332,9 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
 def latch_zones(params: dict, data: Measured, options: dict, effects=None) -> np.ndarray:
     """(n, 4) zones of seed Fig. 6 of the four latches at every row (nearest driven row), from the
     (cached) FE run of the model with ``params``."""
-    from .core import NO_EFFECTS
+    from femast.experiments import EffectStack
 
-    prep, _, _, _, fe = _run(params, data, effects or NO_EFFECTS, options)
+    prep, _, _, _, fe = _run(params, data, effects or EffectStack(), options)
     rows = prep["rows"]
     j = np.clip(np.searchsorted(prep["s"][rows], prep["s"]), 0, rows.size - 1)
     jm = np.clip(j - 1, 0, rows.size - 1)
@@ -376,7 +375,7 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
 
 
 def _default_EA() -> float:
-    from ..adam.parameters import BayParameters
+    from femast.adam.parameters import BayParameters
 
     return float(BayParameters().cable_EA)
 

@@ -15,11 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..effects.base import resolve
-from ..errors import ModelError
-from ..latch import LATCHING, UNLATCHING, latch_force
-from .core import EffectStack, Measured
-from .fitting import predict
+from femast.effects import resolve
+from femast.errors import ModelError
+from femast.experiments import EffectStack, Measured, predict
+from femast.latch import LATCHING, UNLATCHING, latch_force
 
 
 def _stack(exp, effects):
@@ -72,8 +71,8 @@ def mast_top_path(
         F = mag * np.sin(2 * np.pi * cycles * t)
         fx, fy = F * np.cos(ang), F * np.sin(ang)
     elif kind == "seed000":
-        from ..guyed.cdpr import trajectory_loads
-        from ..guyed.rocaspect import fig5a_trajectory, rocaspect_geometry
+        from femast.guyed.cdpr import trajectory_loads
+        from femast.guyed.rocaspect import fig5a_trajectory, rocaspect_geometry
 
         _, wr = trajectory_loads(rocaspect_geometry(), fig5a_trajectory(12))
         dw = wr[:, 0] - wr[0, 0]
@@ -102,7 +101,7 @@ def mast_top_data(
     drift_m : amplitude of a slow thermal drift of the top (m) that no effect models.
     Returns ``(data, truth)`` with ``truth`` the noise-free displacements ``{dx_m, dy_m, dz_m}``.
     """
-    from .registry import get_experiment
+    from femast.experiments import get_experiment
 
     exp = experiment or get_experiment("mast-top")
     rng = np.random.default_rng(seed + 1000)
@@ -147,7 +146,7 @@ def latch_pull_data(
     drift_N : a slow drift of the load cell (N) that no effect models.
     Returns ``(data, truth)`` with the true bead positions (m) and force jumps (N).
     """
-    from .registry import get_experiment
+    from femast.experiments import get_experiment
 
     exp = experiment or get_experiment("latch-pull")
     o = exp.options
@@ -258,7 +257,7 @@ def bay_torsion_data(
     params : baseline ``{latch_k, latch_mu}`` (default the seed's pull-test fit).
     drift_Nm : amplitude of a slow drift of the load cell (N m) that no effect models.
     Returns ``(data, truth)`` with ``truth`` the noise-free ``{Mz_Nm}``."""
-    from .registry import get_experiment
+    from femast.experiments import get_experiment
 
     exp = experiment or get_experiment("bay-torsion")
     path = dict(path or bay_torsion_path(seed=seed))
@@ -335,7 +334,7 @@ def tip_cycle_data(
 
     params : baseline ``{cable_EA}``.  drift_m : a slow drift of the tip along x and y
     (m) that no effect models.  Returns ``(data, truth)`` with the noise-free channels."""
-    from .registry import get_experiment
+    from femast.experiments import get_experiment
 
     exp = experiment or get_experiment("tip-cycle")
     path = dict(path or tip_cycle_path(seed=seed))

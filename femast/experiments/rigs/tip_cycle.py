@@ -72,12 +72,12 @@ import time
 
 import numpy as np
 
-from .. import progress
-from ..errors import ConvergenceError, FemastError, ModelError
+from femast import progress
+from femast.errors import ConvergenceError, FemastError, ModelError
+from femast.experiments import Column, Experiment, Measured, Parameter, prepared, turning_points
+from femast.experiments.fe_cache import cached, kernel_threads
+
 from .bay_torsion import LATCH_FIELDS, bay_parameters
-from .core import Column, Experiment, Measured, Parameter, prepared
-from .fe_cache import cached, kernel_threads
-from .residuals import turning_points
 
 L_MAST_40 = 6.84  # m, the 40-bay mast of seed 001 Sec. VII
 LOADS = ("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm")
@@ -118,7 +118,7 @@ def _prepare(data: Measured, options: dict) -> dict:
 # --------------------------------------------------------------------------- FE run
 def mast_inputs(params: dict, options: dict) -> dict:
     """The dict passed through the ``bay_parameters`` hook (baseline inputs of every bay, SI)."""
-    from ..adam.parameters import BayParameters
+    from femast.adam.parameters import BayParameters
 
     base = BayParameters()
     d = {
@@ -152,9 +152,9 @@ def run_mast(
     Returns ``motion`` (m, 6) = [ux, uy, uz (m), rx, ry, rz (rad)] of the control node relative to
     the pretensioned state, ``bead`` (m, n_bays, 4) bead positions (m), ``zone`` (m, n_bays, 4),
     ``increments``, ``iterations``, ``wall_time``."""
-    from ..adam import build_mast
-    from ..adam.steps import CONVERGENCE, add_initial_steps
-    from ..analysis import Analysis
+    from femast.adam import build_mast
+    from femast.adam.steps import CONVERGENCE, add_initial_steps
+    from femast.analysis import Analysis
 
     t0 = time.perf_counter()
     am = build_mast(int(n_bays), bay_parameters(inputs), fold=int(fold), alternate=bool(alternate))
@@ -270,7 +270,7 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
 
 def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: dict) -> None:
     """Tip displacement x and tip twist (as L rz, L the mast height) against the signed tip load, mm."""
-    from ..adam.parameters import SEED_BAY_HEIGHT
+    from femast.adam.parameters import SEED_BAY_HEIGHT
 
     s = prepared(data, _prepare, options)["load"]
     L = int(options["n_bays"]) * float(dict(options.get("bay") or {}).get("l", SEED_BAY_HEIGHT))
@@ -287,7 +287,7 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
 
 
 def _defaults():
-    from ..adam.parameters import BayParameters
+    from femast.adam.parameters import BayParameters
 
     p = BayParameters()
     return float(p.cable_EA), float(p.longeron_t)

@@ -73,10 +73,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..errors import DataFileError
-from ..latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force, latch_zone
-from .core import Column, Experiment, Measured, Parameter, prepared
-from .residuals import noise_floor, turning_points
+from femast.errors import DataFileError
+from femast.experiments import Column, Experiment, Measured, Parameter, noise_floor, prepared, turning_points
+from femast.latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force, latch_zone
 
 SIDE_OUT = 1  # the outer cable (section 2) is loaded: unlatching rig, dT = T2 >= 0
 SIDE_IN = -1  # the inner cable (section 1, through the backstop) is loaded: latching rig, dT = -T1 <= 0

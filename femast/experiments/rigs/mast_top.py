@@ -49,8 +49,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..guyed.mast_3r import jacobian_3r
-from .core import Column, Experiment, Measured, Parameter, prepared
+from femast.experiments import Column, Experiment, Measured, Parameter, prepared
+from femast.guyed.mast_3r import jacobian_3r
 
 WRENCH = ("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm")
 DISPLACEMENT = ("dx_m", "dy_m", "dz_m")

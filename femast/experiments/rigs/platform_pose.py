@@ -44,10 +44,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
+from femast.errors import ModelError
+from femast.experiments import Column, Experiment, Measured, Parameter, from_arrays
+
 from . import mast_top
-from .core import Column, Experiment, Measured, Parameter
-from .data import from_arrays
 
 POSE_IN = ("x_cmd_m", "y_cmd_m", "z_cmd_m", "roll_cmd_rad", "pitch_cmd_rad", "yaw_cmd_rad")
 TENSIONS = tuple(f"tau{j}_N" for j in range(1, 9))
@@ -56,7 +56,7 @@ _CACHE: dict = {}
 
 
 def _masts(options):
-    from ..guyed.mast_sets import mast_set
+    from femast.guyed.mast_sets import mast_set
 
     key = (options["mast_model"], float(options["pretension_N"]))
     if key not in _CACHE:
@@ -75,7 +75,7 @@ def _inputs(data: Measured):
 
 def _mast_top_response(w_hist, w_cal, k_theta, effects, i):
     """Top translations (k, 3) of mast i by the mast-top model (3R + effects) for its wrench history."""
-    from ..guyed.rocaspect import mast_bases, mast_tops
+    from femast.guyed.rocaspect import mast_bases, mast_tops
 
     dw = w_hist - w_cal
     cols = dict(zip(mast_top.WRENCH, dw.T))
@@ -90,9 +90,9 @@ def _mast_top_response(w_hist, w_cal, k_theta, effects, i):
 
 def model(params: dict, data: Measured, effects, options: dict) -> dict:
     """Platform pose on compliant masts (module docstring); returns ``{x_m, y_m, z_m}`` in m."""
-    from ..guyed.mast_sets import _TEST_OF
-    from ..guyed.platform_pose import CableRobot, MastSet, pose_trajectory
-    from ..guyed.rocaspect import TABLE_III, rocaspect_geometry
+    from femast.guyed.mast_sets import _TEST_OF
+    from femast.guyed.platform_pose import CableRobot, MastSet, pose_trajectory
+    from femast.guyed.rocaspect import TABLE_III, rocaspect_geometry
 
     poses, tau = _inputs(data)
     base = _masts(options)

@@ -57,11 +57,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis import Analysis
-from ..effects.base import load_script
-from ..errors import ModelError
-from ..modal import modal_analysis
-from .core import Column, Experiment, Measured, Parameter, prepared
+from femast.analysis import Analysis
+from femast.effects import load_script
+from femast.errors import ModelError
+from femast.experiments import Column, Experiment, Measured, Parameter, prepared
+from femast.modal import modal_analysis
 
 FITS = {"pretension": ("pretension",), "mass": ("unit_mass",), "both": ("pretension", "unit_mass")}
 
@@ -132,7 +132,7 @@ def _state_model(T, m, load, options):
         model, drive = build(T, m, load, options)
         direction = np.asarray(options["drive_direction"], float)
     else:
-        from ..adam.vibration import mock_bay_side
+        from femast.adam.vibration import mock_bay_side
 
         side = mock_bay_side(T, options.get("bay"), m, options.get("cable_mass_kg_per_m"))
         model, drive, direction = side.model, side.unit, side.normal
@@ -215,7 +215,7 @@ class VibrationExperiment(Experiment):
     """The ``vibration`` experiment: its fitted parameters follow the option ``fit``."""
 
     def __post_init__(self):
-        from ..adam.mass import UNIT_MASS
+        from femast.adam.mass import UNIT_MASS
 
         opts = dict(self.options)
         if opts.get("unit_mass_kg") is None:
