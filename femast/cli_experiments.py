@@ -1,11 +1,11 @@
-"""``femast compare``, ``diagnose`` (issue 7), ``experiments``, ``effects``, ``examples`` (issue 17),
+"""``femast compare``, ``diagnose``, ``experiments``, ``effects``, ``examples``,
 registered by :mod:`femast.cli`.
 
 ::
 
     femast compare EXPERIMENT DATA.csv [--effects a,b] [--fit] [--out DIR] [--json]
     femast diagnose EXPERIMENT DATA.csv [--out DIR] [--json] [--workers N] [--scheduler ADDRESS]
-                    [--effects a,b]
+                    [--effects a,b] [--candidates a,b] [--exclude a,b]
     femast experiments [--json]            femast effects [EXPERIMENT] [--json]
     femast examples [--copy DIR]
 
@@ -14,8 +14,8 @@ defining ``experiment``; DATA is a CSV file or ``example`` (the experiment's shi
 :mod:`femast.examples`).  Outputs go to ``--out``, by default ``./compare/EXPERIMENT_DATASTEM``
 (``./diagnose/...``) in the working directory.  An ``--effects`` entry
 is an effect name, ``SCRIPT.py`` (every effect the script registers) or ``SCRIPT.py:name``.
-``diagnose --effects`` names the effects already in the model being diagnosed (an extension of
-issue 7: after adding the missing effect, diagnose the new model).
+``diagnose --effects`` names the effects already in the model being diagnosed (after adding the missing effect, diagnose the new model); ``--candidates`` / ``--exclude`` choose
+the effects it tries.
 """
 
 from __future__ import annotations
@@ -75,21 +75,26 @@ def experiment_rows() -> list[dict]:
 
 
 def effect_rows(experiment=None) -> list[dict]:
-    """Every registered effect (or those applicable to ``experiment``): name, title, one sentence of
-    physics, the experiments it is implemented for."""
+    """Every registered effect (or those applicable to ``experiment``, an Experiment): name, title, one
+    sentence of physics, the registered experiments it applies to, the quantities its mechanism needs."""
     from .effects import list_effects
+    from .experiments import list_experiments
 
+    experiments = list_experiments()
     rows = []
     for e in list_effects():
-        exps = [n for n in e.implementations if e.applies_to(n)]
-        if experiment is not None and experiment not in exps:
+        if experiment is not None and not e.applies_to(experiment):
             continue
+        m = e.mechanism
         rows.append(
             {
                 "name": e.name,
                 "title": e.title,
                 "physics": _first_sentence(e.physics),
-                "experiments": exps,
+                "experiments": [x.name for x in experiments if e.applies_to(x)],
+                "quantities": [k for k in ("load", "displacement", "time", "temperature") if k in (m.hook, *m.needs)]
+                if m is not None
+                else [],
                 "seed": e.seed,
             }
         )
@@ -112,14 +117,15 @@ def _effects(args):
     if args.experiment:
         from .experiments import get_experiment
 
-        exp = get_experiment(args.experiment).name
+        exp = get_experiment(args.experiment)
     rows = effect_rows(exp)
     if args.json:
         print(json.dumps(rows, indent=2))
         return
-    print(f"effects{' of ' + exp if exp else ''} (femast compare ... --effects NAME[,NAME]):")
+    print(f"effects{' of ' + exp.name if exp else ''} (femast compare ... --effects NAME[,NAME]):")
     for r in rows:
-        print(f"  {r['name']:<22s} {r['title']} [{', '.join(r['experiments'])}]")
+        where = r["experiments"] + ([f"any rig with {' + '.join(r['quantities'])}"] if r["quantities"] else [])
+        print(f"  {r['name']:<22s} {r['title']} [{', '.join(where)}]")
         print(f"  {'':<22s} {r['physics']}")
 
 
@@ -183,7 +189,16 @@ def _diagnose(args):
     from .experiments import diagnose, format_diagnose
 
     exp, data, effects, out = _setup(args)
-    res = diagnose(exp, data, base_effects=effects, workers=args.workers, scheduler=args.scheduler, out=out)
+    res = diagnose(
+        exp,
+        data,
+        _effect_names(args.candidates) if args.candidates else None,
+        exclude=_effect_names(args.exclude),
+        base_effects=effects,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        out=out,
+    )
     print(json.dumps(res.report, indent=2) if args.json else format_diagnose(exp, res))
     _freeze_heap_for_exit()
 
@@ -192,7 +207,7 @@ def _freeze_heap_for_exit():
     """The command's files are written and closed: move every object to the garbage collector's
     permanent generation, so that the interpreter's shutdown does not search the whole heap (numba's
     typing and code objects, matplotlib) for cycles -- 0.5-0.7 s of the bay-torsion diagnosis at a
-    load of 5, 0.1 s with this (issue 21).  Objects are still released by reference counting at exit."""
+    load of 5, 0.1 s with this.  Objects are still released by reference counting at exit."""
     import gc
 
     gc.freeze()
@@ -269,6 +284,13 @@ def register(subparsers, fmt=None) -> None:
     p.add_argument(
         "--effects", default=None, help="comma-separated effects already in the model being diagnosed (default: none)"
     )
+    p.add_argument(
+        "--candidates",
+        default=None,
+        help="comma-separated effects to try: names, SCRIPT.py or SCRIPT.py:name (default: every effect that "
+        "applies to the experiment)",
+    )
+    p.add_argument("--exclude", default=None, help="comma-separated effects not to try (default: none)")
     p.set_defaults(func=_diagnose)
     p = subparsers.add_parser(
         "experiments",

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..effects.parameters import Parameter  # noqa: F401  (re-exported: experiments declare Parameters)
+from ..effects.quantities import HOOKS, check_quantities
 from ..errors import ModelError
 
 
@@ -126,7 +127,7 @@ class Experiment:
         required non-channel column.
     load_label : name and unit of the load measure, for reports.
     extra_segments : optional ``extra_segments(data, params, options) -> [(kind, mask)]`` of
-        experiment-specific path segments (e.g. the latch zones of seed 001 Fig. 6).
+        experiment-specific path segments (e.g. the latch zones of Stohlman & Pellegrino, Fig. 6).
     plot_measured : optional ``plot_measured(ax, data, predicted, params, options)`` drawing the
         measured-against-model panel of the compare figure (default: channels against row).
     channel_weights : factors converting each channel to ``error_unit`` for the overall RMS
@@ -145,16 +146,22 @@ class Experiment:
         (p + 1)``).  ``expensive: True`` makes ``diagnose`` refit in parallel by default even when
         the baseline fit was fast (its runs came from a cache); with ``diff_step`` it also makes the
         fit save runs (secant Jacobians, seeded refits, positive parameters spanning two decades in
-        log scale: :func:`~femast.experiments.fitting.fit`, issue 21).
+        log scale: :func:`~femast.experiments.fitting.fit`).
     source : where it came from (a built-in name or a script path), set by the registry.
     noise_covariates : optional ``noise_covariates(data, params, options, fit) -> {channel: {name:
         (n,) array}}`` of quantities the noise level of a channel may grow with, because of how
-        the data are measured (latch-pull: the slope of the law, seed 001 Eq. 15); the noise model
+        the data are measured (latch-pull: the slope of the law, Stohlman & Pellegrino, Eq. 15); the noise model
         of ``diagnose`` (:mod:`femast.experiments.noise`) tests them.
     path_coordinate : optional ``path_coordinate(data, options) -> (n,)`` the quantity the test
         drives along its passes (latch-pull: the bead position), whose repeated passes give the
         noise model a model-free level (:func:`~femast.experiments.noise.cycle_scatter`); default:
         the load measure.
+
+    quantities : ``{kind: Quantity}`` the physical quantities the model shows to effects
+        (:mod:`femast.effects.quantities`): ``"load"`` and ``"displacement"`` (the model passes them
+        through ``effects.apply("load", ...)`` and ``effects.apply("displacement", ...)``),
+        ``"temperature"`` (a data column).  Every effect whose mechanism acts on quantities the
+        experiment declares applies to it, the library's and the user's alike.
 
     Every channel ``c`` also accepts an optional column ``sigma_c`` (same unit) with the standard
     uncertainty of each row; ``diagnose`` then uses it as the noise of that channel.
@@ -183,6 +190,7 @@ class Experiment:
     source: str = ""
     noise_covariates: Callable | None = None
     path_coordinate: Callable | None = None
+    quantities: dict = field(default_factory=dict)
 
     def __post_init__(self):
         names = [c.name for c in self.columns]
@@ -194,6 +202,15 @@ class Experiment:
         pn = [p.name for p in self.parameters]
         if len(set(pn)) != len(pn):
             raise ModelError(f"experiment {self.name}: duplicate parameter names in {pn}")
+        quantities = check_quantities(f"experiment {self.name}", self.quantities)
+        object.__setattr__(self, "quantities", quantities)
+        hooks = dict(self.hooks)
+        for kind in HOOKS:
+            if kind in quantities and kind not in hooks:
+                q = quantities[kind]
+                shape = f"(n, {len(q.axes)}) about {', '.join(q.axes)}" if q.axes else "(n,)"
+                hooks[kind] = f"{kind} {shape} {q.unit}{': ' + q.doc if q.doc else ''}"
+        object.__setattr__(self, "hooks", hooks)
 
     # ------------------------------------------------------------------ helpers
     @property
@@ -291,11 +308,14 @@ class EffectStack:
     ``items`` is a list of ``(effect_name, implementation, params)``; ``apply(hook, value, **ctx)``
     passes ``value`` through every implementation attached to ``hook``, in their ``order``.
     An implementation's function is called as ``fn(value, params, ctx)`` and returns the new value;
-    ``ctx`` holds the keyword arguments of the hook call.
+    ``ctx`` holds ``context`` (what the framework gives every effect: ``time``, ``t_s``,
+    ``temperature``, ``quantities``; :func:`effect_context`), the load as it entered the ``"load"``
+    hook (``load``) and after its effects (``load_eff``), and the keyword arguments of the hook call.
     """
 
-    def __init__(self, items=()):
+    def __init__(self, items=(), context=None):
         self.items = sorted(list(items), key=lambda it: it[1].order)
+        self.context = dict(context or {})
 
     def __bool__(self):
         return bool(self.items)
@@ -307,14 +327,33 @@ class EffectStack:
 
     def apply(self, hook: str, value, **ctx):
         """Apply the active effects attached to ``hook`` to ``value`` (see the class docstring)."""
+        if hook == "load" and self.items:
+            self.context["load"] = value
+        full = {**self.context, **ctx}
         for _, impl, params in self.items:
             if impl.hook == hook:
-                value = impl.apply(value, params, ctx)
+                value = impl.apply(value, params, full)
+        if hook == "load" and self.items:
+            self.context["load_eff"] = value
         return value
 
     def on(self, hook: str) -> bool:
         """True if an active effect is attached to ``hook``."""
         return any(impl.hook == hook for _, impl, _ in self.items)
+
+
+def effect_context(exp: Experiment, data: Measured) -> dict:
+    """What the framework gives every effect of a model run on ``data`` (:class:`EffectStack`)."""
+    t = data.columns.get("t_s")
+    ctx = {
+        "time": data.tau,
+        "t_s": np.asarray(t, float) if t is not None else np.arange(data.n, dtype=float),
+        "quantities": exp.quantities,
+    }
+    temp = exp.quantities.get("temperature")
+    if temp is not None and temp.column in data.columns:
+        ctx["temperature"] = data[temp.column]
+    return ctx
 
 
 NO_EFFECTS = EffectStack()

@@ -13,7 +13,7 @@ Format
   latch pull test).
 
 Every error is a :class:`~femast.errors.DataFileError` naming the file, the line and the
-column, and listing the accepted values.  Beyond the format, the values are checked (issue 16):
+column, and listing the accepted values.  Beyond the format, the values are checked:
 every value within 1e15 of its unit (a larger one is a corrupt cell and would overflow the fit);
 no measured channel (``experiment.channels``) all zero or constant (nothing was measured: a
 disconnected sensor or a wrong column); a file separated by ';', tabs or '|' is refused with an

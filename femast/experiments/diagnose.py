@@ -116,6 +116,7 @@ def diagnose(
     data: Measured,
     candidates=None,
     *,
+    exclude=(),
     base_effects=(),
     workers=None,
     scheduler=None,
@@ -126,7 +127,8 @@ def diagnose(
 
     candidates : effect names to try (default: every effect applicable to the experiment and not in
         ``base_effects``); each is fitted in each of its forms (``effect/form``), the information
-        criterion picks the form.  base_effects : effects already in the model being diagnosed
+        criterion picks the form.  exclude : effect names not to try (e.g. one whose refit is known
+        to fail, or a mechanism the rig cannot have).  base_effects : effects already in the model being diagnosed
         (names or ``effect/form``); their other forms are refitted first (a shape mismatch).
     workers : local worker processes (default: the number of CPUs, unless the refits are estimated
         -- six times the baseline fit time each -- to take less than ``SERIAL_BELOW_S`` = 1 s in all,
@@ -147,13 +149,14 @@ def diagnose(
     """
     exp.require_model("diagnose")
     # the figure is drawn by a process forked now, which imports matplotlib while this one fits the
-    # baseline on the other CPU (FE experiments, local refits; issue 21)
+    # baseline on the other CPU (FE experiments, local refits)
     figs = FigureProcess.start() if out is not None and scheduler is None and exp.fit_options.get("expensive") else None
     try:
         return _diagnose(
             exp,
             data,
             candidates,
+            exclude=exclude,
             base_effects=base_effects,
             workers=workers,
             scheduler=scheduler,
@@ -166,19 +169,25 @@ def diagnose(
             figs.close()
 
 
-def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, pairs, figs) -> OptimizeResult:
-    if isinstance(base_effects, str):
-        base_effects = [e for e in base_effects.split(",") if e.strip()]
-    base_effects = [n for n, _ in resolve(exp, list(base_effects))]
+def _names(names) -> list:
+    """Effect names from a list or a comma-separated string."""
+    if isinstance(names, str):
+        return [e.strip() for e in names.split(",") if e.strip()]
+    return list(names or ())
+
+
+def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, scheduler, out, pairs, figs) -> OptimizeResult:
+    base_effects = [n for n, _ in resolve(exp, _names(base_effects))]
     base_names = {split_form(n)[0] for n in base_effects}
-    key = exp.effect_key
     if candidates is None:
         candidates = [e.name for e in applicable_effects(exp) if e.name not in base_names]
     else:
-        candidates = [split_form(n)[0] for n, _ in resolve(exp, list(candidates))]
+        candidates = [split_form(n)[0] for n, _ in resolve(exp, _names(candidates))]
         dup = set(candidates) & base_names
         if dup:
             raise ModelError(f"candidate effect(s) {', '.join(sorted(dup))} are already in the model")
+    excluded = {split_form(n)[0] for n, _ in resolve(exp, _names(exclude))}
+    candidates = [c for c in candidates if c not in excluded]
     t0 = time.perf_counter()
     with progress.task(f"diagnose: fitting the baseline {exp.name}" + "".join(" + " + e for e in base_effects)):
         baseline = fit(exp, data, base_effects)
@@ -206,7 +215,7 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
         "start": start,
         "noise": sigma,
         "sensitivity": getattr(baseline, "sensitivity", None),
-    }  # seeds the refits' Jacobians (issue 21)
+    }  # seeds the refits' Jacobians
     # stage 1: the forms of the added effects (shape mismatch) and the default form of each candidate;
     # stage 2: the generalised forms of the candidates whose default form has an information-criterion
     # gain (under the null nothing does, and the generalised forms cannot gain where it did not),
@@ -214,7 +223,7 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
     jobs = []
     for b in base_effects:
         name, form = split_form(b)
-        for alt in forms_of(name, key):
+        for alt in forms_of(name, exp):
             if alt != b and alt != name + "/" + (form or ""):
                 effs = [alt if e == b else e for e in base_effects]
                 jobs.append(("form_check", name, alt, effs, start))
@@ -242,7 +251,7 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
             continue
         fitted = {k.split(".", 1)[1]: v for k, v in zip(res.names, res.x) if k.startswith(c + ".")}
         base_fit = {k: v for k, v in zip(res.names, res.x) if "." not in k}
-        for alt in forms_of(c, key)[1:]:
+        for alt in forms_of(c, exp)[1:]:
             _, impl = resolve(exp, [alt])[0]
             st = {**base_fit, **{f"{alt}.{p.name}": fitted[p.name] for p in impl.parameters if p.name in fitted}}
             jobs2.append(("candidate", c, alt, base_effects + [alt], st))
@@ -270,7 +279,7 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
         if getattr(res, "failed", False):
             return {
                 "effect": effect,
-                "form": _form(spec, effect, key),
+                "form": _form(spec, effect, exp),
                 "rms": float(baseline.rms),
                 "ratio": r0,
                 "delta_bic": 0.0,
@@ -293,7 +302,7 @@ def _diagnose(exp, data, candidates, *, base_effects, workers, scheduler, out, p
         table = params_table(res)
         return {
             "effect": effect,
-            "form": _form(spec, effect, key),
+            "form": _form(spec, effect, exp),
             "spec": spec,
             "rms": float(res.rms),
             "ratio": sc["ratio"],
@@ -506,12 +515,12 @@ def _import_pyplot():
     pyplot()
 
 
-def _form(spec: str, effect: str, key: str) -> str:
+def _form(spec: str, effect: str, exp) -> str:
     """Form name of an effect spec ("" for a one-form effect; the default form's name otherwise)."""
     f = split_form(spec)[1]
     if f:
         return f
-    impl = get_effect(effect).implementations.get(key)
+    impl = get_effect(effect).implementation(exp)
     return impl.form if impl else ""
 
 

@@ -31,7 +31,7 @@ from scipy.optimize import OptimizeResult, least_squares
 from .. import progress
 from ..effects.base import resolve
 from ..errors import ModelError
-from .core import EffectStack, Experiment, Measured
+from .core import EffectStack, Experiment, Measured, effect_context
 from .fe_jacobian import LOG_RANGE, POLISH_MIN_DECREASE, _Coords, _FEJacobian, _forward_differences, _polish  # noqa: F401
 from .residuals import noise_floor
 
@@ -84,7 +84,7 @@ def predict(exp: Experiment, data: Measured, params=None, effects=None) -> dict:
     if unknown:
         raise ModelError(f"{exp.name} has no parameter(s) {', '.join(sorted(unknown))}; its parameters: {', '.join(p)}")
     p.update(params or {})
-    out = exp.model(p, data, EffectStack(items), exp.options)
+    out = exp.model(p, data, EffectStack(items, effect_context(exp, data)), exp.options)
     missing = [c for c in exp.channels if c not in out]
     if missing:
         raise ModelError(f"the model of {exp.name} did not return channel(s) {', '.join(missing)}")
@@ -304,7 +304,7 @@ def fit(
     scale = np.array([p.typical for _, p, _ in specs])
     fo = dict(exp.fit_options)
     # a hint for diagnose, not a least_squares option; with finite differences it also turns on the
-    # run-saving Jacobians (secant updates, seeded starts, log scaling, issue 21): every model
+    # run-saving Jacobians (secant updates, seeded starts, log scaling): every model
     # evaluation is an FE run
     secant = bool(fo.pop("expensive", None)) and bool(fo.get("diff_step"))
     co = _Coords(scale, np.array([secant and p.lower > 0 and p.upper >= LOG_RANGE * p.lower for _, p, _ in specs]))

@@ -29,7 +29,7 @@ changes little from one row to the next, the noise does; see
   negative ``A`` put the noise of the rows near zero load at a tenth of its true value and a
   3-sigma row at 20 "sigma"), and no row's variance below ``VAR_FLOOR`` = 0.04 of the mean (sigma
   at least 0.2 of its RMS: a few second differences near the end of the covariate's range cannot
-  establish a noise 5x below the typical; seed 001 Eq. 15's range on the seed's latch is 0.45).  The model is kept when
+  establish a noise 5x below the typical; Stohlman & Pellegrino, Eq. 15's range on the paper's latch is 0.45).  The model is kept when
   its likelihood-ratio statistic against one level exceeds ``HETERO_LR`` = 18.5, the 99th
   percentile of that statistic on white noise (Monte Carlo, 2000 draws of 100-1500 rows along
   signed and unsigned covariates: 16.0-19.8; the second differences are correlated, so it exceeds
@@ -215,7 +215,7 @@ def _lr(d2sq, X):
 def heteroscedastic_fit(r, g, phi: float = 0.0) -> dict:
     """Fit ``Var(noise_i) = A + B g_i + D g_i^2`` to a residual r (n,) with covariate g (n,) (signed or
     not; module docstring).  For the latch-pull covariate (the signed slope s of the law) this is
-    seed 001 Eq. 15's ``sigma_T^2 (1 + s C)^2 + s^2 sigma_d^2``.  Returns ``{coef (A, B, D) in the
+    Stohlman & Pellegrino, Eq. 15's ``sigma_T^2 (1 + s C)^2 + s^2 sigma_d^2``.  Returns ``{coef (A, B, D) in the
     units of r^2 and g, lr, threshold, sigma (n,), range}``; ``range`` is max/min sigma."""
     r, g = np.asarray(r, float), np.asarray(g, float)
     gs = float(np.max(np.abs(g))) or 1.0

@@ -64,7 +64,7 @@ def _safe_fit(exp, data, effects, start, noise, sensitivity=None) -> OptimizeRes
             given_start_clip=True,
             nfev_per_param=REFIT_NFEV,
             start_sensitivity=sensitivity,
-        )  # the baseline's derivatives seed the refit's (issue 21)
+        )  # the baseline's derivatives seed the refit's
     except (ValueError, FemastError, FloatingPointError, ZeroDivisionError) as e:
         return OptimizeResult(failed=True, success=False, message=f"{type(e).__name__}: {e}", effects=tuple(effects))
 
@@ -154,7 +154,7 @@ def _run_tasks(payloads, workers, scheduler, while_waiting=None):
 def frozen_heap():
     """The garbage collector's view of this process's heap frozen while forked children run: a child's
     collections then skip the inherited objects instead of visiting them all, which copies every page
-    they touch (copy-on-write) -- 8-17 % of the CPU of diagnose's refit processes on the bay (issue 21).
+    they touch (copy-on-write) -- 8-17 % of the CPU of diagnose's refit processes on the bay.
     Objects made meanwhile are collected as usual; the frozen ones return to the collector after."""
     import gc
 
@@ -203,6 +203,6 @@ def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base, whi
     if workers is None and scheduler is None and exp.fit_options.get("expensive"):
         # a process per refit (up to OVERSUBSCRIBE x the CPUs): the refits of the FE experiments take
         # 6-15 FE runs each, and a pool of one process per CPU ends with one CPU idle while the
-        # longest refits finish; more processes than CPUs share them to the end (issue 21)
+        # longest refits finish; more processes than CPUs share them to the end
         workers = max(1, min(len(payloads), OVERSUBSCRIBE * (os.cpu_count() or 1)))
     return _run_tasks(payloads, workers, scheduler, while_waiting)

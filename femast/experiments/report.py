@@ -1,4 +1,4 @@
-"""Self-contained HTML reports of ``compare`` and ``diagnose`` (issue 17): one file a team can
+"""Self-contained HTML reports of ``compare`` and ``diagnose``: one file a team can
 share and open offline -- the verdict, the tables, the figures inlined as base64 PNG, and the
 history of the model versions.  No script, no external link, no web font.
 """

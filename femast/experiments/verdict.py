@@ -1,4 +1,4 @@
-"""Scoring of model variants and the verdict of ``diagnose`` (issue 14).
+"""Scoring of model variants and the verdict of ``diagnose``.
 
 Every fit of a diagnosis is scored with the same noise model (:mod:`femast.experiments.noise`):
 ``ratio`` is the RMS of the residuals whitened by the per-row noise, ``ic`` the information
@@ -18,7 +18,7 @@ A candidate is *significant* when both
 * ``explained_fraction >= MIN_SHARE`` (10 %).  With hundreds of residuals a change of shape that
   removes 2 % of a large excess error passes any information criterion, yet it is not the missing
   mechanism: such gains come from a flexible effect bending into a structure it does not model
-  (issue 14: "beam flexibility" with no beam).  10 % of the excess is the smallest share whose
+  ("beam flexibility" with no beam).  10 % of the excess is the smallest share whose
   removal is visible in the residual plot (the RMS of the excess falls by 5 %), and the
   smallest share a second mechanism of a pair contributes in the generalisation benchmark.
 

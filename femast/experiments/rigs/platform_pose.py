@@ -1,5 +1,5 @@
 """Built-in experiment ``platform-pose``: commanded pose, tensions and measured pose of the Rocaspect
-platform on its compliant masts (seed 000 Fig. 7; issue 19 item 4).
+platform on its compliant masts (the Rocaspect paper, Fig. 7).
 
 Data format
 -----------
@@ -35,7 +35,7 @@ Mast effects
 ------------
 The effects of ``mast-top`` apply (``effects_from="mast-top"``) with the 3R baseline: after a pass
 with the linear masts, each mast's wrench history (from calibration) runs through the ``mast-top``
-model with the effects (hooks ``joint_moment``, ``joint_rotation``, ``top_displacement``); the
+model with the effects (its quantities ``load``, ``displacement`` and hook ``top_displacement``); the
 difference of its top translations from the linear 3R ones is fed back into the equilibrium, and
 the pass repeated until the tops move by less than 1 um (as the FE masts are).
 """
@@ -151,7 +151,7 @@ def load_measure(data: Measured, options: dict) -> np.ndarray:
 
 EXPERIMENT = Experiment(
     name="platform-pose",
-    title="CDPR platform pose on compliant masts (seed 000 Fig. 7)",
+    title="CDPR platform pose on compliant masts (the Rocaspect paper, Fig. 7)",
     columns=(
         Column("x_cmd_m", "m", "commanded platform position, base frame, x"),
         Column("y_cmd_m", "m", "commanded platform position, y"),
@@ -181,7 +181,8 @@ EXPERIMENT = Experiment(
     ),
     model=model,
     options={"mast_model": "3R", "pretension_N": 1200.0, "EA_N": 1.0e6, "pulley_radius_m": 0.03, "mass_kg": 50.0},
-    hooks=dict(mast_top.EXPERIMENT.hooks),
+    hooks={"top_displacement": mast_top.EXPERIMENT.hooks["top_displacement"]},
+    quantities=dict(mast_top.EXPERIMENT.quantities),
     doc=__doc__,
     load_measure=load_measure,
     load_label="distance from the calibration pose (m)",

@@ -1,5 +1,5 @@
 """Built-in experiment ``vibration``: measured natural frequencies against the prestressed modal
-analysis (issue 18; seed 001 Sec. IV).
+analysis (Stohlman & Pellegrino, Sec. IV).
 
 Data format
 -----------
@@ -19,7 +19,7 @@ Rows with the same (pretension, load) share one static state and one modal analy
 
 Baseline model
 --------------
-By default the mock bay side of seed 001 Fig. 11 (:func:`femast.adam.vibration.mock_bay_side`:
+By default the mock bay side of Stohlman & Pellegrino, Fig. 11 (:func:`femast.adam.vibration.mock_bay_side`:
 the cable/pulley/latch assembly of an ADAM bay side, four ends anchored, the unit's point mass,
 the cables' lumped mass), brought to equilibrium under the row's load, then its modes
 (:func:`femast.modal.modal_analysis`); mode 1 is the latch's out-of-plane mode of Sec. IV.
@@ -35,7 +35,7 @@ Parameters (which ones are fitted: option ``fit``)
 * ``unit_mass`` (kg): the point mass at the drive node (the latch unit).
 
 The out-of-plane mode alone depends on T / m only: ``fit="pretension"`` (default: the deployed
-mast, mass known, option ``unit_mass_kg``) or ``fit="mass"`` (the seed's calibration: tensions
+mast, mass known, option ``unit_mass_kg``) or ``fit="mass"`` (the paper's calibration: tensions
 known from the settings, option ``pretension_N`` for rows without a setting); ``fit="both"``
 needs data that separates them (modes whose stiffness is not the tension's).
 
@@ -235,7 +235,7 @@ class VibrationExperiment(Experiment):
 
 EXPERIMENT = VibrationExperiment(
     name="vibration",
-    title="natural frequencies against the prestressed modal analysis (seed 001 Sec. IV)",
+    title="natural frequencies against the prestressed modal analysis (Stohlman & Pellegrino, Sec. IV)",
     columns=(
         Column("mode", "-", "mode number, 1 = lowest of the model"),
         Column("f_Hz", "Hz", "measured natural frequency"),
