@@ -126,8 +126,8 @@ def test_piecewise_linear_clearance_is_found_with_its_closing_scale():
     assert d.verdict["kind"] == "missing_effect" and d.verdict["missing_effect"] == "joint_clearance"
     top = d.ranking[0]
     assert top["form"] == "smooth" and top["ratio"] <= d.at_noise
-    # tanh(m / m_c) against clip(m / 20): the fitted closing scale is of the order of 20 N m
-    assert 5.0 < top["params"]["m_c"]["value"] < 40.0
+    # tanh(m / M_c) against clip(m / 20): the fitted closing scale is of the order of 20 N m
+    assert 5.0 < top["params"]["M_c"]["value"] < 40.0
 
 
 @pytest.mark.slow
