@@ -311,8 +311,8 @@ def _needs(effect: Effect) -> str:
         kinds = " and ".join(dict.fromkeys((m.hook, *m.needs)))
         parts.append(f"it needs an experiment declaring the quantities {kinds}")
     if effect.implementations:
-        parts.append(f"it is implemented for {', '.join(effect.implementations)}")
-    return "; ".join(parts) or "it is implemented for nothing yet"
+        parts.append(f"it applies to {', '.join(effect.implementations)}")
+    return "; ".join(parts) or "it applies to nothing yet"
 
 
 def impl_form(effect: Effect, experiment) -> str:
