@@ -3,9 +3,10 @@ registered by :mod:`femast.cli`.
 
 ::
 
-    femast compare EXPERIMENT DATA.csv [--effects a,b] [--fit] [--out DIR] [--json]
+    femast compare EXPERIMENT DATA.csv [--effects a,b] [--fit] [--params-from RUN] [--sigma CH=V,...]
+                   [--out DIR] [--json]
     femast diagnose EXPERIMENT DATA.csv [--out DIR] [--json] [--workers N] [--scheduler ADDRESS]
-                    [--effects a,b] [--candidates a,b] [--exclude a,b]
+                    [--effects a,b] [--candidates a,b] [--exclude a,b] [--sigma CH=V,...]
     femast experiments [--json]            femast effects [EXPERIMENT] [--json]
     femast examples [--copy DIR]
 
@@ -41,6 +42,24 @@ def _effect_names(arg):
         else:
             names.append(item)
     return names
+
+
+def _sigmas(arg) -> dict:
+    """``--sigma dx_m=2e-5,dy_m=2e-5`` -> ``{"dx_m": 2e-5, "dy_m": 2e-5}`` (checked by the noise model)."""
+    from .errors import ModelError
+
+    out = {}
+    for item in (arg or "").split(","):
+        if not item.strip():
+            continue
+        name, eq, value = item.partition("=")
+        if not eq:
+            raise ModelError(f"--sigma {item!r}: give CHANNEL=VALUE in the channel's unit, e.g. --sigma dx_m=2e-5")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise ModelError(f"--sigma {item!r}: {value.strip()!r} is not a number") from None
+    return out
 
 
 def _first_sentence(text: str) -> str:
@@ -169,18 +188,46 @@ def _setup(args):
     exp = get_experiment(args.experiment)
     effects = _effect_names(getattr(args, "effects", None))
     exp.require_model(f"femast {args.command}")
-    path, shown = resolve_data(exp, args.data)
-    data = replace(read_data(exp, path), path=shown)
-    stem = Path(shown.split()[-1]).stem
+    items = args.data if isinstance(args.data, list) else [args.data]
+    found = [resolve_data(exp, d) for d in items]
+    paths, shown = [f[0] for f in found], [f[1] for f in found]
+    data = read_data(exp, paths, time_continuous=args.continuous_time, offsets=args.group_offsets)
+    if len(paths) == 1:
+        data = replace(data, path=shown[0])
+    stem = Path(shown[0].split()[-1]).stem + (f"_and_{len(paths) - 1}_more" if len(paths) > 1 else "")
     out = Path(args.out) if args.out else Path(args.command) / f"{exp.name}_{stem}"
     return exp, data, effects, out
+
+
+def params_from(run) -> tuple:
+    """(parameters ``{name: value}``, effects) of an earlier compare: its output folder or compare.json."""
+    from .errors import ModelError
+
+    path = Path(run)
+    if path.is_dir():
+        path = path / "compare.json"
+    if not path.is_file():
+        raise ModelError(
+            f"--params-from {run}: no compare.json there; give a compare output folder or its compare.json"
+        )
+    try:
+        rep = json.loads(path.read_text())
+        params = {k: float(v["value"]) for k, v in rep["params"].items()}
+        effects = list(rep.get("effects", []))
+    except (ValueError, KeyError, TypeError) as e:
+        raise ModelError(f"--params-from {path}: not a compare report ({type(e).__name__}: {e})") from None
+    return params, effects
 
 
 def _compare(args):
     from .experiments import compare, format_compare
 
     exp, data, effects, out = _setup(args)
-    res = compare(exp, data, effects, fit=args.fit, out=out)
+    params = None
+    if args.params_from:
+        params, run_effects = params_from(args.params_from)
+        effects = effects or run_effects
+    res = compare(exp, data, effects, fit=args.fit, params=params, out=out, sigma=_sigmas(args.sigma))
     print(json.dumps(res.report, indent=2) if args.json else format_compare(exp, res))
     _freeze_heap_for_exit()
 
@@ -195,6 +242,7 @@ def _diagnose(args):
         _effect_names(args.candidates) if args.candidates else None,
         exclude=_effect_names(args.exclude),
         base_effects=effects,
+        sigma=_sigmas(args.sigma),
         workers=args.workers,
         scheduler=args.scheduler,
         out=out,
@@ -228,9 +276,21 @@ def register(subparsers, fmt=None) -> None:
     )
     data_help = (
         "measured data, a CSV file with a header row (formats: `femast experiments`, docs/experiments.md), "
-        "or 'example' for the example shipped with femast"
+        "or 'example' for the example shipped with femast; several files are one data set, each file a "
+        "group (a station, specimen or run)"
+    )
+    continuous_help = (
+        "the files (or groups) are one test whose time goes on from one to the next (default: separate "
+        "tests, time restarts in each)"
+    )
+    offsets_help = (
+        "fit a zero of its own for every group and channel, e.g. sensors zeroed at each station (default: no)"
     )
     out_help = "output folder (default: ./%(prog_cmd)s/EXPERIMENT_DATASTEM in the working directory)"
+    sigma_help = (
+        "sensor uncertainty of channels, CHANNEL=VALUE[,...] in the channel's unit, e.g. dx_m=2e-5 (default: "
+        "sigma_ columns, else the repeatability of repeated rows, else estimated from the residual)"
+    )
     p = subparsers.add_parser(
         "compare",
         help="run a model along measured data and show where it fails",
@@ -241,7 +301,9 @@ def register(subparsers, fmt=None) -> None:
         "output folder.  Example: femast compare mast-top example --fit",
     )
     p.add_argument("experiment", help=exp_help)
-    p.add_argument("data", help=data_help)
+    p.add_argument("data", nargs="+", help=data_help)
+    p.add_argument("--continuous-time", action="store_true", help=continuous_help)
+    p.add_argument("--group-offsets", action="store_true", help=offsets_help)
     p.add_argument(
         "--effects",
         default=None,
@@ -255,6 +317,14 @@ def register(subparsers, fmt=None) -> None:
         help="fit the model and effect parameters (default: run with the default parameters)",
     )
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "compare"})
+    p.add_argument("--sigma", default=None, help=sigma_help)
+    p.add_argument(
+        "--params-from",
+        metavar="RUN",
+        default=None,
+        help="take the parameters (and effects) of an earlier compare, its output folder or compare.json: fit on "
+        "one data set, score another (with --fit: start the fit there) (default: the model's defaults)",
+    )
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.set_defaults(func=_compare)
     p = subparsers.add_parser(
@@ -267,8 +337,11 @@ def register(subparsers, fmt=None) -> None:
         "Example: femast diagnose mast-top example",
     )
     p.add_argument("experiment", help=exp_help)
-    p.add_argument("data", help=data_help)
+    p.add_argument("data", nargs="+", help=data_help)
+    p.add_argument("--continuous-time", action="store_true", help=continuous_help)
+    p.add_argument("--group-offsets", action="store_true", help=offsets_help)
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "diagnose"})
+    p.add_argument("--sigma", default=None, help=sigma_help)
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.add_argument(
         "--workers",

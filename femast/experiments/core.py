@@ -31,6 +31,7 @@ import numpy as np
 from ..effects.parameters import Parameter  # noqa: F401  (re-exported: experiments declare Parameters)
 from ..effects.quantities import HOOKS, check_quantities
 from ..errors import ModelError
+from .measured import Measured
 
 
 @dataclass(frozen=True)
@@ -52,57 +53,10 @@ class Column:
 
 #: Optional time column accepted by every experiment (s); without it time is the row index.
 TIME_COLUMN = Column("t_s", "s", "time of the sample (optional; rows must be in time order)", required=False)
-
-
-@dataclass
-class Measured:
-    """Measured data of one experiment: ``columns[name]`` (n,) float arrays, rows in time order.
-
-    path : the file it came from (or ``"<arrays>"``).  lines : file line number of each row
-    (1-based), used to point at rows in reports and errors.  ``cache`` holds quantities an
-    experiment prepares once per data set (see :attr:`Experiment.prepare`).
-    """
-
-    experiment: str
-    columns: dict
-    path: str = "<arrays>"
-    lines: np.ndarray | None = None
-    cache: dict = field(default_factory=dict, repr=False, compare=False)
-
-    def __post_init__(self):
-        self.columns = {k: np.asarray(v, dtype=float) for k, v in self.columns.items()}
-        if self.lines is None:
-            self.lines = np.arange(2, self.n + 2)  # header on line 1
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        return self.columns[name]
-
-    def __contains__(self, name: str) -> bool:
-        return name in self.columns
-
-    @property
-    def n(self) -> int:
-        """Number of rows (samples)."""
-        return len(next(iter(self.columns.values()))) if self.columns else 0
-
-    @property
-    def tau(self) -> np.ndarray:
-        """Normalised time in [0, 1] (from ``t_s`` if present, else the row index), dimensionless."""
-        t = self.columns.get("t_s")
-        if t is None:
-            t = np.arange(self.n, dtype=float)
-        span = t[-1] - t[0]
-        return (t - t[0]) / span if span > 0 else np.zeros(self.n)
-
-    def subset(self, rows) -> Measured:
-        """A copy restricted to ``rows`` (index array or mask), with an empty cache."""
-        rows = np.asarray(rows)
-        return Measured(self.experiment, {k: v[rows] for k, v in self.columns.items()}, self.path, self.lines[rows])
-
-    def __getstate__(self):  # the cache is rebuilt where it is needed (worker processes)
-        d = dict(self.__dict__)
-        d["cache"] = {}
-        return d
+#: Optional group column accepted by every experiment: the station, specimen or run of each row (any label).
+GROUP_COLUMN = Column(
+    "group", "-", "group of the row: a station, specimen or test run (optional; any label)", required=False
+)
 
 
 @dataclass(frozen=True)
@@ -122,7 +76,8 @@ class Experiment:
     prepare : optional ``prepare(data, options) -> dict`` of per-data-set quantities, cached in
         ``data.cache`` (e.g. joint moments, directions of motion).
     initial_guess : optional ``initial_guess(data, options) -> {param: value}`` start of a fit.
-    load_measure : optional ``load_measure(data, options) -> (n,) signed load`` that drives the
+    load_measure : optional ``load_measure(data, options) -> (n,) signed load`` (or (n, k) on several
+        axes: taken along its principal direction) that drives the
         segmentation (loading, unloading, reversals, near-zero load, peaks); default: the first
         required non-channel column.
     load_label : name and unit of the load measure, for reports.
@@ -232,12 +187,14 @@ class Experiment:
 
     @property
     def all_columns(self) -> tuple:
-        """Declared columns, the optional time column ``t_s`` and an optional ``sigma_<channel>``
-        (per-row standard uncertainty, the channel's unit) for every channel."""
+        """Declared columns, the optional time column ``t_s``, the optional ``group`` column and an
+        optional ``sigma_<channel>`` (per-row standard uncertainty, the channel's unit) for every channel."""
         cols = tuple(self.columns)
         names = {c.name for c in cols}
         if TIME_COLUMN.name not in names:
             cols += (TIME_COLUMN,)
+        if GROUP_COLUMN.name not in names:
+            cols += (GROUP_COLUMN,)
         for ch in self.channels:
             if f"sigma_{ch}" not in names:
                 unit = next((c.unit for c in self.columns if c.name == ch), "")

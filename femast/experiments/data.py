@@ -156,12 +156,29 @@ def check_header(exp: Experiment, header, path: str = "<arrays>", line: int = 1)
     return names
 
 
-def read_data(exp: Experiment, path) -> Measured:
-    """Read and check a measured-data file of experiment ``exp`` (see the module docstring).
+def read_data(exp: Experiment, path, *, time_continuous: bool = False, offsets: bool = False) -> Measured:
+    """Read and check a measured-data file of experiment ``exp`` (see the module docstring), or
+    several: ``path`` a list of files, each a group of the data (its rows' ``group`` labels prefixed
+    by the file name where it has a ``group`` column).
 
-    Returns a :class:`~femast.experiments.core.Measured` whose ``lines`` give the file line of
+    time_continuous : the files (or groups) are one test whose time goes on from one to the next,
+        rather than separate tests whose time restarts (:class:`~femast.experiments.measured.Measured`).
+    offsets : fit a zero of its own for every group and channel.
+
+    Returns a :class:`~femast.experiments.measured.Measured` whose ``lines`` give the file line of
     every row.  Raises :class:`~femast.errors.DataFileError` on any malformed content.
     """
+    if isinstance(path, (list, tuple)):
+        if len(path) == 1:
+            path = path[0]
+        else:
+            return combine([read_data(exp, p) for p in path], time_continuous=time_continuous, offsets=offsets)
+    data = _read_one(exp, path)
+    data.time_continuous, data.offsets = bool(time_continuous), bool(offsets)
+    return data
+
+
+def _read_one(exp: Experiment, path) -> Measured:
     path = Path(path)
     if not path.is_file():
         raise DataFileError(f"{path}: no such data file")
@@ -192,6 +209,7 @@ def read_data(exp: Experiment, path) -> Measured:
         )
     ncol = len(header)
     values = np.empty((len(rows), ncol))
+    labels = []
     for r, (cells, line) in enumerate(zip(rows, lines)):
         if len(cells) != ncol:
             raise DataFileError(
@@ -199,6 +217,14 @@ def read_data(exp: Experiment, path) -> Measured:
                 f"{ncol} columns ({', '.join(header)})"
             )
         for c, text in enumerate(cells):
+            if header[c] == "group":
+                if not text.strip():
+                    raise DataFileError(
+                        f"{path} line {line}, column 'group': an empty cell; every row needs its group's label"
+                    )
+                labels.append(text.strip())
+                values[r, c] = 0.0
+                continue
             col = exp.column(header[c])
             s = text.strip()
             codes = dict((t.lower(), v) for t, v in col.codes)
@@ -222,7 +248,7 @@ def read_data(exp: Experiment, path) -> Measured:
         raise DataFileError(
             f"{path}: {len(rows)} data row(s); {exp.name} needs at least {exp.min_rows} (one per sample, in time order)"
         )
-    cols = {h: values[:, i] for i, h in enumerate(header)}
+    cols = {h: values[:, i] for i, h in enumerate(header) if h != "group"}
     check_values(exp, cols, str(path), lines)
     if "t_s" in cols and np.any(np.diff(cols["t_s"]) < 0):
         bad = int(np.flatnonzero(np.diff(cols["t_s"]) < 0)[0]) + 1
@@ -230,12 +256,65 @@ def read_data(exp: Experiment, path) -> Measured:
             f"{path} line {lines[bad]}, column 't_s': time goes backwards "
             f"({cols['t_s'][bad - 1]:g} s then {cols['t_s'][bad]:g} s); rows must be in time order"
         )
-    return Measured(exp.name, cols, str(path), np.asarray(lines))
+    groups, names = group_codes(labels) if labels else (None, ())
+    return Measured(exp.name, cols, str(path), np.asarray(lines), groups=groups, group_names=names)
+
+
+def group_codes(labels) -> tuple:
+    """``(codes (n,) int, names)`` of group labels, numbered in order of first appearance."""
+    names = list(dict.fromkeys(str(x) for x in labels))
+    index = {n: i for i, n in enumerate(names)}
+    return np.array([index[str(x)] for x in labels], dtype=int), tuple(names)
+
+
+def combine(parts, *, time_continuous: bool = False, offsets: bool = False) -> Measured:
+    """One data set of several (files, runs), each a group (its own groups kept, labelled
+    ``part/label``).  With ``time_continuous`` the time of each part is shifted to start one of its
+    steps after the end of the part before (one test recorded in parts); otherwise each part's time
+    restarts (separate tests)."""
+    parts = list(parts)
+    if not parts:
+        raise DataFileError("no data to combine")
+    cols = set(parts[0].columns)
+    for d in parts[1:]:
+        if set(d.columns) != cols:
+            raise DataFileError(
+                f"{d.path}: its columns ({', '.join(sorted(d.columns))}) differ from those of {parts[0].path} "
+                f"({', '.join(sorted(cols))}); give every file the same columns"
+            )
+    labels, end = [], None
+    columns = {k: [] for k in parts[0].columns}
+    for d in parts:
+        stem = Path(d.path).stem
+        if d.groups is None:
+            labels += [stem] * d.n
+        else:
+            labels += [f"{stem}/{d.group_names[g]}" for g in d.groups]
+        for k, v in d.columns.items():
+            if k == "t_s" and time_continuous and end is not None:
+                step = float(np.median(np.diff(v))) if v.size > 1 else 1.0
+                v = v - v[0] + end + max(step, 0.0)
+            columns[k].append(v)
+        if "t_s" in columns:
+            end = float(columns["t_s"][-1][-1])
+    groups, names = group_codes(labels)
+    return Measured(
+        parts[0].experiment,
+        {k: np.concatenate(v) for k, v in columns.items()},
+        ", ".join(str(d.path) for d in parts),
+        np.concatenate([d.lines for d in parts]),
+        groups=groups,
+        group_names=names,
+        time_continuous=time_continuous,
+        offsets=offsets,
+    )
 
 
 def from_arrays(exp: Experiment, **columns) -> Measured:
-    """Build :class:`Measured` data from arrays (same checks as :func:`read_data`)."""
+    """Build :class:`Measured` data from arrays (same checks as :func:`read_data`); a ``group``
+    column holds any labels (text or numbers)."""
     check_header(exp, list(columns), "<arrays>", 0)
+    labels = columns.pop("group", None)
     arrs = {k: np.asarray(v, dtype=float).ravel() for k, v in columns.items()}
     sizes = {k: a.size for k, a in arrs.items()}
     if len(set(sizes.values())) != 1:
@@ -248,7 +327,13 @@ def from_arrays(exp: Experiment, **columns) -> Measured:
     if n < exp.min_rows:
         raise DataFileError(f"<arrays>: {n} rows; {exp.name} needs at least {exp.min_rows}")
     check_values(exp, arrs, "<arrays>", np.arange(n), measured=False)
-    return Measured(exp.name, arrs)
+    if labels is None:
+        return Measured(exp.name, arrs)
+    labels = list(np.asarray(labels).ravel())
+    if len(labels) != n:
+        raise DataFileError(f"<arrays>: the group column has {len(labels)} rows, the others {n}")
+    groups, names = group_codes(labels)
+    return Measured(exp.name, arrs, groups=groups, group_names=names)
 
 
 def write_data(path, data: Measured, exp: Experiment | None = None, comments=(), fmt: str = "%.9g") -> Path:
@@ -258,11 +343,12 @@ def write_data(path, data: Measured, exp: Experiment | None = None, comments=(),
     names = list(data.columns)
     if exp is not None:  # the experiment's column order
         names = [c.name for c in exp.all_columns if c.name in data.columns]
+    group = [data.group_names[g] for g in data.groups] if data.groups is not None else None
     with open(path, "w", newline="") as fh:
         for c in comments:
             fh.write(f"# {c}\n")
         w = csv.writer(fh, lineterminator="\n")
-        w.writerow(names)
-        for row in np.column_stack([data.columns[k] for k in names]):
-            w.writerow([fmt % v for v in row])
+        w.writerow(names + (["group"] if group else []))
+        for i, row in enumerate(np.column_stack([data.columns[k] for k in names])):
+            w.writerow([fmt % v for v in row] + ([group[i]] if group else []))
     return path

@@ -45,11 +45,13 @@ from scipy.optimize import OptimizeResult
 from .. import progress
 from ..effects.base import applicable_effects, forms_of, get_effect, loaded_scripts, resolve, split_form
 from ..errors import ModelError
+from .baseline import fit_with_noise
 from .compare import analyse
 from .core import Experiment, Measured
 from .figure_process import FigureProcess
 from .figures import diagnose_figure, display_scale
-from .fitting import fit, params_table, predict
+from .fitting import params_table, predict
+from .heldout import heldout_check
 from .noise import noise_model, pinned_rows
 
 # the refits' executor (re-exported: diagnose.REFIT_NFEV, diagnose._mp_context, ... keep working)
@@ -118,17 +120,21 @@ def diagnose(
     *,
     exclude=(),
     base_effects=(),
+    sigma=None,
     workers=None,
     scheduler=None,
     out=None,
     pairs: bool = True,
+    heldout: bool = True,
 ) -> OptimizeResult:
     """Refit the model with each candidate effect (every form), pairs of the best, and conclude.
 
     candidates : effect names to try (default: every effect applicable to the experiment and not in
         ``base_effects``); each is fitted in each of its forms (``effect/form``), the information
         criterion picks the form.  exclude : effect names not to try (e.g. one whose refit is known
-        to fail, or a mechanism the rig cannot have).  base_effects : effects already in the model being diagnosed
+        to fail, or a mechanism the rig cannot have).
+    sigma : ``{channel: level}`` the sensor uncertainty of channels (their units; ``sigma_`` columns
+        give it per row): the noise model's first source (:mod:`femast.experiments.noise`).  base_effects : effects already in the model being diagnosed
         (names or ``effect/form``); their other forms are refitted first (a shape mismatch).
     workers : local worker processes (default: the number of CPUs, unless the refits are estimated
         -- six times the baseline fit time each -- to take less than ``SERIAL_BELOW_S`` = 1 s in all,
@@ -137,6 +143,10 @@ def diagnose(
     out : folder for ``diagnose.json``, ``diagnose.png`` and ``diagnose_report.html`` (self-contained,
         figures inlined; nothing written if None).
     pairs : refit pairs of the top candidates jointly (their verdict: femast.experiments.verdict).
+    heldout : check the baseline, every significant candidate and the best pairs on held-out data
+        (:mod:`femast.experiments.heldout`: leave-one-group-out, else leave-one-block-of-cycles-out):
+        a candidate is kept only if it lowers the held-out error, a pair only if it beats its best
+        member held out too.
 
     Returns an ``OptimizeResult`` with ``experiment``, ``n_samples``, ``noise`` (per channel: the
     per-row noise, (n,) arrays), ``noise_model`` (``{channel: ChannelNoise}``), ``noise_rms``,
@@ -158,10 +168,12 @@ def diagnose(
             candidates,
             exclude=exclude,
             base_effects=base_effects,
+            sigma=sigma,
             workers=workers,
             scheduler=scheduler,
             out=out,
             pairs=pairs,
+            heldout=heldout,
             figs=figs,
         )
     finally:
@@ -176,7 +188,9 @@ def _names(names) -> list:
     return list(names or ())
 
 
-def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, scheduler, out, pairs, figs) -> OptimizeResult:
+def _diagnose(
+    exp, data, candidates, *, exclude, base_effects, sigma, workers, scheduler, out, pairs, heldout, figs
+) -> OptimizeResult:
     base_effects = [n for n, _ in resolve(exp, _names(base_effects))]
     base_names = {split_form(n)[0] for n in base_effects}
     if candidates is None:
@@ -190,15 +204,10 @@ def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, schedule
     candidates = [c for c in candidates if c not in excluded]
     t0 = time.perf_counter()
     with progress.task(f"diagnose: fitting the baseline {exp.name}" + "".join(" + " + e for e in base_effects)):
-        baseline = fit(exp, data, base_effects)
+        baseline, models = fit_with_noise(exp, data, base_effects, sigma=sigma)  # the weights of the refits
     t_base = time.perf_counter() - t0
     nch, chans = len(exp.channels), exp.channels
-    models = noise_model(exp, data, baseline, correlate=False, generic=False)  # weights of the refits
-    sigma = {c: models[c].sigma for c in chans}
-    if any(m.kind.startswith(("heteroscedastic", "given")) for m in models.values()):
-        baseline = fit(
-            exp, data, base_effects, start=dict(zip(baseline.names, baseline.x)), noise=sigma, given_start_clip=True
-        )
+    sigma_w = {c: models[c].sigma for c in chans}
     start = dict(zip(baseline.names, baseline.x))
     if exp.fit_options.get("expensive") and exp.options.get("fe_reference", False) is None:
         # the refits' reference run (the baseline model at its solution, femast.experiments.fe_reference),
@@ -208,12 +217,9 @@ def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, schedule
         "source": exp.source,
         "options": exp.options,
         "scripts": list(loaded_scripts()),
-        "data_experiment": data.experiment,
-        "columns": data.columns,
-        "path": data.path,
-        "lines": data.lines,
+        "data": data,
         "start": start,
-        "noise": sigma,
+        "noise": sigma_w,
         "sensitivity": getattr(baseline, "sensitivity", None),
     }  # seeds the refits' Jacobians
     # stage 1: the forms of the added effects (shape mismatch) and the default form of each candidate;
@@ -236,7 +242,7 @@ def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, schedule
         data,
         payloads,
         start,
-        sigma,
+        sigma_w,
         workers,
         scheduler,
         t_base,
@@ -261,7 +267,7 @@ def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, schedule
             data,
             [{**payload0, "effects": effs, "start": st} for *_, effs, st in jobs2],
             start,
-            sigma,
+            sigma_w,
             workers,
             scheduler,
             t_base,
@@ -272,7 +278,7 @@ def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, schedule
     s0 = score(baseline, models, chans, data.n)  # under the noise model of the refits' weights
     r0, ic0 = s0["ratio"], s0["ic"]
     thr = at_noise_threshold(data.n, nch)
-    a = analyse(exp, data, _with_noise(baseline, sigma))
+    a = analyse(exp, data, _with_noise(baseline, sigma_w))
     worst_kind = a["by_kind"][0]["kind"] if a["by_kind"] else None
 
     def entry_of(effect, spec, res):
@@ -391,29 +397,37 @@ def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, schedule
             for z in (x, y):
                 st.update({f"{by[z]['spec']}.{k}": v["value"] for k, v in by[z]["params"].items()})
             pl.append({**payload0, "start": st, "effects": base_effects + [by[x]["spec"], by[y]["spec"]]})
-        pfits, _ = _dispatch(exp, data, pl, start, sigma, workers, scheduler, t_base)
+        pfits, _ = _dispatch(exp, data, pl, start, sigma_w, workers, scheduler, t_base)
         pair_fits = [(x, y, res) for (x, y), res in zip(combos, pfits) if not getattr(res, "failed", False)]
     # final noise model from the residual of the best model (femast.experiments.noise), everything rescored
     cands = [baseline, *ok, *(res for *_, res in pair_fits)]
     best_res = min(cands, key=lambda f: score(f, models, chans, data.n)["rss"])
-    models = noise_model(exp, data, best_res, pinned=pinned_rows(baseline, chans))
-    sigma = {c: models[c].sigma for c in chans}
+    models = noise_model(exp, data, best_res, pinned=pinned_rows(baseline, chans), sigma=sigma)
+    sigma_w = {c: models[c].sigma for c in chans}
     s0 = score(baseline, models, chans, data.n)
     r0, ic0 = s0["ratio"], s0["ic"]
     n_eff = min(m.n_eff for m in models.values())
     thr = at_noise_threshold(int(round(n_eff)), nch)
-    a = analyse(exp, data, _with_noise(baseline, sigma))
+    a = analyse(exp, data, _with_noise(baseline, sigma_w))
     worst_kind = a["by_kind"][0]["kind"] if a["by_kind"] else None
     ranking, fits, form_check = rank()
     by = {e["effect"]: e for e in ranking}
     pair_list = sorted((pair_entry(x, y, res, by) for x, y, res in pair_fits), key=lambda p: p["delta_bic"])
+    # held-out check: a mechanism is kept only if it also lowers the error on data its fit has not seen
+    base_ho = None
+    if heldout:
+        base_ho = heldout_check(
+            exp, data, baseline, base_effects, ranking, fits, pair_list, sigma_w, payload0, workers, scheduler, t_base
+        )
     best_e = next((e for e in ranking if e["significant"]), None)
     where = _remaining_where(a["masks"], best_e["_z"] if best_e else s0["z"], nch, thr)
     titles = {e["effect"]: get_effect(e["effect"]).title for e in ranking}
     pairs_json = [{k: v for k, v in p.items() if not k.startswith("_")} for p in pair_list]
-    verdict = conclude(r0, thr, ranking, pairs_json, form_check, titles, where)
+    verdict = conclude(
+        r0, thr, ranking, [p for p in pairs_json if p.get("heldout_ok", True)], form_check, titles, where
+    )
     base_table = params_table(baseline)
-    noise_rms = float(np.sqrt(np.mean([np.mean((exp.weight(c) * sigma[c]) ** 2) for c in chans])))
+    noise_rms = float(np.sqrt(np.mean([np.mean((exp.weight(c) * sigma_w[c]) ** 2) for c in chans])))
     public = (
         "effect",
         "rms",
@@ -428,6 +442,8 @@ def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, schedule
         "ic_gain",
         "share_ok",
         "delta_bic_robust",
+        "heldout_ratio",
+        "heldout_ok",
     )
     report = {
         "experiment": exp.name,
@@ -439,6 +455,7 @@ def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, schedule
             "ratio": float(r0),
             "effects": list(base_effects),
             "bic": float(ic0),
+            "heldout_ratio": base_ho,
         },
         "ranking": [
             {**{k: e[k] for k in public if k in e}, **({"failed": True} if e.get("failed") else {})} for e in ranking
@@ -446,7 +463,7 @@ def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, schedule
         "verdict": verdict,
         "data": str(data.path),
         "error_unit": exp.error_unit,
-        "noise": {c: float(np.sqrt(np.mean(sigma[c] ** 2))) for c in chans},
+        "noise": {c: float(np.sqrt(np.mean(sigma_w[c] ** 2))) for c in chans},
         "noise_model": {c: models[c].to_json() for c in chans},
         "n_eff": float(n_eff),
         "pairs": pairs_json,
@@ -458,13 +475,13 @@ def _diagnose(exp, data, candidates, *, exclude, base_effects, workers, schedule
     }
     best_fit = None
     if verdict["kind"] == "missing_pair" and pair_list:
-        best_fit = pair_list[0]["_fit"]
+        best_fit = next((p["_fit"] for p in pair_list if p["effects"] == verdict["missing_effects"]), None)
     elif ranking and not ranking[0].get("failed"):
         best_fit = fits[ranking[0]["effect"]]
     result = OptimizeResult(
         experiment=exp.name,
         n_samples=data.n,
-        noise=sigma,
+        noise=sigma_w,
         noise_model=models,
         noise_rms=noise_rms,
         baseline={
@@ -531,6 +548,13 @@ def _with_noise(res: OptimizeResult, sigma: dict) -> OptimizeResult:
     return r
 
 
+def _ho(ratio, prefix: str = "") -> str:
+    """A held-out ratio for the text report ("" / "-" where none was computed)."""
+    if ratio is None or not np.isfinite(ratio):
+        return "" if prefix else "-"
+    return f"{prefix}{ratio:.2f}" + ("x" if prefix else "")
+
+
 def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
     """Plain-text summary of a diagnosis (what ``femast diagnose`` prints)."""
     f, ul = display_scale(exp.error_unit)
@@ -540,7 +564,7 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
         f"{result.executor})",
         f"  noise floor {f * result.noise_rms:.4g} {ul}; baseline"
         f"{' + ' + '+'.join(b['effects']) if b['effects'] else ''} RMS {f * b['rms']:.4g} {ul} "
-        f"({b['ratio']:.2f}x noise)",
+        f"({b['ratio']:.2f}x noise{_ho(b.get('heldout_ratio'), '; held out ')})",
     ]
     if result.by_kind:
         lines.append(
@@ -548,9 +572,14 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
         )
     nm = getattr(result, "noise_model", None) or {}
     for c, m in nm.items():
-        lines.append(f"  noise of {c}: {m.kind} -- {m.reason}")
+        fc, uc = display_scale(exp.unit_of(c))
+        lines.append(f"  noise of {c}: {fc * m.sigma_rms:.4g} {uc} from {m.source} ({m.kind}) -- {m.reason}")
+        if m.disagree:
+            lines.append(
+                "    the sources disagree: " + ", ".join(f"{k} {fc * v:.4g} {uc}" for k, v in m.levels.items())
+            )
     lines.append(
-        f"  {'rank':>4s}  {'effect':<22s} {'form':<10s} {'RMS':>10s} {'x noise':>8s} {'dBIC':>9s} "
+        f"  {'rank':>4s}  {'effect':<22s} {'form':<10s} {'RMS':>10s} {'x noise':>8s} {'held out':>8s} {'dBIC':>9s} "
         f"{'share':>6s}  sig  parameters"
     )
     for i, e in enumerate(result.ranking):
@@ -563,13 +592,14 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
         )
         lines.append(
             f"  {i + 1:>4d}  {e['effect']:<22s} {e.get('form') or '-':<10s} {f * e['rms']:>10.4g} "
-            f"{e['ratio']:>8.2f} {e['delta_bic']:>9.1f} {100 * e['explained_fraction']:>5.0f}%  "
+            f"{e['ratio']:>8.2f} {_ho(e.get('heldout_ratio')):>8s} {e['delta_bic']:>9.1f} "
+            f"{100 * e['explained_fraction']:>5.0f}%  "
             f"{'yes' if e['significant'] else ' no'}  {ps}"
         )
     for p in (getattr(result, "pairs", None) or [])[:3]:
         lines.append(
             f"  pair  {' + '.join(p['effects']):<33s} {f * p['rms']:>10.4g} {p['ratio']:>8.2f} "
-            f"{p['delta_bic']:>9.1f} {100 * p['explained_fraction']:>5.0f}%  "
+            f"{_ho(p.get('heldout_ratio')):>8s} {p['delta_bic']:>9.1f} {100 * p['explained_fraction']:>5.0f}%  "
             f"{'yes' if p['significant'] else ' no'}"
         )
     for fc in getattr(result, "form_check", None) or []:

@@ -84,12 +84,37 @@ def predict(exp: Experiment, data: Measured, params=None, effects=None) -> dict:
     if unknown:
         raise ModelError(f"{exp.name} has no parameter(s) {', '.join(sorted(unknown))}; its parameters: {', '.join(p)}")
     p.update(params or {})
-    out = exp.model(p, data, EffectStack(items, effect_context(exp, data)), exp.options)
-    missing = [c for c in exp.channels if c not in out]
-    if missing:
-        raise ModelError(f"the model of {exp.name} did not return channel(s) {', '.join(missing)}")
+    parts = data.group_subsets() or [(slice(None), data)]  # group by group: each starts from rest
+    out = {c: np.empty(data.n) for c in exp.channels}
+    for rows, part in parts:
+        o = exp.model(p, part, EffectStack(items, effect_context(exp, part)), exp.options)
+        missing = [c for c in exp.channels if c not in o]
+        if missing:
+            raise ModelError(f"the model of {exp.name} did not return channel(s) {', '.join(missing)}")
+        for c in exp.channels:
+            out[c][rows] = np.asarray(o[c], dtype=float).reshape(part.n)
     progress.tick()
-    return {c: np.asarray(out[c], dtype=float).reshape(data.n) for c in exp.channels}
+    if data.offsets:
+        out = with_offsets(exp, data, out)
+    return out
+
+
+def with_offsets(exp: Experiment, data: Measured, predicted: dict) -> dict:
+    """``predicted`` plus a zero of its own for every group and channel (``data.offsets``): the mean
+    of the channel's residual over the group -- each station re-zeroed, fitted in closed form."""
+    out = {}
+    groups = data.group_rows() or [("all", np.ones(data.n, bool))]
+    for c in exp.channels:
+        y = np.array(predicted[c], float)
+        for _, rows in groups:
+            y[rows] += np.mean(data[c][rows] - y[rows])
+        out[c] = y
+    return out
+
+
+def n_offsets(exp: Experiment, data: Measured) -> int:
+    """Parameters the offsets add (one per group and channel), counted in the information criterion."""
+    return data.n_groups * len(exp.channels) if data.offsets else 0
 
 
 def channel_residuals(exp: Experiment, data: Measured, predicted: dict) -> dict:
@@ -135,7 +160,7 @@ def _result(exp, data, specs, x, stderr, cov, sigma, predicted, fitted, success,
     res = channel_residuals(exp, data, predicted)
     nums = summary_numbers(exp, res, sigma)
     base, eff = _split(specs, x)
-    p = len(x) if fitted else 0
+    p = len(x) + n_offsets(exp, data) if fitted else 0
     z = np.concatenate([res[c] / sigma[c] for c in exp.channels])
     at_bound = [
         full
@@ -243,6 +268,7 @@ def fit(
     given_start_clip: bool = False,
     nfev_per_param: int | None = None,
     start_sensitivity: dict | None = None,
+    rows=None,
 ) -> OptimizeResult:
     """Fit the baseline parameters and those of the switched-on ``effects`` to the data.
 
@@ -260,6 +286,9 @@ def fit(
         start (the ``sensitivity`` of an earlier fit, e.g. the baseline's for diagnose's refits): the
         first Jacobian of an expensive experiment fitted by finite differences takes these
         columns instead of FE runs.  The Jacobian at the solution (covariance) is always computed.
+    rows : (n,) bool, the rows the fit sees (default all): the model still runs along the whole path
+        -- its state at a row depends on the rows before -- and the other rows are predicted, not
+        fitted (held-out validation, :mod:`femast.experiments.heldout`); needs ``noise``.
 
     Returns an ``OptimizeResult`` with ``x``, ``names``, ``units``, ``stderr``, ``cov``,
     ``params`` (baseline ``{name: value}``), ``effect_params`` (``{effect: {name: value}}``),
@@ -400,6 +429,8 @@ def fit(
         return best
 
     if noise is None:
+        if rows is not None:
+            raise ModelError("a fit on some rows (rows=...) needs the noise of every channel (noise=...)")
         base, eff = _split(specs, x0)
         sigma0 = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
         sol = solve(sigma0, starts, seed(start_sensitivity, sigma0, x0))
@@ -418,6 +449,9 @@ def fit(
             sol = sol2
     else:
         sigma = {c: _sigma_of(noise, c, data.n) for c in exp.channels}
+        if rows is not None:  # rows not fitted weigh nothing: an infinite noise
+            rows = np.asarray(rows, bool)
+            sigma = {c: np.where(rows, np.broadcast_to(v, (data.n,)), np.inf) for c, v in sigma.items()}
         sol = solve(sigma, starts, seed(start_sensitivity, sigma, x0))
     x = co.to_x(sol.x)
     dxdu = co.dx_du(sol.x)
@@ -443,8 +477,9 @@ def fit(
         sol.nfev_total,
         [i[0] for i in impls],
     )
-    rows = sigma_rows(sigma)
-    out.sensitivity = {full: -sol.jac[:, i] * rows / dxdu[i] for i, (full, _, _) in enumerate(specs)}
+    sr = sigma_rows(sigma)
+    with np.errstate(invalid="ignore"):  # rows not fitted: their columns stay NaN (unknown)
+        out.sensitivity = {full: -sol.jac[:, i] * sr / dxdu[i] for i, (full, _, _) in enumerate(specs)}
     out.fe_runs = int(sol.fe_runs)
     out.fe_reference = exp.options.get("fe_reference")  # the reference run of the fit's FE runs, or None
     return out

@@ -19,7 +19,7 @@ from scipy.optimize import OptimizeResult
 from .. import progress
 from ..effects.base import load_script
 from ..errors import FemastError, ModelError
-from .core import Experiment, Measured
+from .core import Experiment
 from .fitting import fit
 
 _START_METHOD = None  # multiprocessing start method of the local pool (None: the platform's default)
@@ -37,7 +37,7 @@ def _refit_task(payload: dict) -> OptimizeResult:
     for script in payload["scripts"]:
         load_script(script)
     exp = experiment_from_source(payload["source"], payload["options"])
-    data = Measured(payload["data_experiment"], payload["columns"], payload["path"], payload["lines"])
+    data = payload["data"]
     res = _safe_fit(
         exp,
         data,
@@ -45,12 +45,13 @@ def _refit_task(payload: dict) -> OptimizeResult:
         start=payload["start"],
         noise=payload["noise"],
         sensitivity=payload.get("sensitivity"),
+        rows=payload.get("rows"),
     )
     res.pid = os.getpid()
     return res
 
 
-def _safe_fit(exp, data, effects, start, noise, sensitivity=None) -> OptimizeResult:
+def _safe_fit(exp, data, effects, start, noise, sensitivity=None, rows=None) -> OptimizeResult:
     """:func:`fit`, or a result with ``failed = True`` and the error as ``message`` when the model
     cannot be evaluated even at the start of the refit (an FE run that does not converge with the
     effect's default parameters): one failed candidate must not end the whole diagnosis."""
@@ -63,7 +64,8 @@ def _safe_fit(exp, data, effects, start, noise, sensitivity=None) -> OptimizeRes
             noise=noise,
             given_start_clip=True,
             nfev_per_param=REFIT_NFEV,
-            start_sensitivity=sensitivity,
+            start_sensitivity=sensitivity if rows is None else None,
+            rows=rows,
         )  # the baseline's derivatives seed the refit's
     except (ValueError, FemastError, FloatingPointError, ZeroDivisionError) as e:
         return OptimizeResult(failed=True, success=False, message=f"{type(e).__name__}: {e}", effects=tuple(effects))
@@ -173,7 +175,7 @@ def _quietly(fn):
 
 
 def _candidate(payload) -> str:
-    return payload["effects"][-1]
+    return payload.get("label") or (payload["effects"] or ["the baseline"])[-1]
 
 
 def _serial_refits(payloads):
@@ -192,7 +194,15 @@ def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base, whi
     if not _rebuildable(exp):
         return (
             [
-                _safe_fit(exp, data, p["effects"], start=p["start"], noise=sigma, sensitivity=p.get("sensitivity"))
+                _safe_fit(
+                    exp,
+                    data,
+                    p["effects"],
+                    start=p["start"],
+                    noise=p.get("noise", sigma),
+                    sensitivity=p.get("sensitivity"),
+                    rows=p.get("rows"),
+                )
                 for p in payloads
             ],
             "serial (experiment defined in memory: worker processes cannot rebuild it)",

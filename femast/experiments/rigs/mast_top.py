@@ -101,15 +101,9 @@ def initial_guess(data: Measured, options: dict) -> dict:
 
 
 def load_measure(data: Measured, options: dict) -> np.ndarray:
-    """Signed bending moment at the base (N m): the joint moments (m1, m2) projected on their
-    principal direction, the sign chosen so that the largest |value| is positive."""
-    prep = prepared(data, _prepare, options)
-    m = prep["m"][:, :2]
-    if not np.any(m):
-        return np.zeros(data.n)
-    _, _, Vt = np.linalg.svd(m - 0.0, full_matrices=False)
-    s = m @ Vt[0]
-    return s if s[np.argmax(np.abs(s))] > 0 else -s
+    """The bending moments at the base (N m), (n, 2): the joint moments (m1, m2); the segmentation
+    takes them along their principal direction."""
+    return prepared(data, _prepare, options)["m"][:, :2]
 
 
 def noise_covariates(data: Measured, params: dict, options: dict, fit=None) -> dict:
