@@ -112,45 +112,42 @@ def heldout_ratio(exp, residuals: dict, sigma: dict) -> float:
 HO_MARGIN = 0.02  # a mechanism must lower the held-out ratio by at least 2 % (its scatter between redraws)
 
 
-def heldout_check(exp, data, baseline, base_effects, ranking, fits, pairs, sigma, payload0, workers, scheduler, t_base):
-    """The held-out stage of ``diagnose`` (module docstring): the baseline, every significant
-    candidate and the two best significant pairs are refitted once per fold (in parallel, on the
-    refits' executor) and scored on the rows each fold left out.  Sets, on the ranking's entries and
-    the pairs, ``heldout_ratio`` and ``heldout_ok`` -- a candidate lowers the baseline's held-out
-    ratio by ``HO_MARGIN``, a pair its best member's -- and makes those that fail not significant
-    (the reading says why).  Returns the baseline's held-out ratio (None without folds)."""
-    from .refits import _dispatch
-
+def heldout_check(d) -> None:
+    """The held-out stage of ``diagnose`` (module docstring), on a
+    :class:`~femast.experiments.diagnosis.Diagnosis`: the baseline, every significant candidate and
+    the two best significant pairs are refitted once per fold (in parallel, on the refits' executor)
+    and scored on the rows each fold left out.  Sets ``d.heldout_ratio`` (the baseline's) and, on the
+    ranking's entries and the pairs, ``heldout_ratio`` and ``heldout_ok`` -- a candidate lowers the
+    baseline's held-out ratio by ``HO_MARGIN``, a pair its best member's -- and makes the candidates
+    that fail not significant (the reading says why)."""
+    exp, data = d.exp, d.data
     fold_list = folds(exp, data, 3 if exp.fit_options.get("expensive") else None)
     if not fold_list:
-        return None
-    cands = [e for e in ranking if e.get("significant")]
-    best_pairs = [p for p in pairs if p.get("significant")][:2]
-    models = [("baseline", list(base_effects), baseline)]
-    models += [(e["effect"], list(base_effects) + [e["spec"]], fits[e["effect"]]) for e in cands]
-    models += [(" + ".join(p["effects"]), None, p["_fit"]) for p in best_pairs]
-    payloads = []
-    for name, effects, res in models:
-        effects = list(res.effects) if effects is None else effects
-        st = dict(zip(res.names, res.x))
-        for fold, left_out in fold_list:
-            payloads.append(
-                {
-                    **payload0,
-                    "effects": effects,
-                    "start": st,
-                    "noise": sigma,
-                    "rows": ~left_out,
-                    "label": f"{name}, {fold} held out",
-                }
-            )
-    results, _ = _dispatch(exp, data, payloads, payload0["start"], sigma, workers, scheduler, t_base)
+        return
+    cands = [e for e in d.ranking if e.get("significant")]
+    best_pairs = [p for p in d.pairs if p.get("significant")][:2]
+    models = [("baseline", list(d.base_effects), d.baseline)]
+    models += [(e["effect"], list(d.base_effects) + [e["spec"]], d.fits[e["effect"]]) for e in cands]
+    models += [(" + ".join(p["effects"]), list(p["_fit"].effects), p["_fit"]) for p in best_pairs]
+    sigma = d.weights
+    specs = [
+        {
+            "effects": effects,
+            "start": dict(zip(res.names, res.x)),
+            "noise": sigma,
+            "rows": ~left_out,
+            "label": f"{name}, {fold} held out",
+        }
+        for name, effects, res in models
+        for fold, left_out in fold_list
+    ]
+    results = d.refit(specs)
     k = len(fold_list)
     ratio = {}
     for i, (name, _, _) in enumerate(models):
         ho = assemble(exp, data, fold_list, results[i * k : (i + 1) * k])
         ratio[name] = (heldout_ratio(exp, ho.residuals, sigma), ho.failed)
-    r0, _ = ratio["baseline"]
+    r0 = d.heldout_ratio = ratio["baseline"][0]
     for e in cands:
         r, failed = ratio[e["effect"]]
         e["heldout_ratio"], e["heldout_folds_failed"] = r, failed
@@ -161,11 +158,9 @@ def heldout_check(exp, data, baseline, base_effects, ranking, fits, pairs, sigma
                 f" Held out, it does not lower the error on data its fit has not seen ({r:.2f}x against the "
                 f"baseline's {r0:.2f}x): not kept."
             )
-    by = {e["effect"]: e for e in ranking}
+    by = {e["effect"]: e for e in d.ranking}
     for p in best_pairs:
         r, failed = ratio[" + ".join(p["effects"])]
         members = [by[m]["heldout_ratio"] for m in p["effects"] if "heldout_ratio" in by.get(m, {})]
-        best_member = min(members) if members else r0
         p["heldout_ratio"], p["heldout_folds_failed"] = r, failed
-        p["heldout_ok"] = bool(np.isfinite(r) and r < (1.0 - HO_MARGIN) * best_member)
-    return r0
+        p["heldout_ok"] = bool(np.isfinite(r) and r < (1.0 - HO_MARGIN) * min(members, default=r0))

@@ -18,9 +18,9 @@ from scipy.optimize import OptimizeResult
 
 from .. import progress
 from ..effects.base import load_script
-from ..errors import FemastError, ModelError
+from ..errors import ModelError
 from .core import Experiment
-from .fitting import fit
+from .fitting import MODEL_FAILURES, fit
 
 _START_METHOD = None  # multiprocessing start method of the local pool (None: the platform's default)
 REFIT_NFEV = 25  # evaluations per parameter and start of a refit (a converging refit needs 5-20; a direction the
@@ -67,7 +67,7 @@ def _safe_fit(exp, data, effects, start, noise, sensitivity=None, rows=None) -> 
             start_sensitivity=sensitivity if rows is None else None,
             rows=rows,
         )  # the baseline's derivatives seed the refit's
-    except (ValueError, FemastError, FloatingPointError, ZeroDivisionError) as e:
+    except (*MODEL_FAILURES, ArithmeticError) as e:
         return OptimizeResult(failed=True, success=False, message=f"{type(e).__name__}: {e}", effects=tuple(effects))
 
 
