@@ -43,30 +43,18 @@ def _effect_names(arg):
     return names
 
 
-def _first_sentence(text: str) -> str:
-    """The first sentence of ``text`` on one line."""
-    text = " ".join((text or "").split())
-    for i in range(len(text) - 1):
-        if (
-            text[i] == "."
-            and text[i + 1] == " "
-            and not text[max(0, i - 3) : i].endswith(("Eq", "Sec", "e.g", "i.e", "Fig", "Eqs", "Tab"))
-        ):
-            return text[: i + 1]
-    return text
-
-
 def experiment_rows() -> list[dict]:
     """Every registered experiment: name, title, its example data file (or None), its effects."""
     from . import examples
     from .effects import applicable_effects
     from .experiments import list_experiments
+    from .text import first_sentence
 
     return [
         {
             "name": e.name,
             "title": e.title,
-            "physics": _first_sentence(e.doc) if e.doc else e.title,
+            "physics": first_sentence(e.doc) if e.doc else e.title,
             "example": examples.BY_EXPERIMENT.get(e.name),
             "effects": [f.name for f in applicable_effects(e)],
         }
@@ -78,6 +66,7 @@ def effect_rows(experiment=None) -> list[dict]:
     """Every registered effect (or those applicable to ``experiment``): name, title, one sentence of
     physics, the experiments it is implemented for."""
     from .effects import list_effects
+    from .text import first_sentence
 
     rows = []
     for e in list_effects():
@@ -88,7 +77,7 @@ def effect_rows(experiment=None) -> list[dict]:
             {
                 "name": e.name,
                 "title": e.title,
-                "physics": _first_sentence(e.physics),
+                "physics": first_sentence(e.physics),
                 "experiments": exps,
                 "seed": e.seed,
             }
@@ -101,10 +90,17 @@ def _experiments(args):
     if args.json:
         print(json.dumps(rows, indent=2))
         return
-    print("experiments (femast compare|diagnose EXPERIMENT DATA.csv; DATA 'example' uses the shipped example):")
+    from .text import hanging
+
+    print(
+        hanging(
+            "experiments", "(femast compare|diagnose EXPERIMENT DATA.csv; DATA 'example' uses the shipped example):", 0
+        )
+    )
+    pad = 2 + max(len(r["name"]) for r in rows) + 1
     for r in rows:
-        print(f"  {r['name']:<12s} {r['title']}")
-        print(f"  {'':<12s} example data: {r['example'] or '(none shipped)'}; effects: {', '.join(r['effects'])}")
+        print(hanging(f"  {r['name']}", r["title"], pad))
+        print(hanging("", f"example data: {r['example'] or '(none shipped)'}; effects: {', '.join(r['effects'])}", pad))
 
 
 def _effects(args):
@@ -117,10 +113,13 @@ def _effects(args):
     if args.json:
         print(json.dumps(rows, indent=2))
         return
+    from .text import hanging
+
     print(f"effects{' of ' + exp if exp else ''} (femast compare ... --effects NAME[,NAME]):")
+    pad = 2 + max((len(r["name"]) for r in rows), default=0) + 1
     for r in rows:
-        print(f"  {r['name']:<22s} {r['title']} [{', '.join(r['experiments'])}]")
-        print(f"  {'':<22s} {r['physics']}")
+        print(hanging(f"  {r['name']}", f"{r['title']} [{', '.join(r['experiments'])}]", pad))
+        print(hanging("", r["physics"], pad))
 
 
 def _examples(args):
@@ -136,10 +135,13 @@ def _examples(args):
         print(f"copied {len(examples.names())} example files to {dest}")
         return
     by_file = {v: k for k, v in examples.BY_EXPERIMENT.items()}
+    from .text import hanging
+
     print(f"example data shipped with femast (in {examples.FOLDER}):")
+    pad = 2 + max(len(n) for n in examples.names()) + 1
     for n in examples.names():
-        use = f"  ('example' for {by_file[n]})" if n in by_file else ""
-        print(f"  {n:<30s} {examples.describe(n)}{use}")
+        use = f" ('example' for {by_file[n]})" if n in by_file else ""
+        print(hanging(f"  {n}", examples.describe(n) + use, pad))
 
 
 def resolve_data(exp, data: str):
@@ -155,11 +157,26 @@ def resolve_data(exp, data: str):
     return Path(data), data
 
 
+def _check_order(args) -> None:
+    """``femast compare example mast-top``: the experiment and the data the wrong way round."""
+    from .errors import FemastError
+    from .experiments import list_experiments
+
+    names = {e.name for e in list_experiments()}
+    first, second = args.experiment, args.data
+    if first not in names and not first.endswith(".py") and (second in names or second.endswith(".py")):
+        raise FemastError(
+            f"'{first}' is not an experiment but '{second}' is: the experiment comes first, then the data "
+            f"(femast {args.command} {second} {first})"
+        )
+
+
 def _setup(args):
     from dataclasses import replace
 
     from .experiments import get_experiment, read_data
 
+    _check_order(args)
     exp = get_experiment(args.experiment)
     effects = _effect_names(getattr(args, "effects", None))
     exp.require_model(f"femast {args.command}")

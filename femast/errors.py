@@ -46,3 +46,12 @@ class ResultsWriteError(FemastError, OSError):
 
 class SampleTimeout(FemastError):
     """A sample of a study ran longer than the study's ``timeout_s`` (it is recorded as failed)."""
+
+
+def did_you_mean(name, choices) -> str:
+    """`` (did you mean 'x'?)`` for the choice closest to a mistyped ``name`` (difflib's ratio of at
+    least 0.6), or ``""`` when none is close: the tail of an "unknown ..." message."""
+    import difflib
+
+    close = difflib.get_close_matches(str(name), [str(c) for c in choices], n=1, cutoff=0.6)
+    return f" (did you mean '{close[0]}'?)" if close else ""

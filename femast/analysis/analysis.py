@@ -93,6 +93,7 @@ class Analysis:
         restart_every: int | None = None,
         linear_solver: str = "auto",
     ):
+        _check_model_argument(model, out)
         prepare_kernels()  # first run: kernels compile in the background (femast.jit_background)
         self.model = model
         self.on_frame = on_frame
@@ -278,6 +279,24 @@ class Analysis:
         sparse = any(st.output_frequency > 1 for st in self.model.steps)
         where = "passed to on_frame (out=None: nothing written)" if self.out is None else f"saved in '{self.out}'"
         return where + (" at the steps' output frequency, the last one included" if sparse else "")
+
+
+def _check_model_argument(model, out) -> None:
+    """The first argument is the model: ``fm.solve("results/x", m)`` (the two swapped) or a model
+    of another kind is a one-line ModelError naming what was given and the right call."""
+    from ..model.model import Model
+
+    if isinstance(model, Model):
+        return
+    if isinstance(out, Model):
+        raise ModelError(
+            f"solve/Analysis got the results folder {model!r} first and the model second: "
+            f"the model comes first, fm.solve(model, {str(model)!r})"
+        )
+    raise ModelError(
+        f"solve/Analysis needs a femast Model as its first argument (fm.solve(model, folder)); got "
+        f"{type(model).__name__} {str(model)[:60]!r}"
+    )
 
 
 def solve(model, out="results", **options) -> Results | None:

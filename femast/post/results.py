@@ -55,7 +55,7 @@ from pathlib import Path
 import numpy as np
 
 from ..elements.base import DOF_NAMES
-from ..errors import FemastError, ResultsWriteError
+from ..errors import FemastError, ResultsWriteError, did_you_mean
 from .npz import LOG_NAME, RECORD_MAGIC, TMP_SUFFIX, append_record, record_bytes, scan_log, truncate_log  # noqa: F401
 from .npz import atomic_savez as _atomic_savez
 
@@ -322,9 +322,11 @@ class Results:
     """Read a results folder: ``Results("results/run")``.
 
     ``len(results)`` frames (converged increments, frame 0 is the initial state);
-    ``results.frame(i)`` a dict of arrays; ``results.node_history(label, "uz")`` a time
-    history (components ux uy uz, rx ry rz (accumulated spins), rfx..rmz reactions,
-    fx..mz applied loads); ``results.element_history(family, label, name, column)``.
+    ``results.frame(i)`` a dict of arrays (SI units: m, rad, N, N m), ``results.frame(step="load")``
+    the last frame of a step; ``results.node_history(label, "uz")`` a history over the frames
+    (components ux uy uz in m, rx ry rz accumulated rotations in rad, rfx..rfz reactions in N,
+    rmx..rmz in N m, fx..mz applied loads); ``results.element_history(family, label, name)``;
+    ``results.time`` the total time of each frame, ``results.steps`` the step name of each frame.
     """
 
     def __init__(self, folder):
@@ -410,8 +412,16 @@ class Results:
     def families(self) -> list[str]:
         return [str(f) for f in self.mesh["families"]]
 
-    def frame(self, i: int) -> dict:
-        """The arrays of frame ``i`` (0 = initial state; negative counts from the end)."""
+    def frame(self, i: int | None = None, *, step: str | None = None, index: int = -1) -> dict:
+        """The arrays of frame ``i`` (0 = initial state; negative counts from the end), or with
+        ``step``, frame ``index`` of that step (``res.frame(step="load")``: its last converged
+        increment; ``index=0`` its first; :meth:`frame_number` gives the frame's number)."""
+        if step is not None:
+            if i is not None:
+                raise FemastError("give a frame number or step=NAME (with index=), not both")
+            i = self.frame_number(step, index)
+        elif i is None:
+            raise FemastError("give a frame number (0 = initial state, -1 = last) or step=NAME")
         try:
             i = range(len(self.files))[int(i)]
         except IndexError:
@@ -436,6 +446,26 @@ class Results:
                 ) from None
         return self._cache[i]
 
+    def frame_number(self, step: str, index: int = -1) -> int:
+        """The number of frame ``index`` of step ``step`` (-1: the step's last converged increment,
+        0: its first; the initial state, frame 0, belongs to no step), for histories:
+        ``res.node_history(tip, "uz")[res.frame_number("load")]``."""
+        steps = self.steps
+        mine = [k for k in range(1, len(steps)) if steps[k] == str(step)]
+        if not mine:
+            names = list(dict.fromkeys(steps[1:]))
+            raise FemastError(
+                f"{self.folder}: no frame of step '{step}'{did_you_mean(step, names)}; "
+                f"its steps: {', '.join(names) or '(none: only the initial state)'}"
+            )
+        try:
+            return mine[int(index)]
+        except IndexError:
+            raise FemastError(
+                f"{self.folder}: step '{step}' has {len(mine)} frames; index {index} is out of range "
+                f"(0..{len(mine) - 1}, or -1 for its last)"
+            ) from None
+
     def _node_row(self, label):
         rows = np.flatnonzero(self.node_labels == int(label))
         if rows.size == 0:
@@ -457,7 +487,17 @@ class Results:
         return [str(self.frame(i)["step"]) for i in range(len(self))]
 
     def node_history(self, label, component: str) -> np.ndarray:
-        """History of one nodal quantity (see class docstring) over all frames."""
+        """One nodal quantity of node ``label`` (the label ``Model.node`` returned) over all frames:
+        an array of ``len(results)`` values, frame 0 (the initial state) first.
+
+        component : ``ux``, ``uy``, ``uz`` displacement (m); ``rx``, ``ry``, ``rz`` (or ``urx``..)
+            accumulated rotation about the global axes (rad, beyond 2 pi: the spins summed over the
+            increments); ``rfx``, ``rfy``, ``rfz`` reaction force (N) and ``rmx``, ``rmy``, ``rmz``
+            reaction moment (N m) at a supported or prescribed DOF (0 elsewhere); ``fx``, ``fy``, ``fz``
+            applied force (N) and ``mx``, ``my``, ``mz`` applied moment (N m).  Case-insensitive.
+
+        Frame ``k`` of step ``s`` is ``res.frame_number(s, k)``; the value at the end of step
+        ``"load"``: ``res.node_history(tip, "uz")[res.frame_number("load")]``."""
         key = component.lower()
         if key not in _COMPONENTS:
             raise FemastError(f"unknown nodal component '{component}'; use one of {', '.join(_COMPONENTS)}")
@@ -466,7 +506,10 @@ class Results:
         return np.array([self.frame(i)[arr][row, col] for i in range(len(self))])
 
     def element_history(self, family: str, label: int, name: str) -> np.ndarray:
-        """History of element output ``name`` (e.g. 'section_forces', 'N') of element ``label``."""
+        """Element output ``name`` of element ``label`` of ``family`` over all frames (first axis:
+        frame).  Beams (``"beam"``): ``section_forces``, shape (frames, 2 ends, 6): N, Vy, Vz (N) and
+        T, My, Mz (N m) in the element's local axes, end 1 then end 2; trusses and cables: ``N``
+        (axial force, N).  The names a family writes are listed when one is missing."""
         if family not in self.families:
             raise FemastError(f"no element family '{family}' in these results; families: {', '.join(self.families)}")
         rows = np.flatnonzero(self.mesh[f"labels/{family}"] == int(label))
