@@ -185,7 +185,7 @@ experiment = Experiment(name="rig-x", title="a rig whose model is not written ye
 def test_unknown_and_pending_experiments(tmp_path):
     with pytest.raises(
         ModelError,
-        match=r"unknown experiment 'mast'; accepted: mast-top, latch-pull, bay-torsion, "
+        match=r"unknown experiment 'mast' \(did you mean 'mast-top'\?\); accepted: mast-top, latch-pull, bay-torsion, "
         r"tip-cycle, vibration, platform-pose or the path of a Python script",
     ):
         get_experiment("mast")
