@@ -65,6 +65,10 @@ class Analysis:
         reading the results folder back (which costs about as much as the analysis of a small
         model).  Do not modify the arrays: the same ones are being written to disk.
     observers : more observers of the run (:class:`~femast.analysis.output.Observer`).
+    restart_every : save a restart point every that many converged increments (docs/restart.md);
+        default None: none (a restarted run goes on saving them as before).
+    restart : the results folder of an earlier run of the same model to continue from its last
+        restart point (``femast run SCRIPT --restart FOLDER`` sets it for every analysis of a script).
     linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.solvers.backends`):
         "auto" (default: LAPACK's dense LU up to 64 DOFs; LAPACK's band solver for a narrow reverse
         Cuthill-McKee band, as in a mast; PARDISO, if installed, for other models of 1000 DOFs or

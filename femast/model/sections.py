@@ -91,15 +91,17 @@ class Section:
 
 
 def shear_modulus(E: float, nu: float, name: str = "section") -> float:
-    """Isotropic shear modulus G = E / (2 (1 + nu)), Pa.  Poisson's ratio ``nu`` must lie in
-    (-1, 0.5] (an isotropic solid's range; -1 would make G infinite)."""
+    """Isotropic shear modulus G = E / (2 (1 + nu)), Pa, of Young's modulus ``E`` (Pa).  Poisson's
+    ratio ``nu`` must lie in (-1, 0.5] (an isotropic solid's range; -1 would make G infinite);
+    ``name`` (the section's) labels the messages."""
     E = number(E, f"section '{name}': Young's modulus E", "Pa", positive=True)
     nu = number(nu, f"section '{name}': Poisson's ratio nu", "", lo=-1.0, hi=0.5)
     return E / (2.0 * (1.0 + nu))
 
 
 def circular_solid(d: float, E: float, nu: float = 0.3, name: str = "circular solid") -> Section:
-    """Solid circular section of diameter ``d`` (m); E in Pa."""
+    """Solid circular section of diameter ``d`` (m); ``E`` in Pa, Poisson's ratio ``nu``; ``name``
+    labels it in messages."""
     return circular_tube(d, 0.0, E, nu, name=name)
 
 
@@ -115,7 +117,8 @@ def circular_tube(
 ) -> Section:
     """Circular tube (a pipe) of outer diameter ``d_out`` and inner diameter ``d_in`` (m), or, by
     keyword, of outer diameter ``d`` and wall thickness ``t`` (m): ``circular_tube(d=0.03, t=0.002,
-    E=70e9)`` is ``circular_tube(0.03, 0.026, E=70e9)``.  E in Pa, Poisson's ratio ``nu``.
+    E=70e9)`` is ``circular_tube(0.03, 0.026, E=70e9)``.  E in Pa, Poisson's ratio ``nu``; ``name``
+    labels it in messages.
 
     J is the polar moment pi (d_out^4 - d_in^4) / 32, exact for circular sections.
     """
@@ -128,7 +131,8 @@ def circular_tube(
 
 
 def square_solid(s: float, E: float, nu: float = 0.3, name: str = "square solid") -> Section:
-    """Solid square of side ``s`` (m); J = 0.1406 s^4 (St Venant, b/a = 1)."""
+    """Solid square of side ``s`` (m); ``E`` in Pa, Poisson's ratio ``nu``, ``name`` for messages;
+    J = 0.1406 s^4 (St Venant, b/a = 1)."""
     _check_dims(name, s, 0.0)
     A = s * s
     I = s**4 / 12.0
@@ -148,7 +152,7 @@ def square_tube(
     """Square tube (a box section) of outer side ``s_out`` and inner side ``s_in`` (m), or, by
     keyword, of width ``b`` and wall thickness ``t`` (m), as steel tables give it:
     ``square_tube(b=0.03, t=0.002, E=70e9)`` is ``square_tube(0.03, 0.026, E=70e9)``.  E in Pa,
-    Poisson's ratio ``nu``.
+    Poisson's ratio ``nu``; ``name`` labels it in messages.
 
     A = s_out^2 - s_in^2 and I = (s_out^4 - s_in^4)/12 (the Rocaspect paper, Eqs. 11, 9).
     J = t (s_out - t)^3 with t = (s_out - s_in)/2 (Bredt; see the module note on the Rocaspect

@@ -24,7 +24,9 @@ def render_png(
     """Render frame ``frame`` of ``results`` to ``png``; displacements magnified by ``scale``.
     ``color_by``: '|U|' (displacement magnitude) or None.  Orthographic isometric view, the
     undeformed shape in grey and labelled, a vertical colour bar in the unit that suits the
-    displacements (um, mm or m)."""
+    displacements (um, mm or m).  ``show_undeformed``: draw the initial shape in grey;
+    ``window_size``: (width, height) of the image in pixels; ``title``: the caption (default: the
+    folder, the frame and its step).  Returns the PNG's path."""
     if not os.environ.get("DISPLAY"):
         # headless: render through EGL, which VTK's wheels ship (no X server, no OSMesa needed)
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
@@ -96,8 +98,9 @@ def render_png(
 
 
 def largest_displacement_frame(results) -> tuple[int, float]:
-    """(frame index, largest nodal |U| in m) of the frame whose largest nodal displacement
-    magnitude is the largest of the run (the first such frame on ties)."""
+    """(frame index, largest nodal |U| in m) of the frame of ``results`` (a Results or a results
+    folder) whose largest nodal displacement magnitude is the largest of the run (the first such
+    frame on ties)."""
     res = results if isinstance(results, Results) else Results(results)
     best, umax = 0, -1.0
     for i in range(len(res)):
