@@ -181,7 +181,7 @@ def _setup(args):
     effects = _effect_names(getattr(args, "effects", None))
     exp.require_model(f"femast {args.command}")
     path, shown = resolve_data(exp, args.data)
-    data = replace(read_data(exp, path), path=shown)
+    data = replace(read_data(exp, path, units=getattr(args, "units", None)), path=shown)
     stem = Path(shown.split()[-1]).stem
     out = Path(args.out) if args.out else Path(args.command) / f"{exp.name}_{stem}"
     return exp, data, effects, out
@@ -232,6 +232,11 @@ def register(subparsers, fmt=None) -> None:
         "measured data, a CSV file with a header row (formats: `femast experiments`, docs/experiments.md), "
         "or 'example' for the example shipped with femast"
     )
+    units_help = (
+        "the unit the values of a column are in when its header says another, COLUMN=UNIT[,...] "
+        "(e.g. dx_m=mm; a header may also carry the unit itself, dx_mm); naming the header's own unit "
+        "(dx_m=m) confirms it and skips the size check of that column (default: the headers' units)"
+    )
     out_help = "output folder (default: ./%(prog_cmd)s/EXPERIMENT_DATASTEM in the working directory)"
     p = subparsers.add_parser(
         "compare",
@@ -257,6 +262,7 @@ def register(subparsers, fmt=None) -> None:
         help="fit the model and effect parameters (default: run with the default parameters)",
     )
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "compare"})
+    p.add_argument("--units", default=None, help=units_help)
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.set_defaults(func=_compare)
     p = subparsers.add_parser(
@@ -271,6 +277,7 @@ def register(subparsers, fmt=None) -> None:
     p.add_argument("experiment", help=exp_help)
     p.add_argument("data", help=data_help)
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "diagnose"})
+    p.add_argument("--units", default=None, help=units_help)
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.add_argument(
         "--workers",

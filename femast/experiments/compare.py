@@ -29,6 +29,7 @@ from .residuals import (
     signatures,
     turning_points,
 )
+from .units import check_data as check_units
 
 
 def load_path(exp: Experiment, data: Measured) -> np.ndarray:
@@ -87,6 +88,7 @@ def compare(
     ``files``, ``version`` (in the history, or None), ``success``, ``message``.
     """
     exp.require_model("compare")
+    check_units(exp, data)  # a unit mistake (mm under an m header) stops here, naming the column
     if isinstance(effects, str):
         effects = [e for e in effects.split(",") if e.strip()]
     effects = list(effects)

@@ -156,12 +156,19 @@ def check_header(exp: Experiment, header, path: str = "<arrays>", line: int = 1)
     return names
 
 
-def read_data(exp: Experiment, path) -> Measured:
+def read_data(exp: Experiment, path, units=None) -> Measured:
     """Read and check a measured-data file of experiment ``exp`` (see the module docstring).
+
+    A header may name a column in another unit (``dx_mm`` for ``dx_m``): its values are converted
+    (:mod:`femast.experiments.units`).  ``units``: ``{column: unit}`` or ``"dx_m=mm,fx_N=lbf"``,
+    the unit the values of a column are really in (a header that says the wrong unit).
 
     Returns a :class:`~femast.experiments.core.Measured` whose ``lines`` give the file line of
     every row.  Raises :class:`~femast.errors.DataFileError` on any malformed content.
     """
+    from . import units as _units
+
+    override = _units.parse_override(units)
     path = Path(path)
     if not path.is_file():
         raise DataFileError(f"{path}: no such data file")
@@ -178,7 +185,8 @@ def read_data(exp: Experiment, path) -> Measured:
                         err = _separator_error(path, line, cells[0], exp)
                         if err is not None:
                             raise err
-                    header, header_line = check_header(exp, cells, str(path), line), line
+                    named, factors = _units.header_columns(exp, [c.strip() for c in cells], f"{path} line {line}")
+                    header, header_line = check_header(exp, named, str(path), line), line
                     continue
                 rows.append(cells)
                 lines.append(line)
@@ -222,6 +230,11 @@ def read_data(exp: Experiment, path) -> Measured:
         raise DataFileError(
             f"{path}: {len(rows)} data row(s); {exp.name} needs at least {exp.min_rows} (one per sample, in time order)"
         )
+    scaled = _units.override_factors(exp, header, override, str(path))
+    for i, h in enumerate(header):
+        f = factors[i] * scaled.get(h, 1.0)
+        if f != 1.0:
+            values[:, i] *= f
     cols = {h: values[:, i] for i, h in enumerate(header)}
     check_values(exp, cols, str(path), lines)
     if "t_s" in cols and np.any(np.diff(cols["t_s"]) < 0):
@@ -230,7 +243,9 @@ def read_data(exp: Experiment, path) -> Measured:
             f"{path} line {lines[bad]}, column 't_s': time goes backwards "
             f"({cols['t_s'][bad - 1]:g} s then {cols['t_s'][bad]:g} s); rows must be in time order"
         )
-    return Measured(exp.name, cols, str(path), np.asarray(lines))
+    data = Measured(exp.name, cols, str(path), np.asarray(lines))
+    data.cache[_units.CONFIRMED] = tuple(c for c, f in scaled.items() if f == 1.0)  # --units dx_m=m
+    return data
 
 
 def from_arrays(exp: Experiment, **columns) -> Measured:

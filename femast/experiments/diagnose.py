@@ -65,6 +65,7 @@ from .refits import (  # noqa: F401
     _serial_refits,
 )
 from .residuals import AT_NOISE, at_noise_threshold
+from .units import check_data as check_units
 from .verdict import MIN_SHARE, SIGNIFICANT_DBIC, conclude, flags, pair_candidates, robust_delta, score, share
 
 
@@ -146,6 +147,7 @@ def diagnose(
     document), ``executor``, ``files``, ``success``, ``message``.
     """
     exp.require_model("diagnose")
+    check_units(exp, data)  # a unit mistake (mm under an m header) stops here, naming the column
     # the figure is drawn by a process forked now, which imports matplotlib while this one fits the
     # baseline on the other CPU (FE experiments, local refits; issue 21)
     figs = FigureProcess.start() if out is not None and scheduler is None and exp.fit_options.get("expensive") else None
