@@ -191,7 +191,7 @@ def _compare(args):
     from .experiments import compare, format_compare
 
     exp, data, effects, out = _setup(args)
-    res = compare(exp, data, effects, fit=args.fit, out=out)
+    res = compare(exp, data, effects, fit=args.fit, out=out, max_rows=args.max_rows)
     print(json.dumps(res.report, indent=2) if args.json else format_compare(exp, res))
     _freeze_heap_for_exit()
 
@@ -200,7 +200,9 @@ def _diagnose(args):
     from .experiments import diagnose, format_diagnose
 
     exp, data, effects, out = _setup(args)
-    res = diagnose(exp, data, base_effects=effects, workers=args.workers, scheduler=args.scheduler, out=out)
+    res = diagnose(
+        exp, data, base_effects=effects, workers=args.workers, scheduler=args.scheduler, out=out, max_rows=args.max_rows
+    )
     print(json.dumps(res.report, indent=2) if args.json else format_diagnose(exp, res))
     _freeze_heap_for_exit()
 
@@ -263,6 +265,12 @@ def register(subparsers, fmt=None) -> None:
     )
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "compare"})
     p.add_argument("--units", default=None, help=units_help)
+    p.add_argument(
+        "--max-rows",
+        type=int,
+        default=10_000,
+        help="rows used at most: a longer record is thinned to every k-th row, and femast says so",
+    )
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.set_defaults(func=_compare)
     p = subparsers.add_parser(
@@ -278,6 +286,12 @@ def register(subparsers, fmt=None) -> None:
     p.add_argument("data", help=data_help)
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "diagnose"})
     p.add_argument("--units", default=None, help=units_help)
+    p.add_argument(
+        "--max-rows",
+        type=int,
+        default=10_000,
+        help="rows used at most: a longer record is thinned to every k-th row, and femast says so",
+    )
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.add_argument(
         "--workers",

@@ -136,9 +136,12 @@ class PlainProgress:
 
 
 @contextlib.contextmanager
-def task(desc: str, unit: str = "evaluations"):
-    """A bar counting the :func:`tick` calls made inside the ``with`` block (innermost task gets them)."""
-    bar = _bar(desc=desc, unit=f" {unit}", total=None, bar_format="{desc}: {n_fmt}{unit} [{elapsed}]{postfix}")
+def task(desc: str, unit: str = "evaluations", delay: float = 0.0):
+    """A bar counting the :func:`tick` calls made inside the ``with`` block (innermost task gets them);
+    ``delay`` (s): shown only once the work has taken that long."""
+    bar = _bar(
+        desc=desc, unit=f" {unit}", total=None, bar_format="{desc}: {n_fmt}{unit} [{elapsed}]{postfix}", delay=delay
+    )
     entry = (bar, {})
     _ACTIVE.append(entry)
     try:

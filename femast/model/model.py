@@ -494,8 +494,7 @@ class Model:
         follow.  The reference node may be a node without elements (e.g. a control node).
         ``mass`` (kg) and ``inertia`` (kg m^2 about the centre of mass, see :meth:`point_mass`)
         of the body, its centre of mass at ``centre`` (m, global; default the reference node),
-        are a point mass at the reference node.  ``name`` labels the body in messages (default
-        rigid-1, rigid-2...)."""
+        are a point mass at the reference node.  ``name`` labels the body (default rigid-1...)."""
         from .constraints import rigid_body_spec
 
         name = name or f"rigid-{len(self.rigid_bodies) + 1}"
@@ -518,10 +517,8 @@ class Model:
 
     # ----------------------------------------------------------------- steps
     def step(self, name: str | None = None, **options) -> Step:
-        """Append a static step called ``name`` (default Step-1, Step-2...; names are unique); options
-        are :class:`Step` fields: ``period`` (step time, s), ``initial_increment``, ``min_increment``,
-        ``max_increment`` (s of step time), ``max_increments``, ``control``, ``stabilize``,
-        ``output_frequency``.  Returns the step, to which loads and prescribed motion are added."""
+        """Append a static step called ``name`` (default Step-1, Step-2...); options are :class:`Step`
+        fields: ``period`` (s), ``initial_increment``, ``max_increments``, ``control``... Returns it."""
         name = name or f"Step-{len(self.steps) + 1}"
         if any(s.name == name for s in self.steps):
             raise ModelError(f"step '{name}' is defined twice; step names must be unique")
