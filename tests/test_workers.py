@@ -11,10 +11,10 @@ import textwrap
 import time
 
 import pytest
+from process_tree import assert_session_ends, session_processes
 
 from femast import jit, workers
 from femast.errors import FemastError, TaskTimeout, WorkerDied
-from process_tree import assert_session_ends, session_processes
 
 
 def _square(x):
@@ -118,3 +118,19 @@ def test_sigkill_of_the_parent_ends_workers_inside_compiled_code(tmp_path):
     finally:
         for pid in session_processes(p.pid):
             os.kill(pid, signal.SIGKILL)
+
+
+def test_the_docs_example_runs_as_a_script(tmp_path):
+    """docs/workers.md's example, run as `python script.py` (its main block starts the workers)."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "workers.md").read_text()
+    (block,) = re.findall(r"```python\n(.*?)```", text, re.S)
+    (quoted,) = re.findall(r"prints `([^`]+)`", text)
+    (tmp_path / "example.py").write_text(block)
+    p = subprocess.run(
+        [sys.executable, "example.py"], cwd=tmp_path, capture_output=True, text=True, timeout=300, check=True
+    )
+    assert eval(p.stdout.strip()) == [1.0 / (1.0 / k + 1.0 / 2.0e6) for k in (1.0e6, 2.0e6, 4.0e6, 8.0e6)]
+    assert eval(quoted) == eval(p.stdout.strip())
