@@ -134,7 +134,7 @@ def _die_with_parent() -> None:
         pass
 
 
-def _watchdog(conn) -> None:
+def _watchdog() -> None:
     """Portable fallback: end this worker as soon as its parent is gone (its sentinel fires)."""
     parent = multiprocessing.parent_process()
     if parent is None:  # pragma: no cover
@@ -155,7 +155,7 @@ def _worker_main(conn, initializer, initargs) -> None:
     parent = multiprocessing.parent_process()
     if parent is not None and not parent.is_alive():  # the parent died before prctl took effect
         os._exit(1)
-    threading.Thread(target=_watchdog, args=(conn,), daemon=True, name="femast-watchdog").start()
+    threading.Thread(target=_watchdog, daemon=True, name="femast-watchdog").start()
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     except (ValueError, OSError):  # pragma: no cover
@@ -259,14 +259,13 @@ class Pool(concurrent.futures.Executor):
     def submit(self, fn, /, *args, timeout_s: float | None = ..., **kwargs) -> concurrent.futures.Future:
         """Run ``fn(*args, **kwargs)`` in a worker; ``timeout_s`` (s) overrides the pool's."""
         fut = concurrent.futures.Future()
-        payload = None
+        task_id = next(self._ids)
+        payload = _dumps((task_id, fn, args, kwargs))  # (here: a task that cannot be pickled fails in the caller)
         with self._lock:
             if self._closing:
                 raise RuntimeError(f"{self.name}: cannot submit to a pool that is shut down")
             if self._broken is not None:
                 raise WorkerDied(self._broken)
-            task_id = next(self._ids)
-            payload = _dumps((task_id, fn, args, kwargs))
             self._queue.append((task_id, fut, payload, self.timeout_s if timeout_s is ... else timeout_s))
         self._wake()
         return fut
@@ -350,13 +349,13 @@ class Pool(concurrent.futures.Executor):
             if self._wake_r in ready:
                 while self._wake_r.poll():
                     self._wake_r.recv_bytes()
-            for i, s in enumerate(list(self._slots)):
+            for s in list(self._slots):
                 if s.conn in ready or s.process.sentinel in ready:
-                    self._collect(i, s)
+                    self._collect(s)
             now = time.monotonic()
-            for i, s in enumerate(list(self._slots)):
+            for s in list(self._slots):
                 if s.task is not None and s.task[2] is not None and now >= s.task[2]:
-                    self._time_out(i, s)
+                    self._time_out(s)
         if self._broken is not None:
             self._fail_all(self._broken)
 
@@ -378,7 +377,7 @@ class Pool(concurrent.futures.Executor):
             deadline = None if timeout_s is None else time.monotonic() + float(timeout_s)
             s.task = (task_id, fut, deadline)
 
-    def _collect(self, i: int, s: _Slot) -> None:
+    def _collect(self, s: _Slot) -> None:
         """A worker answered or died."""
         try:
             while s.conn.poll():
@@ -427,17 +426,24 @@ class Pool(concurrent.futures.Executor):
                         'that starts them is run with `python script.py`, put its work under `if __name__ == "__main__":`'
                     )
                 return
+        self._replace(s)
+
+    def _replace(self, s: _Slot) -> None:
+        """A new worker in the place of the ended ``s`` (none once closing with nothing queued)."""
+        i = self._slots.index(s)
         if not self._closing or self._queue:
             self._slots[i] = self._start()
+        else:
+            del self._slots[i]
 
-    def _time_out(self, i: int, s: _Slot) -> None:
+    def _time_out(self, s: _Slot) -> None:
         """A task ran over its time-out: its worker is killed and replaced."""
         task_id, fut, deadline = s.task
         s.task = None
         _kill(s.process)
         _stop(s)
         fut.set_exception(TaskTimeout(f"{self.name}: a task ran over its time-out; its worker process was killed"))
-        self._slots[i] = self._start()
+        self._replace(s)
 
     def _fail_all(self, reason: str) -> None:
         with self._lock:
