@@ -51,22 +51,21 @@ columns all run on this pool.
 
 from __future__ import annotations
 
+import atexit
 import collections
 import concurrent.futures
 import itertools
 import multiprocessing
 import os
 import pickle
-import sys
 import threading
 import time
-import traceback
 import weakref
 from multiprocessing.connection import wait as _wait_ready
 
 from .errors import FemastError, TaskTimeout, WorkerDied
+from .worker_main import COMPILING, dumps, worker_main
 
-_COMPILING = b"compiling"  # a worker's message: numba has begun compiling a femast kernel
 STOP_WAIT_S = 5.0  # a worker asked to stop gets this long before it is killed (s)
 _START_FAILURES_MAX = 3  # workers in a row dying before their first task: the pool is broken
 _POOLS: weakref.WeakSet = weakref.WeakSet()  # live pools, killed at interpreter exit
@@ -105,103 +104,6 @@ def start_method() -> str:
     return "spawn"
 
 
-# --------------------------------------------------------------------------- pickling
-def _dumps(obj) -> bytes:
-    try:
-        return pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
-    except (pickle.PicklingError, AttributeError, TypeError):
-        try:
-            import cloudpickle
-        except ImportError:
-            raise
-        return cloudpickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
-
-
-# --------------------------------------------------------------------------- the worker side
-def _die_with_parent() -> None:
-    """Linux: the kernel sends SIGKILL to this process when its parent ends (no Python needed: a
-    worker busy in a compiled loop holding the GIL dies too)."""
-    if not sys.platform.startswith("linux"):
-        return
-    try:
-        import ctypes
-        import signal
-
-        libc = ctypes.CDLL(None, use_errno=True)
-        pr_set_pdeathsig = 1
-        libc.prctl(pr_set_pdeathsig, int(signal.SIGKILL), 0, 0, 0)
-    except (OSError, AttributeError):  # pragma: no cover - no prctl: the watchdog thread remains
-        pass
-
-
-def _watchdog() -> None:
-    """Portable fallback: end this worker as soon as its parent is gone (its sentinel fires)."""
-    parent = multiprocessing.parent_process()
-    if parent is None:  # pragma: no cover
-        return
-    parent.join()  # returns when the parent process has ended
-    os._exit(1)
-
-
-class _RemoteError(FemastError):
-    """An exception of a worker that could not be sent back as itself."""
-
-
-def _worker_main(conn, initializer, initargs) -> None:
-    """A worker: set up, then run tasks from ``conn`` until told to stop or the parent is gone."""
-    import signal
-
-    _die_with_parent()
-    parent = multiprocessing.parent_process()
-    if parent is not None and not parent.is_alive():  # the parent died before prctl took effect
-        os._exit(1)
-    threading.Thread(target=_watchdog, daemon=True, name="femast-watchdog").start()
-    try:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
-    except (ValueError, OSError):  # pragma: no cover
-        pass
-    from . import jit
-
-    jit.notice_to(lambda: conn.send_bytes(_COMPILING))  # (from the task's thread, between its replies)
-    if initializer is not None:
-        initializer(*pickle.loads(initargs))
-    conn.send_bytes(_dumps(None))  # ready: a task's time-out counts from now on
-    while True:
-        try:
-            msg = conn.recv_bytes()
-        except (EOFError, OSError):  # the parent is gone
-            break
-        if not msg:
-            break
-        task_id, fn, args, kwargs = pickle.loads(msg)
-        try:
-            reply = (task_id, True, fn(*args, **kwargs))
-        except BaseException as exc:  # sent back to the caller, who decides
-            reply = (task_id, False, _portable(exc))
-        try:
-            data = _dumps(reply)
-        except Exception as exc:
-            data = _dumps((task_id, False, _RemoteError(f"the task's result could not be sent back: {exc}")))
-        try:
-            conn.send_bytes(data)
-        except (EOFError, OSError):
-            break
-    os._exit(0)  # no exit handlers of the task code (thread pools of numba, tqdm monitors)
-
-
-def _portable(exc: BaseException) -> BaseException:
-    """``exc`` if it survives pickling, else a :class:`_RemoteError` with its type and text; the
-    worker's traceback goes along as a note."""
-    tb = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
-    try:
-        pickle.loads(_dumps(exc))
-    except Exception:
-        exc = _RemoteError(f"{type(exc).__name__}: {exc}")
-    if hasattr(exc, "add_note"):
-        exc.add_note(f"(in a worker process)\n{tb}")
-    return exc
-
-
 # --------------------------------------------------------------------------- the parent side
 class _Slot:
     """One worker process and the task it runs."""
@@ -231,7 +133,7 @@ class Pool(concurrent.futures.Executor):
         self.timeout_s = timeout_s
         self._ctx = multiprocessing.get_context(start_method())
         self._initializer = initializer
-        self._initargs = _dumps(tuple(initargs))
+        self._initargs = dumps(tuple(initargs))
         self._ids = itertools.count()
         self._queue = collections.deque()  # (task id, future, payload, timeout_s)
         self._lock = threading.Lock()
@@ -260,7 +162,7 @@ class Pool(concurrent.futures.Executor):
         """Run ``fn(*args, **kwargs)`` in a worker; ``timeout_s`` (s) overrides the pool's."""
         fut = concurrent.futures.Future()
         task_id = next(self._ids)
-        payload = _dumps((task_id, fn, args, kwargs))  # (here: a task that cannot be pickled fails in the caller)
+        payload = dumps((task_id, fn, args, kwargs))  # (here: a task that cannot be pickled fails in the caller)
         with self._lock:
             if self._closing:
                 raise RuntimeError(f"{self.name}: cannot submit to a pool that is shut down")
@@ -304,7 +206,7 @@ class Pool(concurrent.futures.Executor):
     def _start(self) -> _Slot:
         mine, theirs = self._ctx.Pipe(duplex=True)
         p = self._ctx.Process(
-            target=_worker_main,
+            target=worker_main,
             args=(theirs, self._initializer, self._initargs),
             name=f"femast-worker ({self.name})",
             daemon=True,
@@ -382,7 +284,7 @@ class Pool(concurrent.futures.Executor):
         try:
             while s.conn.poll():
                 data = s.conn.recv_bytes()
-                if data == _COMPILING:
+                if data == COMPILING:
                     from . import jit
 
                     jit.announce()  # (once per process: the tree's notice)
@@ -500,7 +402,5 @@ def _kill_all_at_exit() -> None:
         for s in pool._slots:
             _kill(s.process)
 
-
-import atexit  # noqa: E402
 
 atexit.register(_kill_all_at_exit)
