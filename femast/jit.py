@@ -7,9 +7,9 @@ the foreground.  The first time numba starts compiling a femast kernel, one noti
 for the whole process tree (a worker of :mod:`femast.workers` passes it on to its parent, which
 prints it once)::
 
-    femast: compiling femast's numba kernels (first run after an install or an update: about
-    1-3 min of CPU for a model that uses every element family; cached for later runs). `femast
-    warmup` does it ahead.
+    femast: compiling femast's numba kernels, once after an install or an update (about 30 s of
+    CPU for a small model, 1-3 min for every element family); later runs load them from the
+    cache. `femast warmup` does it ahead.
 
 and, on a terminal, a bar counts the kernels compiled, naming the current one.  ``femast --quiet``
 or ``FEMAST_QUIET=1`` silences both.  ``femast warmup`` (:mod:`femast.warmup`) compiles every
@@ -22,8 +22,9 @@ import sys
 import threading
 
 NOTICE = (
-    "femast: compiling femast's numba kernels (first run after an install or an update: about 1-3 min of CPU "
-    "for a model that uses every element family; cached for later runs). `femast warmup` does it ahead."
+    "femast: compiling femast's numba kernels, once after an install or an update (about 30 s of CPU for a "
+    "small model, 1-3 min for every element family); later runs load them from the cache. "
+    "`femast warmup` does it ahead."
 )
 
 _announced = False  # this process has claimed (or given up) the notice
