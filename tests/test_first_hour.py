@@ -76,13 +76,15 @@ def test_error_text_is_not_mixed_with_a_bar(monkeypatch, capsys, tmp_path):
 # ------------------------------------------------------------------ compile notice
 def _fake_event(module):
     return types.SimpleNamespace(
-        is_start=True, data={"dispatcher": types.SimpleNamespace(py_func=types.SimpleNamespace(__module__=module))}
+        is_start=True,
+        data={"dispatcher": types.SimpleNamespace(py_func=types.SimpleNamespace(__module__=module, __name__="kernel"))},
     )
 
 
 def test_compile_notice_once_per_process_and_only_for_femast(monkeypatch, capsys):
     monkeypatch.setattr(jit, "_announced", False)
-    monkeypatch.setattr(jit, "_shared", None)
+    monkeypatch.setattr(jit, "_delegate", None)
+    monkeypatch.setattr(jit, "_depth", 0)
     jit._on_start(_fake_event("numpy_user_module"))
     assert capsys.readouterr().err == ""
     jit._on_start(_fake_event("femast.rotations"))
@@ -94,7 +96,8 @@ def test_compile_notice_once_per_process_and_only_for_femast(monkeypatch, capsys
 
 def test_compile_notice_respects_quiet(monkeypatch, capsys):
     monkeypatch.setattr(jit, "_announced", False)
-    monkeypatch.setattr(jit, "_shared", None)
+    monkeypatch.setattr(jit, "_delegate", None)
+    monkeypatch.setattr(jit, "_depth", 0)
     monkeypatch.setenv("FEMAST_QUIET", "1")
     jit._on_start(_fake_event("femast.rotations"))
     assert capsys.readouterr().err == ""
