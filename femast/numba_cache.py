@@ -9,7 +9,7 @@ An installed package (a wheel under ``site-packages``) never changes one file at
 update rewrites every file, which invalidates every cache entry, so nothing is done there.  In a
 source checkout (an editable install, or the tree on ``PYTHONPATH``), :func:`configure`, called
 once by ``import femast``, points numba's cache at a folder named after a SHA-1 of the package's
-numba sources (every ``.py`` file that mentions numba)::
+numba sources (every ``.py`` file with a numba-compiled function)::
 
     femast/__pycache__/numba-<key>/          (or $NUMBA_CACHE_DIR/femast-<key>/ when that is set)
 
@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import shutil
 
 ENV = "FEMAST_NUMBA_CACHE_GUARD"
@@ -39,9 +40,16 @@ def is_source_checkout(root: str) -> bool:
     return not any(p in ("site-packages", "dist-packages") for p in parts)
 
 
+# a decorator naming a numba compiler (``@njit``, ``@numba.njit(...)``, ``@intrinsic``...) or a call
+# ``njit(...)``: the file compiles code that cached kernels may embed
+_COMPILES = re.compile(
+    rb"^[ \t]*@[ \t]*(?:\w+\.)*(?:njit|jit|vectorize|guvectorize|intrinsic|overload\w*|cfunc|stencil)\b|\bnjit\(", re.M
+)
+
+
 def source_key(root: str) -> str:
     """SHA-1 (16 hex digits) of the relative paths and contents of the ``.py`` files under
-    ``root`` that mention numba (``__pycache__`` and hidden folders skipped)."""
+    ``root`` that compile code with numba (``__pycache__`` and hidden folders skipped)."""
     h = hashlib.sha1()
     for dirpath, dirs, files in os.walk(root):
         dirs[:] = sorted(d for d in dirs if d != "__pycache__" and not d.startswith("."))
@@ -54,7 +62,7 @@ def source_key(root: str) -> str:
                     data = fh.read()
             except OSError:
                 continue
-            if b"numba" in data:
+            if _COMPILES.search(data):
                 h.update(os.path.relpath(path, root).encode() + b"\0" + data + b"\0")
     return h.hexdigest()[:16]
 

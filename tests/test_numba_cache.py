@@ -108,8 +108,8 @@ def test_two_processes_starting_at_once_after_an_edit(tmp_path):
 def test_the_key_follows_numba_sources_only(tmp_path):
     pkg = _package(tmp_path, "")
     key = numba_cache.source_key(str(pkg))
-    (pkg / "notes.py").write_text("TEXT = 'no compiled code here'\n")
-    assert numba_cache.source_key(str(pkg)) == key  # a file without numba: same kernels
+    (pkg / "notes.py").write_text("TEXT = 'no compiled code here, only numba in a docstring'\n")
+    assert numba_cache.source_key(str(pkg)) == key  # a file without compiled code: same kernels
     (pkg / "helper.py").write_text(HELPER.format(options="", factor="5.0"))
     assert numba_cache.source_key(str(pkg)) != key
 
