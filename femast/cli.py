@@ -234,12 +234,15 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None):
     import warnings
 
-    format_warning = warnings.formatwarning
+    from . import progress
+
+    format_warning, quiet = warnings.formatwarning, progress._QUIET
     warnings.formatwarning = _one_line_warnings(format_warning)
     try:
         return _main(argv)
-    finally:
+    finally:  # main() called from Python (tests, notebooks): the caller's settings come back
         warnings.formatwarning = format_warning
+        progress.set_quiet(quiet)
 
 
 def _one_line_warnings(python_format):

@@ -85,6 +85,8 @@ def test_compile_notice_once_per_process_and_only_for_femast(monkeypatch, capsys
     monkeypatch.setattr(jit, "_announced", False)
     monkeypatch.setattr(jit, "_delegate", None)
     monkeypatch.setattr(jit, "_depth", 0)
+    monkeypatch.setattr(progress, "_QUIET", False)  # (whatever an earlier test left)
+    monkeypatch.delenv("FEMAST_QUIET", raising=False)
     jit._on_start(_fake_event("numpy_user_module"))
     assert capsys.readouterr().err == ""
     jit._on_start(_fake_event("femast.rotations"))

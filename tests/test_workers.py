@@ -40,7 +40,11 @@ def _announces():
 
 
 def test_pool_results_errors_timeouts_and_dead_workers(monkeypatch, capsys):
+    from femast import progress
+
     monkeypatch.setattr(jit, "_announced", False)
+    monkeypatch.setattr(progress, "_QUIET", False)  # (whatever an earlier test left)
+    monkeypatch.delenv("FEMAST_QUIET", raising=False)
     with workers.Pool(2, timeout_s=60.0, name="test") as pool:
         assert list(pool.map(_square, range(7))) == [x * x for x in range(7)]
         with pytest.raises(KeyError, match="no such thing"):
