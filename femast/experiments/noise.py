@@ -370,16 +370,9 @@ def with_correlation(model: ChannelNoise, r, pinned=None) -> ChannelNoise:
     else:
         phi = 0.0
         if phi_hat > thr:  # the residual is correlated, its differences are not: a slow model error
-            why = (
-                f"no serial correlation in the noise: the residual's lag-1 autocorrelation {phi_hat:.2f} is above "
-                f"{thr:.2f} (the 99th percentile on white noise), but its differences allow at most {cap:.2f}: a "
-                "slowly varying model error, not correlated noise"
-            )
+            why = f"no serial correlation in the noise: the residual's lag-1 autocorrelation {phi_hat:.2f} is above {thr:.2f} (the 99th percentile on white noise), but its differences allow at most {cap:.2f}: a slowly varying model error, not correlated noise"  # noqa: E501
         else:
-            why = (
-                f"no serial correlation (lag-1 autocorrelation {phi_hat:.2f} <= {thr:.2f}, the 99th percentile on "
-                "white noise)"
-            )
+            why = f"no serial correlation (lag-1 autocorrelation {phi_hat:.2f} <= {thr:.2f}, the 99th percentile on white noise)"
         kind = base_kind
     sigma = model.sigma * math.sqrt(ar1_factor(phi0) / ar1_factor(phi))
     return ChannelNoise(

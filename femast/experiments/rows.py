@@ -37,7 +37,7 @@ def thin(data, max_rows: int | None = None, what: str = "compare"):
     k = math.ceil(n / limit)
     rows = np.arange(0, n, k)
     warnings.warn(
-        f"{data.path}: {n} rows; {what} uses every {k}th row ({rows.size} rows): the noise floor, fits and "
+        f"{data.path}: {n} rows; {what} uses one row in {k} ({rows.size} rows): the noise floor, fits and "
         f"tests are those of the subsample (--max-rows N to use more)",
         DataWarning,
         stacklevel=3,

@@ -73,9 +73,9 @@ SUFFIXES = {
 # be in, its pint name).  The scale measured/model of a column in unit U whose values are in V
 # is the number of V in one U.
 _LIKELY = {
-    "[length]": ("mm", "um", "cm", "inch", "ft", "m"),
+    "[length]": ("mm", "um", "cm", "inch", "m"),  # (not ft: 3.28x is within a default model's reach)
     "[force]": ("kN", "lbf", "mN", "N"),
-    "[torque]": ("N*mm", "kN*m", "lbf*inch", "lbf*ft", "N*m"),
+    "[torque]": ("N*mm", "kN*m", "lbf*inch", "N*m"),
     "[angle]": ("deg", "mrad", "arcsec", "arcmin", "urad", "rad"),
     "[frequency]": ("kHz", "mHz", "Hz"),  # (pint reads rpm and rad/s with rad = 1: no 2 pi)
 }

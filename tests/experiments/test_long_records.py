@@ -16,7 +16,7 @@ from femast.experiments.rows import thin
 def test_thin_keeps_every_kth_row_and_their_file_lines():
     exp = get_experiment("mast-top")
     data = read_data(exp, examples.for_experiment("mast-top"))  # 500 rows
-    with pytest.warns(DataWarning, match=r"500 rows; compare uses every 3th row \(167 rows\)"):
+    with pytest.warns(DataWarning, match=r"500 rows; compare uses one row in 3 \(167 rows\)"):
         small = thin(data, 200)
     np.testing.assert_array_equal(small["dx_m"], data["dx_m"][::3])
     np.testing.assert_array_equal(small.lines, data.lines[::3])
