@@ -332,6 +332,8 @@ def test_slack_guys_are_in_equilibrium_and_engage_past_the_slack():
     np.testing.assert_allclose(k * u + k_g * np.sign(u) * np.maximum(np.abs(u) - th_s, 0.0), m, rtol=1e-12, atol=1e-12)
     inside = np.abs(m) <= k * th_s
     np.testing.assert_allclose(u[inside], m[inside] / k)
+    one = mech.slack_guys_rotation(m, k, k_g, th_s, sides=1)  # one guy, on the positive side
+    np.testing.assert_allclose(k * one + k_g * np.maximum(one - th_s, 0.0), m, rtol=1e-12, atol=1e-12)
 
 
 def test_preisach_with_uniform_symmetric_relays_has_the_everett_branch():

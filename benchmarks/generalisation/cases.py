@@ -401,8 +401,9 @@ CASES = (
         "mast-top",
         "effect",
         ("progressive_stiffness",),
-        (_m("guys", "slack", k_g_rel=2.0, theta_s=0.5e-4),),
-        doc="two slack guys going taut past a rotation: the joint stiffens (no gap, no friction)",
+        (_m("guys", "slack", k_g_rel=2.0, theta_s=0.3e-4, sides=1),),
+        amp=20.0,
+        doc="a slack guy going taut past a rotation on one side: the joint stiffens that way (no gap, no friction)",
     ),
     Case(
         "mt_friction_preisach",
@@ -509,7 +510,7 @@ def _joint_rotation(m, k, mechs, t, tau):
         elif name == "viscous":
             u = viscous_joint(m, t, k, p["T"] * k)
         elif name == "guys":
-            u = mech.slack_guys_rotation(m, k, p["k_g_rel"] * k, p["theta_s"])
+            u = mech.slack_guys_rotation(m, k, p["k_g_rel"] * k, p["theta_s"], p.get("sides", 2))
         elif name == "preisach":
             u = mech.preisach_joint_rotation(m, k, p["c"], p["M_max"])
         elif name == "creep":

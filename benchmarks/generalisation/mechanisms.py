@@ -261,13 +261,15 @@ def cantilever_compliance(L: float, sections, shear_GA: float | None = None):
 
 
 # --------------------------------------------------------------------------- guys, relays, creep
-def slack_guys_rotation(m, k: float, k_g: float, theta_s: float) -> np.ndarray:
-    """A joint of stiffness k braced by two opposite guys, each slack by the rotation ``theta_s``:
-    ``m = k u + k_g sign(u) <|u| - theta_s>`` (a guy pulls once the joint has turned past its slack),
-    so ``u = m / k`` while ``|m| <= k theta_s``, else ``sign(m) (|m| + k_g theta_s) / (k + k_g)``."""
+def slack_guys_rotation(m, k: float, k_g: float, theta_s: float, sides: int = 2) -> np.ndarray:
+    """A joint of stiffness k braced by guys, each slack by the rotation ``theta_s``: one guy per side
+    (``sides`` 2), or one guy only, on the side of positive rotation (``sides`` 1).  A guy pulls once
+    the joint has turned past its slack: ``m = k u + k_g <|u| - theta_s>`` on a braced side, so
+    ``u = m / k`` while ``|m| <= k theta_s``, else ``sign(m) (|m| + k_g theta_s) / (k + k_g)``."""
     m = np.asarray(m, float)
     a = np.abs(m)
-    return np.where(a <= k * theta_s, m / k, np.sign(m) * (a + k_g * theta_s) / (k + k_g))
+    braced = np.where(a <= k * theta_s, m / k, np.sign(m) * (a + k_g * theta_s) / (k + k_g))
+    return braced if sides == 2 else np.where(m > 0, braced, m / k)
 
 
 def preisach_relays(alpha, beta, weights, u) -> np.ndarray:
