@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import connection as conn
 from . import mechanisms as mech
 from . import noise as nz
 from .rigs import (
@@ -42,6 +43,12 @@ SIGMA_LOADCELL_N = 0.5  # load cell noise (N), latch pull
 EQ15 = {"C": 2.5e-6, "sigma_T": 0.4, "sigma_d": 8e-6}  # cable compliance m/N, load-cell N, distance m
 AR_PHI = 0.6  # lag-1 autocorrelation of the correlated noise
 STUDENT_NU = 3.0  # degrees of freedom of the heavy-tailed noise
+# joint test (a connection on an actuator): elastic stiffness, protocols, noise of the two channels
+JT_K = 2.0e6  # N/m
+JT_AMPS_N, JT_STEP_N = (2.0e3, 4.0e3, 6.0e3, 8.0e3), 40.0  # force protocol (N)
+JT_AMPS_M, JT_STEP_M = (1.0e-3, 2.0e-3, 3.0e-3, 4.0e-3), 0.04e-3  # displacement protocol (m)
+JT_SIGMA_U, JT_SIGMA_F = 20e-6, 20.0  # displacement transducer (m), load cell (N)
+JT_QUANTUM_U, JT_QUANTUM_F = 10e-6, 10.0  # the resolution of a test recorded to 0.01 mm and 0.01 kN
 SPIKES, SPIKE_N = 12, 10.0  # single-sample spikes per latch-pull data set, their largest size (N)
 
 
@@ -660,7 +667,36 @@ def _latch(case: Case, rng) -> dict:
     return {"x_mm": 1e3 * xm, "dT_N": dTm, "t_s": t}
 
 
+# =========================================================================== joint test
+def _joint(case: Case, rng) -> dict:
+    """A connection cycled on an actuator: the BWBN connection driven through a displacement
+    protocol (its force measured), or an elastic connection (with a clearance) driven through a
+    force protocol; both channels measured with noise."""
+    bw = [p for name, _, p in case.mechanisms if name == "bwbn"]
+    if bw:
+        u, _ = conn.cyclic_protocol(JT_AMPS_M, step=JT_STEP_M)
+        F = conn.bwbn_driven(u, conn.BWBN(**bw[0]), substeps=8)
+    else:
+        F, _ = conn.cyclic_protocol(JT_AMPS_N, step=JT_STEP_N)
+        u = F / JT_K
+        for name, _form, p in case.mechanisms:
+            if name == "clearance":
+                u = u + mech.clearance_hertz(F, p["c"], p["k0"], p["K"])
+    n = u.size
+    if case.noise == "white":
+        um = u + nz.white(rng, n, JT_SIGMA_U * case.level)
+        Fm = F + nz.white(rng, n, JT_SIGMA_F * case.level)
+    elif case.noise == "quantised":  # a little noise, then the recorder's resolution
+        um = JT_QUANTUM_U * np.round((u + nz.white(rng, n, 0.3 * JT_QUANTUM_U)) / JT_QUANTUM_U)
+        Fm = JT_QUANTUM_F * np.round((F + nz.white(rng, n, 0.3 * JT_QUANTUM_F)) / JT_QUANTUM_F)
+    else:
+        raise ValueError(f"noise {case.noise!r} is not a joint-test noise model (white, quantised)")
+    return {"F_N": Fm, "u_m": um}
+
+
 def generate(case: Case, seed: int) -> dict:
     """Data columns (in the experiment's units) of one draw of ``case``."""
     rng = np.random.default_rng(seed)
+    if case.experiment == "joint-test":
+        return _joint(case, rng)
     return _mast(case, rng) if case.experiment == "mast-top" else _latch(case, rng)

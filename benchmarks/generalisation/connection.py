@@ -93,13 +93,14 @@ def bwbn_driven(u, c: BWBN, substeps: int = 20, state: bool = False):
     return (F, Z, E) if state else F
 
 
-def cyclic_protocol(amplitudes_m, trailing: int = 2, trailing_share: float = 0.75, rows_per_mm: float = 10.0):
-    """A displacement protocol of connection tests (m): for each amplitude a primary cycle, then
-    ``trailing`` cycles at ``trailing_share`` of it (the CUREE protocol's shape); rows spaced about
-    ``1 / rows_per_mm`` mm along the path.  Returns the path and the index of the cycle of each row."""
+def cyclic_protocol(amplitudes, trailing: int = 2, trailing_share: float = 0.75, step: float = 1e-4):
+    """A cyclic protocol of connection tests (in the unit of ``amplitudes``: m, or N for a force
+    protocol): for each amplitude a primary cycle, then ``trailing`` cycles at ``trailing_share`` of
+    it (the CUREE protocol's shape); rows about ``step`` apart along the path.  Returns the path and
+    the index of the cycle of each row."""
     peaks, cyc = [], []
     k = 0
-    for a in amplitudes_m:
+    for a in amplitudes:
         for amp in [a] + [trailing_share * a] * trailing:
             peaks += [amp, -amp, 0.0]
             cyc += [k, k, k]
@@ -108,7 +109,7 @@ def cyclic_protocol(amplitudes_m, trailing: int = 2, trailing_share: float = 0.7
     cycle = [np.zeros(1, dtype=int)]
     last = 0.0
     for p, g in zip(peaks, cyc):
-        m = max(2, int(np.ceil(abs(p - last) * 1e3 * rows_per_mm)))
+        m = max(2, int(np.ceil(abs(p - last) / step)))
         path.append(np.linspace(last, p, m + 1)[1:])
         cycle.append(np.full(m, g))
         last = p
