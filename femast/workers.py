@@ -148,6 +148,9 @@ class Pool(concurrent.futures.Executor):
         self._thread.start()
         self._started.wait()
         _POOLS.add(self)
+        if self._broken is not None:
+            self._thread.join(STOP_WAIT_S)
+            raise WorkerDied(self._broken)
 
     @property
     def workers(self) -> int:
@@ -225,11 +228,17 @@ class Pool(concurrent.futures.Executor):
         try:
             try:
                 self._slots.extend(self._start() for _ in range(self._n))
+            except BaseException as exc:  # e.g. Python refusing to start a process while a worker imports
+                with self._lock:
+                    self._broken = f"{self.name}: cannot start worker processes ({type(exc).__name__}: {exc})"
+                raise
             finally:
                 self._started.set()
             self._loop()
-        except BaseException as exc:  # pragma: no cover - a bug here must not hang the caller
-            self._fail_all(f"{self.name}: the pool's manager failed ({type(exc).__name__}: {exc})")
+        except BaseException as exc:  # a bug here must not hang the caller
+            with self._lock:
+                self._broken = self._broken or f"{self.name}: the pool's manager failed ({type(exc).__name__}: {exc})"
+            self._fail_all(self._broken)
         finally:
             _stop_all(self._slots)
             self._wake_r.close()
