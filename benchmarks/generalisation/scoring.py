@@ -104,7 +104,9 @@ def is_right(expect: str, expected_effects, verdict: dict) -> bool:
     if expect == "ool":
         return kind in ("not_explained", "form_imperfect")
     if expect == "time":
-        return kind == "not_explained" or (kind in ("missing", "form_imperfect") and bool(named) and named <= TIME_EFFECTS)
+        return kind == "not_explained" or (
+            kind in ("missing", "form_imperfect") and bool(named) and named <= TIME_EFFECTS
+        )
     if kind not in ("missing", "form_imperfect"):
         return False
     return named == set(expected_effects)
