@@ -35,7 +35,9 @@ API (a :class:`concurrent.futures.Executor`)::
   (which runs in every worker as it starts, replacements included) and keep them in a module
   global of the worker, rather than with every task.
 * ``timeout_s`` (s, per task, from the moment a worker takes it; ``submit(..., timeout_s=...)``
-  overrides it for one task).  ``None``: no limit.
+  overrides it for one task).  ``None``: no limit.  ``start_timeout_s`` (s) bounds a worker's
+  start (import and ``initializer``); workers that die or hang as they start, three in a row,
+  end the pool: every task then fails with :class:`~femast.errors.WorkerDied`.
 * Leaving the ``with`` block normally waits for the submitted tasks; leaving it by an exception
   (Ctrl-C included) kills the workers at once.  :meth:`Pool.kill` does that explicitly.
 * A worker ignores SIGINT (Ctrl-C is its parent's to handle), and prints no first-run compile
