@@ -62,30 +62,18 @@ def _sigmas(arg) -> dict:
     return out
 
 
-def _first_sentence(text: str) -> str:
-    """The first sentence of ``text`` on one line."""
-    text = " ".join((text or "").split())
-    for i in range(len(text) - 1):
-        if (
-            text[i] == "."
-            and text[i + 1] == " "
-            and not text[max(0, i - 3) : i].endswith(("Eq", "Sec", "e.g", "i.e", "Fig", "Eqs", "Tab"))
-        ):
-            return text[: i + 1]
-    return text
-
-
 def experiment_rows() -> list[dict]:
     """Every registered experiment: name, title, its example data file (or None), its effects."""
     from . import examples
     from .effects import applicable_effects
     from .experiments import list_experiments
+    from .text import first_sentence
 
     return [
         {
             "name": e.name,
             "title": e.title,
-            "physics": _first_sentence(e.doc) if e.doc else e.title,
+            "physics": first_sentence(e.doc) if e.doc else e.title,
             "example": examples.BY_EXPERIMENT.get(e.name),
             "effects": [f.name for f in applicable_effects(e)],
         }
@@ -98,6 +86,7 @@ def effect_rows(experiment=None) -> list[dict]:
     sentence of physics, the registered experiments it applies to, the quantities its mechanism needs."""
     from .effects import list_effects
     from .experiments import list_experiments
+    from .text import first_sentence
 
     experiments = list_experiments()
     rows = []
@@ -109,7 +98,7 @@ def effect_rows(experiment=None) -> list[dict]:
             {
                 "name": e.name,
                 "title": e.title,
-                "physics": _first_sentence(e.physics),
+                "physics": first_sentence(e.physics),
                 "experiments": [x.name for x in experiments if e.applies_to(x)],
                 "quantities": [k for k in ("load", "displacement", "time", "temperature") if k in (m.hook, *m.needs)]
                 if m is not None
@@ -125,10 +114,17 @@ def _experiments(args):
     if args.json:
         print(json.dumps(rows, indent=2))
         return
-    print("experiments (femast compare|diagnose EXPERIMENT DATA.csv; DATA 'example' uses the shipped example):")
+    from .text import hanging
+
+    print(
+        hanging(
+            "experiments", "(femast compare|diagnose EXPERIMENT DATA.csv; DATA 'example' uses the shipped example):", 0
+        )
+    )
+    pad = 2 + max(len(r["name"]) for r in rows) + 1
     for r in rows:
-        print(f"  {r['name']:<12s} {r['title']}")
-        print(f"  {'':<12s} example data: {r['example'] or '(none shipped)'}; effects: {', '.join(r['effects'])}")
+        print(hanging(f"  {r['name']}", r["title"], pad))
+        print(hanging("", f"example data: {r['example'] or '(none shipped)'}; effects: {', '.join(r['effects'])}", pad))
 
 
 def _effects(args):
@@ -141,11 +137,14 @@ def _effects(args):
     if args.json:
         print(json.dumps(rows, indent=2))
         return
+    from .text import hanging
+
     print(f"effects{' of ' + exp.name if exp else ''} (femast compare ... --effects NAME[,NAME]):")
+    pad = 2 + max((len(r["name"]) for r in rows), default=0) + 1
     for r in rows:
         where = r["experiments"] + ([f"any rig with {' + '.join(r['quantities'])}"] if r["quantities"] else [])
-        print(f"  {r['name']:<22s} {r['title']} [{', '.join(where)}]")
-        print(f"  {'':<22s} {r['physics']}")
+        print(hanging(f"  {r['name']}", f"{r['title']} [{', '.join(where)}]", pad))
+        print(hanging("", r["physics"], pad))
 
 
 def _examples(args):
@@ -161,10 +160,13 @@ def _examples(args):
         print(f"copied {len(examples.names())} example files to {dest}")
         return
     by_file = {v: k for k, v in examples.BY_EXPERIMENT.items()}
+    from .text import hanging
+
     print(f"example data shipped with femast (in {examples.FOLDER}):")
+    pad = 2 + max(len(n) for n in examples.names()) + 1
     for n in examples.names():
-        use = f"  ('example' for {by_file[n]})" if n in by_file else ""
-        print(f"  {n:<30s} {examples.describe(n)}{use}")
+        use = f" ('example' for {by_file[n]})" if n in by_file else ""
+        print(hanging(f"  {n}", examples.describe(n) + use, pad))
 
 
 def resolve_data(exp, data: str):
@@ -180,18 +182,36 @@ def resolve_data(exp, data: str):
     return Path(data), data
 
 
+def _check_order(args) -> None:
+    """``femast compare example mast-top``: the experiment and the data the wrong way round."""
+    from .errors import FemastError
+    from .experiments import list_experiments
+
+    names = {e.name for e in list_experiments()}
+    first = args.experiment
+    second = args.data[0] if isinstance(args.data, list) else args.data
+    if first not in names and not first.endswith(".py") and (second in names or second.endswith(".py")):
+        raise FemastError(
+            f"'{first}' is not an experiment but '{second}' is: the experiment comes first, then the data "
+            f"(femast {args.command} {second} {first})"
+        )
+
+
 def _setup(args):
     from dataclasses import replace
 
     from .experiments import get_experiment, read_data
 
+    _check_order(args)
     exp = get_experiment(args.experiment)
     effects = _effect_names(getattr(args, "effects", None))
     exp.require_model(f"femast {args.command}")
     items = args.data if isinstance(args.data, list) else [args.data]
     found = [resolve_data(exp, d) for d in items]
     paths, shown = [f[0] for f in found], [f[1] for f in found]
-    data = read_data(exp, paths, time_continuous=args.continuous_time, offsets=args.group_offsets)
+    data = read_data(
+        exp, paths, getattr(args, "units", None), time_continuous=args.continuous_time, offsets=args.group_offsets
+    )
     if len(paths) == 1:
         data = replace(data, path=shown[0])
     stem = Path(shown[0].split()[-1]).stem + (f"_and_{len(paths) - 1}_more" if len(paths) > 1 else "")
@@ -227,9 +247,10 @@ def _compare(args):
     if args.params_from:
         params, run_effects = params_from(args.params_from)
         effects = effects or run_effects
-    res = compare(exp, data, effects, fit=args.fit, params=params, out=out, sigma=_sigmas(args.sigma))
+    res = compare(
+        exp, data, effects, fit=args.fit, params=params, out=out, sigma=_sigmas(args.sigma), max_rows=args.max_rows
+    )
     print(json.dumps(res.report, indent=2) if args.json else format_compare(exp, res))
-    _freeze_heap_for_exit()
 
 
 def _diagnose(args):
@@ -246,19 +267,9 @@ def _diagnose(args):
         workers=args.workers,
         scheduler=args.scheduler,
         out=out,
+        max_rows=args.max_rows,
     )
     print(json.dumps(res.report, indent=2) if args.json else format_diagnose(exp, res))
-    _freeze_heap_for_exit()
-
-
-def _freeze_heap_for_exit():
-    """The command's files are written and closed: move every object to the garbage collector's
-    permanent generation, so that the interpreter's shutdown does not search the whole heap (numba's
-    typing and code objects, matplotlib) for cycles -- 0.5-0.7 s of the bay-torsion diagnosis at a
-    load of 5, 0.1 s with this.  Objects are still released by reference counting at exit."""
-    import gc
-
-    gc.freeze()
 
 
 def register(subparsers, fmt=None) -> None:
@@ -285,6 +296,11 @@ def register(subparsers, fmt=None) -> None:
     )
     offsets_help = (
         "fit a zero of its own for every group and channel, e.g. sensors zeroed at each station (default: no)"
+    )
+    units_help = (
+        "the unit the values of a column are in when its header says another, COLUMN=UNIT[,...] "
+        "(e.g. dx_m=mm; a header may also carry the unit itself, dx_mm); naming the header's own unit "
+        "(dx_m=m) confirms it and skips the size check of that column (default: the headers' units)"
     )
     out_help = "output folder (default: ./%(prog_cmd)s/EXPERIMENT_DATASTEM in the working directory)"
     sigma_help = (
@@ -325,6 +341,13 @@ def register(subparsers, fmt=None) -> None:
         help="take the parameters (and effects) of an earlier compare, its output folder or compare.json: fit on "
         "one data set, score another (with --fit: start the fit there) (default: the model's defaults)",
     )
+    p.add_argument("--units", default=None, help=units_help)
+    p.add_argument(
+        "--max-rows",
+        type=int,
+        default=10_000,
+        help="rows used at most: a longer record is thinned to every k-th row, and femast says so",
+    )
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.set_defaults(func=_compare)
     p = subparsers.add_parser(
@@ -342,6 +365,13 @@ def register(subparsers, fmt=None) -> None:
     p.add_argument("--group-offsets", action="store_true", help=offsets_help)
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "diagnose"})
     p.add_argument("--sigma", default=None, help=sigma_help)
+    p.add_argument("--units", default=None, help=units_help)
+    p.add_argument(
+        "--max-rows",
+        type=int,
+        default=10_000,
+        help="rows used at most: a longer record is thinned to every k-th row, and femast says so",
+    )
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.add_argument(
         "--workers",

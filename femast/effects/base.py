@@ -55,7 +55,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
-from ..errors import ModelError
+from ..errors import ModelError, did_you_mean
 from .parameters import Parameter  # noqa: F401  (re-exported: effects declare Parameters)
 from .quantities import ALWAYS, HOOKS
 from .scripts import effects_of_script, load_script, loaded_scripts  # noqa: F401  (re-exported)
@@ -237,7 +237,9 @@ def get_effect(name: str) -> Effect:
     try:
         return _REGISTRY[name]
     except KeyError:
-        raise ModelError(f"unknown effect '{name}'; accepted effects: {', '.join(sorted(_REGISTRY))}") from None
+        raise ModelError(
+            f"unknown effect '{name}'{did_you_mean(name, _REGISTRY)}; accepted effects: {', '.join(sorted(_REGISTRY))}"
+        ) from None
 
 
 def list_effects() -> tuple:
@@ -277,7 +279,8 @@ def resolve(experiment, names) -> list:
         seen.add(name)
         if name not in _REGISTRY:
             raise ModelError(
-                f"unknown effect '{name}' for {experiment.name}; accepted effects: {', '.join(ok) or '(none)'}"
+                f"unknown effect '{name}' for {experiment.name}{did_you_mean(name, ok or _REGISTRY)}; "
+                f"accepted effects: {', '.join(ok) or '(none)'}"
             )
         eff = _REGISTRY[name]
         impl = eff.implementation(experiment)

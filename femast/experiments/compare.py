@@ -30,6 +30,8 @@ from .residuals import (
     signatures,
     turning_points,
 )
+from .rows import thin
+from .units import check_data as check_units
 
 
 def load_path(exp: Experiment, data: Measured) -> np.ndarray:
@@ -89,6 +91,7 @@ def compare(
     history: bool = True,
     noise=None,
     sigma=None,
+    max_rows: int | None = None,
 ) -> OptimizeResult:
     """Run the model variant (baseline + ``effects``) along the measured path of ``data``.
 
@@ -103,6 +106,8 @@ def compare(
     out : output folder for ``compare.json``, ``compare.png``, ``history.jsonl``, ``history.png`` and
         ``compare_report.html`` (self-contained, figures inlined; nothing is written if None).
         history : append the run to the history file.
+    max_rows : above this many rows (default 10 000), every k-th row is used and a DataWarning
+        says so (:mod:`femast.experiments.rows`).
 
     Returns an ``OptimizeResult`` with ``experiment``, ``n_samples``, ``effects``, ``fitted``,
     ``run`` (the model run/fit result), ``params`` (``{name: value}`` of every parameter: the
@@ -115,6 +120,8 @@ def compare(
     ``report`` (JSON dict), ``files``, ``version`` (in the history, or None), ``success``, ``message``.
     """
     exp.require_model("compare")
+    data = thin(data, max_rows, "compare")  # a long record: every k-th row (femast.experiments.rows)
+    check_units(exp, data)  # a unit mistake (mm under an m header) stops here, naming the column
     if isinstance(effects, str):
         effects = [e for e in effects.split(",") if e.strip()]
     effects = list(effects)

@@ -33,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import progress
 from ..errors import DataFileError
 from .core import Experiment, Measured
 
@@ -156,60 +157,32 @@ def check_header(exp: Experiment, header, path: str = "<arrays>", line: int = 1)
     return names
 
 
-def read_data(exp: Experiment, path, *, time_continuous: bool = False, offsets: bool = False) -> Measured:
-    """Read and check a measured-data file of experiment ``exp`` (see the module docstring), or
-    several: ``path`` a list of files, each a group of the data (its rows' ``group`` labels prefixed
-    by the file name where it has a ``group`` column).
-
-    time_continuous : the files (or groups) are one test whose time goes on from one to the next,
-        rather than separate tests whose time restarts (:class:`~femast.experiments.measured.Measured`).
-    offsets : fit a zero of its own for every group and channel.
-
-    Returns a :class:`~femast.experiments.measured.Measured` whose ``lines`` give the file line of
-    every row.  Raises :class:`~femast.errors.DataFileError` on any malformed content.
-    """
-    if isinstance(path, (list, tuple)):
-        if len(path) == 1:
-            path = path[0]
-        else:
-            return combine([read_data(exp, p) for p in path], time_continuous=time_continuous, offsets=offsets)
-    data = _read_one(exp, path)
-    data.time_continuous, data.offsets = bool(time_continuous), bool(offsets)
-    return data
-
-
-def _read_one(exp: Experiment, path) -> Measured:
-    path = Path(path)
-    if not path.is_file():
-        raise DataFileError(f"{path}: no such data file")
-    header, header_line, rows, lines = None, 0, [], []
-    with open(path, newline="", encoding="utf-8-sig") as fh:
-        reader = csv.reader(fh)
+def _fast_values(exp: Experiment, header, rows, ncol: int):
+    """The (rows, columns) values when every row has ``ncol`` cells and every cell of a column
+    without words (codes) is a plain ASCII decimal number, finite; None otherwise (the cell-by-cell
+    reader then finds and names the first bad cell)."""
+    if any(len(cells) != ncol for cells in rows):
+        return None
+    values = np.empty((len(rows), ncol))
+    for c, column in enumerate(zip(*rows)) if rows else ():
+        if exp.column(header[c]).codes:
+            return None
+        text = ",".join(column)
+        if not text.isascii() or "_" in text:  # digit separators, other scripts' digits: looked at one by one
+            return None
         try:
-            for cells in reader:
-                line = reader.line_num
-                if not cells or not "".join(cells).strip() or cells[0].lstrip().startswith("#"):
-                    continue
-                if header is None:
-                    if len(cells) == 1:
-                        err = _separator_error(path, line, cells[0], exp)
-                        if err is not None:
-                            raise err
-                    header, header_line = check_header(exp, cells, str(path), line), line
-                    continue
-                rows.append(cells)
-                lines.append(line)
-        except csv.Error as exc:
-            raise DataFileError(f"{path} line {reader.line_num}: not valid CSV ({exc})") from None
-        except UnicodeDecodeError as exc:
-            raise DataFileError(f"{path}: not a text (UTF-8) CSV file ({exc.reason})") from None
-    if header is None:
-        raise DataFileError(
-            f"{path}: no header row; the first non-comment line must name the columns: {_accepted(exp)}"
-        )
+            values[:, c] = np.array(column, dtype=float)
+        except ValueError:
+            return None
+    if not np.all(np.isfinite(values)):
+        return None
+    return values
+
+
+def _cell_values(exp: Experiment, header, rows, lines, path, header_line) -> np.ndarray:
+    """The values read cell by cell, raising DataFileError at the first bad cell."""
     ncol = len(header)
     values = np.empty((len(rows), ncol))
-    labels = []
     for r, (cells, line) in enumerate(zip(rows, lines)):
         if len(cells) != ncol:
             raise DataFileError(
@@ -217,14 +190,6 @@ def _read_one(exp: Experiment, path) -> Measured:
                 f"{ncol} columns ({', '.join(header)})"
             )
         for c, text in enumerate(cells):
-            if header[c] == "group":
-                if not text.strip():
-                    raise DataFileError(
-                        f"{path} line {line}, column 'group': an empty cell; every row needs its group's label"
-                    )
-                labels.append(text.strip())
-                values[r, c] = 0.0
-                continue
             col = exp.column(header[c])
             s = text.strip()
             codes = dict((t.lower(), v) for t, v in col.codes)
@@ -244,10 +209,105 @@ def _read_one(exp: Experiment, path) -> Measured:
                     "(remove the row or fill in the value)"
                 )
             values[r, c] = v
+    return values
+
+
+def _group_labels(header, rows, lines, path) -> list:
+    """The labels of the ``group`` column (any text), each cell replaced by ``0`` for the number
+    reader; [] without a group column.  Rows of the wrong length are left to the number reader."""
+    if "group" not in header:
+        return []
+    g, labels = header.index("group"), []
+    for cells, line in zip(rows, lines):
+        if len(cells) != len(header):
+            continue
+        label = cells[g].strip()
+        if not label:
+            raise DataFileError(f"{path} line {line}, column 'group': an empty cell; every row needs its group's label")
+        labels.append(label)
+        cells[g] = "0"
+    return labels
+
+
+def read_data(exp: Experiment, path, units=None, *, time_continuous: bool = False, offsets: bool = False) -> Measured:
+    """Read and check a measured-data file of experiment ``exp`` (see the module docstring), or
+    several: ``path`` a list of files, each a group of the data (its rows' ``group`` labels prefixed
+    by the file name where it has a ``group`` column).
+
+    A header may name a column in another unit (``dx_mm`` for ``dx_m``): its values are converted
+    (:mod:`femast.experiments.units`).  ``units``: ``{column: unit}`` or ``"dx_m=mm,fx_N=lbf"``,
+    the unit the values of a column are really in (a header that says the wrong unit).
+    time_continuous : the files (or groups) are one test whose time goes on from one to the next,
+        rather than separate tests whose time restarts (:class:`~femast.experiments.measured.Measured`).
+    offsets : fit a zero of its own for every group and channel.
+
+    Returns a :class:`~femast.experiments.measured.Measured` whose ``lines`` give the file line of
+    every row.  Raises :class:`~femast.errors.DataFileError` on any malformed content.
+    """
+    from .units import CONFIRMED
+
+    if isinstance(path, (list, tuple)):
+        if len(path) == 1:
+            path = path[0]
+        else:
+            parts = [read_data(exp, p, units) for p in path]
+            data = combine(parts, time_continuous=time_continuous, offsets=offsets)
+            data.cache[CONFIRMED] = parts[0].cache.get(CONFIRMED, ())  # the same --units for every file
+            return data
+    data = _read_one(exp, path, units)
+    data.time_continuous, data.offsets = bool(time_continuous), bool(offsets)
+    return data
+
+
+def _read_one(exp: Experiment, path, units) -> Measured:
+    from . import units as _units
+
+    override = _units.parse_override(units)
+    path = Path(path)
+    if not path.is_file():
+        raise DataFileError(f"{path}: no such data file")
+    header, header_line, rows, lines = None, 0, [], []
+    with open(path, newline="", encoding="utf-8-sig") as fh, progress.task(f"reading {path.name}", "rows", 2.0) as bar:
+        reader = csv.reader(fh)
+        try:
+            for cells in reader:
+                if len(rows) % 100_000 == 99_999:  # a long record: the count moves
+                    bar.update(100_000)
+                line = reader.line_num
+                if not cells or not "".join(cells).strip() or cells[0].lstrip().startswith("#"):
+                    continue
+                if header is None:
+                    if len(cells) == 1:
+                        err = _separator_error(path, line, cells[0], exp)
+                        if err is not None:
+                            raise err
+                    named, factors = _units.header_columns(exp, [c.strip() for c in cells], f"{path} line {line}")
+                    header, header_line = check_header(exp, named, str(path), line), line
+                    continue
+                rows.append(cells)
+                lines.append(line)
+        except csv.Error as exc:
+            raise DataFileError(f"{path} line {reader.line_num}: not valid CSV ({exc})") from None
+        except UnicodeDecodeError as exc:
+            raise DataFileError(f"{path}: not a text (UTF-8) CSV file ({exc.reason})") from None
+    if header is None:
+        raise DataFileError(
+            f"{path}: no header row; the first non-comment line must name the columns: {_accepted(exp)}"
+        )
+    ncol = len(header)
+    labels = _group_labels(header, rows, lines, path)
+    values = _fast_values(exp, header, rows, ncol)  # whole columns at once: 2 million rows in seconds
+    if values is None:  # some cell needs looking at: cell by cell, naming the first bad one
+        values = _cell_values(exp, header, rows, lines, path, header_line)
     if len(rows) < exp.min_rows:
         raise DataFileError(
             f"{path}: {len(rows)} data row(s); {exp.name} needs at least {exp.min_rows} (one per sample, in time order)"
         )
+    scaled = _units.override_factors(exp, header, override, str(path))
+    for i, h in enumerate(header):
+        f = factors[i] * scaled.get(h, 1.0)
+        if f != 1.0:
+            values[:, i] *= f
     cols = {h: values[:, i] for i, h in enumerate(header) if h != "group"}
     check_values(exp, cols, str(path), lines)
     if "t_s" in cols and np.any(np.diff(cols["t_s"]) < 0):
@@ -257,7 +317,9 @@ def _read_one(exp: Experiment, path) -> Measured:
             f"({cols['t_s'][bad - 1]:g} s then {cols['t_s'][bad]:g} s); rows must be in time order"
         )
     groups, names = group_codes(labels) if labels else (None, ())
-    return Measured(exp.name, cols, str(path), np.asarray(lines), groups=groups, group_names=names)
+    data = Measured(exp.name, cols, str(path), np.asarray(lines), groups=groups, group_names=names)
+    data.cache[_units.CONFIRMED] = tuple(c for c, f in scaled.items() if f == 1.0)  # --units dx_m=m
+    return data
 
 
 def group_codes(labels) -> tuple:

@@ -70,6 +70,8 @@ from .refits import (  # noqa: F401
     _serial_refits,
 )
 from .residuals import AT_NOISE, at_noise_threshold  # noqa: F401  (AT_NOISE: re-exported)
+from .rows import thin
+from .units import check_data as check_units
 from .verdict import SIGNIFICANT_DBIC, conclude  # noqa: F401  (SIGNIFICANT_DBIC: re-exported)
 
 
@@ -86,6 +88,7 @@ def diagnose(
     out=None,
     pairs: bool = True,
     heldout: bool = True,
+    max_rows: int | None = None,
 ) -> OptimizeResult:
     """Refit the model with each candidate effect (every form), pairs of the best, and conclude.
 
@@ -94,8 +97,9 @@ def diagnose(
         criterion picks the form.  exclude : effect names not to try (e.g. one whose refit is known
         to fail, or a mechanism the rig cannot have).
     sigma : ``{channel: level}`` the sensor uncertainty of channels (their units; ``sigma_`` columns
-        give it per row): the noise model's first source (:mod:`femast.experiments.noise`).  base_effects : effects already in the model being diagnosed
-        (names or ``effect/form``); their other forms are refitted first (a shape mismatch).
+        give it per row): the noise model's first source (:mod:`femast.experiments.noise`).
+    base_effects : effects already in the model being diagnosed (names or ``effect/form``); their
+        other forms are refitted first (a shape mismatch).
     workers : local worker processes (default: the number of CPUs, unless the refits are estimated
         -- six times the baseline fit time each -- to take less than ``SERIAL_BELOW_S`` = 1 s in all,
         which is less than starting the processes costs; 1 runs in this process).
@@ -107,6 +111,8 @@ def diagnose(
         (:mod:`femast.experiments.heldout`: leave-one-group-out, else leave-one-block-of-cycles-out):
         a candidate is kept only if it lowers the held-out error, a pair only if it beats its best
         member held out too.
+    max_rows : above this many rows (default 10 000), every k-th row is used and a DataWarning
+        says so (:mod:`femast.experiments.rows`).
 
     The stages, in order (each a function of its module, reading and writing a
     :class:`~femast.experiments.diagnosis.Diagnosis`): the baseline fit and the noise model its refits
@@ -126,6 +132,8 @@ def diagnose(
     document), ``executor``, ``files``, ``success``, ``message``.
     """
     exp.require_model("diagnose")
+    data = thin(data, max_rows, "diagnose")  # a long record: every k-th row (femast.experiments.rows)
+    check_units(exp, data)  # a unit mistake (mm under an m header) stops here, naming the column
     # the figure is drawn by a process forked now, which imports matplotlib while this one fits the
     # baseline on the other CPU (FE experiments, local refits)
     figs = FigureProcess.start() if out is not None and scheduler is None and exp.fit_options.get("expensive") else None
