@@ -37,7 +37,7 @@ USER_EXPERIMENT = textwrap.dedent('''
         model=model, hooks={"extension": "u (n,) m"}, error_unit="m")
 
     register_effect(Effect(
-        name="spring_slip", title="slip of the spring mount", physics="the mount slips by +-s with the force sign",
+        name="spring_slip", title="slip of the spring mount", physics="The mount slips by +-s with the force sign.",
         signature="a step at zero force", acts_where=("near-zero load",),
         implementations={"spring-test": Implementation(
             hook="extension", apply=_slip,
