@@ -26,6 +26,7 @@ from ..errors import ModelError
 from . import validation
 from .amplitudes import Amplitude
 from .arrays import ElementList, add_beams, add_nodes, add_trusses
+from .gravity import _step_gravity
 from .sections import Section
 
 LOAD_NAMES = ("fx", "fy", "fz", "mx", "my", "mz")
@@ -201,6 +202,7 @@ def _step_follow(self, node, times, **tables):
 Step.rotate = _step_rotate
 Step.temperature = _step_temperature
 Step.follow = _step_follow
+Step.gravity = _step_gravity
 
 
 class Model:
@@ -472,7 +474,7 @@ class Model:
         3 principal values along the global axes or a 3x3 matrix, initial global axes) at
         ``node``, its centre of mass ``offset`` (m) from the node (modal analyses, issue 18).
         Returns the :class:`femast.modal.mass.PointMassSpec`."""
-        from ..modal.mass import point_mass_spec
+        from .mass import point_mass_spec
 
         self._check_node(node, "point mass")
         spec = point_mass_spec(node, mass, inertia, offset, name)
