@@ -19,8 +19,13 @@ same signature without ``kind`` (see :class:`femast.elements.cable_devices.UserD
 
 Built-in laws:
 
-* capstan pulley (Euler-Eytelwein): ``r = T_out - T_in exp(sigma mu phi)``; the band is
-  ``exp(-mu phi) <= T_out / T_in <= exp(mu phi)``;
+* capstan drum (Euler-Eytelwein: a cable sliding on a fixed drum or surface):
+  ``r = T_out - T_in exp(sigma mu phi)``; the band is ``exp(-mu phi) <= T_out / T_in <= exp(mu phi)``;
+* sheave (a wheel turning on a pin in a bearing with journal friction mu_b): the bearing's
+  friction torque ``mu_b r_pin |F|`` on the resultant ``|F| = sqrt(T_in^2 + T_out^2 - 2 T_in T_out
+  cos phi)`` of the two tensions holds the torque ``(T_out - T_in) r``:
+  ``r = T_out - T_in - sigma rho |F|`` with ``rho = mu_b r_pin / r``; the band is
+  ``|T_out - T_in| <= rho |F|``;
 * latch (seed 001 Eqs. 5, 14): ``r = T_out - T_in - dT_sigma(x)``, ``x = Lb - s``; the backstop
   bounds ``s <= Lb + x_backstop``.  Optional hysteresis as in :mod:`femast.latch`.
 
@@ -42,10 +47,12 @@ CAPSTAN = 1  # pulley with Coulomb friction (capstan law)
 LATCH = 2  # roller latch of seed 001
 CLAMP = 3  # fixed clamp: no sliding
 USER = 4  # a user law
+SHEAVE = 5  # sheave turning on a pin with bearing friction
 
 N_PARAM = 10
 """Length of a device's parameter row (the layout of each kind is in ``device_params``)."""
 
+# capstan row: [mu_k, mu_s, ...]; sheave row: [rho_k, rho_s, ...] (rho = mu_b r_pin / r)
 # latch parameter row: [r, x_backstop, k, mu, h, R, Lb, Fh, ell, -]
 LATCH_LB = 6
 
@@ -57,6 +64,21 @@ def builtin_law(kind, sigma, T_in, T_out, s, phi, p):
         mu = p[0]
         E = math.exp(sigma * mu * phi)
         return T_out - T_in * E, -E, 1.0, 0.0, -T_in * E * sigma * mu
+    if kind == SHEAVE:
+        rho = p[0]
+        c = math.cos(phi)
+        F2 = T_in * T_in + T_out * T_out - 2.0 * T_in * T_out * c
+        F = math.sqrt(F2) if F2 > 0.0 else 0.0
+        if F <= 1e-300:  # both sides slack: no resultant, no friction
+            return T_out - T_in, -1.0, 1.0, 0.0, 0.0
+        a = sigma * rho / F
+        return (
+            T_out - T_in - sigma * rho * F,
+            -1.0 - a * (T_in - T_out * c),
+            1.0 - a * (T_out - T_in * c),
+            0.0,
+            -a * T_in * T_out * math.sin(phi),
+        )
     if kind == LATCH:
         x = p[LATCH_LB] - s
         D, dD = branch_scalar(x, sigma, p[0:6], p[7], p[8])

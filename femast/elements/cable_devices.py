@@ -1,5 +1,5 @@
-"""A cable over an ordered list of devices: pulleys (frictionless or capstan, point or sized),
-latches, clamps and user devices (issue 19; seed 001 Sec. II.B.2, Eqs. 2-5).
+"""A cable over an ordered list of devices: pulleys (frictionless), sheaves with bearing friction,
+capstan drums, latches, clamps and user devices (seed 001 Sec. II.B.2, Eqs. 2-5).
 
 Seed 001 writes the cable element for a cable over any number of pulleys, latches or other
 devices, each with its own law for the jump ``Delta T_i = T_{i+1} - T_i``.  One element here is
@@ -18,13 +18,11 @@ is unchanged; this family reproduces it (tests) and generalises it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from numba import njit
 
 from ..errors import ModelError
-from ..latch import LatchParameters, _as_param_array, validate_latch_array
+from ..latch import validate_latch_array
 from ._cable_geometry import (
     GEO_ADJACENT_PULLEYS,
     GEO_INSIDE_PULLEY,
@@ -35,94 +33,32 @@ from ._cable_geometry import (
     cable_geometry,
 )
 from ._device_kernels import ERR_ACTIVE_SET, ERR_SHORT, SLIDE_FREE, STOP, device_kernel, kernel_for_law
-from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, LATCH_LB, N_PARAM, USER, builtin_law
+from ._device_laws import CAPSTAN, FREE, LATCH, LATCH_LB, N_PARAM, SHEAVE, USER, builtin_law
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput, chain_nodes
+from .cable_device_specs import (  # noqa: F401  (the devices are imported from here)
+    Clamp,
+    Drum,
+    Latch,
+    Pulley,
+    Sheave,
+    UserDevice,
+    geometry_radius,
+    kind_and_params,
+)
 
 MODE_NAMES = {0: "stick", 1: "slide (out side pulls)", -1: "slide (in side pulls)", 2: "at stop", 3: "frictionless"}
 
-__all__ = ["Pulley", "Latch", "Clamp", "UserDevice", "CableDeviceFamily", "MODE_NAMES", "wrap_geometry"]
-
-
-@dataclass(frozen=True)
-class Pulley:
-    """A pulley at a node.  radius : m (0: a point pulley; > 0: the cable leaves on the tangent
-    points and wraps the pulley, see :mod:`._cable_geometry`).  mu : Coulomb friction coefficient
-    between cable and pulley (0: frictionless; > 0: capstan law ``exp(-mu phi) <= T_out/T_in <=
-    exp(mu phi)`` with the wrap angle phi from the current geometry)."""
-
-    radius: float = 0.0
-    mu: float = 0.0
-
-
-@dataclass(frozen=True)
-class Latch:
-    """A roller latch of seed 001 (Eqs. 5, 14) at a node; the bead is on the cable.
-
-    params : :class:`~femast.latch.LatchParameters` (default the seed's fit).
-    bead : material coordinate Lb of the bead, m (unstretched length from node 0); ``None`` with
-        :meth:`CableDeviceFamily.pretensioned` puts it at ``x0`` in the initial geometry.
-    x0 : initial bead position, m (default ``-x_backstop``: latched, on the backstop).
-    hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.latch` (N, m).
-    The section before the latch runs through the backstop (as in :class:`CableLatchFamily`)."""
-
-    params: LatchParameters | None = None
-    bead: float | None = None
-    x0: float | None = None
-    hysteresis_force: float = 0.0
-    hysteresis_length: float = 3e-4
-
-
-@dataclass(frozen=True)
-class Clamp:
-    """A clamp: the cable is fixed to the node (no sliding)."""
-
-
-@dataclass(frozen=True)
-class UserDevice:
-    """A device with a user law: a numba ``@njit`` function
-
-        law(sigma, T_in, T_out, s, phi, p) -> (r, dr/dT_in, dr/dT_out, dr/ds, dr/dphi)
-
-    (floats; N, m, rad) following the contract of :mod:`._device_laws`: r is the unbalanced force of
-    the branch on which the cable slides in direction sigma (+1: the out side pulls, ds < 0; -1: the
-    in side pulls); the device sticks while r(+1) <= 0 <= r(-1).  params : up to 10 floats, passed as
-    ``p``.  All user devices of one family share one law function (dispatch on ``p`` for several)."""
-
-    law: object
-    params: tuple = ()
-
-
-def _kind_and_params(dev, k, name):
-    p = np.zeros(N_PARAM)
-    if isinstance(dev, Pulley):
-        for what, v in (("radius", dev.radius), ("mu", dev.mu)):
-            if not (np.isfinite(v) and v >= 0.0):
-                raise ModelError(
-                    f"{name} device {k} (Pulley): {what} = {v!r} must be finite and >= 0 "
-                    f"({'m' if what == 'radius' else 'friction coefficient'})"
-                )
-        if dev.mu > 0.0:
-            p[0] = dev.mu
-            return CAPSTAN, p, float(dev.radius)
-        return FREE, p, float(dev.radius)
-    if isinstance(dev, Latch):
-        arr = _as_param_array(dev.params)
-        validate_latch_array(arr, f"{name} device {k} (Latch)")
-        p[:6] = arr
-        p[7] = dev.hysteresis_force
-        p[8] = dev.hysteresis_length
-        if not (np.isfinite(p[7]) and p[7] >= 0.0 and np.isfinite(p[8]) and p[8] > 0.0):
-            raise ModelError(f"{name} device {k} (Latch): hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
-        return LATCH, p, 0.0
-    if isinstance(dev, Clamp):
-        return CLAMP, p, 0.0
-    if isinstance(dev, UserDevice):
-        q = np.asarray(dev.params, dtype=float).ravel()
-        if q.size > N_PARAM or not np.all(np.isfinite(q)):
-            raise ModelError(f"{name} device {k} (UserDevice): give at most {N_PARAM} finite parameters")
-        p[: q.size] = q
-        return USER, p, 0.0
-    raise ModelError(f"{name} device {k}: {dev!r} is not a device; use Pulley, Latch, Clamp or UserDevice")
+__all__ = [
+    "Pulley",
+    "Sheave",
+    "Drum",
+    "Latch",
+    "Clamp",
+    "UserDevice",
+    "CableDeviceFamily",
+    "MODE_NAMES",
+    "wrap_geometry",
+]
 
 
 _COMBINED = {}
@@ -256,7 +192,7 @@ class CableDeviceFamily(ElementFamily):
         kinds, radius, P = [], np.zeros(nn), np.zeros((n_el, max(n - 1, 1), N_PARAM))
         users = set()
         for k, dev in enumerate(devices):
-            kind, p, r = _kind_and_params(dev, k, name)
+            kind, p, r = kind_and_params(dev, k, name)
             kinds.append(kind)
             radius[k + 1] = r
             P[:, k] = p
@@ -354,13 +290,15 @@ class CableDeviceFamily(ElementFamily):
                 raise ModelError(f"{self.name}: device_values has device {k!r}; the devices are 0..{len(devices) - 1}")
             dev = devices[k]
             if isinstance(dev, Latch):
-                cols = {nm: i for i, nm in enumerate(self._LATCH_NAMES) if nm}
+                cols = {nm: ((i,), 1.0) for i, nm in enumerate(self._LATCH_NAMES) if nm}
             elif isinstance(dev, Pulley) and self.kinds[k] == CAPSTAN:
-                cols = {"mu": 0}
+                cols = {"mu": ((0, 1), 1.0)}
+            elif isinstance(dev, Sheave) and self.kinds[k] == SHEAVE:
+                cols = {"mu": ((0, 1), dev.pin_radius / dev.radius)}  # rho = mu r_pin / r
             else:
                 raise ModelError(
                     f"{self.name} device {k} ({type(dev).__name__}): has no per-element parameters (a "
-                    "Latch and a Pulley with mu > 0 have)"
+                    "Latch, a Drum or Pulley with mu > 0 and a Sheave with mu > 0 have)"
                 )
             for nm, v in dict(params).items():
                 if nm not in cols:
@@ -375,7 +313,9 @@ class CableDeviceFamily(ElementFamily):
                         f"{self.name} device {k}: {nm} must be a number or one per element ({n_el}), "
                         f"got shape {np.shape(v)}"
                     ) from None
-                self.P[:, k, cols[nm]] = arr
+                idx, scale = cols[nm]
+                for i in idx:
+                    self.P[:, k, i] = arr * scale
             for el in range(n_el):  # construction only, not a hot path
                 where = f"{self.name} device {k} ({type(dev).__name__}), element {el}"
                 if isinstance(dev, Latch):
@@ -388,7 +328,9 @@ class CableDeviceFamily(ElementFamily):
                     ):
                         raise ModelError(f"{where}: hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
                 elif not (np.isfinite(self.P[el, k, 0]) and self.P[el, k, 0] > 0.0):
-                    raise ModelError(f"{where}: capstan mu = {self.P[el, k, 0]!r} must be finite and > 0")
+                    raise ModelError(f"{where}: mu must be finite and > 0 (got {self.P[el, k, 0]!r} for the law)")
+                elif self.kinds[k] == SHEAVE and not self.P[el, k, 0] < 1.0:
+                    raise ModelError(f"{where}: mu pin_radius / radius = {self.P[el, k, 0]!r} must be < 1")
 
     def _per_element(self, value, what):
         a = np.asarray(value, dtype=float)
@@ -415,7 +357,7 @@ class CableDeviceFamily(ElementFamily):
             )
         radius = np.zeros(nn)
         for k, d in enumerate(devices):
-            radius[k + 1] = d.radius if isinstance(d, Pulley) else 0.0
+            radius[k + 1] = geometry_radius(d)
         EA_ = np.broadcast_to(np.asarray(EA, float), (n_el,))
         T0_ = np.broadcast_to(np.asarray(T0, float), (n_el,))
         if np.any(~(T0_ >= 0)):

@@ -1,0 +1,169 @@
+"""The devices a cable runs over (what a model script writes): frictionless pulleys, sheaves
+with bearing friction, capstan drums, latches, clamps and user laws; each becomes a law kind and a
+parameter row of :mod:`._device_laws` for :class:`~femast.elements.cable_devices.CableDeviceFamily`.
+See ``docs/cable_devices.md`` for which physical object each device is."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ModelError
+from ..latch import LatchParameters, _as_param_array, validate_latch_array
+from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, N_PARAM, SHEAVE, USER
+
+
+@dataclass(frozen=True)
+class Pulley:
+    """A frictionless pulley at a node, or (``mu > 0``) a capstan drum (see :class:`Drum`).
+
+    radius : m (0: a point pulley; > 0: the cable leaves on the tangent points and wraps the
+    pulley, see :mod:`._cable_geometry`).  mu : Coulomb friction coefficient between the cable and
+    a surface it *slides on* (0: frictionless; > 0: the capstan law ``exp(-mu phi) <= T_out/T_in
+    <= exp(mu phi)`` with the wrap angle phi from the current geometry: right for a fixed drum, a
+    fairlead or a cable sliding in a groove, not for a sheave that turns: use :class:`Sheave`)."""
+
+    radius: float = 0.0
+    mu: float = 0.0
+
+
+@dataclass(frozen=True)
+class Drum(Pulley):
+    """A capstan drum: a fixed (non-rotating) drum or surface the cable slides on, Coulomb friction
+    ``mu`` between cable and drum (the capstan law, Euler-Eytelwein; ``Pulley(radius, mu)`` is the
+    same device).  radius : m (0: a point drum)."""
+
+
+@dataclass(frozen=True)
+class Sheave:
+    """A sheave: a wheel of radius ``radius`` (m) that turns on a pin of radius ``pin_radius`` (m)
+    in a bearing with (journal) friction coefficient ``mu``; the cable does not slip on the wheel.
+
+    The bearing's friction torque ``mu pin_radius |F|``, with ``|F| = sqrt(T_in^2 + T_out^2 - 2
+    T_in T_out cos phi)`` the resultant of the two tensions on the pin (phi the wrap angle), holds
+    the torque ``(T_out - T_in) radius`` of the tension difference: the wheel sticks while
+    ``|T_out - T_in| <= rho |F|`` and turns with ``T_out - T_in = +- rho |F|``, ``rho = mu
+    pin_radius / radius``.  A quarter wrap loses about ``1.4 rho`` of the tension (a capstan of the
+    same mu: ``exp(mu pi/2) - 1``, 60 times more for mu = 0.3 and pin_radius / radius = 0.1).
+    mu = 0 (default): a frictionless sheave (:class:`Pulley` of the same radius, bit for bit).
+
+    point : True treats the sheave as a point in the cable's geometry (the radius then only sets
+        ``rho``); False (default) wraps the cable round it as a :class:`Pulley` of that radius."""
+
+    radius: float
+    pin_radius: float = 0.0
+    mu: float = 0.0
+    point: bool = False
+
+
+def geometry_radius(dev) -> float:
+    """Radius (m) with which a device enters the cable geometry (0: a point)."""
+    if isinstance(dev, Pulley):
+        return float(dev.radius)
+    if isinstance(dev, Sheave):
+        return 0.0 if dev.point else float(dev.radius)
+    return 0.0
+
+
+def _sheave_params(dev, k, name, p):
+    for what, v in (("radius", dev.radius), ("pin_radius", dev.pin_radius), ("mu", dev.mu)):
+        if not (isinstance(v, (int, float, np.floating, np.integer)) and np.isfinite(v) and v >= 0.0):
+            raise ModelError(f"{name} device {k} (Sheave): {what} = {v!r} must be a finite number >= 0")
+    if not dev.radius > 0.0:
+        raise ModelError(f"{name} device {k} (Sheave): radius = {dev.radius!r} m must be > 0 (the wheel's radius)")
+    if not dev.pin_radius < dev.radius:
+        raise ModelError(
+            f"{name} device {k} (Sheave): pin_radius = {dev.pin_radius!r} m must be smaller than the "
+            f"radius {dev.radius!r} m (the pin runs inside the wheel)"
+        )
+    rho = dev.mu * dev.pin_radius / dev.radius
+    if not rho < 1.0:
+        raise ModelError(
+            f"{name} device {k} (Sheave): mu pin_radius / radius = {rho:.6g} must be < 1 (a sheave that "
+            "could never turn); check mu (a friction coefficient) and the radii (m)"
+        )
+    radius = 0.0 if dev.point else float(dev.radius)
+    if rho == 0.0:
+        return FREE, p, radius
+    p[0] = p[1] = rho
+    return SHEAVE, p, radius
+
+
+@dataclass(frozen=True)
+class Latch:
+    """A roller latch of seed 001 (Eqs. 5, 14) at a node; the bead is on the cable.
+
+    params : :class:`~femast.latch.LatchParameters` (default the seed's fit).
+    bead : material coordinate Lb of the bead, m (unstretched length from node 0); ``None`` with
+        :meth:`CableDeviceFamily.pretensioned` puts it at ``x0`` in the initial geometry.
+    x0 : initial bead position, m (default ``-x_backstop``: latched, on the backstop).
+    hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.latch` (N, m).
+    The section before the latch runs through the backstop (as in :class:`CableLatchFamily`)."""
+
+    params: LatchParameters | None = None
+    bead: float | None = None
+    x0: float | None = None
+    hysteresis_force: float = 0.0
+    hysteresis_length: float = 3e-4
+
+
+@dataclass(frozen=True)
+class Clamp:
+    """A clamp: the cable is fixed to the node (no sliding)."""
+
+
+@dataclass(frozen=True)
+class UserDevice:
+    """A device with a user law: a numba ``@njit`` function
+
+        law(sigma, T_in, T_out, s, phi, p) -> (r, dr/dT_in, dr/dT_out, dr/ds, dr/dphi)
+
+    (floats; N, m, rad) following the contract of :mod:`._device_laws`: r is the unbalanced force of
+    the branch on which the cable slides in direction sigma (+1: the out side pulls, ds < 0; -1: the
+    in side pulls); the device sticks while r(+1) <= 0 <= r(-1).  params : up to 10 floats, passed as
+    ``p``.  All user devices of one family share one law function (dispatch on ``p`` for several)."""
+
+    law: object
+    params: tuple = ()
+
+
+def kind_and_params(dev, k, name):
+    """(law kind, parameter row (N_PARAM,), geometry radius m) of device ``dev`` (index k of cable ``name``)."""
+    p = np.zeros(N_PARAM)
+    if isinstance(dev, Pulley):
+        for what, v in (("radius", dev.radius), ("mu", dev.mu)):
+            if not (np.isfinite(v) and v >= 0.0):
+                raise ModelError(
+                    f"{name} device {k} (Pulley): {what} = {v!r} must be finite and >= 0 "
+                    f"({'m' if what == 'radius' else 'friction coefficient'})"
+                )
+        if dev.mu > 0.0:
+            p[0] = p[1] = dev.mu
+            return CAPSTAN, p, float(dev.radius)
+        return FREE, p, float(dev.radius)
+    if isinstance(dev, Sheave):
+        return _sheave_params(dev, k, name, p)
+    if isinstance(dev, Latch):
+        arr = _as_param_array(dev.params)
+        validate_latch_array(arr, f"{name} device {k} (Latch)")
+        p[:6] = arr
+        p[7] = dev.hysteresis_force
+        p[8] = dev.hysteresis_length
+        if not (np.isfinite(p[7]) and p[7] >= 0.0 and np.isfinite(p[8]) and p[8] > 0.0):
+            raise ModelError(f"{name} device {k} (Latch): hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
+        return LATCH, p, 0.0
+    if isinstance(dev, Clamp):
+        return CLAMP, p, 0.0
+    if isinstance(dev, UserDevice):
+        q = np.asarray(dev.params, dtype=float).ravel()
+        if q.size > N_PARAM or not np.all(np.isfinite(q)):
+            raise ModelError(f"{name} device {k} (UserDevice): give at most {N_PARAM} finite parameters")
+        p[: q.size] = q
+        return USER, p, 0.0
+    raise ModelError(
+        f"{name} device {k}: {dev!r} is not a device; use Pulley, Sheave, Drum, Latch, Clamp or UserDevice"
+    )
+
+
+__all__ = ["Pulley", "Drum", "Sheave", "Latch", "Clamp", "UserDevice", "geometry_radius", "kind_and_params"]
