@@ -81,7 +81,9 @@ def main(argv=None):
     for gravity in (True, False):
         am = build(args.bays, gravity)
         t0 = time.perf_counter()
-        an = fm.Analysis(am.model, out / ("with_gravity" if gravity else "without"), progress=False, convergence=CONVERGENCE)
+        an = fm.Analysis(
+            am.model, out / ("with_gravity" if gravity else "without"), progress=False, convergence=CONVERGENCE
+        )
         res = an.run()
         runs[gravity] = (am, an, res, time.perf_counter() - t0)
     am, an, res, wall = runs[True]

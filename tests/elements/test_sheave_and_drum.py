@@ -161,3 +161,16 @@ def test_per_element_sheave_friction():
     q = res.output["tension"][:, 1] / res.output["tension"][:, 0]
     assert q[0] == pytest.approx(sheave_ratio(0.06, math.pi / 2, 1), rel=1e-12)
     assert q[1] == pytest.approx(sheave_ratio(0.02, math.pi / 2, 1), rel=1e-12)
+
+
+def test_docs_page_quotes_what_the_example_prints(tmp_path, capsys):
+    import re
+
+    from doc_examples import printed_in, run_python_blocks
+
+    text = run_python_blocks("cable_devices.md", cwd=tmp_path)
+    out = capsys.readouterr().out
+    quoted = re.findall(r"`((?:Drum|Sheave): T_out/T_in[^`]+)`", text)
+    assert len(quoted) == 2
+    for q in quoted:
+        assert printed_in(q, out), q

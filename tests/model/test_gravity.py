@@ -119,7 +119,7 @@ def _chain_reference(n, span, L0, EA, W):
         V = 0.5 * (n - 1) * P  # vertical force in the first link (symmetry)
         x = z = 0.0
         zs = [0.0]
-        for i in range(n):
+        for _ in range(n):
             T = math.hypot(H, V)
             ell = l0 * (1 + T / EA)
             x += ell * H / T
