@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..errors import ModelError
+from ..errors import ElementConvergenceError, ModelError
 from ..latch import validate_latch_array
 from ._cable_geometry import (
     GEO_ADJACENT_PULLEYS,
@@ -418,7 +418,7 @@ class CableDeviceFamily(ElementFamily):
         bad = np.flatnonzero(err)
         if bad.size:
             el = bad[0]
-            self._raise(el, int(err[el]), int(where[el]), X[el])
+            self._raise(el, int(err[el]), int(where[el]), X[el], state)
         return ElementResponse(
             f=f,
             k=k,
@@ -427,7 +427,7 @@ class CableDeviceFamily(ElementFamily):
             output=LazyOutput(lambda: self._output(T, new, phi[:, :m], lf if scaled else None)),
         )
 
-    def _raise(self, el, code, where, X):
+    def _raise(self, el, code, where, X, state):
         name = f"{self.name} element {el}"
         if code < 10:
             raise ModelError(_geometry_message(code, where, name, self.nodes[el], self.radius, X))
@@ -438,9 +438,22 @@ class CableDeviceFamily(ElementFamily):
                 "coordinates, or build with CableDeviceFamily.pretensioned"
             )
         what = "cycled between stick and slip" if code == ERR_ACTIVE_SET else "did not converge"
-        raise ModelError(
-            f"{name}: the device equations {what} (devices {[type(d).__name__ for d in self.devices]}); "
-            "take smaller load increments"
+        m = self.n_sections - 1
+        where_latches = ""
+        cells = []
+        for k in np.flatnonzero(self.kinds == LATCH):
+            p = self.P[el, k]
+            xc = float(np.sqrt(max((p[0] + p[5]) ** 2 - (p[4] + p[0]) ** 2, 0.0)))
+            cells.append(2.0 * xc / 256.0)
+            where_latches += f"; latch {k}: bead at {1e3 * (p[LATCH_LB] - state[el, k]):.4g} mm"
+        step = f" (less than {1e3 * min(cells):.3g} mm, one cell of the rollers' contact zone)" if cells else ""
+        modes = ", ".join(MODE_NAMES.get(int(v), str(v)) for v in state[el, m:])
+        raise ElementConvergenceError(
+            f"{name}: the device equations {what} from the committed state (devices "
+            f"{[type(d).__name__ for d in self.devices]}: {modes}{where_latches}). In an analysis the "
+            "increment is cut back. If the step still gives up there: limit max_increment so that an "
+            f"increment moves the cable through a latch by little{step}; check the device parameters (SI: "
+            "k in N/m, radii in m) and that no sliding device has both of its sections slack"
         )
 
     def _output(self, T, new, phi, lf=None):

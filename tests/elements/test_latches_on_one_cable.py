@@ -141,3 +141,45 @@ def test_two_latches_in_an_analysis():
             if modes[d] in (1, -1) and T[d] + T[d + 1] > 0:
                 assert T[d + 1] - T[d] == pytest.approx(eq14(beads[d], modes[d], p), abs=1e-8)
     assert seen[-1][3][1] > XC and seen[-1][3][0] > -2.0e-3 + 1e-6
+
+
+def test_unconverged_device_equations_cut_the_increment_back(monkeypatch):
+    """A kernel that fails for increments above 0.2 mm (emulated): the analysis cuts back and goes on;
+    called directly, the error names the devices, the beads and what to change."""
+    import femast.elements.cable_devices as cd
+    from femast.errors import ElementConvergenceError
+
+    real = cd.device_kernel
+    limit = 0.2e-3
+
+    def flaky(X, radius, EA, L0, kinds, P, state, f, K, new, T, phi, energy, err, where):
+        real(X, radius, EA, L0, kinds, P, state, f, K, new, T, phi, energy, err, where)
+        if abs(X[0, -1, 0] - flaky.committed) > limit:
+            err[0] = 10
+        return None
+
+    flaky.committed = X2[-1, 0]
+    monkeypatch.setattr(cd, "device_kernel", flaky)
+    fam = CableDeviceFamily.pretensioned([[0, 1, 2, 3]], X2, EA_CABLE, T0, [Latch(params(30e3)), Latch(params(1e5))])
+    Xp = X2.copy()
+    Xp[-1, 0] += 1e-3
+    with pytest.raises(ElementConvergenceError, match=r"did not converge.*latch 0: bead at -2 mm.*max_increment"):
+        fam.evaluate(Xp, None, fam.initial_state(), IncrementContext())
+
+    m = fm.Model("flaky")
+    nodes = [m.node(*x) for x in X2]
+    fam2 = CableDeviceFamily.pretensioned([[0, 1, 2, 3]], X2, EA_CABLE, T0, [Latch(params(30e3)), Latch(params(1e5))])
+    fam2.nodes = np.array([nodes])
+    m.add_family(fam2)
+    for n in nodes[:-1]:
+        m.fix(n)
+    m.fix(nodes[-1], "uy", "uz")
+    m.step("pull", initial_increment=1.0).load(nodes[-1], fx=20.0)
+
+    def track(fr):
+        flaky.committed = X2[-1, 0] + fr["U"][3, 0]
+
+    an = fm.Analysis(m, None, progress=False, on_frame=track)
+    an.run()
+    assert an.summary.cutbacks >= 1
+    assert an.summary.increments >= 2
