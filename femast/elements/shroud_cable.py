@@ -61,6 +61,7 @@ from numba import njit
 
 from ..errors import ModelError
 from .base import ElementFamily, ElementResponse
+from .shroud_hysteresis import friction_return, hysteresis_array
 from .shroud_law import DyneemaLaw, strain_from_tension
 
 PARTS = {"none": 0, "material": 1, "geometric": 2, "full": 3}
@@ -100,10 +101,15 @@ def dyneema_tangent_rigidity(tau, k0, k1, k2):
 
 
 @njit(cache=True)
-def shroud_family_kernel(nodes, x, R, offsets, L0, law, parts, gx, gw, f, K, tau_out, eps_out, len_out, energy, err):
-    """All shroud elements in one call: forces f (n, 12), tangent K (n, 12, 12), tension, strain,
-    length, strain energy and an error code per element (see module docstring).  Serial on purpose:
-    a family holds a few ropes (3 per mast), and ``parallel=True`` doubles the compile time (~11 s)."""
+def shroud_family_kernel(
+    nodes, x, R, offsets, L0, law, hyst, state, parts, gx, gw, f, K, new, tau_out, eps_out, len_out, energy, err
+):
+    """All shroud elements in one call: forces f (n, 12), tangent K (n, 12, 12), trial state ``new``,
+    tension, strain, length, strain energy and an error code per element (see module docstring).
+    ``hyst`` (n, 2): [eta (-), k_s (N)] of the loading/unloading option (:mod:`.shroud_hysteresis`;
+    eta = 0: off); ``state`` (n, 2) committed [strain, friction tension (N)] (read only; unused when
+    off).  Serial on purpose: a family holds a few ropes (3 per mast), and ``parallel=True`` doubles
+    the compile time (~11 s)."""
     for el in range(nodes.shape[0]):
         a = nodes[el, 0]
         b = nodes[el, 1]
@@ -134,6 +140,13 @@ def shroud_family_kernel(nodes, x, R, offsets, L0, law, parts, gx, gw, f, K, tau
             if not (kt > 0.0):
                 err[el] = ERR_BEYOND_LAW
                 continue
+        eta = hyst[el, 0]
+        if eta > 0.0:  # loading/unloading: a friction tension in parallel, |tau_f| <= eta tau
+            tf, dtf = friction_return(eps, tau, kt * L0[el], eta, hyst[el, 1], state[el, 0], state[el, 1])
+            new[el, 0] = eps
+            new[el, 1] = tf
+            tau += tf
+            kt += dtf / L0[el]
         tau_out[el] = tau
         eps_out[el] = eps
         len_out[el] = l
@@ -144,6 +157,8 @@ def shroud_family_kernel(nodes, x, R, offsets, L0, law, parts, gx, gw, f, K, tau
                 t, ok = dyneema_tension(gx[g] * eps, k0, k1, k2)
                 en += gw[g] * t
             en *= eps * L0[el]
+        if eta > 0.0:  # the friction element's stick spring
+            en += 0.5 * L0[el] * new[el, 1] ** 2 / hyst[el, 1]
         energy[el] = en
         # D = [-G_a, G_b], G = [I, -[r]x]; B = D^T e
         Dm = np.zeros((3, 12))
@@ -245,6 +260,11 @@ class ShroudCableFamily(ElementFamily):
         (a beam, a fix) -- keep offset-free ropes on translational-only nodes in another family.
     length_error : lack of fit per rope, m (scalar or per element; default 0): the rope is stress free
         at ``L0 + length_error`` (negative: cut short, so it pulls harder).
+    hysteresis : the loading/unloading option (Rocaspect paper Fig. 4a, :mod:`.shroud_hysteresis`):
+        the half-width eta (-, 0 <= eta < 1, scalar or per rope) of the loop between the loading
+        branch ``(1 + eta) tau(eps)`` and the unloading branch ``(1 - eta) tau(eps)`` about the law;
+        0 (default): the paper's single curve.
+    stick_rigidity : N, the friction element's stick rigidity k_s (default 10 k0 of each rope).
     name : label used in messages and results.
 
     Thermal strain: ``length_factor`` (n_el,), written by the analysis from the temperatures of a
@@ -254,10 +274,18 @@ class ShroudCableFamily(ElementFamily):
     ``length`` (m, between the end points), ``slack`` (1.0 when the rope carries nothing).
     """
 
-    n_state = 0
-    path_independent = True
-
-    def __init__(self, nodes, L0, law=None, offsets=None, labels=None, name: str = "shroud", length_error=None):
+    def __init__(
+        self,
+        nodes,
+        L0,
+        law=None,
+        offsets=None,
+        labels=None,
+        name: str = "shroud",
+        length_error=None,
+        hysteresis=0.0,
+        stick_rigidity=None,
+    ):
         self.name = name
         nodes = np.asarray(nodes)
         if nodes.ndim == 1:
@@ -292,6 +320,10 @@ class ShroudCableFamily(ElementFamily):
         self.tangent_parts = "full"
         self.length_factor = np.ones(n_el)
         self.set_length_errors(0.0 if length_error is None else length_error)
+        self.hysteresis = hysteresis_array(hysteresis, stick_rigidity, self.law, n_el, name)
+        # with the loading/unloading option the rope has a state [strain, friction tension (N)]
+        self.n_state = 2 if np.any(self.hysteresis[:, 0] > 0.0) else 0
+        self.path_independent = self.n_state == 0
 
     def set_length_errors(self, length_error) -> None:
         """Lack of fit per rope, m (scalar or one per element; replaces any given before): rope e is stress
@@ -347,6 +379,9 @@ class ShroudCableFamily(ElementFamily):
         energy = np.zeros(n)
         err = np.zeros(n, dtype=np.int64)
         L0 = np.ascontiguousarray(self.stress_free_lengths())
+        # (with the loading/unloading option and no state given: a rope loaded from slack)
+        st = np.ascontiguousarray(state, dtype=float) if self.n_state and state is not None else np.zeros((n, 2))
+        new = st.copy()
         shroud_family_kernel(
             self.nodes,
             x,
@@ -354,11 +389,14 @@ class ShroudCableFamily(ElementFamily):
             self.offsets,
             L0,
             self.law,
+            self.hysteresis,
+            st,
             PARTS[self.tangent_parts],
             _GX,
             _GW,
             f,
             K,
+            new,
             tau,
             eps,
             length,
@@ -388,7 +426,9 @@ class ShroudCableFamily(ElementFamily):
                 msg = "nodal coordinates are not finite"
             raise ModelError(f"{self.name} element {self.labels[el]}: {msg}")
         output = {"tension": tau, "strain": eps, "length": length, "slack": (eps < 0.0).astype(float)}
-        return ElementResponse(f=f, k=K, state=state, output=output, energy=energy)
+        if self.n_state:
+            output["friction_tension"] = new[:, 1].copy()
+        return ElementResponse(f=f, k=K, state=new if self.n_state else state, output=output, energy=energy)
 
 
 def unstretched_length(law, tension, length):
@@ -399,7 +439,16 @@ def unstretched_length(law, tension, length):
 
 
 def add_shrouds(
-    model, pairs, law=None, tension=None, L0=None, offsets=None, name: str = "shroud", length_error=None
+    model,
+    pairs,
+    law=None,
+    tension=None,
+    L0=None,
+    offsets=None,
+    name: str = "shroud",
+    length_error=None,
+    hysteresis=0.0,
+    stick_rigidity=None,
 ) -> ShroudCableFamily:
     """Add Dyneema shrouds between node-label pairs ``pairs`` ((n, 2)) to ``model``; returns the family.
 
@@ -407,7 +456,9 @@ def add_shrouds(
     in the model's *initial* geometry, including the offsets); neither means taut at zero tension.
     ``offsets`` (n, 2, 3) as in :class:`ShroudCableFamily`.  ``length_error`` (m, scalar or per rope): lack
     of fit added to the unstretched lengths so found (a rope meant to carry ``tension`` but cut
-    ``length_error`` too long).  Raises ModelError for coincident
+    ``length_error`` too long).  ``hysteresis``, ``stick_rigidity``: the loading/unloading option of
+    :class:`ShroudCableFamily` (``tension`` is then the tension of the law itself, the average
+    curve: the rope starts with no friction tension).  Raises ModelError for coincident
     attachment points, non-positive lengths or stiffness, and tensions outside the law's range.
     """
 
@@ -427,6 +478,7 @@ def add_shrouds(
         )
     if L0 is not None and tension is not None:
         raise ModelError(f"{name}: give the unstretched length L0 or the tension, not both")
+    eta = hysteresis_array(hysteresis, stick_rigidity, laws, n, name)[:, 0]
     if tension is not None:
         tau = _per_element(tension, n, name, "tension (N)")
         L0v = np.empty(n)
@@ -437,12 +489,21 @@ def add_shrouds(
                     f"{name} {k + 1}: tension {float(tau[k])!r} N must be >= 0 and below "
                     f"{lk.tau_max_valid:.4g} N, where the rope law is increasing"
                 )
-            L0v[k] = float(unstretched_length(lk, tau[k], length[k]))
+            # with the loading/unloading option the rope, tensioned by loading, is on its loading branch
+            # (1 + eta) tau_e: the law's tension there is tension / (1 + eta)
+            L0v[k] = float(unstretched_length(lk, tau[k] / (1.0 + eta[k]), length[k]))
     elif L0 is not None:
         L0v = _per_element(L0, n, name, "L0 (m)")
     else:
         L0v = length.copy()
     fam = ShroudCableFamily(
-        pairs, L0v, laws, offsets=None if offsets is None else off, name=name, length_error=length_error
+        pairs,
+        L0v,
+        laws,
+        offsets=None if offsets is None else off,
+        name=name,
+        length_error=length_error,
+        hysteresis=hysteresis,
+        stick_rigidity=stick_rigidity,
     )
     return model.add_family(fam)
