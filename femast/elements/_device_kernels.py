@@ -92,7 +92,7 @@ def _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi, T, dT
             A[d, d] = c
         else:
             sigma = float(mode)
-            r, rTi, rTo, rs, rphi = _law(kinds[d], sigma, T[i_in], T[i_out], S[d + 1], phi[d], P[d])
+            r, rTi, rTo, rs, rphi = _law(kinds[d], sigma, T[i_in], T[i_out], S[d + 1], phi[d], P[d], False)
             R[d] = r
             if d >= 1:
                 A[d, d - 1] += -rTi * dT_dl0[i_in]
@@ -389,14 +389,16 @@ def solve_devices(L, phi, EA, L0, kinds, P, S_c, modes_c, S, modes, bufs):
                 continue
             if kinds[d] == CLAMP or kinds[d] == FREE:
                 continue
-            rp = _law(kinds[d], 1.0, T[d], T[d + 1], S[d + 1], phi[d], P[d])[0]
+            # static friction for a device at rest; one that slid in the last increment goes on at
+            # the kinetic law in its direction (it sticks again on arrest or reversal)
+            rp = _law(kinds[d], 1.0, T[d], T[d + 1], S[d + 1], phi[d], P[d], modes_c[d] != SLIP_OUT)[0]
             if rp > tol_f and rp > worst:
                 worst = rp
                 wd = d
                 wmode = SLIP_OUT
             if modes[d] == STOP:
                 continue  # the stop holds any pull from the in side
-            rm = _law(kinds[d], -1.0, T[d], T[d + 1], S[d + 1], phi[d], P[d])[0]
+            rm = _law(kinds[d], -1.0, T[d], T[d + 1], S[d + 1], phi[d], P[d], modes_c[d] != SLIP_IN)[0]
             if rm < -tol_f and -rm > worst:
                 worst = -rm
                 wd = d

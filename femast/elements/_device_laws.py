@@ -10,12 +10,16 @@ at the device (unstretched length from node 0).  A device either grips the cable
 stays at its committed value) or lets it slide.  Sliding in direction ``sigma = +1`` means the
 out side pulls the cable through (``ds < 0``), ``sigma = -1`` the in side (``ds > 0``).  A law is
 
-    law(kind, sigma, T_in, T_out, s, phi, p) -> (r, dr/dT_in, dr/dT_out, dr/ds, dr/dphi)
+    law(kind, sigma, T_in, T_out, s, phi, p, static) -> (r, dr/dT_in, dr/dT_out, dr/ds, dr/dphi)
 
 with ``r`` the unbalanced force (N) of branch ``sigma``: the device slides on branch sigma where
 ``r = 0``, and it sticks while ``r(+1) <= 0 <= r(-1)`` (the static band).  ``phi`` is the wrap
-angle (rad) from the current geometry and ``p`` the device's parameter row.  A user law has the
-same signature without ``kind`` (see :class:`femast.elements.cable_devices.UserDevice`).
+angle (rad) from the current geometry and ``p`` the device's parameter row.  ``static``: the band
+of a device at rest (static friction, ``mu_s``) rather than the law of one that slides (kinetic,
+``mu_k``); a device slips when its static band is exceeded, slides on at the kinetic law, and
+sticks again when it stops or reverses (rate independent; ``mu_s = mu_k`` is one coefficient).
+A user law has the signature without ``kind`` and ``static`` (see
+:class:`femast.elements.cable_devices.UserDevice`): one coefficient.
 
 Built-in laws:
 
@@ -40,7 +44,7 @@ import math
 
 from numba import njit
 
-from ._cable_kernels import branch_scalar
+from ._cable_kernels import branch_scalar_mu
 
 FREE = 0  # frictionless pulley
 CAPSTAN = 1  # pulley with Coulomb friction (capstan law)
@@ -53,19 +57,21 @@ N_PARAM = 10
 """Length of a device's parameter row (the layout of each kind is in ``device_params``)."""
 
 # capstan row: [mu_k, mu_s, ...]; sheave row: [rho_k, rho_s, ...] (rho = mu_b r_pin / r)
-# latch parameter row: [r, x_backstop, k, mu, h, R, Lb, Fh, ell, -]
+# latch parameter row: [r, x_backstop, k, mu_s, h, R, Lb, Fh, ell, mu_k]
 LATCH_LB = 6
+LATCH_MU_K = 9
 
 
 @njit(cache=True)
-def builtin_law(kind, sigma, T_in, T_out, s, phi, p):
-    """The built-in laws (module note): returns (r, dr/dT_in, dr/dT_out, dr/ds, dr/dphi), N and N/m, N/rad."""
+def builtin_law(kind, sigma, T_in, T_out, s, phi, p, static):
+    """The built-in laws (module note): returns (r, dr/dT_in, dr/dT_out, dr/ds, dr/dphi), N and N/m,
+    N/rad; ``static``: the static coefficient (the band of a device at rest)."""
     if kind == CAPSTAN:
-        mu = p[0]
+        mu = p[1] if static else p[0]
         E = math.exp(sigma * mu * phi)
         return T_out - T_in * E, -E, 1.0, 0.0, -T_in * E * sigma * mu
     if kind == SHEAVE:
-        rho = p[0]
+        rho = p[1] if static else p[0]
         c = math.cos(phi)
         F2 = T_in * T_in + T_out * T_out - 2.0 * T_in * T_out * c
         F = math.sqrt(F2) if F2 > 0.0 else 0.0
@@ -81,7 +87,7 @@ def builtin_law(kind, sigma, T_in, T_out, s, phi, p):
         )
     if kind == LATCH:
         x = p[LATCH_LB] - s
-        D, dD = branch_scalar(x, sigma, p[0:6], p[7], p[8])
+        D, dD = branch_scalar_mu(x, sigma, p[0:6], p[3] if static else p[LATCH_MU_K], p[7], p[8])
         return T_out - T_in - D, -1.0, 1.0, dD, 0.0
     return T_out - T_in, -1.0, 1.0, 0.0, 0.0
 

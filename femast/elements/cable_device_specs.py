@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..latch import LatchParameters, _as_param_array, validate_latch_array
-from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, N_PARAM, SHEAVE, USER
+from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, LATCH_MU_K, N_PARAM, SHEAVE, USER
 
 
 @dataclass(frozen=True)
@@ -22,10 +22,15 @@ class Pulley:
     pulley, see :mod:`._cable_geometry`).  mu : Coulomb friction coefficient between the cable and
     a surface it *slides on* (0: frictionless; > 0: the capstan law ``exp(-mu phi) <= T_out/T_in
     <= exp(mu phi)`` with the wrap angle phi from the current geometry: right for a fixed drum, a
-    fairlead or a cable sliding in a groove, not for a sheave that turns: use :class:`Sheave`)."""
+    fairlead or a cable sliding in a groove, not for a sheave that turns: use :class:`Sheave`).
+    mu_s, mu_k : static and kinetic coefficients instead of the one ``mu`` (mu_s >= mu_k >= 0;
+    mu_k defaults to mu_s): the cable starts to slide at mu_s, slides on at mu_k and grips again
+    when it stops or reverses."""
 
     radius: float = 0.0
     mu: float = 0.0
+    mu_s: float | None = None
+    mu_k: float | None = None
 
 
 @dataclass(frozen=True)
@@ -49,12 +54,35 @@ class Sheave:
     mu = 0 (default): a frictionless sheave (:class:`Pulley` of the same radius, bit for bit).
 
     point : True treats the sheave as a point in the cable's geometry (the radius then only sets
-        ``rho``); False (default) wraps the cable round it as a :class:`Pulley` of that radius."""
+        ``rho``); False (default) wraps the cable round it as a :class:`Pulley` of that radius.
+    mu_s, mu_k : static and kinetic bearing friction instead of the one ``mu`` (as :class:`Pulley`)."""
 
     radius: float
     pin_radius: float = 0.0
     mu: float = 0.0
     point: bool = False
+    mu_s: float | None = None
+    mu_k: float | None = None
+
+
+def friction_coefficients(mu, mu_s, mu_k, who):
+    """(mu_s, mu_k) from the one coefficient ``mu`` (static = kinetic) or the pair (mu_k defaults to
+    mu_s), checked: finite, mu_s >= mu_k >= 0 (the convention of the ball joints)."""
+    if mu_s is not None and mu:
+        raise ModelError(
+            f"{who}: give mu (static = kinetic) or mu_s (and mu_k), not both (mu = {mu!r}, mu_s = {mu_s!r})"
+        )
+    s = mu if mu_s is None else mu_s
+    k = s if mu_k is None else mu_k
+    s, k = (float(v) if isinstance(v, (np.floating, np.integer)) else v for v in (s, k))
+    for what, v in (("mu" if mu_s is None else "mu_s", s), ("mu_k", k)):
+        if not (isinstance(v, (int, float, np.floating, np.integer)) and np.isfinite(v) and v >= 0.0):
+            raise ModelError(f"{who}: {what} = {v!r} must be a finite friction coefficient >= 0")
+    if k > s:
+        raise ModelError(
+            f"{who}: kinetic mu_k = {k!r} above static mu_s = {s!r}; a device slips at mu_s and slides on at mu_k <= mu_s"
+        )
+    return float(s), float(k)
 
 
 def geometry_radius(dev) -> float:
@@ -67,26 +95,28 @@ def geometry_radius(dev) -> float:
 
 
 def _sheave_params(dev, k, name, p):
+    who = f"{name} device {k} (Sheave)"
     for what, v in (("radius", dev.radius), ("pin_radius", dev.pin_radius), ("mu", dev.mu)):
         if not (isinstance(v, (int, float, np.floating, np.integer)) and np.isfinite(v) and v >= 0.0):
-            raise ModelError(f"{name} device {k} (Sheave): {what} = {v!r} must be a finite number >= 0")
+            raise ModelError(f"{who}: {what} = {v!r} must be a finite number >= 0")
     if not dev.radius > 0.0:
-        raise ModelError(f"{name} device {k} (Sheave): radius = {dev.radius!r} m must be > 0 (the wheel's radius)")
+        raise ModelError(f"{who}: radius = {dev.radius!r} m must be > 0 (the wheel's radius)")
     if not dev.pin_radius < dev.radius:
         raise ModelError(
-            f"{name} device {k} (Sheave): pin_radius = {dev.pin_radius!r} m must be smaller than the "
-            f"radius {dev.radius!r} m (the pin runs inside the wheel)"
+            f"{who}: pin_radius = {dev.pin_radius!r} m must be smaller than the radius {dev.radius!r} m (the pin "
+            "runs inside the wheel)"
         )
-    rho = dev.mu * dev.pin_radius / dev.radius
-    if not rho < 1.0:
+    mu_s, mu_k = friction_coefficients(dev.mu, dev.mu_s, dev.mu_k, who)
+    rho_s, rho_k = mu_s * dev.pin_radius / dev.radius, mu_k * dev.pin_radius / dev.radius
+    if not rho_s < 1.0:
         raise ModelError(
-            f"{name} device {k} (Sheave): mu pin_radius / radius = {rho:.6g} must be < 1 (a sheave that "
-            "could never turn); check mu (a friction coefficient) and the radii (m)"
+            f"{who}: mu pin_radius / radius = {rho_s:.6g} must be < 1 (a sheave that could never turn); check mu "
+            "(a friction coefficient) and the radii (m)"
         )
     radius = 0.0 if dev.point else float(dev.radius)
-    if rho == 0.0:
+    if rho_s == 0.0:
         return FREE, p, radius
-    p[0] = p[1] = rho
+    p[0], p[1] = rho_k, rho_s
     return SHEAVE, p, radius
 
 
@@ -99,6 +129,8 @@ class Latch:
         :meth:`CableDeviceFamily.pretensioned` puts it at ``x0`` in the initial geometry.
     x0 : initial bead position, m (default ``-x_backstop``: latched, on the backstop).
     hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.latch` (N, m).
+    mu_s, mu_k : static and kinetic friction between rollers and bead (default both ``params.mu``,
+        the paper's one coefficient): the static band of Eq. 14 uses mu_s, a sliding bead mu_k.
     The section before the latch runs through the backstop (as in :class:`CableLatchFamily`)."""
 
     params: LatchParameters | None = None
@@ -106,6 +138,8 @@ class Latch:
     x0: float | None = None
     hysteresis_force: float = 0.0
     hysteresis_length: float = 3e-4
+    mu_s: float | None = None
+    mu_k: float | None = None
 
 
 @dataclass(frozen=True)
@@ -132,14 +166,14 @@ def kind_and_params(dev, k, name):
     """(law kind, parameter row (N_PARAM,), geometry radius m) of device ``dev`` (index k of cable ``name``)."""
     p = np.zeros(N_PARAM)
     if isinstance(dev, Pulley):
-        for what, v in (("radius", dev.radius), ("mu", dev.mu)):
-            if not (np.isfinite(v) and v >= 0.0):
-                raise ModelError(
-                    f"{name} device {k} (Pulley): {what} = {v!r} must be finite and >= 0 "
-                    f"({'m' if what == 'radius' else 'friction coefficient'})"
-                )
-        if dev.mu > 0.0:
-            p[0] = p[1] = dev.mu
+        who = f"{name} device {k} ({type(dev).__name__})"
+        if not (np.isfinite(dev.radius) and dev.radius >= 0.0):
+            raise ModelError(f"{who}: radius = {dev.radius!r} must be finite and >= 0 (m)")
+        if not (np.isfinite(dev.mu) and dev.mu >= 0.0):
+            raise ModelError(f"{who}: mu = {dev.mu!r} must be finite and >= 0 (friction coefficient)")
+        mu_s, mu_k = friction_coefficients(dev.mu, dev.mu_s, dev.mu_k, who)
+        if mu_s > 0.0:
+            p[0], p[1] = mu_k, mu_s
             return CAPSTAN, p, float(dev.radius)
         return FREE, p, float(dev.radius)
     if isinstance(dev, Sheave):
@@ -150,6 +184,11 @@ def kind_and_params(dev, k, name):
         p[:6] = arr
         p[7] = dev.hysteresis_force
         p[8] = dev.hysteresis_length
+        if dev.mu_s is not None or dev.mu_k is not None:
+            mu_s = arr[3] if dev.mu_s is None else dev.mu_s
+            p[3], p[LATCH_MU_K] = friction_coefficients(0.0, mu_s, dev.mu_k, f"{name} device {k} (Latch)")
+        else:
+            p[LATCH_MU_K] = arr[3]
         if not (np.isfinite(p[7]) and p[7] >= 0.0 and np.isfinite(p[8]) and p[8] > 0.0):
             raise ModelError(f"{name} device {k} (Latch): hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
         return LATCH, p, 0.0
@@ -166,4 +205,14 @@ def kind_and_params(dev, k, name):
     )
 
 
-__all__ = ["Pulley", "Drum", "Sheave", "Latch", "Clamp", "UserDevice", "geometry_radius", "kind_and_params"]
+__all__ = [
+    "Pulley",
+    "Drum",
+    "Sheave",
+    "Latch",
+    "Clamp",
+    "UserDevice",
+    "geometry_radius",
+    "kind_and_params",
+    "friction_coefficients",
+]

@@ -33,7 +33,7 @@ from ._cable_geometry import (
     cable_geometry,
 )
 from ._device_kernels import ERR_ACTIVE_SET, ERR_SHORT, SLIDE_FREE, STOP, device_kernel, kernel_for_law
-from ._device_laws import CAPSTAN, FREE, LATCH, LATCH_LB, N_PARAM, SHEAVE, USER, builtin_law
+from ._device_laws import CAPSTAN, FREE, LATCH, LATCH_LB, LATCH_MU_K, N_PARAM, SHEAVE, USER, builtin_law
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput, chain_nodes
 from .cable_device_specs import (  # noqa: F401  (the devices are imported from here)
     Clamp,
@@ -69,11 +69,11 @@ def _combined_law(user):
     if user not in _COMBINED:
 
         @njit
-        def law(kind, sigma, T_in, T_out, s, phi, p):
+        def law(kind, sigma, T_in, T_out, s, phi, p, static):
             if kind == USER:
                 r, a, b, c, d = user(sigma, T_in, T_out, s, phi, p)
                 return float(r), float(a), float(b), float(c), float(d)
-            return builtin_law(kind, sigma, T_in, T_out, s, phi, p)
+            return builtin_law(kind, sigma, T_in, T_out, s, phi, p, static)
 
         _COMBINED[user] = law
     return _COMBINED[user]
@@ -291,10 +291,12 @@ class CableDeviceFamily(ElementFamily):
             dev = devices[k]
             if isinstance(dev, Latch):
                 cols = {nm: ((i,), 1.0) for i, nm in enumerate(self._LATCH_NAMES) if nm}
+                cols.update(mu=((3, LATCH_MU_K), 1.0), mu_s=((3,), 1.0), mu_k=((LATCH_MU_K,), 1.0))
             elif isinstance(dev, Pulley) and self.kinds[k] == CAPSTAN:
-                cols = {"mu": ((0, 1), 1.0)}
+                cols = {"mu": ((0, 1), 1.0), "mu_s": ((1,), 1.0), "mu_k": ((0,), 1.0)}
             elif isinstance(dev, Sheave) and self.kinds[k] == SHEAVE:
-                cols = {"mu": ((0, 1), dev.pin_radius / dev.radius)}  # rho = mu r_pin / r
+                c = dev.pin_radius / dev.radius  # rho = mu r_pin / r
+                cols = {"mu": ((0, 1), c), "mu_s": ((1,), c), "mu_k": ((0,), c)}
             else:
                 raise ModelError(
                     f"{self.name} device {k} ({type(dev).__name__}): has no per-element parameters (a "
@@ -327,10 +329,15 @@ class CableDeviceFamily(ElementFamily):
                         and self.P[el, k, 8] > 0.0
                     ):
                         raise ModelError(f"{where}: hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
-                elif not (np.isfinite(self.P[el, k, 0]) and self.P[el, k, 0] > 0.0):
-                    raise ModelError(f"{where}: mu must be finite and > 0 (got {self.P[el, k, 0]!r} for the law)")
-                elif self.kinds[k] == SHEAVE and not self.P[el, k, 0] < 1.0:
-                    raise ModelError(f"{where}: mu pin_radius / radius = {self.P[el, k, 0]!r} must be < 1")
+                    mu_s, mu_k = self.P[el, k, 3], self.P[el, k, LATCH_MU_K]
+                else:
+                    mu_k, mu_s = self.P[el, k, 0], self.P[el, k, 1]
+                    if not (np.isfinite(mu_s) and mu_s > 0.0):
+                        raise ModelError(f"{where}: mu must be finite and > 0 (got {mu_s!r} for the law)")
+                    if self.kinds[k] == SHEAVE and not mu_s < 1.0:
+                        raise ModelError(f"{where}: mu pin_radius / radius = {mu_s!r} must be < 1")
+                if not (np.isfinite(mu_k) and 0.0 <= mu_k <= mu_s):
+                    raise ModelError(f"{where}: kinetic mu_k must lie in [0, mu_s] (static {mu_s!r}, kinetic {mu_k!r})")
 
     def _per_element(self, value, what):
         a = np.asarray(value, dtype=float)
