@@ -31,7 +31,8 @@ Built-in laws:
   ``r = T_out - T_in - sigma rho |F|`` with ``rho = mu_b r_pin / r``; the band is
   ``|T_out - T_in| <= rho |F|``;
 * latch (seed 001 Eqs. 5, 14): ``r = T_out - T_in - dT_sigma(x)``, ``x = Lb - s``; the backstop
-  bounds ``s <= Lb + x_backstop``.  Optional hysteresis as in :mod:`femast.latch`.
+  bounds ``s <= Lb + x_backstop``.  Optional hysteresis as in :mod:`femast.latch`, and the bearing
+  friction of a sheave at the same node (ADAM's pulley-and-latch unit): ``- sigma rho |F|`` more.
 
 Frictionless pulleys (equal strains on both sides, which is equal tensions when taut and a
 proportional share of the slack when slack, as in :mod:`._cable_kernels`) and clamps (never
@@ -53,13 +54,34 @@ CLAMP = 3  # fixed clamp: no sliding
 USER = 4  # a user law
 SHEAVE = 5  # sheave turning on a pin with bearing friction
 
-N_PARAM = 10
+N_PARAM = 12
 """Length of a device's parameter row (the layout of each kind is in ``device_params``)."""
 
 # capstan row: [mu_k, mu_s, ...]; sheave row: [rho_k, rho_s, ...] (rho = mu_b r_pin / r)
-# latch parameter row: [r, x_backstop, k, mu_s, h, R, Lb, Fh, ell, mu_k]
+# latch parameter row: [r, x_backstop, k, mu_s, h, R, Lb, Fh, ell, mu_k, rho_k, rho_s] (rho: the
+# bearing friction of a sheave at the latch, as in the pulley-and-latch unit of ADAM; 0: none)
 LATCH_LB = 6
 LATCH_MU_K = 9
+LATCH_RHO = 10
+
+
+@njit(cache=True)
+def _bearing(sigma, T_in, T_out, phi, rho):
+    """A sheave's bearing: r = T_out - T_in - sigma rho |F|, |F| = sqrt(T_in^2 + T_out^2 - 2 T_in T_out
+    cos phi); returns (r, dr/dT_in, dr/dT_out, dr/ds = 0, dr/dphi)."""
+    c = math.cos(phi)
+    F2 = T_in * T_in + T_out * T_out - 2.0 * T_in * T_out * c
+    F = math.sqrt(F2) if F2 > 0.0 else 0.0
+    if F <= 1e-300:  # both sides slack: no resultant, no friction
+        return T_out - T_in, -1.0, 1.0, 0.0, 0.0
+    a = sigma * rho / F
+    return (
+        T_out - T_in - sigma * rho * F,
+        -1.0 - a * (T_in - T_out * c),
+        1.0 - a * (T_out - T_in * c),
+        0.0,
+        -a * T_in * T_out * math.sin(phi),
+    )
 
 
 @njit(cache=True)
@@ -71,23 +93,14 @@ def builtin_law(kind, sigma, T_in, T_out, s, phi, p, static):
         E = math.exp(sigma * mu * phi)
         return T_out - T_in * E, -E, 1.0, 0.0, -T_in * E * sigma * mu
     if kind == SHEAVE:
-        rho = p[1] if static else p[0]
-        c = math.cos(phi)
-        F2 = T_in * T_in + T_out * T_out - 2.0 * T_in * T_out * c
-        F = math.sqrt(F2) if F2 > 0.0 else 0.0
-        if F <= 1e-300:  # both sides slack: no resultant, no friction
-            return T_out - T_in, -1.0, 1.0, 0.0, 0.0
-        a = sigma * rho / F
-        return (
-            T_out - T_in - sigma * rho * F,
-            -1.0 - a * (T_in - T_out * c),
-            1.0 - a * (T_out - T_in * c),
-            0.0,
-            -a * T_in * T_out * math.sin(phi),
-        )
+        return _bearing(sigma, T_in, T_out, phi, p[1] if static else p[0])
     if kind == LATCH:
         x = p[LATCH_LB] - s
         D, dD = branch_scalar_mu(x, sigma, p[0:6], p[3] if static else p[LATCH_MU_K], p[7], p[8])
+        rho = p[LATCH_RHO + 1] if static else p[LATCH_RHO]
+        if rho > 0.0:  # a sheave's bearing at the latch (the unit's pulley)
+            r, a, b, _, d = _bearing(sigma, T_in, T_out, phi, rho)
+            return r - D, a, b, dD, d
         return T_out - T_in - D, -1.0, 1.0, dD, 0.0
     return T_out - T_in, -1.0, 1.0, 0.0, 0.0
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..latch import LatchParameters, _as_param_array, validate_latch_array
-from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, LATCH_MU_K, N_PARAM, SHEAVE, USER
+from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, LATCH_MU_K, LATCH_RHO, N_PARAM, SHEAVE, USER
 
 
 @dataclass(frozen=True)
@@ -131,6 +131,9 @@ class Latch:
     hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.latch` (N, m).
     mu_s, mu_k : static and kinetic friction between rollers and bead (default both ``params.mu``,
         the paper's one coefficient): the static band of Eq. 14 uses mu_s, a sliding bead mu_k.
+    sheave : a :class:`Sheave` at the same node (the pulley of ADAM's pulley-and-latch unit): its
+        bearing friction ``rho |F|`` adds to the latch's jump (its radius sets only rho: the node
+        stays a point).  None (default): a frictionless pulley there, as the paper's element.
     The section before the latch runs through the backstop (as in :class:`CableLatchFamily`)."""
 
     params: LatchParameters | None = None
@@ -140,6 +143,7 @@ class Latch:
     hysteresis_length: float = 3e-4
     mu_s: float | None = None
     mu_k: float | None = None
+    sheave: Sheave | None = None
 
 
 @dataclass(frozen=True)
@@ -155,7 +159,7 @@ class UserDevice:
 
     (floats; N, m, rad) following the contract of :mod:`._device_laws`: r is the unbalanced force of
     the branch on which the cable slides in direction sigma (+1: the out side pulls, ds < 0; -1: the
-    in side pulls); the device sticks while r(+1) <= 0 <= r(-1).  params : up to 10 floats, passed as
+    in side pulls); the device sticks while r(+1) <= 0 <= r(-1).  params : up to 12 floats, passed as
     ``p``.  All user devices of one family share one law function (dispatch on ``p`` for several)."""
 
     law: object
@@ -189,6 +193,12 @@ def kind_and_params(dev, k, name):
             p[3], p[LATCH_MU_K] = friction_coefficients(0.0, mu_s, dev.mu_k, f"{name} device {k} (Latch)")
         else:
             p[LATCH_MU_K] = arr[3]
+        if dev.sheave is not None:
+            if not isinstance(dev.sheave, Sheave):
+                raise ModelError(f"{name} device {k} (Latch): sheave must be a Sheave, got {type(dev.sheave).__name__}")
+            q = np.zeros(N_PARAM)
+            if _sheave_params(dev.sheave, k, name, q)[0] == SHEAVE:
+                p[LATCH_RHO], p[LATCH_RHO + 1] = q[0], q[1]
         if not (np.isfinite(p[7]) and p[7] >= 0.0 and np.isfinite(p[8]) and p[8] > 0.0):
             raise ModelError(f"{name} device {k} (Latch): hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
         return LATCH, p, 0.0

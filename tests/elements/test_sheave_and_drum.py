@@ -174,3 +174,48 @@ def test_docs_page_quotes_what_the_example_prints(tmp_path, capsys):
     assert len(quoted) == 2
     for q in quoted:
         assert printed_in(q, out), q
+
+
+def eq14_out(x, p):
+    """Eq. 14 (Stohlman & Pellegrino), unlatching branch, written out here."""
+    rho = p.r + p.R
+    y = math.sqrt(max(rho**2 - x**2, 0.0))
+    delta = max(y - p.h - p.r, 0.0)
+    return -2.0 * p.k * delta * (x - p.mu * y) / (y + p.mu * x)
+
+
+def test_latch_with_the_bearing_of_its_unit_sheave():
+    """ADAM's pulley-and-latch unit: a latch and a sheave at one node.  A sliding bead's jump is Eq. 14
+    plus the bearing's rho |F|; out of the rollers' reach the unit is a sheave (closed form above)."""
+    from femast.elements.cable_devices import Latch
+    from femast.latch import LatchParameters
+
+    p = LatchParameters.seed_fit()
+    sheave = Sheave(0.01, 0.002, 0.3, point=True)
+    rho = 0.3 * 0.002 / 0.01
+    Xc = np.array([[0.0, 0.0, 0.0], [0.3, 0.0, 0.0], [0.3, 0.4, 0.0]])  # a quarter turn at the unit
+    fam = CableDeviceFamily.pretensioned([[0, 1, 2]], Xc, 2e4, 20.0, [Latch(p, sheave=sheave)])
+    st = fam.initial_state()
+    inside = out = 0
+    for du in np.linspace(0.0, 0.02, 201)[1:]:
+        X = Xc.copy()
+        X[2, 1] += du
+        r = ev(fam, X, st)
+        st = r.state
+        T, x = r.output["tension"][0], r.output["bead_position"][0, 0]
+        if st[0, 1] != 1:
+            continue
+        F = math.sqrt(T[0] ** 2 + T[1] ** 2)  # (phi = pi / 2: cos phi = 0)
+        assert T[1] - T[0] == pytest.approx(eq14_out(x, p) + rho * F, abs=1e-8)
+        inside += abs(x) < 2.34e-3
+        out += abs(x) > 2.35e-3
+    assert inside > 3 and out > 3
+    assert T[1] / T[0] == pytest.approx(sheave_ratio(rho, math.pi / 2, 1), rel=1e-10)
+    # the tangent of the sliding unit
+    X = Xc.copy()
+    X[2, 1] += 0.0014
+    st0 = fam.initial_state()
+    r = ev(fam, X, st0)
+    assert r.state[0, 1] == 1
+    Kfd = fd_tangent(fam, X, None, st0, h=1e-8, dofs=range(3))[0]
+    np.testing.assert_allclose(trans(r.k[0]), trans(Kfd), rtol=0, atol=1e-6 * np.abs(r.k).max())
