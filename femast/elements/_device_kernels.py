@@ -36,13 +36,14 @@ from numba import njit
 
 from ._cable_geometry import GEO_OK, cable_geometry
 from ._cable_kernels import latch_opening_scalar
+from ._device_algebra import cable_forces_and_tangent
 from ._device_algebra import section_tensions as _sections
 from ._device_algebra import solve_small as _solve_small
 from ._device_laws import CLAMP, FREE, LATCH, builtin_law, max_step, s_max_of
 
 _law = builtin_law
 """The device law the kernels call (a module global, so that the kernels cache; a family with a user
-law runs a copy of this module with ``_law`` replaced, see :func:`kernel_for_law`)."""
+law runs a copy of this module with ``_law`` replaced, see :mod:`._device_user_kernels`)."""
 
 STICK = 0
 SLIP_OUT = 1  # sigma = +1: the out side pulls (dS < 0)
@@ -482,63 +483,4 @@ def device_kernel(X, radius, EA, L0, kinds, P, state, f, K, state_new, T_out, ph
                 dlt = latch_opening_scalar(p[6] - S[d + 1], p[0], p[4], p[5])
                 en += p[2] * dlt * dlt
         energy[el] = en
-        # dS/dx = -A^-1 (RL G + Rphi dphi)
-        Y = np.zeros((m, 3 * nn))
-        if m > 0:
-            rhs = np.empty(m)
-            col = np.empty(m)
-            for a in range(3 * nn):
-                for d in range(m):
-                    acc = Rphi[d] * dphi[d, a]
-                    for i in range(n):
-                        acc += RL[d, i] * G[i, a]
-                    rhs[d] = -acc
-                if _solve_small(A, rhs, col):
-                    for d in range(m):
-                        Y[d, a] = col[d]
-        # dT_i/dx = dT/dL G_i + dT/dS_i Y_{i-1} + dT/dS_{i+1} Y_i
-        for i in range(n):
-            l0 = S[i + 1] - S[i]
-            dTdL = EA[el] / l0 if T[i] > 0.0 else 0.0
-            for a in range(3 * nn):
-                v = dTdL * G[i, a]
-                if i >= 1:
-                    v -= dT_dl0[i] * Y[i - 1, a]  # dl0_i/dS_i = -1
-                if i < m:
-                    v += dT_dl0[i] * Y[i, a]  # dl0_i/dS_{i+1} = +1
-                dTdx[i, a] = v
-        for i in range(n):
-            for a in range(nn):
-                for c in range(3):
-                    f[el, 6 * a + c] += T[i] * G[i, 3 * a + c]
-        for a in range(nn):
-            for c in range(3):
-                ra = 3 * a + c
-                for b in range(nn):
-                    for d2 in range(3):
-                        rb = 3 * b + d2
-                        v = 0.0
-                        for i in range(n):
-                            v += T[i] * H[i, ra, rb] + G[i, ra] * dTdx[i, rb]
-                        K[el, 6 * a + c, 6 * b + d2] = v
-
-
-_USER_KERNELS = {}
-
-
-def kernel_for_law(law):
-    """:func:`device_kernel` calling ``law`` (same signature as :func:`._device_laws.builtin_law`)
-    instead of the built-in laws: a copy of this module's kernels, compiled on first use (not cached
-    on disk: the law is the user's)."""
-    if law not in _USER_KERNELS:
-        import inspect
-        import sys
-        import types
-
-        src = inspect.getsource(sys.modules[__name__]).replace("@njit(cache=True)", "@njit")
-        mod = types.ModuleType(__name__ + "_user")
-        mod.__package__ = __package__
-        exec(compile(src, f"<{__name__} with user law {getattr(law, '__name__', law)}>", "exec"), mod.__dict__)
-        mod._law = law
-        _USER_KERNELS[law] = mod.device_kernel
-    return _USER_KERNELS[law]
+        cable_forces_and_tangent(S, G, H, dphi, A, RL, Rphi, T, dT_dl0, EA[el], f[el], K[el], dTdx)

@@ -215,6 +215,65 @@ def kind_and_params(dev, k, name):
     )
 
 
+LATCH_NAMES = ("r", "x_backstop", "k", "mu", "h", "R", None, "hysteresis_force", "hysteresis_length")
+
+
+def set_device_values(P, kinds, devices, values, name):
+    """Per-element device parameters (``device_values`` of :class:`CableDeviceFamily`) written into the
+    parameter rows ``P`` (n_el, n_devices, N_PARAM), validated per element."""
+    n_el = P.shape[0]
+    if not isinstance(values, dict):
+        raise ModelError(f"{name}: device_values must be a dict {{device index: {{parameter: values}}}}")
+    for k, params in values.items():
+        if not (isinstance(k, (int, np.integer)) and 0 <= k < len(devices)):
+            raise ModelError(f"{name}: device_values has device {k!r}; the devices are 0..{len(devices) - 1}")
+        dev = devices[k]
+        if isinstance(dev, Latch):
+            cols = {nm: ((i,), 1.0) for i, nm in enumerate(LATCH_NAMES) if nm}
+            cols.update(mu=((3, LATCH_MU_K), 1.0), mu_s=((3,), 1.0), mu_k=((LATCH_MU_K,), 1.0))
+        elif isinstance(dev, Pulley) and kinds[k] == CAPSTAN:
+            cols = {"mu": ((0, 1), 1.0), "mu_s": ((1,), 1.0), "mu_k": ((0,), 1.0)}
+        elif isinstance(dev, Sheave) and kinds[k] == SHEAVE:
+            c = dev.pin_radius / dev.radius  # rho = mu r_pin / r
+            cols = {"mu": ((0, 1), c), "mu_s": ((1,), c), "mu_k": ((0,), c)}
+        else:
+            raise ModelError(
+                f"{name} device {k} ({type(dev).__name__}): has no per-element parameters (a "
+                "Latch, a Drum or Pulley with mu > 0 and a Sheave with mu > 0 have)"
+            )
+        for nm, v in dict(params).items():
+            if nm not in cols:
+                raise ModelError(
+                    f"{name} device {k} ({type(dev).__name__}): unknown parameter {nm!r}; use {', '.join(cols)}"
+                )
+            try:
+                arr = np.broadcast_to(np.asarray(v, dtype=float), (n_el,))
+            except (TypeError, ValueError):
+                raise ModelError(
+                    f"{name} device {k}: {nm} must be a number or one per element ({n_el}), got shape {np.shape(v)}"
+                ) from None
+            idx, scale = cols[nm]
+            for i in idx:
+                P[:, k, i] = arr * scale
+        for el in range(n_el):  # construction only, not a hot path
+            where = f"{name} device {k} ({type(dev).__name__}), element {el}"
+            if isinstance(dev, Latch):
+                validate_latch_array(P[el, k, :6], where)
+                if not (
+                    np.isfinite(P[el, k, 7]) and P[el, k, 7] >= 0.0 and np.isfinite(P[el, k, 8]) and P[el, k, 8] > 0.0
+                ):
+                    raise ModelError(f"{where}: hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
+                mu_s, mu_k = P[el, k, 3], P[el, k, LATCH_MU_K]
+            else:
+                mu_k, mu_s = P[el, k, 0], P[el, k, 1]
+                if not (np.isfinite(mu_s) and mu_s > 0.0):
+                    raise ModelError(f"{where}: mu must be finite and > 0 (got {mu_s!r} for the law)")
+                if kinds[k] == SHEAVE and not mu_s < 1.0:
+                    raise ModelError(f"{where}: mu pin_radius / radius = {mu_s!r} must be < 1")
+            if not (np.isfinite(mu_k) and 0.0 <= mu_k <= mu_s):
+                raise ModelError(f"{where}: kinetic mu_k must lie in [0, mu_s] (static {mu_s!r}, kinetic {mu_k!r})")
+
+
 __all__ = [
     "Pulley",
     "Drum",
@@ -225,4 +284,5 @@ __all__ = [
     "geometry_radius",
     "kind_and_params",
     "friction_coefficients",
+    "set_device_values",
 ]

@@ -22,7 +22,6 @@ import numpy as np
 from numba import njit
 
 from ..errors import ElementConvergenceError, ModelError
-from ..latch import validate_latch_array
 from ._cable_geometry import (
     GEO_ADJACENT_PULLEYS,
     GEO_INSIDE_PULLEY,
@@ -32,8 +31,9 @@ from ._cable_geometry import (
     GEO_ZERO_LENGTH,
     cable_geometry,
 )
-from ._device_kernels import ERR_ACTIVE_SET, ERR_SHORT, SLIDE_FREE, STOP, device_kernel, kernel_for_law
-from ._device_laws import CAPSTAN, FREE, LATCH, LATCH_LB, LATCH_MU_K, N_PARAM, SHEAVE, USER, builtin_law
+from ._device_kernels import ERR_ACTIVE_SET, ERR_SHORT, SLIDE_FREE, STOP, device_kernel
+from ._device_laws import FREE, LATCH, LATCH_LB, N_PARAM, USER, builtin_law
+from ._device_user_kernels import kernel_for_law
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput, chain_nodes
 from .cable_device_specs import (  # noqa: F401  (the devices are imported from here)
     Clamp,
@@ -44,6 +44,7 @@ from .cable_device_specs import (  # noqa: F401  (the devices are imported from 
     UserDevice,
     geometry_radius,
     kind_and_params,
+    set_device_values,
 )
 
 MODE_NAMES = {0: "stick", 1: "slide (out side pulls)", -1: "slide (in side pulls)", 2: "at stop", 3: "frictionless"}
@@ -148,10 +149,11 @@ class CableDeviceFamily(ElementFamily):
     s0 : (n_el, n-1) or (n-1,) initial material coordinates of the cable at the devices, m
         (needed where the cable is gripped: capstans, clamps, user devices; a latch's comes from
         its bead: s = Lb - x0).  Use :meth:`pretensioned` to get them from a geometry.
-    device_values : per-element device parameters (issue 20: scatter per latch or pulley), a dict
+    device_values : per-element device parameters (scatter per latch or pulley), a dict
         ``{device index: {parameter: value or (n_el,) values}}``; parameters of a Latch: r,
         x_backstop, k, mu, h, R (SI, :class:`~femast.latch.LatchParameters`), hysteresis_force,
-        hysteresis_length; of a capstan Pulley (mu > 0): mu.  Each element's values are validated.
+        hysteresis_length, mu_s, mu_k; of a Drum (capstan Pulley) and of a Sheave with friction: mu,
+        mu_s, mu_k (``mu`` sets both).  Each element's values are validated.
     length_error : lack of fit per section, m, (n_el, n) or (n,) (default 0): the cable in section
         i is that much longer than nominal.  The sum lengthens the cable (L0); the errors of the
         sections before a device move the cable's material coordinate there (s0, a bead).
@@ -208,7 +210,7 @@ class CableDeviceFamily(ElementFamily):
         self.P = P
         self._law = _combined_law(users.pop()) if users else None
         if device_values:
-            self._set_device_values(device_values, devices)
+            set_device_values(self.P, self.kinds, devices, device_values, self.name)
         dL = np.zeros((n_el, n))
         if length_error is not None:
             try:
@@ -277,67 +279,6 @@ class CableDeviceFamily(ElementFamily):
                 f"from 0 to L0 = {self.L0[el]:.6g} m along the cable (section {i} has none)"
             )
         self.S0 = S0
-
-    _LATCH_NAMES = ("r", "x_backstop", "k", "mu", "h", "R", None, "hysteresis_force", "hysteresis_length")
-
-    def _set_device_values(self, values, devices):
-        """Per-element device parameters (``device_values`` of the constructor), validated per element."""
-        n_el = self.nodes.shape[0]
-        if not isinstance(values, dict):
-            raise ModelError(f"{self.name}: device_values must be a dict {{device index: {{parameter: values}}}}")
-        for k, params in values.items():
-            if not (isinstance(k, (int, np.integer)) and 0 <= k < len(devices)):
-                raise ModelError(f"{self.name}: device_values has device {k!r}; the devices are 0..{len(devices) - 1}")
-            dev = devices[k]
-            if isinstance(dev, Latch):
-                cols = {nm: ((i,), 1.0) for i, nm in enumerate(self._LATCH_NAMES) if nm}
-                cols.update(mu=((3, LATCH_MU_K), 1.0), mu_s=((3,), 1.0), mu_k=((LATCH_MU_K,), 1.0))
-            elif isinstance(dev, Pulley) and self.kinds[k] == CAPSTAN:
-                cols = {"mu": ((0, 1), 1.0), "mu_s": ((1,), 1.0), "mu_k": ((0,), 1.0)}
-            elif isinstance(dev, Sheave) and self.kinds[k] == SHEAVE:
-                c = dev.pin_radius / dev.radius  # rho = mu r_pin / r
-                cols = {"mu": ((0, 1), c), "mu_s": ((1,), c), "mu_k": ((0,), c)}
-            else:
-                raise ModelError(
-                    f"{self.name} device {k} ({type(dev).__name__}): has no per-element parameters (a "
-                    "Latch, a Drum or Pulley with mu > 0 and a Sheave with mu > 0 have)"
-                )
-            for nm, v in dict(params).items():
-                if nm not in cols:
-                    raise ModelError(
-                        f"{self.name} device {k} ({type(dev).__name__}): unknown parameter {nm!r}; use "
-                        f"{', '.join(cols)}"
-                    )
-                try:
-                    arr = np.broadcast_to(np.asarray(v, dtype=float), (n_el,))
-                except (TypeError, ValueError):
-                    raise ModelError(
-                        f"{self.name} device {k}: {nm} must be a number or one per element ({n_el}), "
-                        f"got shape {np.shape(v)}"
-                    ) from None
-                idx, scale = cols[nm]
-                for i in idx:
-                    self.P[:, k, i] = arr * scale
-            for el in range(n_el):  # construction only, not a hot path
-                where = f"{self.name} device {k} ({type(dev).__name__}), element {el}"
-                if isinstance(dev, Latch):
-                    validate_latch_array(self.P[el, k, :6], where)
-                    if not (
-                        np.isfinite(self.P[el, k, 7])
-                        and self.P[el, k, 7] >= 0.0
-                        and np.isfinite(self.P[el, k, 8])
-                        and self.P[el, k, 8] > 0.0
-                    ):
-                        raise ModelError(f"{where}: hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
-                    mu_s, mu_k = self.P[el, k, 3], self.P[el, k, LATCH_MU_K]
-                else:
-                    mu_k, mu_s = self.P[el, k, 0], self.P[el, k, 1]
-                    if not (np.isfinite(mu_s) and mu_s > 0.0):
-                        raise ModelError(f"{where}: mu must be finite and > 0 (got {mu_s!r} for the law)")
-                    if self.kinds[k] == SHEAVE and not mu_s < 1.0:
-                        raise ModelError(f"{where}: mu pin_radius / radius = {mu_s!r} must be < 1")
-                if not (np.isfinite(mu_k) and 0.0 <= mu_k <= mu_s):
-                    raise ModelError(f"{where}: kinetic mu_k must lie in [0, mu_s] (static {mu_s!r}, kinetic {mu_k!r})")
 
     def _per_element(self, value, what):
         a = np.asarray(value, dtype=float)

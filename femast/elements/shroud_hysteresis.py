@@ -8,7 +8,7 @@ curve, :mod:`.shroud_law`):
 
     tau = tau_e(eps) + tau_f,        |tau_f| <= eta tau_e(eps)
 
-with ``tau_e`` the tension of Eq. 25 (inverted, :func:`femast.elements.shroud_cable.dyneema_tension`)
+with ``tau_e`` the tension of Eq. 25 (inverted, :func:`femast.elements._shroud_kernels.dyneema_tension`)
 and ``tau_f`` the friction tension: it sticks (grows with a stick rigidity ``k_s`` times the strain
 increment) until it reaches ``+-eta tau_e``, then slides.  Under monotone loading the rope follows
 the loading branch ``(1 + eta) tau_e(eps)`` (after a short stick run of strain about ``eta tau_e /
