@@ -27,6 +27,7 @@ from . import validation
 from .amplitudes import Amplitude
 from .arrays import ElementList, add_beams, add_nodes, add_trusses
 from .gravity import _step_gravity
+from .mass import point_mass_spec
 from .sections import Section
 
 LOAD_NAMES = ("fx", "fy", "fz", "mx", "my", "mz")
@@ -483,8 +484,6 @@ class Model:
         3 principal values along the global axes or a 3x3 matrix, initial global axes) at
         ``node``, its centre of mass ``offset`` (m) from the node (modal analyses, gravity); ``name``
         labels it in messages.  Returns the :class:`femast.model.mass.PointMassSpec`."""
-        from .mass import point_mass_spec
-
         self._check_node(node, "point mass")
         spec = point_mass_spec(node, mass, inertia, offset, name)
         self.point_masses.append(spec)
