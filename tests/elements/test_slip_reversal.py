@@ -44,7 +44,9 @@ def _joint(theta_z, prev_moment_z, F=100.0, committed_mz=0.0):
     prev[I_M + 2] = prev_moment_z
     f, K, new, out = np.zeros(12), np.zeros((12, 12)), np.zeros(N_STATE), np.zeros(11)
     xb = np.array([F / K_PEN, 0.0, 0.0])
-    ball_joint_element(np.zeros(3), xb, np.eye(3), Rb, np.zeros(3), K_PEN, K_S, MU, MU, B, st, f, K, new, out, prev, True)
+    ball_joint_element(
+        np.zeros(3), xb, np.eye(3), Rb, np.zeros(3), K_PEN, K_S, MU, MU, B, st, f, K, new, out, prev, True
+    )
     return f, K, new
 
 
