@@ -161,3 +161,13 @@ def test_a_script_without_a_main_guard_gets_a_clear_error_not_a_hang(tmp_path):
     assert p.returncode != 0
     last = p.stderr.strip().splitlines()[-1]
     assert last.startswith("femast.errors.WorkerDied") and 'if __name__ == "__main__":' in last
+
+
+def _never_returns():
+    time.sleep(3600)
+
+
+def test_workers_that_never_get_set_up_end_the_pool_with_an_error():
+    with workers.Pool(2, initializer=_never_returns, start_timeout_s=5.0, name="test") as pool:
+        with pytest.raises(WorkerDied, match="as they start"):
+            pool.submit(_square, 3).result(timeout=600)
