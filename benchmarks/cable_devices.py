@@ -24,7 +24,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from femast.elements.base import IncrementContext  # noqa: E402
-from femast.elements.cable_devices import CableDeviceFamily, Drum, Latch, Pulley  # noqa: E402
+from femast.elements.cable_devices import CableDeviceFamily, Latch, Pulley  # noqa: E402
 from femast.latch import LatchParameters, latch_force  # noqa: E402
 
 EA = 1.0e5
@@ -44,7 +44,7 @@ def run(fam, X0, moves):
 def capstan(ax):
     mu = 0.3
     X = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.2, 0.0]])
-    fam = CableDeviceFamily.pretensioned([[0, 1, 2]], X, EA, 100.0, [Drum(mu=mu)])
+    fam = CableDeviceFamily.pretensioned([[0, 1, 2]], X, EA, 100.0, [Pulley(mu=mu)])
     u = np.r_[np.linspace(0, 0.01, 101), np.linspace(0.01, -0.004, 141)]
     moves = np.zeros((len(u), 3, 3))
     moves[:, 2, 1] = u
