@@ -133,7 +133,9 @@ def print_summary(info: dict):
         f"  initial step: cables at {info['pretension_N']:.1f} N in equilibrium; stabilisation energy / strain "
         f"energy = {info['stabilization_ratio']:.2e}"
     )
-    print(f"  peak moment {info['peak_moment_Nm']:.1f} N m (the bay's moment on the rig) at {info['peak_at_deg']:.3f} deg")
+    print(
+        f"  peak moment {info['peak_moment_Nm']:.1f} N m (the bay's moment on the rig) at {info['peak_at_deg']:.3f} deg"
+    )
     print(f"  latches reach zone {ZONE_LABELS[3]} at (deg), sides 0-3: {rel}")
     print(
         f"  end: rotation {info['final_rotation_deg']:.4f} deg, moment {info['final_moment_Nm']:.3f} N m, "

@@ -276,7 +276,14 @@ def as_completed(futures, desc: str, unit: str = "tasks", relays=None, name=None
             runs = f"{sum(c[0] for c in counts)} model runs" if counts else ""
             fe = sum(c[1] for c in counts)
             post = ", ".join(
-                s for s in (f"{len(futures) - len(pending)} of {len(futures)} finished", runs, fe and f"{fe} FE runs", last) if s
+                s
+                for s in (
+                    f"{len(futures) - len(pending)} of {len(futures)} finished",
+                    runs,
+                    fe and f"{fe} FE runs",
+                    last,
+                )
+                if s
             )
             bar.set_postfix_str(post, refresh=True)
             yield from finished

@@ -38,9 +38,7 @@ def _texts(fig, renderer):
             if t.get_visible() and t.get_text():
                 out.append((f"axes {i} {name} {t.get_text()!r}", t.get_window_extent(renderer)))
         for axis, name in ((ax.xaxis, "x tick labels"), (ax.yaxis, "y tick labels")):
-            boxes = [
-                t.get_window_extent(renderer) for t in axis.get_ticklabels() if t.get_visible() and t.get_text()
-            ]
+            boxes = [t.get_window_extent(renderer) for t in axis.get_ticklabels() if t.get_visible() and t.get_text()]
             out += [(f"axes {i} {name}", b) for b in boxes]
     return out
 
@@ -62,7 +60,7 @@ def legend_overlaps(fig) -> list[str]:
         for what, tb in texts:
             if _overlap(box, tb):
                 bad.append(f"legend [{names}] covers {what}")
-        for leg2, box2 in legs[k + 1 :]:
+        for _, box2 in legs[k + 1 :]:
             if _overlap(box, box2):
                 bad.append(f"legend [{names}] covers another legend")
     return bad

@@ -47,7 +47,6 @@ def test_plain_line_shows_tasks_partly_done():
     assert out.getvalue().splitlines() == ["diagnose: 1.5/4 refits [0:02 elapsed, ~0:03 left]"]  # 2 s * 2.5 / 1.5
 
 
-
 def test_a_bar_over_tasks_moves_inside_running_tasks(monkeypatch):
     """Two tasks running elsewhere: before either finishes the bar stands between 0 and 1 step (each
     task's evaluations against twice the most any has done: 4/8 + 2/8); once one has finished after
@@ -81,10 +80,14 @@ def test_a_bar_over_tasks_moves_inside_running_tasks(monkeypatch):
 
         t = threading.Thread(target=work, daemon=True)
         t.start()
-        seen = [f.result() for f in progress.as_completed(futures, "diagnose", "refits", relays, "xy".__getitem__, 0.02)]
+        seen = [
+            f.result() for f in progress.as_completed(futures, "diagnose", "refits", relays, "xy".__getitem__, 0.02)
+        ]
         t.join()
     assert seen == ["a", "b"]
     lines = out.getvalue().splitlines()
     assert any(ln.startswith("diagnose: 0.8/2 refits, 0 of 2 finished, 6 model runs [") for ln in lines)
-    assert any(ln.startswith("diagnose: 1.2/2 refits, 1 of 2 finished, 10 model runs, 2 FE runs, last: x [") for ln in lines)
+    assert any(
+        ln.startswith("diagnose: 1.2/2 refits, 1 of 2 finished, 10 model runs, 2 FE runs, last: x [") for ln in lines
+    )
     assert lines[-1].startswith("diagnose: 2/2 refits, 2 of 2 finished, 10 model runs, 2 FE runs, last: y [")
