@@ -212,7 +212,7 @@ def plot(results, path):
             label="the rest (Python between the parts)" if y == 0 else None,
         )
         ax.text(r["whole"] / r["superlu"] + 0.02, y, f"{r['whole'] / r['superlu']:.2f}", va="center")
-    ax.axvline(1.3, color="r", ls=":", label="target 1.3 (issue 21)")
+    ax.axvline(1.3, color="r", ls=":", label="target 1.3")
     ax.set(
         yticks=range(len(results)),
         yticklabels=[f"{r['bays']} bays" for r in results],

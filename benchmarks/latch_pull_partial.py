@@ -90,7 +90,7 @@ def main():
 
     exp = get_experiment("latch-pull")
     latch = SeedLatch()
-    print("null cases (independent rig data, 0.5 N / 2 um noise, seed fit):")
+    print("null cases (independent rig data, 0.5 N / 2 um noise, the published latch fit):")
     print(f"  {'case':32s} {'rows':>5s} {'RMS/noise drawn':>16s} {'RMS/noise est.':>15s}")
     runs = {}
     for name, (knots, side, x0) in paths(latch).items():
@@ -116,7 +116,7 @@ def main():
     ):
         run, cols, p = runs[name]
         ax.plot(cols["x_mm"], cols["dT_N"], ".", ms=2, color="0.6", label="independent rig data (0.5 N noise)")
-        ax.plot(cols["x_mm"], p, "-", lw=1.0, color="C3", label="latch-pull model, loaded side (issue 22)")
+        ax.plot(cols["x_mm"], p, "-", lw=1.0, color="C3", label="latch-pull model, loaded side")
         ax.plot(
             1e3 * run["x_meas"],
             direction_rule(run["x_meas"], run["dT"], SEED),
