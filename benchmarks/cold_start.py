@@ -1,4 +1,4 @@
-"""Time to first result on a fresh install (issue 17): the getting_started script and the main job
+"""Time to first result on a fresh install: the getting_started script and the main job
 (``benchmarks/verification.py``) with an empty numba cache, then again with the cache written.
 
     python benchmarks/cold_start.py [--only getting_started|verification] [--warm] [--in-process]
@@ -16,7 +16,7 @@ outlives the script; the benchmark waits for it before the next run and prints i
 when it finished (from its ``FEMAST_JIT_LOG``).  ``--in-process`` measures the old way
 (``FEMAST_BACKGROUND_COMPILE=0``: numba compiles in the script's process).
 
-Targets (issue 17): getting_started < 8 s and the main job < 15 s, cold.
+Targets: getting_started < 8 s and the main job < 15 s, cold.
 """
 
 from __future__ import annotations

@@ -44,7 +44,7 @@ PARTS = [  # (module, attribute path, label); an indented label is part of the o
     ("femast.analysis.system", "System.update", "configuration update"),
     ("femast.analysis.system", "System.commit", "commit (per increment)"),
     ("femast.analysis.output", "ResultsObserver.converged", "results frame (per increment)"),
-    # older femast (issue 8): the same parts under their names of then
+    # older femast: the same parts under their names of then
     ("femast.analysis", "Analysis._residual", "residual assembly"),
     ("femast.analysis", "Analysis._converged", "convergence test"),
     ("femast.analysis", "Analysis._update", "configuration update"),
@@ -174,7 +174,7 @@ def plot(results, path):
     import matplotlib
 
     matplotlib.use("Agg")
-    from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+    from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
     plotstyle.use()
     import matplotlib.pyplot as plt
@@ -212,7 +212,7 @@ def plot(results, path):
             label="the rest (Python between the parts)" if y == 0 else None,
         )
         ax.text(r["whole"] / r["superlu"] + 0.02, y, f"{r['whole'] / r['superlu']:.2f}", va="center")
-    ax.axvline(1.3, color="r", ls=":", label="target 1.3 (issue 21)")
+    ax.axvline(1.3, color="r", ls=":", label="target 1.3")
     ax.set(
         yticks=range(len(results)),
         yticklabels=[f"{r['bays']} bays" for r in results],

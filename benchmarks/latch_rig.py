@@ -26,7 +26,7 @@ import numpy as np
 
 
 class SeedLatch:
-    """Roller latch of seed 001 Sec. III.A (SI): r, R, h (m), k (N/m, one roller), mu (-), x_backstop (m)."""
+    """Roller latch of Stohlman & Pellegrino, Sec. III.A (SI): r, R, h (m), k (N/m, one roller), mu (-), x_backstop (m)."""
 
     def __init__(self, r=1.1e-3, x_backstop=2.0e-3, k=1e5, mu=0.07, h=1.5e-3, R=2.4e-3):
         self.r, self.xb, self.k, self.mu, self.h, self.R = r, x_backstop, k, mu, h, R

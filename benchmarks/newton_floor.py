@@ -1,4 +1,4 @@
-"""The floor of the Newton loop: femast's own parts in a loop written for one model (issue 8).
+"""The floor of the Newton loop: femast's own parts in a loop written for one model.
 
     python benchmarks/newton_floor.py [--bays 40] [--repeat 3]
 

@@ -1,4 +1,4 @@
-"""Newton variants: factorisations and wall time per increment (issue 21, item 2).
+"""Newton variants: factorisations and wall time per increment.
 
     python benchmarks/newton_variants.py [--bays 40 400] [--png docs/figures/newton_variants.png]
 

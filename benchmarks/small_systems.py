@@ -1,4 +1,4 @@
-"""Linear solves of small tangents: SuperLU, the band back-end and a dense LAPACK LU (issue 21, item 3).
+"""Linear solves of small tangents: SuperLU, the band back-end and a dense LAPACK LU.
 
     python benchmarks/small_systems.py [--rounds 5] [--png benchmarks/out/small_systems.png]
 

@@ -1,4 +1,4 @@
-"""Linear-solver back-ends on femast's own tangents (issue 21, item 1).
+"""Linear-solver back-ends on femast's own tangents.
 
     python benchmarks/solver_backends.py [--bays 40 400 1000] [--reps 7] [--png docs/figures/solver_backends.png]
 

@@ -16,7 +16,7 @@ from . import _aliases, numba_cache
 
 numba_cache.check()  # delete numba caches whose njit helpers in other files changed (femast.numba_cache)
 
-_aliases.install()  # the import paths of before the package move (issue 15) keep working
+_aliases.install()  # the import paths of before the package move keep working
 
 from .analysis import Analysis, solve
 from .analysis.solvers.arclength import ArcLength

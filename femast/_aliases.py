@@ -1,4 +1,4 @@
-"""The import paths of before the package move (issue 15), kept working.
+"""The import paths of before the package move, kept working.
 
 ``import femast.results``, ``from femast.sections import ...``, ``from femast import plotstyle``,
 ``femast.solvers.control``... resolve to the modules at their new places (``femast.post.results``,
@@ -39,7 +39,7 @@ OLD_PATHS = {
     "femast.verification_arclength": "femast.verification.arclength",
     "femast.verification_modal": "femast.verification.modal",
     "femast.references": "femast.verification.references",
-    "femast.guyed.shroud": "femast.elements.shroud_law",  # the law of the shroud element (issue 15)
+    "femast.guyed.shroud": "femast.elements.shroud_law",  # the law of the shroud element
 }
 
 

@@ -50,7 +50,7 @@ def _run(args):
 def _vtk(args):
     from .post.vtk import export_vtk
 
-    out = Path(args.out) / Path(args.results).resolve().name  # ./vtk/NAME: beside render's ./render (issue 17)
+    out = Path(args.out) / Path(args.results).resolve().name  # ./vtk/NAME: beside render's ./render
     pvd = export_vtk(args.results, out, every=args.every)
     print(f"wrote {pvd} (open it in ParaView; apply 'Warp By Vector' with U to see the deformed shape)")
 
@@ -215,12 +215,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=_warmup)
     try:
-        from .cli_experiments import register  # compare / diagnose (issue 7), when present
+        from .cli_experiments import register  # compare / diagnose, when present
     except ImportError:
         register = None
     if register is not None:
         register(sub, _Help)
-    from .studies.cli import register as register_study  # femast study (issue 20)
+    from .studies.cli import register as register_study  # femast study
 
     register_study(sub, _Help)
     for name, sp in sub.choices.items():  # --quiet also after the command (SUPPRESS: keeps the main one's value)
@@ -235,7 +235,7 @@ def main(argv=None):
     import gc
 
     # one short process: collect young objects every 20 000 allocations instead of 700 (a bay-torsion
-    # diagnosis made ~400 collections, 0.2-0.5 s of its serial CPU; 15 with this; issue 21); the
+    # diagnosis made ~400 collections, 0.2-0.5 s of its serial CPU; 15 with this); the
     # caller's thresholds come back at the end (main() called from Python: tests, notebooks)
     thresholds, frozen = gc.get_threshold(), gc.get_freeze_count()
     gc.set_threshold(max(thresholds[0], 20_000), 50, 100)

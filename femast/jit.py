@@ -29,7 +29,7 @@ import time
 # cold compile CPU time of the main kernels, s (numba 0.68, one core of the development machine,
 # recorded with numba's compile events; benchmarks/cold_start.py measures the whole first run).
 COMPILE_S = {
-    "femast.elements.beam_corot.beam_family_kernel": 8.5,  # 11-12 s before the end loops (issue 17)
+    "femast.elements.beam_corot.beam_family_kernel": 8.5,  # 11-12 s before the end loops
     "femast.analysis.configuration.update_configuration": 1.9,
     "femast.rotations.apply_spins": 1.0,
     "femast.analysis.solvers.convergence.force_moment_abs_max": 0.9,
@@ -49,8 +49,8 @@ SETUP_PYTHON_MAX = 20_000  # inner-loop iterations (~10 ms of Python)
 # Set-up kernels that return new arrays computed from their arguments alone and write none of them
 # (qualified names): on the plain-Python path their results are remembered by a digest of the
 # arguments, so a process that builds the same small model again and again (the FE fits of
-# femast.experiments: 50-60 runs of one bay in a diagnosis) computes its pattern once (issue 21:
-# the bay's assembly pattern is 12 ms of its 82 ms per run in Python).
+# femast.experiments: 50-60 runs of one bay in a diagnosis) computes its pattern once
+# (the bay's assembly pattern is 12 ms of its 82 ms per run in Python).
 MEMO_KERNELS = frozenset({"femast.analysis.assembly._pattern_kernel", "femast.analysis.solvers.ordering._permuted_csc"})
 MEMO_ENTRIES = 16
 _MEMO: dict = {}
@@ -245,7 +245,7 @@ def _warm_adam():
 
 
 def _warm_guyed():
-    """The guyed mast of seed 000 with its shroud cables: pretension and one small wrench."""
+    """The guyed mast of the Rocaspect paper with its shroud cables: pretension and one small wrench."""
     from femast.guyed.fe_mast import MastFE
 
     MastFE(400.0, n_beam=4).run_wrenches([[1.0, 0.0, 0.0, 0.0, 0.0, 0.0]])

@@ -1,4 +1,4 @@
-"""First run without waiting for the compiler (issue 17): compile numba kernels in a background
+"""First run without waiting for the compiler: compile numba kernels in a background
 process while the first, small analyses run the same kernels in the Python interpreter.
 
 On a fresh install numba has nothing in its cache and compiling femast's kernels costs 10-15 s of

@@ -1,4 +1,4 @@
-"""Latch law of seed 001 (section III.A, Eqs. 6-14): force jump across a roller latch.
+"""Latch law of Stohlman & Pellegrino (section III.A, Eqs. 6-14): force jump across a roller latch.
 
 The latch is two friction rollers (radius ``r``) on cantilever springs gripping a
 spherical bead (radius ``R``) fixed on the cable, with a backstop behind the
@@ -89,7 +89,7 @@ ZONE_LABELS = ("(a) at backstop", "(b) behind roller axis", "(c) in front of rol
 
 @dataclass(frozen=True)
 class LatchParameters:
-    """Parameters of the latch law (seed 001, Section III.A), SI units.
+    """Parameters of the latch law (Stohlman & Pellegrino, Section III.A), SI units.
 
     r : roller radius, m.
     x_backstop : distance of the backstop behind the roller axis, m (backstop at x = -x_backstop).
@@ -108,7 +108,7 @@ class LatchParameters:
 
     @classmethod
     def seed_fit(cls) -> LatchParameters:
-        """The fit of seed 001, Section III.C: r = 1.1 mm, x_backstop = 2.0 mm,
+        """The fit of Stohlman & Pellegrino, Section III.C: r = 1.1 mm, x_backstop = 2.0 mm,
         k = 100 N/mm, mu = 0.07, h = 1.5 mm, R = 2.4 mm (returned in SI)."""
         return cls(r=1.1e-3, x_backstop=2.0e-3, k=100e3, mu=0.07, h=1.5e-3, R=2.4e-3)
 
@@ -244,7 +244,7 @@ def _broadcast(x, sigma, params):
 
 
 def latch_force(x, direction, params=None, derivative: bool = False):
-    """Force jump dT = T2 - T1 (N) of a *moving* bead, seed 001 Eq. 14.
+    """Force jump dT = T2 - T1 (N) of a *moving* bead, Stohlman & Pellegrino, Eq. 14.
 
     x : bead position, m (positive outside the latch, see module docstring); any shape.
     direction : +1 (``UNLATCHING``, dx > 0) or -1 (``LATCHING``, dx < 0), broadcast with x.
@@ -295,7 +295,7 @@ def friction_band(x, params=None):
 def hysteresis_force(x, params=None, force: float = 0.0, length: float = 3e-4):
     """Extra friction H(x) (N) of the *latch hysteresis* option, for bead positions x (m).
 
-    Seed 001 fits one curve near the latched state ("the model assumes no hysteresis in this
+    Stohlman & Pellegrino fit one curve near the latched state ("the model assumes no hysteresis in this
     region", Sec. III.C) and so predicts no residual rotation at zero moment (Sec. VIII).  The
     option adds a friction force that is largest with the bead seated on the backstop and
     fades over ``length`` (m) as the bead moves out, vanishing at the roller axis::

@@ -1,4 +1,4 @@
-"""Identification of the latch law from pull tests (seed 001, Section III.B-C, Eq. 15).
+"""Identification of the latch law from pull tests (Stohlman & Pellegrino, Section III.B-C, Eq. 15).
 
 A pull test (seed Fig. 8) pulls the bead into (latching) or out of (unlatching) the
 latch with one cable while the cable on the other side of the latch is slack, and
@@ -72,7 +72,7 @@ class PullTest:
 
 
 def remove_cable_stretch(d, T, EA, L_cable, d0=0.0, sign=1):
-    """Bead position from the cable end distance, seed 001 Eq. 15 (m).
+    """Bead position from the cable end distance, Stohlman & Pellegrino, Eq. 15 (m).
 
     d : cable end-to-end distance, m.  T : tension, N.  EA : axial rigidity, N.
     L_cable : unstretched length of the loaded cable, m.  d0 : offset, m.

@@ -1,4 +1,4 @@
-"""The analysis package (issue 15): the docs tour runs, the state saves and loads bit for bit,
+"""The analysis package: the docs tour runs, the state saves and loads bit for bit,
 commit/rollback restore exactly, the Newton variants reach the same solution, observers hear
 every converged increment, and the size rules of the package hold."""
 
@@ -237,7 +237,7 @@ EXCEPTIONS = {
     ("analysis/analysis.py", "post"),  # the results folder an Analysis returns (Results, run_outcome)
     ("analysis/output.py", "post"),  # output is the observer that owns the results writer
 }
-ALWAYS = {"errors", "rotations", "progress", "jit"}  # jit: the first-run compile (issue 17)
+ALWAYS = {"errors", "rotations", "progress", "jit"}  # jit: the first-run compile
 
 
 @pytest.mark.parametrize("package", sorted(MAY_IMPORT))

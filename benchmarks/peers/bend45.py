@@ -1,5 +1,5 @@
 """The Bathe-Bolourchi 45-degree bend, a small model with many increments, in femast and OpenSeesPy
-(issue 21, item 3: the fixed cost per increment).
+(the fixed cost per increment).
 
     python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--no-folder] [--strict] [--profile] [--parts] [--docs]
 
@@ -218,7 +218,7 @@ def main(argv=None):
         "--strict",
         action="store_true",
         help="femast's strict correction test only "
-        "(Convergence(predicted=False), the rule before issue 21's predicted correction)",
+        "(Convergence(predicted=False), the rule before the predicted correction)",
     )
     ap.add_argument("--docs", action="store_true")
     args = ap.parse_args(argv)

@@ -1,4 +1,4 @@
-"""Parameters of an ADAM-type bay (seed 001): every dimension, section, material, pretension and
+"""Parameters of an ADAM-type bay (Stohlman & Pellegrino): every dimension, section, material, pretension and
 latch parameter, in SI units, with the source of each default value.
 
 The seed gives the bay height (6.84 m / 40 bays = 0.171 m), the ball joints (mu = 0.5, B = 4 mm),
@@ -18,7 +18,7 @@ from ..errors import ModelError
 from ..latch import LatchParameters, contact_half_width, validate_latch_array
 from ..model.sections import Section, circular_tube
 
-#: Bay height of seed 001, Sec. VII: 40 bays make a 6.84 m mast.
+#: Bay height of Stohlman & Pellegrino, Sec. VII: 40 bays make a 6.84 m mast.
 SEED_BAY_HEIGHT = 6.84 / 40
 
 

@@ -23,7 +23,7 @@ from .build import AdamModel
 #: of the penalty forces (k_pen x 1 ulp of a coordinate, ~2e-4 N).
 CONVERGENCE = Convergence(force_tol=1e-9, disp_tol=1e-6, max_iterations=25)
 
-#: Table 1 of seed 001: tip torsion and shear of the pointing manoeuvre (Sec. VII).
+#: Table 1 of Stohlman & Pellegrino: tip torsion and shear of the pointing manoeuvre (Sec. VII).
 TABLE1_M = 6.8  # N m about z
 TABLE1_F = 14.0  # N along x
 
@@ -49,7 +49,7 @@ def stabilize_for(am: AdamModel, fraction: float = 1e-4, dt0: float = 1.0) -> St
 def add_initial_steps(
     am: AdamModel, stabilize: Stabilize | None = None, hold_control: tuple = (), settle: bool = False
 ):
-    """The initial step of seed 001 Sec. II.C: the deployed, pretensioned structure comes to
+    """The initial step of Stohlman & Pellegrino, Sec. II.C: the deployed, pretensioned structure comes to
     equilibrium with its cable pretensions under viscous stabilisation (step ``pretension``); the
     steps added after it have no stabilisation (the seed: "no stabilization is used after the
     initial stable state is achieved").

@@ -115,18 +115,18 @@ class Analysis:
             raise ModelError(f"model '{model.name}' has no steps; add one with model.step()")
         if not (model.beams or model.trusses or model.families):
             raise ModelError(f"model '{model.name}' has no elements")
-        for s in model.steps:  # (again: a step's fields may have been set after model.step(); issue 16)
+        for s in model.steps:  # (again: a step's fields may have been set after model.step())
             validation.step_increments(s)
         self.families = build_families(model)
         check_controls(model)
-        # length errors and temperatures (issue 20): None when the model has neither
+        # length errors and temperatures: None when the model has neither
         self.fields = FieldLoads(model, self.families) if has_fields(model) else None
         self.summary = AnalysisSummary()
         self.system = System(model, self.families, self.summary, linear_solver=linear_solver)
         self.state = State.initial(self.system.X0, self.families)
         self.output = ResultsOutput(out, [on_frame])
         self.observers = [self.output, *observers]
-        # restart (issue 16, restart.py): save a restart point every n increments; continue from one
+        # restart (restart.py): save a restart point every n increments; continue from one
         self.restart = restart_folder(out, restart)
         self.resume = None
         if restart_every is not None:
@@ -250,7 +250,7 @@ class Analysis:
                 if k < first:
                     continue
                 self._state.step = k
-                if getattr(step, "kind", "static") == "frequency":  # modes of the state (issue 18)
+                if getattr(step, "kind", "static") == "frequency":  # modes of the state
                     from ..modal.step import run_frequency_step
 
                     run_frequency_step(self, step)
@@ -258,7 +258,7 @@ class Analysis:
                     inside = self.resume is not None and k == self.resume["step"] and not self.resume["step_done"]
                     run_step(self, step, resume=self.resume if inside else None)
             self.summary.status, self.summary.completed = "completed", True
-        except BaseException as exc:  # the summary says how the run ended (issue 16), then the error goes on
+        except BaseException as exc:  # the summary says how the run ended, then the error goes on
             self.summary.status, self.summary.message = run_outcome(exc)
             if isinstance(exc, ConvergenceError):
                 for obs in self.observers:

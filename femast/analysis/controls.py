@@ -127,7 +127,7 @@ class TimeIncrements(Plan):
                 for t in amp.times
                 if 0 < t < period
             }
-        )  # temperature amplitudes (issue 20)
+        )  # temperature amplitudes
         self.load_start, self.pres_start = st.loads.copy(), st.prescribed.copy()
         self.load_rows, self.pres_rows = _rows(analysis.model, step.loads), _rows(analysis.model, step.prescribed)
         sys_ = analysis.system

@@ -296,7 +296,7 @@ class Newton:
             pdu, pdlam = inc.predictor
             Du += pdu
             if whole:
-                # a predictor of the whole increment (a reference run's converged increment, issue 21):
+                # a predictor of the whole increment (a reference run's converged increment):
                 # the prescribed motion goes in with it, not again in the first iteration, and the
                 # first iteration is no linear solve from the committed state (no linear-increment rule)
                 system.update(pdu, dpres if has_dpres else None)

@@ -99,7 +99,7 @@ class System:
         )
         if self.dofmap.n_free == 0:
             raise ModelError(f"model '{model.name}' has no free DOFs")
-        validation.loads_on_active_dofs(model, self.dofmap)  # a load nothing stiffens: an error (issue 16)
+        validation.loads_on_active_dofs(model, self.dofmap)  # a load nothing stiffens: an error
         self.check_balance = validation.self_equilibrated(self.families)
         self._constrained = self.constraints.active  # fixed from here on (asked every iteration)
         self.assembler = Assembler(self.dofmap, self.families, full=self._constrained)
@@ -343,7 +343,7 @@ class System:
             float(sum(np.sum(r.energy) for r in responses if r.energy is not None)),
             equilibrium,
         )
-        if equilibrium and self.check_balance:  # issue 16: the reactions balance the loads
+        if equilibrium and self.check_balance:  # the reactions balance the loads
             validation.check_equilibrium(
                 st.x,
                 P,

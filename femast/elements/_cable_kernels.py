@@ -1,4 +1,4 @@
-"""numba kernels of the cable/pulley/latch element (seed 001, Eqs. 2-5 and 14).
+"""numba kernels of the cable/pulley/latch element (Stohlman & Pellegrino, Eqs. 2-5 and 14).
 
 Private module: the public face is :mod:`femast.elements.cable_latch`.
 

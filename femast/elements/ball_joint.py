@@ -1,4 +1,4 @@
-"""Ball joint with Coulomb friction: seed 001, Section II.B.1 (|M| <= mu B |F|).
+"""Ball joint with Coulomb friction: Stohlman & Pellegrino, Section II.B.1 (|M| <= mu B |F|).
 
 A joint ties a longeron end node *a* to a coincident corner node *b*.  Translations are
 tied by a stiff penalty; the relative rotation is resisted by a friction moment whose
@@ -72,8 +72,8 @@ __all__ = [
     "SEED_B",
 ]
 
-SEED_MU = 0.5  # seed 001, Sec. II.B.1: static = kinetic friction coefficient
-SEED_B = 0.004  # seed 001, Sec. II.B.1: longeron ball end radius, m
+SEED_MU = 0.5  # Stohlman & Pellegrino, Sec. II.B.1: static = kinetic friction coefficient
+SEED_B = 0.004  # Stohlman & Pellegrino, Sec. II.B.1: longeron ball end radius, m
 # Default penalty k_pen = PENALTY_FACTOR * (largest EA/L of the members at the joint): the tie
 # gap |F|/k_pen is 1e-4 of the stretch of the stiffest connected member under the same force.
 PENALTY_FACTOR = 1e4
@@ -98,7 +98,7 @@ def _per_joint(value, n, what, name):
 
 
 class BallJointFamily(ElementFamily):
-    """A batch of friction ball joints (seed 001, Sec. II.B.1).
+    """A batch of friction ball joints (Stohlman & Pellegrino, Sec. II.B.1).
 
     Parameters
     ----------
@@ -348,7 +348,7 @@ def add_ball_joints(
     labels=None,
     name="ball_joint",
 ) -> BallJointFamily:
-    """Add friction ball joints (seed 001, Sec. II.B.1) between coincident node pairs.
+    """Add friction ball joints (Stohlman & Pellegrino, Sec. II.B.1) between coincident node pairs.
 
     pairs : [(longeron_end, corner), ...] node labels.
     mu, B : friction coefficient and ball end radius, m (seed: 0.5, 0.004); scalars or per joint.

@@ -1,7 +1,7 @@
 """A cable over an ordered list of devices: pulleys (frictionless or capstan, point or sized),
-latches, clamps and user devices (issue 19; seed 001 Sec. II.B.2, Eqs. 2-5).
+latches, clamps and user devices (Stohlman & Pellegrino, Sec. II.B.2, Eqs. 2-5).
 
-Seed 001 writes the cable element for a cable over any number of pulleys, latches or other
+Stohlman & Pellegrino write the cable element for a cable over any number of pulleys, latches or other
 devices, each with its own law for the jump ``Delta T_i = T_{i+1} - T_i``.  One element here is
 one cable of n sections between n + 1 nodes; ``devices[k]`` sits at interior node k + 1.  The
 equations and the stick/slip return mapping are in :mod:`._device_kernels`, the laws (and the
@@ -56,7 +56,7 @@ class Pulley:
 
 @dataclass(frozen=True)
 class Latch:
-    """A roller latch of seed 001 (Eqs. 5, 14) at a node; the bead is on the cable.
+    """A roller latch of Stohlman & Pellegrino (Eqs. 5, 14) at a node; the bead is on the cable.
 
     params : :class:`~femast.latch.LatchParameters` (default the seed's fit).
     bead : material coordinate Lb of the bead, m (unstretched length from node 0); ``None`` with
@@ -212,7 +212,7 @@ class CableDeviceFamily(ElementFamily):
     s0 : (n_el, n-1) or (n-1,) initial material coordinates of the cable at the devices, m
         (needed where the cable is gripped: capstans, clamps, user devices; a latch's comes from
         its bead: s = Lb - x0).  Use :meth:`pretensioned` to get them from a geometry.
-    device_values : per-element device parameters (issue 20: scatter per latch or pulley), a dict
+    device_values : per-element device parameters (scatter per latch or pulley), a dict
         ``{device index: {parameter: value or (n_el,) values}}``; parameters of a Latch: r,
         x_backstop, k, mu, h, R (SI, :class:`~femast.latch.LatchParameters`), hysteresis_force,
         hysteresis_length; of a capstan Pulley (mu > 0): mu.  Each element's values are validated.

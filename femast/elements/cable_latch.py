@@ -1,4 +1,4 @@
-"""Cable over pulleys and a latch: the user element of seed 001, Section II.B.2 (Eqs. 2-5).
+"""Cable over pulleys and a latch: the user element of Stohlman & Pellegrino, Section II.B.2 (Eqs. 2-5).
 
 One element is one continuous cable divided into n straight sections by n+1
 anchor nodes.  Each interior node is a frictionless pulley, except (optionally)
@@ -98,7 +98,7 @@ def _hysteresis(hysteresis_force, hysteresis_length, latch, has, name):
 
 
 class CableLatchFamily(ElementFamily):
-    """A batch of cable/pulley/latch elements (seed 001, Eqs. 2-5 and 14), all with n sections.
+    """A batch of cable/pulley/latch elements (Stohlman & Pellegrino, Eqs. 2-5 and 14), all with n sections.
 
     Parameters
     ----------
@@ -119,8 +119,8 @@ class CableLatchFamily(ElementFamily):
         ``H = hysteresis_force * w(x)``, ``w = 1`` on the backstop fading to 0 at the roller axis
         over ``hysteresis_length`` (see :func:`femast.latch.hysteresis_force`).
     length_error : lack of fit per section, m, shape (n_el, n) or (n,) (default 0): the cable
-        that runs in section i is ``length_error[:, i]`` longer than its nominal unstretched length
-        (issue 20).  Their sum lengthens the cable (L0); those of the sections before the latch
+        that runs in section i is ``length_error[:, i]`` longer than its nominal unstretched length.
+        Their sum lengthens the cable (L0); those of the sections before the latch
         node move the bead along the cable (Lb).  A pretensioned cable over frictionless pulleys
         with a section too short by d then gains ``EA d / L0`` of tension (on rigid anchors).
     name : label used in messages and results.
@@ -440,7 +440,7 @@ def cable_equations(
     hysteresis_force=0.0,
     hysteresis_length=3e-4,
 ):
-    """Residuals of the 2n equations of one element (seed 001, Eqs. 2-5), for checking a solution.
+    """Residuals of the 2n equations of one element (Stohlman & Pellegrino, Eqs. 2-5), for checking a solution.
 
     X : (n+1, 3) anchor positions, m.  T : (n,) tensions, N.  L0_sections : (n,) unstretched
     lengths, m.  status : latch status (stick/backstop: the latch row is x - x_committed, m;

@@ -1,4 +1,4 @@
-"""Mass matrices (issue 18): element families, point masses and rigid bodies, assembled on the
+"""Mass matrices: element families, point masses and rigid bodies, assembled on the
 analysis' own DOF numbering and reduced through its constraints.
 
 Where the mass comes from (all SI):

@@ -1,4 +1,4 @@
-"""The ``frequency`` step of model scripts (issue 18; Abaqus *FREQUENCY after a *STATIC step).
+"""The ``frequency`` step of model scripts (Abaqus *FREQUENCY after a *STATIC step).
 
 ``model.frequency_step("modes", n_modes=10)`` appends a step that changes nothing: the analysis
 computes the lowest ``n_modes`` modes of the state reached so far (the initial state if it is the

@@ -5,7 +5,7 @@
 * :mod:`.constraints`: rigid bodies and equal-DOF ties; :mod:`.thermal`: length errors and thermal strain;
 * :mod:`.validation`: checks of user input (and the equilibrium check of converged increments).
 
-``femast.model`` was one module before the package move (issue 15); its names are re-exported here.
+``femast.model`` was one module before the package move; its names are re-exported here.
 """
 
 from .model import LOAD_NAMES, BeamSpec, Condition, Model, Step, TrussSpec, dof_index

@@ -1,5 +1,5 @@
 """Many nodes, beams or trusses from arrays: ``model.nodes(X)``, ``model.beams(pairs, section)``,
-``model.trusses(pairs, EA)`` (issue 21).
+``model.trusses(pairs, EA)``.
 
 One vectorised check of the whole table replaces a Python call (and its checks) per element: the
 1000-bay mast (4004 nodes, 12000 beams) builds in a few hundredths of a second instead of seconds.

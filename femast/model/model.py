@@ -85,7 +85,7 @@ class TrussSpec:
     pretension: float | None
     tension_only: bool
     family: str
-    mass_per_length: float = 0.0  # kg/m (modal analyses, issue 18)
+    mass_per_length: float = 0.0  # kg/m (modal analyses)
 
 
 @dataclass
@@ -108,12 +108,12 @@ class Step:
     max_increments : most increments allowed in the step.
     control : None (load / prescribed-displacement control) or a control strategy such as
         :class:`femast.analysis.solvers.control.DisplacementControl`.
-    stabilize : None, or a :class:`femast.analysis.solvers.stabilize.Stabilize` (issue 3).
+    stabilize : None, or a :class:`femast.analysis.solvers.stabilize.Stabilize`.
     hit_times : step times (s) at which an increment must end (amplitude table points
         are added automatically).
     output_frequency : write a frame (and call the analysis' ``on_frame``) every this many
         increments and at the step's last increment (Abaqus *OUTPUT, FREQUENCY); 1 (default):
-        every increment.  Frames cost a small model more than its Newton iterations (issue 8);
+        every increment.  Frames cost a small model more than its Newton iterations;
         a run that gives up still writes its last converged increment.
     """
 
@@ -129,7 +129,7 @@ class Step:
     output_frequency: int = 1
     loads: list = field(default_factory=list)
     prescribed: list = field(default_factory=list)
-    temperatures: list = field(default_factory=list)  # (labels, values K or degC, amplitude): issue 20
+    temperatures: list = field(default_factory=list)  # (labels, values K or degC, amplitude)
     _model: Model = field(default=None, repr=False)
 
     def load(self, node, amplitude: Amplitude | None = None, **components):
@@ -224,7 +224,7 @@ class Model:
         self.ties: list = []
         self.steps: list[Step] = []
         self.point_masses: list = []  # femast.modal.mass.PointMassSpec (modal analyses)
-        self.length_errors: dict = {}  # element label -> m (lack of fit, issue 20)
+        self.length_errors: dict = {}  # element label -> m (lack of fit)
         self.expansion: dict = {}  # element label -> 1/K
         self.initial_temperatures: dict = {}  # element label -> K or degC
         self._next_element = 1
@@ -470,7 +470,7 @@ class Model:
     def point_mass(self, node, mass: float = 0.0, inertia=None, offset=None, name: str = ""):
         """A mass ``mass`` (kg) with rotary ``inertia`` (kg m^2 about its centre of mass: a scalar,
         3 principal values along the global axes or a 3x3 matrix, initial global axes) at
-        ``node``, its centre of mass ``offset`` (m) from the node (modal analyses, issue 18).
+        ``node``, its centre of mass ``offset`` (m) from the node (modal analyses).
         Returns the :class:`femast.modal.mass.PointMassSpec`."""
         from ..modal.mass import point_mass_spec
 

@@ -3,7 +3,7 @@
 A :class:`Section` holds E (Pa), G (Pa), A (m^2), Iy, Iz (m^4, second moments about
 the element's local y and z axes) and J (m^4, St Venant torsion constant).
 
-Note on seed 000, Eq. 10.  The seed gives ``J = s_out L (s_out^2 + L^2) / 12`` for
+Note on Eq. 10 of the Rocaspect paper.  The paper gives ``J = s_out L (s_out^2 + L^2) / 12`` for
 the square-tube mast; that is the polar moment of a solid s_out x L plate, not a
 torsion constant of the tube cross-section (it grows with the beam length L).
 :func:`square_tube` uses Bredt's thin-walled formula for a closed section,
@@ -37,7 +37,7 @@ class Section:
     Iy, Iz : second moments of area about local y and z, m^4.
     J : St Venant torsion constant, m^4.
     name : optional label used in messages and output.
-    rho : density, kg/m^3 (default 0: massless; only modal analyses use it, issue 18).  Give it
+    rho : density, kg/m^3 (default 0: massless; only modal analyses use it).  Give it
         with ``sec.with_(rho=2700.0)``.
     """
 
@@ -125,9 +125,9 @@ def square_solid(s: float, E: float, nu: float = 0.3, name: str = "square solid"
 def square_tube(s_out: float, s_in: float, E: float, nu: float = 0.3, name: str = "square tube") -> Section:
     """Square tube of outer side ``s_out`` and inner side ``s_in`` (m); E in Pa.
 
-    A = s_out^2 - s_in^2 and I = (s_out^4 - s_in^4)/12 (seed 000 Eqs. 11, 9).
+    A = s_out^2 - s_in^2 and I = (s_out^4 - s_in^4)/12 (the Rocaspect paper, Eqs. 11, 9).
     J = t (s_out - t)^3 with t = (s_out - s_in)/2 (Bredt; see the module note on
-    seed 000 Eq. 10).
+    the Rocaspect paper, Eq. 10).
     """
     _check_dims(name, s_out, s_in)
     t = 0.5 * (s_out - s_in)
@@ -141,7 +141,7 @@ def square_tube(s_out: float, s_in: float, E: float, nu: float = 0.3, name: str 
 
 
 def seed000_eq10_torsion_constant(s_out: float, L: float) -> float:
-    """Seed 000 Eq. 10 as printed, J = s_out L (s_out^2 + L^2) / 12 (m^4). Dimensionally
+    """Eq. 10 of the Rocaspect paper as printed, J = s_out L (s_out^2 + L^2) / 12 (m^4). Dimensionally
     an area moment but not a torsion constant of the section; kept only for comparison."""
     return s_out * L * (s_out**2 + L**2) / 12.0
 

@@ -1,4 +1,4 @@
-"""Sources of error in the model: member length errors (lack of fit) and thermal strain (issue 20).
+"""Sources of error in the model: member length errors (lack of fit) and thermal strain.
 
 A beam or truss element whose stress-free length differs from the distance between its nodes is
 modelled by a *length factor* s per element: the element is stress free at the length ``L s``,

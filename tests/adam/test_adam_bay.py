@@ -1,4 +1,4 @@
-"""ADAM bay builder (seed 001): Eq. 1 kinematics, bad input, pretension equilibrium, torsion paths.
+"""ADAM bay builder (Stohlman & Pellegrino): Eq. 1 kinematics, bad input, pretension equilibrium, torsion paths.
 
 References are independent of femast's own output: Eq. 1 (closed form), Newton's third law and
 the bay's symmetry, and for the release twist a reduced model (rigid frames on the Eq. 1 path,

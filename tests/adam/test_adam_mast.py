@@ -1,4 +1,4 @@
-"""40-bay ADAM mast (seed 001 Sec. VII, Table 1): tip response, the identified parameters, the table.
+"""40-bay ADAM mast (Stohlman & Pellegrino, Sec. VII, Table 1): tip response, the identified parameters, the table.
 
 The reference values are the seed's Table 1 (x = 1740 um, theta_z = 3030 arcsec under M + F), the
 mast's symmetry (-M-F mirrors M+F) and the latch law's release force (43.9 N, seed's fit)."""

@@ -1,4 +1,4 @@
-"""Latch identification from pull tests (seed 001, Section III.B-C, Eq. 15)."""
+"""Latch identification from pull tests (Stohlman & Pellegrino, Section III.B-C, Eq. 15)."""
 
 import copy
 

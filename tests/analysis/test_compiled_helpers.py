@@ -1,4 +1,4 @@
-"""The compiled helpers of the Newton loop (issue 8) against the numpy/scipy expressions they replace."""
+"""The compiled helpers of the Newton loop against the numpy/scipy expressions they replace."""
 
 import numpy as np
 import scipy.sparse as sp

@@ -1,4 +1,4 @@
-"""The dense LAPACK LU for small tangents (issue 21, item 3): solutions against numpy's dense solve,
+"""The dense LAPACK LU for small tangents: solutions against numpy's dense solve,
 unsymmetric, indefinite and singular matrices, the automatic rule (dense up to DENSE_MAX_DOFS) and
 an analysis through it against SuperLU."""
 

@@ -1,5 +1,5 @@
-"""Kernels compiled in a background process while the first run interprets them (issue 17,
-femast/jit_background.py): the interpreted kernels give bit for bit the compiled results, and the
+"""Kernels compiled in a background process while the first run interprets them
+(femast/jit_background.py): the interpreted kernels give bit for bit the compiled results, and the
 worker fills numba's cache so that the next call loads it instead of compiling."""
 
 import json

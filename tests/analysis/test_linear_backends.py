@@ -1,4 +1,4 @@
-"""Linear-solver back-ends (issue 21, item 1): the banded LAPACK factorisations, CHOLMOD and
+"""Linear-solver back-ends: the banded LAPACK factorisations, CHOLMOD and
 PARDISO against a dense solve, their behaviour on unsymmetric, indefinite and singular matrices,
 the automatic choice and the fall-back when an optional back-end is missing."""
 

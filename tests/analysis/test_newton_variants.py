@@ -1,4 +1,4 @@
-"""Newton variants (issue 21, item 2): Broyden's update, modified and quasi-Newton runs reaching
+"""Newton variants: Broyden's update, modified and quasi-Newton runs reaching
 the full-Newton solution with fewer factorisations than iterations, the options' errors."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The predicted-correction acceptance of Newton iterations (issue 21): an iteration whose force test
+"""The predicted-correction acceptance of Newton iterations: an iteration whose force test
 passes is accepted when its simplified Newton correction (one more solve with the factorisation in
 hand) shows the next correction below the correction tolerance (femast/analysis/solvers/convergence.py).
 

@@ -1,4 +1,4 @@
-"""femast.jit.setup_call remembers the plain-Python results of the pure set-up kernels (issue 21):
+"""femast.jit.setup_call remembers the plain-Python results of the pure set-up kernels:
 the same results as computing them, never shared with the caller, and a kernel listed as pure
 writes none of its arguments."""
 

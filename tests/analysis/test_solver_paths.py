@@ -1,4 +1,4 @@
-"""Issue 8: the fast paths of the Newton loop give the same answers as the plain ones.
+"""The fast paths of the Newton loop give the same answers as the plain ones.
 
 * converged responses of path-independent families reused at the next increment's start;
 * the symbolic analysis (ordering) done from the assembly pattern at set-up;

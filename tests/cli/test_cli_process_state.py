@@ -1,5 +1,5 @@
 """femast.cli.main called from Python (tests, notebooks) leaves the interpreter as it found it: the
-garbage collector's thresholds that the command raises for its own short process (issue 21) come
+garbage collector's thresholds that the command raises for its own short process come
 back, and the heap that compare/diagnose freeze for a quick exit is given back to the collector.
 And femast's warnings reach a command's user as one line each."""
 

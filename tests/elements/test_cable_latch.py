@@ -1,4 +1,4 @@
-"""Cable/pulley/latch element of seed 001, Eqs. 2-5 (femast.elements.cable_latch)."""
+"""Cable/pulley/latch element of Stohlman & Pellegrino, Eqs. 2-5 (femast.elements.cable_latch)."""
 
 import numpy as np
 import pytest

@@ -1,5 +1,5 @@
 """Length errors (lack of fit), thermal strain and per-element device parameters of the cable
-families (issue 20, item 1): cable/latch (seed 001 Eqs. 2-5) and cable over devices."""
+families: cable/latch (Stohlman & Pellegrino, Eqs. 2-5) and cable over devices."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""Latch hysteresis option of the cable/latch element (seed 001 Sec. VIII, the missing physics)
+"""Latch hysteresis option of the cable/latch element (Stohlman & Pellegrino, Sec. VIII, the missing physics)
 and the residual rotation it gives a bay at zero moment.
 
 References: the hysteresis law written out by hand here (w(x) from its definition), Eq. 14 of the

@@ -1,4 +1,4 @@
-"""Latch law of seed 001, Eqs. 6-14 (femast.latch)."""
+"""Latch law of Stohlman & Pellegrino, Eqs. 6-14 (femast.latch)."""
 
 import math
 

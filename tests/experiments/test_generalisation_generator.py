@@ -1,4 +1,4 @@
-"""The independent data generator of the diagnose generalisation benchmark (issue 14, item 4).
+"""The independent data generator of the diagnose generalisation benchmark.
 
 Its physics is checked against closed forms (not against femast's effects, which it must not
 share code or functional form with); the two rigs' baselines are cross-checked against femast's
@@ -260,7 +260,7 @@ def test_verdict_adapter_reads_old_and_new_reports():
     assert is_right("null", (), read_verdict(null)) and not is_right("null", (), read_verdict(none))
 
 
-def test_verdict_adapter_reads_the_issue14_kinds():
+def test_verdict_adapter_reads_the_verdict_kinds():
     pair = {
         "verdict": {
             "kind": "missing_pair",

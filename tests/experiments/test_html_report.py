@@ -1,4 +1,4 @@
-"""Issue 17 item 6: compare and diagnose write a self-contained HTML report that opens offline.
+"""compare and diagnose write a self-contained HTML report that opens offline.
 
 The static checks run everywhere; the browser check renders the page in headless Chromium
 (Debian's package ``chromium``) and asks the browser itself whether the verdict is shown and every

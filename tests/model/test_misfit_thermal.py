@@ -1,4 +1,4 @@
-"""Length errors (lack of fit) and thermal strain (issue 20, item 1) against closed forms."""
+"""Length errors (lack of fit) and thermal strain against closed forms."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""femast.studies (issue 20): distributions, sampling, the Sobol' estimators against closed forms,
+"""femast.studies: distributions, sampling, the Sobol' estimators against closed forms,
 percentile intervals' coverage, the store (resume, failures), runners (serial, local processes),
 femast model outputs against the cantilever closed form, and bad input before any sample runs."""
 
@@ -228,7 +228,7 @@ def test_model_outputs_match_the_cantilever_closed_form(tmp_path):
     assert np.allclose(-w[:, 0], F * L_M**3 / (3 * E * I), rtol=2e-3)
     assert np.allclose(rot, F * L_M**2 / (2 * E * I), rtol=2e-3)
     # unloaded: back to zero (elastic), to the correction tolerance (disp_tol 1e-6 of the unload
-    # increment, the loaded deflection: since issue 21 an increment may be accepted on its predicted
+    # increment, the loaded deflection: an increment may be accepted on its predicted
     # next correction, ~1e-7 of it here, without the extra iteration that went to round-off)
     assert np.all(np.abs(w[:, 1]) <= 1e-6 * np.abs(w[:, 0]))
 

@@ -60,7 +60,7 @@ from ...errors import ModelError
 def field_abs_max(v, is_rot):
     """(largest |v_i| over the translational DOFs, over the rotational ones) of a vector on the
     free DOFs (``is_rot`` flags the rotations); -1 for a field without DOFs, NaN if v holds one.
-    One pass, no temporaries (the masked maxima of numpy cost ~10 us per call, issue 8)."""
+    One pass, no temporaries (the masked maxima of numpy cost ~10 us per call)."""
     t = -1.0
     r = -1.0
     for i in range(v.shape[0]):

@@ -1,4 +1,4 @@
-"""A dense LU through LAPACK for small tangents (issue 21, item 3).
+"""A dense LU through LAPACK for small tangents.
 
 For a system of a few dozen to a couple of hundred DOFs the arithmetic of any factorisation is a
 few microseconds; what costs is the bookkeeping around it (SuperLU's symbolic structures, the

@@ -243,7 +243,7 @@ class SparseLU:
         """LU of the permuted matrix B in its own (NATURAL) column order.  The matrix refactorised
         every iteration (:attr:`values`) goes straight to scipy's SuperLU binding with its index
         arrays converted once: ``splu`` checks and converts them on every call, ~30 us, 2 % of a
-        40-bay iteration (issue 8).  The options are those ``splu`` passes."""
+        40-bay iteration.  The options are those ``splu`` passes."""
         if self._engine is not None and B is self._B and not superlu:
             return self._engine.factorize()
         if _DIRECT["gstrf"] is not None and B is self._B:
