@@ -35,7 +35,7 @@ CASES = [
     ("cable_hysteresis", {"eta": 0.06}, "cycles", 0.0, 4e-5, (2.6e5, 2.5e5), 4),
     ("progressive_stiffness", {"beta": 8e-4}, "ramps", 0.0, 5e-5, (2.0e5, 2.5e5), 5),
     ("pretension_loss", {"lam": 0.15}, "cycles", 0.0, 6e-5, (2.7e5, 2.3e5), 6),
-    ("beam_flexibility", {"E": 7e10}, "rotating", 250.0, 3e-5, (5.1e4, 5.3e4), 7),  # the Rocaspect paper, test 5 (slack)
+    ("beam_flexibility", {"E": 7e10}, "rotating", 250.0, 3e-5, (5.1e4, 5.3e4), 7),  # Rocaspect test 5 (slack)
 ]
 
 
