@@ -38,7 +38,7 @@ from femast.adam.steps import (
     add_measured_torsion,
     measured_style_path,
 )
-from femast.latch import ZONE_LABELS
+from femast.elements.latch_law import ZONE_LABELS
 from femast.post.vtk import export_vtk
 
 ROOT = Path(__file__).resolve().parents[1]

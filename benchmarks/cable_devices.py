@@ -25,7 +25,7 @@ import numpy as np  # noqa: E402
 
 from femast.elements.base import IncrementContext  # noqa: E402
 from femast.elements.cable_devices import CableDeviceFamily, Latch, Pulley  # noqa: E402
-from femast.latch import LatchParameters, latch_force  # noqa: E402
+from femast.elements.latch_law import LatchParameters, latch_force  # noqa: E402
 
 EA = 1.0e5
 

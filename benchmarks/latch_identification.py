@@ -24,7 +24,7 @@ plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force  # noqa: E402
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force  # noqa: E402
 from femast.latch_identification import fit_pull_tests, simulate_pull_test  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "out"

@@ -29,7 +29,7 @@ plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from femast.latch import (  # noqa: E402
+from femast.elements.latch_law import (  # noqa: E402
     LATCHING,
     UNLATCHING,
     LatchParameters,

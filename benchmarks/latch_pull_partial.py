@@ -36,7 +36,7 @@ def fe_partial_unlatching(
     ``status`` latch status (0 stick, +1 slip out, -1 slip in, 2 backstop)."""
     import femast as fm
     from femast.elements.cable_latch import CableLatchFamily
-    from femast.latch import LatchParameters, latch_force
+    from femast.elements.latch_law import LatchParameters, latch_force
 
     P = LatchParameters.seed_fit()
     m = fm.Model("latch pull test")
@@ -71,7 +71,7 @@ def fe_partial_unlatching(
 def direction_rule(x, dT, params):
     """The latch-pull prediction of the direction of motion for a moving bead: branch of the direction of motion
     clipped to that direction's sign (for the figure only)."""
-    from femast.latch import latch_force
+    from femast.elements.latch_law import latch_force
 
     p = np.array([params["r"], params["x_backstop"], params["k"], params["mu"], 1.5e-3, 2.4e-3])
     sig = np.sign(np.gradient(x))

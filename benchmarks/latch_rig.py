@@ -1,6 +1,6 @@
 """Independent simulator of the seed-001 latch pull-test rig (Sec. III.B, Fig. 8), for test data.
 
-Written from the seed's equations without :mod:`femast.latch` or the ``latch-pull`` experiment,
+Written from the seed's equations without :mod:`femast.elements.latch_law` or the ``latch-pull`` experiment,
 so that data with partial reversals can test that model.  Differences in form on purpose:
 
 * the latch law is evaluated in the seed's angle form, Eqs. 7-11 (``cos(theta) = x / (r + R)``,

@@ -119,7 +119,7 @@ def run_adam_bay(tangent):
 
 
 def plot(all_runs, png):
-    from femast import plotstyle
+    from femast.post import plotstyle
 
     plt = plotstyle.pyplot()
     models = list(all_runs)

@@ -32,7 +32,7 @@ COMPILE_S = {
     "femast.elements.beam_corot.beam_family_kernel": 8.5,  # 11-12 s before the end loops
     "femast.analysis.configuration.update_configuration": 1.9,
     "femast.rotations.apply_spins": 1.0,
-    "femast.analysis.solvers.convergence.force_moment_abs_max": 0.9,
+    "femast.analysis.convergence.force_moment_abs_max": 0.9,
     "femast.rotations._rotation_vectors": 0.6,
 }
 
@@ -51,7 +51,7 @@ SETUP_PYTHON_MAX = 20_000  # inner-loop iterations (~10 ms of Python)
 # arguments, so a process that builds the same small model again and again (the FE fits of
 # femast.experiments: 50-60 runs of one bay in a diagnosis) computes its pattern once
 # (the bay's assembly pattern is 12 ms of its 82 ms per run in Python).
-MEMO_KERNELS = frozenset({"femast.analysis.assembly._pattern_kernel", "femast.analysis.solvers.ordering._permuted_csc"})
+MEMO_KERNELS = frozenset({"femast.analysis.assembly._pattern_kernel", "femast.analysis.linalg.ordering._permuted_csc"})
 MEMO_ENTRIES = 16
 _MEMO: dict = {}
 _MEMO_LOCK = threading.Lock()  # (models built in threads: a Study on dask threads)
@@ -256,7 +256,7 @@ def _warm_laws():
     import numpy as np
 
     from femast.effects.operators import play, proportional_play
-    from femast.latch import latch_force
+    from femast.elements.latch_law import latch_force
 
     x = np.linspace(-1e-3, 1e-3, 5)
     latch_force(x, 1.0, derivative=True)

@@ -3,6 +3,7 @@ commit/rollback restore exactly, the Newton variants reach the same solution, ob
 every converged increment, and the size rules of the package hold."""
 
 import ast
+import re
 from pathlib import Path
 
 import numpy as np
@@ -166,7 +167,7 @@ MODULE_LINES, CLASS_LINES = 500, 300
 SIZE_EXCEPTIONS = {  # the formatter (ruff, one statement per line) lengthened these; each is to be split by concept
     "analysis/newton.py": (530, "Newton.solve's modes, to become strategies"),
     "analysis/newton.py:Newton": (330, "Newton.solve's modes, to become strategies"),
-    "analysis/solvers/linear.py:SparseLU": (330, "the factorisation paths, to be split from the pivot checks"),
+    "analysis/linalg/linear.py:SparseLU": (330, "the factorisation paths, to be split from the pivot checks"),
     "analysis/system.py:System": (340, "numbering, assembly and update in one class, to be split"),
     "elements/cable_devices.py": (530, "the family's set-up, to be split from its state handling"),
     "elements/cable_devices.py:CableDeviceFamily": (330, "the family's set-up, to be split from its state handling"),
@@ -194,9 +195,10 @@ def test_one_newton_loop():
 
 
 def test_the_loop_knows_nothing_of_files():
-    for name in ("newton.py", "stepping.py", "controls.py", "system.py", "state.py"):
-        src = (PKG / "analysis" / name).read_text()
-        assert "ResultsWriter" not in src and "results import" not in src, name
+    loop = [PKG / "analysis" / n for n in ("newton.py", "stepping.py", "system.py", "state.py")]
+    for path in loop + sorted((PKG / "analysis" / "control").glob("*.py")):
+        src = path.read_text()
+        assert "ResultsWriter" not in src and "results import" not in src, path.name
 
 
 def _imports(path):
@@ -223,7 +225,7 @@ def _femast_parts(path):
 # what each package of the layout may import (docs/architecture.md, "What may import what");
 # its own package, errors, rotations, progress and jit always
 MAY_IMPORT = {
-    "elements": {"latch"},
+    "elements": set(),
     "model": {"elements"},
     "analysis": {"model", "elements"},
     "modal": {"analysis", "model", "elements"},
@@ -237,7 +239,7 @@ EXCEPTIONS = {
     ("analysis/analysis.py", "post"),  # the results folder an Analysis returns (Results, run_outcome)
     ("analysis/output.py", "post"),  # output is the observer that owns the results writer
 }
-ALWAYS = {"errors", "rotations", "progress", "jit"}  # jit: the first-run compile
+ALWAYS = {"errors", "rotations", "progress", "jit", "_moved"}  # jit: the first-run compile; _moved: old paths
 
 
 @pytest.mark.parametrize("package", sorted(MAY_IMPORT))
@@ -287,9 +289,20 @@ OLD_TO_NEW = [
     ("femast.dofs", "femast.analysis.dofs"),
     ("femast.reduction", "femast.analysis.reduction"),
     ("femast.configuration", "femast.analysis.configuration"),
-    ("femast.solvers", "femast.analysis.solvers"),
-    ("femast.solvers.control", "femast.analysis.solvers.control"),
-    ("femast.solvers.linear", "femast.analysis.solvers.linear"),
+    ("femast.solvers.control", "femast.analysis.control"),
+    ("femast.solvers.linear", "femast.analysis.linalg.linear"),
+    ("femast.analysis.solvers.control", "femast.analysis.control"),
+    ("femast.analysis.solvers.arclength", "femast.analysis.control.arclength"),
+    ("femast.analysis.solvers.stabilize", "femast.analysis.control.stabilize"),
+    ("femast.analysis.solvers.convergence", "femast.analysis.convergence"),
+    ("femast.analysis.solvers.linear", "femast.analysis.linalg.linear"),
+    ("femast.analysis.solvers.ordering", "femast.analysis.linalg.ordering"),
+    ("femast.analysis.solvers.banded", "femast.analysis.linalg.banded"),
+    ("femast.analysis.solvers.backends", "femast.analysis.linalg.backends"),
+    ("femast.analysis.solvers.dense", "femast.analysis.linalg.dense"),
+    ("femast.analysis.controls", "femast.analysis.control"),
+    ("femast.analysis.viscous", "femast.analysis.control.stabilize"),
+    ("femast.latch", "femast.elements.latch_law"),
     ("femast.mass", "femast.modal.mass"),
     ("femast.modal_output", "femast.modal.output"),
     ("femast.frequency_step", "femast.modal.step"),
@@ -300,28 +313,50 @@ OLD_TO_NEW = [
 ]
 
 
+def _forget(name):
+    """Drop ``name`` from sys.modules so that importing it runs its module again (and warns)."""
+    import sys
+
+    sys.modules.pop(name, None)
+    parent, _, leaf = name.rpartition(".")
+    if parent in sys.modules and leaf in vars(sys.modules[parent]):
+        delattr(sys.modules[parent], leaf)
+
+
 @pytest.mark.parametrize("old, new", OLD_TO_NEW)
-def test_old_import_paths_are_the_moved_modules(old, new):
+def test_an_old_import_path_warns_and_gives_the_moved_module(old, new):
     import importlib
     import sys
 
-    mod = importlib.import_module(old)
+    _forget(old)
+    with pytest.warns(DeprecationWarning, match=rf"{re.escape(old)} has moved to {re.escape(new)}.*femast 0\.3"):
+        mod = importlib.import_module(old)
     assert mod is importlib.import_module(new) and sys.modules[old] is sys.modules[new]
-    assert (
-        mod.__name__ == new
-        and mod.__file__.endswith(new.replace(".", "/") + ".py")
-        or mod.__file__.endswith(new.replace(".", "/") + "/__init__.py")
-    )
+    assert mod.__name__ == new
     parent, _, leaf = old.rpartition(".")
     assert getattr(importlib.import_module(parent), leaf) is mod  # from femast import results
 
 
-def test_old_names_resolve_to_the_same_objects():
-    from femast.results import Results as OldResults
-    from femast.sections import circular_tube as old_tube
-    from femast.solvers.control import LoadControl as OldControl
+def test_the_old_paths_are_plain_modules_not_an_import_hook():
+    import sys
 
-    from femast.analysis.solvers.control import LoadControl
+    assert not [f for f in sys.meta_path if type(f).__module__.startswith("femast")]
+    for old, _ in OLD_TO_NEW:
+        rel = old.replace("femast.solvers.", "femast.analysis.solvers.").split(".")[1:]  # femast.solvers: that folder
+        path = PKG.joinpath(*rel).with_suffix(".py")
+        assert path.is_file() or (PKG.joinpath(*rel) / "__init__.py").is_file(), old
+
+
+def test_old_names_resolve_to_the_same_objects():
+    for old in ("femast.results", "femast.sections", "femast.solvers.control"):
+        _forget(old)
+    with pytest.warns(DeprecationWarning):
+        from femast.solvers.control import LoadControl as OldControl
+
+        from femast.results import Results as OldResults
+        from femast.sections import circular_tube as old_tube
+
+    from femast.analysis.control import LoadControl
     from femast.model.sections import circular_tube
     from femast.post.results import Results
 
@@ -339,13 +374,33 @@ def test_old_names_resolve_to_the_same_objects():
         _ = fm.nonexistent
 
 
-def test_a_numba_kernel_of_a_moved_module_caches_beside_its_new_file():
+#: femast modules that exist only as old paths (femast/_moved.py), and the tests of them
+OLD_PATH_FILES = {p for p in PKG.rglob("*.py") if "moved(__name__" in p.read_text()}
+
+
+def test_the_project_imports_no_old_path():
+    old = tuple(o for o, _ in OLD_TO_NEW) + ("femast.solvers", "femast.analysis.solvers")
+    root = PKG.parent
+    pattern = re.compile(r"^\s*(?:from|import)\s+(femast(?:\.\w+)+)", re.M)
+    offenders = []
+    for p in (
+        sorted(PKG.rglob("*.py")) + sorted((root / "tests").rglob("*.py")) + sorted((root / "benchmarks").rglob("*.py"))
+    ):
+        if p in OLD_PATH_FILES or p == Path(__file__).resolve():
+            continue
+        mods = {m for m in _imports(p) if m.startswith("femast.")}
+        offenders += [
+            f"{p.relative_to(root)}: {m}" for m in mods if m in old or m.startswith(tuple(o + "." for o in old))
+        ]
+    for p in sorted((root / "docs").rglob("*.md")):
+        for m in pattern.findall(p.read_text()):
+            if m in old or m.startswith(tuple(o + "." for o in old)):
+                offenders.append(f"{p.relative_to(root)}: {m}")
+    assert not offenders, "old import paths (use the new ones, femast/_moved.py): " + ", ".join(offenders)
+
+
+def test_a_numba_kernel_of_a_moved_module_is_compiled_from_its_new_file():
     from femast.analysis.configuration import update_configuration
 
     # numba keys its cache on the source file: the kernel is loaded once, from the new path
     assert update_configuration.py_func.__code__.co_filename.endswith("femast/analysis/configuration.py")
-    from numba.core.caching import NullCache
-
-    assert not isinstance(update_configuration._cache, NullCache)  # cache=True kept
-    index = Path(update_configuration._cache._cache_file._index_path)
-    assert index.name.startswith("configuration.update_configuration-")  # keyed on the new file

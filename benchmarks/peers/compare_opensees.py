@@ -19,7 +19,7 @@ Targets, printed with their verdict:
 * femast / OpenSees <= 0.08 at 40 bays and <= 0.06 at 400 and 1000 bays (best of the runs and
   median of the runs, CPU time and wall time);
 * time per Newton iteration <= 1.3 x the fastest factorisation + solve of the same tangent among
-  the installed back-ends (:mod:`femast.analysis.solvers.backends`), timed in isolation on the converged
+  the installed back-ends (:mod:`femast.analysis.linalg.backends`), timed in isolation on the converged
   tangent (median of 7);
 * growth of the time per iteration from the smallest to the largest size at most linear: the
   exponent p of t ~ n^p is printed (target p <= 1).

@@ -14,8 +14,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, fields, replace
 
+from ..elements.latch_law import LatchParameters, contact_half_width, validate_latch_array
 from ..errors import ModelError
-from ..latch import LatchParameters, contact_half_width, validate_latch_array
 from ..model.sections import Section, circular_tube
 
 #: Bay height of Stohlman & Pellegrino, Sec. VII: 40 bays make a 6.84 m mast.
@@ -46,7 +46,7 @@ class BayParameters:
     cable_EA : axial rigidity of the cables, N.  Not in the seed: identified from Table 1.
     pretension : cable tension of the deployed, latched bay before it comes to equilibrium, N
         (Figs. 13-14: 125-210 N).
-    latch : :class:`~femast.latch.LatchParameters` (seed Sec. III.C fit by default).
+    latch : :class:`~femast.elements.latch_law.LatchParameters` (seed Sec. III.C fit by default).
     hysteresis_force, hysteresis_length : latch hysteresis near the latched state (N, m); 0
         switches it off (the seed's model).  See ``docs/cable_latch_element.md``.
 
@@ -173,7 +173,7 @@ class BayParameters:
             )
         if not isinstance(self.latch, LatchParameters):
             raise ModelError(
-                f"BayParameters: latch must be a femast.latch.LatchParameters, got {type(self.latch).__name__}"
+                f"BayParameters: latch must be a femast.elements.latch_law.LatchParameters, got {type(self.latch).__name__}"
             )
         validate_latch_array(self.latch.as_array(), "BayParameters.latch")
         if self.hysteresis_force > 0 and self.latch.x_backstop >= contact_half_width(self.latch):

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..latch import ZONE_BACKSTOP, ZONE_BEHIND_AXIS, ZONE_FREE, ZONE_IN_FRONT, ZONE_LABELS
+from ..elements.latch_law import ZONE_BACKSTOP, ZONE_BEHIND_AXIS, ZONE_FREE, ZONE_IN_FRONT, ZONE_LABELS
 from ..post.results import Results
 from .build import AdamModel
 

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.solvers.convergence import Convergence
-from ..analysis.solvers.stabilize import Stabilize
+from ..analysis.control.stabilize import Stabilize
+from ..analysis.convergence import Convergence
 from ..errors import ModelError
 from .build import AdamModel
 
@@ -31,7 +31,7 @@ TABLE1_F = 14.0  # N along x
 def stabilize_for(am: AdamModel, fraction: float = 1e-4, dt0: float = 1.0) -> Stabilize:
     """Viscous stabilisation for the initial step of an ADAM model.
 
-    femast's :class:`~femast.analysis.solvers.stabilize.Stabilize` scales the damping of each DOF by the
+    femast's :class:`~femast.analysis.control.stabilize.Stabilize` scales the damping of each DOF by the
     diagonal of the tangent.  Here the largest diagonal terms are the ball-joint penalties
     (``joint_penalty_factor`` x EA/l of a longeron), 1e5-1e6 times the stiffness of the cable net
     that sets the prestressed shape; with the default energy fraction the step would end far from
@@ -82,14 +82,14 @@ def add_idealised_torsion(
     in the bay's folding sense and back to 0, with x and y held (z and the tilts free).
 
     The twist is driven by displacement control of the control node's rz with a moment about z
-    as the reference load (:class:`~femast.analysis.solvers.control.DisplacementControl`), so rz stays a
+    as the reference load (:class:`~femast.analysis.control.DisplacementControl`), so rz stays a
     free DOF and the moment is the load factor: step ``<name>-out`` (0 -> theta_max) and
     ``<name>-back`` (theta_max -> 0; its reference moment is a large fixed value, so that the
     pattern never vanishes whatever moment the bay holds at theta_max).  With ``unload`` a last,
     load-controlled step ``<name>-unload`` brings the moment to zero: the bay settles at its
     residual rotation at zero moment (seed Sec. VIII).  ``max_increment``: fraction of each step.
     Returns the steps."""
-    from ..analysis.solvers.control import DisplacementControl
+    from ..analysis.control import DisplacementControl
 
     if not (0 < theta_max < am.params.stowed_angle):
         raise ModelError(

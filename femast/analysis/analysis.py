@@ -25,11 +25,11 @@ from ..jit import prepare as prepare_kernels
 from ..model import validation
 from ..model.thermal import FieldLoads, check_controls, has_fields
 from ..post.results import Results, run_outcome
+from .convergence import Convergence
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
 from .restart import RestartOutput, load_restart, restart_folder, restore
-from .solvers.convergence import Convergence
 from .state import State
 from .stepping import run_step
 from .summary import AnalysisSummary
@@ -43,7 +43,7 @@ class Analysis:
         frame then only goes to ``on_frame``, and :meth:`run` returns None.  For scripts and fits
         that keep what they need in memory (an FE experiment's many short runs).
 
-    convergence : :class:`~femast.analysis.solvers.convergence.Convergence` (tolerances, max iterations).
+    convergence : :class:`~femast.analysis.convergence.Convergence` (tolerances, max iterations).
     progress : show a tqdm progress bar per step.
     cutback : factor applied to a failed increment (Abaqus: 0.25).
     growth : factor applied after two easy increments (Abaqus: 1.5).
@@ -65,7 +65,7 @@ class Analysis:
         reading the results folder back (which costs about as much as the analysis of a small
         model).  Do not modify the arrays: the same ones are being written to disk.
     observers : more observers of the run (:class:`~femast.analysis.output.Observer`).
-    linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.solvers.backends`):
+    linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.linalg.backends`):
         "auto" (default: LAPACK's dense LU up to 64 DOFs; LAPACK's band solver for a narrow reverse
         Cuthill-McKee band, as in a mast; PARDISO, if installed, for other models of 1000 DOFs or
         more; else SuperLU), or one forced by name: "superlu", "banded", "dense", "cholmod", "pardiso".

@@ -47,7 +47,7 @@ Every Newton iteration: tangent (if due), solve, correct the load factor, update
 configuration, evaluate the residual, test convergence.  On convergence the state is committed,
 on failure rolled back (both one call).  Under full Newton and fixed loads an iteration whose force
 test passes may also be accepted on its predicted next correction, one more solve with the
-factorisation in hand (``Convergence(predicted=True)``, :mod:`~femast.analysis.solvers.convergence`).
+factorisation in hand (``Convergence(predicted=True)``, :mod:`~femast.analysis.convergence`).
 """
 
 from __future__ import annotations
@@ -59,8 +59,8 @@ import numpy as np
 
 from ..elements.base import IncrementContext
 from ..errors import ModelError, SingularModelError
+from .convergence import Convergence, all_finite
 from .deadline import check as check_deadline
-from .solvers.convergence import Convergence, all_finite
 
 
 @dataclass
@@ -79,7 +79,7 @@ class Increment:
     predict : ``predict(du_p) -> dlam``, the tangent predictor of the load factor from
     K du_p = P_ref (arc length), or None.  dlambda : ``dlambda(du_r, du_p, Du) -> dlam or None``,
     the load-factor correction of an iteration (None: the constraint has no solution).
-    viscous : a :class:`~femast.analysis.viscous.ViscousTerm` (stabilised step), or None.
+    viscous : a :class:`~femast.analysis.control.stabilize.ViscousTerm` (stabilised step), or None.
     direct : assemble straight into the solver's matrix where possible (off for arc length, whose
     verified results were computed through the CSR tangent; the two differ at round-off).
     """
@@ -123,7 +123,7 @@ TANGENTS = ("auto", "full", "modified", "quasi-newton", "initial")
 class Newton:
     """Newton-Raphson iterations on one increment (see module docstring).
 
-    convergence : :class:`~femast.analysis.solvers.convergence.Convergence`.
+    convergence : :class:`~femast.analysis.convergence.Convergence`.
     line_search : secant line search when a step overshoots (fixed loads only): True, False, or
         "auto": only when retrying an increment that failed.
     tangent : "auto", "full", "modified", "quasi-newton" or "initial" (see module docstring).

@@ -23,10 +23,10 @@ from ..model import validation
 from ..model.constraints import Constraints, transpose_times
 from .assembly import Assembler, assigning_positions
 from .configuration import update_configuration
+from .convergence import all_finite, force_moment_abs_max, scaled_size
 from .dofs import number_dofs
+from .linalg.linear import SparseLU, mechanism_dofs
 from .reduction import ReducedTangent
-from .solvers.convergence import all_finite, force_moment_abs_max, scaled_size
-from .solvers.linear import SparseLU, mechanism_dofs
 
 
 @njit(cache=True)
@@ -311,7 +311,7 @@ class System:
         """Force/moment residual against the largest element nodal force/moment or applied load
         (Abaqus' 'flux' magnitude), displacement correction against the increment:
         (converged, residual ratio, force test passed, scaled correction), see
-        :meth:`~femast.analysis.solvers.convergence.Convergence.measure`."""
+        :meth:`~femast.analysis.convergence.Convergence.measure`."""
         fmax, mmax = force_moment_abs_max(P)
         for resp in responses:
             ff, mm = force_moment_abs_max(resp.f)
@@ -324,7 +324,7 @@ class System:
 
     def scaled_size(self, v, Du):
         """The correction test's measure of a correction ``v`` given the increment so far ``Du``
-        (:func:`~femast.analysis.solvers.convergence.scaled_size`)."""
+        (:func:`~femast.analysis.convergence.scaled_size`)."""
         return scaled_size(v, Du, self.is_rot, self.length)
 
     def commit(self, responses, P, res, lam, equilibrium=True):

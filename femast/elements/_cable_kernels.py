@@ -47,7 +47,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..latch import latch_dT_scalar, latch_opening_scalar
+from .latch_law import latch_dT_scalar, latch_opening_scalar
 
 STICK = 0
 SLIP_OUT = 1

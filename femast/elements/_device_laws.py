@@ -22,7 +22,7 @@ Built-in laws:
 * capstan pulley (Euler-Eytelwein): ``r = T_out - T_in exp(sigma mu phi)``; the band is
   ``exp(-mu phi) <= T_out / T_in <= exp(mu phi)``;
 * latch (Stohlman & Pellegrino, Eqs. 5, 14): ``r = T_out - T_in - dT_sigma(x)``, ``x = Lb - s``; the backstop
-  bounds ``s <= Lb + x_backstop``.  Optional hysteresis as in :mod:`femast.latch`.
+  bounds ``s <= Lb + x_backstop``.  Optional hysteresis as in :mod:`femast.elements.latch_law`.
 
 Frictionless pulleys (equal strains on both sides, which is equal tensions when taut and a
 proportional share of the slack when slack, as in :mod:`._cable_kernels`) and clamps (never

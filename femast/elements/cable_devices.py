@@ -24,7 +24,6 @@ import numpy as np
 from numba import njit
 
 from ..errors import ModelError
-from ..latch import LatchParameters, _as_param_array, validate_latch_array
 from ._cable_geometry import (
     GEO_ADJACENT_PULLEYS,
     GEO_INSIDE_PULLEY,
@@ -37,6 +36,7 @@ from ._cable_geometry import (
 from ._device_kernels import ERR_ACTIVE_SET, ERR_SHORT, SLIDE_FREE, STOP, device_kernel, kernel_for_law
 from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, LATCH_LB, N_PARAM, USER, builtin_law
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput, chain_nodes
+from .latch_law import LatchParameters, _as_param_array, validate_latch_array
 
 MODE_NAMES = {0: "stick", 1: "slide (out side pulls)", -1: "slide (in side pulls)", 2: "at stop", 3: "frictionless"}
 
@@ -58,11 +58,11 @@ class Pulley:
 class Latch:
     """A roller latch of Stohlman & Pellegrino (Eqs. 5, 14) at a node; the bead is on the cable.
 
-    params : :class:`~femast.latch.LatchParameters` (default the seed's fit).
+    params : :class:`~femast.elements.latch_law.LatchParameters` (default the seed's fit).
     bead : material coordinate Lb of the bead, m (unstretched length from node 0); ``None`` with
         :meth:`CableDeviceFamily.pretensioned` puts it at ``x0`` in the initial geometry.
     x0 : initial bead position, m (default ``-x_backstop``: latched, on the backstop).
-    hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.latch` (N, m).
+    hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.elements.latch_law` (N, m).
     The section before the latch runs through the backstop (as in :class:`CableLatchFamily`)."""
 
     params: LatchParameters | None = None
@@ -214,7 +214,7 @@ class CableDeviceFamily(ElementFamily):
         its bead: s = Lb - x0).  Use :meth:`pretensioned` to get them from a geometry.
     device_values : per-element device parameters (scatter per latch or pulley), a dict
         ``{device index: {parameter: value or (n_el,) values}}``; parameters of a Latch: r,
-        x_backstop, k, mu, h, R (SI, :class:`~femast.latch.LatchParameters`), hysteresis_force,
+        x_backstop, k, mu, h, R (SI, :class:`~femast.elements.latch_law.LatchParameters`), hysteresis_force,
         hysteresis_length; of a capstan Pulley (mu > 0): mu.  Each element's values are validated.
     length_error : lack of fit per section, m, (n_el, n) or (n,) (default 0): the cable in section
         i is that much longer than nominal.  The sum lengthens the cable (L0); the errors of the

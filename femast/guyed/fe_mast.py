@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..analysis import Analysis
-from ..analysis.solvers.convergence import Convergence
+from ..analysis.convergence import Convergence
 from ..elements.shroud_cable import ShroudCableFamily, unstretched_length
 from ..elements.shroud_law import DyneemaLaw
 from ..errors import ModelError

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from ..analysis.solvers.convergence import force_moment_abs_max
+from ..analysis.convergence import force_moment_abs_max
 from ..elements.base import IncrementContext
 from ..errors import ModelError, StateError
 from .mass import assemble_mass

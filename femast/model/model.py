@@ -107,8 +107,8 @@ class Step:
     initial_increment, min_increment, max_increment : increments of step time, s.
     max_increments : most increments allowed in the step.
     control : None (load / prescribed-displacement control) or a control strategy such as
-        :class:`femast.analysis.solvers.control.DisplacementControl`.
-    stabilize : None, or a :class:`femast.analysis.solvers.stabilize.Stabilize`.
+        :class:`femast.analysis.control.DisplacementControl`.
+    stabilize : None, or a :class:`femast.analysis.control.stabilize.Stabilize`.
     hit_times : step times (s) at which an increment must end (amplitude table points
         are added automatically).
     output_frequency : write a frame (and call the analysis' ``on_frame``) every this many

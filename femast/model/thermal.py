@@ -22,7 +22,7 @@ amplitude 0 -> 1 -> 0 is a thermal cycle back to the start temperature).  Temper
 redefined in a later step stay.  Length errors act from the start of the first step.
 
 :class:`FieldLoads` is what the analysis uses: it writes the length factors of the beam and
-truss families at each increment (femast/analysis/controls.py).
+truss families at each increment (femast/analysis/control/).
 """
 
 from __future__ import annotations

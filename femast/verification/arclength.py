@@ -8,7 +8,7 @@ from __future__ import annotations
 import tempfile
 
 from ..analysis import Analysis
-from ..analysis.solvers.arclength import ArcLength
+from ..analysis.control.arclength import ArcLength
 from ..model import Model
 from ..model.sections import Section
 from . import references as ref

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis import Analysis
-from ..analysis.solvers.control import DisplacementControl
+from ..analysis.control import DisplacementControl
 from ..model import Model
 from ..model.sections import Section, square_tube
 from . import references as ref

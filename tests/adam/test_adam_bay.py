@@ -22,7 +22,7 @@ from femast.adam.steps import (
     add_measured_torsion,
     measured_style_path,
 )
-from femast.latch import ZONE_BACKSTOP, ZONE_FREE, LatchParameters
+from femast.elements.latch_law import ZONE_BACKSTOP, ZONE_FREE, LatchParameters
 
 P = BayParameters()
 

@@ -10,7 +10,7 @@ import femast as fm
 from femast.adam import BayParameters, build_mast
 from femast.adam.post import SEED_TABLE1, TABLE1_ROWS, format_table1, tip_table
 from femast.adam.steps import CONVERGENCE, add_initial_steps, add_table1_steps
-from femast.latch import UNLATCHING, latch_force
+from femast.elements.latch_law import UNLATCHING, latch_force
 
 
 @pytest.fixture(scope="module")

@@ -5,8 +5,8 @@ import copy
 import numpy as np
 import pytest
 
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.errors import ModelError
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.latch_identification import (
     fit_latch,
     fit_pull_tests,

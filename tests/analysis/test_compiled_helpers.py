@@ -5,8 +5,8 @@ import scipy.sparse as sp
 from scipy.linalg import expm
 
 from femast.analysis.configuration import update_configuration
-from femast.analysis.solvers.convergence import field_abs_max, force_moment_abs_max
-from femast.analysis.solvers.linear import _unpermute
+from femast.analysis.convergence import field_abs_max, force_moment_abs_max
+from femast.analysis.linalg.linear import _unpermute
 from femast.model.constraints import transpose_times
 from femast.rotations import skew
 

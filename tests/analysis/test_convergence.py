@@ -8,7 +8,7 @@ import numpy as np
 from femast.adam import build_mast
 from femast.adam.steps import CONVERGENCE, add_initial_steps
 from femast.analysis import Analysis
-from femast.analysis.solvers.convergence import Convergence
+from femast.analysis.convergence import Convergence
 
 
 def _check(conv, r, du, Du, iteration):

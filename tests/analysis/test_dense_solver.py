@@ -11,8 +11,8 @@ from test_linear_backends import backward_error, chain_matrix
 
 import femast as fm
 from femast.analysis import Analysis
-from femast.analysis.solvers import backends, dense
-from femast.analysis.solvers.linear import SparseLU
+from femast.analysis.linalg import backends, dense
+from femast.analysis.linalg.linear import SparseLU
 from femast.errors import SingularModelError
 
 

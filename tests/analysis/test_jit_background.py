@@ -147,7 +147,7 @@ def test_helpers_of_interpreted_kernels_are_interpreted_not_compiled(tmp_path):
         import json, numpy as np, scipy.sparse as sp
         from femast import jit_background
         from femast.analysis import assembly
-        from femast.analysis.solvers import banded
+        from femast.analysis.linalg import banded
         jit_background.install()
         rng = np.random.default_rng(1)
         n, b = 12, 2

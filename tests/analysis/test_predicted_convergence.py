@@ -1,6 +1,6 @@
 """The predicted-correction acceptance of Newton iterations: an iteration whose force test
 passes is accepted when its simplified Newton correction (one more solve with the factorisation in
-hand) shows the next correction below the correction tolerance (femast/analysis/solvers/convergence.py).
+hand) shows the next correction below the correction tolerance (femast/analysis/convergence.py).
 
 Checks: one iteration fewer than the strict rule on a hardening spring whose equilibrium is the
 root of a cubic (closed form) and on a large-deflection cantilever (against a tightly converged
@@ -17,8 +17,8 @@ import pytest
 
 import femast as fm
 from femast.analysis import Analysis
+from femast.analysis.convergence import Convergence, scaled_size
 from femast.analysis.newton import Newton
-from femast.analysis.solvers.convergence import Convergence, scaled_size
 from femast.elements.base import ElementFamily, ElementResponse
 from femast.errors import ModelError
 

@@ -7,7 +7,7 @@ import pytest
 
 from femast import jit
 from femast.analysis.assembly import _block_pattern, _pattern_kernel
-from femast.analysis.solvers.ordering import _permuted_csc, permuted
+from femast.analysis.linalg.ordering import _permuted_csc, permuted
 
 
 def _pattern_args(seed):

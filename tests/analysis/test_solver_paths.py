@@ -17,7 +17,7 @@ import scipy.sparse.linalg as spla
 
 import femast as fm
 from femast.analysis import Analysis
-from femast.analysis.solvers.linear import SparseLU
+from femast.analysis.linalg.linear import SparseLU
 from femast.elements.base import ElementFamily, ElementResponse
 from femast.errors import ConvergenceError
 from femast.post.results import ResultsWriter

@@ -9,8 +9,8 @@ from femast.analysis import Analysis
 from femast.elements.base import IncrementContext
 from femast.elements.cable_devices import CableDeviceFamily, Clamp, Latch, Pulley
 from femast.elements.cable_latch import BACKSTOP, CableLatchFamily
+from femast.elements.latch_law import LatchParameters
 from femast.errors import ModelError
-from femast.latch import LatchParameters
 from femast.testing import fd_tangent
 
 P = LatchParameters.seed_fit()

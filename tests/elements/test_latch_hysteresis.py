@@ -17,7 +17,7 @@ from femast.adam import build_bay
 from femast.adam.steps import CONVERGENCE, add_idealised_torsion, add_initial_steps
 from femast.elements.base import IncrementContext
 from femast.elements.cable_latch import BACKSTOP, SLIP_IN, SLIP_OUT, STICK, CableLatchFamily, cable_equations
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.testing import fd_tangent
 
 P = LatchParameters.seed_fit()

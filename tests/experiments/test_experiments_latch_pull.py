@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.experiments import AT_NOISE, compare, diagnose, from_arrays, get_experiment, predict, run_model
 from femast.experiments.synthetic import latch_pull_data
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
 
 EXP = get_experiment("latch-pull")
 N_SIGMA = 4.0  # identified parameters within 4 Jacobian standard errors (two-sided p ~ 6e-5 per parameter)

@@ -170,7 +170,7 @@ def test_mast_rig_matches_the_3r_jacobian():
 
 
 def test_latch_rig_matches_the_seed_law():
-    from femast.latch import LATCHING, UNLATCHING, latch_force
+    from femast.elements.latch_law import LATCHING, UNLATCHING, latch_force
 
     p = np.array([LATCH[k] for k in ("r", "xb", "k", "mu", "h", "R")])
     x = np.linspace(-2e-3, 4e-3, 301)

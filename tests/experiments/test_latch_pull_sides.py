@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.errors import DataFileError
 from femast.experiments import AT_NOISE, compare, diagnose, from_arrays, get_experiment, predict, read_data
 from femast.experiments.latch_pull import infer_side
 from femast.experiments.synthetic import latch_pull_data
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "benchmarks"))

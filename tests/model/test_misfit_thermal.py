@@ -271,7 +271,7 @@ def test_bad_inputs_name_the_item_and_the_unit():
 
 
 def test_thermal_step_under_arc_length_is_refused():
-    from femast.analysis.solvers.arclength import ArcLength
+    from femast.analysis.control.arclength import ArcLength
 
     m = fm.Model("arc")
     n1, n2 = m.node(0, 0, 0), m.node(1, 0, 0)
