@@ -25,7 +25,7 @@ from ..jit import prepare as prepare_kernels
 from ..model import validation
 from ..model.thermal import FieldLoads, check_controls, has_fields
 from ..post.results import Results, run_outcome
-from .convergence import Convergence
+from .convergence import Convergence, validate
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
@@ -43,7 +43,8 @@ class Analysis:
         frame then only goes to ``on_frame``, and :meth:`run` returns None.  For scripts and fits
         that keep what they need in memory (an FE experiment's many short runs).
 
-    convergence : :class:`~femast.analysis.convergence.Convergence` (tolerances, max iterations).
+    convergence : :class:`~femast.analysis.convergence.Convergence` (tolerances, max iterations), or a
+        convergence test of your own (the contract: :mod:`femast.analysis.convergence`).
     progress : show a tqdm progress bar per step.
     cutback : factor applied to a failed increment (Abaqus: 0.25).
     growth : factor applied after two easy increments (Abaqus: 1.5).
@@ -103,7 +104,7 @@ class Analysis:
                 "(Analysis.x, .R, .summary) remains",
                 stacklevel=2,
             )
-        self.convergence = convergence or Convergence()
+        self.convergence = Convergence() if convergence is None else validate(convergence)
         self.progress = progress
         self.cutback = cutback
         self.growth = growth

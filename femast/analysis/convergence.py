@@ -43,6 +43,23 @@ entry over the field's increment, the larger of the two fields):
   affine-covariant Lipschitz constant omega).
 
 The strict rule stays selectable: ``Convergence(predicted=False)``.
+
+**A convergence test of your own** (the contract :class:`~femast.analysis.newton.Newton` honours).
+Any object with an integer ``max_iterations`` (iterations per attempt) and a method
+
+    check(r, du, Du, is_rot, ref_force, ref_moment, length, iteration) -> (converged, residual_ratio)
+
+is a convergence test: pass it as ``Analysis(..., convergence=test)``.  Newton calls ``check`` after
+every iteration of every attempt, with ``r`` the residual on the free DOFs (N, N m; the free DOFs'
+order), ``du`` the correction of that iteration and ``Du`` the increment so far (m, rad; ``du`` is
+None only when there is no correction yet), ``is_rot`` the mask of rotational free DOFs,
+``ref_force`` / ``ref_moment`` the reference force (N) and moment (N m) of the force test above,
+``length`` the model size (m) and ``iteration`` the number of iterations done in the attempt (1
+after the first).  It stops the attempt when ``converged`` is true; ``residual_ratio`` (a float,
+dimensionless) is what the divergence test and the messages report.  A subclass of
+:class:`Convergence` that overrides :meth:`Convergence.check` is such a test; its own checks replace
+femast's, and the predicted-correction acceptance (which needs femast's measures) is off for it.
+:func:`evaluate` is the one place the analysis asks a test.
 """
 
 from __future__ import annotations
@@ -149,7 +166,10 @@ class Convergence:
     def check(self, r, du, Du, is_rot, ref_force, ref_moment, length, iteration=0):
         """Return (converged, residual_ratio) given the free residual ``r``, the last
         correction ``du``, the increment so far ``Du``, the bool mask ``is_rot`` and the number
-        of Newton iterations done in this attempt (1: the linear-increment rule applies)."""
+        of Newton iterations done in this attempt (1: the linear-increment rule applies).
+
+        The method a test of your own overrides (module docstring): Newton then calls it after every
+        iteration instead of femast's force and correction tests."""
         return self.measure(r, du, Du, is_rot, ref_force, ref_moment, length, iteration)[:2]
 
     def accept_predicted(self, previous, last, predicted):
@@ -196,3 +216,35 @@ class Convergence:
                 if dmax[k] >= 0.0:
                     size = max(size, dmax[k] / max(Dmax[k], 1e-9 * dref))
         return ok or linear, worst, forces, size
+
+
+def evaluate(test, r, du, Du, is_rot, ref_force, ref_moment, length, iteration=0):
+    """Ask the convergence test ``test`` about an iteration: (converged, residual_ratio, forces_ok,
+    correction size).  femast's own :class:`Convergence` answers all four (:meth:`Convergence.measure`);
+    a test whose ``check`` is its own (a class of yours, or a subclass overriding
+    :meth:`Convergence.check`) answers the first two, and forces_ok is then False and the size NaN,
+    so the predicted-correction acceptance is never used on its behalf."""
+    if getattr(type(test), "check", None) is Convergence.check:
+        return test.measure(r, du, Du, is_rot, ref_force, ref_moment, length, iteration)
+    ok, ratio = test.check(r, du, Du, is_rot, ref_force, ref_moment, length, iteration)
+    return bool(ok), float(ratio), False, math.nan
+
+
+def predicts(test) -> bool:
+    """Whether ``test`` accepts iterations on their predicted correction: femast's own test with
+    ``predicted=True`` (a test with its own ``check`` never does)."""
+    return getattr(type(test), "check", None) is Convergence.check and bool(getattr(test, "predicted", False))
+
+
+def validate(test):
+    """``test`` if it keeps the contract (module docstring), else a one-line :class:`ModelError`."""
+    name = type(test).__name__
+    if not callable(getattr(test, "check", None)):
+        raise ModelError(
+            f"convergence={name}: a convergence test needs a method check(r, du, Du, is_rot, ref_force, "
+            "ref_moment, length, iteration) returning (converged, residual_ratio); see femast.analysis.convergence"
+        )
+    n = getattr(test, "max_iterations", None)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ModelError(f"convergence={name}: max_iterations={n!r} must be a whole number >= 1")
+    return test

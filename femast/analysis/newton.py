@@ -59,7 +59,7 @@ import numpy as np
 
 from ..elements.base import IncrementContext
 from ..errors import ModelError, SingularModelError
-from .convergence import Convergence, all_finite
+from .convergence import Convergence, all_finite, predicts
 from .deadline import check as check_deadline
 
 
@@ -218,7 +218,8 @@ class Newton:
         # already meets its tolerance: the iterations left are for the displacement test)
         if it == 0 or since >= self.refactor_every:
             return True
-        slow_r = ratios[-1] > 1e-2 * self.convergence.force_tol and ratios[-1] > self.slow * ratios[-2]
+        force_tol = getattr(self.convergence, "force_tol", 0.0)  # (a test of your own may have none)
+        slow_r = ratios[-1] > 1e-2 * force_tol and ratios[-1] > self.slow * ratios[-2]
         slow_d = len(steps) >= 2 and steps[-1] > self.slow * steps[-2]
         return slow_r or slow_d
 
@@ -271,7 +272,7 @@ class Newton:
         keep = self.tangent == "auto" and all(f.path_independent for f in system.families)
         # the predicted-correction acceptance: full Newton (the factorisation in hand formed at the
         # previous iterate), fixed loads, no line search (its steps are not Newton's corrections)
-        predict = conv.predicted and method == "full" and not uses_lam and not line_search
+        predict = predicts(conv) and method == "full" and not uses_lam and not line_search
         sizes = []  # scaled size of each correction of this attempt (Convergence.measure)
         formed_at = None  # (x, R) of this attempt's last factorisation ("auto", path-independent)
 

@@ -23,7 +23,7 @@ from ..model import validation
 from ..model.constraints import Constraints, transpose_times
 from .assembly import Assembler, assigning_positions
 from .configuration import update_configuration
-from .convergence import all_finite, force_moment_abs_max, scaled_size
+from .convergence import all_finite, evaluate, force_moment_abs_max, scaled_size
 from .dofs import number_dofs
 from .linalg.linear import SparseLU, mechanism_dofs
 from .reduction import ReducedTangent
@@ -310,8 +310,8 @@ class System:
     def converged(self, convergence, r, du, Du, responses, P, iteration=0):
         """Force/moment residual against the largest element nodal force/moment or applied load
         (Abaqus' 'flux' magnitude), displacement correction against the increment:
-        (converged, residual ratio, force test passed, scaled correction), see
-        :meth:`~femast.analysis.convergence.Convergence.measure`."""
+        (converged, residual ratio, force test passed, scaled correction), as the convergence test
+        answers them (:func:`~femast.analysis.convergence.evaluate`)."""
         fmax, mmax = force_moment_abs_max(P)
         for resp in responses:
             ff, mm = force_moment_abs_max(resp.f)
@@ -320,7 +320,7 @@ class System:
         L = self.length
         ref_f = max(fmax, 1e-2 * mmax / L, self.zero_force)
         ref_m = max(mmax, 1e-2 * fmax * L, self.zero_force * L)
-        return convergence.measure(r, du, Du, self.is_rot, ref_f, ref_m, L, iteration)
+        return evaluate(convergence, r, du, Du, self.is_rot, ref_f, ref_m, L, iteration)
 
     def scaled_size(self, v, Du):
         """The correction test's measure of a correction ``v`` given the increment so far ``Du``
