@@ -8,7 +8,8 @@ import pytest
 
 import femast as fm
 from femast.analysis import Analysis
-from femast.analysis.newton import Broyden, Newton
+from femast.analysis.newton import Newton
+from femast.analysis.tangent_update import Broyden
 
 
 def test_broyden_solves_an_affine_system_from_a_wrong_inverse():
