@@ -251,10 +251,9 @@ class Analysis:
                 if k < first:
                     continue
                 self._state.step = k
-                if getattr(step, "kind", "static") == "frequency":  # modes of the state
-                    from ..modal.step import run_frequency_step
-
-                    run_frequency_step(self, step)
+                runner = getattr(step, "runner", None)  # a step of another kind runs itself (e.g. modes)
+                if runner is not None:
+                    step_runner(runner)(self, step)
                 else:
                     inside = self.resume is not None and k == self.resume["step"] and not self.resume["step_done"]
                     run_step(self, step, resume=self.resume if inside else None)
@@ -286,3 +285,13 @@ def solve(model, out="results", **options) -> Results | None:
     with ``out=None``, see :class:`Analysis`).
     Options are those of :class:`Analysis`."""
     return Analysis(model, out, **options).run()
+
+
+def step_runner(path: str):
+    """The function ``"module:function"`` that runs a step of a kind of its own (a step class's
+    ``runner``, e.g. the frequency step's ``femast.modal.step:run_frequency_step``), called as
+    ``function(analysis, step)``: the analysis imports no package above it."""
+    import importlib
+
+    module, _, name = path.partition(":")
+    return getattr(importlib.import_module(module), name)

@@ -152,7 +152,7 @@ def add_beams(
     mass_per_length (kg/m; None: section rho A), length_error_m (m), alpha_per_K (1/K): one value or
     one per element.  Returns the element labels (int64 array)."""
     what = f"model '{model.name}': beams()"
-    from .model import BeamSpec
+    from .specs import BeamSpec
 
     labs, rows = node_rows(model, nodes, what)
     n = len(labs)
@@ -239,7 +239,7 @@ def add_trusses(
     tension_only, mass_per_length (kg/m), length_error_m (m), alpha_per_K (1/K): one value or one
     per element; family: a name or one per element (None: "cable" or "truss").  Returns the labels."""
     what = f"model '{model.name}': trusses()"
-    from .model import TrussSpec
+    from .specs import TrussSpec
 
     labs, rows = node_rows(model, nodes, what)
     n = len(labs)

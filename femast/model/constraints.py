@@ -125,7 +125,7 @@ def rigid_body_spec(model, reference, nodes, name: str) -> RigidBodySpec:
 def tie_spec(model, master, slave, dofs) -> TieSpec:
     """The :class:`TieSpec` of :meth:`Model.tie <femast.model.Model.tie>` after checking it
     (default DOFs: the three translations; "all": the six)."""
-    from .model import dof_index
+    from .specs import dof_index
 
     model._check_node(master, "tie")
     model._check_node(slave, "tie")

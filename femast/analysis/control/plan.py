@@ -2,7 +2,7 @@
 
 A control strategy (:mod:`.load`, :mod:`.displacement`, :mod:`.arclength`, or one of your own)
 holds the user's parameters and makes a *plan* for each step with its ``plan(analysis, step)``
-method (:func:`plan_for`; docs/architecture.md shows a control of your own).  The plan is all that
+method (:func:`femast.analysis.control.plan_for`; docs/architecture.md shows a control of your own).  The plan is all that
 differs between strategies in the step loop (stepping.py): it proposes each increment (times,
 loads, predictor, load-factor constraint: a :class:`~femast.analysis.newton.Increment`), shrinks it
 after a failure (cutback) and sizes the next one after a success.  The Newton loop and the output
@@ -36,21 +36,6 @@ def _values(rows, start, frac_time, period):
         else:
             out[i, dof] = start[i, dof] + frac_time * (magnitude - start[i, dof])
     return out
-
-
-def plan_for(analysis, step, control):
-    """The plan of ``step`` under ``control``: the control's own (its ``plan`` method); a control
-    without one gets the time increments of load control (or the arc-length plan if its
-    ``arc_length`` attribute is true)."""
-    if hasattr(control, "plan"):
-        return control.plan(analysis, step)
-    if getattr(control, "arc_length", False):
-        from .arclength import ArcIncrements
-
-        return ArcIncrements(analysis, step, control)
-    from .load import TimeIncrements
-
-    return TimeIncrements(analysis, step, control)
 
 
 class Plan:
