@@ -151,5 +151,5 @@ def test_femast_table():
     }
     assert "rotations.py" in deps["elements/_ball_joint_kernels.py"]  # logm_so3_into
     assert {"rotations.py", "elements/_stack.py"} <= set(deps["elements/beam_corot.py"])
-    assert "latch.py" in deps["elements/_cable_kernels.py"]
+    assert "elements/latch_law.py" in deps["elements/_cable_kernels.py"]
     assert deps["rotations.py"] == []
