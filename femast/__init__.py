@@ -14,7 +14,7 @@ Quick start::
 
 from . import _moved, numba_cache
 
-numba_cache.check()  # delete numba caches whose njit helpers in other files changed (femast.numba_cache)
+numba_cache.configure()  # a source checkout: numba's cache in a folder keyed by the kernels' sources
 
 from .analysis import Analysis, solve
 from .analysis.control import ArcLength, DisplacementControl, LoadControl, Stabilize
@@ -62,4 +62,4 @@ def __getattr__(name):  # fm.results, fm.sections...: the old top-level modules 
 
 from .jit import watch as _watch_compile
 
-_watch_compile()  # announce the first-run numba compile once (femast.jit)
+_watch_compile()  # announce the first-run numba compile once per process tree (femast.jit)

@@ -88,9 +88,11 @@ GRAPH = {m: _module_imports(p) for m, p in MODULES.items()}
 LEVELS = [
     {"errors", "_moved"},
     {"rotations", "progress", "numba_cache", "examples"},
-    {"jit"},  # the kernels' compile helpers
+    {"jit"},  # the kernels' compile notice and set-up helpers
+    {"worker_main"},
+    {"workers"},  # the one executor of worker processes
     {"elements"},
-    {"testing", "model", "jit_background"},
+    {"testing", "model"},
     {"post"},
     {"analysis"},
     {"femast"},  # the public API: femast/__init__.py
@@ -100,19 +102,13 @@ LEVELS = [
     {"effects"},
     {"experiments"},
     {"studies"},
-    {"cli_experiments"},
+    {"cli_experiments", "warmup"},
     {"cli"},
     {"old paths"},
 ]
 LEVEL = {u: k for k, units in enumerate(LEVELS) for u in units}
 #: the crossings of the layering that remain: (unit, unit it imports) -> why, and who removes it
 CROSSINGS = {
-    ("jit", "adam"): "femast warmup's models: the warm-up moves out of the core",
-    ("jit", "guyed"): "femast warmup's models: the warm-up moves out of the core",
-    ("jit", "effects"): "femast warmup's kernels: the warm-up moves out of the core",
-    ("jit", "elements"): "femast warmup's kernels: the warm-up moves out of the core",
-    ("jit", "femast"): "femast warmup's models: the warm-up moves out of the core",
-    ("jit", "jit_background"): "the background compile, which becomes an opt-in or goes",
     ("effects", "experiments"): "effects declare the experiments' Parameter: the framework split puts it below both",
 }
 #: module circles that remain (the modules of each), with the same reason

@@ -94,7 +94,7 @@ class Analysis:
         restart_every: int | None = None,
         linear_solver: str = "auto",
     ):
-        prepare_kernels()  # first run: kernels compile in the background (femast.jit_background)
+        prepare_kernels()  # the first-run compile notice armed (femast.jit)
         self.model = model
         self.on_frame = on_frame
         self.out = out
