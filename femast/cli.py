@@ -50,8 +50,7 @@ def _run(args):
 def _vtk(args):
     from .post.vtk import export_vtk
 
-    out = Path(args.out) / Path(args.results).resolve().name  # ./vtk/NAME: beside render's ./render
-    pvd = export_vtk(args.results, out, every=args.every)
+    pvd = export_vtk(args.results, args.out, every=args.every)  # RESULTS/vtk, as export_vtk(res)
     print(f"wrote {pvd} (open it in ParaView; apply 'Warp By Vector' with U to see the deformed shape)")
 
 
@@ -110,9 +109,28 @@ def _info(args):
             f"cutbacks {s.get('cutbacks', 0)}, wall time {s.get('wall_time', 0.0):.2f} s"
         )
         for st in s.get("steps", []):
-            print(f"  step {st['name']}: {st['increments']} increments, {st['iterations']} iterations")
+            n, k = st["increments"], st["iterations"]
+            print(f"  step {st['name']}: {n} increment{'' if n == 1 else 's'}, {k} iteration{'' if k == 1 else 's'}")
         if s.get("message"):
             print(f"  {s['message']}")
+
+
+class _Intermixed(argparse.ArgumentParser):
+    """A command's parser that takes its options anywhere among its positional arguments
+    (``femast render RES --frame last shape.png`` as well as ``femast render RES shape.png --frame
+    last``): argparse's ``parse_known_intermixed_args``.  A command taking a script's arguments
+    verbatim (``run``) parses as usual."""
+
+    _inside = False
+
+    def parse_known_args(self, args=None, namespace=None):
+        if self._inside or any(a.nargs in (argparse.REMAINDER, argparse.PARSER) for a in self._actions):
+            return super().parse_known_args(args, namespace)
+        self._inside = True  # (Python < 3.12 calls parse_known_args from the intermixed parse)
+        try:
+            return self.parse_known_intermixed_args(args, namespace)
+        finally:
+            self._inside = False
 
 
 class _Help(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
@@ -142,7 +160,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="show the full Python traceback of an error (default: one line naming the item)",
     )
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Intermixed)
     p = sub.add_parser(
         "run",
         help="run a model or benchmark script",
@@ -169,8 +187,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("results", help="results folder written by an analysis (fm.solve(model, FOLDER))")
     p.add_argument(
         "--out",
-        default="vtk",
-        help="folder in which a subfolder named after RESULTS gets the series (default: vtk, in the working directory)",
+        default=None,
+        help="folder of the .vtu files and series.pvd (default: RESULTS/vtk, where export_vtk(results) writes them)",
     )
     p.add_argument("--every", type=int, default=1, help="write every n-th frame")
     p.set_defaults(func=_vtk)

@@ -35,7 +35,9 @@ API (a :class:`concurrent.futures.Executor`)::
   (which runs in every worker as it starts, replacements included) and keep them in a module
   global of the worker, rather than with every task.
 * ``timeout_s`` (s, per task, from the moment a worker takes it; ``submit(..., timeout_s=...)``
-  overrides it for one task).  ``None``: no limit.
+  overrides it for one task).  ``None``: no limit.  ``start_timeout_s`` (s) bounds a worker's
+  start (import and ``initializer``); workers that die or hang as they start, three in a row,
+  end the pool: every task then fails with :class:`~femast.errors.WorkerDied`.
 * Leaving the ``with`` block normally waits for the submitted tasks; leaving it by an exception
   (Ctrl-C included) kills the workers at once.  :meth:`Pool.kill` does that explicitly.
 * A worker ignores SIGINT (Ctrl-C is its parent's to handle), and prints no first-run compile
@@ -112,6 +114,7 @@ class _Slot:
         self.process, self.conn = process, conn
         self.task = None  # (task id, future, deadline or None)
         self.ready = False  # set up (initializer run): takes tasks
+        self.start_deadline = None  # monotonic s by which it must be set up (None: no limit)
         self.done = 0  # tasks finished
 
 
@@ -123,14 +126,26 @@ class Pool(concurrent.futures.Executor):
     timeout_s : s, default time-out of a task, counted from when a worker takes it; a task over
         it fails with :class:`~femast.errors.TaskTimeout` and its worker is killed and replaced.
     name : shown in error messages ("study workers", "diagnose refits").
+    start_timeout_s : s, a worker not set up this long after it was started (importing, running
+        ``initializer``) is killed and counts as a worker that died as it started; ``None``: no
+        limit.
     """
 
-    def __init__(self, workers: int, initializer=None, initargs=(), timeout_s: float | None = None, name="femast"):
+    def __init__(
+        self,
+        workers: int,
+        initializer=None,
+        initargs=(),
+        timeout_s: float | None = None,
+        name="femast",
+        start_timeout_s: float | None = None,
+    ):
         workers = worker_count(workers)
         if timeout_s is not None and not (timeout_s > 0):
             raise FemastError(f"timeout_s = {timeout_s!r} must be > 0 s (or None: no limit)")
         self.name = name
         self.timeout_s = timeout_s
+        self.start_timeout_s = start_timeout_s
         self._ctx = multiprocessing.get_context(start_method())
         self._initializer = initializer
         self._initargs = dumps(tuple(initargs))
@@ -148,6 +163,9 @@ class Pool(concurrent.futures.Executor):
         self._thread.start()
         self._started.wait()
         _POOLS.add(self)
+        if self._broken is not None:
+            self._thread.join(STOP_WAIT_S)
+            raise WorkerDied(self._broken)
 
     @property
     def workers(self) -> int:
@@ -213,7 +231,10 @@ class Pool(concurrent.futures.Executor):
         )
         p.start()
         theirs.close()  # only the worker holds its end: its reads see EOF when this process ends
-        return _Slot(p, mine)
+        slot = _Slot(p, mine)
+        if self.start_timeout_s is not None:
+            slot.start_deadline = time.monotonic() + float(self.start_timeout_s)
+        return slot
 
     def _wake(self) -> None:
         try:
@@ -225,11 +246,17 @@ class Pool(concurrent.futures.Executor):
         try:
             try:
                 self._slots.extend(self._start() for _ in range(self._n))
+            except BaseException as exc:  # e.g. Python refusing to start a process while a worker imports
+                with self._lock:
+                    self._broken = f"{self.name}: cannot start worker processes ({type(exc).__name__}: {exc})"
+                raise
             finally:
                 self._started.set()
             self._loop()
-        except BaseException as exc:  # pragma: no cover - a bug here must not hang the caller
-            self._fail_all(f"{self.name}: the pool's manager failed ({type(exc).__name__}: {exc})")
+        except BaseException as exc:  # a bug here must not hang the caller
+            with self._lock:
+                self._broken = self._broken or f"{self.name}: the pool's manager failed ({type(exc).__name__}: {exc})"
+            self._fail_all(self._broken)
         finally:
             _stop_all(self._slots)
             self._wake_r.close()
@@ -245,6 +272,7 @@ class Pool(concurrent.futures.Executor):
                 self._dispatch()
             now = time.monotonic()
             deadlines = [s.task[2] for s in self._slots if s.task is not None and s.task[2] is not None]
+            deadlines += [s.start_deadline for s in self._slots if not s.ready and s.start_deadline is not None]
             timeout = None if not deadlines else max(0.0, min(deadlines) - now)
             waitables = [self._wake_r] + [s.conn for s in self._slots] + [s.process.sentinel for s in self._slots]
             ready = _wait_ready(waitables, timeout)
@@ -258,6 +286,9 @@ class Pool(concurrent.futures.Executor):
             for s in list(self._slots):
                 if s.task is not None and s.task[2] is not None and now >= s.task[2]:
                     self._time_out(s)
+                elif not s.ready and s.start_deadline is not None and now >= s.start_deadline:
+                    s.start_deadline = None
+                    _kill(s.process)  # its sentinel fires: collected as a worker that died as it started
         if self._broken is not None:
             self._fail_all(self._broken)
 
@@ -324,7 +355,7 @@ class Pool(concurrent.futures.Executor):
             if self._start_failures >= _START_FAILURES_MAX:
                 with self._lock:
                     self._broken = (
-                        f"{self.name}: worker processes die as they start (exit code {code}); if the script "
+                        f"{self.name}: worker processes die (or hang) as they start (exit code {code}); if the script "
                         'that starts them is run with `python script.py`, put its work under `if __name__ == "__main__":`'
                     )
                 return

@@ -86,7 +86,7 @@ GRAPH = {m: _module_imports(p) for m, p in MODULES.items()}
 # ------------------------------------------------------------------------------ the layering
 #: the units from the bottom up: a unit imports only units of lower levels (docs/architecture.md)
 LEVELS = [
-    {"errors", "_moved"},
+    {"errors", "_moved", "text"},
     {"rotations", "progress", "numba_cache", "examples"},
     {"jit"},  # the kernels' compile notice and set-up helpers
     {"worker_main"},

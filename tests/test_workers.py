@@ -138,3 +138,36 @@ def test_the_docs_example_runs_as_a_script(tmp_path):
     )
     assert eval(p.stdout.strip()) == [1.0 / (1.0 / k + 1.0 / 2.0e6) for k in (1.0e6, 2.0e6, 4.0e6, 8.0e6)]
     assert eval(quoted) == eval(p.stdout.strip())
+
+
+UNGUARDED = textwrap.dedent(
+    """
+    from femast import workers
+
+    def square(x):
+        return x * x
+
+    with workers.Pool(2) as pool:  # not under `if __name__ == "__main__":`
+        print(list(pool.map(square, range(4))))
+    """
+)
+
+
+def test_a_script_without_a_main_guard_gets_a_clear_error_not_a_hang(tmp_path):
+    """Each worker imports the script and would start workers of its own: Python refuses that, the
+    workers die as they start, and the script ends with an error that says what to change."""
+    (tmp_path / "unguarded.py").write_text(UNGUARDED)
+    p = subprocess.run([sys.executable, "unguarded.py"], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert p.returncode != 0
+    last = p.stderr.strip().splitlines()[-1]
+    assert last.startswith("femast.errors.WorkerDied") and 'if __name__ == "__main__":' in last
+
+
+def _never_returns():
+    time.sleep(3600)
+
+
+def test_workers_that_never_get_set_up_end_the_pool_with_an_error():
+    with workers.Pool(2, initializer=_never_returns, start_timeout_s=5.0, name="test") as pool:
+        with pytest.raises(WorkerDied, match="as they start"):
+            pool.submit(_square, 3).result(timeout=600)

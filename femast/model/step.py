@@ -65,8 +65,10 @@ class Step:
     _model: object = field(default=None, repr=False)  # the Model the step belongs to
 
     def load(self, node, amplitude: Amplitude | None = None, **components):
-        """Nodal force/moment at the end of the step: ``step.load(n, fx=10.0, mz=-2.0)`` (N, N m,
-        global axes, fixed directions).  A load not redefined in a later step stays applied."""
+        """Nodal force/moment on ``node`` at the end of the step: ``step.load(n, fx=10.0, mz=-2.0)``;
+        ``components`` fx, fy, fz (N) and mx, my, mz (N m), global axes, fixed directions.  The load
+        ramps linearly in step time, or follows ``amplitude`` (an :class:`Amplitude` of step time).
+        A load not redefined in a later step stays applied."""
         self._model._check_node(node, f"load in step '{self.name}'")
         if not components:
             raise ModelError(f"step '{self.name}': load on node {node} has no components; give e.g. fx=1.0")
@@ -82,8 +84,9 @@ class Step:
         return self
 
     def prescribe(self, node, amplitude: Amplitude | None = None, **components):
-        """Prescribed displacement/rotation at the end of the step: ``step.prescribe(n, ux=0.01,
-        rz=0.05)`` (m, rad).  A prescribed rotation component is the accumulated spin about that
+        """Prescribed displacement/rotation of ``node`` at the end of the step: ``step.prescribe(n, ux=0.01,
+        rz=0.05)``; ``components`` ux, uy, uz (m) and rx, ry, rz (rad), reached linearly in step time
+        or along ``amplitude``.  A prescribed rotation component is the accumulated spin about that
         global axis (exact when the other two rotation components are held)."""
         self._model._check_node(node, f"prescribed motion in step '{self.name}'")
         if not components:
@@ -113,7 +116,8 @@ def _step_temperature(self, T, elements=None, family=None, where=None, amplitude
 def _step_rotate(self, node, axis, angle: float, amplitude: Amplitude | None = None):
     """Prescribe a rotation of ``node`` by ``angle`` (rad) about the fixed global ``axis`` (any
     direction) at the end of the step: the three rotation components are driven together, which
-    is exact for a rotation about a fixed axis."""
+    is exact for a rotation about a fixed axis.  The angle is reached linearly in step time, or
+    along ``amplitude`` (an :class:`Amplitude` of step time)."""
     a = np.asarray(axis, dtype=float)
     if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) == 0:
         raise ModelError(f"step '{self.name}': rotation axis {axis!r} must be a non-zero 3-vector")

@@ -40,6 +40,7 @@ from .study import Study
 
 _STUDY = None  # the study of this worker process
 KILL_GRACE_S = 2.0  # a sample's worker is killed this long (s) after timeout_s, if the sample has not stopped itself
+START_S = 600.0  # with a timeout_s, a worker may take this long (s) more to start (import, load or compile kernels)
 _DASK_STUDIES = {}  # payload hash -> study (dask workers)
 
 
@@ -369,7 +370,10 @@ def _run_local(study, chunks, make, record, workers, s):
 
     tw = time.perf_counter()
     timeout = None if study.timeout_s is None else study.timeout_s + KILL_GRACE_S
-    with Pool(workers, _init_local, (cp.dumps(study),), timeout_s=timeout, name="study workers") as pool:
+    start = None if timeout is None else START_S + timeout  # (its warm-up sample too)
+    with Pool(
+        workers, _init_local, (cp.dumps(study),), timeout_s=timeout, name="study workers", start_timeout_s=start
+    ) as pool:
         s.warmup_time = time.perf_counter() - tw
         if timeout is None:
             try:
