@@ -383,8 +383,10 @@ class Model:
     def frequency_step(
         self, name: str | None = None, n_modes: int = 10, shift_hz: float | None = None, vtk: bool = False
     ):
-        """Append a step that computes the lowest ``n_modes`` vibration modes of the state reached so
-        far (prestress and loads included; see :mod:`femast.model.frequency`); returns it."""
+        """Append a step called ``name`` that computes the lowest ``n_modes`` vibration modes of the
+        state reached so far (prestress and loads included; see :mod:`femast.model.frequency`): the modes
+        nearest ``shift_hz`` (Hz) when given, else the lowest; ``vtk=True`` also writes an animated
+        VTK series per mode.  Returns it."""
         from .frequency import add_frequency_step
 
         return add_frequency_step(self, name, n_modes, shift_hz, vtk)
