@@ -1,4 +1,4 @@
-"""Independent simulator of the seed-001 latch pull-test rig (Sec. III.B, Fig. 8), for test data.
+"""Independent simulator of the latch pull-test rig of Stohlman & Pellegrino (Sec. III.B, Fig. 8), for test data.
 
 Written from the seed's equations without :mod:`femast.elements.latch_law` or the ``latch-pull`` experiment,
 so that data with partial reversals can test that model.  Differences in form on purpose:

@@ -1,4 +1,4 @@
-"""Steps and load paths of the seed-001 analyses: the initial (pretension) step, the single-bay
+"""Steps and load paths of the ADAM analyses (Stohlman & Pellegrino): the initial (pretension) step, the single-bay
 torsion paths (Figs. 16-17) and the 40-bay load sequence (Table 1).
 
 All angles in rad unless the name says ``_deg``; lengths in m, forces in N, moments in N m.

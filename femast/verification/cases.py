@@ -165,7 +165,7 @@ def bend45(n_elements=16, out_dir=None, progress=False):
 
 
 def linear_compliance(n_elements=4, L=3.651, out_dir=None):
-    """Tip compliance of the seed-000 square-tube cantilever from the FE tangent at the
+    """Tip compliance of the Rocaspect paper's square-tube cantilever from the FE tangent at the
     undeformed state against the beam-theory compliance (the Rocaspect paper, Eq. 8, correct J)."""
     sec = square_tube(0.1, 0.094, E=2.1e11, nu=0.3)
     m, root, tip = _cantilever(n_elements, L=L, section=sec, up=(0.0, 1.0, 0.0))
