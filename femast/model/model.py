@@ -23,6 +23,7 @@ from ..elements.base import DOF_NAMES
 from ..errors import ModelError
 from . import validation
 from .arrays import ElementList, add_beams, add_nodes, add_trusses
+from .mass import point_mass_spec
 from .sections import Section
 from .specs import _DOF_INDEX, LOAD_NAMES, BeamSpec, TrussSpec, dof_index  # noqa: F401  (re-exported)
 from .step import Condition, Step, _finite  # noqa: F401  (re-exported)
@@ -66,7 +67,7 @@ class Model:
         self.rigid_bodies: list = []
         self.ties: list = []
         self.steps: list[Step] = []
-        self.point_masses: list = []  # femast.model.point_mass.PointMassSpec (modal analyses)
+        self.point_masses: list = []  # femast.model.mass.PointMassSpec (modal analyses, gravity)
         self.length_errors: dict = {}  # element label -> m (lack of fit)
         self.expansion: dict = {}  # element label -> 1/K
         self.initial_temperatures: dict = {}  # element label -> K or degC
@@ -318,10 +319,8 @@ class Model:
     def point_mass(self, node, mass: float = 0.0, inertia=None, offset=None, name: str = ""):
         """A mass ``mass`` (kg) with rotary ``inertia`` (kg m^2 about its centre of mass: a scalar,
         3 principal values along the global axes or a 3x3 matrix, initial global axes) at
-        ``node``, its centre of mass ``offset`` (m) from the node (modal analyses); ``name`` labels
-        it in messages.  Returns the :class:`femast.model.point_mass.PointMassSpec`."""
-        from .point_mass import point_mass_spec
-
+        ``node``, its centre of mass ``offset`` (m) from the node (modal analyses, gravity); ``name``
+        labels it in messages.  Returns the :class:`femast.model.mass.PointMassSpec`."""
         self._check_node(node, "point mass")
         spec = point_mass_spec(node, mass, inertia, offset, name)
         self.point_masses.append(spec)

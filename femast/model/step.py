@@ -12,6 +12,7 @@ from ..elements.base import DOF_NAMES
 from ..errors import ModelError
 from . import validation
 from .amplitudes import Amplitude
+from .gravity import _step_gravity
 from .specs import _DOF_INDEX, _LOAD_INDEX, LOAD_NAMES
 
 
@@ -137,3 +138,4 @@ def _step_follow(self, node, times, **tables):
 Step.rotate = _step_rotate
 Step.temperature = _step_temperature
 Step.follow = _step_follow
+Step.gravity = _step_gravity

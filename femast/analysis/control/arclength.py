@@ -30,7 +30,7 @@ from tqdm.auto import tqdm
 from ...errors import ConvergenceError, ModelError
 from ...model import dof_index
 from ..newton import Increment
-from .plan import Plan, step_values
+from .plan import Plan, gravity_of, step_values, with_gravity
 
 
 @dataclass
@@ -55,10 +55,10 @@ class ArcLength:
         return ArcIncrements(analysis, step, self)
 
     def setup(self, analysis, step):
-        if not step.loads:
+        if not step.loads and getattr(step, "gravity_spec", None) is None:
             raise ModelError(
                 f"step '{step.name}': arc-length control needs a reference load pattern; "
-                "define at least one load in the step"
+                "define at least one load (or gravity) in the step"
             )
         if step.prescribed:
             raise ModelError(
@@ -115,7 +115,12 @@ class ArcIncrements(Plan):
         super().__init__(analysis, step, control)
         st = self.state
         self.load_start = st.loads.copy()
-        self.P_ref = step_values(analysis.model, step.loads, self.load_start, 1.0, step.period) - self.load_start
+        gravity = gravity_of(analysis, step)
+        if gravity is not None and gravity[2] is not None:
+            raise ModelError(f"step '{step.name}': a gravity amplitude cannot be used with arc length")
+        user_start = self.load_start if gravity is None else self.load_start - gravity[0]
+        P_end = with_gravity(step_values(analysis.model, step.loads, user_start, 1.0, step.period), gravity, 1.0, 1.0)
+        self.P_ref = P_end - self.load_start
         st.lam = 0.0
         st.size = st.first_size = None  # the first arc length comes from the first predictor
         st.step_time = 0.0

@@ -18,7 +18,7 @@ from tqdm.auto import tqdm
 from ...errors import ConvergenceError, ModelError
 from ..newton import Increment
 from ..summary import StabilizationWarning
-from .plan import Plan, _rows, _values
+from .plan import Plan, _rows, _values, gravity_of, with_gravity
 from .stabilize import ViscousTerm
 
 
@@ -44,7 +44,9 @@ class TimeIncrements(Plan):
         self.dt_min = step.min_increment or period * 1e-5
         self.dt_max = step.max_increment or period
         self.uses_lam = control.solves_for_load_factor
-        if self.uses_lam and any(c.amplitude is not None for c in step.loads):
+        self.gravity = gravity_of(analysis, step)
+        g_amp = None if self.gravity is None else self.gravity[2]
+        if self.uses_lam and (g_amp is not None or any(c.amplitude is not None for c in step.loads)):
             raise ModelError(
                 f"step '{step.name}': amplitudes cannot be used with {type(control).__name__}; "
                 "the load factor is an unknown"
@@ -65,8 +67,11 @@ class TimeIncrements(Plan):
                 for t in amp.times
                 if 0 < t < period
             }
-        )  # temperature amplitudes
-        self.load_start, self.pres_start = st.loads.copy(), st.prescribed.copy()
+            | {float(t) for t in (g_amp.times if g_amp is not None else ()) if 0 < t < period}
+        )  # temperature and gravity amplitudes
+        # the concentrated loads at the step's start (the applied loads less the gravity)
+        self.load_start = st.loads.copy() if self.gravity is None else st.loads - self.gravity[0]
+        self.pres_start = st.prescribed.copy()
         self.load_rows, self.pres_rows = _rows(analysis.model, step.loads), _rows(analysis.model, step.prescribed)
         sys_ = analysis.system
         # the constrained DOFs that are not fixed (prescribed in some step); none: every increment's
@@ -132,13 +137,14 @@ class TimeIncrements(Plan):
         )
         if self.uses_lam:
             inc.lam = st.lam
-            P_end = _values(self.load_rows, self.load_start, 1.0, period)
-            inc.P_start, inc.P_ref = self.load_start, P_end - self.load_start
+            P_end = with_gravity(_values(self.load_rows, self.load_start, 1.0, period), self.gravity, 1.0, period)
+            P_start = with_gravity(self.load_start, self.gravity, 0.0, period)
+            inc.P_start, inc.P_ref = P_start, P_end - P_start
             eq, control = self.control.eq, self.control
             node, dof = sys_.free_node[eq], sys_.free_dof[eq]
             inc.dlambda = lambda du_r, du_p, Du: control.dlambda(du_r, du_p, sys_.dof_value(node, dof), frac)
         else:
-            inc.P = _values(self.load_rows, self.load_start, frac, period)
+            inc.P = with_gravity(_values(self.load_rows, self.load_start, frac, period), self.gravity, frac, period)
         dpres = None
         if self.any_moving:
             pres = _values(self.pres_rows, self.pres_start, frac, period)

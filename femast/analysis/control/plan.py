@@ -14,7 +14,10 @@ A plan keeps what it carries from increment to increment in the analysis :class:
 
 from __future__ import annotations
 
+import numpy as np
 from tqdm.auto import tqdm
+
+from ...model.gravity import step_gravity, unit_gravity_loads
 
 
 def step_values(model, conds, start, frac_time, period):
@@ -36,6 +39,32 @@ def _values(rows, start, frac_time, period):
         else:
             out[i, dof] = start[i, dof] + frac_time * (magnitude - start[i, dof])
     return out
+
+
+def gravity_of(analysis, step):
+    """(G at the step's start, G at its end, amplitude) of the step's gravity, (n, 6) N and N m
+    (:mod:`femast.model.gravity`), or None when no step up to this one has gravity."""
+
+    def unit():
+        cached = getattr(analysis, "_unit_gravity", None)
+        if cached is None:
+            X0 = analysis.X0
+            cached = unit_gravity_loads(analysis.model, analysis.families, X0, np.tile(np.eye(3), (len(X0), 1, 1)))
+            try:
+                analysis._unit_gravity = cached
+            except AttributeError:  # an analysis object that takes no new attributes: no cache
+                pass
+        return cached
+
+    return step_gravity(analysis.model, step, unit)
+
+
+def with_gravity(P, gravity, frac, period):
+    """Concentrated loads P (n, 6) plus the step's gravity at step-time fraction ``frac``."""
+    if gravity is None:
+        return P
+    G0, G1, amplitude = gravity
+    return P + (amplitude(frac * period) * G1 if amplitude is not None else G0 + frac * (G1 - G0))
 
 
 class Plan:
