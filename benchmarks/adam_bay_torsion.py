@@ -45,10 +45,10 @@ ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs" / "figures"
 
 SEED_NOTE = {
-    "ideal": "seed Fig. 16: model of the ideal path, all four latches\n"
+    "ideal": "Stohlman & Pellegrino Fig. 16: model of the ideal path, all four latches\n"
     "release together; experiment: -35 N m to start, about\n"
     "3 deg to unlatch three of four latches",
-    "actual": "seed Fig. 17: model driven by the measured theta_z, x, y;\n"
+    "actual": "Stohlman & Pellegrino Fig. 17: model driven by the measured theta_z, x, y;\n"
     "one latch stays latched after the other three release\n"
     "(here: a synthetic measured-style path)",
 }
@@ -83,9 +83,9 @@ def run_path(
         path.to_csv(folder / "path.csv")
     export_vtk(res, folder / "vtk", every=1 if not quick else 4)
     title = (
-        "ADAM bay, idealised path (seed Fig. 16)"
+        "ADAM bay, idealised path (cf. Stohlman & Pellegrino Fig. 16)"
         if kind == "ideal"
-        else "ADAM bay, measured-style path with off-axis drift (seed Fig. 17)"
+        else "ADAM bay, measured-style path with off-axis drift (cf. Stohlman & Pellegrino Fig. 17)"
     )
     if hysteresis is not None:
         title += f"\nlatch hysteresis F_h = {hysteresis[0]:g} N, ell = {hysteresis[1] * 1e3:g} mm"
@@ -133,7 +133,9 @@ def print_summary(info: dict):
         f"  initial step: cables at {info['pretension_N']:.1f} N in equilibrium; stabilisation energy / strain "
         f"energy = {info['stabilization_ratio']:.2e}"
     )
-    print(f"  peak moment {info['peak_moment_Nm']:.1f} N m (seed sign) at {info['peak_at_deg']:.3f} deg")
+    print(
+        f"  peak moment {info['peak_moment_Nm']:.1f} N m (the bay's moment on the rig) at {info['peak_at_deg']:.3f} deg"
+    )
     print(f"  latches reach zone {ZONE_LABELS[3]} at (deg), sides 0-3: {rel}")
     print(
         f"  end: rotation {info['final_rotation_deg']:.4f} deg, moment {info['final_moment_Nm']:.3f} N m, "

@@ -81,7 +81,7 @@ def main():
     )
     ax.set_xlabel("out-of-plane resonance of the latch (Hz)")
     ax.set_ylabel("average cable tension (N)")
-    ax.set_title("Seed 001 Sec. IV: mock bay side")
+    ax.set_title("ADAM mock bay side (Stohlman & Pellegrino, Sec. IV)")
     ax.legend(fontsize=8)
     ax = axes[1]
     ax.axhspan(-v.EQ16_SD_N, v.EQ16_SD_N, color="0.85", label="+- 8.9 N (2 lbf)")

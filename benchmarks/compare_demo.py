@@ -97,7 +97,7 @@ def make_data() -> None:
         cols[k] = np.array(v) * (um if k.endswith("_m") else arcsec)
     exp = get_experiment("tip-cycle")
     write_data(
-        DATA / "tip_cycle_seed001_table1.csv",
+        DATA / "tip_cycle_table1.csv",
         Measured("tip-cycle", cols),
         exp,
         fmt="%.6g",

@@ -90,7 +90,7 @@ def main():
 
     exp = get_experiment("latch-pull")
     latch = SeedLatch()
-    print("null cases (independent rig data, 0.5 N / 2 um noise, seed fit):")
+    print("null cases (independent rig data, 0.5 N / 2 um noise, the published latch fit):")
     print(f"  {'case':32s} {'rows':>5s} {'RMS/noise drawn':>16s} {'RMS/noise est.':>15s}")
     runs = {}
     for name, (knots, side, x0) in paths(latch).items():

@@ -123,7 +123,7 @@ def error_figure(folder, png):
     for a in ax:
         a.grid(alpha=0.3)
         a.legend(fontsize=8)
-    fig.suptitle("Guyed Rocaspect mast 1: top position minus the nominal mast's (FE, seed 000 shroud law)")
+    fig.suptitle("Guyed Rocaspect mast 1: top position minus the nominal mast's (FE, Rocaspect Dyneema law)")
     fig.tight_layout()
     fig.savefig(png, dpi=110)
     plt.close(fig)

@@ -128,7 +128,7 @@ class MeasuredPath:
 
     def to_csv(self, path) -> None:
         """Write ``theta_deg, ux_m, uy_m`` (the experiments' bay-torsion format) plus the step time."""
-        head = "# measured-style path of the ADAM bay's control node (seed 001 Sec. VI.B). " + (
+        head = "# measured-style path of the ADAM bay's control node (Stohlman & Pellegrino, Sec. VI.B). " + (
             "SYNTHETIC: " + self.note if self.synthetic else self.note
         )
         data = np.column_stack([self.t, np.degrees(self.theta), self.x, self.y])

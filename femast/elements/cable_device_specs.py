@@ -255,6 +255,7 @@ def set_device_values(P, kinds, devices, values, name):
             idx, scale = cols[nm]
             for i in idx:
                 P[:, k, i] = arr * scale
+        c = dev.pin_radius / dev.radius if isinstance(dev, Sheave) and kinds[k] == SHEAVE else 1.0  # rho per mu
         for el in range(n_el):  # construction only, not a hot path
             where = f"{name} device {k} ({type(dev).__name__}), element {el}"
             if isinstance(dev, Latch):
@@ -267,11 +268,16 @@ def set_device_values(P, kinds, devices, values, name):
             else:
                 mu_k, mu_s = P[el, k, 0], P[el, k, 1]
                 if not (np.isfinite(mu_s) and mu_s > 0.0):
-                    raise ModelError(f"{where}: mu must be finite and > 0 (got {mu_s!r} for the law)")
+                    raise ModelError(f"{where}: mu (mu_s) must be finite and > 0 (got {mu_s / c:.6g})")
                 if kinds[k] == SHEAVE and not mu_s < 1.0:
-                    raise ModelError(f"{where}: mu pin_radius / radius = {mu_s!r} must be < 1")
+                    raise ModelError(
+                        f"{where}: mu pin_radius / radius = {mu_s:.6g} must be < 1 (mu = {mu_s / c:.6g}; "
+                        "a bearing's journal friction is well below 1)"
+                    )
             if not (np.isfinite(mu_k) and 0.0 <= mu_k <= mu_s):
-                raise ModelError(f"{where}: kinetic mu_k must lie in [0, mu_s] (static {mu_s!r}, kinetic {mu_k!r})")
+                raise ModelError(
+                    f"{where}: kinetic mu_k must lie in [0, mu_s] (static {mu_s / c:.6g}, kinetic {mu_k / c:.6g})"
+                )
 
 
 __all__ = [

@@ -30,7 +30,7 @@ _TEST_OF = {None: "7 and 10", 0.0: "5 and 9", 400.0: "4", 800.0: "3", 1200.0: "1
 def _check(pretension):
     if pretension is not None and not (np.isfinite(pretension) and 0.0 <= pretension <= 1200.0):
         raise ModelError(
-            f"shroud pretension {pretension!r} N: the seed's masts are identified for 0 to 1200 N "
+            f"shroud pretension {pretension!r} N: the Rocaspect masts are identified for 0 to 1200 N "
             "(None: shrouds detached)"
         )
 
