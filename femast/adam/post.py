@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..latch import ZONE_BACKSTOP, ZONE_BEHIND_AXIS, ZONE_FREE, ZONE_IN_FRONT, ZONE_LABELS
+from ..elements.latch_law import ZONE_BACKSTOP, ZONE_BEHIND_AXIS, ZONE_FREE, ZONE_IN_FRONT, ZONE_LABELS
 from ..post.results import Results
 from .build import AdamModel
 
@@ -125,7 +125,7 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
     import matplotlib
 
     matplotlib.use("Agg")
-    from ..post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+    from ..post import plotstyle  # noqa: E402  (the one femast figure style)
 
     plotstyle.use()
     import matplotlib.pyplot as plt
@@ -188,7 +188,7 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
 
 
 # ---------------------------------------------------------------------------- Table 1
-#: Seed 001 Table 1, rows 0, M+F, 0, -M-F, 0, ... (x, y, z in um; theta_x, theta_y, theta_z in
+#: Stohlman & Pellegrino, Table 1, rows 0, M+F, 0, -M-F, 0, ... (x, y, z in um; theta_x, theta_y, theta_z in
 #: arcsec).  The extracted table prints the x displacement under -M-F as "-1.740" and under M+F
 #: after the first cycle as "1.740": read here as -1740 and 1740 um (a thousands separator).
 SEED_TABLE1 = np.array(
