@@ -1,4 +1,4 @@
-"""Single ADAM bay in torsion: seed 001 Figs. 16 (idealised path) and 17 (actual path).
+"""Single ADAM bay in torsion: Stohlman & Pellegrino, Figs. 16 (idealised path) and 17 (actual path).
 
     femast run benchmarks/adam_bay_torsion.py [--path ideal|actual|both] [--out DIR] [--docs]
                                               [--hysteresis F_h ell] [--quick] [--no-progress]
@@ -38,7 +38,7 @@ from femast.adam.steps import (
     add_measured_torsion,
     measured_style_path,
 )
-from femast.latch import ZONE_LABELS
+from femast.elements.latch_law import ZONE_LABELS
 from femast.post.vtk import export_vtk
 
 ROOT = Path(__file__).resolve().parents[1]

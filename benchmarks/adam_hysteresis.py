@@ -1,4 +1,4 @@
-"""Latch hysteresis near the latched state (seed 001 Sec. VIII: the missing physics).
+"""Latch hysteresis near the latched state (Stohlman & Pellegrino, Sec. VIII: the missing physics).
 
     femast run benchmarks/adam_hysteresis.py [--target 0.10] [--length 1e-3] [--force F_h]
                                              [--skip-mast] [--docs] [--no-progress]
@@ -116,7 +116,7 @@ def main(argv=None):
     import matplotlib
 
     matplotlib.use("Agg")
-    from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+    from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
     plotstyle.use()
     import matplotlib.pyplot as plt

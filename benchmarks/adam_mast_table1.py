@@ -1,4 +1,4 @@
-"""40-bay ADAM mast (6.84 m) under the load sequence of seed 001, Table 1.
+"""40-bay ADAM mast (6.84 m) under the load sequence of Stohlman & Pellegrino, Table 1.
 
     femast run benchmarks/adam_mast_table1.py [--cycles 3] [--fit] [--hysteresis F_h ell]
                                               [--compare-mu MU] [--render] [--docs] [--no-progress]

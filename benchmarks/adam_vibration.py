@@ -1,4 +1,4 @@
-"""Seed 001 Sec. IV reproduced (issue 18): the mock bay side's out-of-plane latch resonance
+"""Stohlman & Pellegrino's Sec. IV reproduced: the mock bay side's out-of-plane latch resonance
 against the average cable tension, the unit's effective mass identified from Eq. 16, the model
 curve against Eq. 16 (deviation in N against the fit's scatter) and the inverse use.
 

@@ -1,4 +1,4 @@
-"""Mast-1 top displacement of the Rocaspect robot predicted by the seed's mast models (seed 000, Figs. 5-6).
+"""Mast-1 top displacement of the Rocaspect robot predicted by the Rocaspect paper's mast models (Figs. 5-6).
 
 The platform follows a trajectory like the seed's Fig. 5a (:func:`femast.guyed.rocaspect.fig5a_trajectory`).
 At each pose the cable tensions come from the barycentric tension distribution, the cable
@@ -42,7 +42,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
 plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402

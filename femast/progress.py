@@ -1,4 +1,4 @@
-"""Progress for waits a person sits through (issue 17): tqdm bars on stderr, erased when done.
+"""Progress for waits a person sits through: tqdm bars on stderr, erased when done.
 
 Bars show only when stderr is a terminal and femast is not quiet (``femast --quiet``,
 :func:`set_quiet`, or the environment variable ``FEMAST_QUIET=1``), so logs, pipes and test

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
-from ..latch import LatchParameters, _as_param_array, validate_latch_array
 from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, LATCH_MU_K, LATCH_RHO, N_PARAM, SHEAVE, USER
+from .latch_law import LatchParameters, _as_param_array, validate_latch_array
 
 
 @dataclass(frozen=True)
@@ -122,13 +122,13 @@ def _sheave_params(dev, k, name, p):
 
 @dataclass(frozen=True)
 class Latch:
-    """A roller latch of seed 001 (Eqs. 5, 14) at a node; the bead is on the cable.
+    """A roller latch of Stohlman & Pellegrino (Eqs. 5, 14) at a node; the bead is on the cable.
 
-    params : :class:`~femast.latch.LatchParameters` (default the seed's fit).
+    params : :class:`~femast.elements.latch_law.LatchParameters` (default the seed's fit).
     bead : material coordinate Lb of the bead, m (unstretched length from node 0); ``None`` with
         :meth:`CableDeviceFamily.pretensioned` puts it at ``x0`` in the initial geometry.
     x0 : initial bead position, m (default ``-x_backstop``: latched, on the backstop).
-    hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.latch` (N, m).
+    hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.elements.latch_law` (N, m).
     mu_s, mu_k : static and kinetic friction between rollers and bead (default both ``params.mu``,
         the paper's one coefficient): the static band of Eq. 14 uses mu_s, a sliding bead mu_k.
     sheave : a :class:`Sheave` at the same node (the pulley of ADAM's pulley-and-latch unit): its

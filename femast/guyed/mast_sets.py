@@ -1,4 +1,4 @@
-"""The four Rocaspect masts under each mast model, as :class:`~.platform_pose.MastSet` (seed 000).
+"""The four Rocaspect masts under each mast model, as :class:`~.platform_pose.MastSet`.
 
 * ``"3R"``: Eqs. 4-6 (corrected J) with the Table III joint stiffnesses of the 50 kg tests at the
   shroud pretension (0 N: test "5 and 9", 400 N: "4", 800 N: "3", 1200 N: "1 and 8"; ``None``,

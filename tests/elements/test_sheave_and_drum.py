@@ -204,7 +204,7 @@ def test_latch_with_the_bearing_of_its_unit_sheave():
     """ADAM's pulley-and-latch unit: a latch and a sheave at one node.  A sliding bead's jump is Eq. 14
     plus the bearing's rho |F|; out of the rollers' reach the unit is a sheave (closed form above)."""
     from femast.elements.cable_devices import Latch
-    from femast.latch import LatchParameters
+    from femast.elements.latch_law import LatchParameters
 
     p = LatchParameters.seed_fit()
     sheave = Sheave(0.01, 0.002, 0.3, point=True)

@@ -1,4 +1,4 @@
-"""Measured-data files: format, example files, and bad input (issue 7 item 8)."""
+"""Measured-data files: format, example files, and bad input."""
 
 from pathlib import Path
 
