@@ -83,7 +83,7 @@ def tip_cycle_example(docs: bool) -> dict:
     t0 = time.perf_counter()
     c = compare(exp, data, fit=True, out=out / "baseline")
     t1 = time.perf_counter()
-    d = diagnose(exp, data, out=out / "baseline")
+    d = diagnose(exp, data, workers="auto", out=out / "baseline")
     t2 = time.perf_counter()
     c2 = compare(exp, data, [d.verdict["best_candidate"]], fit=True, out=out / "final")
     print(
