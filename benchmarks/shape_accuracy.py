@@ -1,5 +1,5 @@
 """Shape accuracy of the ADAM mast under manufacturing and assembly scatter (Stohlman &
-Pellegrino's ADAM mast): how far is the tip from where it should be, after deployment and after the Table 1
+Pellegrino): how far is the tip from where it should be, after deployment and after the Table 1
 load cycles, which inputs drive it, and how does it grow with the number of bays?
 
     python -m femast.benchmarks.shape_accuracy [--seat seated|tied] [--bays 10 20] [--samples 32 32]
@@ -55,10 +55,12 @@ from femast.post import plotstyle
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs" / "figures"
 ARCSEC = 180.0 / np.pi * 3600.0
-ATK_LENGTH_M = 1.3e-3  # ADAM paper, Sec. I: ATK's length accuracy and repeatability, +- m over 60 m
+ATK_LENGTH_M = 1.3e-3  # Stohlman & Pellegrino, Sec. I: ATK's length accuracy and repeatability, +- m over 60 m
 ATK_ROT_RAD = np.radians(0.02)  # +- 0.02 deg of rotational misalignment over 60 m
 ATK_BAYS = 350  # 350 bays of 0.171 m: 59.9 m, ATK's 60 m
-SEED_BAY_RESIDUAL_RAD = np.radians(0.10)  # ADAM paper, Sec. VIII: residual rotation of one bay at zero moment
+PAPER_BAY_RESIDUAL_RAD = np.radians(
+    0.10
+)  # Stohlman & Pellegrino, Sec. VIII: residual rotation of one bay at zero moment
 FIELDS = [f for _, f, *_ in SCATTER]
 GROUP_OF = {f: g for g, f, *_ in SCATTER}
 
@@ -338,7 +340,7 @@ def fig_residual_scaling(results, png, nominal_only=()):
     med = np.maximum(np.array([np.median(np.abs(r["metrics"]["cycle_twist"])) for r in results]), np.radians(1e-6))
     p95 = np.array([p95_abs(r["metrics"]["cycle_twist"])["estimate"] for r in results])
     nn = np.linspace(1, nn_nom.max(), 50)
-    ax.plot(nn, np.degrees(nn / 2 * SEED_BAY_RESIDUAL_RAD), "k--", label="the paper's estimate: n/2 bays x 0.10 deg")
+    ax.plot(nn, np.degrees(nn / 2 * PAPER_BAY_RESIDUAL_RAD), "k--", label="the paper's estimate: n/2 bays x 0.10 deg")
     ax.plot(nn_nom, np.degrees(nom), "o-", color="C0", label="full model, nominal mast")
     ax.plot(n, np.degrees(med), "s-", color="C1", label="full model, scatter: median")
     ax.plot(n, np.degrees(p95), "^-", color="C3", label="full model, scatter: 95th percentile")
