@@ -296,6 +296,7 @@ def build_mast(
             hysteresis_length=p.hysteresis_length,
             length_error=sc["cable_dL"].reshape(-1, 2),
             name=LATCH_FAMILY,
+            mu_k=None if p.latch_mu_k is None else np.minimum(p.latch_mu_k, latch_array(sc, p)[:, 3]),
         )
     )
     if fam is not None:

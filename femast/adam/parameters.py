@@ -49,6 +49,10 @@ class BayParameters:
     latch : :class:`~femast.latch.LatchParameters` (seed Sec. III.C fit by default).
     hysteresis_force, hysteresis_length : latch hysteresis near the latched state (N, m); 0
         switches it off (the seed's model).  See ``docs/cable_latch_element.md``.
+    latch_mu_k : kinetic friction of the latch rollers (-); None (default): the latch's ``mu``, the
+        paper's one coefficient (Sec. III.A: "the kinetic and static coefficients ... are assumed to
+        be equal").  Below it, ``latch.mu`` is the static coefficient: a bead starts to slide at
+        ``latch.mu`` and slides on at ``latch_mu_k``.
 
     Joints
     ------
@@ -89,6 +93,7 @@ class BayParameters:
     latch: LatchParameters = field(default_factory=LatchParameters.seed_fit)
     hysteresis_force: float = 0.0
     hysteresis_length: float = 3e-4
+    latch_mu_k: float | None = None
     mu: float = 0.5
     B: float = 0.004
     mu_k: float | None = None
@@ -118,6 +123,7 @@ class BayParameters:
         "latch": "SI",
         "hysteresis_force": "N",
         "hysteresis_length": "m",
+        "latch_mu_k": "-",
         "mu": "-",
         "B": "m",
         "mu_k": "-",
@@ -206,6 +212,11 @@ class BayParameters:
                 f"BayParameters: latch must be a femast.latch.LatchParameters, got {type(self.latch).__name__}"
             )
         validate_latch_array(self.latch.as_array(), "BayParameters.latch")
+        v = self.latch_mu_k
+        if v is not None and (not _is_number(v) or not (0.0 <= v <= self.latch.mu)):
+            raise ModelError(
+                f"BayParameters: latch_mu_k = {v!r} must lie in [0, latch.mu = {self.latch.mu:g}] (kinetic <= static) or be None"
+            )
         if self.hysteresis_force > 0 and self.latch.x_backstop >= contact_half_width(self.latch):
             raise ModelError(
                 "BayParameters: latch hysteresis needs the backstop inside the roller contact "

@@ -24,9 +24,11 @@ from __future__ import annotations
 import math
 import warnings
 
+import numpy as np
 from tqdm.auto import tqdm
 
 from ..errors import ConvergenceError, ModelError
+from ..model.gravity import step_gravity, unit_gravity_loads
 from .newton import Increment
 from .summary import StabilizationWarning
 from .viscous import ViscousTerm
@@ -51,6 +53,32 @@ def _values(rows, start, frac_time, period):
         else:
             out[i, dof] = start[i, dof] + frac_time * (magnitude - start[i, dof])
     return out
+
+
+def gravity_of(analysis, step):
+    """(G at the step's start, G at its end, amplitude) of the step's gravity, (n, 6) N and N m
+    (:mod:`femast.model.gravity`), or None when no step up to this one has gravity."""
+
+    def unit():
+        cached = getattr(analysis, "_unit_gravity", None)
+        if cached is None:
+            X0 = analysis.X0
+            cached = unit_gravity_loads(analysis.model, analysis.families, X0, np.tile(np.eye(3), (len(X0), 1, 1)))
+            try:
+                analysis._unit_gravity = cached
+            except AttributeError:  # an analysis object that takes no new attributes: no cache
+                pass
+        return cached
+
+    return step_gravity(analysis.model, step, unit)
+
+
+def with_gravity(P, gravity, frac, period):
+    """Concentrated loads P (n, 6) plus the step's gravity at step-time fraction ``frac``."""
+    if gravity is None:
+        return P
+    G0, G1, amplitude = gravity
+    return P + (amplitude(frac * period) * G1 if amplitude is not None else G0 + frac * (G1 - G0))
 
 
 def plan_for(analysis, step, control):
@@ -106,7 +134,9 @@ class TimeIncrements(Plan):
         self.dt_min = step.min_increment or period * 1e-5
         self.dt_max = step.max_increment or period
         self.uses_lam = control.solves_for_load_factor
-        if self.uses_lam and any(c.amplitude is not None for c in step.loads):
+        self.gravity = gravity_of(analysis, step)
+        g_amp = None if self.gravity is None else self.gravity[2]
+        if self.uses_lam and (g_amp is not None or any(c.amplitude is not None for c in step.loads)):
             raise ModelError(
                 f"step '{step.name}': amplitudes cannot be used with {type(control).__name__}; "
                 "the load factor is an unknown"
@@ -127,8 +157,11 @@ class TimeIncrements(Plan):
                 for t in amp.times
                 if 0 < t < period
             }
-        )  # temperature amplitudes (issue 20)
-        self.load_start, self.pres_start = st.loads.copy(), st.prescribed.copy()
+            | {float(t) for t in (g_amp.times if g_amp is not None else ()) if 0 < t < period}
+        )  # temperature and gravity amplitudes
+        # the concentrated loads at the step's start (the applied loads less the gravity)
+        self.load_start = st.loads.copy() if self.gravity is None else st.loads - self.gravity[0]
+        self.pres_start = st.prescribed.copy()
         self.load_rows, self.pres_rows = _rows(analysis.model, step.loads), _rows(analysis.model, step.prescribed)
         sys_ = analysis.system
         # the constrained DOFs that are not fixed (prescribed in some step); none: every increment's
@@ -194,13 +227,14 @@ class TimeIncrements(Plan):
         )
         if self.uses_lam:
             inc.lam = st.lam
-            P_end = _values(self.load_rows, self.load_start, 1.0, period)
-            inc.P_start, inc.P_ref = self.load_start, P_end - self.load_start
+            P_end = with_gravity(_values(self.load_rows, self.load_start, 1.0, period), self.gravity, 1.0, period)
+            P_start = with_gravity(self.load_start, self.gravity, 0.0, period)
+            inc.P_start, inc.P_ref = P_start, P_end - P_start
             eq, control = self.control.eq, self.control
             node, dof = sys_.free_node[eq], sys_.free_dof[eq]
             inc.dlambda = lambda du_r, du_p, Du: control.dlambda(du_r, du_p, sys_.dof_value(node, dof), frac)
         else:
-            inc.P = _values(self.load_rows, self.load_start, frac, period)
+            inc.P = with_gravity(_values(self.load_rows, self.load_start, frac, period), self.gravity, frac, period)
         dpres = None
         if self.any_moving:
             pres = _values(self.pres_rows, self.pres_start, frac, period)
@@ -295,7 +329,12 @@ class ArcIncrements(Plan):
         super().__init__(analysis, step, control)
         st = self.state
         self.load_start = st.loads.copy()
-        self.P_ref = step_values(analysis.model, step.loads, self.load_start, 1.0, step.period) - self.load_start
+        gravity = gravity_of(analysis, step)
+        if gravity is not None and gravity[2] is not None:
+            raise ModelError(f"step '{step.name}': a gravity amplitude cannot be used with arc length")
+        user_start = self.load_start if gravity is None else self.load_start - gravity[0]
+        P_end = with_gravity(step_values(analysis.model, step.loads, user_start, 1.0, step.period), gravity, 1.0, 1.0)
+        self.P_ref = P_end - self.load_start
         st.lam = 0.0
         st.size = st.first_size = None  # the first arc length comes from the first predictor
         st.step_time = 0.0

@@ -26,6 +26,8 @@ from ..errors import ModelError
 from . import validation
 from .amplitudes import Amplitude
 from .arrays import ElementList, add_beams, add_nodes, add_trusses
+from .gravity import _step_gravity
+from .mass import point_mass_spec
 from .sections import Section
 
 LOAD_NAMES = ("fx", "fy", "fz", "mx", "my", "mz")
@@ -205,6 +207,7 @@ def _step_follow(self, node, times, **tables):
 Step.rotate = _step_rotate
 Step.temperature = _step_temperature
 Step.follow = _step_follow
+Step.gravity = _step_gravity
 
 
 class Model:
@@ -479,10 +482,8 @@ class Model:
     def point_mass(self, node, mass: float = 0.0, inertia=None, offset=None, name: str = ""):
         """A mass ``mass`` (kg) with rotary ``inertia`` (kg m^2 about its centre of mass: a scalar,
         3 principal values along the global axes or a 3x3 matrix, initial global axes) at
-        ``node``, its centre of mass ``offset`` (m) from the node (modal analyses); ``name`` labels
-        it in messages.  Returns the :class:`femast.modal.mass.PointMassSpec`."""
-        from ..modal.mass import point_mass_spec
-
+        ``node``, its centre of mass ``offset`` (m) from the node (modal analyses, gravity); ``name``
+        labels it in messages.  Returns the :class:`femast.model.mass.PointMassSpec`."""
         self._check_node(node, "point mass")
         spec = point_mass_spec(node, mass, inertia, offset, name)
         self.point_masses.append(spec)

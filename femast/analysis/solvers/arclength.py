@@ -49,10 +49,10 @@ class ArcLength:
     arc_length = True
 
     def setup(self, analysis, step):
-        if not step.loads:
+        if not step.loads and getattr(step, "gravity_spec", None) is None:
             raise ModelError(
                 f"step '{step.name}': arc-length control needs a reference load pattern; "
-                "define at least one load in the step"
+                "define at least one load (or gravity) in the step"
             )
         if step.prescribed:
             raise ModelError(

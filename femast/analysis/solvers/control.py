@@ -49,10 +49,10 @@ class DisplacementControl:
             )
         self.eq = int(eq)
         self.start = analysis.dof_value(idx, d)
-        if not step.loads:
+        if not step.loads and getattr(step, "gravity_spec", None) is None:
             raise ModelError(
                 f"step '{step.name}': displacement control needs a reference load pattern; "
-                "define at least one load in the step"
+                "define at least one load (or gravity) in the step"
             )
 
     def target(self, fraction):
