@@ -113,7 +113,7 @@ def mast_model(n_bays: int, cycles: int = 1, params: BayParameters | None = None
     for a study's model factory.  Returns (model, control node label)."""
     am = build_mast(n_bays, params or STUDY_PARAMS, scatter=as_scatter(values, n_bays))
     add_initial_steps(am)
-    add_table1_steps(am, cycles=cycles)
+    add_table1_steps(am, cycles=cycles, increments=1)  # one increment per step (the study's runs so far)
     return am.model, am.control
 
 
@@ -143,7 +143,7 @@ def tip_history(
     t0 = time.process_time()
     am = build_mast(n_bays, params or STUDY_PARAMS, scatter=None if values is None else as_scatter(values, n_bays))
     add_initial_steps(am, settle=settle)
-    add_table1_steps(am, cycles=cycles, M=M, F=F)
+    add_table1_steps(am, cycles=cycles, M=M, F=F, increments=1)  # one increment per step (the study's runs so far)
     row = am.model.index(am.control)
     last = {}
 
