@@ -1,6 +1,6 @@
 """Ground test of a vertical ADAM mast: the mast under its own weight, then the Table 1 load cycle.
 
-    python benchmarks/adam_ground_test.py [--bays 40] [--out results/adam_ground_test] [--docs]
+    python -m femast.benchmarks.adam_ground_test [--bays 40] [--out results/adam_ground_test] [--docs]
 
 ADAM (Stohlman & Pellegrino, Sec. I) names gravity, with friction, as one of the two primary
 causes of static position errors in ground tests.  The mast stands vertical (base frame fixed,

@@ -1,6 +1,6 @@
 """The Rocaspect mast with the shrouds' loading/unloading law: a hysteresis loop of the mast top.
 
-    python benchmarks/guyed_shroud_hysteresis.py [--eta 0.05 0.1] [--force 400] [--out DIR] [--docs]
+    python -m femast.benchmarks.guyed_shroud_hysteresis [--eta 0.05 0.1] [--force 400] [--out DIR] [--docs]
 
 The Rocaspect paper (Sec. IV-A, Fig. 4a) finds "a significant difference between loading and
 unloading the shroud" and fits its polynomial to the average.  ``MastFE(shroud_hysteresis=eta)``

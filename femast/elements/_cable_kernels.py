@@ -1,4 +1,4 @@
-"""numba kernels of the cable/pulley/latch element (seed 001, Eqs. 2-5 and 14).
+"""numba kernels of the cable/pulley/latch element (Stohlman & Pellegrino, Eqs. 2-5 and 14).
 
 Private module: the public face is :mod:`femast.elements.cable_latch`.
 
@@ -47,7 +47,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..latch import latch_dT_scalar, latch_opening_scalar
+from .latch_law import latch_dT_scalar, latch_opening_scalar
 
 STICK = 0
 SLIP_OUT = 1

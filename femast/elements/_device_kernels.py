@@ -1,4 +1,4 @@
-"""numba kernel of the cable over an ordered list of devices (issue 19; seed 001 Sec. II.B.2).
+"""numba kernel of the cable over an ordered list of devices (Stohlman & Pellegrino, Sec. II.B.2).
 
 Private module: the public face is :mod:`femast.elements.cable_devices`.
 
@@ -165,7 +165,7 @@ def _newton(S, L, phi, EA, L0, kinds, P, modes, targets, smax, bufs):
                 S[d + 1] += dS[d]
             _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi, T, dT_dl0, de_dl0, e)
             return 0
-        # sliding latches: the first equilibrium in the direction of motion (seed 001 Sec. II.B.2).
+        # sliding latches: the first equilibrium in the direction of motion (Stohlman & Pellegrino, Sec. II.B.2).
         # Per device a bracket [back, front] along the motion: back = the furthest point where the
         # device is still pushed, front = the nearest where it is pushed back; Newton steps are kept
         # inside it and below one grid cell, else a cell forward (front unknown) or bisection.

@@ -1,4 +1,4 @@
-"""Device laws of a cable over devices (issue 19; seed 001 Sec. II.B.2, Eq. 5): the numba side.
+"""Device laws of a cable over devices (Stohlman & Pellegrino, Sec. II.B.2, Eq. 5): the numba side.
 
 Private module: the public face is :mod:`femast.elements.cable_devices`.
 
@@ -30,8 +30,8 @@ Built-in laws:
   cos phi)`` of the two tensions holds the torque ``(T_out - T_in) r``:
   ``r = T_out - T_in - sigma rho |F|`` with ``rho = mu_b r_pin / r``; the band is
   ``|T_out - T_in| <= rho |F|``;
-* latch (seed 001 Eqs. 5, 14): ``r = T_out - T_in - dT_sigma(x)``, ``x = Lb - s``; the backstop
-  bounds ``s <= Lb + x_backstop``.  Optional hysteresis as in :mod:`femast.latch`, and the bearing
+* latch (Stohlman & Pellegrino, Eqs. 5, 14): ``r = T_out - T_in - dT_sigma(x)``, ``x = Lb - s``; the backstop
+  bounds ``s <= Lb + x_backstop``.  Optional hysteresis as in :mod:`femast.elements.latch_law`, and the bearing
   friction of a sheave at the same node (ADAM's pulley-and-latch unit): ``- sigma rho |F|`` more.
 
 Frictionless pulleys (equal strains on both sides, which is equal tensions when taut and a
@@ -49,7 +49,7 @@ from ._cable_kernels import branch_scalar_mu
 
 FREE = 0  # frictionless pulley
 CAPSTAN = 1  # pulley with Coulomb friction (capstan law)
-LATCH = 2  # roller latch of seed 001
+LATCH = 2  # roller latch of Stohlman & Pellegrino
 CLAMP = 3  # fixed clamp: no sliding
 USER = 4  # a user law
 SHEAVE = 5  # sheave turning on a pin with bearing friction
@@ -123,7 +123,7 @@ def s_max_of(kind, p):
 def max_step(kind, s, p):
     """Largest change of s (m) in one Newton step of a sliding device: inside a latch's roller
     contact zone, one cell of the grid the single-latch element marches on (so the bead stops at
-    the *first* equilibrium in its direction of motion, seed 001 Sec. II.B.2); else +inf."""
+    the *first* equilibrium in its direction of motion, Stohlman & Pellegrino, Sec. II.B.2); else +inf."""
     if kind == LATCH:
         r = p[0]
         h = p[4]

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
-from ..latch import LatchParameters, _as_param_array, validate_latch_array
 from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, LATCH_MU_K, LATCH_RHO, N_PARAM, SHEAVE, USER
+from .latch_law import LatchParameters, _as_param_array, validate_latch_array
 
 
 @dataclass(frozen=True)
@@ -122,13 +122,13 @@ def _sheave_params(dev, k, name, p):
 
 @dataclass(frozen=True)
 class Latch:
-    """A roller latch of seed 001 (Eqs. 5, 14) at a node; the bead is on the cable.
+    """A roller latch of Stohlman & Pellegrino (Eqs. 5, 14) at a node; the bead is on the cable.
 
-    params : :class:`~femast.latch.LatchParameters` (default the seed's fit).
+    params : :class:`~femast.elements.latch_law.LatchParameters` (default the seed's fit).
     bead : material coordinate Lb of the bead, m (unstretched length from node 0); ``None`` with
         :meth:`CableDeviceFamily.pretensioned` puts it at ``x0`` in the initial geometry.
     x0 : initial bead position, m (default ``-x_backstop``: latched, on the backstop).
-    hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.latch` (N, m).
+    hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.elements.latch_law` (N, m).
     mu_s, mu_k : static and kinetic friction between rollers and bead (default both ``params.mu``,
         the paper's one coefficient): the static band of Eq. 14 uses mu_s, a sliding bead mu_k.
     sheave : a :class:`Sheave` at the same node (the pulley of ADAM's pulley-and-latch unit): its
@@ -255,6 +255,7 @@ def set_device_values(P, kinds, devices, values, name):
             idx, scale = cols[nm]
             for i in idx:
                 P[:, k, i] = arr * scale
+        c = dev.pin_radius / dev.radius if isinstance(dev, Sheave) and kinds[k] == SHEAVE else 1.0  # rho per mu
         for el in range(n_el):  # construction only, not a hot path
             where = f"{name} device {k} ({type(dev).__name__}), element {el}"
             if isinstance(dev, Latch):
@@ -267,11 +268,16 @@ def set_device_values(P, kinds, devices, values, name):
             else:
                 mu_k, mu_s = P[el, k, 0], P[el, k, 1]
                 if not (np.isfinite(mu_s) and mu_s > 0.0):
-                    raise ModelError(f"{where}: mu must be finite and > 0 (got {mu_s!r} for the law)")
+                    raise ModelError(f"{where}: mu (mu_s) must be finite and > 0 (got {mu_s / c:.6g})")
                 if kinds[k] == SHEAVE and not mu_s < 1.0:
-                    raise ModelError(f"{where}: mu pin_radius / radius = {mu_s!r} must be < 1")
+                    raise ModelError(
+                        f"{where}: mu pin_radius / radius = {mu_s:.6g} must be < 1 (mu = {mu_s / c:.6g}; "
+                        "a bearing's journal friction is well below 1)"
+                    )
             if not (np.isfinite(mu_k) and 0.0 <= mu_k <= mu_s):
-                raise ModelError(f"{where}: kinetic mu_k must lie in [0, mu_s] (static {mu_s!r}, kinetic {mu_k!r})")
+                raise ModelError(
+                    f"{where}: kinetic mu_k must lie in [0, mu_s] (static {mu_s / c:.6g}, kinetic {mu_k / c:.6g})"
+                )
 
 
 __all__ = [

@@ -1,5 +1,5 @@
 """A cable over an ordered list of devices: pulleys (frictionless), sheaves with bearing friction,
-capstan drums, latches, clamps and user devices (seed 001 Sec. II.B.2, Eqs. 2-5).
+capstan drums, latches, clamps and user devices (Stohlman & Pellegrino, Sec. II.B.2, Eqs. 2-5).
 
 Seed 001 writes the cable element for a cable over any number of pulleys, latches or other
 devices, each with its own law for the jump ``Delta T_i = T_{i+1} - T_i``.  One element here is
@@ -151,7 +151,7 @@ class CableDeviceFamily(ElementFamily):
         its bead: s = Lb - x0).  Use :meth:`pretensioned` to get them from a geometry.
     device_values : per-element device parameters (scatter per latch or pulley), a dict
         ``{device index: {parameter: value or (n_el,) values}}``; parameters of a Latch: r,
-        x_backstop, k, mu, h, R (SI, :class:`~femast.latch.LatchParameters`), hysteresis_force,
+        x_backstop, k, mu, h, R (SI, :class:`~femast.elements.latch_law.LatchParameters`), hysteresis_force,
         hysteresis_length, mu_s, mu_k; of a Drum (capstan Pulley) and of a Sheave with friction: mu,
         mu_s, mu_k (``mu`` sets both).  Each element's values are validated.
     length_error : lack of fit per section, m, (n_el, n) or (n,) (default 0): the cable in section

@@ -1,9 +1,9 @@
-"""Cable over pulleys and a latch: the user element of seed 001, Section II.B.2 (Eqs. 2-5).
+"""Cable over pulleys and a latch: the user element of Stohlman & Pellegrino, Section II.B.2 (Eqs. 2-5).
 
 One element is one continuous cable divided into n straight sections by n+1
 anchor nodes.  Each interior node is a frictionless pulley, except (optionally)
 one, the *latch node*, where the cable passes through a roller latch that grips a
-bead fixed on the cable (latch law: :mod:`femast.latch`, Eqs. 6-14).  The element
+bead fixed on the cable (latch law: :mod:`femast.elements.latch_law`, Eqs. 6-14).  The element
 solves its 2n equations (n tensions, n unstretched lengths) internally and returns
 the nodal forces and the consistent tangent; see ``docs/cable_latch_element.md``.
 
@@ -43,7 +43,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
-from ..latch import LatchParameters, _as_param_array, latch_zone, validate_latch_array
 from ._cable_kernels import (
     BACKSTOP,
     ERR_BEAD_OFF_CABLE,
@@ -56,6 +55,7 @@ from ._cable_kernels import (
 )
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput, chain_nodes
 from .cable_latch_equations import cable_equations
+from .latch_law import LatchParameters, _as_param_array, latch_zone, validate_latch_array
 
 STATUS_NAMES = {STICK: "stick", SLIP_OUT: "slip out", SLIP_IN: "slip in", BACKSTOP: "backstop"}
 
@@ -115,7 +115,7 @@ def _kinetic(mu_k, latch, has, name):
 
 
 class CableLatchFamily(ElementFamily):
-    """A batch of cable/pulley/latch elements (seed 001, Eqs. 2-5 and 14), all with n sections.
+    """A batch of cable/pulley/latch elements (Stohlman & Pellegrino, Eqs. 2-5 and 14), all with n sections.
 
     Parameters
     ----------
@@ -126,7 +126,7 @@ class CableLatchFamily(ElementFamily):
         (every interior node is then a frictionless pulley and the element is a cable
         over pulleys).  Scalar or per element (0 = no latch).
     bead : material coordinate Lb of the bead, m (unstretched length from node 0), Eq. 5.
-    latch : :class:`~femast.latch.LatchParameters` (or (n_el, 6) array, SI); default the seed's fit.
+    latch : :class:`~femast.elements.latch_law.LatchParameters` (or (n_el, 6) array, SI); default the seed's fit.
     x0 : initial bead position, m (default ``-x_backstop``: latched, against the backstop).
     max_strain : largest cable strain accepted in a committed configuration; beyond it the
         total unstretched length is reported as too short (default 0.1).
@@ -134,14 +134,14 @@ class CableLatchFamily(ElementFamily):
         element; default 0: off, the seed's law).  Near the latched state the static band
         widens to ``[dT_in - H, dT_out + H]`` and a sliding bead follows the widened branches,
         ``H = hysteresis_force * w(x)``, ``w = 1`` on the backstop fading to 0 at the roller axis
-        over ``hysteresis_length`` (see :func:`femast.latch.hysteresis_force`).
+        over ``hysteresis_length`` (see :func:`femast.elements.latch_law.hysteresis_force`).
     mu_k : kinetic friction between rollers and bead (scalar or per element; default None: the
         latch's ``mu``, the paper's one coefficient).  With ``mu_k < mu`` the latch's ``mu`` is the
         static coefficient: a bead at rest starts to slide when the jump leaves the band of Eq. 14
         at ``mu``, slides on along Eq. 14 at ``mu_k``, and grips again when it stops or reverses.
     length_error : lack of fit per section, m, shape (n_el, n) or (n,) (default 0): the cable
         that runs in section i is ``length_error[:, i]`` longer than its nominal unstretched length
-        (issue 20).  Their sum lengthens the cable (L0); those of the sections before the latch
+        (a lack of fit).  Their sum lengthens the cable (L0); those of the sections before the latch
         node move the bead along the cable (Lb).  A pretensioned cable over frictionless pulleys
         with a section too short by d then gains ``EA d / L0`` of tension (on rigid anchors).
     name : label used in messages and results.

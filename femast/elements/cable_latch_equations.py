@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..latch import hysteresis_force as hysteresis_force_law
-from ..latch import latch_force
 from ._cable_kernels import BACKSTOP, SLIP_OUT, STICK
+from .latch_law import hysteresis_force as hysteresis_force_law
+from .latch_law import latch_force
 
 
 def cable_equations(
@@ -26,7 +26,7 @@ def cable_equations(
     hysteresis_force=0.0,
     hysteresis_length=3e-4,
 ):
-    """Residuals of the 2n equations of one element (seed 001, Eqs. 2-5), for checking a solution.
+    """Residuals of the 2n equations of one element (Stohlman & Pellegrino, Eqs. 2-5), for checking a solution.
 
     X : (n+1, 3) anchor positions, m.  T : (n,) tensions, N.  L0_sections : (n,) unstretched
     lengths, m.  status : latch status (stick/backstop: the latch row is x - x_committed, m;

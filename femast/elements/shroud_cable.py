@@ -1,4 +1,4 @@
-"""Tension-only Dyneema shroud cable: two nodes, the tension-dependent rope law of seed 000 (Eq. 25).
+"""Tension-only Dyneema shroud cable: two nodes, the tension-dependent rope law of the Rocaspect paper (Eq. 25).
 
 One element is a straight rope between two end points.  Each end point may sit on a
 *rigid offset* from its node (a lever rigidly attached to the node, as the seed's
@@ -9,7 +9,7 @@ shroud attachment points C_ir are rigidly attached to the mast top C_i3):
 with R_a the node's total rotation.  Without offsets the element is a plain cable with
 translational DOFs only.
 
-Axial law (seed 000, Eqs. 25, 27, as corrected in :mod:`femast.elements.shroud_law`).  The strain is
+Axial law (the Rocaspect paper, Eqs. 25, 27, as corrected in :mod:`femast.elements.shroud_law`).  The strain is
 measured from the unstretched length L0, ``eps = l / L0 - 1``, and the tension is the root of
 ``tau = g(tau) eps`` with ``g = k0 + k1 tau + k2 tau^2`` (k0 in N, k1 dimensionless, k2 in 1/N):
 
@@ -42,7 +42,7 @@ Construction: :class:`ShroudCableFamily` takes the unstretched lengths; :func:`a
 adds shrouds to a :class:`~femast.model.Model` given either the unstretched length or the
 tension that each carries in the model's initial geometry.
 
-Sources of error (issue 20, as the cable families of :mod:`femast.model.thermal`): a *length error*
+Sources of error (as the cable families of :mod:`femast.model.thermal`): a *length error*
 dL per rope (lack of fit, m; ``length_error=``, :meth:`ShroudCableFamily.set_length_errors`) makes it
 stress free at ``L0 + dL``; a thermal strain scales that by the ``length_factor``
 ``s = 1 + alpha (T - T_init)`` the analysis writes from a step's temperatures
@@ -105,7 +105,7 @@ def _per_element(value, n_el, name, what):
 
 
 class ShroudCableFamily(ElementFamily):
-    """A batch of tension-only Dyneema ropes (seed 000, Eq. 25), optionally on rigid end offsets.
+    """A batch of tension-only Dyneema ropes (the Rocaspect paper, Eq. 25), optionally on rigid end offsets.
 
     Parameters
     ----------

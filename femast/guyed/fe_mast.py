@@ -1,4 +1,4 @@
-"""The Rocaspect mast in the FE core, checked against the analytic complete-mast model (seed 000, item 3 of issue 6).
+"""The Rocaspect mast in the FE core, checked against the analytic complete-mast model (the Rocaspect paper).
 
 Model (SI units)
 ----------------
@@ -12,7 +12,7 @@ Model (SI units)
     ``e_r = C_ir - C_i3`` of the top node, so the top is the rigid body the seed's model assumes.
   - ``attach="wall"``: shrouds 1 and 2 are tied to a beam node 0.25 m below the top through a 0.05 m
     rigid offset to the tube wall (the physical mast); the top segment of the tube is then flexible.
-* Sources of error (issue 20): ``length_error`` (m, per shroud) cuts the shrouds that much longer
+* Sources of error: ``length_error`` (m, per shroud) cuts the shrouds that much longer
   than the pretension asks (lack of fit; negative: shorter, tighter); ``temperature_change_K`` heats
   the shrouds and the tube by dT in a step ``"thermal"`` after the pretension, with the expansion
   coefficients ``shroud_alpha_per_K`` and ``beam_alpha_per_K`` (1/K; the seed gives none: Dyneema
@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..analysis import Analysis
-from ..analysis.solvers.convergence import Convergence
+from ..analysis.convergence import Convergence
 from ..elements.shroud_cable import ShroudCableFamily, unstretched_length
 from ..elements.shroud_law import DyneemaLaw
 from ..errors import ModelError

@@ -1,4 +1,4 @@
-"""Prestressed modal analysis (issue 18) about a converged state of a static analysis.
+"""Prestressed modal analysis about a converged state of a static analysis.
 
 At a converged state the small vibrations u(t) = phi sin(omega t) obey
 
@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.solvers.convergence import force_moment_abs_max
+from ..analysis.convergence import force_moment_abs_max
 from ..elements.base import IncrementContext
 from ..errors import ModelError, StateError
 from .eigen import default_shift, solve_eigen
@@ -135,7 +135,7 @@ class Modes:
 def _state(analysis):
     """(K_ff, residual on the free DOFs, reference force, reference moment) at the analysis'
     current configuration and committed state."""
-    sys_ = getattr(analysis, "system", None)  # the analysis package of issue 15: System holds the assembly
+    sys_ = getattr(analysis, "system", None)  # the analysis package: System holds the assembly
     if sys_ is not None:
         responses = sys_.evaluate(sys_.committed_context())
         res = sys_.residual(responses, analysis.loads)

@@ -10,8 +10,8 @@ from scipy.optimize import brentq
 
 from femast.elements.base import IncrementContext
 from femast.elements.cable_devices import CableDeviceFamily, Drum, Latch, Sheave
+from femast.elements.latch_law import LatchParameters
 from femast.errors import ModelError
-from femast.latch import LatchParameters
 
 EA = 1.0e5  # N
 T0 = 100.0  # N

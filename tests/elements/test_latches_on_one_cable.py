@@ -10,7 +10,7 @@ import pytest
 import femast as fm
 from femast.elements.base import IncrementContext
 from femast.elements.cable_devices import CableDeviceFamily, Latch
-from femast.latch import LatchParameters
+from femast.elements.latch_law import LatchParameters
 
 EA_CABLE = 2.0e4  # N
 T0 = 5.0  # N

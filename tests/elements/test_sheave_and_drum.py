@@ -163,6 +163,22 @@ def test_per_element_sheave_friction():
     assert q[1] == pytest.approx(sheave_ratio(0.02, math.pi / 2, 1), rel=1e-12)
 
 
+@pytest.mark.parametrize(
+    "values, words",
+    [
+        ({"mu_s": [0.3, 0.2], "mu_k": [0.1, 0.25]}, r"element 1: kinetic mu_k .* \(static 0\.2, kinetic 0\.25\)"),
+        ({"mu": [0.3, 6.0]}, r"element 1: mu pin_radius / radius = 1\.2 must be < 1 \(mu = 6;"),
+        ({"mu": [0.0, 0.3]}, r"element 0: mu \(mu_s\) must be finite and > 0 \(got 0\)"),
+    ],
+)
+def test_per_element_sheave_friction_errors_quote_the_users_mu(values, words):
+    # the family stores rho = mu r_pin / r (here 0.2 mu); its messages speak of the mu the user gave
+    with pytest.raises(ModelError, match=words):
+        CableDeviceFamily.pretensioned(
+            [[0, 1, 2], [0, 1, 2]], X90, EA, 100.0, [Sheave(0.05, 0.01, 0.3, point=True)], device_values={0: values}
+        )
+
+
 def test_docs_page_quotes_what_the_example_prints(tmp_path, capsys):
     import re
 
@@ -188,7 +204,7 @@ def test_latch_with_the_bearing_of_its_unit_sheave():
     """ADAM's pulley-and-latch unit: a latch and a sheave at one node.  A sliding bead's jump is Eq. 14
     plus the bearing's rho |F|; out of the rollers' reach the unit is a sheave (closed form above)."""
     from femast.elements.cable_devices import Latch
-    from femast.latch import LatchParameters
+    from femast.elements.latch_law import LatchParameters
 
     p = LatchParameters.seed_fit()
     sheave = Sheave(0.01, 0.002, 0.3, point=True)
