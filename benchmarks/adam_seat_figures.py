@@ -46,7 +46,7 @@ def bay_figures(seat: str, max_increment: float) -> str:
 def table1(seat: str, n_bays: int, cycles: int):
     am = build_mast(n_bays, BayParameters(seat=seat))
     add_initial_steps(am)
-    add_table1_steps(am, cycles=cycles)
+    add_table1_steps(am, cycles=cycles, increments=1)  # one increment per step, as docs/adam_mast.md's table
     with tempfile.TemporaryDirectory() as out:
         an = fm.Analysis(am.model, out, progress=False, convergence=CONVERGENCE)
         labels, values = tip_table(an.run(), am)
