@@ -110,9 +110,16 @@ def _info(args):
             f"cutbacks {s.get('cutbacks', 0)}, wall time {s.get('wall_time', 0.0):.2f} s"
         )
         for st in s.get("steps", []):
-            print(f"  step {st['name']}: {st['increments']} increments, {st['iterations']} iterations")
+            if "frequencies_hz" in st:
+                print(f"  step {st['name']}: modes at {', '.join(f'{f:.4g}' for f in st['frequencies_hz'])} Hz")
+            else:
+                print(
+                    f"  step {st['name']}: {st.get('increments', 0)} increments, {st.get('iterations', 0)} iterations"
+                )
         if s.get("message"):
             print(f"  {s['message']}")
+    else:
+        print("  status: unknown (no readable summary.json)")
 
 
 class _Help(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):

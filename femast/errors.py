@@ -44,5 +44,10 @@ class ResultsWriteError(FemastError, OSError):
     run stops at the frame that could not be written and its summary says "failed"."""
 
 
+class FolderInUseError(FemastError):
+    """A results (or history) folder is being written by another femast run: two writers would mix
+    their frames, so the second is refused; the message names the folder and the other process."""
+
+
 class SampleTimeout(FemastError):
     """A sample of a study ran longer than the study's ``timeout_s`` (it is recorded as failed)."""

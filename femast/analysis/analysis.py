@@ -25,10 +25,11 @@ from ..jit import prepare as prepare_kernels
 from ..model import validation
 from ..model.thermal import FieldLoads, check_controls, has_fields
 from ..post.results import Results, run_outcome
+from ..post.writer import lock_folder
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
-from .restart import RestartOutput, load_restart, restart_folder, restore
+from .restart import RestartOutput, load_restart, require_point, restart_folder, restore
 from .solvers.convergence import Convergence
 from .state import State
 from .stepping import run_step
@@ -236,8 +237,13 @@ class Analysis:
         """Run all steps; returns the :class:`Results` of the folder, or None with ``out=None``."""
         t0 = _time.perf_counter()
         ti = None
+        self.folder_lock = None
         try:
             first = 0
+            if self.out is not None:  # one writer per folder, taken before a restart point is read
+                if self.restart is not None:
+                    require_point(self.restart)  # (no folder is made for a restart that has nothing to read)
+                self.folder_lock = lock_folder(self.out)
             if self.restart is not None:
                 self.resume = load_restart(self.restart, self)  # None: the point is the start
                 if self.resume is not None:
@@ -267,8 +273,12 @@ class Analysis:
         finally:
             self.summary.increment_time = _time.perf_counter() - ti if ti is not None else 0.0
             self.summary.wall_time = _time.perf_counter() - t0
-            for obs in self.observers:
-                obs.finished(self)
+            try:
+                for obs in self.observers:
+                    obs.finished(self)
+            finally:
+                if self.folder_lock is not None:
+                    self.folder_lock.release()
             if self.progress:
                 tqdm.write(str(self.summary))
         return None if self.out is None else Results(self.out)
