@@ -31,6 +31,7 @@ import json
 import os
 import socket
 import stat
+import time
 from pathlib import Path
 
 from ..errors import FemastError, FolderInUseError
@@ -111,13 +112,14 @@ def remove_own(path) -> bool:
     return True
 
 
-def open_write(path, append: bool = False, truncate: bool = False) -> int:
+def open_write(path, append: bool = False, truncate: bool = False, read: bool = False) -> int:
     """A file descriptor of regular file ``path`` opened for writing (created if missing; appended to
-    with ``append``; emptied with ``truncate``), never through a symbolic link, never a FIFO or device."""
+    with ``append``; emptied with ``truncate``; readable too with ``read``), never through a symbolic
+    link, never a FIFO or device."""
     st = lstat_or_none(path)
     if st is not None and not stat.S_ISREG(st.st_mode):
         raise _refuse(path, st.st_mode, "writes")
-    flags = os.O_WRONLY | os.O_CREAT | _NOFOLLOW | _NONBLOCK | _BINARY
+    flags = (os.O_RDWR if read else os.O_WRONLY) | os.O_CREAT | _NOFOLLOW | _NONBLOCK | _BINARY
     flags |= (os.O_APPEND if append else 0) | (os.O_TRUNC if truncate else 0)
     fd = _open(path, flags, "writes")
     _regular_or_close(fd, path, "writes")
@@ -226,31 +228,41 @@ class FolderLock:
     :meth:`acquire` or FolderInUseError naming the folder and the pid that holds it; :meth:`release`.
     ``what`` names the folder in the message ("results folder", "history folder")."""
 
-    def __init__(self, folder, what: str = "results folder"):
+    def __init__(self, folder, what: str = "results folder", name: str = LOCK_NAME):
         self.folder = Path(folder)
         self.what = what
+        self.name = name
         self.fd = None
 
-    def acquire(self) -> FolderLock:
+    def acquire(self, wait_s: float = 0.0) -> FolderLock:
+        """Take the lock, waiting up to ``wait_s`` seconds for another holder to let it go."""
         if self.fd is not None or fcntl is None:
             return self
-        path = self.folder / LOCK_NAME
+        path = self.folder / self.name
         st = lstat_or_none(path)
         if st is not None and not stat.S_ISREG(st.st_mode):
             raise _refuse(path, st.st_mode, "locks")
         fd = _open(path, os.O_RDWR | os.O_CREAT | _NOFOLLOW | _NONBLOCK | _BINARY, "locks")
         _regular_or_close(fd, path, "locks")
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as exc:
-            holder = _holder(fd)
-            os.close(fd)
-            if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-                raise
-            raise FolderInUseError(
-                f"{self.what} '{self.folder}' is being written by another femast run ({holder}); wait for it to "
-                "end, or give this one another folder"
-            ) from None
+        deadline = time.monotonic() + wait_s
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except OSError as exc:
+                if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                    os.close(fd)
+                    raise
+                if time.monotonic() < deadline:
+                    time.sleep(0.02)
+                    continue
+                holder = _holder(fd)
+                os.close(fd)
+                waited = f" (waited {wait_s:g} s)" if wait_s else ""
+                raise FolderInUseError(
+                    f"{self.what} '{self.folder}' is being written by another femast run ({holder}){waited}; "
+                    "wait for it to end, or give this one another folder"
+                ) from None
         self.fd = fd
         try:  # who holds it, for the message of the next one (a full disk: the message says less)
             os.ftruncate(fd, 0)

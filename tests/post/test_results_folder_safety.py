@@ -109,9 +109,7 @@ def first_writer(tmp_path):
     script.write_text(_SLOW)
     out = tmp_path / "r"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([os.getcwd(), os.environ.get("PYTHONPATH", "")])}
-    p = subprocess.Popen(
-        [sys.executable, str(script), str(out), "slow"], env=env, stdout=subprocess.PIPE, text=True
-    )
+    p = subprocess.Popen([sys.executable, str(script), str(out), "slow"], env=env, stdout=subprocess.PIPE, text=True)
     try:
         deadline = time.time() + 300  # (a cold start compiles the kernels)
         for line in p.stdout:
@@ -169,6 +167,7 @@ def test_a_fifo_in_the_folder_is_refused_not_read(tmp_path, name):
         ({"status": "completed", "increments": 1.5}, "'increments' = 1.5 is not a whole number"),
         ("[" * 100_000 + "]" * 100_000, "the summary is not valid JSON"),
     ],
+    ids=["wall_time", "status", "steps", "increments", "deep"],
 )
 def test_femast_info_names_a_damaged_summary_in_one_line(tmp_path, capsys, summary, field):
     out = tmp_path / "r"
