@@ -23,7 +23,16 @@ from .analysis.solvers.arclength import ArcLength
 from .analysis.solvers.control import DisplacementControl, LoadControl
 from .analysis.solvers.convergence import Convergence
 from .analysis.solvers.stabilize import Stabilize
-from .errors import ConvergenceError, DataFileError, EquilibriumError, FemastError, ModelError, SingularModelError
+from .errors import (
+    ConvergenceError,
+    DataFileError,
+    EquilibriumError,
+    FemastError,
+    FolderInUseError,
+    ModelError,
+    ResultsWriteError,
+    SingularModelError,
+)
 from .model import Model
 from .model.amplitudes import Amplitude
 from .model.sections import Section, circular_solid, circular_tube, shear_modulus, square_solid, square_tube
@@ -52,6 +61,8 @@ __all__ = [
     "ConvergenceError",
     "DataFileError",
     "EquilibriumError",
+    "FolderInUseError",
+    "ResultsWriteError",
 ]
 __version__ = "0.1.0"
 
