@@ -25,6 +25,12 @@ class DataFileError(FemastError, ValueError):
     """A measured-data file is malformed."""
 
 
+class NonFiniteError(FemastError, FloatingPointError):
+    """An element family returned NaN or infinite internal forces.  Inside an increment it is a failed
+    attempt (a cutback: a too-large increment can drive a law out of its range); anywhere else (the
+    initial state, the end of a run) it stops the run, naming the family and the element."""
+
+
 class EquilibriumError(FemastError):
     """A converged increment whose reactions do not balance the applied loads (a lost load)."""
 

@@ -26,6 +26,7 @@ from ..model import validation
 from ..model.thermal import FieldLoads, check_controls, has_fields
 from ..post.results import Results, run_outcome
 from ..post.writer import lock_folder
+from .equilibrium import check_end_of_run
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
@@ -35,6 +36,17 @@ from .state import State
 from .stepping import run_step
 from .summary import AnalysisSummary
 from .system import System
+
+MIN_CUTBACK, MAX_CUTBACK = 1e-3, 0.9  # a factor of 1 (or NaN) never shrinks an increment: no end
+MAX_GROWTH = 10.0
+
+
+def _factor(value, name: str, lo: float, hi: float, why: str) -> float:
+    """``value`` as a finite float between ``lo`` and ``hi``, or a ModelError naming ``name`` and why."""
+    v = validation.number(value, f"Analysis: {name}")
+    if not lo <= v <= hi:
+        raise ModelError(f"Analysis: {name} = {v:g} must be between {lo:g} and {hi:g} ({why})")
+    return v
 
 
 class Analysis:
@@ -46,8 +58,10 @@ class Analysis:
 
     convergence : :class:`~femast.analysis.solvers.convergence.Convergence` (tolerances, max iterations).
     progress : show a tqdm progress bar per step.
-    cutback : factor applied to a failed increment (Abaqus: 0.25).
-    growth : factor applied after two easy increments (Abaqus: 1.5).
+    cutback : factor applied to a failed increment (Abaqus: 0.25), between 0.001 and 0.9.
+    growth : factor applied after two easy increments (Abaqus: 1.5), between 1 (no growth) and 10.
+    max_cutbacks : the most cutbacks of one step (1000): a step cut back that often gives up with a
+        ConvergenceError saying where, whatever its minimum increment.
     line_search : secant line search when a Newton step overshoots (load control): True, False, or
         "auto" (default): only when retrying an increment that failed, where plain Newton
         already went astray (a line search slows the easy increments down).
@@ -93,6 +107,7 @@ class Analysis:
         restart=None,
         restart_every: int | None = None,
         linear_solver: str = "auto",
+        max_cutbacks: int = 1000,
     ):
         prepare_kernels()  # first run: kernels compile in the background (femast.jit_background)
         self.model = model
@@ -105,10 +120,27 @@ class Analysis:
                 stacklevel=2,
             )
         self.convergence = convergence or Convergence()
+        self.convergence.validate()  # (fields may have been changed after construction)
         self.progress = progress
-        self.cutback = cutback
-        self.growth = growth
-        self.easy_iterations = easy_iterations
+        self.cutback = _factor(
+            cutback,
+            "cutback",
+            MIN_CUTBACK,
+            MAX_CUTBACK,
+            "a failed increment is retried this much smaller: 1 or more "
+            "never shrinks it, and the step would never end; Abaqus uses 0.25",
+        )
+        self.growth = _factor(
+            growth,
+            "growth",
+            1.0,
+            MAX_GROWTH,
+            "easy increments grow by this factor: below 1 every increment shrinks; Abaqus uses 1.5",
+        )
+        self.easy_iterations = validation.whole(easy_iterations, "Analysis: easy_iterations", minimum=1)
+        self.max_cutbacks = validation.whole(max_cutbacks, "Analysis: max_cutbacks", minimum=1)
+        if line_search not in (True, False, "auto"):
+            raise ModelError(f'Analysis: line_search = {line_search!r}; give True, False or "auto"')
         self.line_search = line_search
         self.extrapolate = extrapolate
         self.algorithm = Newton(self.convergence, line_search=line_search, tangent=tangent)
@@ -263,6 +295,7 @@ class Analysis:
                 else:
                     inside = self.resume is not None and k == self.resume["step"] and not self.resume["step_done"]
                     run_step(self, step, resume=self.resume if inside else None)
+            check_end_of_run(self)  # no result without equilibrium (equilibrium.py)
             self.summary.status, self.summary.completed = "completed", True
         except BaseException as exc:  # the summary says how the run ended (issue 16), then the error goes on
             self.summary.status, self.summary.message = run_outcome(exc)

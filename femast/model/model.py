@@ -162,7 +162,15 @@ class Step:
             v = _finite(
                 value, f"step '{self.name}': prescribed {name} on node {node}", "m" if name.lower()[0] == "u" else "rad"
             )
-            self.prescribed.append(Condition(node, _DOF_INDEX[name.lower()], v, amplitude))
+            dof = _DOF_INDEX[name.lower()]
+            for c in self.prescribed:
+                if int(c.node) == int(node) and c.dof == dof:
+                    unit = "m" if dof < 3 else "rad"
+                    raise ModelError(
+                        f"step '{self.name}': node {node} {DOF_NAMES[dof]} is prescribed twice in this step "
+                        f"({c.magnitude:g} {unit}, then {v:g} {unit}); give it one value (a later step may change it)"
+                    )
+            self.prescribed.append(Condition(node, dof, v, amplitude))
         return self
 
 
@@ -280,6 +288,14 @@ class Model:
         except (TypeError, ValueError, OverflowError):
             ok = False
         if not ok:
+            try:
+                fractional = float(label) != int(label) and not isinstance(label, (str, bytes, bool))
+            except (TypeError, ValueError, OverflowError):
+                fractional = False
+            if fractional:  # (2.7 is no label, and not node 2 either)
+                raise ModelError(
+                    f"{where}: node label {label!r} is not a whole number; give the label Model.node returned"
+                )
             known = self._node_labels
             hint = f"known labels {known[0]}..{known[-1]}" if known else "the model has no nodes yet"
             raise ModelError(f"{where}: unknown node {label!r} ({hint}); create it with model.node(x, y, z)")
@@ -312,10 +328,7 @@ class Model:
         n = validation.whole(n, f"beam {n1}-{n2}: number of elements n", minimum=1)
         a, b = self.xyz(n1), self.xyz(n2)
         L = float(np.linalg.norm(b - a))
-        if L <= 1e-12 * max(1.0, float(np.abs(a).max())):
-            raise ModelError(
-                f"beam {n1}-{n2}: nodes {n1} and {n2} coincide (length {L:g} m); a beam needs two distinct nodes"
-            )
+        validation.element_length(L, float(max(np.abs(a).max(), np.abs(b).max())), f"beam {n1}-{n2}", "beam", n1, n2)
         up_arr = np.asarray(up, dtype=object)
         if up_arr.shape != (3,):
             raise ModelError(f"beam {n1}-{n2}: up-vector {up!r} must be 3 numbers (a global direction)")
@@ -428,9 +441,9 @@ class Model:
         EA = _finite(EA, f"truss {n1}-{n2}: EA", "N")
         if EA <= 0:
             raise ModelError(f"truss {n1}-{n2}: EA = {EA} N must be positive")
-        L = float(np.linalg.norm(self.xyz(n2) - self.xyz(n1)))
-        if L <= 1e-12:
-            raise ModelError(f"truss {n1}-{n2}: nodes {n1} and {n2} coincide; a truss needs two distinct nodes")
+        a, b = self.xyz(n1), self.xyz(n2)
+        L = float(np.linalg.norm(b - a))
+        validation.element_length(L, float(max(np.abs(a).max(), np.abs(b).max())), f"truss {n1}-{n2}", "truss", n1, n2)
         if L0 is not None and pretension is not None:
             raise ModelError(f"truss {n1}-{n2}: give L0 or pretension, not both")
         if L0 is not None:
