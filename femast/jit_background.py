@@ -13,7 +13,7 @@ femast kernel by a :class:`_Hook` that
    first need, fed through a pipe) to compile the kernel for these argument types into numba's
    on-disk cache, and meanwhile runs the kernel's Python source (:func:`interpreted`) -- the same
    arithmetic in the same order on IEEE doubles, so the results are bit for bit those of the
-   compiled kernel (tests/test_jit_background.py);
+   compiled kernel (tests/analysis/test_jit_background.py);
 3. runs interpreted only while that is cheap: at most :data:`INTERPRET_MAX_ITEMS` array items in
    the arguments and the last interpreted call under :data:`INTERPRET_MAX_S` of CPU; for a larger
    model it waits for the worker if the worker has begun that kernel, and otherwise compiles it

@@ -7,7 +7,7 @@ mechanisms are written in other, equally physical functional forms (Dahl, Bouc-W
 Jenkins friction; tanh, Hertz and piecewise-linear contact; ...), so a diagnosis that only
 recognises femast's own parameterisation fails here.  Keeping it in ``benchmarks/`` makes the
 independence structural: nothing in ``femast`` can import it, it imports nothing from ``femast``
-(``tests/test_generalisation_generator.py`` checks the imports of every module), and it is not
+(``tests/experiments/test_generalisation_generator.py`` checks the imports of every module), and it is not
 part of the installed library, which has no use for fake data with hidden mechanisms.
 
 Modules (numpy only; ``gallery`` also draws with matplotlib):

@@ -36,7 +36,7 @@ Options of the algorithm: a secant line search (``line_search``) and the tangent
   peer masts that saves one factorisation in four or five with the same iterations
   (docs/performance.md).  A restart point keeps the configuration that factorisation was formed at
   (:meth:`Newton.reuse_configuration`), and a restarted run forms it again there, so that it
-  continues bit for bit as the uninterrupted run (tests/test_restart.py).
+  continues bit for bit as the uninterrupted run (tests/analysis/test_restart.py).
   ``"modified"`` and ``"quasi-newton"`` are not chosen
   automatically: on the peer masts (40-1000 bays) and the ADAM bay they need more iterations
   than they save factorisations, and they do not beat full Newton's time

@@ -15,7 +15,7 @@ line a frame of the 45-degree bend cost ~70 us at load 7 on 2 cores, a sixth of 
 and writes each frame by copying the block's byte views, the packed scalars and the element
 outputs into a copy of the layout.  A frame whose scalars or element outputs differ in type,
 dtype or shape from the first one's gets None, and the caller takes the general path.  The bytes
-are those of the general path (tests/test_frame_writer.py compares them).
+are those of the general path (tests/post/test_frame_writer.py compares them).
 """
 
 from __future__ import annotations

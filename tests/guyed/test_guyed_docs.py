@@ -19,7 +19,7 @@ def test_benchmark_accepts_a_fourth_model():
 
     import numpy as np
 
-    path = Path(__file__).resolve().parents[1] / "benchmarks" / "guyed_mast_models.py"
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "guyed_mast_models.py"
     spec = importlib.util.spec_from_file_location("guyed_mast_models", path)
     bench = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = bench  # dataclasses look their module up there

@@ -9,7 +9,7 @@ import pytest
 from femast.rotations import expm_so3
 from femast.testing import fd_tangent
 
-DOC = Path(__file__).resolve().parents[1] / "docs" / "user_elements.md"
+DOC = Path(__file__).resolve().parents[2] / "docs" / "user_elements.md"
 
 
 @pytest.fixture(scope="module")

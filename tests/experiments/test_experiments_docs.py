@@ -8,7 +8,7 @@ from doc_examples import printed_in, replay_transcript, run_python_blocks
 
 from femast.effects import list_effects, unregister_effect
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 
 

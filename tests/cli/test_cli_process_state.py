@@ -11,7 +11,7 @@ from pathlib import Path
 
 from femast.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_main_restores_the_collector(tmp_path, capsys):

@@ -5,7 +5,7 @@ Default suite (about a minute): the baselines are the issue-5 FE models (checked
 long files are subsampled, and one real hidden-effect diagnosis on a short twist path.  The full
 hidden-effect cases (one per effect, varied paths, noise levels and parameters; a null case and an
 out-of-library drift) take 1-3 minutes each and are marked ``slow``: ``pytest -m slow
-tests/test_experiments_fe.py``.
+tests/experiments/test_experiments_fe.py``.
 """
 
 import json
@@ -23,7 +23,7 @@ from femast.experiments.bay_torsion import bay_inputs, fe_rows
 from femast.experiments.synthetic import bay_torsion_data, bay_torsion_path, tip_cycle_data, tip_cycle_path
 from femast.experiments.tip_cycle import MOTION
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 BT = get_experiment("bay-torsion")
 N_SIGMA = 4.0  # identified effect parameters within 4 Jacobian standard errors (two-sided p ~ 6e-5)
 REL_TOL = 0.15  # ... and within 15 %: 41-61 samples, the hidden effects are 3-8x the noise (12 % seen at worst)

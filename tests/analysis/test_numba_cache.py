@@ -11,7 +11,7 @@ import pytest
 
 from femast import numba_cache
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 CALLER = textwrap.dedent("""
     from numba import njit

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 # The start of a child script that lists the kernels compiled in its own process (compiled_here).
 COMPILE_LISTENER = textwrap.dedent("""
     from numba.core import event

@@ -18,7 +18,7 @@ from femast.experiments.latch_pull import infer_side
 from femast.experiments.synthetic import latch_pull_data
 from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 from latch_rig import SeedLatch, paths, simulate, to_columns  # noqa: E402
 

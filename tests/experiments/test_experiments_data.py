@@ -10,7 +10,7 @@ from femast.errors import DataFileError, ModelError
 from femast.experiments import compare, diagnose, from_arrays, get_experiment, read_data, write_data
 from femast.experiments.synthetic import mast_top_data
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "femast" / "examples"
 MT = get_experiment("mast-top")
 HEADER = "fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_m,dy_m,dz_m"

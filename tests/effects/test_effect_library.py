@@ -22,7 +22,7 @@ from femast.errors import ModelError
 from femast.experiments import Parameter, get_experiment, list_experiments, predict
 from femast.experiments.synthetic import mast_top_data, mast_top_path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 REQUIRED = (
     "joint_clearance",
     "friction_hysteresis",
@@ -80,7 +80,7 @@ def test_applicability_of_the_built_in_effects():
         "pretension_loss",
     } <= mt
     assert {"latch_hysteresis", "friction_hysteresis", "stretch_error", "cable_hysteresis"} <= lp
-    # the FE experiments (their own tests: tests/test_experiments_fe.py)
+    # the FE experiments (their own tests: tests/experiments/test_experiments_fe.py)
     bt = {e.name for e in applicable_effects("bay-torsion")}
     tc = {e.name for e in applicable_effects("tip-cycle")}
     assert bt == {"ball_joint_friction", "latch_hysteresis", "pretension_loss", "off_axis_motion"}

@@ -335,7 +335,7 @@ def test_guyed_study_script_runs_its_samples(tmp_path):
     import femast.studies as st
     from femast.studies.cli import load_script
 
-    study = load_script(Path(__file__).resolve().parents[1] / "benchmarks" / "study_guyed.py")
+    study = load_script(Path(__file__).resolve().parents[2] / "benchmarks" / "study_guyed.py")
     s = st.run(study, tmp_path / "g", samples=2)
     assert s.complete and s.failed == 0 and s.ok == 10
     res = st.load(tmp_path / "g")
@@ -353,7 +353,7 @@ def test_platform_study_calibration_removes_the_static_lean_of_erroneous_shrouds
     from pathlib import Path
 
     ns = runpy.run_path(
-        str(Path(__file__).resolve().parents[1] / "benchmarks" / "study_guyed_platform.py"), run_name="__femast_study__"
+        str(Path(__file__).resolve().parents[2] / "benchmarks" / "study_guyed_platform.py"), run_name="__femast_study__"
     )
     rng = np.random.default_rng(0)
     dL, pre = rng.normal(0.0, 0.5e-3, 12), rng.normal(T0, 60.0, 12)

@@ -269,7 +269,7 @@ def test_docs_fe_example_runs_and_matches_its_printed_output():
     import re
     from pathlib import Path
 
-    text = (Path(__file__).resolve().parents[1] / "docs" / "guyed_masts.md").read_text()
+    text = (Path(__file__).resolve().parents[2] / "docs" / "guyed_masts.md").read_text()
     section = text.split("## The FE mast")[1].split("\n## ")[0]
     code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
     expected = re.search(r"Output:\n\n```\n(.*?)```", section, re.S).group(1).strip().splitlines()

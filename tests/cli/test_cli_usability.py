@@ -18,7 +18,7 @@ from femast.cli import build_parser, main
 from femast.effects import applicable_effects, list_effects
 from femast.experiments import get_experiment, list_experiments
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 # ------------------------------------------------------------------ progress

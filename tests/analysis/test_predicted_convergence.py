@@ -253,7 +253,7 @@ def test_a_stabilised_step_accepted_on_its_prediction_stays_within_the_tolerance
     """A viscously stabilised step of a truss model (translations only: no rotation field): the rule
     accepts an iterate early there too, each frame stays within disp_tol of the strict run's
     (times that increment's largest displacement), and the unstabilised step after it reaches the
-    equilibrium that scipy's fsolve gives for the two-bar system (tests/test_stabilize.py)."""
+    equilibrium that scipy's fsolve gives for the two-bar system (tests/analysis/test_stabilize.py)."""
     from test_stabilize import _exact_equilibrium, _guyed_mast
 
     tol = fm.Convergence().disp_tol
