@@ -126,7 +126,7 @@ def _small_residual(analysis, r, responses) -> None:
             eq = int(np.flatnonzero(mask)[np.argmax(np.abs(r[mask]))])
             raise EquilibriumError(
                 f"{_where(analysis)}: the completed run is not in equilibrium: a residual of {worst:.3g} {unit} at "
-                f"{sys_.dofmap.describe(eq)}, {worst / ref:.3g} of the force scale {ref:.3g} {unit} (at most "
-                f"{END_RATIO:g} allowed{' with the viscous forces' if extra else ''}): the convergence test accepted "
+                f"{sys_.dofmap.describe(eq)}, {100 * worst / ref:.3g} % of the force scale {ref:.3g} {unit} (at most "
+                f"{100 * END_RATIO:g} % allowed{' with the viscous forces' if extra else ''}): the convergence test accepted "
                 "increments that are not converged; tighten its tolerances (Convergence(force_tol=..., disp_tol=...))"
             )
