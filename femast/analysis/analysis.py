@@ -120,7 +120,8 @@ class Analysis:
                 stacklevel=2,
             )
         self.convergence = convergence or Convergence()
-        self.convergence.validate()  # (fields may have been changed after construction)
+        if hasattr(self.convergence, "validate"):  # (fields may have been changed after construction)
+            self.convergence.validate()
         self.progress = progress
         self.cutback = _factor(
             cutback,

@@ -52,6 +52,26 @@ def _abs_sum(a):
     return s
 
 
+def _shape_message(family, r, f_shape, k_shape) -> str:
+    """Why ``family``'s response ``r`` is refused: its f or k does not have the contract's shape."""
+    return (
+        f"element family '{family.name}' returned f of shape {np.shape(r.f)} and k of shape {np.shape(r.k)}; "
+        f"its {f_shape[0]} element(s) of {f_shape[1] // 6} nodes need f {f_shape} and k {k_shape} (6 DOFs per "
+        "node, femast/elements/base.py): fix the family's evaluate()"
+    )
+
+
+def _nonfinite_message(family, f, labels) -> str:
+    """Which element of ``family`` returned the non-finite forces ``f`` (node ``labels`` by row)."""
+    e = int(np.flatnonzero(~np.isfinite(np.asarray(f)).all(axis=1))[0])
+    label = int(family.labels[e]) if hasattr(family, "labels") else e + 1
+    nodes = ", ".join(str(labels[n]) for n in np.asarray(family.nodes)[e])
+    return (
+        f"element family '{family.name}' returned NaN or infinite internal forces for element {label} (nodes "
+        f"{nodes}); check its parameters, or its evaluate() for a user element, at that configuration"
+    )
+
+
 SHORT = 1e-6  # an element shorter than this fraction of the model's size swamps the tangent's conditioning
 
 
@@ -192,28 +212,11 @@ class System:
                 continue
             r = f.evaluate(x, R, s, ctx)
             if np.shape(r.f) != self._shapes[i][0] or np.shape(r.k) != self._shapes[i][1]:
-                raise ModelError(self._shape_message(f, r))
+                raise ModelError(_shape_message(f, r, *self._shapes[i]))
             if not all_finite(r.f):  # (compiled: numpy's isfinite + all cost ~2 us a call)
-                raise NonFiniteError(self._nonfinite_message(f, r.f))
+                raise NonFiniteError(_nonfinite_message(f, r.f, self._labels))
             responses.append(r)
         return responses
-
-    def _shape_message(self, family, r) -> str:
-        (f_shape, k_shape) = self._shapes[self.families.index(family)]
-        return (
-            f"element family '{family.name}' returned f of shape {np.shape(r.f)} and k of shape {np.shape(r.k)}; "
-            f"its {f_shape[0]} elements of {f_shape[1] // 6} nodes need f {f_shape} and k {k_shape} (6 DOFs per "
-            "node, femast/elements/base.py): fix the family's evaluate()"
-        )
-
-    def _nonfinite_message(self, family, f) -> str:
-        e = int(np.flatnonzero(~np.isfinite(np.asarray(f)).all(axis=1))[0])
-        label = int(family.labels[e]) if hasattr(family, "labels") else e + 1
-        nodes = ", ".join(str(self._labels[n]) for n in np.asarray(family.nodes)[e])
-        return (
-            f"element family '{family.name}' returned NaN or infinite internal forces for element {label} (nodes "
-            f"{nodes}); check its parameters, or its evaluate() for a user element, at that configuration"
-        )
 
     def nonfinite_tangent(self, responses):
         """Why a factorisation or solve failed, if an element tangent holds a NaN or inf (tested

@@ -48,6 +48,7 @@ from numba import njit
 from ...errors import ModelError, SingularModelError
 from . import backends
 from .ordering import entry_keys, permuted, permuted_positions, rcm, same_pattern, try_orderings
+from .pivots import PivotChecks
 
 try:  # scipy's SuperLU binding, called directly for the matrix refactorised every iteration
     from scipy.sparse.linalg._dsolve._superlu import gstrf as _gstrf
@@ -56,8 +57,6 @@ except ImportError:  # pragma: no cover - a scipy that moved it: splu is used in
 _DIRECT = {"gstrf": _gstrf}  # set to None if the binding's signature ever differs
 
 ORDERINGS = ("auto", "rcm", "mmd", "colamd")
-PIVOT_TOL = 1e-13  # a pivot this small against its DOF's stiffness (or column) is round-off: a mechanism
-EPS_TOL = 1e-16  # a pivot this small against the largest one is below double precision whatever its DOF
 BACKENDS = backends.NAMES
 _FLOAT_MAX = float(np.finfo(float).max)
 
@@ -90,7 +89,7 @@ def _unpermute(y, perm, x):
     return m
 
 
-class SparseLU:
+class SparseLU(PivotChecks):
     """Factorise once per iteration, solve for one or more right-hand sides.
 
     symmetric : every element family has a symmetric tangent (diagonal pivoting only).
@@ -364,95 +363,6 @@ class SparseLU:
             return True
         np.take(data[0], data[1], out=self._B.data)
         self._lu = self._timed(self._factor_permuted, self._B)
-        return False
-
-    def _guarded(self, step):
-        """Run ``step()`` (sets self._lu; True if the pattern was newly analysed) with SuperLU's
-        failures raised as SingularModelError, then the zero-pivot test when it is due.  A
-        factorisation that stopped at an exactly zero pivot is confirmed by SuperLU first
-        (:meth:`_confirm_singular`): another pivot sequence may well get through."""
-        try:  # SuperLU reports a singular matrix as RuntimeError (only spsolve warns instead)
-            analysed = step()
-        except RuntimeError as exc:
-            self._lu = None
-            if self._B is None or self._confirm_singular():
-                raise SingularModelError(str(exc)) from None
-            return
-        self._checked = False
-        if analysed or self.pivot_check == "always" or self._dmax is None:
-            self._check_pivots()
-
-    def _check_pivots(self):
-        """Zero-pivot test of the factorisation (scipy builds L and U as CSC matrices for SuperLU's:
-        ~10 % of a factorisation), judged on the model (module docstring): a pivot is suspect when it
-        is round-off against its own DOF's stiffness (|u_kk| <= PIVOT_TOL |B_kk|) or against the
-        largest pivot to double precision (|u_kk| <= EPS_TOL max |u|); a suspect factorisation is
-        confirmed by SuperLU's partial pivoting before the tangent is called singular."""
-        if self._lu is self._confirmed:  # SuperLU's, after a suspect factorisation: judged as then
-            if self._confirm_singular():
-                self._lu = None
-                raise SingularModelError("zero pivot in the LU factorisation")
-            return
-        pivots = getattr(self._lu, "pivot_magnitudes", None)
-        d = pivots() if pivots is not None else np.abs(self._lu.U.diagonal())
-        if d.size and self._suspect(d, self._diagonal()) and self._confirm_singular():
-            self._lu = None
-            raise SingularModelError("zero pivot in the LU factorisation")
-        if self._lu is not None and not self._checked:
-            self._dmax = float(np.max(d, initial=0.0))
-            self._checked = True
-
-    def _suspect(self, d, diag) -> bool:
-        """Pivots ``d`` (in B's column order, or any order if ``diag`` is None) that may be a
-        mechanism's: non-finite, round-off against their DOF's diagonal ``diag`` of B, or against
-        the largest pivot to double precision.  Without a per-DOF scale (back-ends that pivot in
-        their own order), the relative test against the largest pivot (PIVOT_TOL) is used."""
-        if not np.all(np.isfinite(d)):
-            return True
-        big = float(np.max(d))
-        if diag is None:
-            return float(np.min(d)) <= PIVOT_TOL * big
-        return bool(np.any(d <= np.maximum(PIVOT_TOL * diag, EPS_TOL * big)))
-
-    def _diagonal(self):
-        """|B_kk| of the matrix just factorised, in the order of its pivots, or None when the
-        back-end pivots in an order of its own (CHOLMOD, PARDISO)."""
-        engine = self._engine
-        if engine is not None and engine.name not in ("banded", "dense"):
-            return None
-        if self._band_input() and engine._from_band:
-            return np.abs(engine._L[0])  # (split band storage: row 0 of the lower part is B's diagonal)
-        return np.abs(self._B.diagonal())
-
-    def _values(self):
-        """B with the values just factorised (from the band storage when they were written there)."""
-        if self._band_input() and self._engine._from_band:
-            B = self._B.copy()
-            B.data = self._engine.band_values[self._engine.band_positions(np.arange(B.nnz))]
-            return B
-        return self._B
-
-    def _confirm_singular(self) -> bool:
-        """True if SuperLU with partial pivoting (COLAMD order, a row interchange whenever a
-        diagonal is below the column's largest entry) finds the tangent just factorised singular
-        too: it stops at an exactly zero pivot, or one of its pivots is round-off against the
-        largest entry of its column.  False: SuperLU's factorisation replaces the suspect one (a
-        stiffness contrast the first pivot sequence could not resolve is not a mechanism)."""
-        if self._B is None:
-            return True
-        B = self._values().tocsc()
-        try:
-            lu = spla.splu(B, permc_spec="COLAMD", diag_pivot_thresh=1.0)
-        except RuntimeError:
-            return True
-        u = np.abs(lu.U.diagonal())
-        colmax = np.abs(B).max(axis=0).toarray().ravel()[lu.perm_c]
-        if not np.all(np.isfinite(u)) or np.any(u <= PIVOT_TOL * colmax):
-            return True
-        self._lu = self._confirmed = lu  # (it solves B x = b like the factor it replaces)
-        self._dmax = float(np.max(u, initial=0.0))
-        self._checked = True
-        self.confirmations += 1
         return False
 
     def solve(self, rhs):
