@@ -1,7 +1,7 @@
-"""Time to first result on a fresh install (issue 17): the getting_started script and the main job
+"""Time to first result on a fresh install: the getting_started script and the main job
 (``benchmarks/verification.py``) with an empty numba cache, then again with the cache written.
 
-    python benchmarks/cold_start.py [--only getting_started|verification] [--warm] [--in-process]
+    python benchmarks/cold_start.py [--only getting_started|verification] [--warm]
 
 femast is copied (without any ``__pycache__``) into a temporary folder that comes first on
 ``PYTHONPATH``, and ``NUMBA_CACHE_DIR`` is unset, so numba writes its cache beside that copy as it
@@ -11,18 +11,15 @@ folder; its wall time and its CPU time (user + sys of the child and everything i
 ``resource.getrusage(RUSAGE_CHILDREN)``) are printed with the machine's load average, because
 on a shared machine the wall time grows with the load while the CPU time hardly does.
 
-By default femast compiles its kernels in a background worker (femast/jit_background.py) that
-outlives the script; the benchmark waits for it before the next run and prints its CPU time and
-when it finished (from its ``FEMAST_JIT_LOG``).  ``--in-process`` measures the old way
-(``FEMAST_BACKGROUND_COMPILE=0``: numba compiles in the script's process).
+numba compiles the kernels in the script's own process, in the foreground (its CPU time is the
+child's).
 
-Targets (issue 17): getting_started < 8 s and the main job < 15 s, cold.
+Targets: getting_started < 8 s and the main job < 15 s, cold.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import re
 import resource
@@ -64,25 +61,7 @@ def _run(cmd, env, cwd):
     return wall, cpu, p.returncode, (p.stderr or "")[-2000:]
 
 
-def _wait_for_workers(log: Path, src: Path, started: float, timeout_s: float = 900.0):
-    """(worker CPU s, s from the run's start to the last compile's end) once every background
-    worker that logged to ``log`` has finished and no compile claim is left in ``src``; (0, 0)
-    when none ran."""
-    t_end = time.time() + timeout_s
-    while True:
-        records = [json.loads(x) for x in log.read_text().splitlines()] if log.exists() else []
-        pids = {r["pid"] for r in records}
-        done = {r["pid"]: r for r in records if r.get("worker_done")}
-        claims = list(src.rglob("*.femast-compiling"))
-        if (set(done) >= pids and not claims) or time.time() > t_end:
-            break
-        time.sleep(0.2)
-    if not records:
-        return 0.0, 0.0
-    return sum(r["cpu_s"] for r in done.values()), max(r["time"] for r in records) - started
-
-
-def measure(case: str, warm: bool, in_process: bool = False) -> list[tuple]:
+def measure(case: str, warm: bool) -> list[tuple]:
     tmp = Path(tempfile.mkdtemp(prefix=f"femast_cold_{case}_"))
     try:
         src = _fresh_copy(tmp)
@@ -91,34 +70,21 @@ def measure(case: str, warm: bool, in_process: bool = False) -> list[tuple]:
         env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CACHE_DIR")}
         env["PYTHONPATH"] = str(src)
         env["MPLBACKEND"] = "Agg"
-        env["FEMAST_BACKGROUND_COMPILE"] = "0" if in_process else "1"
         if case == "getting_started":
             cmd = [sys.executable, str(_getting_started_script(run))]
         else:
             cmd = [sys.executable, str(ROOT / "benchmarks" / "verification.py"), "--out", str(run / "verification")]
         rows = []
         for label in ("cold", "warm")[: 2 if warm else 1]:
-            log = tmp / f"jit_{label}.jsonl"
-            env["FEMAST_JIT_LOG"] = str(log)
             load = os.getloadavg()[0]
-            started = time.time()
             wall, cpu, rc, err = _run(cmd, env, run)
             if rc not in (0,):
                 raise SystemExit(f"{case} ({label}) failed with exit code {rc}:\n{err}")
-            worker_cpu, worker_end = _wait_for_workers(log, src, started)
-            rows.append((label, wall, cpu, load, worker_cpu, worker_end))
+            rows.append((label, wall, cpu, load))
         n_index = sum(f.endswith(".nbi") for _, _, fs in os.walk(src) for f in fs)
-        print(
-            f"{case} (target < {TARGETS[case]:.0f} s cold; {n_index} numba index files written; "
-            f"{'compiled in the process' if in_process else 'background compile'}):"
-        )
-        for label, wall, cpu, load, worker_cpu, worker_end in rows:
-            extra = (
-                f"; background worker CPU {worker_cpu:5.1f} s, done {worker_end:5.1f} s after the start"
-                if worker_cpu
-                else ""
-            )
-            print(f"  {label:4s}: wall {wall:5.1f} s, CPU {cpu:5.1f} s (load {load:.1f}){extra}")
+        print(f"{case} (target < {TARGETS[case]:.0f} s cold; {n_index} numba index files written):")
+        for label, wall, cpu, load in rows:
+            print(f"  {label:4s}: wall {wall:5.1f} s, CPU {cpu:5.1f} s (load {load:.1f})")
         return rows
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
@@ -128,11 +94,6 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--only", choices=sorted(TARGETS), default=None, help="run one case (default: both)")
     ap.add_argument("--warm", action="store_true", help="also run each case a second time, cache written")
-    ap.add_argument(
-        "--in-process",
-        action="store_true",
-        help="compile in the script's process (FEMAST_BACKGROUND_COMPILE=0), as before the background worker",
-    )
     args = ap.parse_args(argv)
     print(
         f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}; femast from {ROOT / 'femast'} "
@@ -140,7 +101,7 @@ def main(argv=None):
     )
     verdict = []
     for case in [args.only] if args.only else ["getting_started", "verification"]:
-        (label, wall, cpu, load, worker_cpu, _), *_ = measure(case, args.warm, args.in_process)
+        (label, wall, cpu, load), *_ = measure(case, args.warm)
         verdict.append(
             f"{case}: cold {wall:.1f} s wall / {cpu:.1f} s CPU (load {load:.1f}), target < "
             f"{TARGETS[case]:.0f} s: "

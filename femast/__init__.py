@@ -14,7 +14,7 @@ Quick start::
 
 from . import _aliases, numba_cache
 
-numba_cache.check()  # delete numba caches whose njit helpers in other files changed (femast.numba_cache)
+numba_cache.configure()  # a source checkout: numba's cache in a folder keyed by the kernels' sources
 
 _aliases.install()  # the import paths of before the package move (issue 15) keep working
 
@@ -73,4 +73,4 @@ def __getattr__(name):  # fm.results, fm.sections...: the old top-level modules,
 
 from .jit import watch as _watch_compile
 
-_watch_compile()  # announce the first-run numba compile once (femast.jit)
+_watch_compile()  # announce the first-run numba compile once per process tree (femast.jit)

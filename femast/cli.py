@@ -91,7 +91,7 @@ def _render(args):
 
 
 def _warmup(args):
-    from .jit import warmup
+    from .warmup import warmup
 
     print("compiling (or loading from numba's cache) every femast kernel:")
     t = warmup()
@@ -239,26 +239,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None):
-    import gc
-
-    # one short process: collect young objects every 20 000 allocations instead of 700 (a bay-torsion
-    # diagnosis made ~400 collections, 0.2-0.5 s of its serial CPU; 15 with this; issue 21); the
-    # caller's thresholds come back at the end (main() called from Python: tests, notebooks)
-    thresholds, frozen = gc.get_threshold(), gc.get_freeze_count()
-    gc.set_threshold(max(thresholds[0], 20_000), 50, 100)
     import warnings
 
-    format_warning = warnings.formatwarning
+    from . import progress
+
+    format_warning, quiet = warnings.formatwarning, progress._QUIET
     warnings.formatwarning = _one_line_warnings(format_warning)
     try:
         return _main(argv)
-    finally:
+    finally:  # main() called from Python (tests, notebooks): the caller's settings come back
         warnings.formatwarning = format_warning
-        gc.set_threshold(*thresholds)
-        if argv is not None and not frozen:
-            # called from Python with its own arguments (not the `femast` command, which exits now):
-            # the heap that compare/diagnose froze for a quick exit goes back to the collector
-            gc.unfreeze()
+        progress.set_quiet(quiet)
 
 
 def _one_line_warnings(python_format):

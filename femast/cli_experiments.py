@@ -176,7 +176,6 @@ def _compare(args):
     exp, data, effects, out = _setup(args)
     res = compare(exp, data, effects, fit=args.fit, out=out)
     print(json.dumps(res.report, indent=2) if args.json else format_compare(exp, res))
-    _freeze_heap_for_exit()
 
 
 def _diagnose(args):
@@ -185,17 +184,6 @@ def _diagnose(args):
     exp, data, effects, out = _setup(args)
     res = diagnose(exp, data, base_effects=effects, workers=args.workers, scheduler=args.scheduler, out=out)
     print(json.dumps(res.report, indent=2) if args.json else format_diagnose(exp, res))
-    _freeze_heap_for_exit()
-
-
-def _freeze_heap_for_exit():
-    """The command's files are written and closed: move every object to the garbage collector's
-    permanent generation, so that the interpreter's shutdown does not search the whole heap (numba's
-    typing and code objects, matplotlib) for cycles -- 0.5-0.7 s of the bay-torsion diagnosis at a
-    load of 5, 0.1 s with this (issue 21).  Objects are still released by reference counting at exit."""
-    import gc
-
-    gc.freeze()
 
 
 def register(subparsers, fmt=None) -> None:

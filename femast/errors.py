@@ -57,3 +57,12 @@ class FolderInUseError(FemastError):
 
 class SampleTimeout(FemastError):
     """A sample of a study ran longer than the study's ``timeout_s`` (it is recorded as failed)."""
+
+
+class WorkerDied(FemastError):
+    """A worker process of a :class:`femast.workers.Pool` died running a task (killed, out of
+    memory, a crash in compiled code), or the pool was stopped before the task ran."""
+
+
+class TaskTimeout(FemastError, TimeoutError):
+    """A task of a :class:`femast.workers.Pool` ran over its time-out; its worker was killed."""

@@ -1,43 +1,39 @@
-"""The first-run compile of femast's numba kernels: a notice when it happens, and ``femast warmup``.
+"""numba kernels in the user's process: the first-run compile notice and the set-up kernels' plain-Python path.
 
-numba compiles each kernel the first time it is called and keeps it in its on-disk cache (beside
-the installed package, or in ``NUMBA_CACHE_DIR``); only kernels a model calls are compiled.  On a
-fresh install the first analysis therefore meets the compiler.  :func:`prepare` (called by every
-:class:`femast.Analysis`) hands that compile to a background worker process while small analyses
-run the kernels uncompiled (:mod:`femast.jit_background`), and prints once per process, only if
-something is actually being compiled, ::
+numba compiles each kernel the first time it is called and keeps it in its on-disk cache (see
+:mod:`femast.numba_cache` for where); only kernels a model calls are compiled.  On a fresh install
+(or after an update) the first analysis therefore meets the compiler, in the user's process, in
+the foreground.  The first time numba starts compiling a femast kernel, one notice goes to stderr
+for the whole process tree (a worker of :mod:`femast.workers` passes it on to its parent, which
+prints it once)::
 
-    femast: compiling femast kernels in a background process, first run only, ~12 s; small analyses
-    run uncompiled meanwhile (`femast warmup` compiles ahead)
+    femast: compiling femast's numba kernels, once after an install or an update (about 30 s of
+    CPU for a small model, 1-3 min for every element family); later runs load them from the
+    cache. `femast warmup` does it ahead.
 
-to stderr (or "compiling femast kernels, first run only, ~12 s" when numba compiles in the
-process: ``FEMAST_BACKGROUND_COMPILE=0``, kernels called outside an analysis); ``femast --quiet``
-or ``FEMAST_QUIET=1`` silences it.  The estimate is the sum of the measured cold-compile CPU times
-(:data:`COMPILE_S`) of the kernels of the loaded femast modules whose cache is missing.
-
-:func:`warmup` compiles every kernel ahead, in this process, by running small models of each
-element family (for CI images and cluster workers, whose first job should not pay for it).
+and, on a terminal, a bar counts the kernels compiled, naming the current one.  ``femast --quiet``
+or ``FEMAST_QUIET=1`` silences both.  ``femast warmup`` (:mod:`femast.warmup`) compiles every
+kernel ahead.
 """
 
 from __future__ import annotations
 
-import os
 import sys
 import threading
-import time
 
-# cold compile CPU time of the main kernels, s (numba 0.68, one core of the development machine,
-# recorded with numba's compile events; benchmarks/cold_start.py measures the whole first run).
-COMPILE_S = {
-    "femast.elements.beam_corot.beam_family_kernel": 8.5,  # 11-12 s before the end loops (issue 17)
-    "femast.analysis.configuration.update_configuration": 1.9,
-    "femast.rotations.apply_spins": 1.0,
-    "femast.analysis.solvers.convergence.force_moment_abs_max": 0.9,
-    "femast.rotations._rotation_vectors": 0.6,
-}
+NOTICE = (
+    "femast: compiling femast's numba kernels, once after an install or an update (about 30 s of CPU for a "
+    "small model, 1-3 min for every element family); later runs load them from the cache. "
+    "`femast warmup` does it ahead."
+)
 
-_announced = False
+_announced = False  # this process has claimed (or given up) the notice
 _installed = False
+_delegate = None  # in a worker process: passes the notice on to the parent
+_bar = None
+_depth = 0
+_compiled = 0
+
 
 # Set-up kernels (run once per analysis: assembly pattern, orderings, position maps) run as plain
 # Python on inputs up to this many items: a small model then never compiles them (nor queues them
@@ -104,97 +100,85 @@ def setup_call(kernel, n_items: int, *args):
     return _copy_result(hit)
 
 
-def _dispatchers():
-    """(qualified name, dispatcher) of every cacheable, non-inlined numba kernel of the loaded
-    femast modules."""
-    try:
-        from numba.core.registry import CPUDispatcher
-    except ImportError:  # pragma: no cover
-        return []
-    seen, out = set(), []
-    for mod_name, mod in list(sys.modules.items()):
-        if not mod_name.startswith("femast") or mod is None:
-            continue
-        for obj in list(vars(mod).values()):
-            if isinstance(obj, CPUDispatcher) and id(obj) not in seen:
-                seen.add(id(obj))
-                if obj.targetoptions.get("inline", "never") != "never" or getattr(obj, "_cache", None) is None:
-                    continue
-                if not obj.py_func.__module__.startswith("femast"):
-                    continue
-                out.append((f"{obj.py_func.__module__}.{obj.py_func.__name__}", obj))
-    return out
+def notice_to(send) -> None:
+    """In a worker process: instead of printing the notice, call ``send()`` once (the worker's pool
+    then has its parent print it, once for the whole process tree)."""
+    global _delegate
+    _delegate = send
 
 
-def uncached(dispatchers=None):
-    """Qualified names of the kernels (default: those of the loaded femast modules) with no
-    compiled code on disk yet."""
-    names = []
-    for name, d in dispatchers if dispatchers is not None else _dispatchers():
-        try:
-            index = d._cache._cache_file._index_path
-        except AttributeError:  # another numba cache layout: assume compiled
-            continue
-        if not os.path.exists(index) and not d.signatures:
-            names.append(name)
-    return names
-
-
-def estimate_s(names) -> float:
-    """Estimated compile time of ``names``, s: the measured costs of the big kernels (the small
-    ones, 0.2-0.4 s each, are not counted: a loaded module's kernel is not always called)."""
-    return sum(COMPILE_S.get(n, 0.0) for n in names)
-
-
-def _announce(background: bool = False) -> None:
-    """Print the compile notice once per process (unless quiet)."""
+def _claim() -> bool:
+    """True the first time in this process (this process prints, or passes on, the notice)."""
     global _announced
     if _announced:
-        return
+        return False
     _announced = True
-    from .progress import quiet
+    return True
 
-    if quiet():
+
+def announce(bar: bool = False) -> None:
+    """Print the compile notice (once per process, unless quiet) and, with ``bar``, open the bar of
+    the kernels this process compiles; in a worker, pass the notice on to the parent instead."""
+    global _bar
+    from . import progress
+
+    if not _claim():
         return
-    est = max(estimate_s(uncached()), 1.0)
-    if background:
-        print(
-            f"femast: compiling femast kernels in a background process, first run only, ~{est:.0f} s; "
-            "small analyses run uncompiled meanwhile (`femast warmup` compiles ahead)",
-            file=sys.stderr,
-            flush=True,
-        )
-    else:
-        print(
-            f"femast: compiling femast kernels, first run only, ~{est:.0f} s (`femast warmup` does it ahead)",
-            file=sys.stderr,
-            flush=True,
-        )
-
-
-def _on_compile(event):
-    if _announced or not event.is_start:
+    if _delegate is not None:
+        _delegate()
         return
+    if progress.quiet():
+        return
+    print(NOTICE, file=sys.stderr, flush=True)
+    if bar and progress.enabled():
+        _bar = progress.counter(None, "compiling femast kernels", unit="kernels")
+
+
+def _femast_kernel(event):
     try:
-        mod = event.data["dispatcher"].py_func.__module__
+        func = event.data["dispatcher"].py_func
     except (KeyError, AttributeError):
+        return None
+    return func.__name__ if func.__module__.startswith("femast") else None
+
+
+def _on_start(event) -> None:
+    global _depth
+    name = _femast_kernel(event)
+    if name is None:
         return
-    if mod.startswith("femast"):
-        _announce()
+    if not _announced:
+        announce(bar=True)
+    _depth += 1
+    if _bar is not None and _depth == 1:
+        _bar.set_postfix_str(name, refresh=True)
+
+
+def _on_end(event) -> None:
+    global _depth, _compiled
+    if _femast_kernel(event) is None:
+        return
+    _depth = max(0, _depth - 1)
+    _compiled += 1
+    if _bar is not None:
+        _bar.update(1)
+        if _depth == 0:
+            _bar.set_postfix_str("", refresh=True)
 
 
 def prepare() -> None:
-    """Before an analysis: the compile notice is armed and every loaded femast kernel compiles in a
-    background process on first use (:mod:`femast.jit_background`)."""
+    """Before an analysis: the compile notice is armed (:func:`watch`); an open kernel bar of an
+    earlier analysis is closed."""
+    global _bar
     watch()
-    from . import jit_background
-
-    jit_background._announce = lambda: _announce(background=True)
-    jit_background.install()
+    if _bar is not None and _depth == 0:
+        _bar.close()
+        _bar = None
 
 
 def watch() -> None:
-    """Print the compile notice the first time numba compiles a femast kernel in this process."""
+    """Print the compile notice the first time numba compiles a femast kernel in this process
+    (numba's compile events)."""
     global _installed
     if _installed:
         return
@@ -206,85 +190,9 @@ def watch() -> None:
 
     class _Listener(event.Listener):
         def on_start(self, ev):
-            _on_compile(ev)
+            _on_start(ev)
 
         def on_end(self, ev):
-            pass
+            _on_end(ev)
 
     event.register("numba:compile", _Listener())
-
-
-# --------------------------------------------------------------------------- warm-up
-def _warm_core():
-    """A beam + truss cantilever with a rigid body, a load step and an arc-length step."""
-    import femast as fm
-
-    m = fm.Model("warmup")
-    a = m.node(0.0, 0.0, 0.0)
-    b = m.node(1.0, 0.0, 0.0)
-    c = m.node(1.0, 0.5, 0.0)
-    m.beam(a, b, fm.circular_tube(0.03, 0.026, E=70e9), up=(0, 0, 1), n=4)
-    m.truss(b, c, EA=1e6)
-    m.fix(a)
-    m.fix(c)
-    m.step("load", initial_increment=0.5).load(b, fz=-10.0, mx=1.0)
-    fm.Analysis(m, None, progress=False, on_frame=lambda frame: None).run()
-
-
-def _warm_adam():
-    """The ADAM bay (cables over pulleys and latches, friction ball joints, joint springs, rigid
-    bodies and ties) through its preload and a short twist."""
-    import femast as fm
-    from femast.adam import build_bay
-    from femast.adam.steps import CONVERGENCE, add_idealised_torsion, add_initial_steps
-
-    am = build_bay()
-    add_initial_steps(am)
-    add_idealised_torsion(am, 0.01, max_increment=0.5, unload=False)
-    fm.Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=lambda frame: None).run()
-
-
-def _warm_guyed():
-    """The guyed mast of seed 000 with its shroud cables: pretension and one small wrench."""
-    from femast.guyed.fe_mast import MastFE
-
-    MastFE(400.0, n_beam=4).run_wrenches([[1.0, 0.0, 0.0, 0.0, 0.0, 0.0]])
-
-
-def _warm_laws():
-    """The latch law and the hysteresis operators of the effects, called from Python."""
-    import numpy as np
-
-    from femast.effects.operators import play, proportional_play
-    from femast.latch import latch_force
-
-    x = np.linspace(-1e-3, 1e-3, 5)
-    latch_force(x, 1.0, derivative=True)
-    play(x, 1e-4)
-    proportional_play(x, 0.1)
-
-
-PARTS = (
-    ("core: beams, trusses, solver", _warm_core),
-    ("ADAM bay: cables, latches, ball joints", _warm_adam),
-    ("guyed mast: shroud cables", _warm_guyed),
-    ("latch law and effect operators", _warm_laws),
-)
-
-
-def warmup(report=print) -> float:
-    """Compile (or load from the cache) every femast kernel in this process; returns the wall time, s."""
-    t_all = time.perf_counter()
-    before = os.environ.get("FEMAST_BACKGROUND_COMPILE")
-    os.environ["FEMAST_BACKGROUND_COMPILE"] = "0"  # compile here, not in a background worker
-    try:
-        for what, fn in PARTS:
-            t0 = time.perf_counter()
-            fn()
-            report(f"  {what}: {time.perf_counter() - t0:.1f} s")
-    finally:
-        if before is None:
-            del os.environ["FEMAST_BACKGROUND_COMPILE"]
-        else:
-            os.environ["FEMAST_BACKGROUND_COMPILE"] = before
-    return time.perf_counter() - t_all

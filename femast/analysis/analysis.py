@@ -109,7 +109,7 @@ class Analysis:
         linear_solver: str = "auto",
         max_cutbacks: int = 1000,
     ):
-        prepare_kernels()  # first run: kernels compile in the background (femast.jit_background)
+        prepare_kernels()  # the first-run compile notice armed (femast.jit)
         self.model = model
         self.on_frame = on_frame
         self.out = out

@@ -8,11 +8,11 @@ again resumes an interrupted study.
 
 from __future__ import annotations
 
-import os
 import runpy
 from pathlib import Path
 
 from ..errors import StudyError
+from ..workers import cpu_count
 
 EXIT_FAILED_SAMPLES = 3
 
@@ -41,7 +41,7 @@ def _study(args):
         raise StudyError("give --workers (local processes) or --scheduler (a dask cluster), not both")
     study = load_script(args.script)
     out = args.out or str(Path("studies") / Path(args.script).stem)
-    workers = args.workers if args.workers is not None else (os.cpu_count() or 1)
+    workers = args.workers if args.workers is not None else cpu_count()
     try:
         s = run(study, out, samples=args.samples, workers=workers, scheduler=args.scheduler, chunk_size=args.chunk_size)
     except KeyboardInterrupt:

@@ -7,35 +7,41 @@ it stopped when run again with the same folder: the runs on disk are not run aga
 points of the others do not depend on which were done (:mod:`femast.studies.sampling`).  At most
 two chunks per worker are in flight, so memory does not grow with the number of samples.
 
+Local workers are the processes of :class:`femast.workers.Pool` (they end with this process,
+however it ends).  A study with a ``timeout_s`` runs its samples in worker processes even with
+``workers=1``, one sample per task: a sample stuck where no signal reaches it (inside a compiled
+loop) has its worker killed at ``timeout_s`` + :data:`KILL_GRACE_S` and is recorded as failed, and
+the study goes on.  A worker that dies under a sample (out of memory, a crash in compiled code)
+fails that sample the same way.
+
 Worker warm-up: numba compiles femast's kernels once into its on-disk cache; a fresh process
-still loads them on its first analysis.  Local workers are forked (Linux, macOS: spawned) from
-this process after it has run one nominal sample, so they inherit the loaded kernels; dask
-workers run one nominal sample each (``client.run``) before the study.  The warm-up samples are
-not recorded.
+still loads them on its first analysis.  Each local worker runs one nominal sample as it starts,
+and dask workers run one each (``client.run``) before the study.  The warm-up samples are not
+recorded.
 """
 
 from __future__ import annotations
 
 import hashlib
 import math
-import multiprocessing as mp
 import os
-import pickle
 import socket
 import time
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
+from concurrent.futures import FIRST_COMPLETED, wait
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import progress
 from ..analysis.deadline import deadline
-from ..errors import SampleTimeout, StudyError
+from ..errors import SampleTimeout, StudyError, TaskTimeout, WorkerDied
+from ..workers import Pool
 from .store import Store
 from .study import Study
 
 _STUDY = None  # the study of this worker process
+KILL_GRACE_S = 2.0  # a sample's worker is killed this long (s) after timeout_s, if the sample has not stopped itself
+START_S = 600.0  # with a timeout_s, a worker may take this long (s) more to start (import, load or compile kernels)
 _DASK_STUDIES = {}  # payload hash -> study (dask workers)
 
 
@@ -165,14 +171,12 @@ def run_chunk(study: Study, runs, base, block, values) -> list:
     return rows
 
 
-def _init_local(study):
+def _init_local(payload: bytes):
     global _STUDY
-    import signal
+    import pickle
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's: it stops the workers
-    _STUDY = pickle.loads(study) if isinstance(study, bytes) else study
-    if isinstance(study, bytes):  # spawned: warm this process
-        warm(_STUDY)
+    _STUDY = pickle.loads(payload)
+    warm(_STUDY)
 
 
 def _local_chunk(runs, base, block, values):
@@ -283,7 +287,8 @@ def _drive(study, store, samples, workers, client, chunk_size, limit):
     todo = np.setdiff1d(np.arange(total, dtype=np.int64), done)
     if limit is not None:
         todo = todo[: int(limit)]
-    engine = "dask" if client is not None else ("local" if workers > 1 else "serial")
+    # a time-out needs samples in processes that can be killed (a stuck compiled loop ignores signals)
+    engine = "dask" if client is not None else ("local" if workers > 1 or study.timeout_s is not None else "serial")
     if client is not None:
         workers = max(1, sum(client.nthreads().values()))
     s = RunSummary(
@@ -357,70 +362,121 @@ def _pipeline(chunks, make, record, submit, wait_one, in_flight):
 
 
 def _run_local(study, chunks, make, record, workers, s):
-    methods = mp.get_all_start_methods()
-    tw, cw = time.perf_counter(), _cpu()
-    if "fork" in methods and os.name == "posix" and not _macos():
-        warm(study)  # the forked workers inherit the loaded kernels
-        ctx, arg = mp.get_context("fork"), study
-        s.warmup_cpu = _cpu() - cw
-    else:
-        try:
-            import cloudpickle as cp
-        except ImportError:
-            cp = pickle
-        ctx, arg = mp.get_context("spawn"), cp.dumps(study)
-    s.warmup_time = time.perf_counter() - tw
-    ex = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_local, initargs=(arg,))
+    """The chunks on a :class:`~femast.workers.Pool` of ``workers`` processes; with a ``timeout_s``,
+    one sample per task (see the module docstring)."""
     try:
-        try:
-            _pipeline(
-                chunks,
-                make,
-                record,
-                lambda *a: ex.submit(_local_chunk, *a),
-                lambda p: wait(p, return_when=FIRST_COMPLETED),
-                2 * workers,
+        import cloudpickle as cp  # (functions of a study script travel by value)
+    except ImportError:  # pragma: no cover
+        import pickle as cp
+
+    tw = time.perf_counter()
+    timeout = None if study.timeout_s is None else study.timeout_s + KILL_GRACE_S
+    start = None if timeout is None else START_S + timeout  # (its warm-up sample too)
+    with Pool(
+        workers, _init_local, (cp.dumps(study),), timeout_s=timeout, name="study workers", start_timeout_s=start
+    ) as pool:
+        s.warmup_time = time.perf_counter() - tw
+        if timeout is None:
+            try:
+                _pipeline(
+                    chunks,
+                    make,
+                    record,
+                    lambda *a: pool.submit(_local_chunk, *a),
+                    lambda p: wait(p, return_when=FIRST_COMPLETED),
+                    2 * workers,
+                )
+            except WorkerDied:
+                raise StudyError(
+                    f"a worker process died (killed, out of memory, or a crash in compiled code) after "
+                    f"{s.ran} runs of this call; the finished runs are stored: run again to resume, "
+                    "with --workers 1 to see which sample crashes"
+                ) from None
+        else:
+            _pipeline(chunks, make, record, lambda *a: _ChunkOfSamples(pool, study, a), _wait_chunks, 2 * workers)
+
+
+class _ChunkOfSamples:
+    """A chunk submitted sample by sample (each its own task, killable at its time-out); done when
+    every sample is; ``result()`` gives the chunk's rows, a killed or lost sample as a failed row."""
+
+    def __init__(self, pool, study, chunk):
+        self.chunk = chunk
+        self.study = study
+        runs, base, block, values = chunk
+        self.futures = [
+            pool.submit(
+                _local_chunk,
+                runs[i : i + 1],
+                base[i : i + 1],
+                block[i : i + 1],
+                {k: a[i : i + 1] for k, a in values.items()},
             )
-        except BrokenProcessPool:
-            raise StudyError(
-                f"a worker process died (killed, out of memory, or a crash in compiled code) after "
-                f"{s.ran} runs of this call; the finished runs are stored: run again to resume, "
-                "with --workers 1 to see which sample crashes"
-            ) from None
-    except BaseException:
-        # interrupted (or a worker died): the chunks in flight are lost, nothing half-written
-        # (only this process writes); stop the workers now rather than after their chunks
-        for p in list(getattr(ex, "_processes", {}).values()):
-            p.terminate()
-        ex.shutdown(wait=False, cancel_futures=True)
-        raise
-    ex.shutdown(wait=True)
+            for i in range(len(runs))
+        ]
+
+    def done(self):
+        return all(f.done() for f in self.futures)
+
+    def result(self):
+        runs, base, block, values = self.chunk
+        names = self.study.design.block_names()
+        rows = []
+        for i, f in enumerate(self.futures):
+            try:
+                rows.extend(f.result())
+                continue
+            except TaskTimeout:
+                error = f"SampleTimeout: {_over(self.study.timeout_s)} (inside compiled code: its worker was killed)"
+            except WorkerDied as exc:
+                error = f"WorkerDied: {exc}"
+            rows.append(
+                {
+                    "run": int(runs[i]),
+                    "base": int(base[i]),
+                    "block": names[int(block[i])],
+                    "status": "failed",
+                    "error": error,
+                    "seconds": float(self.study.timeout_s or 0.0),
+                    "worker": "",
+                    "inputs": {k: (float(a[i]) if a.ndim == 1 else a[i].copy()) for k, a in values.items()},
+                    "outputs": {},
+                }
+            )
+        return rows
 
 
-def _macos():
-    import sys
-
-    return sys.platform == "darwin"
+def _wait_chunks(pending):
+    """(finished, still pending) chunks of samples, after at least one has finished."""
+    while True:
+        finished = {c for c in pending if c.done()}
+        if finished:
+            return finished, pending - finished
+        wait([f for c in pending for f in c.futures if not f.done()], return_when=FIRST_COMPLETED)
 
 
 def _run_dask(study, chunks, make, record, client, s):
     import cloudpickle
-    from distributed import wait as dwait
+    from distributed import as_completed
 
     payload = cloudpickle.dumps(study)
     tw = time.perf_counter()
     client.run(_dask_warm, payload)
     s.warmup_time = time.perf_counter() - tw
     fut = client.scatter(payload, broadcast=True)
+    finished = as_completed([], loop=client.loop)  # this client's (not a default client's: there may be none)
 
-    def wait_one(p):
-        r = dwait(p, return_when="FIRST_COMPLETED")
-        return r.done, r.not_done
+    def submit(*a):
+        f = client.submit(_dask_chunk, fut, *a, pure=False)
+        finished.add(f)
+        return f
+
+    def wait_one(pending):
+        f = next(finished)
+        return {f}, pending - {f}
 
     try:
-        _pipeline(
-            chunks, make, record, lambda *a: client.submit(_dask_chunk, fut, *a, pure=False), wait_one, 2 * s.workers
-        )
+        _pipeline(chunks, make, record, submit, wait_one, 2 * s.workers)
     except Exception as exc:
         if type(exc).__name__ != "KilledWorker":
             raise

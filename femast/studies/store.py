@@ -147,7 +147,10 @@ class Store:
             fields.append(pa.field(n, pa.float64() if input_sizes[n] is None else pa.list_(pa.float64())))
         for k in outs:
             shp = shapes.get(k)
-            fields.append(pa.field(k, pa.float64() if shp is not None and len(shp) == 0 else pa.list_(pa.float64())))
+            if shp is None:  # no sample has given it yet (a chunk of failed runs): nulls, typed by later chunks
+                fields.append(pa.field(k, pa.null()))
+            else:
+                fields.append(pa.field(k, pa.float64() if len(shp) == 0 else pa.list_(pa.float64())))
         table = pa.table({f.name: pa.array(cols[f.name], type=f.type) for f in fields})
         first = min(r["run"] for r in rows)
         name = f"chunk-{first:010d}-{len(rows)}.parquet"
@@ -177,7 +180,9 @@ class Store:
         sizes = {x["name"]: x["size"] for x in self.manifest["spec"]["design"]["inputs"]}
         for c in columns:
             col = table.column(c)
-            if pa.types.is_list(col.type):
+            if pa.types.is_null(col.type):  # an output no sample has given (all failed)
+                out[c] = np.full(len(col), np.nan)[order]
+            elif pa.types.is_list(col.type):
                 shp = shapes.get(c) or ((sizes[c],) if sizes.get(c) else None)
                 width = int(np.prod(shp)) if shp else 0
                 col = col.combine_chunks()

@@ -1,5 +1,6 @@
-"""femast.numba_cache: a cached kernel calling an njit helper of another file is recompiled after
-the helper changes (numba alone keeps the old helper: numba issue #1833)."""
+"""femast.numba_cache: in a source checkout, a cached kernel calling an njit helper of another file
+runs the edited helper after an edit (numba alone keeps the old helper: numba issue #1833), because
+the cache folder is keyed by the kernels' sources; an installed package is left alone."""
 
 import os
 import subprocess
@@ -34,8 +35,8 @@ HELPER = textwrap.dedent("""
 RUN = textwrap.dedent("""
     import os, sys
     if os.environ.get("GUARD") == "1":
-        from femast.numba_cache import check
-        check(sys.argv[1], "pkg")
+        from femast.numba_cache import configure
+        configure(sys.argv[1], "pkg")
     import pkg.caller
     print(repr(pkg.caller.caller(1.0)))
 """)
@@ -66,21 +67,25 @@ def _run(tmp_path, pkg, guard, numba_cache_dir=None):
 def test_edited_helper_in_another_file(tmp_path, options, guard):
     pkg = _package(tmp_path, options)
     assert _run(tmp_path, pkg, guard) == 3.0  # 1 * 2 + 1, compiled and cached
-    assert list((pkg / "__pycache__").glob("caller.*.nbi"))
+    assert list((pkg / "__pycache__").rglob("caller.*.nbi"))
     (pkg / "helper.py").write_text(HELPER.format(options=options, factor="5.0"))
     # exact: small integers in doubles.  Without the guard numba loads caller's stale cache (the
     # old helper): this shows the bug is real on the installed numba.
     assert _run(tmp_path, pkg, guard) == (6.0 if guard else 3.0)
+    if guard:  # and back: the first folder is found again, with the first helper
+        (pkg / "helper.py").write_text(HELPER.format(options=options, factor="2.0"))
+        assert _run(tmp_path, pkg, guard) == 3.0
 
 
 def test_edited_helper_with_numba_cache_dir(tmp_path):
-    """The cache files are found through numba's locator wherever it puts them: NUMBA_CACHE_DIR."""
+    """With NUMBA_CACHE_DIR set, the keyed folder is made inside it."""
     pkg = _package(tmp_path, "inline='always'")
     cache = tmp_path / "numba-cache"
     assert _run(tmp_path, pkg, True, cache) == 3.0
-    assert list(cache.rglob("caller.*.nbi")) and not list(pkg.rglob("*.nbi"))
+    assert list(cache.glob("pkg-*/**/caller.*.nbi")) and not list(pkg.rglob("*.nbi"))
     (pkg / "helper.py").write_text(HELPER.format(options="inline='always'", factor="5.0"))
     assert _run(tmp_path, pkg, True, cache) == 6.0
+    assert len(list(cache.glob("pkg-*"))) == 2
 
 
 def test_two_processes_starting_at_once_after_an_edit(tmp_path):
@@ -100,56 +105,31 @@ def test_two_processes_starting_at_once_after_an_edit(tmp_path):
     assert [float(out.strip().splitlines()[-1]) for out, _ in outs] == [6.0, 6.0]
 
 
-def test_unchanged_tree_deletes_nothing(tmp_path):
+def test_the_key_follows_numba_sources_only(tmp_path):
     pkg = _package(tmp_path, "")
-    assert _run(tmp_path, pkg, True) == 3.0
-    cached = sorted((pkg / "__pycache__").glob("caller.*.nb?"))
-    assert cached
-    assert numba_cache.check(str(pkg), "pkg") == []  # fast path: the tree stamp matches
-    os.utime(pkg / "helper.py")  # a checkout touching mtimes only
-    (pkg / "__pycache__" / numba_cache.TREE_STAMP).unlink()  # (and a lost tree stamp): slow path
-    assert numba_cache.check(str(pkg), "pkg") == []
-    assert sorted((pkg / "__pycache__").glob("caller.*.nb?")) == cached
-
-
-def test_changed_helper_deletes_only_its_callers_cache(tmp_path):
-    pkg = _package(tmp_path, "")
-    (pkg / "other.py").write_text("from numba import njit\n\n\n@njit(cache=True)\ndef other(x):\n    return x\n")
-    assert _run(tmp_path, pkg, True) == 3.0
-    pycache = pkg / "__pycache__"
-    (pycache / "other.other-5.py0.nbi").write_text("")  # stands for other's cache files
+    key = numba_cache.source_key(str(pkg))
+    (pkg / "notes.py").write_text("TEXT = 'no compiled code here, only numba in a docstring'\n")
+    assert numba_cache.source_key(str(pkg)) == key  # a file without compiled code: same kernels
     (pkg / "helper.py").write_text(HELPER.format(options="", factor="5.0"))
-    deleted = numba_cache.check(str(pkg), "pkg")
-    assert deleted and all(Path(p).name.startswith("caller.") for p in deleted)
-    assert not list(pycache.glob("caller.*.nb?")) and (pycache / "other.other-5.py0.nbi").exists()
-    assert numba_cache.check(str(pkg), "pkg") == []  # stamped: once only
+    assert numba_cache.source_key(str(pkg)) != key
 
 
-def test_unwritable_cache_and_files_gone_meanwhile(tmp_path, monkeypatch):
-    pkg = _package(tmp_path, "")
-    monkeypatch.setattr(numba_cache, "cache_dir", lambda py_file: None)  # numba: no writable locator
-    assert numba_cache.check(str(pkg), "pkg") == []
-    monkeypatch.undo()
-    (pkg / "__pycache__").mkdir()
-    (pkg / "__pycache__" / "caller.caller-7.py0.nbi").write_text("")
-    real_remove = os.remove
-
-    def remove(path):  # another process deleted it first
-        real_remove(path)
-        raise FileNotFoundError(path)
-
-    monkeypatch.setattr(numba_cache.os, "remove", remove)
-    assert numba_cache.check(str(pkg), "pkg") == []
+def test_an_installed_package_is_left_alone(tmp_path, monkeypatch):
+    site = tmp_path / "lib" / "site-packages"
+    site.mkdir(parents=True)
+    pkg = _package(site, "")
+    monkeypatch.delenv(numba_cache.ENV, raising=False)
+    assert numba_cache.configure(str(pkg), "pkg") is None
+    assert not (pkg / "__pycache__").exists()
 
 
-def test_femast_table():
-    """The dependencies found in femast itself include the known cross-file helpers."""
-    root = Path(numba_cache.__file__).parent
-    deps = {
-        os.path.relpath(k, root): [os.path.relpath(d, root) for d in v]
-        for k, v in numba_cache.dependencies(str(root), "femast").items()
-    }
-    assert "rotations.py" in deps["elements/_ball_joint_kernels.py"]  # logm_so3_into
-    assert {"rotations.py", "elements/_stack.py"} <= set(deps["elements/beam_corot.py"])
-    assert "latch.py" in deps["elements/_cable_kernels.py"]
-    assert deps["rotations.py"] == []
+def test_old_folders_beyond_the_newest_are_pruned(tmp_path):
+    parent = tmp_path / "__pycache__"
+    for i in range(6):
+        d = parent / f"numba-{i:016x}"
+        d.mkdir(parents=True)
+        os.utime(d, (1000.0 + i, 1000.0 + i))
+    (parent / "other").mkdir()
+    numba_cache._prune(str(parent), str(parent / "numba-0000000000000005"))
+    left = sorted(p.name for p in parent.iterdir())
+    assert left == ["numba-0000000000000003", "numba-0000000000000004", "numba-0000000000000005", "other"]

@@ -1,7 +1,6 @@
-"""femast.cli.main called from Python (tests, notebooks) leaves the interpreter as it found it: the
-garbage collector's thresholds that the command raises for its own short process (issue 21) come
-back, and the heap that compare/diagnose freeze for a quick exit is given back to the collector.
-And femast's warnings reach a command's user as one line each."""
+"""femast.cli.main called from Python (tests, notebooks) leaves the interpreter as it found it (the
+garbage collector's settings untouched), and femast's warnings reach a command's user as one line
+each."""
 
 import gc
 import os
@@ -20,7 +19,7 @@ def test_main_restores_the_collector(tmp_path, capsys):
     assert main(["compare", "mast-top", "example", "--out", str(tmp_path / "o"), "--json"]) == 0
     capsys.readouterr()
     assert gc.get_threshold() == before
-    assert gc.get_freeze_count() == 0  # (compare froze the heap before its exit)
+    assert gc.get_freeze_count() == 0
 
 
 def test_a_partial_frame_is_one_warning_line_on_the_command_line(tmp_path, capsys):

@@ -8,7 +8,6 @@ import sys
 import types
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import femast as fm
@@ -77,48 +76,42 @@ def test_error_text_is_not_mixed_with_a_bar(monkeypatch, capsys, tmp_path):
 # ------------------------------------------------------------------ compile notice
 def _fake_event(module):
     return types.SimpleNamespace(
-        is_start=True, data={"dispatcher": types.SimpleNamespace(py_func=types.SimpleNamespace(__module__=module))}
+        is_start=True,
+        data={"dispatcher": types.SimpleNamespace(py_func=types.SimpleNamespace(__module__=module, __name__="kernel"))},
     )
 
 
 def test_compile_notice_once_per_process_and_only_for_femast(monkeypatch, capsys):
     monkeypatch.setattr(jit, "_announced", False)
-    monkeypatch.setattr(jit, "uncached", lambda: ["femast.elements.beam_corot.beam_family_kernel"])
-    jit._on_compile(_fake_event("numpy_user_module"))
+    monkeypatch.setattr(jit, "_delegate", None)
+    monkeypatch.setattr(jit, "_depth", 0)
+    monkeypatch.setattr(progress, "_QUIET", False)  # (whatever an earlier test left)
+    monkeypatch.delenv("FEMAST_QUIET", raising=False)
+    jit._on_start(_fake_event("numpy_user_module"))
     assert capsys.readouterr().err == ""
-    jit._on_compile(_fake_event("femast.rotations"))
-    jit._on_compile(_fake_event("femast.analysis.assembly"))
+    jit._on_start(_fake_event("femast.rotations"))
+    jit._on_start(_fake_event("femast.analysis.assembly"))
     err = capsys.readouterr().err
-    assert err.count("compiling femast kernels, first run only") == 1
-    assert f"~{jit.COMPILE_S['femast.elements.beam_corot.beam_family_kernel']:.0f} s" in err
+    assert err.count("compiling femast's numba kernels") == 1
+    assert "femast warmup" in err and "min" in err  # what to do about it, and roughly how long
 
 
 def test_compile_notice_respects_quiet(monkeypatch, capsys):
     monkeypatch.setattr(jit, "_announced", False)
+    monkeypatch.setattr(jit, "_delegate", None)
+    monkeypatch.setattr(jit, "_depth", 0)
     monkeypatch.setenv("FEMAST_QUIET", "1")
-    jit._on_compile(_fake_event("femast.rotations"))
+    jit._on_start(_fake_event("femast.rotations"))
     assert capsys.readouterr().err == ""
-
-
-def test_kernels_compiled_in_this_process_are_not_uncached(monkeypatch):
-    from femast.rotations import apply_spins
-
-    # compiled here even when its cache is missing (else, with the background compile on, the call
-    # runs interpreted: the case right after rotations.py changed, until the worker has compiled it)
-    monkeypatch.setenv("FEMAST_BACKGROUND_COMPILE", "0")
-    apply_spins(np.tile(np.eye(3), (1, 1, 1)), np.zeros((1, 3)))
-    names = dict(jit._dispatchers())
-    assert "femast.rotations.apply_spins" in names
-    assert "femast.rotations.apply_spins" not in jit.uncached()
-    # inlined helpers never get a cache of their own and are not listed
-    assert "femast.rotations.logm_so3_into" not in names
 
 
 @pytest.mark.slow
 def test_warmup_command(capsys):
+    from femast.warmup import PARTS
+
     assert main(["warmup"]) == 0
     out = capsys.readouterr().out
-    assert all(what in out for what, _ in jit.PARTS)
+    assert all(what in out for what, _ in PARTS)
 
 
 # ------------------------------------------------------------------ the CLI explains itself

@@ -16,6 +16,20 @@ pytestmark = pytest.mark.skipif(
 )
 
 
+@pytest.fixture(autouse=True)
+def _fork_possible_in_this_process():
+    """The fork path needs a process without GNU OpenMP threads; an earlier test (in any order) may
+    have run a parallel numba kernel on them, and they cannot be stopped."""
+    import numba
+
+    try:
+        layer = numba.threading_layer()
+    except ValueError:  # no parallel kernel has run
+        return
+    if layer == "omp":
+        pytest.skip("an earlier test started GNU OpenMP threads in this process: no fork here")
+
+
 @pytest.fixture
 def forking(monkeypatch):
     """Forking allowed although earlier tests may have left threads behind (the functions forked here

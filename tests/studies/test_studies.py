@@ -648,18 +648,17 @@ def _sometimes_slow(x):
 
 @pytest.mark.parametrize("workers", [1, 2])
 def test_samples_over_the_timeout_are_recorded_failed(tmp_path, workers):
-    import time
-
     study = st.Study(
         run=_sometimes_slow, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], sampler="mc", seed=2, timeout_s=0.3
     )
-    t0 = time.perf_counter()
     s = st.run(study, tmp_path / "t", samples=20, workers=workers)
     res = st.load(tmp_path / "t")
-    n_slow = int(np.sum(res.table(["x"])["x"] > 0.8))
+    t = res.table(["x", "seconds", "status"])
+    slow = t["x"] > 0.8
+    n_slow = int(np.sum(slow))
     assert n_slow > 0 and s.failed == n_slow and s.ok == 20 - n_slow
     assert all("SampleTimeout: the sample ran over timeout_s = 0.3 s" in r for _, r in res.failures())
-    assert time.perf_counter() - t0 < 5.0 * n_slow / workers  # the slow samples were cut short
+    assert np.all(t["seconds"][slow] < 5.0)  # the slow samples were stopped before their 5 s sleep ended
     with pytest.raises(StudyError, match="timeout_s"):
         st.Study(run=_sometimes_slow, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], timeout_s=0)
 
