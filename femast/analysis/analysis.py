@@ -271,6 +271,7 @@ class Analysis:
         t0 = _time.perf_counter()
         ti = None
         self.folder_lock = None
+        self.output.writer = None  # (a run refused its folder writes no summary there, not even an earlier run's)
         try:
             first = 0
             if self.out is not None:  # one writer per folder, taken before a restart point is read

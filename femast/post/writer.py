@@ -133,8 +133,13 @@ class ResultsWriter:
                 pass
             self._release()
             raise ResultsWriteError(self._message(exc)) from exc
-        except BaseException:
+        except BaseException as exc:
             self._close_files()
+            if isinstance(exc, FemastError):  # (a link or FIFO where femast writes: the summary says why)
+                try:
+                    self._write_summary({"status": "failed", "completed": False, "message": f"FemastError: {exc}"})
+                except (OSError, FemastError):
+                    pass
             self._release()
             raise
 
