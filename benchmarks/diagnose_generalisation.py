@@ -188,6 +188,8 @@ def truth_label(row) -> str:
         return "null"
     if row["expect"] == "ool":
         return "out of library"
+    if row["expect"] == "time":
+        return "out of library (time)"
     return " + ".join(sorted(row["expected_effects"]))  # as the verdict columns
 
 

@@ -50,8 +50,7 @@ def _run(args):
 def _vtk(args):
     from .post.vtk import export_vtk
 
-    out = Path(args.out) / Path(args.results).resolve().name  # ./vtk/NAME: beside render's ./render (issue 17)
-    pvd = export_vtk(args.results, out, every=args.every)
+    pvd = export_vtk(args.results, args.out, every=args.every)  # RESULTS/vtk, as export_vtk(res)
     print(f"wrote {pvd} (open it in ParaView; apply 'Warp By Vector' with U to see the deformed shape)")
 
 
@@ -112,14 +111,31 @@ def _info(args):
         for st in s.get("steps", []):
             if "frequencies_hz" in st:
                 print(f"  step {st['name']}: modes at {', '.join(f'{f:.4g}' for f in st['frequencies_hz'])} Hz")
-            else:
-                print(
-                    f"  step {st['name']}: {st.get('increments', 0)} increments, {st.get('iterations', 0)} iterations"
-                )
+                continue
+            n, k = st.get("increments", 0), st.get("iterations", 0)
+            print(f"  step {st['name']}: {n} increment{'' if n == 1 else 's'}, {k} iteration{'' if k == 1 else 's'}")
         if s.get("message"):
             print(f"  {s['message']}")
     else:
         print("  status: unknown (no readable summary.json)")
+
+
+class _Intermixed(argparse.ArgumentParser):
+    """A command's parser that takes its options anywhere among its positional arguments
+    (``femast render RES --frame last shape.png`` as well as ``femast render RES shape.png --frame
+    last``): argparse's ``parse_known_intermixed_args``.  A command taking a script's arguments
+    verbatim (``run``) parses as usual."""
+
+    _inside = False
+
+    def parse_known_args(self, args=None, namespace=None):
+        if self._inside or any(a.nargs in (argparse.REMAINDER, argparse.PARSER) for a in self._actions):
+            return super().parse_known_args(args, namespace)
+        self._inside = True  # (Python < 3.12 calls parse_known_args from the intermixed parse)
+        try:
+            return self.parse_known_intermixed_args(args, namespace)
+        finally:
+            self._inside = False
 
 
 class _Help(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
@@ -149,7 +165,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="show the full Python traceback of an error (default: one line naming the item)",
     )
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Intermixed)
     p = sub.add_parser(
         "run",
         help="run a model or benchmark script",
@@ -176,8 +192,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("results", help="results folder written by an analysis (fm.solve(model, FOLDER))")
     p.add_argument(
         "--out",
-        default="vtk",
-        help="folder in which a subfolder named after RESULTS gets the series (default: vtk, in the working directory)",
+        default=None,
+        help="folder of the .vtu files and series.pvd (default: RESULTS/vtk, where export_vtk(results) writes them)",
     )
     p.add_argument("--every", type=int, default=1, help="write every n-th frame")
     p.set_defaults(func=_vtk)

@@ -43,30 +43,18 @@ def _effect_names(arg):
     return names
 
 
-def _first_sentence(text: str) -> str:
-    """The first sentence of ``text`` on one line."""
-    text = " ".join((text or "").split())
-    for i in range(len(text) - 1):
-        if (
-            text[i] == "."
-            and text[i + 1] == " "
-            and not text[max(0, i - 3) : i].endswith(("Eq", "Sec", "e.g", "i.e", "Fig", "Eqs", "Tab"))
-        ):
-            return text[: i + 1]
-    return text
-
-
 def experiment_rows() -> list[dict]:
     """Every registered experiment: name, title, its example data file (or None), its effects."""
     from . import examples
     from .effects import applicable_effects
     from .experiments import list_experiments
+    from .text import first_sentence
 
     return [
         {
             "name": e.name,
             "title": e.title,
-            "physics": _first_sentence(e.doc) if e.doc else e.title,
+            "physics": first_sentence(e.doc) if e.doc else e.title,
             "example": examples.BY_EXPERIMENT.get(e.name),
             "effects": [f.name for f in applicable_effects(e)],
         }
@@ -78,6 +66,7 @@ def effect_rows(experiment=None) -> list[dict]:
     """Every registered effect (or those applicable to ``experiment``): name, title, one sentence of
     physics, the experiments it is implemented for."""
     from .effects import list_effects
+    from .text import first_sentence
 
     rows = []
     for e in list_effects():
@@ -88,7 +77,7 @@ def effect_rows(experiment=None) -> list[dict]:
             {
                 "name": e.name,
                 "title": e.title,
-                "physics": _first_sentence(e.physics),
+                "physics": first_sentence(e.physics),
                 "experiments": exps,
                 "seed": e.seed,
             }
@@ -101,10 +90,17 @@ def _experiments(args):
     if args.json:
         print(json.dumps(rows, indent=2))
         return
-    print("experiments (femast compare|diagnose EXPERIMENT DATA.csv; DATA 'example' uses the shipped example):")
+    from .text import hanging
+
+    print(
+        hanging(
+            "experiments", "(femast compare|diagnose EXPERIMENT DATA.csv; DATA 'example' uses the shipped example):", 0
+        )
+    )
+    pad = 2 + max(len(r["name"]) for r in rows) + 1
     for r in rows:
-        print(f"  {r['name']:<12s} {r['title']}")
-        print(f"  {'':<12s} example data: {r['example'] or '(none shipped)'}; effects: {', '.join(r['effects'])}")
+        print(hanging(f"  {r['name']}", r["title"], pad))
+        print(hanging("", f"example data: {r['example'] or '(none shipped)'}; effects: {', '.join(r['effects'])}", pad))
 
 
 def _effects(args):
@@ -117,10 +113,13 @@ def _effects(args):
     if args.json:
         print(json.dumps(rows, indent=2))
         return
+    from .text import hanging
+
     print(f"effects{' of ' + exp if exp else ''} (femast compare ... --effects NAME[,NAME]):")
+    pad = 2 + max((len(r["name"]) for r in rows), default=0) + 1
     for r in rows:
-        print(f"  {r['name']:<22s} {r['title']} [{', '.join(r['experiments'])}]")
-        print(f"  {'':<22s} {r['physics']}")
+        print(hanging(f"  {r['name']}", f"{r['title']} [{', '.join(r['experiments'])}]", pad))
+        print(hanging("", r["physics"], pad))
 
 
 def _examples(args):
@@ -136,10 +135,13 @@ def _examples(args):
         print(f"copied {len(examples.names())} example files to {dest}")
         return
     by_file = {v: k for k, v in examples.BY_EXPERIMENT.items()}
+    from .text import hanging
+
     print(f"example data shipped with femast (in {examples.FOLDER}):")
+    pad = 2 + max(len(n) for n in examples.names()) + 1
     for n in examples.names():
-        use = f"  ('example' for {by_file[n]})" if n in by_file else ""
-        print(f"  {n:<30s} {examples.describe(n)}{use}")
+        use = f" ('example' for {by_file[n]})" if n in by_file else ""
+        print(hanging(f"  {n}", examples.describe(n) + use, pad))
 
 
 def resolve_data(exp, data: str):
@@ -155,16 +157,31 @@ def resolve_data(exp, data: str):
     return Path(data), data
 
 
+def _check_order(args) -> None:
+    """``femast compare example mast-top``: the experiment and the data the wrong way round."""
+    from .errors import FemastError
+    from .experiments import list_experiments
+
+    names = {e.name for e in list_experiments()}
+    first, second = args.experiment, args.data
+    if first not in names and not first.endswith(".py") and (second in names or second.endswith(".py")):
+        raise FemastError(
+            f"'{first}' is not an experiment but '{second}' is: the experiment comes first, then the data "
+            f"(femast {args.command} {second} {first})"
+        )
+
+
 def _setup(args):
     from dataclasses import replace
 
     from .experiments import get_experiment, read_data
 
+    _check_order(args)
     exp = get_experiment(args.experiment)
     effects = _effect_names(getattr(args, "effects", None))
     exp.require_model(f"femast {args.command}")
     path, shown = resolve_data(exp, args.data)
-    data = replace(read_data(exp, path), path=shown)
+    data = replace(read_data(exp, path, units=getattr(args, "units", None)), path=shown)
     stem = Path(shown.split()[-1]).stem
     out = Path(args.out) if args.out else Path(args.command) / f"{exp.name}_{stem}"
     return exp, data, effects, out
@@ -174,7 +191,7 @@ def _compare(args):
     from .experiments import compare, format_compare
 
     exp, data, effects, out = _setup(args)
-    res = compare(exp, data, effects, fit=args.fit, out=out)
+    res = compare(exp, data, effects, fit=args.fit, out=out, max_rows=args.max_rows)
     print(json.dumps(res.report, indent=2) if args.json else format_compare(exp, res))
 
 
@@ -182,7 +199,9 @@ def _diagnose(args):
     from .experiments import diagnose, format_diagnose
 
     exp, data, effects, out = _setup(args)
-    res = diagnose(exp, data, base_effects=effects, workers=args.workers, scheduler=args.scheduler, out=out)
+    res = diagnose(
+        exp, data, base_effects=effects, workers=args.workers, scheduler=args.scheduler, out=out, max_rows=args.max_rows
+    )
     print(json.dumps(res.report, indent=2) if args.json else format_diagnose(exp, res))
 
 
@@ -202,6 +221,11 @@ def register(subparsers, fmt=None) -> None:
     data_help = (
         "measured data, a CSV file with a header row (formats: `femast experiments`, docs/experiments.md), "
         "or 'example' for the example shipped with femast"
+    )
+    units_help = (
+        "the unit the values of a column are in when its header says another, COLUMN=UNIT[,...] "
+        "(e.g. dx_m=mm; a header may also carry the unit itself, dx_mm); naming the header's own unit "
+        "(dx_m=m) confirms it and skips the size check of that column (default: the headers' units)"
     )
     out_help = "output folder (default: ./%(prog_cmd)s/EXPERIMENT_DATASTEM in the working directory)"
     p = subparsers.add_parser(
@@ -228,6 +252,13 @@ def register(subparsers, fmt=None) -> None:
         help="fit the model and effect parameters (default: run with the default parameters)",
     )
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "compare"})
+    p.add_argument("--units", default=None, help=units_help)
+    p.add_argument(
+        "--max-rows",
+        type=int,
+        default=10_000,
+        help="rows used at most: a longer record is thinned to every k-th row, and femast says so",
+    )
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.set_defaults(func=_compare)
     p = subparsers.add_parser(
@@ -242,6 +273,13 @@ def register(subparsers, fmt=None) -> None:
     p.add_argument("experiment", help=exp_help)
     p.add_argument("data", help=data_help)
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "diagnose"})
+    p.add_argument("--units", default=None, help=units_help)
+    p.add_argument(
+        "--max-rows",
+        type=int,
+        default=10_000,
+        help="rows used at most: a longer record is thinned to every k-th row, and femast says so",
+    )
     p.add_argument("--json", action="store_true", help="print the JSON report instead of the text summary")
     p.add_argument(
         "--workers",

@@ -66,3 +66,12 @@ class WorkerDied(FemastError):
 
 class TaskTimeout(FemastError, TimeoutError):
     """A task of a :class:`femast.workers.Pool` ran over its time-out; its worker was killed."""
+
+
+def did_you_mean(name, choices) -> str:
+    """`` (did you mean 'x'?)`` for the choice closest to a mistyped ``name`` (difflib's ratio of at
+    least 0.6), or ``""`` when none is close: the tail of an "unknown ..." message."""
+    import difflib
+
+    close = difflib.get_close_matches(str(name), [str(c) for c in choices], n=1, cutoff=0.6)
+    return f" (did you mean '{close[0]}'?)" if close else ""

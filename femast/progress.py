@@ -10,6 +10,11 @@ never mixed into the error message.
   as they happen (:func:`tick` ``("FE runs")`` from the FE experiments).
 * :func:`items` -- a bar over a known list (the cases of a benchmark, the refits of diagnose),
   naming the item being worked on.
+
+A terminal that reports no width (``script``, some CI consoles: 0 columns) cannot draw a bar; there,
+and wherever ``FEMAST_PROGRESS=plain`` is set (a log file), progress is plain text instead: a line
+every few seconds (:data:`PLAIN_INTERVAL_S`) with the count, the elapsed time and, when the total
+is known, the estimated time left.
 """
 
 from __future__ import annotations
@@ -43,16 +48,100 @@ def quiet() -> bool:
     return _QUIET or os.environ.get("FEMAST_QUIET", "").strip() not in ("", "0")
 
 
+PLAIN_INTERVAL_S = 5.0  # seconds between two lines of plain-text progress
+
+
+def plain() -> bool:
+    """True when progress is written as plain lines: ``FEMAST_PROGRESS=plain`` (not quiet), or
+    stderr a terminal that reports no width (0 columns), where a bar would not show."""
+    if quiet():
+        return False
+    if os.environ.get("FEMAST_PROGRESS", "").strip().lower() == "plain":
+        return True
+    if not enabled():
+        return False
+    try:
+        return os.get_terminal_size(sys.stderr.fileno()).columns <= 0
+    except (AttributeError, ValueError, OSError):
+        return False
+
+
 def _bar(**kw):
+    if plain():
+        return PlainProgress(**kw)
     from tqdm.auto import tqdm
 
     return tqdm(disable=not enabled(), leave=False, file=sys.stderr, dynamic_ncols=True, **kw)
 
 
+def _clock(seconds: float) -> str:
+    m, s = divmod(int(round(seconds)), 60)
+    return f"{m // 60}:{m % 60:02d}:{s:02d}" if m >= 60 else f"{m}:{s:02d}"
+
+
+class PlainProgress:
+    """Progress as plain text lines on stderr, one every ``interval`` seconds at most (the first
+    after ``interval`` too: a short wait prints nothing), ``desc: 12/40 refits, 3 FE runs
+    [0:25 elapsed, ~1:02 left]``.  The methods a tqdm bar offers that femast uses."""
+
+    disable = False
+
+    def __init__(self, desc="", total=None, unit="it", interval=None, file=None, clock=None, **_):
+        import time
+
+        self._time = clock or time.monotonic
+        self.desc, self.total, self.unit, self.n, self.postfix = desc, total, unit, 0, ""
+        self.interval = PLAIN_INTERVAL_S if interval is None else interval
+        self.file = file or sys.stderr
+        self.start = self._last = self._time()
+
+    def line(self) -> str:
+        """The progress line as it stands."""
+        now = self._time() - self.start
+        count = f"{self.n}/{self.total}" if self.total else f"{self.n}"
+        when = f"{_clock(now)} elapsed"
+        if self.total and 0 < self.n < self.total:
+            when += f", ~{_clock(now * (self.total - self.n) / self.n)} left"
+        post = f", {self.postfix}" if self.postfix else ""
+        return f"{self.desc}: {count}{self.unit}{post} [{when}]"
+
+    def _maybe_print(self):
+        if self._time() - self._last >= self.interval:
+            self._last = self._time()
+            try:
+                print(self.line(), file=self.file, flush=True)
+            except (OSError, ValueError):
+                pass
+
+    def update(self, k=1):
+        self.n += k
+        self._maybe_print()
+
+    def set_postfix_str(self, s="", refresh=True):
+        self.postfix = str(s)
+        self._maybe_print()
+
+    def refresh(self):
+        self._maybe_print()
+
+    def close(self):
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+
 @contextlib.contextmanager
-def task(desc: str, unit: str = "evaluations"):
-    """A bar counting the :func:`tick` calls made inside the ``with`` block (innermost task gets them)."""
-    bar = _bar(desc=desc, unit=f" {unit}", total=None, bar_format="{desc}: {n_fmt}{unit} [{elapsed}]{postfix}")
+def task(desc: str, unit: str = "evaluations", delay: float = 0.0):
+    """A bar counting the :func:`tick` calls made inside the ``with`` block (innermost task gets them);
+    ``delay`` (s): shown only once the work has taken that long."""
+    bar = _bar(
+        desc=desc, unit=f" {unit}", total=None, bar_format="{desc}: {n_fmt}{unit} [{elapsed}]{postfix}", delay=delay
+    )
     entry = (bar, {})
     _ACTIVE.append(entry)
     try:

@@ -8,6 +8,9 @@ hidden mechanisms (each ``(mechanism, form, {parameters})``, written with
   (in another functional form than femast's);
 * ``expect="pair"``: two library mechanisms at once (``effects`` both);
 * ``expect="ool"``: a mechanism femast has no effect for (out of library);
+* ``expect="time"``: a time-dependent mechanism femast has no effect for (creep): a correct
+  diagnosis says that nothing in the library explains it, or names only effects that change with
+  time, never a rate-independent one (friction);
 * ``expect="null"``: the baseline physics only (``redraws`` noise draws).
 
 :func:`generate` returns the data columns of one draw (``seed`` -> numpy ``default_rng``).
@@ -19,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import connection as conn
 from . import mechanisms as mech
 from . import noise as nz
 from .rigs import (
@@ -38,6 +42,14 @@ SIGMA_TRACKER_M = 50e-6  # laser tracker noise per axis (m), mast top
 SIGMA_LOADCELL_N = 0.5  # load cell noise (N), latch pull
 EQ15 = {"C": 2.5e-6, "sigma_T": 0.4, "sigma_d": 8e-6}  # cable compliance m/N, load-cell N, distance m
 AR_PHI = 0.6  # lag-1 autocorrelation of the correlated noise
+STUDENT_NU = 3.0  # degrees of freedom of the heavy-tailed noise
+# joint test (a connection on an actuator): elastic stiffness, protocols, noise of the two channels
+JT_K = 2.0e6  # N/m
+JT_AMPS_N, JT_STEP_N = (2.0e3, 4.0e3, 6.0e3, 8.0e3), 40.0  # force protocol (N)
+JT_AMPS_M, JT_STEP_M = (1.0e-3, 2.0e-3, 3.0e-3, 4.0e-3), 0.04e-3  # displacement protocol (m)
+JT_SIGMA_U, JT_SIGMA_F = 20e-6, 20.0  # displacement transducer (m), load cell (N)
+JT_QUANTUM_U, JT_QUANTUM_F = 10e-6, 10.0  # the resolution of a test recorded to 0.01 mm and 0.01 kN
+SPIKES, SPIKE_N = 12, 10.0  # single-sample spikes per latch-pull data set, their largest size (N)
 
 
 @dataclass(frozen=True)
@@ -389,6 +401,45 @@ CASES = (
         noise="eq15",
         doc="load-cell zero drift during the test",
     ),
+    # ---------------------------------------------------------------- the misses of real use (heavy tails, spikes,
+    # mechanisms that look like a pair, creep, a mechanism about one axis)
+    Case(
+        "mt_guys_slack",
+        "mast-top",
+        "effect",
+        ("progressive_stiffness",),
+        (_m("guys", "slack", k_g_rel=2.0, theta_s=0.3e-4, sides=1),),
+        amp=20.0,
+        doc="a slack guy going taut past a rotation on one side: the joint stiffens that way (no gap, no friction)",
+    ),
+    Case(
+        "mt_friction_preisach",
+        "mast-top",
+        "effect",
+        ("friction_hysteresis",),
+        (_m("preisach", "gauss", c=4e-5, M_max=40.0),),
+        level=0.5,
+        doc="micro-slip contacts that jump (Preisach relays): hysteresis with curved branches",
+    ),
+    Case(
+        "mt_creep_log",
+        "mast-top",
+        "time",
+        (),
+        (_m("creep", "log", phi=0.08, t0=1.0),),
+        path="holds",
+        level=0.5,
+        doc="logarithmic creep of the joints, loads held at every peak and at zero",
+    ),
+    Case(
+        "mt_clearance_x_only",
+        "mast-top",
+        "effect",
+        ("joint_clearance",),
+        (_m("clearance", "hertz", c=0.5e-4, k0=2e4, K=5.7e7, joints=(0,)),),
+        path="biaxial",
+        doc="play then Hertzian contact in the joint about x only; both axes loaded",
+    ),
     # ---------------------------------------------------------------- nulls (20 redraws each)
     Case("mt_null_white", "mast-top", "null", redraws=20, doc="baseline only, white noise"),
     Case("mt_null_ar1", "mast-top", "null", noise="ar1", redraws=20, doc="baseline only, AR(1) noise"),
@@ -412,6 +463,23 @@ CASES = (
         doc="baseline only, Eq. 15 stretch removal (heteroscedastic)",
     ),
     Case("lp_null_ar1", "latch-pull", "null", noise="ar1", n=400, redraws=20, doc="baseline only, AR(1) noise"),
+    Case(
+        "mt_null_student",
+        "mast-top",
+        "null",
+        noise="student",
+        n=66,
+        redraws=20,
+        doc="baseline only, 66 samples, heavy-tailed (Student-t, 3 degrees of freedom) noise",
+    ),
+    Case(
+        "lp_null_spikes",
+        "latch-pull",
+        "null",
+        noise="spikes",
+        redraws=20,
+        doc="baseline only, white load-cell noise and 12 single-sample spikes",
+    ),
 )
 
 
@@ -448,6 +516,12 @@ def _joint_rotation(m, k, mechs, t, tau):
             u = (mech.loop_quadratic(m, p["eps"]) if form == "quadratic" else mech.loop_power(m, p["eps"])) / k
         elif name == "viscous":
             u = viscous_joint(m, t, k, p["T"] * k)
+        elif name == "guys":
+            u = mech.slack_guys_rotation(m, k, p["k_g_rel"] * k, p["theta_s"], p.get("sides", 2))
+        elif name == "preisach":
+            u = mech.preisach_joint_rotation(m, k, p["c"], p["M_max"])
+        elif name == "creep":
+            u = mech.log_creep_rotation(m, t, k, p["phi"], p["t0"])
     if u is None:
         u = m / k
     for name, form, p in mechs:
@@ -468,8 +542,9 @@ def _mast(case: Case, rng) -> dict:
     tau = (t - t[0]) / (t[-1] - t[0])
     M = joint_moments(w)
     theta = np.zeros_like(M)
-    for j in (0, 1):
-        theta[:, j] = _joint_rotation(M[:, j], K_JOINTS[j], case.mechanisms, t, tau)
+    for j in (0, 1):  # a mechanism with "joints" acts on those bending joints only (0: about x, 1: about y)
+        mechs = tuple(mm for mm in case.mechanisms if j in mm[2].get("joints", (0, 1)))
+        theta[:, j] = _joint_rotation(M[:, j], K_JOINTS[j], mechs, t, tau)
     d = top_translation(theta)
     for name, form, p in case.mechanisms:
         if name == "beam":
@@ -494,8 +569,10 @@ def _mast(case: Case, rng) -> dict:
         f = np.hypot(w[:, 0], w[:, 1])
         scale = 0.4 + 1.6 * f / max(f.max(), 1e-12)
         e = [nz.heteroscedastic(rng, scale, sig) for _ in range(3)]
+    elif case.noise == "student":  # heavy tails (a tracker losing the reflector now and then)
+        e = [nz.student_t(rng, case.n, sig, STUDENT_NU) for _ in range(3)]
     else:
-        raise ValueError(f"noise {case.noise!r} is not a mast-top noise model (white, ar1, hetero)")
+        raise ValueError(f"noise {case.noise!r} is not a mast-top noise model (white, ar1, hetero, student)")
     cols = {c: w[:, i] for i, c in enumerate(("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"))}
     for i, c in enumerate(("dx_m", "dy_m", "dz_m")):
         cols[c] = d[:, i] + e[i]
@@ -583,12 +660,43 @@ def _latch(case: Case, rng) -> dict:
         xm, dTm = nz.eq15_measurement(
             rng, xm, dTm, EQ15["C"], EQ15["sigma_T"] * case.level, EQ15["sigma_d"] * case.level
         )
+    elif case.noise == "spikes":  # white load-cell noise and single-sample spikes
+        dTm = dTm + nz.white(rng, x.size, sig) + nz.spikes(rng, x.size, SPIKES, SPIKE_N * case.level)
     else:
-        raise ValueError(f"noise {case.noise!r} is not a latch-pull noise model (white, ar1, eq15)")
+        raise ValueError(f"noise {case.noise!r} is not a latch-pull noise model (white, ar1, eq15, spikes)")
     return {"x_mm": 1e3 * xm, "dT_N": dTm, "t_s": t}
+
+
+# =========================================================================== joint test
+def _joint(case: Case, rng) -> dict:
+    """A connection cycled on an actuator: the BWBN connection driven through a displacement
+    protocol (its force measured), or an elastic connection (with a clearance) driven through a
+    force protocol; both channels measured with noise."""
+    bw = [p for name, _, p in case.mechanisms if name == "bwbn"]
+    if bw:
+        u, _ = conn.cyclic_protocol(JT_AMPS_M, step=JT_STEP_M)
+        F = conn.bwbn_driven(u, conn.BWBN(**bw[0]), substeps=8)
+    else:
+        F, _ = conn.cyclic_protocol(JT_AMPS_N, step=JT_STEP_N)
+        u = F / JT_K
+        for name, _form, p in case.mechanisms:
+            if name == "clearance":
+                u = u + mech.clearance_hertz(F, p["c"], p["k0"], p["K"])
+    n = u.size
+    if case.noise == "white":
+        um = u + nz.white(rng, n, JT_SIGMA_U * case.level)
+        Fm = F + nz.white(rng, n, JT_SIGMA_F * case.level)
+    elif case.noise == "quantised":  # a little noise, then the recorder's resolution
+        um = JT_QUANTUM_U * np.round((u + nz.white(rng, n, 0.3 * JT_QUANTUM_U)) / JT_QUANTUM_U)
+        Fm = JT_QUANTUM_F * np.round((F + nz.white(rng, n, 0.3 * JT_QUANTUM_F)) / JT_QUANTUM_F)
+    else:
+        raise ValueError(f"noise {case.noise!r} is not a joint-test noise model (white, quantised)")
+    return {"F_N": Fm, "u_m": um}
 
 
 def generate(case: Case, seed: int) -> dict:
     """Data columns (in the experiment's units) of one draw of ``case``."""
     rng = np.random.default_rng(seed)
+    if case.experiment == "joint-test":
+        return _joint(case, rng)
     return _mast(case, rng) if case.experiment == "mast-top" else _latch(case, rng)

@@ -258,3 +258,60 @@ def cantilever_compliance(L: float, sections, shear_GA: float | None = None):
     if shear_GA:
         c_f += L / shear_GA
     return c_f, c_m
+
+
+# --------------------------------------------------------------------------- guys, relays, creep
+def slack_guys_rotation(m, k: float, k_g: float, theta_s: float, sides: int = 2) -> np.ndarray:
+    """A joint of stiffness k braced by guys, each slack by the rotation ``theta_s``: one guy per side
+    (``sides`` 2), or one guy only, on the side of positive rotation (``sides`` 1).  A guy pulls once
+    the joint has turned past its slack: ``m = k u + k_g <|u| - theta_s>`` on a braced side, so
+    ``u = m / k`` while ``|m| <= k theta_s``, else ``sign(m) (|m| + k_g theta_s) / (k + k_g)``."""
+    m = np.asarray(m, float)
+    a = np.abs(m)
+    braced = np.where(a <= k * theta_s, m / k, np.sign(m) * (a + k_g * theta_s) / (k + k_g))
+    return braced if sides == 2 else np.where(m > 0, braced, m / k)
+
+
+def preisach_relays(alpha, beta, weights, u) -> np.ndarray:
+    """Preisach operator: the weighted sum of relays along the input history ``u`` (n,).
+
+    Relay j switches to +1 when ``u >= alpha_j`` and to -1 when ``u <= beta_j`` (``alpha_j >=
+    beta_j``), and keeps its state in between; it starts at -1 if ``alpha_j + beta_j > 0``, else +1
+    (the demagnetised state: zero output for a symmetric density).  Returns ``sum_j w_j r_j(t)``."""
+    alpha, beta, w = (np.asarray(v, float) for v in (alpha, beta, weights))
+    if np.any(alpha < beta):
+        raise ValueError("a Preisach relay needs alpha >= beta")
+    r = np.where(alpha + beta > 0, -1.0, 1.0)
+    out = np.empty(len(u))
+    for i, x in enumerate(np.asarray(u, float)):
+        r = np.where(x >= alpha, 1.0, np.where(x <= beta, -1.0, r))
+        out[i] = w @ r
+    return out
+
+
+def preisach_joint_rotation(m, k: float, c: float, M_max: float, n: int = 24) -> np.ndarray:
+    """A joint whose micro-contacts slip by jumps: ``u = m / k + c P(m)`` with the Preisach operator
+    P of relays on a grid of the triangle ``-M_max <= beta <= alpha <= M_max`` weighted by a
+    Gaussian density of the half-width ``(alpha - beta) / 2`` (mean 0.35, sd 0.2 M_max) and of the
+    bias ``(alpha + beta) / 2`` (sd 0.15 M_max); the weights sum to 1, so the slip spans +-c."""
+    g = (np.arange(n) + 0.5) / n * 2.0 * M_max - M_max
+    A, B = np.meshgrid(g, g, indexing="ij")
+    keep = A >= B
+    A, B = A[keep], B[keep]
+    half, bias = 0.5 * (A - B), 0.5 * (A + B)
+    w = np.exp(-0.5 * ((half - 0.35 * M_max) / (0.2 * M_max)) ** 2 - 0.5 * (bias / (0.15 * M_max)) ** 2)
+    w /= w.sum()
+    return np.asarray(m, float) / k + c * preisach_relays(A, B, w, m)
+
+
+def log_creep_rotation(m, t, k: float, phi: float, t0: float) -> np.ndarray:
+    """Linear viscoelastic joint with the logarithmic creep compliance ``J(s) = (1 + phi ln(1 + s/t0)) / k``
+    (s the time since a load change, t0 in s), by Boltzmann superposition of the load steps between
+    samples: ``u_i = sum_{j <= i} (m_j - m_{j-1}) J(t_i - t_j)`` (m_{-1} = 0).  Under a load held
+    from t = 0 the rotation grows as ``ln(1 + t/t0)``; under cycles it lags the load."""
+    m = np.asarray(m, float)
+    t = np.asarray(t, float)
+    dm = np.diff(m, prepend=0.0)
+    s = t[:, None] - t[None, :]
+    J = np.where(s >= 0, 1.0 + phi * np.log1p(np.maximum(s, 0.0) / t0), 0.0) / k
+    return J @ dm

@@ -67,3 +67,21 @@ def eq15_residual_variance(slope, C: float, sigma_T: float, sigma_d: float) -> n
     (N/m) under :func:`eq15_measurement`."""
     s = np.asarray(slope, float)
     return sigma_T**2 * (1.0 + s * C) ** 2 + (s * sigma_d) ** 2
+
+
+def student_t(rng, n: int, sigma: float, nu: float) -> np.ndarray:
+    """Heavy-tailed noise: Student's t with ``nu > 2`` degrees of freedom scaled to the standard
+    deviation sigma (``t sigma sqrt((nu - 2) / nu)``)."""
+    if not nu > 2:
+        raise ValueError(f"Student-t noise needs nu > 2 for a finite variance, got {nu}")
+    return sigma * np.sqrt((nu - 2.0) / nu) * rng.standard_t(nu, n)
+
+
+def spikes(rng, n: int, count: int, size: float) -> np.ndarray:
+    """``count`` single-sample spikes at distinct random rows (none in the first and last 5), each of
+    random sign and a size drawn uniformly in [size / 2, size]; zero elsewhere (a loose connector,
+    electrical interference)."""
+    e = np.zeros(n)
+    rows = rng.choice(np.arange(5, n - 5), size=count, replace=False)
+    e[rows] = rng.choice([-1.0, 1.0], count) * rng.uniform(0.5 * size, size, count)
+    return e

@@ -66,7 +66,8 @@ def mast_path(kind: str, n: int, rng, amplitude_N: float = 10.0, dt_s: float = 0
     from cycle to cycle; ``biaxial`` excursions 0 -> peak -> 0 in changing directions; ``moments``
     force cycles plus independent top-moment cycles (so force and moment are not proportional);
     ``onesided`` pulls along 30 deg that never reverse the load; ``variable_rate`` the cycles30
-    path with slow and fast cycles (time steps 2 s and 0.25 s)."""
+    path with slow and fast cycles (time steps 2 s and 0.25 s); ``holds`` the cycles30 peaks with
+    the load held as long as each ramp lasts at every peak and at zero (a creep test)."""
     ncyc = max(4, n // 60)
     amps = amplitude_N * rng.uniform(0.55, 1.0, ncyc)
     a30 = np.radians(30.0)
@@ -79,6 +80,19 @@ def mast_path(kind: str, n: int, rng, amplitude_N: float = 10.0, dt_s: float = 0
         peaks = np.zeros((2 * ncyc - 1, 2))
         peaks[0::2] = np.column_stack([amps * np.cos(ang), amps * np.sin(ang)])
         f = _ramps(peaks, n)
+    elif kind == "holds":  # cycles30 with the load held at every peak and at zero (a creep test)
+        sgn = np.where(np.arange(ncyc) % 2 == 0, 1.0, -1.0)
+        peaks = np.column_stack([sgn * amps * np.cos(a30), sgn * amps * np.sin(a30)])
+        stops = [np.zeros(2)]
+        for pk in peaks:
+            stops += [pk, np.zeros(2)]
+        seg = n // (2 * len(stops) - 1)  # a ramp and a hold per stop
+        f = [np.zeros((seg, 2))]
+        for a, b in zip(stops[:-1], stops[1:]):
+            q = np.linspace(0.0, 1.0, seg + 1)[1:, None]
+            f += [a + (b - a) * q, np.repeat(b[None], seg, axis=0)]
+        f = np.vstack(f)
+        f = np.vstack([f, np.zeros((n - len(f), 2))]) if len(f) < n else f[:n]
     elif kind == "onesided":
         peaks = np.zeros((2 * ncyc - 1, 2))
         peaks[0::2] = np.column_stack([amps * np.cos(a30), amps * np.sin(a30)])

@@ -19,6 +19,9 @@ Scoring rule (also in the benchmark's docstring and the docs page)
   {X, Y};
 * ``ool`` (out of library): right iff the verdict is ``not_explained`` or ``form_imperfect``
   (no claim that an effect of the library *is* the missing one, and no "nothing is missing");
+* ``time`` (a time-dependent mechanism out of the library, creep): right iff the verdict is
+  ``not_explained``, or names only effects that change with time (``TIME_EFFECTS``): reading
+  creep as a form of friction is wrong;
 * ``null`` redraw: right iff the verdict is ``nothing``; any other verdict is a false alarm.
 
 Score = (number of right effect/pair/ool cases + sum over null cases of the fraction of its
@@ -32,6 +35,7 @@ from __future__ import annotations
 import re
 
 KINDS = ("missing", "form_imperfect", "not_explained", "nothing")
+TIME_EFFECTS = frozenset({"pretension_loss"})  # the library's effects that change with time
 
 _KIND_WORDS = (  # (pattern in a kind field or in the conclusion, kind), first match wins
     (r"form.?imperfect|mechanism found", "form_imperfect"),
@@ -99,6 +103,10 @@ def is_right(expect: str, expected_effects, verdict: dict) -> bool:
         return kind == "nothing"
     if expect == "ool":
         return kind in ("not_explained", "form_imperfect")
+    if expect == "time":
+        return kind == "not_explained" or (
+            kind in ("missing", "form_imperfect") and bool(named) and named <= TIME_EFFECTS
+        )
     if kind not in ("missing", "form_imperfect"):
         return False
     return named == set(expected_effects)

@@ -80,6 +80,10 @@ class Analysis:
         reading the results folder back (which costs about as much as the analysis of a small
         model).  Do not modify the arrays: the same ones are being written to disk.
     observers : more observers of the run (:class:`~femast.analysis.output.Observer`).
+    restart_every : save a restart point every that many converged increments (docs/restart.md);
+        default None: none (a restarted run goes on saving them as before).
+    restart : the results folder of an earlier run of the same model to continue from its last
+        restart point (``femast run SCRIPT --restart FOLDER`` sets it for every analysis of a script).
     linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.solvers.backends`):
         "auto" (default: LAPACK's dense LU up to 64 DOFs; LAPACK's band solver for a narrow reverse
         Cuthill-McKee band, as in a mast; PARDISO, if installed, for other models of 1000 DOFs or
@@ -109,6 +113,7 @@ class Analysis:
         linear_solver: str = "auto",
         max_cutbacks: int = 1000,
     ):
+        _check_model_argument(model, out)
         prepare_kernels()  # the first-run compile notice armed (femast.jit)
         self.model = model
         self.on_frame = on_frame
@@ -323,6 +328,24 @@ class Analysis:
         sparse = any(st.output_frequency > 1 for st in self.model.steps)
         where = "passed to on_frame (out=None: nothing written)" if self.out is None else f"saved in '{self.out}'"
         return where + (" at the steps' output frequency, the last one included" if sparse else "")
+
+
+def _check_model_argument(model, out) -> None:
+    """The first argument is the model: ``fm.solve("results/x", m)`` (the two swapped) or a model
+    of another kind is a one-line ModelError naming what was given and the right call."""
+    from ..model.model import Model
+
+    if isinstance(model, Model):
+        return
+    if isinstance(out, Model):
+        raise ModelError(
+            f"solve/Analysis got the results folder {model!r} first and the model second: "
+            f"the model comes first, fm.solve(model, {str(model)!r})"
+        )
+    raise ModelError(
+        f"solve/Analysis needs a femast Model as its first argument (fm.solve(model, folder)); got "
+        f"{type(model).__name__} {str(model)[:60]!r}"
+    )
 
 
 def solve(model, out="results", **options) -> Results | None:

@@ -31,8 +31,13 @@ class AnalysisSummary:
     def __str__(self):
         state = {"completed": "completed", "interrupted": "INTERRUPTED"}.get(self.status, "FAILED")
         return (
-            f"femast: analysis {state}: {self.increments} increments, {self.iterations} Newton iterations, "
-            f"{self.cutbacks} cutbacks, wall time {self.wall_time:.2f} s "
+            f"femast: analysis {state}: {_count(self.increments, 'increment')}, "
+            f"{_count(self.iterations, 'Newton iteration')}, {_count(self.cutbacks, 'cutback')}, wall time {self.wall_time:.2f} s "
             f"(assembly {self.assembly_time:.2f} s, linear solve {self.solve_time:.2f} s)"
             + (f"\n  {self.message}" if self.message else "")
         )
+
+
+def _count(n: int, noun: str) -> str:
+    """``1 increment``, ``13 increments`` (as femast.text.count; the analysis imports no top-level helpers)."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"

@@ -30,7 +30,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ..errors import ModelError
+from ..errors import ModelError, did_you_mean
 from ..experiments.core import Parameter  # noqa: F401  (re-exported: effects declare Parameters)
 
 
@@ -161,7 +161,9 @@ def get_effect(name: str) -> Effect:
     try:
         return _REGISTRY[name]
     except KeyError:
-        raise ModelError(f"unknown effect '{name}'; accepted effects: {', '.join(sorted(_REGISTRY))}") from None
+        raise ModelError(
+            f"unknown effect '{name}'{did_you_mean(name, _REGISTRY)}; accepted effects: {', '.join(sorted(_REGISTRY))}"
+        ) from None
 
 
 def list_effects() -> tuple:
@@ -201,7 +203,8 @@ def resolve(experiment, names) -> list:
         seen.add(name)
         if name not in _REGISTRY:
             raise ModelError(
-                f"unknown effect '{name}' for {experiment.name}; accepted effects: {', '.join(ok) or '(none)'}"
+                f"unknown effect '{name}' for {experiment.name}{did_you_mean(name, ok or _REGISTRY)}; "
+                f"accepted effects: {', '.join(ok) or '(none)'}"
             )
         eff = _REGISTRY[name]
         impl = eff.implementation(key)

@@ -60,18 +60,27 @@ BEAM_FLEXIBILITY = register_effect(
 )
 
 
-def _off_axis_bay(drive, p, ctx):
-    """Turn the top frame about a vertical axis at p["e"] from the bay axis, towards the centre of
-    side ``options["off_axis_side"]``: the control node moves by (I - R(theta)) c on top of the path."""
-    k = int(ctx["options"].get("off_axis_side", 0))
-    a = np.pi / 2 + k * np.pi / 2
-    cx, cy = p["e"] * np.cos(a), p["e"] * np.sin(a)
+def _turn_about(drive, cx: float, cy: float):
+    """The control path with the top frame turned about a vertical axis through (cx, cy) (m, from the
+    bay axis) instead of the bay axis: the control node moves by (I - R(theta)) c on top of the path."""
     th = drive[:, 0]
     c, s = np.cos(th), np.sin(th)
     out = np.array(drive, dtype=float, copy=True)
     out[:, 1] += cx - (c * cx - s * cy)
     out[:, 2] += cy - (s * cx + c * cy)
     return out
+
+
+def _off_axis_bay(drive, p, ctx):
+    """The rig's axis at (e_x, e_y) from the bay axis: any direction."""
+    return _turn_about(drive, float(p["e_x"]), float(p["e_y"]))
+
+
+def _off_axis_bay_side(drive, p, ctx):
+    """The rig's axis at p["e"] from the bay axis, towards the centre of side ``options["off_axis_side"]``."""
+    k = int(ctx["options"].get("off_axis_side", 0))
+    a = np.pi / 2 + k * np.pi / 2
+    return _turn_about(drive, p["e"] * np.cos(a), p["e"] * np.sin(a))
 
 
 OFF_AXIS = register_effect(
@@ -83,9 +92,10 @@ OFF_AXIS = register_effect(
             "of up to 1 cm in x and y were recorded, so the four latches do not unlatch together.  The idealised "
             "model drives the top by its rotation only (the baseline of bay-torsion follows ux, uy when they are "
             "measured); this effect turns the top frame about a vertical axis at a distance e from the bay axis, "
-            "so the top centre moves by (I - R(theta)) c, |c| = e, on top of the driven path.  By the four-fold "
-            "symmetry of the bay only e counts, not the side it points to.  Without ux, uy this is the unmeasured "
-            "drift of the rig; with them, a measurement point off the frame centre."
+            "so the top centre moves by (I - R(theta)) c on top of the driven path, c = (e_x, e_y) in any direction "
+            "(a square bay repeats itself every 90 degrees, so c and c turned by 90 degrees fit equally well; a "
+            "direction between two sides is another rig).  Without ux, uy this is the unmeasured drift of the rig; "
+            "with them, a measurement point off the frame centre."
         ),
         signature="the latches do not release together: the moment differs where they leave the rollers (zone (c)) "
         "and around release and relatching, where the idealised model has one sharp step",
@@ -97,19 +107,51 @@ OFF_AXIS = register_effect(
                 order=50,
                 parameters=(
                     Parameter(
-                        "e",
+                        "e_x",
+                        "m",
+                        0.0,
+                        -0.05,
+                        0.05,
+                        "x of the rig's rotation axis from the bay axis",
+                        scale=0.01,
+                        starts=(0.007, -0.007),
+                    ),
+                    Parameter(
+                        "e_y",
                         "m",
                         0.01,
-                        0.0,
+                        -0.05,
                         0.05,
-                        "distance of the rig's rotation axis from the bay axis "
-                        "(towards the centre of side off_axis_side)",
+                        "y of the rig's rotation axis from the bay axis",
                         scale=0.01,
+                        starts=(0.007, 0.007),
                     ),
                 ),
                 apply=_off_axis_bay,
-                doc="[ux, uy] += (I - R(theta)) c, c = e (cos a, sin a), a = 90 + 90 k degrees for side k = option "
-                "off_axis_side (side 0: +y).",
+                form="free",
+                doc="[ux, uy] += (I - R(theta)) c, c = (e_x, e_y): the rig turns the top about a vertical axis at "
+                "c, in any direction (the distance is |c|).",
+                forms={
+                    "side": Implementation(
+                        hook="control_path",
+                        order=50,
+                        parameters=(
+                            Parameter(
+                                "e",
+                                "m",
+                                0.01,
+                                0.0,
+                                0.05,
+                                "distance of the rig's rotation axis from the bay axis (towards the centre of side "
+                                "off_axis_side)",
+                                scale=0.01,
+                            ),
+                        ),
+                        apply=_off_axis_bay_side,
+                        doc="[ux, uy] += (I - R(theta)) c, c = e (cos a, sin a), a = 90 + 90 k degrees for side k = "
+                        "option off_axis_side (side 0: +y): the direction known, only the distance fitted.",
+                    )
+                },
             ),
         },
     )

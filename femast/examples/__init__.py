@@ -16,7 +16,7 @@ mast_top_example.csv           mast-top        500 samples of load cycles on a m
 latch_pull_example.csv         latch-pull      two latch pull cycles (synthetic)
 bay_torsion_example.csv        bay-torsion     moment-rotation test of one ADAM bay (synthetic)
 bay_torsion_format.csv         bay-torsion     the bay-torsion format, schematic values only
-tip_cycle_seed001_table1.csv   tip-cycle       seed 001 Table 1 (the seed's FE prediction)
+tip_cycle_seed001_table1.csv   tip-cycle       Table 1 of Stohlman & Pellegrino (their FE prediction)
 vibration_example.csv          vibration       latch resonance at nine tension settings (synthetic)
 platform_pose_example.csv      platform-pose   commanded and measured platform poses (synthetic)
 =============================  ==============  ================================================
@@ -65,11 +65,12 @@ def for_experiment(experiment: str) -> Path:
 
 
 def describe(name: str) -> str:
-    """The first comment line of an example file (what it is)."""
+    """What an example file is: the first sentence of its leading comment block, on one line."""
+    from ..text import first_sentence
+
+    lines = []
     for line in path(name).read_text().splitlines():
-        if line.startswith("#"):
-            text = line.lstrip("# ").strip()
-            if text.count("(") > text.count(")"):  # the remark goes on below: keep the complete part
-                text = text[: text.rindex("(")].rstrip(" ,:;")
-            return text
-    return ""
+        if not line.startswith("#"):
+            break
+        lines.append(line.lstrip("#").strip())
+    return first_sentence(" ".join(lines))

@@ -29,6 +29,8 @@ from .residuals import (
     signatures,
     turning_points,
 )
+from .rows import thin
+from .units import check_data as check_units
 
 
 def load_path(exp: Experiment, data: Measured) -> np.ndarray:
@@ -71,8 +73,12 @@ def compare(
     out=None,
     history: bool = True,
     noise=None,
+    max_rows: int | None = None,
 ) -> OptimizeResult:
     """Run the model variant (baseline + ``effects``) along the measured path of ``data``.
+
+    max_rows : above this many rows (default 10 000), every k-th row is used and a DataWarning
+        says so (:mod:`femast.experiments.rows`).
 
     fit : fit the baseline and effect parameters (:func:`~femast.experiments.fitting.fit`);
         otherwise use ``params`` (baseline ``{name: value}`` and ``"effect.param"`` entries) or the
@@ -87,6 +93,8 @@ def compare(
     ``files``, ``version`` (in the history, or None), ``success``, ``message``.
     """
     exp.require_model("compare")
+    data = thin(data, max_rows, "compare")  # a long record: every k-th row (femast.experiments.rows)
+    check_units(exp, data)  # a unit mistake (mm under an m header) stops here, naming the column
     if isinstance(effects, str):
         effects = [e for e in effects.split(",") if e.strip()]
     effects = list(effects)

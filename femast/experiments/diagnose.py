@@ -65,6 +65,8 @@ from .refits import (  # noqa: F401
     _serial_refits,
 )
 from .residuals import AT_NOISE, at_noise_threshold
+from .rows import thin
+from .units import check_data as check_units
 from .verdict import MIN_SHARE, SIGNIFICANT_DBIC, conclude, flags, pair_candidates, robust_delta, score, share
 
 
@@ -121,8 +123,12 @@ def diagnose(
     scheduler=None,
     out=None,
     pairs: bool = True,
+    max_rows: int | None = None,
 ) -> OptimizeResult:
     """Refit the model with each candidate effect (every form), pairs of the best, and conclude.
+
+    max_rows : above this many rows (default 10 000), every k-th row is used and a DataWarning
+        says so (:mod:`femast.experiments.rows`).
 
     candidates : effect names to try (default: every effect applicable to the experiment and not in
         ``base_effects``); each is fitted in each of its forms (``effect/form``), the information
@@ -146,6 +152,8 @@ def diagnose(
     document), ``executor``, ``files``, ``success``, ``message``.
     """
     exp.require_model("diagnose")
+    data = thin(data, max_rows, "diagnose")  # a long record: every k-th row (femast.experiments.rows)
+    check_units(exp, data)  # a unit mistake (mm under an m header) stops here, naming the column
     # the figure is drawn by a process forked now, which imports matplotlib while this one fits the
     # baseline on the other CPU (FE experiments, local refits; issue 21)
     figs = FigureProcess.start() if out is not None and scheduler is None and exp.fit_options.get("expensive") else None

@@ -82,6 +82,16 @@ SIDE_OUT = 1  # the outer cable (section 2) is loaded: unlatching rig, dT = T2 >
 SIDE_IN = -1  # the inner cable (section 1, through the backstop) is loaded: latching rig, dT = -T1 <= 0
 
 
+SIDE_WINDOW = 5  # rows of the running median the loaded side is read from (spikes of up to 2 rows ignored)
+
+
+def running_median(v, window: int) -> np.ndarray:
+    """Median of each row's centred window of ``window`` (odd) rows, the ends padded with the end values."""
+    h = window // 2
+    p = np.pad(np.asarray(v, float), h, mode="edge")
+    return np.median(np.lib.stride_tricks.sliding_window_view(p, window), axis=1)
+
+
 def infer_side(x, dT) -> np.ndarray:
     """Loaded side (+1 outer cable, -1 inner cable) of each row, inferred from the sign of dT.
 
@@ -91,7 +101,10 @@ def infer_side(x, dT) -> np.ndarray:
     from its second differences) and above 5 % of the largest ``|dT|`` names its side (the second
     differences see only a third of the variance of serially correlated noise -- AR(1), phi = 0.6 --,
     whose excursions out of contact then passed "5 noise" and turned the side in mid-pass; a loaded
-    pass reaches tens of N, 5 % of its peak is many times the noise).  Between the last decisive row of one sign and
+    pass reaches tens of N, 5 % of its peak is many times the noise).  The rows are read through the
+    running median of ``SIDE_WINDOW`` = 5 rows: a loaded pass lasts many samples, while a spike of the
+    load cell (one or two samples of the wrong sign, electrical interference, a loose connector) does not
+    move a median of five and so cannot turn the side.  Between the last decisive row of one sign and
     the first of the other the loaded cable changes; the change is placed just after the farthest
     point reached in the old pass's direction of pull (the outermost x when the outer cable was
     loaded, the innermost when the inner one was), where the rig is turned round.  Rows before the
@@ -100,12 +113,13 @@ def infer_side(x, dT) -> np.ndarray:
     x = np.asarray(x, float)
     dT = np.asarray(dT, float)
     n = dT.size
-    thr = max(5.0 * noise_floor(dT), 0.05 * float(np.max(np.abs(dT), initial=0.0)), 1e-9)
-    dec = np.flatnonzero(np.abs(dT) > thr)
+    med = running_median(dT, SIDE_WINDOW)
+    thr = max(5.0 * noise_floor(dT), 0.05 * float(np.max(np.abs(med), initial=0.0)), 1e-9)
+    dec = np.flatnonzero(np.abs(med) > thr)
     side = np.full(n, SIDE_OUT, dtype=np.int64)
     if dec.size == 0:
         return side
-    sg = np.where(dT[dec] > 0, SIDE_OUT, SIDE_IN)
+    sg = np.where(med[dec] > 0, SIDE_OUT, SIDE_IN)
     cur, start = int(sg[0]), 0
     for a, b, sa, sb in zip(dec[:-1], dec[1:], sg[:-1], sg[1:]):
         if sb == sa:

@@ -369,7 +369,10 @@ def with_correlation(model: ChannelNoise, r, pinned=None) -> ChannelNoise:
         kind = "ar1" if base_kind == "white" else base_kind + "+ar1"
     else:
         phi = 0.0
-        why = f"no serial correlation (lag-1 autocorrelation {phi_hat:.2f} <= {thr:.2f}, the 99th percentile on white noise)"
+        if phi_hat > thr:  # the residual is correlated, its differences are not: a slow model error
+            why = f"no serial correlation in the noise: the residual's lag-1 autocorrelation {phi_hat:.2f} is above {thr:.2f} (the 99th percentile on white noise), but its differences allow at most {cap:.2f}: a slowly varying model error, not correlated noise"  # noqa: E501
+        else:
+            why = f"no serial correlation (lag-1 autocorrelation {phi_hat:.2f} <= {thr:.2f}, the 99th percentile on white noise)"
         kind = base_kind
     sigma = model.sigma * math.sqrt(ar1_factor(phi0) / ar1_factor(phi))
     return ChannelNoise(

@@ -12,7 +12,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..effects.base import load_script
-from ..errors import ModelError
+from ..errors import ModelError, did_you_mean
 from .core import Experiment
 
 _EXPERIMENTS: dict[str, Experiment] = {}
@@ -68,8 +68,8 @@ def get_experiment(name_or_path, **options) -> Experiment:
             exp = _EXPERIMENTS[key]
         except KeyError:
             raise ModelError(
-                f"unknown experiment '{key}'; accepted: {', '.join(_EXPERIMENTS)} or the path of a "
-                "Python script defining `experiment`"
+                f"unknown experiment '{key}'{did_you_mean(key, _EXPERIMENTS)}; accepted: "
+                f"{', '.join(_EXPERIMENTS)} or the path of a Python script defining `experiment`"
             ) from None
     return exp.with_options(**options) if options else exp
 

@@ -18,7 +18,8 @@ from ..errors import ModelError
 @dataclass(frozen=True)
 class Amplitude:
     """Piecewise-linear amplitude: ``times`` (step time, s, increasing) and ``values``
-    (dimensionless factors).  Outside the table the end values are held."""
+    (dimensionless factors).  Outside the table the end values are held.  ``name`` labels it in
+    messages."""
 
     times: np.ndarray
     values: np.ndarray

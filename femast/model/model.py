@@ -133,8 +133,10 @@ class Step:
     _model: Model = field(default=None, repr=False)
 
     def load(self, node, amplitude: Amplitude | None = None, **components):
-        """Nodal force/moment at the end of the step: ``step.load(n, fx=10.0, mz=-2.0)`` (N, N m,
-        global axes, fixed directions).  A load not redefined in a later step stays applied."""
+        """Nodal force/moment on ``node`` at the end of the step: ``step.load(n, fx=10.0, mz=-2.0)``;
+        ``components`` fx, fy, fz (N) and mx, my, mz (N m), global axes, fixed directions.  The load
+        ramps linearly in step time, or follows ``amplitude`` (an :class:`Amplitude` of step time).
+        A load not redefined in a later step stays applied."""
         self._model._check_node(node, f"load in step '{self.name}'")
         if not components:
             raise ModelError(f"step '{self.name}': load on node {node} has no components; give e.g. fx=1.0")
@@ -150,8 +152,9 @@ class Step:
         return self
 
     def prescribe(self, node, amplitude: Amplitude | None = None, **components):
-        """Prescribed displacement/rotation at the end of the step: ``step.prescribe(n, ux=0.01,
-        rz=0.05)`` (m, rad).  A prescribed rotation component is the accumulated spin about that
+        """Prescribed displacement/rotation of ``node`` at the end of the step: ``step.prescribe(n, ux=0.01,
+        rz=0.05)``; ``components`` ux, uy, uz (m) and rx, ry, rz (rad), reached linearly in step time
+        or along ``amplitude``.  A prescribed rotation component is the accumulated spin about that
         global axis (exact when the other two rotation components are held)."""
         self._model._check_node(node, f"prescribed motion in step '{self.name}'")
         if not components:
@@ -189,7 +192,8 @@ def _step_temperature(self, T, elements=None, family=None, where=None, amplitude
 def _step_rotate(self, node, axis, angle: float, amplitude: Amplitude | None = None):
     """Prescribe a rotation of ``node`` by ``angle`` (rad) about the fixed global ``axis`` (any
     direction) at the end of the step: the three rotation components are driven together, which
-    is exact for a rotation about a fixed axis."""
+    is exact for a rotation about a fixed axis.  The angle is reached linearly in step time, or
+    along ``amplitude`` (an :class:`Amplitude` of step time)."""
     a = np.asarray(axis, dtype=float)
     if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) == 0:
         raise ModelError(f"step '{self.name}': rotation axis {axis!r} must be a non-zero 3-vector")
@@ -212,7 +216,7 @@ Step.follow = _step_follow
 
 
 class Model:
-    """A structural model: nodes (6 DOF each), element families, fixed DOFs and steps.
+    """A structural model called ``name``: nodes (6 DOF each), element families, fixed DOFs and steps.
 
     ``model.beams`` and ``model.trusses`` are the lists of beam and truss element specs; called,
     they add many elements from arrays at once (``model.beams(pairs, section, up=...)``,
@@ -256,7 +260,7 @@ class Model:
         return label
 
     def nodes(self, coords) -> list[int]:
-        """Add several nodes from an (n, 3) array of coordinates (m), labelled on from the largest
+        """Add several nodes from ``coords``, an (n, 3) array of coordinates (m), labelled on from the largest
         label so far (as repeated :meth:`node` calls, checked at once); returns their labels."""
         return add_nodes(self, coords)
 
@@ -317,6 +321,7 @@ class Model:
         created in between).  ``up`` (global vector) sets the local y axis: it is made
         orthogonal to the element; Iz resists bending in the plane of the axis and ``up``.
         ``mass_per_length`` (kg/m) overrides the section's ``rho * A`` for modal analyses.
+        ``family`` names the element family (its output key in the results, ``el/<family>/...``).
         ``length_error_m`` (m): the member is stress free when that much longer than its nodes'
         distance (lack of fit, spread evenly over its ``n`` elements); ``alpha_per_K`` (1/K): its
         coefficient of thermal expansion (see :meth:`length_error`, :meth:`thermal_expansion`).
@@ -383,7 +388,8 @@ class Model:
     ) -> np.ndarray:
         """One truss (cable with ``tension_only``) per row of ``nodes`` ((n, 2) node labels), as
         :meth:`truss` for each row but checked at once; also ``model.trusses(...)``.  ``EA`` (N),
-        ``L0`` (m), ``pretension`` (N) and the rest: shared or one per element.  Returns the labels."""
+        ``L0`` (m), ``pretension`` (N), ``family`` (name), ``mass_per_length`` (kg/m),
+        ``length_error_m`` (m), ``alpha_per_K`` (1/K): shared or one per element.  Returns the labels."""
         return add_trusses(
             self, nodes, EA, L0, pretension, tension_only, family, mass_per_length, length_error_m, alpha_per_K
         )
@@ -403,7 +409,7 @@ class Model:
         return set_length_errors(self, elements, dL_m)
 
     def thermal_expansion(self, alpha_per_K, elements=None, family=None, where=None):
-        """Coefficient of thermal expansion (1/K; one value or one per element) of beam and truss
+        """Coefficient of thermal expansion ``alpha_per_K`` (1/K; one value or one per element) of beam and truss
         elements picked by labels, family name or region (``where``: a function of the element
         midpoint, m); none: all.  Returns the labels."""
         from .thermal import set_expansion
@@ -411,8 +417,10 @@ class Model:
         return set_expansion(self, alpha_per_K, elements, family, where)
 
     def initial_temperature(self, T, elements=None, family=None, where=None):
-        """Initial temperature (K or degC, default 0) of beam and truss elements (as Abaqus *INITIAL
-        CONDITIONS, TYPE=TEMPERATURE): the elements are stress free at it.  Returns the labels."""
+        """Initial temperature ``T`` (K or degC, default 0) of beam and truss elements (as Abaqus *INITIAL
+        CONDITIONS, TYPE=TEMPERATURE): the elements are stress free at it.  Picked by ``elements``
+        (labels), ``family`` (name) or ``where`` (a function of the element midpoint, m); none: all.
+        Returns the labels."""
         from .thermal import set_initial_temperature
 
         return set_initial_temperature(self, T, elements, family, where)
@@ -435,7 +443,8 @@ class Model:
         initial geometry; neither means stress-free.  ``mass_per_length`` (kg/m of the initial
         length; modal analyses): consistent mass for trusses, lumped at the ends for cables.
         ``length_error_m`` (m): stress free at the unstretched length + this (lack of fit);
-        ``alpha_per_K`` (1/K): coefficient of thermal expansion.  Returns the element label."""
+        ``alpha_per_K`` (1/K): coefficient of thermal expansion.  ``family``: the element family's
+        name (default "truss", or "cable" with ``tension_only``).  Returns the element label."""
         self._check_node(n1, "truss")
         self._check_node(n2, "truss")
         EA = _finite(EA, f"truss {n1}-{n2}: EA", "N")
@@ -474,7 +483,7 @@ class Model:
 
     # ------------------------------------------------------- boundary conditions
     def fix(self, node, *dofs):
-        """Fix DOFs of ``node`` at zero for the whole analysis: ``fix(n)`` fixes all six,
+        """Fix ``dofs`` of ``node`` at zero for the whole analysis: ``fix(n)`` fixes all six,
         ``fix(n, "ux", "rz")`` some (names ux, uy, uz, rx, ry, rz; "translations", "rotations")."""
         self._check_node(node, "fix")
         self.fixed.setdefault(int(node), set()).update(_fixed_dofs(node, dofs))
@@ -483,8 +492,8 @@ class Model:
     def point_mass(self, node, mass: float = 0.0, inertia=None, offset=None, name: str = ""):
         """A mass ``mass`` (kg) with rotary ``inertia`` (kg m^2 about its centre of mass: a scalar,
         3 principal values along the global axes or a 3x3 matrix, initial global axes) at
-        ``node``, its centre of mass ``offset`` (m) from the node (modal analyses, issue 18).
-        Returns the :class:`femast.modal.mass.PointMassSpec`."""
+        ``node``, its centre of mass ``offset`` (m) from the node (modal analyses); ``name`` labels
+        it in messages.  Returns the :class:`femast.modal.mass.PointMassSpec`."""
         from ..modal.mass import point_mass_spec
 
         self._check_node(node, "point mass")
@@ -498,7 +507,7 @@ class Model:
         follow.  The reference node may be a node without elements (e.g. a control node).
         ``mass`` (kg) and ``inertia`` (kg m^2 about the centre of mass, see :meth:`point_mass`)
         of the body, its centre of mass at ``centre`` (m, global; default the reference node),
-        are a point mass at the reference node."""
+        are a point mass at the reference node.  ``name`` labels the body (default rigid-1...)."""
         from .constraints import rigid_body_spec
 
         name = name or f"rigid-{len(self.rigid_bodies) + 1}"
@@ -521,7 +530,8 @@ class Model:
 
     # ----------------------------------------------------------------- steps
     def step(self, name: str | None = None, **options) -> Step:
-        """Append a static step; options are :class:`Step` fields (period, increments, control...)."""
+        """Append a static step called ``name`` (default Step-1, Step-2...); options are :class:`Step`
+        fields: ``period`` (s), ``initial_increment``, ``max_increments``, ``control``... Returns it."""
         name = name or f"Step-{len(self.steps) + 1}"
         if any(s.name == name for s in self.steps):
             raise ModelError(f"step '{name}' is defined twice; step names must be unique")
@@ -547,8 +557,10 @@ class Model:
     def frequency_step(
         self, name: str | None = None, n_modes: int = 10, shift_hz: float | None = None, vtk: bool = False
     ):
-        """Append a step that computes the lowest ``n_modes`` vibration modes of the state reached so
-        far (prestress and loads included; see :mod:`femast.modal.step`); returns it."""
+        """Append a step called ``name`` that computes the lowest ``n_modes`` vibration modes of the
+        state reached so far (prestress and loads included; see :mod:`femast.modal.step`): the modes
+        nearest ``shift_hz`` (Hz) when given, else the lowest; ``vtk=True`` also writes an animated
+        VTK series per mode.  Returns it."""
         from ..modal.step import add_frequency_step
 
         return add_frequency_step(self, name, n_modes, shift_hz, vtk)

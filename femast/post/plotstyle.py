@@ -74,9 +74,34 @@ def pyplot():
     return plt
 
 
-def display_scale(unit: str):
-    """(factor, label) to show values of SI ``unit`` in a readable unit (m -> mm, rad -> mrad)."""
-    return _SCALES.get(unit, (1.0, unit))
+# units for the magnitude shown: (largest |value| below which the unit is used, factor, label),
+# smallest first; above the last bound the SI unit itself
+_BY_MAGNITUDE = {
+    "m": ((1e-6, 1e9, "nm"), (1e-3, 1e6, "um"), (1.0, 1e3, "mm")),
+    "rad": ((1e-3, 180.0 * 3600.0 / math.pi, "arcsec"), (0.05, 1e3, "mrad"), (math.inf, 180.0 / math.pi, "deg")),
+    "N": ((1.0, 1e3, "mN"), (1e4, 1.0, "N"), (math.inf, 1e-3, "kN")),
+    "N m": ((1.0, 1e3, "N mm"), (1e4, 1.0, "N m"), (math.inf, 1e-3, "kN m")),
+    "Pa": ((1e3, 1.0, "Pa"), (1e6, 1e-3, "kPa"), (1e9, 1e-6, "MPa"), (math.inf, 1e-9, "GPa")),
+}
+
+
+def display_scale(unit: str, values=None):
+    """(factor, label) to show values of SI ``unit`` in a readable unit: with ``values`` (an array
+    or a number), the unit that suits their size (a largest |value| of 7e-5 m shows as 70 um,
+    3e-6 rad as 0.6 arcsec, 0.02 m as 20 mm); without, the default (m -> mm, rad -> mrad)."""
+    if values is None or unit not in _BY_MAGNITUDE:
+        return _SCALES.get(unit, (1.0, unit))
+    import numpy as np
+
+    v = np.abs(np.asarray(values, dtype=float))
+    v = v[np.isfinite(v)]
+    top = float(v.max()) if v.size else 0.0
+    if top == 0.0:
+        return _SCALES.get(unit, (1.0, unit))
+    for bound, factor, label in _BY_MAGNITUDE[unit]:
+        if top < bound:
+            return factor, label
+    return 1.0, unit
 
 
 def split_column(name: str):

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .plotstyle import display_scale
 from .results import Results
 
 
@@ -21,8 +22,11 @@ def render_png(
     title: str | None = None,
 ) -> Path:
     """Render frame ``frame`` of ``results`` to ``png``; displacements magnified by ``scale``.
-    ``color_by``: '|U|' (displacement magnitude, m) or None.  Orthographic isometric view, the
-    undeformed shape in grey and labelled, a vertical colour bar with its unit."""
+    ``color_by``: '|U|' (displacement magnitude) or None.  Orthographic isometric view, the
+    undeformed shape in grey and labelled, a vertical colour bar in the unit that suits the
+    displacements (um, mm or m).  ``show_undeformed``: draw the initial shape in grey;
+    ``window_size``: (width, height) of the image in pixels; ``title``: the caption (default: the
+    folder, the frame and its step).  Returns the PNG's path."""
     if not os.environ.get("DISPLAY"):
         # headless: render through EGL, which VTK's wheels ship (no X server, no OSMesa needed)
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
@@ -47,8 +51,10 @@ def render_png(
         plotter.add_mesh(pv.PolyData(res.X, lines=lines), color="darkgray", line_width=2)
         legend.append(["undeformed shape", "darkgray"])
     deformed = pv.PolyData(pts, lines=lines)
+    umag = np.linalg.norm(fr["U"], axis=1)
+    factor, unit = display_scale("m", umag)  # um for um-scale motion, mm for mm-scale...
     bar = dict(
-        title="displacement (m)",
+        title=f"displacement ({unit})",
         vertical=True,
         position_x=0.84,
         position_y=0.15,
@@ -61,8 +67,8 @@ def render_png(
         color="black",
     )
     if color_by == "|U|":
-        deformed["displacement (m)"] = np.linalg.norm(fr["U"], axis=1)
-        plotter.add_mesh(deformed, scalars="displacement (m)", line_width=4, cmap="viridis", scalar_bar_args=bar)
+        deformed[bar["title"]] = factor * umag
+        plotter.add_mesh(deformed, scalars=bar["title"], line_width=4, cmap="viridis", scalar_bar_args=bar)
         legend.append([f"deformed shape, displacements x {scale:g}", "coloured"])
     else:
         plotter.add_mesh(deformed, color="green", line_width=4)
@@ -92,8 +98,9 @@ def render_png(
 
 
 def largest_displacement_frame(results) -> tuple[int, float]:
-    """(frame index, largest nodal |U| in m) of the frame whose largest nodal displacement
-    magnitude is the largest of the run (the first such frame on ties)."""
+    """(frame index, largest nodal |U| in m) of the frame of ``results`` (a Results or a results
+    folder) whose largest nodal displacement magnitude is the largest of the run (the first such
+    frame on ties)."""
     res = results if isinstance(results, Results) else Results(results)
     best, umax = 0, -1.0
     for i in range(len(res)):

@@ -59,33 +59,9 @@ from .folder import (
     own_dir,
     read_json,
 )
+from .histories import Histories
 from .npz import LOG_NAME, RECORD_MAGIC, TMP_SUFFIX, append_record, record_bytes, scan_log, truncate_log  # noqa: F401
 from .summary_check import check_summary
-
-_COMPONENTS = {
-    "ux": ("U", 0),
-    "uy": ("U", 1),
-    "uz": ("U", 2),
-    "urx": ("URA", 0),
-    "ury": ("URA", 1),
-    "urz": ("URA", 2),
-    "rx": ("URA", 0),
-    "ry": ("URA", 1),
-    "rz": ("URA", 2),
-    "rfx": ("RF", 0),
-    "rfy": ("RF", 1),
-    "rfz": ("RF", 2),
-    "rmx": ("RF", 3),
-    "rmy": ("RF", 4),
-    "rmz": ("RF", 5),
-    "fx": ("P", 0),
-    "fy": ("P", 1),
-    "fz": ("P", 2),
-    "mx": ("P", 3),
-    "my": ("P", 4),
-    "mz": ("P", 5),
-}
-
 
 _FRAME_NAME = re.compile(r"^\d+\.npz$")
 
@@ -115,13 +91,15 @@ from .writer import (  # noqa: E402,F401 (the writer's names, where they were)
 )
 
 
-class Results:
+class Results(Histories):
     """Read a results folder: ``Results("results/run")``.
 
     ``len(results)`` frames (converged increments, frame 0 is the initial state);
-    ``results.frame(i)`` a dict of arrays; ``results.node_history(label, "uz")`` a time
-    history (components ux uy uz, rx ry rz (accumulated spins), rfx..rmz reactions,
-    fx..mz applied loads); ``results.element_history(family, label, name, column)``.
+    ``results.frame(i)`` a dict of arrays (SI units: m, rad, N, N m), ``results.frame(step="load")``
+    the last frame of a step; ``results.node_history(label, "uz")`` a history over the frames
+    (components ux uy uz in m, rx ry rz accumulated rotations in rad, rfx..rfz reactions in N,
+    rmx..rmz in N m, fx..mz applied loads); ``results.element_history(family, label, name)``;
+    ``results.time`` the total time of each frame, ``results.steps`` the step name of each frame.
     """
 
     def __init__(self, folder):
@@ -208,8 +186,16 @@ class Results:
     def families(self) -> list[str]:
         return [str(f) for f in self.mesh["families"]]
 
-    def frame(self, i: int) -> dict:
-        """The arrays of frame ``i`` (0 = initial state; negative counts from the end)."""
+    def frame(self, i: int | None = None, *, step: str | None = None, index: int = -1) -> dict:
+        """The arrays of frame ``i`` (0 = initial state; negative counts from the end), or with
+        ``step``, frame ``index`` of that step (``res.frame(step="load")``: its last converged
+        increment; ``index=0`` its first; :meth:`frame_number` gives the frame's number)."""
+        if step is not None:
+            if i is not None:
+                raise FemastError("give a frame number or step=NAME (with index=), not both")
+            i = self.frame_number(step, index)
+        elif i is None:
+            raise FemastError("give a frame number (0 = initial state, -1 = last) or step=NAME")
         try:
             i = range(len(self.files))[int(i)]
         except IndexError:
@@ -235,52 +221,6 @@ class Results:
                     "the file is damaged: rerun the analysis"
                 ) from None
         return self._cache[i]
-
-    def _node_row(self, label):
-        rows = np.flatnonzero(self.node_labels == int(label))
-        if rows.size == 0:
-            raise FemastError(
-                f"node {label} is not in these results (labels {self.node_labels.min()}..{self.node_labels.max()})"
-            )
-        return int(rows[0])
-
-    def scalar_history(self, name: str) -> np.ndarray:
-        """History of a frame scalar: time, total_time, load_factor, increment, iterations."""
-        return np.array([float(self.frame(i)[name]) for i in range(len(self))])
-
-    @property
-    def time(self):
-        return self.scalar_history("total_time")
-
-    @property
-    def steps(self):
-        return [str(self.frame(i)["step"]) for i in range(len(self))]
-
-    def node_history(self, label, component: str) -> np.ndarray:
-        """History of one nodal quantity (see class docstring) over all frames."""
-        key = component.lower()
-        if key not in _COMPONENTS:
-            raise FemastError(f"unknown nodal component '{component}'; use one of {', '.join(_COMPONENTS)}")
-        arr, col = _COMPONENTS[key]
-        row = self._node_row(label)
-        return np.array([self.frame(i)[arr][row, col] for i in range(len(self))])
-
-    def element_history(self, family: str, label: int, name: str) -> np.ndarray:
-        """History of element output ``name`` (e.g. 'section_forces', 'N') of element ``label``."""
-        if family not in self.families:
-            raise FemastError(f"no element family '{family}' in these results; families: {', '.join(self.families)}")
-        rows = np.flatnonzero(self.mesh[f"labels/{family}"] == int(label))
-        if rows.size == 0:
-            raise FemastError(f"element {label} is not in family '{family}'")
-        key = f"el/{family}/{name}"
-        if key not in self.frame(0):
-            names = [k.split("/")[-1] for k in self.frame(0) if k.startswith(f"el/{family}/")]
-            raise FemastError(f"family '{family}' has no output '{name}'; it has {', '.join(names)}")
-        return np.array([self.frame(i)[key][rows[0]] for i in range(len(self))])
-
-    def positions(self, i: int) -> np.ndarray:
-        """Current nodal positions (m) at frame i."""
-        return self.X + self.frame(i)["U"]
 
 
 DOF_COMPONENTS = DOF_NAMES

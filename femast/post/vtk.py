@@ -46,7 +46,10 @@ def _cell_fields(frame, families, sizes):
 
 def export_vtk(results, folder=None, every: int = 1) -> Path:
     """Write ``<folder>/frame_000001.vtu``... and ``<folder>/series.pvd`` from ``results``
-    (a :class:`~femast.post.results.Results` or a results folder).  Returns the .pvd path."""
+    (a :class:`~femast.post.results.Results` or a results folder), every ``every``-th frame.
+    ``folder`` defaults to ``<results folder>/vtk`` (where ``femast vtk RESULTS`` writes too).
+    Point data: ``U`` (m), ``UR`` and ``URA`` (rad), ``RF`` (N, N m); cell data: each family's
+    outputs (N, N m).  Returns the .pvd path."""
     if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
         raise FemastError(f"every = {every!r}: give a whole number >= 1 (write every n-th frame)")
     res = results if isinstance(results, Results) else Results(results)

@@ -17,13 +17,30 @@ from ..workers import cpu_count
 EXIT_FAILED_SAMPLES = 3
 
 
+def script_path(text) -> Path:
+    """The file of a study script: a path, or the name of an installed module
+    (``femast.benchmarks.study_guyed``: the docs' studies, from any folder)."""
+    p = Path(text)
+    if p.is_file():
+        return p
+    name = str(text)
+    if p.suffix != ".py" and all(part.isidentifier() for part in name.split(".")):
+        import importlib.util
+
+        try:
+            spec = importlib.util.find_spec(name)
+        except (ImportError, ValueError):
+            spec = None
+        if spec is not None and spec.origin and spec.origin.endswith(".py"):
+            return Path(spec.origin)
+    raise StudyError(f"no such study script: {p} (give the path of a .py file or an installed module's name)")
+
+
 def load_script(path) -> Study:  # noqa: F821
     """The ``study`` defined by the script at ``path``."""
     from .study import Study
 
-    p = Path(path)
-    if not p.is_file():
-        raise StudyError(f"no such study script: {p}")
+    p = script_path(path)
     ns = runpy.run_path(str(p), run_name="__femast_study__")
     s = ns.get("study")
     if not isinstance(s, Study):
@@ -40,7 +57,7 @@ def _study(args):
     if args.workers is not None and args.scheduler is not None:
         raise StudyError("give --workers (local processes) or --scheduler (a dask cluster), not both")
     study = load_script(args.script)
-    out = args.out or str(Path("studies") / Path(args.script).stem)
+    out = args.out or str(Path("studies") / script_path(args.script).stem)
     workers = args.workers if args.workers is not None else cpu_count()
     try:
         s = run(study, out, samples=args.samples, workers=workers, scheduler=args.scheduler, chunk_size=args.chunk_size)
@@ -84,7 +101,11 @@ def register(sub, help_formatter):
         "every run succeeded; 3: some runs failed (listed by femast.studies.load(OUT)"
         ".failures()); 2: the study could not run; 130: interrupted.",
     )
-    p.add_argument("script", help="Python file defining study = femast.studies.Study(...)")
+    p.add_argument(
+        "script",
+        help="Python file defining study = femast.studies.Study(...), or an installed module's name "
+        "(femast.benchmarks.study_guyed)",
+    )
     p.add_argument(
         "--samples",
         type=int,

@@ -217,18 +217,6 @@ def test_render_defaults_to_the_largest_displacement(tmp_path, monkeypatch, caps
     assert f"frame {len(res) - 1} of {len(res)}" in capsys.readouterr().out
 
 
-def test_vtk_writes_into_the_working_directory_by_default(tmp_path, monkeypatch, capsys):
-    """Like render (./render/), vtk writes ./vtk/NAME/series.pvd, not into the results folder."""
-    _load_unload(tmp_path / "lu")
-    work = tmp_path / "work"
-    work.mkdir()
-    monkeypatch.chdir(work)
-    assert main(["vtk", str(tmp_path / "lu")]) == 0
-    pvd = work / "vtk" / "lu" / "series.pvd"
-    assert pvd.is_file() and str(Path("vtk") / "lu" / "series.pvd") in capsys.readouterr().out
-    assert not (tmp_path / "lu" / "vtk").exists()
-
-
 # ------------------------------------------------------------------ docs index
 def test_index_has_the_task_entries_and_its_links_resolve():
     import re

@@ -83,9 +83,13 @@ def test_misnamed_column_suggests_the_right_name(tmp_path):
     p = _write(tmp_path, ["# a comment first", HEADER.replace("fy_N", "fy")] + _rows())
     with pytest.raises(DataFileError, match=r"line 2: column 'fy' is not a mast-top column \(did you mean 'fy_N'\?\)"):
         read_data(MT, p)
-    p = _write(tmp_path, [HEADER.replace("dx_m", "dx_mm")] + _rows())
+    p = _write(tmp_path, [HEADER.replace("dx_m", "dx_mn")] + _rows())  # a typo, not a unit
     with pytest.raises(DataFileError, match=r"did you mean 'dx_m'"):
         read_data(MT, p)
+    # a unit suffix is a unit: dx_mm is read as dx_m, in mm (docs/experiments.md, "Units of the data")
+    p = _write(tmp_path, [HEADER.replace("dx_m", "dx_mm")] + _rows())
+    q = _write(tmp_path, [HEADER] + _rows(), name="m.csv")
+    np.testing.assert_allclose(read_data(MT, p)["dx_m"], 1e-3 * read_data(MT, q)["dx_m"], rtol=1e-15)
 
 
 def test_nan_cell(tmp_path):
@@ -144,10 +148,10 @@ def test_no_header_duplicate_column_time_backwards_missing_file(tmp_path):
 
 
 def test_latch_pull_bad_column_lists_the_latch_columns(tmp_path):
-    p = _write(tmp_path, ["x_m,dT_N"] + [f"{i},{i}" for i in range(12)])
+    p = _write(tmp_path, ["x_mn,dT_N"] + [f"{i},{i}" for i in range(12)])
     with pytest.raises(
         DataFileError,
-        match=r"column 'x_m' is not a latch-pull column \(did you mean 'x_mm'\?\); "
+        match=r"column 'x_mn' is not a latch-pull column \(did you mean 'x_mm'\?\); "
         r"accepted columns: x_mm, dT_N, side \(optional\), t_s \(optional\)",
     ):
         read_data(get_experiment("latch-pull"), p)
@@ -185,7 +189,7 @@ experiment = Experiment(name="rig-x", title="a rig whose model is not written ye
 def test_unknown_and_pending_experiments(tmp_path):
     with pytest.raises(
         ModelError,
-        match=r"unknown experiment 'mast'; accepted: mast-top, latch-pull, bay-torsion, "
+        match=r"unknown experiment 'mast' \(did you mean 'mast-top'\?\); accepted: mast-top, latch-pull, bay-torsion, "
         r"tip-cycle, vibration, platform-pose or the path of a Python script",
     ):
         get_experiment("mast")

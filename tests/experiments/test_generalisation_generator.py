@@ -322,3 +322,53 @@ def test_docs_page_example_runs():
     from doc_examples import run_python_blocks
 
     run_python_blocks("diagnose_generalisation.md", cwd=BENCH.parent)
+
+
+# --------------------------------------------------------------------------- guys, relays, creep, heavy tails
+def test_slack_guys_are_in_equilibrium_and_engage_past_the_slack():
+    k, k_g, th_s = 2.5e5, 2.5e5, 0.7e-4
+    m = np.linspace(-60.0, 60.0, 241)
+    u = mech.slack_guys_rotation(m, k, k_g, th_s)
+    np.testing.assert_allclose(k * u + k_g * np.sign(u) * np.maximum(np.abs(u) - th_s, 0.0), m, rtol=1e-12, atol=1e-12)
+    inside = np.abs(m) <= k * th_s
+    np.testing.assert_allclose(u[inside], m[inside] / k)
+    one = mech.slack_guys_rotation(m, k, k_g, th_s, sides=1)  # one guy, on the positive side
+    np.testing.assert_allclose(k * one + k_g * np.maximum(one - th_s, 0.0), m, rtol=1e-12, atol=1e-12)
+
+
+def test_preisach_with_uniform_symmetric_relays_has_the_everett_branch():
+    # relays (a, -a), a uniform on [0, A]: from negative saturation the ascending branch is 2 m / A - 1
+    A = 10.0
+    a = (np.arange(2000) + 0.5) / 2000 * A
+    u = np.concatenate([np.linspace(0, -A, 101), np.linspace(-A, A, 401)[1:]])
+    out = mech.preisach_relays(a, -a, np.full(a.size, 1 / a.size), u)
+    up = u[101:]
+    rising = up > 0
+    np.testing.assert_allclose(out[101:][rising], 2 * up[rising] / A - 1, atol=1e-3)
+    np.testing.assert_allclose(out[101:][~rising], -1.0)
+    with pytest.raises(ValueError, match="alpha >= beta"):
+        mech.preisach_relays([0.0], [1.0], [1.0], u)
+
+
+def test_log_creep_under_a_held_load_and_superposition():
+    k, phi, t0, m0 = 2.5e5, 0.05, 2.0, 30.0
+    t = np.linspace(0.0, 100.0, 201)
+    m = np.full(t.size, m0)
+    np.testing.assert_allclose(mech.log_creep_rotation(m, t, k, phi, t0), m0 * (1 + phi * np.log1p(t / t0)) / k)
+    # loading then unloading at t = 50 s: the recovery is the difference of the two step responses
+    m2 = np.where(t < 50.0, m0, 0.0)
+    late = t >= 50.0
+    ref = m0 * phi * (np.log1p(t[late] / t0) - np.log1p((t[late] - 50.0) / t0)) / k
+    np.testing.assert_allclose(mech.log_creep_rotation(m2, t, k, phi, t0)[late], ref, rtol=1e-12, atol=1e-18)
+
+
+def test_heavy_tailed_noise_and_spikes():
+    rng = np.random.default_rng(3)
+    e = nz.student_t(rng, 200_000, 2.0, 3.0)
+    # quartiles of Student's t with 3 degrees of freedom: +-0.76489, scaled by sigma sqrt(1/3)
+    q1, q3 = np.percentile(e, [25, 75])
+    np.testing.assert_allclose([q1, q3], np.array([-0.76489, 0.76489]) * 2.0 / np.sqrt(3.0), rtol=0.02)
+    assert np.mean(np.abs(e) > 4 * 2.0) > 10 * 6.3e-5  # far more 4-sigma rows than a normal's 6.3e-5
+    s = nz.spikes(rng, 300, 12, 10.0)
+    assert np.count_nonzero(s) == 12 and np.all(np.abs(s[s != 0]) >= 5.0) and np.all(np.abs(s) <= 10.0)
+    assert not s[:5].any() and not s[-5:].any()

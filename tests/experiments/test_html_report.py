@@ -1,21 +1,30 @@
-"""Issue 17 item 6: compare and diagnose write a self-contained HTML report that opens offline.
+"""compare and diagnose write a self-contained HTML report that opens offline.
 
-The static checks run everywhere; the browser check renders the page in headless Chromium
-(Debian's package ``chromium``) and asks the browser itself whether the verdict is shown and every
-figure decoded; it is skipped, saying why, where Chromium is not installed."""
+The static checks run everywhere; the browser check renders every experiment's compare report and
+a diagnosis report in headless Chromium (Debian's package ``chromium``, which ``.ci/run`` installs
+when it is missing), asks the browser itself whether the verdict is shown and every figure
+decoded, and saves a screenshot of each page (in ``$FEMAST_SCREENSHOTS`` when set, else the test's
+temporary folder).  Without Chromium it skips, saying why; under CI (``CI=true``) it fails."""
 
 import base64
 import json
+import os
 import re
 import shutil
 import subprocess
+from pathlib import Path
 
 import pytest
 
+from femast import examples
 from femast.cli import main
+from femast.experiments import list_experiments
 
 CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+# every experiment with shipped example data: its compare report (default parameters, no fit)
+EXPERIMENTS = [e.name for e in list_experiments() if e.name in examples.BY_EXPERIMENT]
+KINDS = ["compare", "diagnose"] + [f"compare:{name}" for name in EXPERIMENTS if name != "mast-top"]
 
 
 @pytest.fixture(scope="module")
@@ -25,6 +34,15 @@ def reports(tmp_path_factory):
     assert main(["compare", "mast-top", "example", "--out", str(out), "--json"]) == 0
     assert main(["diagnose", "latch-pull", "example", "--out", str(folder / "latch"), "--workers", "1", "--json"]) == 0
     return {"compare": out / "compare_report.html", "diagnose": folder / "latch" / "diagnose_report.html"}
+
+
+def _report(reports, kind, folder):
+    """The report of ``kind``: the two built by the fixture, or ``compare:EXPERIMENT`` made now."""
+    if kind in reports:
+        return reports[kind]
+    name = kind.split(":", 1)[1]
+    assert main(["compare", name, "example", "--out", str(folder / name), "--json"]) == 0
+    return folder / name / "compare_report.html"
 
 
 def _images(text):
@@ -78,27 +96,33 @@ window.addEventListener('load', function () {
 </script></body>"""
 
 
-@pytest.mark.parametrize("kind", ["compare", "diagnose"])
-def test_report_renders_in_headless_chromium(reports, kind, tmp_path):
-    if CHROMIUM is None:
-        pytest.skip("Chromium is not installed (Debian: apt-get install chromium); the static checks above ran")
-    page = tmp_path / "probe.html"  # the report plus a probe script that reports what the browser shows
-    page.write_text(reports[kind].read_text(encoding="utf-8").replace("</body>", _PROBE), encoding="utf-8")
+def _chromium(*args, profile):
     cmd = [
         CHROMIUM,
         "--headless",
         "--no-sandbox",
         "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
         "--disable-background-networking",
         "--disable-component-update",
         "--disable-sync",
-        "--no-first-run",
-        f"--user-data-dir={tmp_path / 'profile'}",
-        "--virtual-time-budget=10000",
-        "--dump-dom",
-        page.as_uri(),
+        f"--user-data-dir={profile}",  # a fresh profile for every page
+        *args,
     ]
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=180)
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=180)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_report_renders_in_headless_chromium(reports, kind, tmp_path):
+    if CHROMIUM is None:
+        if os.environ.get("CI") == "true":
+            pytest.fail("Chromium is missing under CI: .ci/run installs Debian's chromium with apt-get")
+        pytest.skip("Chromium is not installed (Debian: apt-get install chromium); the static checks above ran")
+    report = _report(reports, kind, tmp_path)
+    page = tmp_path / "probe.html"  # the report plus a probe script that reports what the browser shows
+    page.write_text(report.read_text(encoding="utf-8").replace("</body>", _PROBE), encoding="utf-8")
+    p = _chromium("--virtual-time-budget=10000", "--dump-dom", page.as_uri(), profile=tmp_path / "profile")
     m = re.search(r'<pre id="probe">(.*?)</pre>', p.stdout)
     assert m, f"Chromium printed no probe result (exit {p.returncode}):\n{p.stderr[-2000:]}"
     probe = json.loads(
@@ -106,3 +130,17 @@ def test_report_renders_in_headless_chromium(reports, kind, tmp_path):
     )
     assert probe["images"] >= 1 and probe["loaded"] == probe["images"]
     assert probe["verdict"] and probe["verdict"].startswith("Verdict:")
+    shots = Path(os.environ.get("FEMAST_SCREENSHOTS") or tmp_path)
+    shots.mkdir(parents=True, exist_ok=True)
+    png = shots / f"{kind.replace(':', '_')}_report.png"
+    p = _chromium(
+        "--hide-scrollbars",
+        "--window-size=1280,2200",
+        f"--screenshot={png}",
+        report.as_uri(),
+        profile=tmp_path / "profile2",
+    )
+    assert png.is_file() and png.read_bytes()[:8] == PNG_MAGIC, (
+        f"no screenshot (exit {p.returncode}): {p.stderr[-1000:]}"
+    )
+    print(f"screenshot of the {kind} report: {png}")

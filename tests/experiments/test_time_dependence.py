@@ -1,0 +1,72 @@
+"""Creep told from friction by the holds of a test (femast.experiments.time_dependence).
+
+Data with a hidden mechanism come from the independent generator of the generalisation benchmark
+(benchmarks/generalisation: Boltzmann superposition of a logarithmic creep function, an elasto-slip
+joint; numpy only).
+"""
+
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+
+from generalisation.cases import _m, generate, get_case  # noqa: E402
+
+from femast.experiments.time_dependence import CREEP_T, hold_drift, holds  # noqa: E402
+
+CH = ("dx_m", "dy_m", "dz_m")
+
+
+def test_holds_are_the_runs_of_a_constant_load():
+    s = np.r_[np.linspace(0, 1, 5), np.ones(8), np.linspace(1, -1, 5)[1:], -np.ones(4), np.zeros(7)]
+    assert holds(s) == [(4, 12), (21, 27)]  # the four rows at -1 are too few
+    assert holds(s + 1e-3 * np.sin(np.arange(s.size)), noise=1e-3) == [(4, 12), (21, 27)]
+
+
+def test_a_steady_drift_at_constant_load_is_measured_in_noise_units():
+    # ramps to +-1 and holds of 12 rows; the response moves on by r per row while held, towards the last load change
+    n_h, m, r, sigma = 12, 4, 0.05, 0.1
+    s, u = [0.0], [0.0]
+    for k in range(10):
+        target = 1.0 if k % 2 == 0 else -1.0
+        s += list(np.linspace(s[-1], target, 6)[1:]) + [target] * n_h
+        u += list(np.linspace(u[-1], target, 6)[1:]) + list(target + np.sign(target) * r * np.arange(n_h))
+    s, u = np.array(s), np.array(u)
+    rng = np.random.default_rng(0)
+    out = hold_drift(s, {"u": u + sigma * rng.standard_normal(u.size)}, {"u": sigma})
+    assert out["holds"] == 10
+    # last third minus first third of a linear drift: r (n_h - m) rows, in units of sigma sqrt(2/m)
+    expected = r * (n_h - m) / sigma / np.sqrt(2.0 / m)
+    assert out["drift"] == pytest.approx(expected, rel=0.15)  # 10 holds: the mean carries 1/sqrt(10) of the noise
+    assert out["creep"]
+
+
+def test_rate_independent_data_do_not_creep_and_white_noise_rarely_says_so():
+    rng = np.random.default_rng(1)
+    s = np.repeat(np.tile([1.0, 0.0, -1.0, 0.0], 4), 12)
+    t = [hold_drift(s, {"u": s + rng.standard_normal(s.size)}, {"u": 1.0})["t"] for _ in range(400)]
+    # Student t with 14 degrees of freedom: P(t > 4) = 6.6e-4
+    assert np.mean(np.array(t) > CREEP_T) <= 3 / 400
+
+
+@pytest.mark.parametrize(
+    "mechanism,creep",
+    [
+        (_m("creep", "log", phi=0.08, t0=1.0), True),
+        (_m("friction", "jenkins", k_s=2.5e5, F_s=7.0), False),
+        (None, False),
+    ],
+    ids=["log creep", "friction", "plain joint"],
+)
+def test_creep_is_told_from_friction_on_independent_data(mechanism, creep):
+    case = replace(get_case("mt_creep_log"), mechanisms=(mechanism,) if mechanism else ())
+    for seed in range(4):
+        cols = generate(case, seed)
+        load = np.hypot(cols["fx_N"], cols["fy_N"]) * np.sign(cols["fx_N"])
+        out = hold_drift(load, {c: cols[c] for c in CH}, {c: 25e-6 for c in CH})
+        assert out["holds"] == 16
+        assert out["creep"] is creep, (seed, out["t"])
