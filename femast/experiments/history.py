@@ -70,17 +70,20 @@ def _finite(v) -> bool:
     return isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v)
 
 
+_DAMAGED = "the file is damaged or was edited: fix or delete that line, or compare into another --out folder"
+
+
 def _record(rec, where: str) -> dict:
     if not isinstance(rec, dict):
-        raise FemastError(f"{where}: a {type(rec).__name__}, not a history record; the file is damaged or was edited")
+        raise FemastError(f"{where}: a {type(rec).__name__}, not a history record; {_DAMAGED}")
     for field in ("version", "rms", "noise_rms", "experiment", "data"):
         if field not in rec:
-            raise FemastError(f"{where}: the history record has no '{field}'; the file is damaged or was edited")
+            raise FemastError(f"{where}: the history record has no '{field}'; {_DAMAGED}")
     for field, (ok, what) in _TYPES.items():
         if field in rec and not ok(rec[field]):
             shown = repr(rec[field])
             shown = shown if len(shown) <= 60 else shown[:57] + "..."
-            raise FemastError(f"{where}: '{field}' = {shown} is not {what}; the file is damaged or was edited")
+            raise FemastError(f"{where}: '{field}' = {shown} is not {what}; {_DAMAGED}")
     return rec
 
 

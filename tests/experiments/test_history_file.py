@@ -51,21 +51,28 @@ def test_a_damaged_record_is_named(tmp_path, line, named):
     assert named in str(err.value)
 
 
-def _append_many(folder, n):
-    for k in range(n):
+def _append_together(folder, barrier, rounds):
+    for k in range(rounds):
+        barrier.wait()
         append_history(folder, _record(k))
 
 
 def test_concurrent_appends_get_distinct_versions(tmp_path):
+    """Three compare runs appending at the same moments to a long history (reading it takes a while,
+    so without a lock two of them would read the same length and write the same version)."""
+    with open(tmp_path / "history.jsonl", "w") as fh:
+        for k in range(3000):
+            fh.write(json.dumps({"version": k + 1, **_record(k)}) + "\n")
     ctx = mp.get_context("spawn")
-    procs = [ctx.Process(target=_append_many, args=(str(tmp_path), 15)) for _ in range(3)]
+    barrier = ctx.Barrier(3)
+    procs = [ctx.Process(target=_append_together, args=(str(tmp_path), barrier, 5)) for _ in range(3)]
     for p in procs:
         p.start()
     for p in procs:
         p.join(300)
     assert all(p.exitcode == 0 for p in procs)
-    recs = read_history(tmp_path)
-    assert [r["version"] for r in recs] == list(range(1, 46))
+    versions = [r["version"] for r in read_history(tmp_path)]
+    assert versions == list(range(1, 3016)), sorted(v for v in set(versions) if versions.count(v) > 1)
 
 
 def test_an_append_waits_for_the_one_in_progress(tmp_path):
@@ -101,3 +108,16 @@ def test_an_effect_name_that_looks_like_broken_maths_is_drawn_as_typed(tmp_path)
     append_history(tmp_path, _record(1) | {"error_unit": "N m"})
     png = plot_history(tmp_path)
     assert png.is_file() and png.stat().st_size > 1000
+
+
+def test_compare_into_a_folder_with_a_damaged_history_says_so_in_one_line(tmp_path, capsys):
+    from femast.cli import main
+
+    (tmp_path / "history.jsonl").write_text(
+        json.dumps({"version": 1, **_record()}) + "\n" + json.dumps({"version": "two", **_record(1)}) + "\n"
+    )
+    assert main(["compare", "latch-pull", "example", "--out", str(tmp_path)]) == 2
+    said = capsys.readouterr().err
+    err = [x for x in said.splitlines() if x.startswith("femast: error")]
+    assert len(err) == 1 and "history.jsonl line 2: 'version' = 'two'" in err[0] and "fix or delete" in err[0], said
+    assert "Traceback" not in said
