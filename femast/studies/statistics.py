@@ -68,6 +68,34 @@ def percentile(x, q: float, confidence: float = 0.95) -> dict:
     }
 
 
+def upper_bound(x, q: float, confidence: float = 0.95) -> dict:
+    """One-sided distribution-free upper confidence bound of the ``q``-quantile of samples ``x``:
+    {'q', 'estimate', 'high', 'rank', 'n', 'coverage', 'needed'}.  x_(u) (sorted, 1-based) lies above
+    xi_q when fewer than u samples fall below it: P = F(u - 1) (F the Binomial(n, q) cdf), and u is
+    the smallest rank with F(u - 1) >= confidence.  'high' is NaN when n is too small; 'needed' is
+    the least n for which the largest sample is a bound (1 - q^n >= confidence: 59 for the 95th
+    percentile at 95 %)."""
+    if not 0.0 < q < 1.0:
+        raise StudyError(f"quantile q = {q!r} must lie in (0, 1) (0.95 for the 95th percentile)")
+    from scipy import stats
+
+    x = np.sort(_values(x))
+    n = len(x)
+    u = int(stats.binom.ppf(confidence, n, q)) + 1
+    if u >= 2 and stats.binom.cdf(u - 2, n, q) >= confidence:
+        u -= 1
+    needed = int(np.ceil(np.log1p(-confidence) / np.log(q)))
+    return {
+        "q": q,
+        "estimate": float(np.quantile(x, q)),
+        "high": float(x[u - 1]) if u <= n else float("nan"),
+        "rank": u,
+        "n": n,
+        "coverage": float(stats.binom.cdf(u - 1, n, q)) if u <= n else float("nan"),
+        "needed": needed,
+    }
+
+
 def bootstrap_ci(x, statistic=np.mean, confidence: float = 0.95, resamples: int = 2000, seed: int = 0) -> dict:
     """Percentile bootstrap interval of ``statistic`` over samples ``x``: {'estimate', 'low', 'high'}."""
     x = _values(x)
