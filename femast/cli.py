@@ -28,12 +28,9 @@ def _run(args):
         del script_args[i : i + 2]
     if restart is not None:
         # the analyses of the script whose results folder is RESTART continue from its restart point
-        from .analysis.restart import ENV, RESTART_DIR
+        from .analysis.restart import ENV, require_point
 
-        if not (Path(restart) / RESTART_DIR / "restart.json").is_file():
-            raise FemastError(
-                f"{restart}: no restart point; run the analysis with restart_every=n to be able to restart it"
-            )
+        require_point(restart)  # (none there, or a link or FIFO in its place: named now, before the script runs)
         old = os.environ.get(ENV)
         os.environ[ENV] = str(restart)
     sys.argv = [str(script)] + script_args

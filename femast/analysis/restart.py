@@ -31,6 +31,7 @@ import io
 import json
 import os
 import re
+import stat
 from dataclasses import fields
 from pathlib import Path
 
@@ -149,7 +150,10 @@ def _model_id(analysis) -> dict:
 def require_point(folder) -> Path:
     """The restart.json of results folder ``folder``, or a FemastError saying there is none."""
     jfile = Path(folder) / RESTART_DIR / "restart.json"
-    if not folder_files.is_regular(jfile):
+    st = folder_files.lstat_or_none(jfile)
+    if st is not None and not stat.S_ISREG(st.st_mode):  # a link, FIFO, folder...: named, never followed
+        raise FemastError(f"{folder}: the restart point is refused: {folder_files.refusal(jfile, st.st_mode, 'reads')}")
+    if st is None:
         raise FemastError(
             f"{folder}: no restart point ({jfile} is missing); run the analysis with "
             "restart_every=n (a restart point every n increments) to be able to restart it"

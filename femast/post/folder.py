@@ -63,7 +63,8 @@ def _kind(mode: int) -> str:
     return "not a regular file"
 
 
-def _refuse(path, mode: int, doing: str, thing: str = "file") -> FemastError:
+def refusal(path, mode: int, doing: str, thing: str = "file") -> FemastError:
+    """The FemastError refusing ``path`` (of ``os.lstat`` mode ``mode``): what it is, where a link points."""
     try:
         where = f" to {os.readlink(path)}" if stat.S_ISLNK(mode) else ""
     except OSError:
@@ -85,7 +86,7 @@ def own_dir(folder, name: str) -> Path:
         pass
     mode = os.lstat(path).st_mode
     if not stat.S_ISDIR(mode):  # a link (to a folder or not), a file, a FIFO...
-        raise _refuse(path, mode, "uses", "folder")
+        raise refusal(path, mode, "uses", "folder")
     return path
 
 
@@ -104,7 +105,7 @@ def remove_own(path) -> bool:
     if st is None:
         return False
     if not stat.S_ISREG(st.st_mode):
-        raise _refuse(path, st.st_mode, "removes")
+        raise refusal(path, st.st_mode, "removes")
     try:
         os.unlink(path)
     except FileNotFoundError:
@@ -118,7 +119,7 @@ def open_write(path, append: bool = False, truncate: bool = False, read: bool = 
     link, never a FIFO or device."""
     st = lstat_or_none(path)
     if st is not None and not stat.S_ISREG(st.st_mode):
-        raise _refuse(path, st.st_mode, "writes")
+        raise refusal(path, st.st_mode, "writes")
     flags = (os.O_RDWR if read else os.O_WRONLY) | os.O_CREAT | _NOFOLLOW | _NONBLOCK | _BINARY
     flags |= (os.O_APPEND if append else 0) | (os.O_TRUNC if truncate else 0)
     fd = _open(path, flags, "writes")
@@ -140,7 +141,7 @@ def _open(path, flags, doing, mode=0o666) -> int:
         if exc.errno in (errno.ELOOP, errno.EMLINK, errno.ENXIO):  # a link under O_NOFOLLOW; a FIFO without reader
             st = lstat_or_none(path)
             if st is not None:
-                raise _refuse(path, st.st_mode, doing) from None
+                raise refusal(path, st.st_mode, doing) from None
         raise
 
 
@@ -148,7 +149,7 @@ def _regular_or_close(fd: int, path, doing: str) -> None:
     mode = os.fstat(fd).st_mode
     if not stat.S_ISREG(mode):
         os.close(fd)
-        raise _refuse(path, mode, doing)
+        raise refusal(path, mode, doing)
     if _NONBLOCK:
         os.set_blocking(fd, True)
 
@@ -168,7 +169,7 @@ def write_atomic(path, data: bytes, sync: bool = False) -> None:
     tmp = path.with_name(path.name + ".tmp")
     st = lstat_or_none(path)
     if st is not None and not stat.S_ISREG(st.st_mode):  # (the rename would replace a link or FIFO)
-        raise _refuse(path, st.st_mode, "writes")
+        raise refusal(path, st.st_mode, "writes")
     fd = create_new(tmp)
     try:
         try:
@@ -191,7 +192,7 @@ def open_regular(path, doing: str = "reads"):
     symbolic link is refused (a FemastError) before anything is read; FileNotFoundError if missing."""
     st = os.lstat(path)
     if not stat.S_ISREG(st.st_mode):
-        raise _refuse(path, st.st_mode, doing)
+        raise refusal(path, st.st_mode, doing)
     fd = _open(path, os.O_RDONLY | _NOFOLLOW | _NONBLOCK | _BINARY, doing)
     _regular_or_close(fd, path, doing)
     return os.fdopen(fd, "rb")
@@ -241,7 +242,7 @@ class FolderLock:
         path = self.folder / self.name
         st = lstat_or_none(path)
         if st is not None and not stat.S_ISREG(st.st_mode):
-            raise _refuse(path, st.st_mode, "locks")
+            raise refusal(path, st.st_mode, "locks")
         fd = _open(path, os.O_RDWR | os.O_CREAT | _NOFOLLOW | _NONBLOCK | _BINARY, "locks")
         _regular_or_close(fd, path, "locks")
         deadline = time.monotonic() + wait_s

@@ -104,6 +104,8 @@ class Results(Histories):
 
     def __init__(self, folder):
         self.folder = Path(folder)
+        if self.folder.exists() and not self.folder.is_dir():
+            raise FemastError(f"{self.folder} is a file, not a results folder; give the folder an analysis wrote")
         if lstat_or_none(self.folder / "mesh.npz") is None:
             raise FemastError(f"{self.folder}: not a femast results folder (no mesh.npz); run an analysis first")
         self._mesh = None  # read on first use (an analysis returns its Results: ~1.5 ms per run saved)
@@ -168,7 +170,7 @@ class Results(Histories):
                 raise
             except Exception as exc:
                 raise FemastError(
-                    f"{self.folder / 'mesh.npz'} is unreadable ({type(exc).__name__}: {exc}); "
+                    f"{self.folder / 'mesh.npz'} is unreadable ({unreadable(exc)}); "
                     "the folder is damaged: rerun the analysis"
                 ) from None
         return self._mesh
@@ -217,13 +219,19 @@ class Results(Histories):
             except Exception as exc:  # zipfile.BadZipFile, EOFError, ValueError, OSError...
                 where = self.files[i] if not isinstance(self.files[i], tuple) else self.files[i][0]
                 raise FemastError(
-                    f"{where}: frame {i} is unreadable ({type(exc).__name__}: {exc}); "
-                    "the file is damaged: rerun the analysis"
+                    f"{where}: frame {i} is unreadable ({unreadable(exc)}); the file is damaged: rerun the analysis"
                 ) from None
         return self._cache[i]
 
 
 DOF_COMPONENTS = DOF_NAMES
+
+
+def unreadable(exc: Exception) -> str:
+    """Why an array file is unreadable, in words (never numpy's hint to load pickled data unsafely)."""
+    if isinstance(exc, ValueError) and "pickle" in str(exc):
+        return "it holds pickled Python objects, which femast never loads: it is not a file femast wrote"
+    return f"{type(exc).__name__}: {exc}"
 
 
 def run_outcome(exc: BaseException) -> tuple[str, str]:

@@ -4,6 +4,7 @@ changed by the refused restart (no frame deleted, no file outside the folder rea
 
 import io
 import json
+import os
 import shutil
 
 import numpy as np
@@ -84,6 +85,29 @@ def test_a_state_file_outside_the_folder_is_never_read(stopped, tmp_path):
     with pytest.raises(fm.FemastError, match=r"'state_file' = '../../outside' is not state-1.npz"):
         _restart(stopped)
     assert _frames(stopped) == frames
+
+
+@pytest.mark.parametrize("kind", ["fifo", "link"])
+def test_a_restart_record_that_is_not_a_regular_file_is_named_not_called_missing(stopped, tmp_path, kind, capsys):
+    from femast.cli import main
+
+    record = stopped / "restart" / "restart.json"
+    outside = tmp_path / "outside.json"
+    outside.write_text(record.read_text())  # (a valid record, out of the folder)
+    record.unlink()
+    if kind == "fifo":
+        os.mkfifo(record)  # (opening it for reading would wait for a writer: never opened)
+    else:
+        record.symlink_to(outside)
+    what = "a FIFO (named pipe)" if kind == "fifo" else f"a symbolic link to {outside}"
+    with pytest.raises(fm.FemastError, match="the restart point is refused") as err:
+        _restart(stopped)
+    assert f"restart.json is {what}, not a file femast made" in str(err.value)
+    script = tmp_path / "model.py"
+    script.write_text("raise SystemExit('the script ran')\n")
+    assert main(["run", "--restart", str(stopped), str(script)]) == 2  # refused before the script runs
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"restart.json is {what}" in err[0] and "no restart point" not in err[0], err
 
 
 @pytest.mark.parametrize(

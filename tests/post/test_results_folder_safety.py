@@ -158,6 +158,24 @@ def test_a_fifo_in_the_folder_is_refused_not_read(tmp_path, name):
     assert f"{name.split('/')[-1]} is a FIFO (named pipe)" in said and "Traceback" not in said, said
 
 
+def test_femast_info_on_a_file_or_a_foreign_array_file_says_what_it_is(tmp_path, capsys):
+    script = tmp_path / "model.py"
+    script.write_text("print('a model')\n")
+    assert main(["info", str(script)]) == 2
+    assert (
+        capsys.readouterr().err.strip()
+        == f"femast: error: {script} is a file, not a results folder; give the folder an analysis wrote"
+    )
+    out = tmp_path / "r"
+    fm.solve(_cantilever(), out, progress=False)
+    (out / "mesh.npz").write_bytes(
+        b"\x93NUMPY\x01\x00v\x00{'descr': '|O', 'fortran_order': False, 'shape': (1,), }" + b" " * 44
+    )
+    assert main(["info", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "mesh.npz is unreadable" in err[0] and "unsafely" not in err[0], err
+
+
 @pytest.mark.parametrize(
     "summary, field",
     [
