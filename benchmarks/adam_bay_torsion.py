@@ -57,7 +57,7 @@ SEED_NOTE = {
 def run_path(
     kind: str, out: Path, theta_max_deg: float, progress: bool, hysteresis=None, quick=False, params_changes=None
 ) -> dict:
-    changes = dict(params_changes or {})
+    changes = {"seat": "tied", **(params_changes or {})}  # the paper's joints (Figs. 16-17)
     if hysteresis is not None:
         changes.update(hysteresis_force=hysteresis[0], hysteresis_length=hysteresis[1])
     am = build_bay(**changes)

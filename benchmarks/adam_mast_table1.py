@@ -94,10 +94,16 @@ def main(argv=None):
     ap.add_argument("--scale", type=float, default=100.0)
     ap.add_argument("--docs", action="store_true", help="copy the rendered PNG to docs/figures/")
     ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument(
+        "--seat",
+        choices=("tied", "seated"),
+        default="tied",
+        help="ball joints: the paper's two-way tie (default here: the paper's table) or seated",
+    )
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    params = BayParameters()
+    params = BayParameters(seat=args.seat)
     summary = {"M_Nm": TABLE1_M, "F_N": TABLE1_F, "cycles": args.cycles}
     if args.fit:
         from femast.adam.identify import fit_tip_response

@@ -3,8 +3,10 @@
 A mast of ``n_bays`` bays has ``n_bays + 1`` square batten frames (side ``b``) at heights
 ``0, l, 2 l, ...``.  Each frame has four rigid corner pieces; each bay has
 
-* four longerons (corotational beams) from the bottom to the top corner pieces, tied to them by
-  friction ball joints (seed Sec. II.B.1: |M| <= mu B |F|) at the ball centres;
+* four longerons (corotational beams) from the bottom to the top corner pieces, joined to them by
+  friction ball joints (seed Sec. II.B.1: |M| <= mu B |F|) at the ball centres: seated by default
+  (the ball sits in its socket, held there by the cables' preload: the seat carries compression and
+  opens in tension; ``BayParameters.seat``), or tied (``seat="tied"``: the paper's two-way tie);
 * on each of its four sides one cable/pulley/latch assembly (seed Sec. II.B.2, Fig. 4): a unit at
   the centre of the side through which
 
@@ -113,7 +115,12 @@ def _check_fold(fold, where):
 
 
 def build_bay(
-    params: BayParameters | None = None, fold: int = 1, name: str = "ADAM bay", cables: bool = True, **changes
+    params: BayParameters | None = None,
+    fold: int = 1,
+    name: str = "ADAM bay",
+    cables: bool = True,
+    scatter=None,
+    **changes,
 ) -> AdamModel:
     """One ADAM bay (seed 001 Sec. II): bottom frame fixed, top frame rigid with the control node.
 
@@ -122,8 +129,9 @@ def build_bay(
     fold : +1 (the bay folds under a positive twist about z) or -1.
     cables : False leaves out the cable/pulley/latch assemblies (frames, longerons and joints only:
         the deployment kinematics of Eq. 1).
+    scatter : per-element values of the bay (:func:`build_mast`).
     Returns an :class:`AdamModel`; add steps to ``.model``."""
-    return build_mast(1, params, fold=fold, alternate=False, name=name, cables=cables, **changes)
+    return build_mast(1, params, fold=fold, alternate=False, name=name, cables=cables, scatter=scatter, **changes)
 
 
 def build_mast(
@@ -216,14 +224,22 @@ def build_mast(
             )
             longerons[j, k] = (a, c)
             pairs += [(a, bot), (c, top)]
+    mu_s = sc["mu"].ravel()
+    seat = (
+        dict(seat="seated", clearance_radial=p.seat_clearance_radial, clearance_axial=p.seat_clearance_axial)
+        if p.seat == "seated"
+        else {}
+    )
     add_ball_joints(
         m,
         pairs,
-        mu=sc["mu"].ravel(),
+        mu_s=mu_s,
+        mu_k=None if p.mu_k is None else mu_s * (p.mu_k / p.mu if p.mu > 0 else 0.0),
         B=p.B,
         penalty_factor=p.joint_penalty_factor,
         stick_factor=p.joint_stick_factor,
         name=JOINT_FAMILY,
+        **seat,
     )
     if p.joint_spring > 0:
         m.add_family(JointSprings(pairs, p.joint_spring, name=SPRING_FAMILY))

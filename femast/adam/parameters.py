@@ -52,7 +52,14 @@ class BayParameters:
 
     Joints
     ------
+    seat : ``"seated"`` (default: the ball sits in its socket, held by the preload; the seat carries
+        compression and opens in tension) or ``"tied"`` (the paper's two-way tie, a captive ball: the
+        reproductions of the paper's figures use it).  See ``docs/ball_joint.md``.
+    seat_clearance_radial : seated joints: radial play of the ball in its socket, m (default 0).
+    seat_clearance_axial : seated joints: axial play from the seat to a retainer, m; None (default):
+        no retainer, the seat opens freely in tension.
     mu, B : ball joint friction coefficient and ball end radius, m (seed Sec. II.B.1: 0.5, 4 mm).
+    mu_k : kinetic friction coefficient of the ball joints; None: the same as ``mu`` (the paper).
     joint_penalty_factor, joint_stick_factor : numerical stiffness factors of the ball joints
         (:func:`femast.elements.ball_joint.add_ball_joints`): k_pen = factor x EA/l and
         k_stick = factor x 4EI/l of the longeron.  1e3 (not the element's 1e4) keeps the round-off
@@ -84,6 +91,10 @@ class BayParameters:
     hysteresis_length: float = 3e-4
     mu: float = 0.5
     B: float = 0.004
+    mu_k: float | None = None
+    seat: str = "seated"
+    seat_clearance_radial: float = 0.0
+    seat_clearance_axial: float | None = None
     joint_penalty_factor: float = 1e3
     joint_stick_factor: float = 0.3
     joint_spring: float = 10.0
@@ -109,6 +120,10 @@ class BayParameters:
         "hysteresis_length": "m",
         "mu": "-",
         "B": "m",
+        "mu_k": "-",
+        "seat": "-",
+        "seat_clearance_radial": "m",
+        "seat_clearance_axial": "m",
         "joint_penalty_factor": "-",
         "joint_stick_factor": "-",
         "joint_spring": "N m/rad",
@@ -141,10 +156,25 @@ class BayParameters:
             v = getattr(self, name)
             if not _is_number(v) or not (v > 0 and math.isfinite(v)):
                 raise ModelError(f"BayParameters: {name} = {v!r} {self.UNITS[name]} must be a finite number > 0")
-        for name in ("corner", "pretension", "mu", "hysteresis_force", "joint_spring"):
+        for name in ("corner", "pretension", "mu", "hysteresis_force", "joint_spring", "seat_clearance_radial"):
             v = getattr(self, name)
             if not _is_number(v) or not (v >= 0 and math.isfinite(v)):
                 raise ModelError(f"BayParameters: {name} = {v!r} {self.UNITS[name]} must be a finite number >= 0")
+        if self.seat not in ("seated", "tied"):
+            raise ModelError(f"BayParameters: seat = {self.seat!r}; use 'seated' (the physical default) or 'tied'")
+        if self.mu_k is not None and (not _is_number(self.mu_k) or not (0 <= self.mu_k <= self.mu)):
+            raise ModelError(
+                f"BayParameters: mu_k = {self.mu_k!r} must lie in [0, mu = {self.mu:g}] (kinetic <= static), or be None"
+            )
+        ca = self.seat_clearance_axial
+        if ca is not None and (not _is_number(ca) or not (ca >= 0 and math.isfinite(ca))):
+            raise ModelError(f"BayParameters: seat_clearance_axial = {ca!r} m must be a finite number >= 0, or None")
+        for name in ("seat_clearance_radial", "seat_clearance_axial"):
+            v = getattr(self, name) or 0.0
+            if v > 0.05 * self.l:
+                raise ModelError(f"BayParameters: {name} = {v:g} m is implausible for a joint; clearances are in m")
+            if v > 0 and self.seat == "tied":
+                raise ModelError(f"BayParameters: {name} = {v:g} m needs seat='seated' (a tied joint has no play)")
         for name in ("longeron_nu", "batten_nu"):
             v = getattr(self, name)
             if not _is_number(v) or not (-1.0 < v < 0.5):

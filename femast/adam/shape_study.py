@@ -38,6 +38,10 @@ SCATTER = (
     ("member lengths", "cable_dL", "abs", 0.05e-3, "m"),
 )
 GROUPS = tuple(dict.fromkeys(g for g, *_ in SCATTER))
+#: The bay of the published study (docs/shape_accuracy.md): the paper's tied ball joints.  The
+#: study on seated joints (the physical default of BayParameters) is the next one; pass
+#: ``params=BayParameters()`` to run it.
+STUDY_PARAMS = BayParameters(seat="tied")
 
 
 def n_uniforms(n_bays: int) -> dict:
@@ -107,7 +111,7 @@ def mast_model(n_bays: int, cycles: int = 1, params: BayParameters | None = None
     """The mast with per-element ``values`` (MastScatter fields, flat or shaped arrays) and its load
     history (pretension step, ``cycles`` Table 1 cycles): a :class:`~femast.model.Model` with steps,
     for a study's model factory.  Returns (model, control node label)."""
-    am = build_mast(n_bays, params, scatter=as_scatter(values, n_bays))
+    am = build_mast(n_bays, params or STUDY_PARAMS, scatter=as_scatter(values, n_bays))
     add_initial_steps(am)
     add_table1_steps(am, cycles=cycles)
     return am.model, am.control
@@ -137,7 +141,7 @@ def tip_history(
     without ``settle``), then one level per load step, all relative to the initial (design)
     geometry: the control node's displacement and rotation vector at the end of each step."""
     t0 = time.process_time()
-    am = build_mast(n_bays, params, scatter=None if values is None else as_scatter(values, n_bays))
+    am = build_mast(n_bays, params or STUDY_PARAMS, scatter=None if values is None else as_scatter(values, n_bays))
     add_initial_steps(am, settle=settle)
     add_table1_steps(am, cycles=cycles, M=M, F=F)
     row = am.model.index(am.control)

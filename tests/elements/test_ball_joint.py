@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from doc_examples import run_python_blocks
+from doc_examples import printed_in, run_python_blocks
 
 import femast as fm
 from femast.elements.ball_joint import (
@@ -351,5 +351,13 @@ def test_default_stiffnesses_follow_the_connected_members():
 
 
 # ----------------------------------------------------------------------------- docs
-def test_doc_examples_run():
-    run_python_blocks("ball_joint.md")
+def test_doc_examples_run(capsys):
+    """The page's examples run and print what the page says they print (numbers as numbers)."""
+    import re
+
+    text = run_python_blocks("ball_joint.md")
+    out = capsys.readouterr().out
+    quoted = re.findall(r"prints `([^`]+)`", text) + re.findall(r"`(seated: [^`]+)`", text)
+    assert len(quoted) >= 3
+    for q in quoted:
+        assert printed_in(q, out), f"ball_joint.md says it prints {q!r}"
