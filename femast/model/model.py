@@ -166,13 +166,7 @@ class Step:
                 value, f"step '{self.name}': prescribed {name} on node {node}", "m" if name.lower()[0] == "u" else "rad"
             )
             dof = _DOF_INDEX[name.lower()]
-            for c in self.prescribed:
-                if int(c.node) == int(node) and c.dof == dof:
-                    unit = "m" if dof < 3 else "rad"
-                    raise ModelError(
-                        f"step '{self.name}': node {node} {DOF_NAMES[dof]} is prescribed twice in this step "
-                        f"({c.magnitude:g} {unit}, then {v:g} {unit}); give it one value (a later step may change it)"
-                    )
+            validation.prescribed_once(self.prescribed, node, dof, v, f"step '{self.name}'")
             self.prescribed.append(Condition(node, dof, v, amplitude))
         return self
 
@@ -292,14 +286,7 @@ class Model:
         except (TypeError, ValueError, OverflowError):
             ok = False
         if not ok:
-            try:
-                fractional = float(label) != int(label) and not isinstance(label, (str, bytes, bool))
-            except (TypeError, ValueError, OverflowError):
-                fractional = False
-            if fractional:  # (2.7 is no label, and not node 2 either)
-                raise ModelError(
-                    f"{where}: node label {label!r} is not a whole number; give the label Model.node returned"
-                )
+            validation.not_fractional(label, where)  # (2.7 is no label, and not node 2 either)
             known = self._node_labels
             hint = f"known labels {known[0]}..{known[-1]}" if known else "the model has no nodes yet"
             raise ModelError(f"{where}: unknown node {label!r} ({hint}); create it with model.node(x, y, z)")

@@ -112,6 +112,28 @@ def coordinates(coords, what: str = "nodes") -> np.ndarray:
 PRECISION = 1e-10
 
 
+def prescribed_once(prescribed, node, dof: int, value: float, where: str) -> None:
+    """A ModelError if DOF ``dof`` of ``node`` is already among the ``prescribed`` conditions of a step
+    (the last value would silently win)."""
+    for c in prescribed:
+        if int(c.node) == int(node) and c.dof == dof:
+            unit = "m" if dof < 3 else "rad"
+            raise ModelError(
+                f"{where}: node {node} {DOF_NAMES[dof]} is prescribed twice in this step "
+                f"({c.magnitude:g} {unit}, then {value:g} {unit}); give it one value (a later step may change it)"
+            )
+
+
+def not_fractional(label, where: str) -> None:
+    """A ModelError if node label ``label`` is a number with a fractional part (never rounded to a node)."""
+    try:
+        fractional = float(label) != int(label) and not isinstance(label, (str, bytes, bool))
+    except (TypeError, ValueError, OverflowError):
+        return
+    if fractional:
+        raise ModelError(f"{where}: node label {label!r} is not a whole number; give the label Model.node returned")
+
+
 def element_length(L: float, far: float, where: str, kind: str, n1, n2) -> None:
     """Check the length ``L`` (m) of a two-node element (nodes ``n1``, ``n2``) whose nodes lie up to
     ``far`` (m) from the origin: a ModelError if the nodes coincide, or if the element is too short
