@@ -1,4 +1,4 @@
-"""Builders of ADAM-type bays and masts (seed 001, Secs. II and VII) for model scripts.
+"""Builders of ADAM-type bays and masts (Stohlman & Pellegrino, Secs. II and VII) for model scripts.
 
 A mast of ``n_bays`` bays has ``n_bays + 1`` square batten frames (side ``b``) at heights
 ``0, l, 2 l, ...``.  Each frame has four rigid corner pieces; each bay has
@@ -122,7 +122,7 @@ def build_bay(
     scatter=None,
     **changes,
 ) -> AdamModel:
-    """One ADAM bay (seed 001 Sec. II): bottom frame fixed, top frame rigid with the control node.
+    """One ADAM bay (Stohlman & Pellegrino, Sec. II): bottom frame fixed, top frame rigid with the control node.
 
     params : :class:`BayParameters` (default: the documented choices); keyword ``changes``
         override single parameters, e.g. ``build_bay(b=0.3, cable_EA=5e4)``.
@@ -144,7 +144,7 @@ def build_mast(
     scatter=None,
     **changes,
 ) -> AdamModel:
-    """A mast of ``n_bays`` identical ADAM bays (seed 001 Sec. VII: 40 bays, 6.84 m).
+    """A mast of ``n_bays`` identical ADAM bays (Stohlman & Pellegrino, Sec. VII: 40 bays, 6.84 m).
 
     params : :class:`BayParameters`; keyword ``changes`` override single parameters.
     fold : folding sense of the first (bottom) bay, +1 or -1.
@@ -154,7 +154,7 @@ def build_mast(
     is the control node at its centre.  ``cables=False`` leaves out the cable assemblies.
     scatter : per-element values (:class:`~femast.adam.scatter.MastScatter` or a dict of its
         fields): friction per ball joint, latch k and mu per latch, pretension per bay side, length
-        error per member (issue 20).  Default: every bay exactly ``params``.
+        error per member.  Default: every bay exactly ``params``.
     Returns an :class:`AdamModel`."""
     try:
         n_ok = int(n_bays) == n_bays and int(n_bays) >= 1 and not isinstance(n_bays, bool)
@@ -296,6 +296,7 @@ def build_mast(
             hysteresis_length=p.hysteresis_length,
             length_error=sc["cable_dL"].reshape(-1, 2),
             name=LATCH_FAMILY,
+            mu_k=None if p.latch_mu_k is None else np.minimum(p.latch_mu_k, latch_array(sc, p)[:, 3]),
         )
     )
     if fam is not None:

@@ -1,4 +1,4 @@
-"""Parameters of an ADAM-type bay (seed 001): every dimension, section, material, pretension and
+"""Parameters of an ADAM-type bay (Stohlman & Pellegrino): every dimension, section, material, pretension and
 latch parameter, in SI units, with the source of each default value.
 
 The seed gives the bay height (6.84 m / 40 bays = 0.171 m), the ball joints (mu = 0.5, B = 4 mm),
@@ -14,11 +14,11 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, fields, replace
 
+from ..elements.latch_law import LatchParameters, contact_half_width, validate_latch_array
 from ..errors import ModelError
-from ..latch import LatchParameters, contact_half_width, validate_latch_array
 from ..model.sections import Section, circular_tube
 
-#: Bay height of seed 001, Sec. VII: 40 bays make a 6.84 m mast.
+#: Bay height of Stohlman & Pellegrino, Sec. VII: 40 bays make a 6.84 m mast.
 SEED_BAY_HEIGHT = 6.84 / 40
 
 
@@ -46,9 +46,13 @@ class BayParameters:
     cable_EA : axial rigidity of the cables, N.  Not in the seed: identified from Table 1.
     pretension : cable tension of the deployed, latched bay before it comes to equilibrium, N
         (Figs. 13-14: 125-210 N).
-    latch : :class:`~femast.latch.LatchParameters` (seed Sec. III.C fit by default).
+    latch : :class:`~femast.elements.latch_law.LatchParameters` (seed Sec. III.C fit by default).
     hysteresis_force, hysteresis_length : latch hysteresis near the latched state (N, m); 0
         switches it off (the seed's model).  See ``docs/cable_latch_element.md``.
+    latch_mu_k : kinetic friction of the latch rollers (-); None (default): the latch's ``mu``, the
+        paper's one coefficient (Sec. III.A: "the kinetic and static coefficients ... are assumed to
+        be equal").  Below it, ``latch.mu`` is the static coefficient: a bead starts to slide at
+        ``latch.mu`` and slides on at ``latch_mu_k``.
 
     Joints
     ------
@@ -89,6 +93,7 @@ class BayParameters:
     latch: LatchParameters = field(default_factory=LatchParameters.seed_fit)
     hysteresis_force: float = 0.0
     hysteresis_length: float = 3e-4
+    latch_mu_k: float | None = None
     mu: float = 0.5
     B: float = 0.004
     mu_k: float | None = None
@@ -118,6 +123,7 @@ class BayParameters:
         "latch": "SI",
         "hysteresis_force": "N",
         "hysteresis_length": "m",
+        "latch_mu_k": "-",
         "mu": "-",
         "B": "m",
         "mu_k": "-",
@@ -203,9 +209,14 @@ class BayParameters:
             )
         if not isinstance(self.latch, LatchParameters):
             raise ModelError(
-                f"BayParameters: latch must be a femast.latch.LatchParameters, got {type(self.latch).__name__}"
+                f"BayParameters: latch must be a femast.elements.latch_law.LatchParameters, got {type(self.latch).__name__}"
             )
         validate_latch_array(self.latch.as_array(), "BayParameters.latch")
+        v = self.latch_mu_k
+        if v is not None and (not _is_number(v) or not (0.0 <= v <= self.latch.mu)):
+            raise ModelError(
+                f"BayParameters: latch_mu_k = {v!r} must lie in [0, latch.mu = {self.latch.mu:g}] (kinetic <= static) or be None"
+            )
         if self.hysteresis_force > 0 and self.latch.x_backstop >= contact_half_width(self.latch):
             raise ModelError(
                 "BayParameters: latch hysteresis needs the backstop inside the roller contact "

@@ -1,11 +1,11 @@
-"""Shape accuracy of ADAM masts under manufacturing and assembly scatter (issue 20, item 4): the
+"""Shape accuracy of ADAM masts under manufacturing and assembly scatter: the
 model factory of the studies in ``benchmarks/shape_accuracy.py`` (``docs/shape_accuracy.md``).
 
 A sample is a dict of per-element values (the fields of :class:`~femast.adam.scatter.MastScatter`);
 :func:`sample_scatter` draws them from the stated scatter :data:`SCATTER` given uniform numbers in
 [0, 1) per *group* of inputs (so that a study can vary one group at a time for group sensitivity
 indices); :func:`tip_history` builds the mast with them, brings it to its pretensioned equilibrium
-(the deployed state, seed 001 Sec. II.C) and applies the Table 1 load cycles (Sec. VII), and
+(the deployed state, Stohlman & Pellegrino, Sec. II.C) and applies the Table 1 load cycles (Sec. VII), and
 returns the tip (control node) position and rotation after deployment and at each load level.
 
 Units: SI inside (m, rad, N); the returned ``u_*`` in m and ``theta_*`` in rad (rotation vector
@@ -24,7 +24,7 @@ from .parameters import BayParameters
 from .scatter import MastScatter
 from .steps import CONVERGENCE, TABLE1_F, TABLE1_M, add_initial_steps, add_table1_steps
 
-#: The stated scatter (issue 20 item 4): every value uniform in [nominal - half, nominal + half],
+#: The stated scatter: every value uniform in [nominal - half, nominal + half],
 #: independent from element to element.  (group, MastScatter field, kind, half width, unit)
 #: kind "rel": half width relative to the nominal value; "abs": absolute (lengths, m).
 SCATTER = (

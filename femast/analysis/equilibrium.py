@@ -28,7 +28,7 @@ import numpy as np
 from ..errors import EquilibriumError
 from ..model import validation
 from .assembly import _scatter_vector
-from .solvers.convergence import field_abs_max, force_moment_abs_max
+from .convergence import field_abs_max, force_moment_abs_max
 
 END_RATIO = 1e-2  # the largest residual of a completed run, as a fraction of its force scale
 ROUND_OFF = 1e-9  # a self-equilibrated family's resultant, as a fraction of its summed forces

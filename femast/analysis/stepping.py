@@ -9,8 +9,7 @@ from __future__ import annotations
 
 from .. import progress as _progress
 from ..errors import ConvergenceError
-from .controls import plan_for
-from .solvers.control import LoadControl
+from .control import LoadControl, plan_for
 
 
 def run_step(analysis, step, resume=None):

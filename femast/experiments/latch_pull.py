@@ -29,7 +29,7 @@ innermost after an inner-cable one).
 
 Baseline model
 --------------
-The latch law of seed 001 Eqs. 12-14 (:mod:`femast.latch`) with ``r``, ``x_backstop``, ``k``,
+The latch law of seed 001 Eqs. 12-14 (:mod:`femast.elements.latch_law`) with ``r``, ``x_backstop``, ``k``,
 ``mu`` fitted and ``h``, ``R`` options (measured; defaults 1.5 mm and 2.4 mm as in the seed).
 Each sample is compared with the nearest state the law allows along the path
 (:func:`admissible_band`):
@@ -73,8 +73,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..elements.latch_law import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force, latch_zone
 from ..errors import DataFileError
-from ..latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force, latch_zone
 from .core import Column, Experiment, Measured, Parameter, prepared
 from .residuals import noise_floor, turning_points
 

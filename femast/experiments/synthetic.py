@@ -16,8 +16,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..effects.base import resolve
+from ..elements.latch_law import LATCHING, UNLATCHING, latch_force
 from ..errors import ModelError
-from ..latch import LATCHING, UNLATCHING, latch_force
 from .core import EffectStack, Measured
 from .fitting import predict
 

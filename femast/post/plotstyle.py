@@ -1,4 +1,4 @@
-"""One plotting style for every femast figure (issue 17): matplotlib settings, axis labels with
+"""One plotting style for every femast figure: matplotlib settings, axis labels with
 units, rounded numbers, titles that fit, and saving.
 
     from femast import plotstyle

@@ -1,4 +1,4 @@
-"""Studies of uncertain inputs (issue 20): run a model over the scatter of its inputs, store
+"""Studies of uncertain inputs: run a model over the scatter of its inputs, store
 every run, and report percentiles, convergence and sensitivity indices.
 
     import femast.studies as st

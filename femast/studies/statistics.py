@@ -1,4 +1,4 @@
-"""Statistics of a study's outputs (issue 20): percentiles with confidence intervals, convergence
+"""Statistics of a study's outputs: percentiles with confidence intervals, convergence
 of the estimates with the number of samples, first-order and total Sobol' indices.
 
 * Percentile intervals are distribution-free order-statistic intervals: for the q-quantile xi_q
@@ -35,7 +35,7 @@ def order_statistic_ranks(n: int, q: float, confidence: float = 0.95) -> tuple:
     """1-based ranks (l, u) with P(x_(l) <= xi_q <= x_(u)) >= confidence; 0 or n + 1 when n is too
     small for that side (no bound)."""
     alpha = 1.0 - confidence
-    from scipy import stats  # (here: importing scipy.stats costs every femast command 0.45 s, issue 21)
+    from scipy import stats  # (here: importing scipy.stats costs every femast command 0.45 s)
 
     l = int(stats.binom.ppf(alpha / 2, n, q))  # P(B <= l - 1) <= alpha / 2
     if l >= 1 and stats.binom.cdf(l - 1, n, q) > alpha / 2:

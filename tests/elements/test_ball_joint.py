@@ -1,4 +1,4 @@
-"""Friction ball joint (seed 001, Sec. II.B.1): slip plateau at mu B |F|, dissipated energy per
+"""Friction ball joint (Stohlman & Pellegrino, Sec. II.B.1): slip plateau at mu B |F|, dissipated energy per
 cycle, no moment without force, consistent tangent (finite differences, stick and slip),
 commit/rollback, a two-beam model solved with fm.solve, bad input."""
 
@@ -21,7 +21,7 @@ from femast.errors import ModelError
 from femast.rotations import expm_so3
 from femast.testing import fd_tangent
 
-MU, B = 0.5, 0.004  # seed 001, Sec. II.B.1
+MU, B = 0.5, 0.004  # Stohlman & Pellegrino, Sec. II.B.1
 
 
 # ----------------------------------------------------------------------------- helpers

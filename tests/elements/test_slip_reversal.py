@@ -1,4 +1,4 @@
-"""Slip reversal between Newton iterations (issue 20): a friction ball joint whose slip direction
+"""Slip reversal between Newton iterations: a friction ball joint whose slip direction
 turns round from one iteration to the next is answered as stuck for that iteration, and such an
 iteration is never accepted as converged.
 
@@ -10,7 +10,7 @@ mast below 1219 iterations and 12 cutbacks (``femast.adam.shape_study``, rng see
 
 Checks: the kernel's stuck answer against its closed form (m = m_c + k_s theta, tangent k_s);
 Newton's refusal of a provisional response (a user family); the scattered mast converging in one
-increment per step with a bounded iteration count and the Coulomb law (seed 001 Sec. II.B.1,
+increment per step with a bounded iteration count and the Coulomb law (Stohlman & Pellegrino, Sec. II.B.1,
 |M| <= mu B |F|) holding at every converged frame.
 """
 
@@ -27,7 +27,7 @@ from femast.elements._ball_joint_kernels import I_M, I_SLIP, N_STATE, REVERSED, 
 from femast.elements.base import ElementFamily, ElementResponse
 from femast.errors import ConvergenceError
 
-MU, B = 0.5, 0.004  # seed 001 Sec. II.B.1
+MU, B = 0.5, 0.004  # Stohlman & Pellegrino, Sec. II.B.1
 K_PEN, K_S = 1e8, 2000.0
 
 

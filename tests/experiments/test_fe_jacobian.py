@@ -1,5 +1,5 @@
 """Finite-difference columns of the expensive fits split with a forked child
-(femast.experiments.fe_jacobian.evaluate_many, issue 21): the same values as computing them here,
+(femast.experiments.fe_jacobian.evaluate_many): the same values as computing them here,
 bit for bit; a child that fails is replaced by this process; serial where forking is unsafe."""
 
 import os

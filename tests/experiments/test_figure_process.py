@@ -1,5 +1,5 @@
-"""A figure drawn by a child forked at the start of a command (femast.experiments.figure_process,
-issue 21): it writes what the function writes; an argument that does not pickle or a failing
+"""A figure drawn by a child forked at the start of a command (femast.experiments.figure_process):
+it writes what the function writes; an argument that does not pickle or a failing
 function returns False (the caller then draws); the child is always reaped."""
 
 import os

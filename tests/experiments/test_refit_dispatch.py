@@ -1,4 +1,4 @@
-"""diagnose's refit executor (femast/experiments/refits.py), issue 21 item 6: the FE experiments'
+"""diagnose's refit executor (femast/experiments/refits.py): the FE experiments'
 refits get a process each by default (more processes than CPUs share them to the end), and a
 helper runs in the calling process while the workers refit."""
 

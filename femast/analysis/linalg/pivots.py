@@ -63,7 +63,7 @@ def confirm(B):
 
 
 class PivotChecks:
-    """The zero-pivot checks of :class:`~femast.analysis.solvers.linear.SparseLU` (a mixin: it uses the
+    """The zero-pivot checks of :class:`~femast.analysis.linalg.linear.SparseLU` (a mixin: it uses the
     solver's ``_lu``, ``_B``, ``_engine``, ``_dmax``, ``_checked``, ``_confirmed``, ``confirmations``
     and ``pivot_check``)."""
 
@@ -85,7 +85,7 @@ class PivotChecks:
 
     def _check_pivots(self):
         """Zero-pivot test of the factorisation (scipy builds L and U as CSC matrices for SuperLU's:
-        ~10 % of a factorisation), judged on the model (:mod:`~femast.analysis.solvers.pivots`): a
+        ~10 % of a factorisation), judged on the model (:mod:`~femast.analysis.linalg.pivots`): a
         suspect factorisation is confirmed by SuperLU's partial pivoting before the tangent is called
         singular."""
         if self._lu is self._confirmed:  # SuperLU's, after a suspect factorisation: judged as then
@@ -114,7 +114,7 @@ class PivotChecks:
 
     def _confirm_singular(self) -> bool:
         """True if SuperLU with partial pivoting finds the tangent just factorised singular too
-        (:func:`~femast.analysis.solvers.pivots.confirm`); False: its factorisation replaces the
+        (:func:`~femast.analysis.linalg.pivots.confirm`); False: its factorisation replaces the
         suspect one."""
         if self._B is None:
             return True
