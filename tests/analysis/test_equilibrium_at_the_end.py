@@ -12,8 +12,8 @@ from femast.elements.ball_joint import add_ball_joints
 from femast.elements.base import ElementFamily, ElementResponse
 from femast.elements.cable_devices import CableDeviceFamily, Pulley
 from femast.elements.cable_latch import CableLatchFamily
+from femast.elements.latch_law import LatchParameters
 from femast.elements.shroud_cable import add_shrouds
-from femast.latch import LatchParameters
 
 
 def beams():
