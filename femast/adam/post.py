@@ -25,8 +25,8 @@ def bay_curve(res: Results, am: AdamModel, bay: int = -1) -> dict:
 
     Returns a dict of arrays, one value per frame: ``step`` (name), ``time`` (total time, s),
     ``theta`` (rz of the control node, rad), ``ux``, ``uy``, ``uz`` (m), ``M`` (moment about z,
-    N m, *seed sign*: the moment of the bay on the loading rig, i.e. minus the moment applied to
-    the bay; the rig holds the bay against stowing with a negative moment), ``M_applied`` (N m),
+    N m, in the sign of Stohlman & Pellegrino: the moment of the bay on the loading rig, i.e. minus
+    the moment applied to the bay; the rig holds the bay against stowing with a negative moment), ``M_applied`` (N m),
     ``bead`` (n, 4) bead positions (m), ``zone`` (n, 4) zones of Fig. 6, ``dT`` (n, 4) N,
     ``tension`` (n, 4, 2) N (sections 1 and 2 of each latch cable)."""
     j = range(am.n_bays)[bay]
