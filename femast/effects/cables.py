@@ -288,8 +288,9 @@ PRETENSION = register_effect(
             "or slips during a test makes the stiffness fall with time; a pretension different from the assumed one "
             "shifts it (identifiable only in models that take the pretension as an input: bay-torsion, tip-cycle)."
         ),
-        signature="the compliance drifts along the test: the error grows with time in proportion to the load (a "
-        "loss during the test); the unlatched bay's moment is offset (an error of the pretension)",
+        signature="the structure softens as the test goes on: the error grows with time in proportion to the load "
+        "(pretension lost during the test); once the latches have released, the bay's moment is offset (a "
+        "pretension set differently from the model's)",
         acts_where=("peak", "loading", "unloading", "zone (d) no contact"),
         seed="Rocaspect guyed mast, Table III; Stohlman & Pellegrino, Eq. 16",
         mechanism=Implementation(

@@ -1,6 +1,6 @@
 """Latch hysteresis near the latched state (Stohlman & Pellegrino, Sec. III.C and conclusion).
 
-Seed 001 fits one curve near the fully latched configuration ("the model assumes no hysteresis
+Stohlman & Pellegrino fit one curve near the fully latched configuration ("the model assumes no hysteresis
 in this region", Fig. 10) and concludes that the latch model must be refined because the bay
 keeps a residual rotation at zero moment (Figs. 16-17).  This effect adds a friction band that
 is widest with the bead seated against the backstop and fades over a length ``ell`` as it moves

@@ -178,7 +178,7 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
         )
     if result.ranking:
         lines.append(f"  reading of #1: {result.ranking[0]['reading']}")
-    lines.append(f"  verdict: {result.verdict['conclusion']} [{result.verdict.get('kind')}]")
+    lines.append(f"  verdict: {result.verdict['conclusion']}")
     if result.files:
         lines.append("  wrote " + ", ".join(result.files.values()))
     return "\n".join(lines)

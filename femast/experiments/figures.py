@@ -15,9 +15,19 @@ def _plt():
     return plotstyle.pyplot()
 
 
-def _common_unit(exp, channels):
-    """The display unit shared by ``channels`` (None if they differ)."""
-    units = {display_scale(exp.unit_of(c))[1] for c in channels}
+def _scales(exp, arrays: dict) -> dict:
+    """(factor, unit label) per channel of ``arrays`` (channel -> values): channels of one SI unit
+    share the unit that suits the largest of their values (70 um, 20 mm, 0.6 arcsec)."""
+    by_unit = {}
+    for c, v in arrays.items():
+        by_unit.setdefault(exp.unit_of(c), []).append(np.ravel(np.asarray(v, dtype=float)))
+    scale = {u: display_scale(u, np.concatenate(vs)) for u, vs in by_unit.items()}
+    return {c: scale[exp.unit_of(c)] for c in arrays}
+
+
+def _common_unit(scales: dict):
+    """The display unit shared by every channel of ``scales`` (None if they differ)."""
+    units = {ul for _, ul in scales.values()}
     return units.pop() if len(units) == 1 else None
 
 
@@ -34,23 +44,27 @@ def compare_figure(exp, data, result, png) -> Path:
     ax2 = fig.add_subplot(gs[1, :])
     ax3 = fig.add_subplot(gs[2, :], sharex=ax2)
     pred = result.predicted
+    shown = _scales(exp, {c: np.concatenate([np.ravel(data[c]), np.ravel(pred[c])]) for c in exp.channels})
+    errors = _scales(
+        exp, {c: np.concatenate([np.ravel(result.residuals[c]), np.ravel(result.noise[c])]) for c in exp.channels}
+    )
     if exp.plot_measured:
         exp.plot_measured(ax0, data, pred, result.params, exp.options)
     else:
         c = exp.channels[0]
-        f, ul = display_scale(exp.unit_of(c))
+        f, ul = shown[c]
         ax0.plot(f * data[c], f * pred[c], ".", ms=3)
         lim = [f * min(data[c].min(), pred[c].min()), f * max(data[c].max(), pred[c].max())]
         ax0.plot(lim, lim, "k--", lw=0.8)
         ax0.set_xlabel("measured " + column_label(c, ul))
         ax0.set_ylabel("model " + column_label(c, ul))
     for i, c in enumerate(exp.channels):
-        f, ul = display_scale(exp.unit_of(c))
+        f, ul = shown[c]
         ax1.plot(rows, f * data[c], ".", ms=2, color=f"C{i}", alpha=0.6)
         ax1.plot(rows, f * pred[c], "-", lw=1.0, color=f"C{i}", label=column_label(c, ul))
     ax1.set_title("measured (dots) and model (lines) along the path")
     ax1.set_xlabel("data row (time order)")
-    uc = _common_unit(exp, exp.channels)
+    uc = _common_unit(shown)
     ax1.set_ylabel(f"measured and model ({uc})" if uc else "measured and model (unit: legend)")
     ax1.legend(ncol=min(3, len(exp.channels)))
     s = result.load
@@ -65,7 +79,7 @@ def compare_figure(exp, data, result, png) -> Path:
     if ax2.get_legend_handles_labels()[0]:  # a path with no marked rows has no legend
         ax2.legend(ncol=3, loc="upper right")
     for i, c in enumerate(exp.channels):
-        f, ul = display_scale(exp.unit_of(c))
+        f, ul = errors[c]
         ax3.plot(rows, f * result.residuals[c], "-", lw=0.8, color=f"C{i}", label=column_label(c, ul))
         if np.ndim(result.noise[c]):  # per-row noise (heteroscedastic model)
             ax3.plot(rows, f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
@@ -91,7 +105,8 @@ def compare_figure(exp, data, result, png) -> Path:
             bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.7),
         )
     ax3.set_xlabel("data row (time order)")
-    ax3.set_ylabel(f"residual, measured - model ({uc})" if uc else "residual, measured - model (unit: legend)")
+    ue = _common_unit(errors)
+    ax3.set_ylabel(f"residual, measured - model ({ue})" if ue else "residual, measured - model (unit: legend)")
     ax3.set_title(
         fit_title(
             ax3,
@@ -117,7 +132,6 @@ def diagnose_figure(exp, data, result, png) -> Path:
     baseline and of the best candidate along the path."""
     plt = _plt()
     png = Path(png)
-    f, ul = display_scale(exp.error_unit)
     entries = (
         [("baseline", result.baseline["rms"], None, False, False, result.baseline.get("heldout_ratio"))]
         + [
@@ -143,6 +157,8 @@ def diagnose_figure(exp, data, result, png) -> Path:
             for p in (getattr(result, "pairs", None) or [])[:3]
         ]
     )
+    errors = [e[1] for e in entries if not e[4]] + [result.noise_rms * result.at_noise]
+    f, ul = display_scale(exp.error_unit, errors)  # the unit that suits the errors shown (um, mm, arcsec)
     fig, (ax0, ax1) = plt.subplots(
         1, 2, figsize=(13, max(4.0, 0.45 * len(entries) + 2)), gridspec_kw={"width_ratios": [1, 1.3]}
     )
@@ -172,9 +188,12 @@ def diagnose_figure(exp, data, result, png) -> Path:
     for yy, e in zip(y, entries):
         if e[4]:
             ax0.text(0.0, yy, "  refit failed", va="center", fontsize=8, color="C3")
-        elif e[2] is not None:
-            ax0.text(f * e[1], yy, f"  dBIC {e[2]:+.0f}", va="center", fontsize=8)
+        elif e[2] is not None:  # right of the bar and of its held-out marker
+            x = max(f * e[1], f * e[5] * result.noise_rms if e[5] is not None and np.isfinite(e[5]) else 0.0)
+            ax0.text(x, yy, f"  dBIC {e[2]:+.0f}", va="center", fontsize=8)
     ax0.set_xlabel(f"RMS error after refit ({ul})")
+    bars = [f * e[1] for e, k in zip(entries, ok) if k] + [f * r * result.noise_rms for _, r in ho]
+    ax0.set_xlim(0, 1.35 * max(bars + [f * result.noise_rms * result.at_noise]))  # the noise lines inside too
     v = result.verdict
     verdict = {
         "missing_effect": f"missing: {v['missing_effect']}",
@@ -190,9 +209,7 @@ def diagnose_figure(exp, data, result, png) -> Path:
             f"verdict: {verdict}",
         )
     )
-    ax0.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize=8)
-    xmax = max([f * e[1] for e, k in zip(entries, ok) if k] + [f * r * result.noise_rms for _, r in ho])
-    ax0.set_xlim(0, 1.35 * xmax)
+    plotstyle.legend_below(ax0, ncol=2, fontsize=8)
     rows = np.arange(data.n)
     zb = np.asarray(getattr(result, "baseline_z", result.baseline_fit.fun)).reshape(len(exp.channels), -1)
     ax1.plot(rows, np.sqrt((zb**2).mean(0)), "-", lw=0.8, color="C0", label="baseline")

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import os
 import threading
-from concurrent.futures import as_completed
 from contextlib import nullcontext
 
 from scipy.optimize import OptimizeResult
@@ -39,19 +38,23 @@ def _refit_task(payload: dict) -> OptimizeResult:
     """One refit (runs in a worker process or on a dask worker)."""
     from .registry import experiment_from_source
 
-    for script in payload["scripts"]:
-        load_script(script)
-    exp = experiment_from_source(payload["source"], payload["options"])
-    data = payload["data"]
-    res = _safe_fit(
-        exp,
-        data,
-        payload["effects"],
-        start=payload["start"],
-        noise=payload["noise"],
-        sensitivity=payload.get("sensitivity"),
-        rows=payload.get("rows"),
-    )
+    progress.relay_to(payload.get("progress_file"))  # the parent's bar moves with each model run of this refit
+    try:
+        for script in payload["scripts"]:
+            load_script(script)
+        exp = experiment_from_source(payload["source"], payload["options"])
+        data = payload["data"]
+        res = _safe_fit(
+            exp,
+            data,
+            payload["effects"],
+            start=payload["start"],
+            noise=payload["noise"],
+            sensitivity=payload.get("sensitivity"),
+            rows=payload.get("rows"),
+        )
+    finally:
+        progress.relay_to(None)
     res.pid = os.getpid()
     return res
 
@@ -162,16 +165,16 @@ def _run_tasks(payloads, workers, scheduler, while_waiting=None, pool=None):
     own = pool is None
     if own:
         pool = Pool(n, initializer=_worker_setup, initargs=_setup_args(payloads[0]), name="diagnose refits")
-    with pool if own else nullcontext():
-        futures = [pool.submit(_refit_task, p) for p in payloads]
+    with pool if own else nullcontext(), progress.Relays() as relays:
+        futures = [pool.submit(_refit_task, dict(p, progress_file=relays.path(i))) for i, p in enumerate(payloads)]
         helper = None
         if while_waiting is not None:
             helper = threading.Thread(target=_quietly, args=(while_waiting,), daemon=True)
             helper.start()
-        with progress.counter(len(futures), f"diagnose: refits on {n} processes", unit="refits") as bar:
-            for fut in as_completed(futures):
-                bar.set_postfix_str(f"done: {_candidate(payloads[futures.index(fut)])}", refresh=False)
-                bar.update(1)
+        for _ in progress.as_completed(
+            futures, f"diagnose: refits on {n} processes", "refits", relays, lambda i: _candidate(payloads[i])
+        ):
+            pass  # the bar advances with every model run inside the refits (relayed by the workers)
         results = [_result(fut, p) for fut, p in zip(futures, payloads)]
         if helper is not None:
             helper.join()

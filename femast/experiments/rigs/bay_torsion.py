@@ -190,7 +190,7 @@ def run_bay(
     reference : a :class:`~femast.analysis.reference.ReferencePath` of another run of the bay whose
         converged increments start this run's, or None.  record_path : a ReferencePath that records
         this run's converged increments, or None.
-    Returns ``Mz`` (m,) N m (seed sign), ``zone`` and ``bead`` (m) (m, 4) of the four latches,
+    Returns ``Mz`` (m,) N m (the bay's moment on the rig), ``zone`` and ``bead`` (m) (m, 4) of the four latches,
     ``uz`` (m,), ``increments``, ``iterations``, ``wall_time``.  (The latches' tension jumps ``dT``
     are no longer recorded: they were not used, and reading any element output costs 20 % of a run.)"""
     from femast.adam import build_bay
@@ -369,7 +369,7 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
     ax.plot(data["theta_deg"], predicted["Mz_Nm"], "-", lw=1.3, color="C3", label="model (path order)")
     ax.axhline(0.0, color="0.7", lw=0.8)
     ax.set_xlabel("z-axis rotation theta (deg)")
-    ax.set_ylabel("Mz (N m, seed sign)")
+    ax.set_ylabel("moment of the bay on the rig, Mz (N m)")
     ax.set_title("single-bay torsion")
     ax.legend(fontsize=8)
 
