@@ -17,6 +17,12 @@ of freedom when nothing moves at constant load; it does not depend on the noise 
 correlation, which the scatter between holds carries.  ``t > CREEP_T`` (4: p < 0.002 one-sided for
 the fewest holds, ``MIN_HOLDS`` = 4) says the displacement keeps moving at constant load.
 
+In ``diagnose`` (:func:`creep_overrules`, on :func:`time_check` of the measured channels): where the
+response keeps moving at constant load, a verdict that names only rate-independent effects is
+wrong whatever their fit says -- a friction form can follow the loops of a creeping joint -- and
+becomes "not explained" with the finding; an effect whose mechanism reads the time
+(``pretension_loss``, a user's creep) may still be named.
+
 Measured (``tests/experiments/test_time_dependence.py``; the generalisation benchmark's mast-top
 rig with the load held at every peak and at zero, 16 holds of 15 rows, four noise draws each):
 logarithmic creep of the joints (``phi = 0.08``, the displacement at the noise after a hold of
@@ -89,3 +95,56 @@ def hold_drift(load, measured: dict, sigma: dict, noise_load: float = 0.0) -> di
         t = float(np.mean(v)) / se if se > 0 else (np.inf if np.mean(v) > 0 else 0.0)
         out.update(t=t, drift=float(np.mean(v)), creep=bool(t > CREEP_T))
     return out
+
+
+# ----------------------------------------------------------------------------- in diagnose's verdict
+def time_check(load, measured: dict, sigma: dict) -> dict:
+    """:func:`hold_drift` of the measured channels along the signed ``load`` of the path, its noise
+    taken from the load itself (:func:`~femast.experiments.residuals.noise_floor`)."""
+    from .residuals import noise_floor
+
+    s = np.asarray(load, dtype=float)
+    return hold_drift(s, measured, sigma, noise_load=noise_floor(s))
+
+
+def creep_overrules(verdict: dict, check: dict, time_dependent) -> dict:
+    """The verdict of ``diagnose`` once the holds have spoken (module docstring).
+
+    verdict : :func:`~femast.experiments.verdict.conclude`'s.  check : :func:`time_check`'s.
+    time_dependent : ``f(effect name) -> bool``, True for an effect that changes with time.
+    Where the response keeps moving at constant load (``check["creep"]``), a verdict that names only
+    rate-independent effects (friction, a gap, a stiffening: they cannot move anything while the
+    load is held) becomes ``not_explained``, saying so; any other verdict gets the finding as
+    ``time_dependence`` and, unless it names a time-dependent effect, a sentence in its conclusion.
+    Returns a new dict (``verdict`` is not changed).
+    """
+    v = dict(verdict)
+    v["time_dependence"] = {k: check.get(k) for k in ("holds", "t", "drift", "creep")}
+    if not check.get("creep"):
+        return v
+    named = list(v.get("missing_effects") or ([v["mechanism"]] if v.get("mechanism") else []))
+    if named and any(time_dependent(e) for e in named):
+        return v
+    finding = (
+        f"the response keeps moving while the load is held (t = {check['t']:.1f} over {check['holds']} holds: "
+        "creep, relaxation or a slipping grip)"
+    )
+    if v.get("kind") in ("missing_effect", "missing_pair", "form_imperfect", "better_form") and named:
+        v.update(
+            kind="not_explained",
+            missing_effect=None,
+            missing_effects=[],
+            mechanism=None,
+            form=None,
+            explained=False,
+            rate_independent_best=named,
+        )
+        v["conclusion"] = (
+            f"none of the candidates explains this: {finding}, which {' + '.join(named)} cannot do (it moves "
+            "the response only when the load changes); a time-dependent mechanism is missing (an effect "
+            "of your own on the time: docs/your_own_rig.md)"
+        )
+        v["try_next"] = ["an effect that moves the response at constant load (creep: docs/your_own_rig.md)"]
+    elif v.get("kind") != "nothing_missing":
+        v["conclusion"] = f"{v.get('conclusion', '')}; {finding}"
+    return v
