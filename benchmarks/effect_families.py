@@ -54,7 +54,7 @@ def main() -> Path:
     ms = 0.01 * 60
     a.plot(m, 1e3 * 1e-4 * np.tanh(m / ms), label="sharp: m_s = 1 % of max |m|")
     for mc in (5.0, 15.0, 40.0):
-        a.plot(m, 1e3 * 1e-4 * np.tanh(m / mc), label=f"smooth: m_c = {mc:g} N m")
+        a.plot(m, 1e3 * 1e-4 * np.tanh(m / mc), label=f"smooth: M_c = {mc:g} N m")
     a.set_xlabel("joint moment m (N m)")
     a.set_ylabel("extra rotation (mrad), c = 0.1 mrad")
     a.set_title("joint_clearance forms")

@@ -1,11 +1,12 @@
-"""``femast compare``, ``diagnose`` (issue 7), ``experiments``, ``effects``, ``examples`` (issue 17),
+"""``femast compare``, ``diagnose``, ``experiments``, ``effects``, ``examples``,
 registered by :mod:`femast.cli`.
 
 ::
 
-    femast compare EXPERIMENT DATA.csv [--effects a,b] [--fit] [--out DIR] [--json]
+    femast compare EXPERIMENT DATA.csv [--effects a,b] [--fit] [--params-from RUN] [--sigma CH=V,...]
+                   [--out DIR] [--json]
     femast diagnose EXPERIMENT DATA.csv [--out DIR] [--json] [--workers N] [--scheduler ADDRESS]
-                    [--effects a,b]
+                    [--effects a,b] [--candidates a,b] [--exclude a,b] [--sigma CH=V,...]
     femast experiments [--json]            femast effects [EXPERIMENT] [--json]
     femast examples [--copy DIR]
 
@@ -14,8 +15,8 @@ defining ``experiment``; DATA is a CSV file or ``example`` (the experiment's shi
 :mod:`femast.examples`).  Outputs go to ``--out``, by default ``./compare/EXPERIMENT_DATASTEM``
 (``./diagnose/...``) in the working directory.  An ``--effects`` entry
 is an effect name, ``SCRIPT.py`` (every effect the script registers) or ``SCRIPT.py:name``.
-``diagnose --effects`` names the effects already in the model being diagnosed (an extension of
-issue 7: after adding the missing effect, diagnose the new model).
+``diagnose --effects`` names the effects already in the model being diagnosed (after adding the missing effect, diagnose the new model); ``--candidates`` / ``--exclude`` choose
+the effects it tries.
 """
 
 from __future__ import annotations
@@ -43,6 +44,24 @@ def _effect_names(arg):
     return names
 
 
+def _sigmas(arg) -> dict:
+    """``--sigma dx_m=2e-5,dy_m=2e-5`` -> ``{"dx_m": 2e-5, "dy_m": 2e-5}`` (checked by the noise model)."""
+    from .errors import ModelError
+
+    out = {}
+    for item in (arg or "").split(","):
+        if not item.strip():
+            continue
+        name, eq, value = item.partition("=")
+        if not eq:
+            raise ModelError(f"--sigma {item!r}: give CHANNEL=VALUE in the channel's unit, e.g. --sigma dx_m=2e-5")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise ModelError(f"--sigma {item!r}: {value.strip()!r} is not a number") from None
+    return out
+
+
 def experiment_rows() -> list[dict]:
     """Every registered experiment: name, title, its example data file (or None), its effects."""
     from . import examples
@@ -63,22 +82,27 @@ def experiment_rows() -> list[dict]:
 
 
 def effect_rows(experiment=None) -> list[dict]:
-    """Every registered effect (or those applicable to ``experiment``): name, title, one sentence of
-    physics, the experiments it is implemented for."""
+    """Every registered effect (or those applicable to ``experiment``, an Experiment): name, title, one
+    sentence of physics, the registered experiments it applies to, the quantities its mechanism needs."""
     from .effects import list_effects
+    from .experiments import list_experiments
     from .text import first_sentence
 
+    experiments = list_experiments()
     rows = []
     for e in list_effects():
-        exps = [n for n in e.implementations if e.applies_to(n)]
-        if experiment is not None and experiment not in exps:
+        if experiment is not None and not e.applies_to(experiment):
             continue
+        m = e.mechanism
         rows.append(
             {
                 "name": e.name,
                 "title": e.title,
                 "physics": first_sentence(e.physics),
-                "experiments": exps,
+                "experiments": [x.name for x in experiments if e.applies_to(x)],
+                "quantities": [k for k in ("load", "displacement", "time", "temperature") if k in (m.hook, *m.needs)]
+                if m is not None
+                else [],
                 "seed": e.seed,
             }
         )
@@ -108,17 +132,18 @@ def _effects(args):
     if args.experiment:
         from .experiments import get_experiment
 
-        exp = get_experiment(args.experiment).name
+        exp = get_experiment(args.experiment)
     rows = effect_rows(exp)
     if args.json:
         print(json.dumps(rows, indent=2))
         return
     from .text import hanging
 
-    print(f"effects{' of ' + exp if exp else ''} (femast compare ... --effects NAME[,NAME]):")
+    print(f"effects{' of ' + exp.name if exp else ''} (femast compare ... --effects NAME[,NAME]):")
     pad = 2 + max((len(r["name"]) for r in rows), default=0) + 1
     for r in rows:
-        print(hanging(f"  {r['name']}", f"{r['title']} [{', '.join(r['experiments'])}]", pad))
+        where = r["experiments"] + ([f"any rig with {' + '.join(r['quantities'])}"] if r["quantities"] else [])
+        print(hanging(f"  {r['name']}", f"{r['title']} [{', '.join(where)}]", pad))
         print(hanging("", r["physics"], pad))
 
 
@@ -163,7 +188,8 @@ def _check_order(args) -> None:
     from .experiments import list_experiments
 
     names = {e.name for e in list_experiments()}
-    first, second = args.experiment, args.data
+    first = args.experiment
+    second = args.data[0] if isinstance(args.data, list) else args.data
     if first not in names and not first.endswith(".py") and (second in names or second.endswith(".py")):
         raise FemastError(
             f"'{first}' is not an experiment but '{second}' is: the experiment comes first, then the data "
@@ -180,18 +206,50 @@ def _setup(args):
     exp = get_experiment(args.experiment)
     effects = _effect_names(getattr(args, "effects", None))
     exp.require_model(f"femast {args.command}")
-    path, shown = resolve_data(exp, args.data)
-    data = replace(read_data(exp, path, units=getattr(args, "units", None)), path=shown)
-    stem = Path(shown.split()[-1]).stem
+    items = args.data if isinstance(args.data, list) else [args.data]
+    found = [resolve_data(exp, d) for d in items]
+    paths, shown = [f[0] for f in found], [f[1] for f in found]
+    data = read_data(
+        exp, paths, getattr(args, "units", None), time_continuous=args.continuous_time, offsets=args.group_offsets
+    )
+    if len(paths) == 1:
+        data = replace(data, path=shown[0])
+    stem = Path(shown[0].split()[-1]).stem + (f"_and_{len(paths) - 1}_more" if len(paths) > 1 else "")
     out = Path(args.out) if args.out else Path(args.command) / f"{exp.name}_{stem}"
     return exp, data, effects, out
+
+
+def params_from(run) -> tuple:
+    """(parameters ``{name: value}``, effects) of an earlier compare: its output folder or compare.json."""
+    from .errors import ModelError
+
+    path = Path(run)
+    if path.is_dir():
+        path = path / "compare.json"
+    if not path.is_file():
+        raise ModelError(
+            f"--params-from {run}: no compare.json there; give a compare output folder or its compare.json"
+        )
+    try:
+        rep = json.loads(path.read_text())
+        params = {k: float(v["value"]) for k, v in rep["params"].items()}
+        effects = list(rep.get("effects", []))
+    except (ValueError, KeyError, TypeError) as e:
+        raise ModelError(f"--params-from {path}: not a compare report ({type(e).__name__}: {e})") from None
+    return params, effects
 
 
 def _compare(args):
     from .experiments import compare, format_compare
 
     exp, data, effects, out = _setup(args)
-    res = compare(exp, data, effects, fit=args.fit, out=out, max_rows=args.max_rows)
+    params = None
+    if args.params_from:
+        params, run_effects = params_from(args.params_from)
+        effects = effects or run_effects
+    res = compare(
+        exp, data, effects, fit=args.fit, params=params, out=out, sigma=_sigmas(args.sigma), max_rows=args.max_rows
+    )
     print(json.dumps(res.report, indent=2) if args.json else format_compare(exp, res))
 
 
@@ -200,7 +258,16 @@ def _diagnose(args):
 
     exp, data, effects, out = _setup(args)
     res = diagnose(
-        exp, data, base_effects=effects, workers=args.workers, scheduler=args.scheduler, out=out, max_rows=args.max_rows
+        exp,
+        data,
+        _effect_names(args.candidates) if args.candidates else None,
+        exclude=_effect_names(args.exclude),
+        base_effects=effects,
+        sigma=_sigmas(args.sigma),
+        workers=args.workers,
+        scheduler=args.scheduler,
+        out=out,
+        max_rows=args.max_rows,
     )
     print(json.dumps(res.report, indent=2) if args.json else format_diagnose(exp, res))
 
@@ -220,7 +287,15 @@ def register(subparsers, fmt=None) -> None:
     )
     data_help = (
         "measured data, a CSV file with a header row (formats: `femast experiments`, docs/experiments.md), "
-        "or 'example' for the example shipped with femast"
+        "or 'example' for the example shipped with femast; several files are one data set, each file a "
+        "group (a station, specimen or run)"
+    )
+    continuous_help = (
+        "the files (or groups) are one test whose time goes on from one to the next (default: separate "
+        "tests, time restarts in each)"
+    )
+    offsets_help = (
+        "fit a zero of its own for every group and channel, e.g. sensors zeroed at each station (default: no)"
     )
     units_help = (
         "the unit the values of a column are in when its header says another, COLUMN=UNIT[,...] "
@@ -228,6 +303,10 @@ def register(subparsers, fmt=None) -> None:
         "(dx_m=m) confirms it and skips the size check of that column (default: the headers' units)"
     )
     out_help = "output folder (default: ./%(prog_cmd)s/EXPERIMENT_DATASTEM in the working directory)"
+    sigma_help = (
+        "sensor uncertainty of channels, CHANNEL=VALUE[,...] in the channel's unit, e.g. dx_m=2e-5 (default: "
+        "sigma_ columns, else the repeatability of repeated rows, else estimated from the residual)"
+    )
     p = subparsers.add_parser(
         "compare",
         help="run a model along measured data and show where it fails",
@@ -238,7 +317,9 @@ def register(subparsers, fmt=None) -> None:
         "output folder.  Example: femast compare mast-top example --fit",
     )
     p.add_argument("experiment", help=exp_help)
-    p.add_argument("data", help=data_help)
+    p.add_argument("data", nargs="+", help=data_help)
+    p.add_argument("--continuous-time", action="store_true", help=continuous_help)
+    p.add_argument("--group-offsets", action="store_true", help=offsets_help)
     p.add_argument(
         "--effects",
         default=None,
@@ -252,6 +333,14 @@ def register(subparsers, fmt=None) -> None:
         help="fit the model and effect parameters (default: run with the default parameters)",
     )
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "compare"})
+    p.add_argument("--sigma", default=None, help=sigma_help)
+    p.add_argument(
+        "--params-from",
+        metavar="RUN",
+        default=None,
+        help="take the parameters (and effects) of an earlier compare, its output folder or compare.json: fit on "
+        "one data set, score another (with --fit: start the fit there) (default: the model's defaults)",
+    )
     p.add_argument("--units", default=None, help=units_help)
     p.add_argument(
         "--max-rows",
@@ -271,8 +360,11 @@ def register(subparsers, fmt=None) -> None:
         "Example: femast diagnose mast-top example",
     )
     p.add_argument("experiment", help=exp_help)
-    p.add_argument("data", help=data_help)
+    p.add_argument("data", nargs="+", help=data_help)
+    p.add_argument("--continuous-time", action="store_true", help=continuous_help)
+    p.add_argument("--group-offsets", action="store_true", help=offsets_help)
     p.add_argument("--out", default=None, help=out_help % {"prog_cmd": "diagnose"})
+    p.add_argument("--sigma", default=None, help=sigma_help)
     p.add_argument("--units", default=None, help=units_help)
     p.add_argument(
         "--max-rows",
@@ -295,6 +387,13 @@ def register(subparsers, fmt=None) -> None:
     p.add_argument(
         "--effects", default=None, help="comma-separated effects already in the model being diagnosed (default: none)"
     )
+    p.add_argument(
+        "--candidates",
+        default=None,
+        help="comma-separated effects to try: names, SCRIPT.py or SCRIPT.py:name (default: every effect that "
+        "applies to the experiment)",
+    )
+    p.add_argument("--exclude", default=None, help="comma-separated effects not to try (default: none)")
     p.set_defaults(func=_diagnose)
     p = subparsers.add_parser(
         "experiments",

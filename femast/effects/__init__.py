@@ -1,33 +1,36 @@
-"""Library of physical effects for ``femast compare`` and ``femast diagnose`` (issue 7).
+"""The effect contract and the library of physical effects for ``femast compare`` and ``diagnose``.
 
-Each effect is a named, documented mechanism with parameters (units, bounds, defaults) and one
-implementation per experiment it applies to (see :mod:`femast.effects.base`).  Built in:
+An effect is a named, documented mechanism with parameters (units, bounds, defaults).  Its
+*mechanism* acts on physical quantities (the load through a connection and the displacement it
+drives, per axis; time; temperature) and applies to every experiment that declares them in
+``Experiment.quantities`` -- a built-in rig or a user's own; rig-specific implementations act on a
+rig's own hooks (see :mod:`femast.effects.base` and :mod:`femast.effects.quantities`).  Built in:
 
-=====================  ==========================================  ==========================================
-name                   mechanism                                   implemented for
-=====================  ==========================================  ==========================================
-joint_clearance        backlash, offset +-c with the load's sign    mast-top, latch-pull
-friction_hysteresis    Coulomb friction, play operator              mast-top, latch-pull
-beam_flexibility       cantilever tube in series (000 Eqs. 8-15)    mast-top
-progressive_stiffness  EA(tau) of seed 000 Eq. 25                   mast-top
-cable_hysteresis       loop width proportional to the load          mast-top, latch-pull
-pretension_loss        stiffness vs pretension; pretension error    mast-top, bay-torsion, tip-cycle
-stretch_error          Eq. 15 stretch-removal error (seed 001)      latch-pull
+=====================  ==========================================  =====================================
+name                   mechanism                                   applies to
+=====================  ==========================================  =====================================
+joint_clearance        backlash, offset +-c with the load's sign    load + displacement; latch-pull
+friction_hysteresis    Coulomb friction, play operator              load; latch-pull
+progressive_stiffness  stiffness rising with the load (Eq. 25)      load + displacement
+cable_hysteresis       loop width proportional to the load          load; latch-pull
+pretension_loss        stiffness falling with time; a pretension    displacement + time; bay-torsion,
+                       error in the FE models                       tip-cycle, vibration
+beam_flexibility       cantilever tube in series                    mast-top
+stretch_error          pull-test stretch-removal error              latch-pull
 latch_hysteresis       friction band near the latched state         latch-pull, bay-torsion, tip-cycle
-ball_joint_friction    |M| = mu B |F| (seed 001 Sec. II.B.1)        bay-torsion, tip-cycle
-off_axis_motion        bay top leaves its axis (seed 001 Sec. VI)   bay-torsion
-=====================  ==========================================  ==========================================
+ball_joint_friction    |M| = mu B |F| of the ADAM ball joints       bay-torsion, tip-cycle
+off_axis_motion        bay top leaves its axis                      bay-torsion
+added_mass, joint_stick  natural-frequency effects                  vibration
+=====================  ==========================================  =====================================
 
-On the FE experiments (bay-torsion, tip-cycle) the effects change what the FE model is built with
-(hook ``bay_parameters``) or the path it is driven along (``control_path``).
-``docs/experiments.md`` documents each one and shows how to register an effect from a script.
+``docs/experiments.md`` documents each one; ``docs/your_own_rig.md`` shows a user's rig using
+them beside its own effects.
 """
 
 from . import joints, structure, cables, latch, vibration  # noqa: F401,I001  (register the built-in effects, in this order)
 from .base import (
     Effect,
     Implementation,
-    Parameter,
     add_implementation,
     applicable_effects,
     get_effect,
@@ -39,11 +42,14 @@ from .base import (
     unregister_effect,
 )
 from .operators import play, proportional_play
+from .parameters import Parameter
+from .quantities import Quantity
 
 __all__ = [
     "Effect",
     "Implementation",
     "Parameter",
+    "Quantity",
     "register_effect",
     "add_implementation",
     "get_effect",

@@ -1,61 +1,94 @@
-"""Effects: named, documented physical mechanisms an experiment's model can switch on.
+"""The effect contract: named, documented physical mechanisms an experiment's model can switch on.
 
-An :class:`Effect` has a name, its physics, the signature its absence leaves in the
-residual, and one :class:`Implementation` per experiment it applies to.  An implementation
-names a *hook* of that experiment's model (``Experiment.hooks``), its own fittable
-:class:`~femast.experiments.core.Parameter` s, and a function
-``apply(value, params, ctx) -> value`` that changes the quantity passing through the hook.
-An implementation with ``apply=None`` records that the effect applies to the experiment but
-is not implemented yet (e.g. for experiments pending an FE model).
+An :class:`Effect` has a name, its physics, the signature its absence leaves in the residual, and
+the :class:`Implementation` s that say how it acts on a model.
 
-Users register their own effects from a script with :func:`register_effect` (or add an
-implementation to an existing effect with :func:`add_implementation`).
+Mechanisms on physical quantities
+---------------------------------
+An effect's ``mechanism`` acts on physical quantities, not on a rig: it names the quantity it
+changes (its ``hook``: ``"load"`` or ``"displacement"``) and those it reads (``needs``: ``"load"``,
+``"temperature"``; time is always there), and it applies to *every* experiment that declares
+them in ``Experiment.quantities`` (:mod:`femast.effects.quantities`) -- a built-in rig or a user's
+own, mixed freely with the user's own effects.  Its parameters may be a function of those
+quantities, ``parameters(quantities) -> (Parameter, ...)``, so that they carry the experiment's
+units and names and are sized by its scales (a clearance ``c`` in the displacement's unit, a
+friction threshold ``M_f`` on a moment, ``F_f`` on a force; one per axis in a per-axis form).
+
+A model calls ``value = effects.apply(hook, value, **ctx)`` at each hook; an implementation's
+``apply(value, params, ctx)`` returns the changed value.  Besides the keyword arguments of the
+call, ``ctx`` holds what the framework provides to every effect:
+
+* ``load`` -- the load as it entered the ``"load"`` hook (before any effect), in the load's unit,
+  ``(n,)`` or ``(n, k)``; ``load_eff`` -- the load after the effects on it;
+* ``time`` -- ``(n,)`` normalised time in [0, 1] over the data (``t_s``, else the row index);
+  ``t_s`` -- time in s (the row index where the data have none);
+* ``temperature`` -- ``(n,)`` in the unit of the declared temperature quantity;
+* ``quantities`` -- the experiment's ``{kind: Quantity}``; ``data``, ``options`` and ``params``
+  (the baseline's) where the model passes them.
+
+The model of a data set with several groups (stations, specimens, runs) is evaluated group by
+group, so a path-dependent effect starts from its relaxed state in every group.
+
+Rig-specific implementations
+----------------------------
+``implementations`` maps an experiment's name to an implementation on one of that experiment's own
+hooks (``Experiment.hooks``: e.g. the inputs an FE bay is built with); it takes precedence over
+the mechanism for that experiment.  An implementation with ``apply=None`` records that the effect
+applies to an experiment but is not implemented yet.
 
 Forms
 -----
 An implementation may carry generalised *forms* of its mechanism (``Implementation.forms``:
 ``{form name: Implementation}``), each a documented physical model of which the implementation's
 own form (``Implementation.form``) is a special case, e.g. ``friction_hysteresis`` with its rigid
-stick (``play``), a finite stick stiffness (``jenkins``) and distributed micro-slip (``iwan``).  A
-form is switched on as ``effect/form`` (``--effects friction_hysteresis/jenkins``); ``diagnose``
-fits every form of a candidate and keeps the one the information criterion prefers.
+stick (``play``), a finite stick stiffness (``jenkins``), distributed micro-slip (``iwan``) and a
+threshold per axis (``per_axis``, on quantities with two axes or more: ``min_axes``).  A form is
+switched on as ``effect/form`` (``--effects friction_hysteresis/jenkins``); ``diagnose`` fits
+every form of a candidate and keeps the one the information criterion prefers.
+
+Users register their own effects from a script with :func:`register_effect` (or add an
+implementation to an existing effect with :func:`add_implementation`); see docs/your_own_rig.md.
 """
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
-import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 from ..errors import ModelError, did_you_mean
-from ..experiments.core import Parameter  # noqa: F401  (re-exported: effects declare Parameters)
+from .parameters import Parameter  # noqa: F401  (re-exported: effects declare Parameters)
+from .quantities import ALWAYS, HOOKS
+from .scripts import effects_of_script, load_script, loaded_scripts  # noqa: F401  (re-exported)
 
 
 @dataclass(frozen=True)
 class Implementation:
-    """How an effect acts on one experiment's model.
+    """How an effect acts on a model.
 
-    hook : name of the model hook it acts on (a key of ``Experiment.hooks``).
-    parameters : its fittable parameters (names unique within the effect).
+    hook : the quantity (``"load"``, ``"displacement"``) or the experiment's own hook it acts on.
+    parameters : its fittable parameters (names unique within the effect), or for a mechanism a
+        function ``parameters(quantities) -> (Parameter, ...)`` of the experiment's quantities.
     apply : ``apply(value, params, ctx) -> new value``; ``params`` is ``{name: value}`` (SI),
-        ``ctx`` the keyword arguments of the hook call.  None: applicable but not implemented yet.
+        ``ctx`` the keyword arguments of the hook call and the framework's (module docstring).
+        None: applicable but not implemented yet.
+    needs : the quantities it reads besides its hook (``("load",)``, ``("temperature",)``).
     order : effects on the same hook are applied in increasing ``order``.
-    doc : how the effect enters this experiment (equation in words).
+    doc : how the effect enters the model (equation in words).
     form : name of this form of the mechanism (e.g. "play"); "" for an effect with one form.
-    forms : ``{name: Implementation}`` of generalised forms (see the module docstring), selected as
+    forms : ``{name: Implementation}`` of generalised forms (module docstring), selected as
         ``effect/name``; each has its own parameters and ``doc``.
+    min_axes : fewest axes its quantities must have (2 for a per-axis form).
     """
 
     hook: str
-    parameters: tuple = ()
+    parameters: tuple | Callable = ()
     apply: Callable | None = None
     order: int = 50
     doc: str = ""
     form: str = ""
     forms: dict = field(default_factory=dict)
+    needs: tuple = ()
+    min_axes: int = 1
 
     def variant(self, form: str | None) -> Implementation:
         """This implementation (``form`` None, "" or its own form name) or its generalised ``form``."""
@@ -77,18 +110,40 @@ class Implementation:
         """False for an applicability recorded before the model exists."""
         return self.apply is not None
 
+    def provided_by(self, quantities: dict) -> bool:
+        """True if ``quantities`` (an experiment's) hold its hook and what it needs, with enough axes."""
+        kinds = (self.hook, *self.needs)
+        if not all(k in quantities or k in ALWAYS for k in kinds):
+            return False
+        return all(quantities[k].n_axes >= self.min_axes for k in kinds if k in HOOKS)
+
+    def bind(self, quantities: dict) -> Implementation:
+        """The implementation with its parameters for ``quantities`` and the forms they allow."""
+        params = self.parameters(quantities) if callable(self.parameters) else tuple(self.parameters)
+        forms = {n: f.bind(quantities) for n, f in self.forms.items() if f.provided_by(quantities)}
+        return replace(self, parameters=tuple(params), forms=forms)
+
+
+def _key_and_quantities(experiment):
+    """(effect key, quantities) of an experiment, or of an experiment's name (no quantities)."""
+    if isinstance(experiment, str):
+        return experiment, {}
+    return experiment.effect_key, dict(getattr(experiment, "quantities", None) or {})
+
 
 @dataclass(frozen=True)
 class Effect:
     """A physical effect (see the module docstring).
 
     name : identifier used on the command line (``--effects joint_clearance``).
-    title : short human name.  physics : what happens, with seed equation references.
+    title : short human name.  physics : what happens, with the papers' equation references.
     signature : what its absence leaves in the residual, in plain words.
     acts_where : kinds of path segment where that residual is largest
         ("near-zero load", "reversal", "loading", "unloading", "peak", or an experiment's own).
-    implementations : ``{experiment name: Implementation}``.
-    seed : the seed reference it comes from.
+    mechanism : the implementation on physical quantities (applies to every experiment that
+        declares them), or None.
+    implementations : ``{experiment name: Implementation}`` on experiments' own hooks.
+    seed : the paper and equation it comes from.
     """
 
     name: str
@@ -98,25 +153,56 @@ class Effect:
     acts_where: tuple = ()
     implementations: dict = field(default_factory=dict)
     seed: str = ""
+    mechanism: Implementation | None = None
 
-    def implementation(self, experiment: str) -> Implementation | None:
-        """The implementation for ``experiment`` (None if the effect does not apply to it)."""
-        return self.implementations.get(experiment)
+    def implementation(self, experiment) -> Implementation | None:
+        """The implementation for ``experiment`` (an Experiment, or a name: rig-specific ones only),
+        its parameters bound to the experiment's quantities; None if the effect does not apply."""
+        key, quantities = _key_and_quantities(experiment)
+        impl = self.implementations.get(key)
+        if impl is not None:
+            return impl.bind(quantities) if callable(impl.parameters) else impl
+        if self.mechanism is not None and self.mechanism.provided_by(quantities):
+            return self.mechanism.bind(quantities)
+        return None
 
-    def applies_to(self, experiment: str) -> bool:
-        """True if the effect is implemented for ``experiment``."""
-        impl = self.implementations.get(experiment)
+    def applies_to(self, experiment) -> bool:
+        """True if the effect is implemented for ``experiment`` (an Experiment or a name)."""
+        impl = self.implementation(experiment)
         return impl is not None and impl.implemented
 
-    def parameters(self, experiment: str) -> tuple:
+    def parameters(self, experiment) -> tuple:
         """Parameters of the effect in ``experiment``."""
-        impl = self.implementations.get(experiment)
+        impl = self.implementation(experiment)
         return impl.parameters if impl else ()
 
 
 _REGISTRY: dict[str, Effect] = {}
-_SCRIPTS: list[str] = []  # scripts loaded in this process (re-loaded by worker processes)
-_SCRIPT_EFFECTS: dict[str, list] = {}  # script path -> names of the effects it registered
+
+
+def _check(effect: Effect) -> None:
+    if "/" in effect.name or "." in effect.name:
+        raise ModelError(f"effect name '{effect.name}': no '/' or '.' (they separate forms and parameters)")
+    impls = list(effect.implementations.items())
+    if effect.mechanism is not None:
+        impls.append(("its mechanism", effect.mechanism))
+    for exp, impl in impls:
+        for label, im in [(impl.form or "default", impl), *impl.forms.items()]:
+            if not callable(im.parameters):
+                names = [p.name for p in im.parameters]
+                if len(set(names)) != len(names):
+                    raise ModelError(f"effect {effect.name} on {exp} (form {label}): duplicate parameter names {names}")
+            if im.hook != impl.hook:
+                raise ModelError(
+                    f"effect {effect.name} on {exp}: form {label} acts on hook '{im.hook}', its "
+                    f"default form on '{impl.hook}'; the forms of one effect share a hook"
+                )
+    m = effect.mechanism
+    if m is not None and m.hook not in HOOKS:
+        raise ModelError(
+            f"effect {effect.name}: its mechanism acts on '{m.hook}', not a quantity ({', '.join(HOOKS)}); "
+            "an experiment's own hook goes in implementations={experiment name: Implementation(...)}"
+        )
 
 
 def register_effect(effect: Effect, replace_existing: bool = False) -> Effect:
@@ -127,18 +213,7 @@ def register_effect(effect: Effect, replace_existing: bool = False) -> Effect:
         raise ModelError(
             f"an effect called '{effect.name}' is already registered; choose another name or pass replace_existing=True"
         )
-    if "/" in effect.name or "." in effect.name:
-        raise ModelError(f"effect name '{effect.name}': no '/' or '.' (they separate forms and parameters)")
-    for exp, impl in effect.implementations.items():
-        for label, im in [(impl.form or "default", impl), *impl.forms.items()]:
-            names = [p.name for p in im.parameters]
-            if len(set(names)) != len(names):
-                raise ModelError(f"effect {effect.name} on {exp} (form {label}): duplicate parameter names {names}")
-            if im.hook != impl.hook:
-                raise ModelError(
-                    f"effect {effect.name} on {exp}: form {label} acts on hook '{im.hook}', its "
-                    f"default form on '{impl.hook}'; the forms of one effect share a hook"
-                )
+    _check(effect)
     _REGISTRY[effect.name] = effect
     return effect
 
@@ -149,9 +224,10 @@ def unregister_effect(name: str) -> None:
 
 
 def add_implementation(effect_name: str, experiment: str, implementation: Implementation) -> Effect:
-    """Make a registered effect apply to another experiment (e.g. a user's)."""
+    """Make a registered effect apply to another experiment, on that experiment's own hook."""
     eff = get_effect(effect_name)
     new = replace(eff, implementations={**eff.implementations, experiment: implementation})
+    _check(new)
     _REGISTRY[effect_name] = new
     return new
 
@@ -172,9 +248,9 @@ def list_effects() -> tuple:
 
 
 def applicable_effects(experiment) -> tuple:
-    """Effects implemented for ``experiment`` (an Experiment or its effect key), registration order."""
-    key = experiment if isinstance(experiment, str) else experiment.effect_key
-    return tuple(e for e in _REGISTRY.values() if e.applies_to(key))
+    """Effects implemented for ``experiment`` (an Experiment, or a name: rig-specific implementations
+    only), in registration order."""
+    return tuple(e for e in _REGISTRY.values() if e.applies_to(experiment))
 
 
 def split_form(name: str) -> tuple:
@@ -187,11 +263,11 @@ def resolve(experiment, names) -> list:
     """Check effect names for ``experiment`` and return ``[(name, Implementation)]``.
 
     A name may select a form of the effect (``effect/form``, see the module docstring); the
-    implementation returned is then that form's.  Raises ModelError for an unknown name, an effect that does not apply to the experiment, or
-    one registered for it but not implemented yet, listing the accepted names each time.
+    implementation returned is then that form's, its parameters bound to the experiment's
+    quantities.  Raises ModelError for an unknown name, an effect that does not apply to the
+    experiment, or one registered for it but not implemented yet, listing the accepted names.
     """
-    key = experiment.effect_key
-    ok = [e.name for e in applicable_effects(key)]
+    ok = [e.name for e in applicable_effects(experiment)]
     out, seen = [], set()
     for name in names:
         name = name.strip()
@@ -207,11 +283,10 @@ def resolve(experiment, names) -> list:
                 f"accepted effects: {', '.join(ok) or '(none)'}"
             )
         eff = _REGISTRY[name]
-        impl = eff.implementation(key)
+        impl = eff.implementation(experiment)
         if impl is None:
             raise ModelError(
-                f"effect '{name}' does not apply to {experiment.name} (it applies to "
-                f"{', '.join(eff.implementations) or 'nothing yet'}); accepted effects: {', '.join(ok)}"
+                f"effect '{name}' does not apply to {experiment.name} ({_needs(eff)}); accepted effects: {', '.join(ok)}"
             )
         if not impl.implemented:
             raise ModelError(
@@ -227,57 +302,31 @@ def resolve(experiment, names) -> list:
             impl = impl.variant(form)
         except ModelError as e:
             raise ModelError(f"effect '{full}' on {experiment.name}: {e}") from None
-        out.append((full if form and form != impl_form(eff, key) else name, impl))
+        out.append((full if form and form != impl_form(eff, experiment) else name, impl))
     return out
 
 
-def impl_form(effect: Effect, experiment_key: str) -> str:
+def _needs(effect: Effect) -> str:
+    """What an effect needs, in words, for an error message."""
+    parts = []
+    m = effect.mechanism
+    if m is not None:
+        kinds = " and ".join(dict.fromkeys((m.hook, *m.needs)))
+        parts.append(f"it needs an experiment declaring the quantities {kinds}")
+    if effect.implementations:
+        parts.append(f"it applies to {', '.join(effect.implementations)}")
+    return "; ".join(parts) or "it applies to nothing yet"
+
+
+def impl_form(effect: Effect, experiment) -> str:
     """Name of the default form of ``effect`` on an experiment ("" if it has one form)."""
-    impl = effect.implementations.get(experiment_key)
+    impl = effect.implementation(experiment)
     return impl.form if impl else ""
 
 
-def forms_of(effect_name: str, experiment_key: str) -> tuple:
+def forms_of(effect_name: str, experiment) -> tuple:
     """Names to switch on each form of an effect on an experiment: ``("effect", "effect/form", ...)``."""
-    impl = get_effect(effect_name).implementations.get(experiment_key)
+    impl = get_effect(effect_name).implementation(experiment)
     if impl is None:
         return ()
     return (effect_name, *(f"{effect_name}/{f}" for f in impl.forms))
-
-
-def load_script(path) -> object:
-    """Import a user script (experiment and/or effects) once per process and return the module.
-
-    The script registers effects with :func:`register_effect` and may define ``experiment``.
-    Its resolved path is remembered so that worker processes of ``diagnose`` load it too.
-    """
-    p = Path(path).resolve()
-    if not p.is_file():
-        raise ModelError(f"no such script: {path}")
-    modname = "femast_user_" + hashlib.sha1(str(p).encode()).hexdigest()[:12]
-    if modname in sys.modules:
-        return sys.modules[modname]
-    spec = importlib.util.spec_from_file_location(modname, p)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[modname] = module
-    before = set(_REGISTRY)
-    try:
-        spec.loader.exec_module(module)
-    except Exception:
-        del sys.modules[modname]
-        raise
-    _SCRIPT_EFFECTS[str(p)] = [n for n in _REGISTRY if n not in before]
-    if str(p) not in _SCRIPTS:
-        _SCRIPTS.append(str(p))
-    return module
-
-
-def effects_of_script(path) -> list:
-    """Names of the effects a script registered when it was loaded (loads it if needed)."""
-    load_script(path)
-    return list(_SCRIPT_EFFECTS.get(str(Path(path).resolve()), []))
-
-
-def loaded_scripts() -> tuple:
-    """Resolved paths of the user scripts loaded in this process."""
-    return tuple(_SCRIPTS)

@@ -1,5 +1,5 @@
-"""Cable and shroud effects: progressive stiffness (seed 000 Eq. 25), cable hysteresis, pretension
-loss or error, and the stretch-removal error of a pull test (seed 001 Eq. 15).
+"""Cable and shroud effects: progressive stiffness (the Rocaspect paper, Eq. 25), cable hysteresis, pretension
+loss or error, and the stretch-removal error of a pull test (Stohlman & Pellegrino, Eq. 15).
 
 Hooks as in :mod:`femast.effects.joints`.
 """
@@ -8,20 +8,52 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiments.core import Parameter
 from .base import Effect, Implementation, register_effect
 from .operators import proportional_iwan, proportional_play
+from .parameters import Parameter
+from .quantities import unit_inverse
 
 FE = ("bay-torsion", "tip-cycle")
 
 
 # ----------------------------------------------------------------------------- progressive stiffness
-def _progressive_mast_top(theta, p, ctx):
-    m = ctx["prep"]["m"][:, :2]
-    theta = theta.copy()
-    a = np.abs(m)
-    theta[:, :2] /= 1.0 + p["beta"] * a + p.get("beta2", 0.0) * a * a
-    return theta
+def _progressive(u, p, ctx):
+    a = np.abs(ctx["load"])
+    return u / (1.0 + p["beta"] * a + p.get("beta2", 0.0) * a * a)
+
+
+def _beta(L, lower=0.0):
+    return Parameter(
+        "beta",
+        unit_inverse(L.unit),
+        0.1 / L.scale,
+        lower * 100 / L.scale,
+        100 / L.scale,
+        "relative stiffening per unit load",
+        scale=0.1 / L.scale,
+        starts=(0.01 / L.scale, 1 / L.scale),
+    )
+
+
+def _progressive_params(q):
+    return (_beta(q["load"]),)
+
+
+def _progressive_quadratic_params(q):
+    L = q["load"]
+    return (
+        _beta(L, lower=-1.0),
+        Parameter(
+            "beta2",
+            unit_inverse(L.unit, 2),
+            0.0,
+            0.0,
+            1e4 / L.scale**2,
+            "relative stiffening per unit load squared (the k2 tau^2 term of the Rocaspect paper's Eq. 25)",
+            scale=1 / L.scale**2,
+            starts=(1 / (10 * L.scale**2), 10 / L.scale**2),
+        ),
+    )
 
 
 PROGRESSIVE_STIFFNESS = register_effect(
@@ -29,7 +61,7 @@ PROGRESSIVE_STIFFNESS = register_effect(
         name="progressive_stiffness",
         title="progressive, tension-dependent shroud/cable stiffness",
         physics=(
-            "Dyneema shrouds stiffen with tension: EA(tau) = k0 + k1 tau + k2 tau^2 (seed 000 Eq. 25, "
+            "Dyneema shrouds stiffen with tension: EA(tau) = k0 + k1 tau + k2 tau^2 (the Rocaspect paper, Eq. 25, "
             ":mod:`femast.elements.shroud_law`).  The shroud that takes up a joint moment m gains tension in proportion "
             "to |m|, so to first order the joint's secant stiffness rises as k (1 + beta |m|), beta = k1 / "
             "(a EA(tau0)) with a the shroud lever arm (m) and tau0 the pretension.  The identified beta gives back "
@@ -38,74 +70,64 @@ PROGRESSIVE_STIFFNESS = register_effect(
         signature="the structure is stiffer than the linear model at high load and softer near zero: the error is "
         "odd in the load, largest at the load peaks",
         acts_where=("peak",),
-        seed="seed 000 Eq. 25",
-        implementations={
-            "mast-top": Implementation(
-                hook="joint_rotation",
-                order=20,
-                parameters=(
-                    Parameter(
-                        "beta",
-                        "1/(N m)",
-                        1e-4,
-                        0.0,
-                        0.1,
-                        "relative stiffening per unit joint moment",
-                        scale=1e-4,
-                        starts=(1e-5, 1e-3),
-                    ),
-                ),
-                apply=_progressive_mast_top,
-                form="linear",
-                doc="theta_k = m_k / (k_k (1 + beta |m_k|)), k = 1, 2 (secant stiffness rising with the moment).",
-                forms={
-                    "quadratic": Implementation(
-                        hook="joint_rotation",
-                        order=20,
-                        parameters=(
-                            Parameter(
-                                "beta",
-                                "1/(N m)",
-                                1e-4,
-                                -0.1,
-                                0.1,
-                                "relative stiffening per unit joint moment",
-                                scale=1e-4,
-                                starts=(1e-5, 1e-3),
-                            ),
-                            Parameter(
-                                "beta2",
-                                "1/(N m)^2",
-                                0.0,
-                                0.0,
-                                1e-2,
-                                "relative stiffening per unit moment squared (the k2 tau^2 term of Eq. 25)",
-                                scale=1e-6,
-                                starts=(1e-7, 1e-5),
-                            ),
-                        ),
-                        apply=_progressive_mast_top,
-                        doc="theta_k = m_k / (k_k (1 + beta |m_k| + beta2 m_k^2)): both terms of Eq. 25 (beta2 = 0: the "
-                        "linear form).",
-                    )
-                },
-            ),
-        },
+        seed="the Rocaspect paper, Eq. 25",
+        mechanism=Implementation(
+            hook="displacement",
+            needs=("load",),
+            order=20,
+            parameters=_progressive_params,
+            apply=_progressive,
+            form="linear",
+            doc="u = u_linear / (1 + beta |L|) on every axis (secant stiffness rising with the load).",
+            forms={
+                "quadratic": Implementation(
+                    hook="displacement",
+                    needs=("load",),
+                    order=20,
+                    parameters=_progressive_quadratic_params,
+                    apply=_progressive,
+                    doc="u = u_linear / (1 + beta |L| + beta2 L^2): both terms of the Rocaspect paper's Eq. 25 (beta2 = "
+                    "0: the linear form).",
+                )
+            },
+        ),
     )
 )
 
 
 # ----------------------------------------------------------------------------- cable hysteresis
-def _cable_hysteresis_mast_top(m, p, ctx):
-    m = m.copy()
-    m[:, :2] = proportional_play(m[:, :2], p["eta"])
-    return m
+def _cable_hysteresis(L, p, ctx):
+    return proportional_play(L, p["eta"])
 
 
-def _cable_hysteresis_mast_top_iwan(m, p, ctx):
-    m = m.copy()
-    m[:, :2] = proportional_iwan(m[:, :2], p["eta"], p["beta"], p["alpha"])
-    return m
+def _cable_hysteresis_iwan(L, p, ctx):
+    return proportional_iwan(L, p["eta"], p["beta"], p["alpha"])
+
+
+_ETA = Parameter("eta", "-", 0.05, 0.0, 0.6, "loop half-width relative to the load", scale=0.05, starts=(0.01, 0.2))
+_ETA_IWAN = (
+    Parameter(
+        "eta",
+        "-",
+        0.3,
+        0.0,
+        0.99,
+        "largest friction threshold of the fibre groups relative to the load",
+        scale=0.1,
+        starts=(0.6, 0.95, 0.3),
+    ),
+    Parameter(
+        "beta",
+        "-",
+        1.0,
+        0.05,
+        50.0,
+        "shape of the threshold distribution P(e <= s) = (s / eta)^beta",
+        scale=1.0,
+        starts=(1.0, 3.0, 0.5),
+    ),
+    Parameter("alpha", "-", 0.1, 0.0, 0.95, "share of the load without friction", scale=0.1, starts=(0.2, 0.0, 0.1)),
+)
 
 
 def _cable_hysteresis_latch_pull(x, p, ctx):
@@ -127,7 +149,7 @@ CABLE_HYSTERESIS = register_effect(
         name="cable_hysteresis",
         title="cable hysteresis between loading and unloading",
         physics=(
-            "A rope stretches less on loading than on unloading at the same tension (seed 000 Fig. 4a: 'a "
+            "A rope stretches less on loading than on unloading at the same tension (the Rocaspect paper, Fig. 4a: 'a "
             "significant difference between loading and unloading the shroud').  Modelled as friction between "
             "fibres whose normal force grows with the tension: a play operator of half-width eta |tau|, so the "
             "loop widens in proportion to the load and closes at zero load (unlike Coulomb friction, whose loop "
@@ -136,70 +158,28 @@ CABLE_HYSTERESIS = register_effect(
         signature="loading and unloading branches with different slopes, a loop whose width grows with the load "
         "and closes at zero; the error is largest at high load and just after reversals",
         acts_where=("peak", "reversal", "loading", "unloading"),
-        seed="seed 000 Sec. IV-A, Fig. 4a",
+        seed="Rocaspect guyed mast, Sec. IV-A, Fig. 4a",
+        mechanism=Implementation(
+            hook="load",
+            order=45,
+            parameters=(_ETA,),
+            apply=_cable_hysteresis,
+            form="play",
+            doc="L -> play(L; eta |L|) on every axis: the cable- or shroud-supported connection is (1 - eta) / k "
+            "compliant on loading and (1 + eta) / k on unloading.",
+            forms={
+                "iwan": Implementation(
+                    hook="load",
+                    order=45,
+                    parameters=_ETA_IWAN,
+                    apply=_cable_hysteresis_iwan,
+                    doc="L -> alpha L + (1 - alpha) mean_j play(L; eta_j |L|), eta_j = eta q_j^(1/beta): a rope's fibre "
+                    "groups with a distribution of friction coefficients (24 groups); smooth loops closing at zero "
+                    "load, return branches curved (beta -> inf, alpha = 0: the play form).",
+                )
+            },
+        ),
         implementations={
-            "mast-top": Implementation(
-                hook="joint_moment",
-                order=45,
-                parameters=(
-                    Parameter(
-                        "eta",
-                        "-",
-                        0.05,
-                        0.0,
-                        0.6,
-                        "loop half-width relative to the load",
-                        scale=0.05,
-                        starts=(0.01, 0.2),
-                    ),
-                ),
-                apply=_cable_hysteresis_mast_top,
-                form="play",
-                doc="m_k -> play(m_k; eta |m_k|), k = 1, 2: the shroud-supported joint is (1 - eta) / k compliant on "
-                "loading and (1 + eta) / k on unloading.",
-                forms={
-                    "iwan": Implementation(
-                        hook="joint_moment",
-                        order=45,
-                        parameters=(
-                            Parameter(
-                                "eta",
-                                "-",
-                                0.3,
-                                0.0,
-                                0.99,
-                                "largest friction threshold of the fibre groups relative to the load",
-                                scale=0.1,
-                                starts=(0.6, 0.95, 0.3),
-                            ),
-                            Parameter(
-                                "beta",
-                                "-",
-                                1.0,
-                                0.05,
-                                50.0,
-                                "shape of the threshold distribution P(e <= s) = (s / eta)^beta",
-                                scale=1.0,
-                                starts=(1.0, 3.0, 0.5),
-                            ),
-                            Parameter(
-                                "alpha",
-                                "-",
-                                0.1,
-                                0.0,
-                                0.95,
-                                "share of the load without friction",
-                                scale=0.1,
-                                starts=(0.2, 0.0, 0.1),
-                            ),
-                        ),
-                        apply=_cable_hysteresis_mast_top_iwan,
-                        doc="m_k -> alpha m_k + (1 - alpha) mean_j play(m_k; eta_j |m_k|), eta_j = eta q_j^(1/beta): the "
-                        "rope's fibre groups with a distribution of friction coefficients (24 groups); smooth loops "
-                        "closing at zero load, return branches curved (beta -> inf, alpha = 0: the play form).",
-                    )
-                },
-            ),
             "latch-pull": Implementation(
                 hook="bead_position",
                 order=45,
@@ -284,14 +264,17 @@ def _pretension_fe(bay, p, ctx):
     return {**bay, "pretension": float(bay["pretension"]) + float(p["dT0"])}
 
 
-def _pretension_mast_top(theta, p, ctx):
-    theta = theta.copy()
-    tau = ctx["prep"]["tau"][:, None]
+def _stiffness_loss(u, p, ctx):
+    tau = ctx["time"]
+    if np.ndim(u) == 2:
+        tau = tau[:, None]
     tc = p.get("t_c")
     if tc is not None:  # saturating (creep-like) loss, normalised to lam at the end of the test
         tau = -np.expm1(-tau / tc) / -np.expm1(-1.0 / tc)
-    theta[:, :2] /= 1.0 - p["lam"] * tau
-    return theta
+    return u / (1.0 - p["lam"] * tau)
+
+
+_LAM = Parameter("lam", "-", 0.1, 0.0, 0.9, "relative stiffness loss over the test", scale=0.1)
 
 
 PRETENSION = register_effect(
@@ -299,47 +282,50 @@ PRETENSION = register_effect(
         name="pretension_loss",
         title="pretension error or loss",
         physics=(
-            "The stiffness of a guyed or cable-braced structure depends on the cable pretension (seed 000 Table "
+            "The stiffness of a guyed or cable-braced structure depends on the cable pretension (the Rocaspect paper, Table "
             "III: the 3R joint stiffness falls from 2.7e5 to 2.2e5 N m/rad between 1200 N and 400 N of shroud "
-            "pretension; seed 001 Eq. 16 measures the ADAM cable pretension by vibration).  A pretension that creeps "
+            "pretension; Stohlman & Pellegrino, Eq. 16 measures the ADAM cable pretension by vibration).  A pretension that creeps "
             "or slips during a test makes the stiffness fall with time; a pretension different from the assumed one "
             "shifts it (identifiable only in models that take the pretension as an input: bay-torsion, tip-cycle)."
         ),
         signature="the compliance drifts along the test: the error grows with time in proportion to the load (a "
         "loss during the test); the unlatched bay's moment is offset (an error of the pretension)",
         acts_where=("peak", "loading", "unloading", "zone (d) no contact"),
-        seed="seed 000 Table III; seed 001 Eq. 16",
-        implementations={
-            "mast-top": Implementation(
-                hook="joint_rotation",
-                order=60,
-                parameters=(Parameter("lam", "-", 0.1, 0.0, 0.9, "relative stiffness loss over the test", scale=0.1),),
-                apply=_pretension_mast_top,
-                form="linear",
-                doc="k_k(t) = k_k (1 - lam tau), tau = normalised time in [0, 1] (t_s column or row index).",
-                forms={
-                    "saturating": Implementation(
-                        hook="joint_rotation",
-                        order=60,
-                        parameters=(
-                            Parameter("lam", "-", 0.1, 0.0, 0.9, "relative stiffness loss over the test", scale=0.1),
-                            Parameter(
-                                "t_c",
-                                "-",
-                                0.3,
-                                0.01,
-                                100.0,
-                                "time constant of the loss, as a fraction of the test's duration",
-                                scale=0.3,
-                                starts=(0.05, 3.0),
-                            ),
+        seed="Rocaspect guyed mast, Table III; Stohlman & Pellegrino, Eq. 16",
+        mechanism=Implementation(
+            hook="displacement",
+            needs=("time",),
+            order=60,
+            parameters=(_LAM,),
+            apply=_stiffness_loss,
+            form="linear",
+            doc="k(t) = k (1 - lam tau): u = u / (1 - lam tau), tau the normalised time in [0, 1] (t_s column or row "
+            "index; per group, or across the files where time is continuous).",
+            forms={
+                "saturating": Implementation(
+                    hook="displacement",
+                    needs=("time",),
+                    order=60,
+                    parameters=(
+                        _LAM,
+                        Parameter(
+                            "t_c",
+                            "-",
+                            0.3,
+                            0.01,
+                            100.0,
+                            "time constant of the loss, as a fraction of the test's duration",
+                            scale=0.3,
+                            starts=(0.05, 3.0),
                         ),
-                        apply=_pretension_mast_top,
-                        doc="k_k(t) = k_k (1 - lam (1 - exp(-tau / t_c)) / (1 - exp(-1 / t_c))): a loss that levels off "
-                        "(creep, slip of a termination); t_c -> inf is the linear form.",
-                    )
-                },
-            ),
+                    ),
+                    apply=_stiffness_loss,
+                    doc="k(t) = k (1 - lam (1 - exp(-tau / t_c)) / (1 - exp(-1 / t_c))): a loss that levels off "
+                    "(creep, slip of a termination); t_c -> inf is the linear form.",
+                )
+            },
+        ),
+        implementations={
             **{
                 e: Implementation(
                     hook="bay_parameters",
@@ -357,7 +343,7 @@ PRETENSION = register_effect(
                     ),
                     apply=_pretension_fe,
                     doc="the FE cables are pretensioned to pretension_N + dT0 (a constant error or a loss before the "
-                    "test, e.g. creep since the vibration measurement of seed 001 Eq. 16).",
+                    "test, e.g. creep since the vibration measurement of Stohlman & Pellegrino, Eq. 16).",
                 )
                 for e in FE
             },
@@ -374,7 +360,7 @@ def _stretch_latch_pull(x, p, ctx):
 STRETCH_ERROR = register_effect(
     Effect(
         name="stretch_error",
-        title="cable stretch-removal error (seed 001 Eq. 15)",
+        title="cable stretch-removal error (Stohlman & Pellegrino, Eq. 15)",
         physics=(
             "Eq. 15 removes the stretch T L_cable / EA of the loaded test cable to get the bead position.  A wrong "
             "EA or L_cable (or the length change of the loaded cable, T (x - x_start) / EA) leaves a position error "
@@ -383,7 +369,7 @@ STRETCH_ERROR = register_effect(
         signature="the measured curve is sheared along x in proportion to the force: the error is largest at the "
         "force peaks and changes sign with the force",
         acts_where=("peak",),
-        seed="seed 001 Eq. 15",
+        seed="Stohlman & Pellegrino, Eq. 15",
         implementations={
             "latch-pull": Implementation(
                 hook="bead_position",

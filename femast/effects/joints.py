@@ -1,14 +1,14 @@
 """Joint effects: clearance (backlash), friction hysteresis, ball-joint friction.
 
-Hooks used (see the experiments' ``hooks``):
+Clearance and friction are mechanisms on the load through a connection and the displacement it
+drives (:mod:`femast.effects.quantities`): they apply to every experiment that declares those
+quantities, with a gap or a threshold per axis in their ``per_axis`` forms.
 
-* mast-top -- ``joint_moment`` (the moments ``m`` (n, 3), N m, about the base axes that drive
-  the elastic joints of the 3R model, seed 000 Eqs. 4-6) and ``joint_rotation`` (the joint
-  rotations ``theta`` (n, 3), rad).  Only the two bending joints (columns 0 and 1) are affected:
-  the torsion joint is rigid and invisible in top translations.
-* latch-pull -- ``bead_position`` (bead position ``x`` (n,), m, seed 001 Eq. 15) and
-  ``branch_force`` (the latching and unlatching branches ``[dT_in, dT_out]`` (n, 2), N, of
-  seed 001 Eq. 14 at the bead positions).
+Rig-specific implementations, on the rigs' own hooks:
+
+* latch-pull -- ``bead_position`` (bead position ``x`` (n,), m, Stohlman & Pellegrino Eq. 15) and
+  ``branch_force`` (the latching and unlatching branches ``[dT_in, dT_out]`` (n, 2), N, of their
+  Eq. 14 at the bead positions);
 * bay-torsion, tip-cycle (FE models) -- ``bay_parameters`` (the dict of inputs the FE bay or
   mast is built with: ``mu``, ``B``, ``pretension``, ...).
 """
@@ -17,27 +17,72 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiments.core import Parameter
 from .base import Effect, Implementation, register_effect
 from .operators import iwan, jenkins, play
+from .parameters import Parameter
 
 FE = ("bay-torsion", "tip-cycle")
 
 
 # ----------------------------------------------------------------------------- clearance
-def _clearance_mast_top(theta, p, ctx):
-    m = ctx["prep"]["m"][:, :2]
-    ms = ctx["prep"]["m_smooth"][:2]
-    theta = theta.copy()
-    theta[:, :2] += p["c"] * np.tanh(m / ms)
-    return theta
+def _per_axis(p, name, axes):
+    """(k,) values of a per-axis parameter ``name_<axis>`` (or the one ``name``), in axis order."""
+    if name in p:
+        return p[name]
+    return np.array([p[f"{name}_{a}"] for a in axes])
 
 
-def _clearance_mast_top_smooth(theta, p, ctx):
-    m = ctx["prep"]["m"][:, :2]
-    theta = theta.copy()
-    theta[:, :2] += p["c"] * np.tanh(m / p["m_c"])
-    return theta
+def _clearance(u, p, ctx):
+    L = ctx["load"]
+    scale = np.maximum(0.01 * np.max(np.abs(L), axis=0), 1e-12)  # a nearly sharp gap: 1 % of the largest load
+    return u + _per_axis(p, "c", ctx["quantities"]["displacement"].axes) * np.tanh(L / scale)
+
+
+def _clearance_smooth(u, p, ctx):
+    return u + p["c"] * np.tanh(ctx["load"] / p[f"{ctx['quantities']['load'].letter}_c"])
+
+
+def _gap(D, per_axis=False, starts=None):
+    names = [f"c_{a}" for a in D.axes] if per_axis else ["c"]
+    where = "about " + ("its axis" if per_axis else "each axis") if D.axes else ""
+    return tuple(
+        Parameter(
+            n,
+            D.unit,
+            D.scale / 10,
+            0.0,
+            20 * D.scale,
+            f"half play of the connection{' ' + where if where else ''} ({D.doc or 'the displacement it drives'})",
+            scale=D.scale / 10,
+            starts=starts or (D.scale / 100, D.scale),
+        )
+        for n in names
+    )
+
+
+def _clearance_params(q):
+    return _gap(q["displacement"])
+
+
+def _clearance_smooth_params(q):
+    D, L = q["displacement"], q["load"]
+    return (
+        *_gap(D, starts=(D.scale / 100, D.scale, 0.3 * D.scale)),
+        Parameter(
+            f"{L.letter}_c",
+            L.unit,
+            L.scale / 200,
+            L.scale * 1e-6,
+            10 * L.scale,
+            f"load over which the contact closes the gap (closed to tanh(1) = 76 % at {L.letter}_c)",
+            scale=L.scale / 200,
+            starts=(L.scale / 2000, 3 * L.scale / 100, L.scale / 200),
+        ),
+    )
+
+
+def _clearance_axes_params(q):
+    return _gap(q["displacement"], per_axis=True)
 
 
 def _clearance_latch_pull(x, p, ctx):
@@ -51,65 +96,50 @@ def _clearance_latch_pull_smooth(x, p, ctx):
 JOINT_CLEARANCE = register_effect(
     Effect(
         name="joint_clearance",
-        title="joint clearance (backlash)",
+        title="clearance (backlash) in a connection",
         physics=(
-            "A joint with a gap: as the load through it changes sign, the joint crosses its play of 2c before the "
+            "A connection with a gap: as the load through it changes sign, it crosses its play of 2c before the "
             "elastic parts take up load again, so the displacement jumps by 2c at the load's zero crossing and is "
-            "offset by +-c with the sign of the load (seed 000 Sec. IV-C suspects the clearance at the mast's beam "
-            "assembly point).  Elastic (no hysteresis): the side of the gap follows the sign of the load, not the "
-            "direction of loading."
+            "offset by +-c with the sign of the load (the Rocaspect paper, Sec. IV-C, suspects the clearance at the "
+            "mast's beam assembly point).  Elastic (no hysteresis): the side of the gap follows the sign of the "
+            "load, not the direction of loading."
         ),
         signature="a step in the displacement where the load changes sign; the error is largest near zero load",
-        # forms: "sharp" (closing scale fixed at 1 % of the largest load: a nearly sharp gap) and "smooth"
-        # (closing scale fitted: a contact that stiffens over a range of load, the sharp gap its limit)
         acts_where=("near-zero load",),
-        seed="seed 000 Sec. IV-C",
-        implementations={
-            "mast-top": Implementation(
-                hook="joint_rotation",
-                order=30,
-                parameters=(
-                    Parameter(
-                        "c", "rad", 1e-4, 0.0, 0.02, "half play of each bending joint", scale=1e-4, starts=(1e-5, 1e-3)
-                    ),
+        seed="Rocaspect guyed mast, Sec. IV-C",
+        mechanism=Implementation(
+            hook="displacement",
+            needs=("load",),
+            order=30,
+            parameters=_clearance_params,
+            apply=_clearance,
+            form="sharp",
+            doc="u += c tanh(L / L_s) on every axis, L_s = 1 % of the largest |L| of the axis in the data (a nearly "
+            "sharp gap: the contact closes within 1 % of the load range).",
+            forms={
+                "smooth": Implementation(
+                    hook="displacement",
+                    needs=("load",),
+                    order=30,
+                    parameters=_clearance_smooth_params,
+                    apply=_clearance_smooth,
+                    doc="u += c tanh(L / L_c): the contact closing the gap stiffens over a load range L_c (named M_c "
+                    "on a moment, F_c on a force; a contact stiffness of about c / L_c); L_c -> 0 is the sharp gap.",
                 ),
-                apply=_clearance_mast_top,
-                form="sharp",
-                doc="theta_k += c tanh(m_k / m_s), k = 1, 2 (bending joints); m_s = 1 % of the largest |m_k| in the "
-                "data (a nearly sharp gap: the contact closes within 1 % of the load range).",
-                forms={
-                    "smooth": Implementation(
-                        hook="joint_rotation",
-                        order=30,
-                        parameters=(
-                            Parameter(
-                                "c",
-                                "rad",
-                                1e-4,
-                                0.0,
-                                0.02,
-                                "half play of each bending joint",
-                                scale=1e-4,
-                                starts=(1e-5, 1e-3, 3e-4),
-                            ),
-                            Parameter(
-                                "m_c",
-                                "N m",
-                                5.0,
-                                1e-3,
-                                1e4,
-                                "closing moment scale of the contact (the gap is closed to tanh(1) = 76 % at m_c)",
-                                scale=5.0,
-                                starts=(0.5, 30.0, 5.0),
-                            ),
-                        ),
-                        apply=_clearance_mast_top_smooth,
-                        doc="theta_k += c tanh(m_k / m_c), k = 1, 2: the contact closing the gap stiffens over a moment "
-                        "range m_c (a contact stiffness of about c / m_c rad per N m); m_c -> 0 is the sharp gap, "
-                        "m_c = 1 % of max |m_k| the default form.",
-                    )
-                },
-            ),
+                "per_axis": Implementation(
+                    hook="displacement",
+                    needs=("load",),
+                    order=30,
+                    parameters=_clearance_axes_params,
+                    apply=_clearance,
+                    min_axes=2,
+                    doc="u_k += c_k tanh(L_k / L_s,k): a gap of its own about each axis (c_x, c_y, ...: a joint "
+                    "with play about one axis only, an overlap longer in one direction); equal gaps are the "
+                    "default form.",
+                ),
+            },
+        ),
+        implementations={
             "latch-pull": Implementation(
                 hook="bead_position",
                 order=30,
@@ -128,7 +158,7 @@ JOINT_CLEARANCE = register_effect(
                 apply=_clearance_latch_pull,
                 form="sharp",
                 doc="x_bead = x - c tanh(dT / 1 N): the latch shifts by c towards the pulling cable (closing within "
-                "about 1 N, the force noise of the seed's rig).",
+                "about 1 N, the force noise of the paper's rig).",
                 forms={
                     "smooth": Implementation(
                         hook="bead_position",
@@ -167,22 +197,86 @@ JOINT_CLEARANCE = register_effect(
 
 
 # ----------------------------------------------------------------------------- friction hysteresis
-def _friction_mast_top(m, p, ctx):
-    m = m.copy()
-    m[:, :2] = play(m[:, :2], p["M_f"])
-    return m
+def _friction(L, p, ctx):
+    return play(L, _friction_threshold(p, ctx))
 
 
-def _friction_mast_top_jenkins(m, p, ctx):
-    m = m.copy()
-    m[:, :2] = jenkins(m[:, :2], p["M_f"], p["alpha"])
-    return m
+def _friction_threshold(p, ctx):
+    q = ctx["quantities"]["load"]
+    name = f"{q.letter}_f"
+    return p[name] if name in p else _per_axis(p, name, q.axes)
 
 
-def _friction_mast_top_iwan(m, p, ctx):
-    m = m.copy()
-    m[:, :2] = iwan(m[:, :2], p["M_f"], p["beta"], p["alpha"])
-    return m
+def _friction_jenkins(L, p, ctx):
+    return jenkins(L, _friction_threshold(p, ctx), p["alpha"])
+
+
+def _friction_iwan(L, p, ctx):
+    return iwan(L, _friction_threshold(p, ctx), p["beta"], p["alpha"])
+
+
+def _threshold(L, per_axis=False, default=100, starts=(1000, 10)):
+    """The slip threshold(s) ``M_f`` / ``F_f`` (``_<axis>`` per axis): default ``L.scale / default``,
+    bounds [0, 100 L.scale], starts ``L.scale / s``."""
+    base = f"{L.letter}_f"
+    names = [f"{base}_{a}" for a in L.axes] if per_axis else [base]
+    return tuple(
+        Parameter(
+            n,
+            L.unit,
+            L.scale / default,
+            0.0,
+            100 * L.scale,
+            f"friction {'moment' if L.letter == 'M' else 'force'} of the connection"
+            + (f" about {n.rsplit('_', 1)[1]}" if per_axis else (" about each axis" if L.axes else "")),
+            scale=L.scale / default,
+            starts=tuple(L.scale / s for s in starts),
+        )
+        for n in names
+    )
+
+
+def _friction_params(q):
+    return _threshold(q["load"])
+
+
+def _friction_axes_params(q):
+    return _threshold(q["load"], per_axis=True)
+
+
+def _friction_jenkins_params(q):
+    return (
+        *_threshold(q["load"], default=100, starts=(500, 20, 100)),
+        Parameter(
+            "alpha",
+            "-",
+            0.3,
+            0.0,
+            1.0,
+            "compliance of the stuck connection relative to the slipping one, k / (k + k_s)",
+            scale=0.3,
+            starts=(0.05, 0.6, 0.3),
+        ),
+    )
+
+
+def _friction_iwan_params(q):
+    return (
+        *_threshold(q["load"], default=50, starts=(250, 10, 50)),
+        Parameter(
+            "beta",
+            "-",
+            1.0,
+            0.05,
+            50.0,
+            "shape of the slip-strength distribution P(r <= s) = (s / threshold)^beta",
+            scale=1.0,
+            starts=(3.0, 0.5, 1.0),
+        ),
+        Parameter(
+            "alpha", "-", 0.1, 0.0, 1.0, "share of the load path that never slips", scale=0.1, starts=(0.0, 0.3, 0.1)
+        ),
+    )
 
 
 def _friction_latch_pull(D, p, ctx):
@@ -195,111 +289,58 @@ def _friction_latch_pull(D, p, ctx):
 FRICTION_HYSTERESIS = register_effect(
     Effect(
         name="friction_hysteresis",
-        title="friction hysteresis in a joint",
+        title="friction hysteresis in a connection",
         physics=(
-            "Coulomb friction in a joint: the joint slips only when the load exceeds the friction threshold in the "
+            "Coulomb friction in a connection: it slips only when the load exceeds the friction threshold in the "
             "direction of motion, so after every reversal it sticks until the load has changed by twice the "
             "friction (play operator).  The offset depends on the direction of loading, not on the sign of the "
-            "load (seed 001 Sec. II.B.1, the ball joints' |M| <= mu B |F| with a constant normal force)."
+            "load (Stohlman & Pellegrino, Sec. II.B.1: the ball joints' |M| <= mu B |F| with a constant normal "
+            "force)."
         ),
         signature="the error changes sign with the direction of loading (loading and unloading offset in opposite "
         "directions) and the response sticks just after each reversal",
         acts_where=("loading", "unloading", "reversal"),
-        seed="seed 001 Sec. II.B.1",
-        implementations={
-            "mast-top": Implementation(
-                hook="joint_moment",
-                order=40,
-                parameters=(
-                    Parameter(
-                        "M_f",
-                        "N m",
-                        10.0,
-                        0.0,
-                        1e5,
-                        "friction moment of each bending joint",
-                        scale=10.0,
-                        starts=(1.0, 100.0),
-                    ),
+        seed="Stohlman & Pellegrino, Sec. II.B.1",
+        mechanism=Implementation(
+            hook="load",
+            order=40,
+            parameters=_friction_params,
+            apply=_friction,
+            form="play",
+            doc="L -> play(L; M_f) on every axis (F_f on a force): the elastic part sees the load less the friction, "
+            "which holds until the load has changed by 2 M_f after a reversal (the connection is rigid while it "
+            "sticks).",
+            forms={
+                "jenkins": Implementation(
+                    hook="load",
+                    order=40,
+                    parameters=_friction_jenkins_params,
+                    apply=_friction_jenkins,
+                    doc="L -> alpha L + play((1 - alpha) L; M_f): the elastic connection k in parallel with a Jenkins "
+                    "element (spring k_s = k (1 - alpha) / alpha in series with a slider of strength M_f); stuck, "
+                    "it is k + k_s stiff, slipping k.  alpha = 0 is the play form.",
                 ),
-                apply=_friction_mast_top,
-                form="play",
-                doc="m_k -> play(m_k; M_f), k = 1, 2: the elastic joint sees the moment less the friction, which "
-                "holds until the moment has changed by 2 M_f after a reversal (the joint is rigid while it "
-                "sticks).",
-                forms={
-                    "jenkins": Implementation(
-                        hook="joint_moment",
-                        order=40,
-                        parameters=(
-                            Parameter(
-                                "M_f",
-                                "N m",
-                                10.0,
-                                0.0,
-                                1e5,
-                                "slip moment of the Jenkins slider",
-                                scale=10.0,
-                                starts=(2.0, 50.0, 10.0),
-                            ),
-                            Parameter(
-                                "alpha",
-                                "-",
-                                0.3,
-                                0.0,
-                                1.0,
-                                "compliance of the stuck joint relative to the slipping one, k / (k + k_s)",
-                                scale=0.3,
-                                starts=(0.05, 0.6, 0.3),
-                            ),
-                        ),
-                        apply=_friction_mast_top_jenkins,
-                        doc="m_k -> alpha m_k + play((1 - alpha) m_k; M_f): the elastic joint k in parallel with a "
-                        "Jenkins element (spring k_s = k (1 - alpha) / alpha in series with a slider of strength "
-                        "M_f); stuck, the joint is k + k_s stiff, slipping k.  alpha = 0 is the play form.",
-                    ),
-                    "iwan": Implementation(
-                        hook="joint_moment",
-                        order=40,
-                        parameters=(
-                            Parameter(
-                                "M_f",
-                                "N m",
-                                20.0,
-                                0.0,
-                                1e5,
-                                "largest slip moment of the micro-slip elements",
-                                scale=20.0,
-                                starts=(4.0, 100.0, 20.0),
-                            ),
-                            Parameter(
-                                "beta",
-                                "-",
-                                1.0,
-                                0.05,
-                                50.0,
-                                "shape of the slip-strength distribution P(r <= s) = (s / M_f)^beta",
-                                scale=1.0,
-                                starts=(3.0, 0.5, 1.0),
-                            ),
-                            Parameter(
-                                "alpha",
-                                "-",
-                                0.1,
-                                0.0,
-                                1.0,
-                                "share of the load path that never slips",
-                                scale=0.1,
-                                starts=(0.0, 0.3, 0.1),
-                            ),
-                        ),
-                        apply=_friction_mast_top_iwan,
-                        doc="m_k -> alpha m_k + (1 - alpha) mean_j play(m_k; r_j): a series Iwan model of 24 "
-                        "elasto-slip elements with slip strengths r_j = M_f q_j^(1/beta) (distributed micro-slip: "
-                        "smooth Masing loops; beta -> inf, alpha = 0 is the play form).",
-                    ),
-                },
-            ),
+                "iwan": Implementation(
+                    hook="load",
+                    order=40,
+                    parameters=_friction_iwan_params,
+                    apply=_friction_iwan,
+                    doc="L -> alpha L + (1 - alpha) mean_j play(L; r_j): a series Iwan model of 24 elasto-slip "
+                    "elements with slip strengths r_j = M_f q_j^(1/beta) (distributed micro-slip: smooth Masing "
+                    "loops; beta -> inf, alpha = 0 is the play form).",
+                ),
+                "per_axis": Implementation(
+                    hook="load",
+                    order=40,
+                    parameters=_friction_axes_params,
+                    apply=_friction,
+                    min_axes=2,
+                    doc="L_k -> play(L_k; M_f,k): a friction threshold of its own about each axis (M_f_x, M_f_y, "
+                    "...); equal thresholds are the play form.",
+                ),
+            },
+        ),
+        implementations={
             "latch-pull": Implementation(
                 hook="branch_force",
                 order=40,
@@ -334,16 +375,16 @@ BALL_JOINT_FRICTION = register_effect(
         name="ball_joint_friction",
         title="ball-joint friction",
         physics=(
-            "Coulomb friction in the longeron ball joints of an ADAM bay (seed 001 Sec. II.B.1): a moving joint "
+            "Coulomb friction in the longeron ball joints of an ADAM bay (Stohlman & Pellegrino, Sec. II.B.1): a moving joint "
             "transmitting a force F resists with a moment |M| = mu B |F| opposing the motion, a joint at rest holds "
-            "|M| <= mu B |F| (mu = 0.5, B = 4 mm in the seed).  Unlike a constant friction it grows with the force "
+            "|M| <= mu B |F| (mu = 0.5, B = 4 mm in the paper).  Unlike a constant friction it grows with the force "
             "through the joint, so the hysteresis widens with the cable pretension and the load."
         ),
         signature="hysteresis whose width grows with the load through the joints: the moment is offset against the "
         "direction of twisting all along the path (bay torsion), the tip keeps a residual displacement at "
         "zero load (mast)",
         acts_where=("reversal", "loading", "unloading", "near-zero load"),
-        seed="seed 001 Sec. II.B.1",
+        seed="Stohlman & Pellegrino, Sec. II.B.1",
         implementations={
             e: Implementation(
                 hook="bay_parameters",

@@ -1,4 +1,4 @@
-"""Latch hysteresis near the latched state (seed 001, Sec. III.C and conclusion).
+"""Latch hysteresis near the latched state (Stohlman & Pellegrino, Sec. III.C and conclusion).
 
 Seed 001 fits one curve near the fully latched configuration ("the model assumes no hysteresis
 in this region", Fig. 10) and concludes that the latch model must be refined because the bay
@@ -7,7 +7,7 @@ is widest with the bead seated against the backstop and fades over a length ``el
 out: ``dT_in -= F_h w``, ``dT_out += F_h w``, ``w = exp(-(x + x_backstop) / ell)``.  The bead
 then sticks near the latched state and keeps a residual position when dT returns to zero.
 
-The shape of the fade is not known from the seed: the form ``shaped`` replaces the exponential by
+The shape of the fade is not known from the paper: the form ``shaped`` replaces the exponential by
 the family ``w = max(1 - gamma d / ell, 0)^(1 / gamma)`` (``d = x + x_backstop``), which is the
 exponential at ``gamma = 0``, a linear fade reaching zero at ``d = ell`` at ``gamma = 1``, a slower,
 hyperbolic tail for ``gamma < 0`` and a fade that ends more abruptly for ``gamma > 1``.
@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..experiments.core import Parameter
 from .base import Effect, Implementation, register_effect
+from .parameters import Parameter
 
 
 def _latch_hysteresis_fe(bay, p, ctx):
@@ -52,9 +52,9 @@ LATCH_HYSTERESIS = register_effect(
         title="latch hysteresis near the latched state",
         physics=__doc__.split("\n\n", 1)[1].strip(),
         signature="latching and unlatching curves differ near the backstop, where the baseline has a single curve; "
-        "the error is concentrated in the latched zones (a)-(b) of seed 001 Fig. 6",
+        "the error is concentrated in the latched zones (a)-(b) of Stohlman & Pellegrino, Fig. 6",
         acts_where=("zone (a) at backstop", "zone (b) behind roller axis", "near-zero load"),
-        seed="seed 001 Sec. III.C, Sec. VIII",
+        seed="Stohlman & Pellegrino, Sec. III.C, Sec. VIII",
         implementations={
             "latch-pull": Implementation(
                 hook="branch_force",

@@ -81,10 +81,17 @@ def _as2d(u):
     return u, np.ascontiguousarray(u.reshape(u.shape[0], -1))
 
 
-def play(u, r: float, p0: float = 0.0) -> np.ndarray:
-    """Play operator of half-width ``r`` (unit of ``u``, >= 0) on each column of ``u`` (n,) or (n, k)."""
+def _widths(r, u2) -> np.ndarray:
+    """Half-widths >= 0 of every entry of u2 (n, k) from ``r``: one value, or one per column (k,)."""
+    r = np.maximum(np.asarray(r, dtype=float), 0.0)
+    return np.ascontiguousarray(np.broadcast_to(r, u2.shape)) if r.ndim else np.full_like(u2, float(r))
+
+
+def play(u, r, p0: float = 0.0) -> np.ndarray:
+    """Play operator of half-width ``r`` (unit of ``u``, >= 0; one value, or one per column) on each
+    column of ``u`` (n,) or (n, k)."""
     u, u2 = _as2d(u)
-    return _play(u2, np.full_like(u2, max(float(r), 0.0)), float(p0)).reshape(u.shape)
+    return _play(u2, _widths(r, u2), float(p0)).reshape(u.shape)
 
 
 def proportional_play(u, eta: float, p0: float = 0.0) -> np.ndarray:
@@ -93,7 +100,7 @@ def proportional_play(u, eta: float, p0: float = 0.0) -> np.ndarray:
     return _play(u2, max(float(eta), 0.0) * np.abs(u2), float(p0)).reshape(u.shape)
 
 
-def jenkins(u, r: float, alpha: float) -> np.ndarray:
+def jenkins(u, r, alpha: float) -> np.ndarray:
     """Elastic joint in parallel with a Jenkins element, driven by its load ``u`` (n,) or (n, k).
 
     Returns the load carried by the elastic joint: ``alpha u + play((1 - alpha) u; r)``.  r : slip
@@ -101,10 +108,11 @@ def jenkins(u, r: float, alpha: float) -> np.ndarray:
     slipping one, ``k / (k + k_s)`` in [0, 1] (k the joint's, k_s the Jenkins spring's stiffness).
     While stuck the joint turns by ``alpha du / k``, while slipping by ``du / k``; the slider carries
     ``(1 - alpha) u`` of every load change until it reaches ``+-r``.  alpha = 0: :func:`play`.
+    r may be one value per column.
     """
     a = min(max(float(alpha), 0.0), 1.0)
     u, u2 = _as2d(u)
-    return (a * u2 + _play(u2 * (1.0 - a), np.full_like(u2, max(float(r), 0.0)), 0.0)).reshape(u.shape)
+    return (a * u2 + _play(u2 * (1.0 - a), _widths(r, u2), 0.0)).reshape(u.shape)
 
 
 def iwan_strengths(R: float, beta: float, n: int = IWAN_ELEMENTS) -> np.ndarray:
@@ -113,14 +121,18 @@ def iwan_strengths(R: float, beta: float, n: int = IWAN_ELEMENTS) -> np.ndarray:
     return max(float(R), 0.0) * q ** (1.0 / max(float(beta), 1e-6))
 
 
-def iwan(u, R: float, beta: float, alpha: float = 0.0, n: int = IWAN_ELEMENTS) -> np.ndarray:
+def iwan(u, R, beta: float, alpha: float = 0.0, n: int = IWAN_ELEMENTS) -> np.ndarray:
     """Series Iwan model driven by its load ``u`` (n,) or (n, k): the load carried by the elastic part.
 
     ``alpha u + (1 - alpha) / n sum_j play(u; r_j)``, ``r_j`` from :func:`iwan_strengths`.  R : largest
     slip strength (unit of u, >= 0); beta : shape of the strength distribution ``P(r <= s) = (s/R)^beta``
     (> 0; large: all near R, Coulomb-like; 1: uniform; small: most slip early, nearly elastic);
-    alpha : share that never slips, in [0, 1].
+    alpha : share that never slips, in [0, 1].  R may be one value per column of u.
     """
+    if np.ndim(R):
+        u, u2 = _as2d(u)
+        cols = [iwan(u2[:, j], Rj, beta, alpha, n) for j, Rj in enumerate(np.broadcast_to(R, u2.shape[1:]))]
+        return np.column_stack(cols).reshape(u.shape)
     a = min(max(float(alpha), 0.0), 1.0)
     radii = iwan_strengths(R, beta, n)
     u, u2 = _as2d(u)

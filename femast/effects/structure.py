@@ -1,5 +1,5 @@
-"""Structural effects: beam bending flexibility in series with the base joint (seed 000 Eqs. 8-15)
-and off-axis motion of the bay top (seed 001 Sec. VI, hook ``control_path`` of bay-torsion)."""
+"""Structural effects: beam bending flexibility in series with the base joint (the Rocaspect paper, Eqs. 8-15)
+and off-axis motion of the bay top (Stohlman & Pellegrino, Sec. VI, hook ``control_path`` of bay-torsion)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..experiments.core import Parameter
 from ..guyed.cantilever import cantilever_compliance, mast_section
 from .base import Effect, Implementation, register_effect
+from .parameters import Parameter
 
 
 @lru_cache(maxsize=64)
@@ -32,7 +32,7 @@ BEAM_FLEXIBILITY = register_effect(
         name="beam_flexibility",
         title="beam bending flexibility in series with the base joint",
         physics=(
-            "The 3R model (seed 000 Eqs. 4-7) takes the mast as rigid on elastic base joints.  The mast is a "
+            "The 3R model (the Rocaspect paper, Eqs. 4-7) takes the mast as rigid on elastic base joints.  The mast is a "
             "square tube (s_out = 0.1 m, s_in = 0.094 m) whose own cantilever compliance (Eqs. 8-15, "
             ":mod:`femast.guyed.cantilever`) acts in series: dc = (J K^-1 J^T + C_beam(E)) dw.  Top forces alone "
             "cannot separate the two (both give a compliance proportional to the force); top moments can, since a "
@@ -41,7 +41,7 @@ BEAM_FLEXIBILITY = register_effect(
         signature="the ratio of the top displacement under a top moment to that under a top force differs from a "
         "rigid mast's; the error follows the top moments",
         acts_where=("peak",),
-        seed="seed 000 Eqs. 8-15",
+        seed="the Rocaspect paper, Eqs. 8-15",
         implementations={
             "mast-top": Implementation(
                 hook="top_displacement",
@@ -88,7 +88,7 @@ OFF_AXIS = register_effect(
         name="off_axis_motion",
         title="off-axis motion of the bay top",
         physics=(
-            "The single-bay torsion rig of seed 001 (Sec. V-VI) does not keep the bay top on its axis: displacements "
+            "The single-bay torsion rig of Stohlman & Pellegrino (Sec. V-VI) does not keep the bay top on its axis: displacements "
             "of up to 1 cm in x and y were recorded, so the four latches do not unlatch together.  The idealised "
             "model drives the top by its rotation only (the baseline of bay-torsion follows ux, uy when they are "
             "measured); this effect turns the top frame about a vertical axis at a distance e from the bay axis, "
@@ -100,7 +100,7 @@ OFF_AXIS = register_effect(
         signature="the latches do not release together: the moment differs where they leave the rollers (zone (c)) "
         "and around release and relatching, where the idealised model has one sharp step",
         acts_where=("latch release/relatch", "zone (c) in front of roller axis", "zone (d) no contact"),
-        seed="seed 001 Sec. VI.B, Fig. 17",
+        seed="Stohlman & Pellegrino, Sec. VI.B, Fig. 17",
         implementations={
             "bay-torsion": Implementation(
                 hook="control_path",

@@ -1,13 +1,13 @@
-"""Experiments: measured data, models of the test, ``compare`` and ``diagnose`` (issue 7).
+"""Experiments: measured data, a model of the test, ``compare`` and ``diagnose``.
 
-An :class:`Experiment` pairs a data format (CSV columns with units) with a model function,
-its fittable parameters and the hooks where physical effects (:mod:`femast.effects`) act.
+The framework: an :class:`Experiment` pairs a data format (CSV columns with units) with a model
+function, its fittable parameters and the hooks where physical effects (:mod:`femast.effects`)
+act; :func:`compare` runs or fits a model variant along the measured path and shows where it
+fails; :func:`diagnose` refits it with each candidate effect and says which one is missing.
 
-Built-in experiments: ``mast-top`` (seed 000, 3R model), ``latch-pull`` (seed 001 latch law),
-``bay-torsion`` (FE single ADAM bay, seed 001 Figs. 16-17), ``tip-cycle`` (FE ADAM mast under
-tip load cycles, seed 001 Table 1) and ``vibration`` (measured natural frequencies against the
-prestressed modal analysis, seed 001 Sec. IV), ``platform-pose`` (the CDPR platform on compliant
-masts, seed 000 Fig. 7).
+The rigs: the built-in experiments live in :mod:`femast.experiments.rigs`, one module per rig,
+each written as a user's own rig is (``mast-top``, ``latch-pull``, ``bay-torsion``,
+``tip-cycle``, ``vibration``, ``platform-pose``); ``femast experiments`` lists them.
 
 Typical use::
 
@@ -22,26 +22,15 @@ Typical use::
 See ``docs/experiments.md`` and ``docs/compare_and_diagnose.md``.
 """
 
-from . import bay_torsion, latch_pull, mast_top, platform_pose, tip_cycle, vibration  # noqa: E402  (built-in experiments)
+from .. import effects as _effects  # noqa: F401  (registers the built-in effects)
+from .compare import compare, format_compare
 from .core import Column, EffectStack, Experiment, Measured, Parameter, prepared
 from .data import from_arrays, read_data, write_data
+from .diagnose import AT_NOISE, SIGNIFICANT_DBIC, diagnose, format_diagnose
+from .fitting import fit, predict, run_model
+from .history import plot_history, read_history
 from .registry import experiment_from_source, get_experiment, list_experiments, register_experiment
-
-for _e in (
-    mast_top.EXPERIMENT,
-    latch_pull.EXPERIMENT,
-    bay_torsion.EXPERIMENT,
-    tip_cycle.EXPERIMENT,
-    vibration.EXPERIMENT,
-    platform_pose.EXPERIMENT,
-):
-    register_experiment(_e)
-
-from .. import effects as _effects  # noqa: E402,F401  (registers the built-in effects)
-from .compare import compare, format_compare  # noqa: E402
-from .diagnose import AT_NOISE, SIGNIFICANT_DBIC, diagnose, format_diagnose  # noqa: E402
-from .fitting import fit, predict, run_model  # noqa: E402
-from .history import plot_history, read_history  # noqa: E402
+from .residuals import noise_floor, turning_points
 
 __all__ = [
     "Column",
@@ -68,4 +57,6 @@ __all__ = [
     "plot_history",
     "AT_NOISE",
     "SIGNIFICANT_DBIC",
+    "noise_floor",
+    "turning_points",
 ]

@@ -15,14 +15,15 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 from .. import progress
+from .baseline import fit_with_noise, plain_params, run_variant, score_with_noise
 from .core import Experiment, Measured
 from .figures import compare_figure, display_scale
 from .fitting import fit as _fit
-from .fitting import params_table, run_model
+from .fitting import params_table
 from .history import append_history, plot_history
+from .noise import noise_model
 from .residuals import (
     TURN_FRACTION,
-    at_noise_threshold,
     noise_floor,
     segment_path,
     segment_report,
@@ -34,11 +35,27 @@ from .units import check_data as check_units
 
 
 def load_path(exp: Experiment, data: Measured) -> np.ndarray:
-    """The signed load that drives the segmentation (``exp.load_measure``, else the first input column)."""
+    """The signed load that drives the segmentation: ``exp.load_measure`` (else the first input
+    column); a load with several axes ((n, k): a moment about two axes) is taken along its principal
+    direction (:func:`principal_load`)."""
     if exp.load_measure is not None:
-        return np.asarray(exp.load_measure(data, exp.options), dtype=float)
+        s = np.asarray(exp.load_measure(data, exp.options), dtype=float)
+        return principal_load(s) if s.ndim == 2 else s
     inputs = [c.name for c in exp.columns if c.required and c.name not in exp.channels]
     return data[inputs[0]] if inputs else np.arange(data.n, dtype=float)
+
+
+def principal_load(L) -> np.ndarray:
+    """(n,) a load of several axes (n, k) projected on its principal direction (the largest singular
+    vector), signed so that its largest value is positive."""
+    L = np.asarray(L, float)
+    if L.ndim == 1 or L.shape[1] == 1:
+        return L.reshape(len(L))
+    if not np.any(L):
+        return np.zeros(len(L))
+    _, _, Vt = np.linalg.svd(L, full_matrices=False)
+    s = L @ Vt[0]
+    return s if s[np.argmax(np.abs(s))] > 0 else -s
 
 
 def analyse(exp: Experiment, data: Measured, run: OptimizeResult) -> dict:
@@ -73,24 +90,34 @@ def compare(
     out=None,
     history: bool = True,
     noise=None,
+    sigma=None,
     max_rows: int | None = None,
 ) -> OptimizeResult:
     """Run the model variant (baseline + ``effects``) along the measured path of ``data``.
 
+    fit : fit the baseline and effect parameters (:func:`~femast.experiments.fitting.fit`);
+        otherwise use ``params`` (baseline ``{name: value}`` and ``"effect.param"`` entries, e.g. the
+        ``params_table`` of another compare, fitted on other data: fit here, predict there) or the
+        defaults.
+    sigma : ``{channel: level}`` the sensor uncertainty of channels (their units), e.g. from the
+        datasheet; ``sigma_<channel>`` columns give it per row.  Without either, the noise comes from
+        repeated rows or, as the fallback, from the residual (:mod:`femast.experiments.noise`).
+    noise : ``{channel: level or (n,) levels}`` fixed weights of the fit (overrides the noise model's).
+    out : output folder for ``compare.json``, ``compare.png``, ``history.jsonl``, ``history.png`` and
+        ``compare_report.html`` (self-contained, figures inlined; nothing is written if None).
+        history : append the run to the history file.
     max_rows : above this many rows (default 10 000), every k-th row is used and a DataWarning
         says so (:mod:`femast.experiments.rows`).
 
-    fit : fit the baseline and effect parameters (:func:`~femast.experiments.fitting.fit`);
-        otherwise use ``params`` (baseline ``{name: value}`` and ``"effect.param"`` entries) or the
-        defaults.
-    out : output folder for ``compare.json``, ``compare.png``, ``history.jsonl``, ``history.png`` and
-        ``compare_report.html`` (self-contained, figures inlined; nothing is written if None).  history : append the run to the history file.
-
     Returns an ``OptimizeResult`` with ``experiment``, ``n_samples``, ``effects``, ``fitted``,
-    ``run`` (the model run/fit result), ``params`` (table with stderr and units), ``rms``
-    (error unit), ``channel_rms``, ``noise`` (per channel), ``noise_rms``, ``ratio`` (rms / noise),
-    ``by_kind`` and ``worst`` (segments, worst first), ``signatures``, ``report`` (JSON dict),
-    ``files``, ``version`` (in the history, or None), ``success``, ``message``.
+    ``run`` (the model run/fit result), ``params`` (``{name: value}`` of every parameter: the
+    baseline's and ``effect.param`` ones -- what ``params=`` of another compare takes: fit here,
+    predict there), ``effect_params`` (``{effect: {name: value}}``), ``params_table`` (``{name:
+    {value, stderr, unit}}``, the same names; ``params=`` takes it too),
+    ``rms`` (error unit), ``channel_rms``, ``noise`` (per channel, (n,) levels), ``noise_model``
+    (``{channel: ChannelNoise}``, with its source), ``noise_rms``, ``ratio`` (robust RMS of the
+    residual over the noise), ``by_kind`` and ``worst`` (segments, worst first), ``signatures``,
+    ``report`` (JSON dict), ``files``, ``version`` (in the history, or None), ``success``, ``message``.
     """
     exp.require_model("compare")
     data = thin(data, max_rows, "compare")  # a long record: every k-th row (femast.experiments.rows)
@@ -98,22 +125,24 @@ def compare(
     if isinstance(effects, str):
         effects = [e for e in effects.split(",") if e.strip()]
     effects = list(effects)
+    params = plain_params(params)
+    for k in params:  # the effects of "effect.param" entries are switched on
+        e = k.split(".", 1)[0]
+        if "." in k and e not in effects:
+            effects.append(e)
     variant = exp.name + "".join(" + " + e for e in effects)
-    if fit:
-        with progress.task(f"fitting {variant}"):
-            run = _fit(exp, data, effects, noise=noise)
-        if getattr(run, "fe_reference", None) is not None:  # the fit's FE runs answer the zones and figures
-            exp = exp.with_options(fe_reference=run.fe_reference)
-    else:
-        params = dict(params or {})
-        base = {k: v for k, v in params.items() if "." not in k}
-        eff = {e: {} for e in effects}
-        for k, v in params.items():
-            if "." in k:
-                e, p = k.split(".", 1)
-                eff.setdefault(e, {})[p] = v
-        with progress.task(f"running {variant}"):
-            run = run_model(exp, data, base, eff, noise=noise)
+    with progress.task(f"{'fitting' if fit else 'running'} {variant}"):
+        if noise is not None:
+            run = _fit(exp, data, effects, noise=noise) if fit else run_variant(exp, data, effects, params, noise)
+        else:
+            run, _ = fit_with_noise(
+                exp, data, effects, sigma=sigma, fitted=fit, params=params, start=params if fit and params else None
+            )
+    if fit and getattr(run, "fe_reference", None) is not None:  # the fit's FE runs answer the zones and figures
+        exp = exp.with_options(fe_reference=run.fe_reference)
+    models = noise_model(exp, data, run, sigma=sigma)
+    sc = score_with_noise(exp, data, run, models)
+    run = _judged(run, sc)
     a = analyse(exp, data, run)
     report = {
         "experiment": exp.name,
@@ -128,14 +157,22 @@ def compare(
         "ratio": run.ratio,
         "bic": run.bic,
         "channels": {
-            c: {"rms": run.channel_rms[c], "noise": run.noise[c], "unit": exp.unit_of(c)} for c in exp.channels
+            c: {
+                "rms": run.channel_rms[c],
+                "noise": models[c].sigma_rms,
+                "ratio": sc.channel_ratio[c],
+                "unit": exp.unit_of(c),
+            }
+            for c in exp.channels
         },
+        "noise_model": {c: models[c].to_json() for c in exp.channels},
+        "n_eff": sc.n_eff,
         "segments_by_kind": a["by_kind"],
         "worst_segments": a["worst"][:5],
         "signatures": a["signatures"][:3],
         "message": run.message,
         "success": bool(run.success),
-        "at_noise": at_noise_threshold(data.n, len(exp.channels)),
+        "at_noise": sc.at_noise,
     }
     files, version = {}, None
     if out is not None:
@@ -170,7 +207,7 @@ def compare(
         effects=tuple(run.effects),
         fitted=bool(fit),
         run=run,
-        params=run.params,
+        params=dict(zip(run.names, (float(x) for x in run.x))),
         effect_params=run.effect_params,
         params_table=report["params"],
         predicted=run.predicted,
@@ -178,8 +215,11 @@ def compare(
         rms=run.rms,
         channel_rms=run.channel_rms,
         noise=run.noise,
+        noise_model=models,
         noise_rms=run.noise_rms,
         ratio=run.ratio,
+        channel_ratio=sc.channel_ratio,
+        at_noise=sc.at_noise,
         bic=run.bic,
         load=a["load"],
         segments=a["segments"],
@@ -211,6 +251,13 @@ def compare(
     return result
 
 
+def _judged(run: OptimizeResult, sc: OptimizeResult) -> OptimizeResult:
+    """A shallow copy of a run with the noise, level and ratio of the noise model it is judged by."""
+    r = OptimizeResult(dict(run))
+    r.noise, r.noise_rms, r.ratio = sc.noise, sc.noise_rms, sc.ratio
+    return r
+
+
 def _fmt(v, unit):
     f, ul = display_scale(unit)
     return f"{f * v:.4g} {ul}"
@@ -235,10 +282,15 @@ def format_compare(exp: Experiment, result: OptimizeResult) -> str:
     )
     for c in exp.channels:
         u = exp.unit_of(c)
+        m = result.noise_model[c]
         lines.append(
-            f"    {c:>8s}: RMS {_fmt(result.channel_rms[c], u)}, noise {_fmt(result.noise[c], u)} "
-            f"({np.sqrt(np.mean((result.residuals[c] / result.noise[c]) ** 2)):.2f}x)"
+            f"    {c:>8s}: RMS {_fmt(result.channel_rms[c], u)}, noise {_fmt(m.sigma_rms, u)} from "
+            f"{m.source} ({result.channel_ratio[c]:.2f}x)"
         )
+        if m.disagree:
+            lines.append(
+                f"    {'':>8s}  noise sources disagree: " + ", ".join(f"{k} {_fmt(v, u)}" for k, v in m.levels.items())
+            )
     lines.append("  error by kind of segment (x noise):")
     for k in result.by_kind:
         lines.append(f"    {k['kind']:>30s}: {k['ratio']:6.2f}x  ({k['n']} samples)")

@@ -16,64 +16,22 @@ It returns a dict ``{channel: (n,) array}`` with one predicted value per row for
 ``experiment.channels``, in the units of the channel's column name.  Everything else (fits,
 noise floor, segmentation, ranking of effects, figures, history) is generic.
 
-Built-in experiments live in :mod:`femast.experiments.mast_top`,
-:mod:`femast.experiments.latch_pull`, :mod:`femast.experiments.bay_torsion` and
-:mod:`femast.experiments.tip_cycle` (FE models); a user adds one from a Python script that
-defines a module-level ``experiment`` (see ``docs/experiments.md``).
+The built-in experiments are rigs written against this contract, one module each in
+:mod:`femast.experiments.rigs`; a user adds one from a Python script that defines a module-level
+``experiment`` (see ``docs/experiments.md``).
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..effects.parameters import Parameter  # noqa: F401  (re-exported: experiments declare Parameters)
+from ..effects.quantities import HOOKS, check_quantities
 from ..errors import ModelError
-
-
-@dataclass(frozen=True)
-class Parameter:
-    """A fittable parameter of a model or of an effect.
-
-    name : identifier (used in JSON reports and as ``params[name]``).
-    unit : its SI unit as text ("N m/rad", "m", "-").
-    default : value used without ``--fit`` and as the start of a fit.
-    lower, upper : bounds of the fit (same unit).
-    doc : one line of physics.
-    scale : typical magnitude, used to scale the fit (default ``|default|`` or 1).
-    starts : extra start values tried by the fit (multi-start for non-convex effects).
-    """
-
-    name: str
-    unit: str
-    default: float
-    lower: float = -math.inf
-    upper: float = math.inf
-    doc: str = ""
-    scale: float | None = None
-    starts: tuple = ()
-
-    def __post_init__(self):
-        if not (self.lower <= self.default <= self.upper):
-            raise ModelError(
-                f"parameter {self.name}: default {self.default!r} {self.unit} lies outside its "
-                f"bounds [{self.lower!r}, {self.upper!r}]"
-            )
-        for s in self.starts:
-            if not (self.lower <= s <= self.upper):
-                raise ModelError(
-                    f"parameter {self.name}: start {s!r} {self.unit} lies outside its bounds "
-                    f"[{self.lower!r}, {self.upper!r}]; give starts within the bounds"
-                )
-
-    @property
-    def typical(self) -> float:
-        """Magnitude used to scale the fit, in the parameter's unit."""
-        if self.scale:
-            return float(self.scale)
-        return abs(float(self.default)) or 1.0
+from .measured import Measured
 
 
 @dataclass(frozen=True)
@@ -95,57 +53,10 @@ class Column:
 
 #: Optional time column accepted by every experiment (s); without it time is the row index.
 TIME_COLUMN = Column("t_s", "s", "time of the sample (optional; rows must be in time order)", required=False)
-
-
-@dataclass
-class Measured:
-    """Measured data of one experiment: ``columns[name]`` (n,) float arrays, rows in time order.
-
-    path : the file it came from (or ``"<arrays>"``).  lines : file line number of each row
-    (1-based), used to point at rows in reports and errors.  ``cache`` holds quantities an
-    experiment prepares once per data set (see :attr:`Experiment.prepare`).
-    """
-
-    experiment: str
-    columns: dict
-    path: str = "<arrays>"
-    lines: np.ndarray | None = None
-    cache: dict = field(default_factory=dict, repr=False, compare=False)
-
-    def __post_init__(self):
-        self.columns = {k: np.asarray(v, dtype=float) for k, v in self.columns.items()}
-        if self.lines is None:
-            self.lines = np.arange(2, self.n + 2)  # header on line 1
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        return self.columns[name]
-
-    def __contains__(self, name: str) -> bool:
-        return name in self.columns
-
-    @property
-    def n(self) -> int:
-        """Number of rows (samples)."""
-        return len(next(iter(self.columns.values()))) if self.columns else 0
-
-    @property
-    def tau(self) -> np.ndarray:
-        """Normalised time in [0, 1] (from ``t_s`` if present, else the row index), dimensionless."""
-        t = self.columns.get("t_s")
-        if t is None:
-            t = np.arange(self.n, dtype=float)
-        span = t[-1] - t[0]
-        return (t - t[0]) / span if span > 0 else np.zeros(self.n)
-
-    def subset(self, rows) -> Measured:
-        """A copy restricted to ``rows`` (index array or mask), with an empty cache."""
-        rows = np.asarray(rows)
-        return Measured(self.experiment, {k: v[rows] for k, v in self.columns.items()}, self.path, self.lines[rows])
-
-    def __getstate__(self):  # the cache is rebuilt where it is needed (worker processes)
-        d = dict(self.__dict__)
-        d["cache"] = {}
-        return d
+#: Optional group column accepted by every experiment: the station, specimen or run of each row (any label).
+GROUP_COLUMN = Column(
+    "group", "-", "group of the row: a station, specimen or test run (optional; any label)", required=False
+)
 
 
 @dataclass(frozen=True)
@@ -165,12 +76,13 @@ class Experiment:
     prepare : optional ``prepare(data, options) -> dict`` of per-data-set quantities, cached in
         ``data.cache`` (e.g. joint moments, directions of motion).
     initial_guess : optional ``initial_guess(data, options) -> {param: value}`` start of a fit.
-    load_measure : optional ``load_measure(data, options) -> (n,) signed load`` that drives the
+    load_measure : optional ``load_measure(data, options) -> (n,) signed load`` (or (n, k) on several
+        axes: taken along its principal direction) that drives the
         segmentation (loading, unloading, reversals, near-zero load, peaks); default: the first
         required non-channel column.
     load_label : name and unit of the load measure, for reports.
     extra_segments : optional ``extra_segments(data, params, options) -> [(kind, mask)]`` of
-        experiment-specific path segments (e.g. the latch zones of seed 001 Fig. 6).
+        experiment-specific path segments (e.g. the latch zones of Stohlman & Pellegrino, Fig. 6).
     plot_measured : optional ``plot_measured(ax, data, predicted, params, options)`` drawing the
         measured-against-model panel of the compare figure (default: channels against row).
     channel_weights : factors converting each channel to ``error_unit`` for the overall RMS
@@ -189,16 +101,22 @@ class Experiment:
         (p + 1)``).  ``expensive: True`` makes ``diagnose`` refit in parallel by default even when
         the baseline fit was fast (its runs came from a cache); with ``diff_step`` it also makes the
         fit save runs (secant Jacobians, seeded refits, positive parameters spanning two decades in
-        log scale: :func:`~femast.experiments.fitting.fit`, issue 21).
+        log scale: :func:`~femast.experiments.fitting.fit`).
     source : where it came from (a built-in name or a script path), set by the registry.
     noise_covariates : optional ``noise_covariates(data, params, options, fit) -> {channel: {name:
         (n,) array}}`` of quantities the noise level of a channel may grow with, because of how
-        the data are measured (latch-pull: the slope of the law, seed 001 Eq. 15); the noise model
+        the data are measured (latch-pull: the slope of the law, Stohlman & Pellegrino, Eq. 15); the noise model
         of ``diagnose`` (:mod:`femast.experiments.noise`) tests them.
     path_coordinate : optional ``path_coordinate(data, options) -> (n,)`` the quantity the test
         drives along its passes (latch-pull: the bead position), whose repeated passes give the
         noise model a model-free level (:func:`~femast.experiments.noise.cycle_scatter`); default:
         the load measure.
+
+    quantities : ``{kind: Quantity}`` the physical quantities the model shows to effects
+        (:mod:`femast.effects.quantities`): ``"load"`` and ``"displacement"`` (the model passes them
+        through ``effects.apply("load", ...)`` and ``effects.apply("displacement", ...)``),
+        ``"temperature"`` (a data column).  Every effect whose mechanism acts on quantities the
+        experiment declares applies to it, the library's and the user's alike.
 
     Every channel ``c`` also accepts an optional column ``sigma_c`` (same unit) with the standard
     uncertainty of each row; ``diagnose`` then uses it as the noise of that channel.
@@ -227,6 +145,7 @@ class Experiment:
     source: str = ""
     noise_covariates: Callable | None = None
     path_coordinate: Callable | None = None
+    quantities: dict = field(default_factory=dict)
 
     def __post_init__(self):
         names = [c.name for c in self.columns]
@@ -238,6 +157,15 @@ class Experiment:
         pn = [p.name for p in self.parameters]
         if len(set(pn)) != len(pn):
             raise ModelError(f"experiment {self.name}: duplicate parameter names in {pn}")
+        quantities = check_quantities(f"experiment {self.name}", self.quantities)
+        object.__setattr__(self, "quantities", quantities)
+        hooks = dict(self.hooks)
+        for kind in HOOKS:
+            if kind in quantities and kind not in hooks:
+                q = quantities[kind]
+                shape = f"(n, {len(q.axes)}) about {', '.join(q.axes)}" if q.axes else "(n,)"
+                hooks[kind] = f"{kind} {shape} {q.unit}{': ' + q.doc if q.doc else ''}"
+        object.__setattr__(self, "hooks", hooks)
 
     # ------------------------------------------------------------------ helpers
     @property
@@ -259,12 +187,14 @@ class Experiment:
 
     @property
     def all_columns(self) -> tuple:
-        """Declared columns, the optional time column ``t_s`` and an optional ``sigma_<channel>``
-        (per-row standard uncertainty, the channel's unit) for every channel."""
+        """Declared columns, the optional time column ``t_s``, the optional ``group`` column and an
+        optional ``sigma_<channel>`` (per-row standard uncertainty, the channel's unit) for every channel."""
         cols = tuple(self.columns)
         names = {c.name for c in cols}
         if TIME_COLUMN.name not in names:
             cols += (TIME_COLUMN,)
+        if GROUP_COLUMN.name not in names:
+            cols += (GROUP_COLUMN,)
         for ch in self.channels:
             if f"sigma_{ch}" not in names:
                 unit = next((c.unit for c in self.columns if c.name == ch), "")
@@ -335,11 +265,14 @@ class EffectStack:
     ``items`` is a list of ``(effect_name, implementation, params)``; ``apply(hook, value, **ctx)``
     passes ``value`` through every implementation attached to ``hook``, in their ``order``.
     An implementation's function is called as ``fn(value, params, ctx)`` and returns the new value;
-    ``ctx`` holds the keyword arguments of the hook call.
+    ``ctx`` holds ``context`` (what the framework gives every effect: ``time``, ``t_s``,
+    ``temperature``, ``quantities``; :func:`effect_context`), the load as it entered the ``"load"``
+    hook (``load``) and after its effects (``load_eff``), and the keyword arguments of the hook call.
     """
 
-    def __init__(self, items=()):
+    def __init__(self, items=(), context=None):
         self.items = sorted(list(items), key=lambda it: it[1].order)
+        self.context = dict(context or {})
 
     def __bool__(self):
         return bool(self.items)
@@ -351,14 +284,33 @@ class EffectStack:
 
     def apply(self, hook: str, value, **ctx):
         """Apply the active effects attached to ``hook`` to ``value`` (see the class docstring)."""
+        if hook == "load" and self.items:
+            self.context["load"] = value
+        full = {**self.context, **ctx}
         for _, impl, params in self.items:
             if impl.hook == hook:
-                value = impl.apply(value, params, ctx)
+                value = impl.apply(value, params, full)
+        if hook == "load" and self.items:
+            self.context["load_eff"] = value
         return value
 
     def on(self, hook: str) -> bool:
         """True if an active effect is attached to ``hook``."""
         return any(impl.hook == hook for _, impl, _ in self.items)
+
+
+def effect_context(exp: Experiment, data: Measured) -> dict:
+    """What the framework gives every effect of a model run on ``data`` (:class:`EffectStack`)."""
+    t = data.columns.get("t_s")
+    ctx = {
+        "time": data.tau,
+        "t_s": np.asarray(t, float) if t is not None else np.arange(data.n, dtype=float),
+        "quantities": exp.quantities,
+    }
+    temp = exp.quantities.get("temperature")
+    if temp is not None and temp.column in data.columns:
+        ctx["temperature"] = data[temp.column]
+    return ctx
 
 
 NO_EFFECTS = EffectStack()

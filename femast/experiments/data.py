@@ -13,7 +13,7 @@ Format
   latch pull test).
 
 Every error is a :class:`~femast.errors.DataFileError` naming the file, the line and the
-column, and listing the accepted values.  Beyond the format, the values are checked (issue 16):
+column, and listing the accepted values.  Beyond the format, the values are checked:
 every value within 1e15 of its unit (a larger one is a corrupt cell and would overflow the fit);
 no measured channel (``experiment.channels``) all zero or constant (nothing was measured: a
 disconnected sensor or a wrong column); a file separated by ';', tabs or '|' is refused with an
@@ -212,16 +212,54 @@ def _cell_values(exp: Experiment, header, rows, lines, path, header_line) -> np.
     return values
 
 
-def read_data(exp: Experiment, path, units=None) -> Measured:
-    """Read and check a measured-data file of experiment ``exp`` (see the module docstring).
+def _group_labels(header, rows, lines, path) -> list:
+    """The labels of the ``group`` column (any text), each cell replaced by ``0`` for the number
+    reader; [] without a group column.  Rows of the wrong length are left to the number reader."""
+    if "group" not in header:
+        return []
+    g, labels = header.index("group"), []
+    for cells, line in zip(rows, lines):
+        if len(cells) != len(header):
+            continue
+        label = cells[g].strip()
+        if not label:
+            raise DataFileError(f"{path} line {line}, column 'group': an empty cell; every row needs its group's label")
+        labels.append(label)
+        cells[g] = "0"
+    return labels
+
+
+def read_data(exp: Experiment, path, units=None, *, time_continuous: bool = False, offsets: bool = False) -> Measured:
+    """Read and check a measured-data file of experiment ``exp`` (see the module docstring), or
+    several: ``path`` a list of files, each a group of the data (its rows' ``group`` labels prefixed
+    by the file name where it has a ``group`` column).
 
     A header may name a column in another unit (``dx_mm`` for ``dx_m``): its values are converted
     (:mod:`femast.experiments.units`).  ``units``: ``{column: unit}`` or ``"dx_m=mm,fx_N=lbf"``,
     the unit the values of a column are really in (a header that says the wrong unit).
+    time_continuous : the files (or groups) are one test whose time goes on from one to the next,
+        rather than separate tests whose time restarts (:class:`~femast.experiments.measured.Measured`).
+    offsets : fit a zero of its own for every group and channel.
 
-    Returns a :class:`~femast.experiments.core.Measured` whose ``lines`` give the file line of
+    Returns a :class:`~femast.experiments.measured.Measured` whose ``lines`` give the file line of
     every row.  Raises :class:`~femast.errors.DataFileError` on any malformed content.
     """
+    from .units import CONFIRMED
+
+    if isinstance(path, (list, tuple)):
+        if len(path) == 1:
+            path = path[0]
+        else:
+            parts = [read_data(exp, p, units) for p in path]
+            data = combine(parts, time_continuous=time_continuous, offsets=offsets)
+            data.cache[CONFIRMED] = parts[0].cache.get(CONFIRMED, ())  # the same --units for every file
+            return data
+    data = _read_one(exp, path, units)
+    data.time_continuous, data.offsets = bool(time_continuous), bool(offsets)
+    return data
+
+
+def _read_one(exp: Experiment, path, units) -> Measured:
     from . import units as _units
 
     override = _units.parse_override(units)
@@ -257,6 +295,7 @@ def read_data(exp: Experiment, path, units=None) -> Measured:
             f"{path}: no header row; the first non-comment line must name the columns: {_accepted(exp)}"
         )
     ncol = len(header)
+    labels = _group_labels(header, rows, lines, path)
     values = _fast_values(exp, header, rows, ncol)  # whole columns at once: 2 million rows in seconds
     if values is None:  # some cell needs looking at: cell by cell, naming the first bad one
         values = _cell_values(exp, header, rows, lines, path, header_line)
@@ -269,7 +308,7 @@ def read_data(exp: Experiment, path, units=None) -> Measured:
         f = factors[i] * scaled.get(h, 1.0)
         if f != 1.0:
             values[:, i] *= f
-    cols = {h: values[:, i] for i, h in enumerate(header)}
+    cols = {h: values[:, i] for i, h in enumerate(header) if h != "group"}
     check_values(exp, cols, str(path), lines)
     if "t_s" in cols and np.any(np.diff(cols["t_s"]) < 0):
         bad = int(np.flatnonzero(np.diff(cols["t_s"]) < 0)[0]) + 1
@@ -277,14 +316,67 @@ def read_data(exp: Experiment, path, units=None) -> Measured:
             f"{path} line {lines[bad]}, column 't_s': time goes backwards "
             f"({cols['t_s'][bad - 1]:g} s then {cols['t_s'][bad]:g} s); rows must be in time order"
         )
-    data = Measured(exp.name, cols, str(path), np.asarray(lines))
+    groups, names = group_codes(labels) if labels else (None, ())
+    data = Measured(exp.name, cols, str(path), np.asarray(lines), groups=groups, group_names=names)
     data.cache[_units.CONFIRMED] = tuple(c for c, f in scaled.items() if f == 1.0)  # --units dx_m=m
     return data
 
 
+def group_codes(labels) -> tuple:
+    """``(codes (n,) int, names)`` of group labels, numbered in order of first appearance."""
+    names = list(dict.fromkeys(str(x) for x in labels))
+    index = {n: i for i, n in enumerate(names)}
+    return np.array([index[str(x)] for x in labels], dtype=int), tuple(names)
+
+
+def combine(parts, *, time_continuous: bool = False, offsets: bool = False) -> Measured:
+    """One data set of several (files, runs), each a group (its own groups kept, labelled
+    ``part/label``).  With ``time_continuous`` the time of each part is shifted to start one of its
+    steps after the end of the part before (one test recorded in parts); otherwise each part's time
+    restarts (separate tests)."""
+    parts = list(parts)
+    if not parts:
+        raise DataFileError("no data to combine")
+    cols = set(parts[0].columns)
+    for d in parts[1:]:
+        if set(d.columns) != cols:
+            raise DataFileError(
+                f"{d.path}: its columns ({', '.join(sorted(d.columns))}) differ from those of {parts[0].path} "
+                f"({', '.join(sorted(cols))}); give every file the same columns"
+            )
+    labels, end = [], None
+    columns = {k: [] for k in parts[0].columns}
+    for d in parts:
+        stem = Path(d.path).stem
+        if d.groups is None:
+            labels += [stem] * d.n
+        else:
+            labels += [f"{stem}/{d.group_names[g]}" for g in d.groups]
+        for k, v in d.columns.items():
+            if k == "t_s" and time_continuous and end is not None:
+                step = float(np.median(np.diff(v))) if v.size > 1 else 1.0
+                v = v - v[0] + end + max(step, 0.0)
+            columns[k].append(v)
+        if "t_s" in columns:
+            end = float(columns["t_s"][-1][-1])
+    groups, names = group_codes(labels)
+    return Measured(
+        parts[0].experiment,
+        {k: np.concatenate(v) for k, v in columns.items()},
+        ", ".join(str(d.path) for d in parts),
+        np.concatenate([d.lines for d in parts]),
+        groups=groups,
+        group_names=names,
+        time_continuous=time_continuous,
+        offsets=offsets,
+    )
+
+
 def from_arrays(exp: Experiment, **columns) -> Measured:
-    """Build :class:`Measured` data from arrays (same checks as :func:`read_data`)."""
+    """Build :class:`Measured` data from arrays (same checks as :func:`read_data`); a ``group``
+    column holds any labels (text or numbers)."""
     check_header(exp, list(columns), "<arrays>", 0)
+    labels = columns.pop("group", None)
     arrs = {k: np.asarray(v, dtype=float).ravel() for k, v in columns.items()}
     sizes = {k: a.size for k, a in arrs.items()}
     if len(set(sizes.values())) != 1:
@@ -297,7 +389,13 @@ def from_arrays(exp: Experiment, **columns) -> Measured:
     if n < exp.min_rows:
         raise DataFileError(f"<arrays>: {n} rows; {exp.name} needs at least {exp.min_rows}")
     check_values(exp, arrs, "<arrays>", np.arange(n), measured=False)
-    return Measured(exp.name, arrs)
+    if labels is None:
+        return Measured(exp.name, arrs)
+    labels = list(np.asarray(labels).ravel())
+    if len(labels) != n:
+        raise DataFileError(f"<arrays>: the group column has {len(labels)} rows, the others {n}")
+    groups, names = group_codes(labels)
+    return Measured(exp.name, arrs, groups=groups, group_names=names)
 
 
 def write_data(path, data: Measured, exp: Experiment | None = None, comments=(), fmt: str = "%.9g") -> Path:
@@ -307,11 +405,12 @@ def write_data(path, data: Measured, exp: Experiment | None = None, comments=(),
     names = list(data.columns)
     if exp is not None:  # the experiment's column order
         names = [c.name for c in exp.all_columns if c.name in data.columns]
+    group = [data.group_names[g] for g in data.groups] if data.groups is not None else None
     with open(path, "w", newline="") as fh:
         for c in comments:
             fh.write(f"# {c}\n")
         w = csv.writer(fh, lineterminator="\n")
-        w.writerow(names)
-        for row in np.column_stack([data.columns[k] for k in names]):
-            w.writerow([fmt % v for v in row])
+        w.writerow(names + (["group"] if group else []))
+        for i, row in enumerate(np.column_stack([data.columns[k] for k in names])):
+            w.writerow([fmt % v for v in row] + ([group[i]] if group else []))
     return path

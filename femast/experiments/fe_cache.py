@@ -14,7 +14,7 @@ and keeps
   (worker processes of ``diagnose`` then reuse each other's runs, and a repeated command is
   nearly free).
 
-The disk entries hold data, never code (issue 16): a run's dict of numeric arrays, numbers and
+The disk entries hold data, never code: a run's dict of numeric arrays, numbers and
 strings is stored as the arrays of an ``.npz`` (no object arrays; read with ``allow_pickle=False``)
 plus a JSON header in the same file with the entry's key, the scalars and a SHA-256 of the arrays.
 A file that is truncated, corrupt, of another format, or whose key or checksum does not match (a

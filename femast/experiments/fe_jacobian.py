@@ -1,4 +1,4 @@
-"""Derivatives and coordinates of the fits of expensive models (the FE experiments), issue 21, item 6.
+"""Derivatives and coordinates of the fits of expensive models (the FE experiments).
 
 Every evaluation of such a model is an FE run (0.1-2 s), so a fit's cost is its number of runs.
 :class:`_FEJacobian` takes forward differences with a floor on the step and Broyden secant updates
@@ -35,7 +35,7 @@ class _FEJacobian:
     J + (y - J s) s^T / (s^T s) (Broyden 1965; Dennis & Schnabel 1996, Sec. 8.1) instead of p more
     FE runs; a step the trust region rejected (the model did not follow the linearisation) makes
     the next Jacobian a finite-difference one again.  ``J0``: columns known at the start (NaN where
-    not), e.g. the baseline's finite differences handed to a refit (issue 21, item 6).
+    not), e.g. the baseline's finite differences handed to a refit.
     ``runs`` counts the evaluations of ``fun`` (cache hits included); ``fd_at`` is the point of the
     last finite-difference Jacobian and ``fd_J`` that Jacobian."""
 
@@ -142,7 +142,7 @@ def _only_thread() -> bool:
 
 def evaluate_many(fun, points, size: int) -> list:
     """``[fun(p) for p in points]`` (each a (size,) float array), the second half of the points in a
-    forked child process while this one computes the first (issue 21: a fit's finite-difference
+    forked child process while this one computes the first (a fit's finite-difference
     columns are independent FE runs, and during a fit in the main process the second CPU is idle; a
     forked child inherits the loaded kernels, the reference path and the model).  The child sends the
     values back as raw float64 bytes through a pipe and ends with ``os._exit``; if it fails, this process
@@ -258,7 +258,7 @@ class _Coords:
     """The fit's coordinates u of the parameters x: ``x / scale`` (linear), or ``ln(x / scale)`` for
     the parameters flagged ``log`` (expensive fits of positive parameters spanning decades: a
     stiffness or an axial rigidity, whose effect goes as 1/x: Gauss-Newton steps in ln x reach
-    the minimum in fewer FE runs than steps in x; issue 21).  ``start`` registers a start value so
+    the minimum in fewer FE runs than steps in x).  ``start`` registers a start value so
     that ``to_x`` gives it back bit for bit (the run cache then answers it)."""
 
     def __init__(self, scale, log):

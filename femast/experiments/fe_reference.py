@@ -1,4 +1,4 @@
-"""Reference runs of the FE experiments: the converged path of one run predicts the next (issue 21).
+"""Reference runs of the FE experiments: the converged path of one run predicts the next.
 
 A fit runs the FE model along the same measured path many times with parameters close to each
 other.  The experiment option ``fe_reference`` names the baseline parameters of a *reference

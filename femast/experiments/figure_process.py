@@ -1,5 +1,4 @@
-"""A figure drawn by a process forked when the command starts, which imports matplotlib meanwhile
-(issue 21, item 6).
+"""A figure drawn by a process forked when the command starts, which imports matplotlib meanwhile.
 
 ``diagnose`` of an FE experiment keeps both CPUs busy while its refits run, but only one while it
 fits the baseline; matplotlib's import (0.45-0.6 s of CPU) used to run in a thread during the refits.

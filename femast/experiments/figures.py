@@ -119,13 +119,27 @@ def diagnose_figure(exp, data, result, png) -> Path:
     png = Path(png)
     f, ul = display_scale(exp.error_unit)
     entries = (
-        [("baseline", result.baseline["rms"], None, False)]
+        [("baseline", result.baseline["rms"], None, False, False, result.baseline.get("heldout_ratio"))]
         + [
-            (r["effect"] + (f" ({r['form']})" if r.get("form") else ""), r["rms"], r["delta_bic"], r["significant"])
+            (
+                r["effect"] + (f" ({r['form']})" if r.get("form") else ""),
+                r["rms"],
+                r["delta_bic"],
+                r["significant"],
+                bool(r.get("failed")),
+                r.get("heldout_ratio"),
+            )
             for r in result.ranking
         ]
         + [
-            (" + ".join(p["effects"]), p["rms"], p["delta_bic"], p["significant"])
+            (
+                " + ".join(p["effects"]),
+                p["rms"],
+                p["delta_bic"],
+                p["significant"] and p.get("heldout_ok", True),
+                False,
+                p.get("heldout_ratio"),
+            )
             for p in (getattr(result, "pairs", None) or [])[:3]
         ]
     )
@@ -133,10 +147,20 @@ def diagnose_figure(exp, data, result, png) -> Path:
         1, 2, figsize=(13, max(4.0, 0.45 * len(entries) + 2)), gridspec_kw={"width_ratios": [1, 1.3]}
     )
     y = np.arange(len(entries))[::-1]
-    colors = ["C0"] + [("C2" if sig else "0.65") for _, _, _, sig in entries[1:]]
-    ax0.barh(y, [f * e[1] for e in entries], color=colors)
+    colors = ["C0"] + [("C2" if e[3] else "0.65") for e in entries[1:]]
+    ok = [not e[4] for e in entries]  # a refit that failed has no error to draw: it is named, not a bar
+    ax0.barh(y[ok], [f * e[1] for e, k in zip(entries, ok) if k], color=[c for c, k in zip(colors, ok) if k])
     ax0.set_yticks(y)
     ax0.set_yticklabels([e[0] for e in entries], fontsize=9)
+    ho = [(yy, e[5]) for yy, e in zip(y, entries) if e[5] is not None and np.isfinite(e[5])]
+    if ho:  # held-out error: the RMS on data the fit has not seen, about ratio x noise floor
+        ax0.plot(
+            [f * r * result.noise_rms for _, r in ho],
+            [yy for yy, _ in ho],
+            "kx",
+            ms=7,
+            label="held out (data the fit has not seen)",
+        )
     ax0.axvline(f * result.noise_rms, color="k", ls="--", lw=1, label="noise floor")
     ax0.axvline(
         f * result.noise_rms * result.at_noise,
@@ -146,7 +170,9 @@ def diagnose_figure(exp, data, result, png) -> Path:
         label=f"at-noise threshold, {num(result.at_noise, 2)} x noise",
     )
     for yy, e in zip(y, entries):
-        if e[2] is not None:
+        if e[4]:
+            ax0.text(0.0, yy, "  refit failed", va="center", fontsize=8, color="C3")
+        elif e[2] is not None:
             ax0.text(f * e[1], yy, f"  dBIC {e[2]:+.0f}", va="center", fontsize=8)
     ax0.set_xlabel(f"RMS error after refit ({ul})")
     v = result.verdict
@@ -158,10 +184,14 @@ def diagnose_figure(exp, data, result, png) -> Path:
         "nothing_missing": "nothing is missing",
     }.get(v.get("kind"), "none of the candidates explains this")
     ax0.set_title(
-        fit_title(ax0, f"{exp.name}: refit with each candidate and pair (green: significant); verdict: {verdict}")
+        fit_title(
+            ax0,
+            f"{exp.name}: refit with each candidate and pair (green: significant and better held out); "
+            f"verdict: {verdict}",
+        )
     )
-    ax0.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
-    xmax = max(f * e[1] for e in entries)
+    ax0.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize=8)
+    xmax = max([f * e[1] for e, k in zip(entries, ok) if k] + [f * r * result.noise_rms for _, r in ho])
     ax0.set_xlim(0, 1.35 * xmax)
     rows = np.arange(data.n)
     zb = np.asarray(getattr(result, "baseline_z", result.baseline_fit.fun)).reshape(len(exp.channels), -1)

@@ -26,16 +26,20 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import OptimizeResult, least_squares
+from scipy.optimize import OptimizeResult
 
 from .. import progress
 from ..effects.base import resolve
-from ..errors import ModelError
-from .core import EffectStack, Experiment, Measured
+from ..errors import FemastError, ModelError
+from .core import EffectStack, Experiment, Measured, effect_context
 from .fe_jacobian import LOG_RANGE, POLISH_MIN_DECREASE, _Coords, _FEJacobian, _forward_differences, _polish  # noqa: F401
+from .fit_problem import FitProblem
 from .residuals import noise_floor
 
 _BAD = 1e6  # whitened residual given to a non-finite prediction (a parameter set the model rejects)
+#: what a model may raise at a parameter set it cannot be evaluated at (an FE run that does not
+#: converge, a singular matrix, a law outside its range): the set is skipped, the fit goes on
+MODEL_FAILURES = (FemastError, ValueError, ArithmeticError, np.linalg.LinAlgError)
 
 
 def _specs(exp: Experiment, impls):
@@ -84,12 +88,37 @@ def predict(exp: Experiment, data: Measured, params=None, effects=None) -> dict:
     if unknown:
         raise ModelError(f"{exp.name} has no parameter(s) {', '.join(sorted(unknown))}; its parameters: {', '.join(p)}")
     p.update(params or {})
-    out = exp.model(p, data, EffectStack(items), exp.options)
-    missing = [c for c in exp.channels if c not in out]
-    if missing:
-        raise ModelError(f"the model of {exp.name} did not return channel(s) {', '.join(missing)}")
+    parts = data.group_subsets() or [(slice(None), data)]  # group by group: each starts from rest
+    out = {c: np.empty(data.n) for c in exp.channels}
+    for rows, part in parts:
+        o = exp.model(p, part, EffectStack(items, effect_context(exp, part)), exp.options)
+        missing = [c for c in exp.channels if c not in o]
+        if missing:
+            raise ModelError(f"the model of {exp.name} did not return channel(s) {', '.join(missing)}")
+        for c in exp.channels:
+            out[c][rows] = np.asarray(o[c], dtype=float).reshape(part.n)
     progress.tick()
-    return {c: np.asarray(out[c], dtype=float).reshape(data.n) for c in exp.channels}
+    if data.offsets:
+        out = with_offsets(exp, data, out)
+    return out
+
+
+def with_offsets(exp: Experiment, data: Measured, predicted: dict) -> dict:
+    """``predicted`` plus a zero of its own for every group and channel (``data.offsets``): the mean
+    of the channel's residual over the group -- each station re-zeroed, fitted in closed form."""
+    out = {}
+    groups = data.group_rows() or [("all", np.ones(data.n, bool))]
+    for c in exp.channels:
+        y = np.array(predicted[c], float)
+        for _, rows in groups:
+            y[rows] += np.mean(data[c][rows] - y[rows])
+        out[c] = y
+    return out
+
+
+def n_offsets(exp: Experiment, data: Measured) -> int:
+    """Parameters the offsets add (one per group and channel), counted in the information criterion."""
+    return data.n_groups * len(exp.channels) if data.offsets else 0
 
 
 def channel_residuals(exp: Experiment, data: Measured, predicted: dict) -> dict:
@@ -135,7 +164,7 @@ def _result(exp, data, specs, x, stderr, cov, sigma, predicted, fitted, success,
     res = channel_residuals(exp, data, predicted)
     nums = summary_numbers(exp, res, sigma)
     base, eff = _split(specs, x)
-    p = len(x) if fitted else 0
+    p = len(x) + n_offsets(exp, data) if fitted else 0
     z = np.concatenate([res[c] / sigma[c] for c in exp.channels])
     at_bound = [
         full
@@ -243,6 +272,7 @@ def fit(
     given_start_clip: bool = False,
     nfev_per_param: int | None = None,
     start_sensitivity: dict | None = None,
+    rows=None,
 ) -> OptimizeResult:
     """Fit the baseline parameters and those of the switched-on ``effects`` to the data.
 
@@ -260,6 +290,9 @@ def fit(
         start (the ``sensitivity`` of an earlier fit, e.g. the baseline's for diagnose's refits): the
         first Jacobian of an expensive experiment fitted by finite differences takes these
         columns instead of FE runs.  The Jacobian at the solution (covariance) is always computed.
+    rows : (n,) bool, the rows the fit sees (default all): the model still runs along the whole path
+        -- its state at a row depends on the rows before -- and the other rows are predicted, not
+        fitted (held-out validation, :mod:`femast.experiments.heldout`); needs ``noise``.
 
     Returns an ``OptimizeResult`` with ``x``, ``names``, ``units``, ``stderr``, ``cov``,
     ``params`` (baseline ``{name: value}``), ``effect_params`` (``{effect: {name: value}}``),
@@ -281,146 +314,27 @@ def fit(
     specs = _specs(exp, impls)
     if not specs:
         return run_model(exp, data, effects=[i[0] for i in impls], noise=noise)
-    start = dict(start or {})
-    unknown = set(start) - {s[0] for s in specs}
-    if unknown:
-        raise ModelError(
-            f"fit start: unknown parameter(s) {', '.join(sorted(unknown))}; accepted: {', '.join(s[0] for s in specs)}"
-        )
-    guess = exp.initial_guess(data, exp.options) if exp.initial_guess else {}
-    x0 = []
-    for full, p, owner in specs:
-        if full in start:
-            v = float(start[full])
-            if not (p.lower <= v <= p.upper) and not given_start_clip:
-                raise ModelError(
-                    f"fit start: {full} = {v!r} {p.unit} lies outside its bounds [{p.lower!r}, "
-                    f"{p.upper!r}]; give a start within the bounds"
-                )
-        else:
-            v = guess.get(full, p.default) if owner is None else p.default
-        x0.append(float(np.clip(v, p.lower, p.upper)))
-    x0 = np.array(x0)
-    scale = np.array([p.typical for _, p, _ in specs])
-    fo = dict(exp.fit_options)
-    # a hint for diagnose, not a least_squares option; with finite differences it also turns on the
-    # run-saving Jacobians (secant updates, seeded starts, log scaling, issue 21): every model
-    # evaluation is an FE run
-    secant = bool(fo.pop("expensive", None)) and bool(fo.get("diff_step"))
-    co = _Coords(scale, np.array([secant and p.lower > 0 and p.upper >= LOG_RANGE * p.lower for _, p, _ in specs]))
-    if secant and "fe_reference" in exp.options and exp.options["fe_reference"] is None:
-        # every FE run of the fit starts its increments from those of the baseline model at the start
-        # (femast.experiments.fe_reference): about half the Newton iterations
-        exp = exp.with_options(fe_reference=_split(specs, x0)[0])
-    lo = co.to_u(np.array([p.lower for _, p, _ in specs]))
-    hi = co.to_u(np.array([p.upper for _, p, _ in specs]))
-
-    def make_fun(sigma):
-        def fun(u):
-            base, eff = _split(specs, co.to_x(u))
-            try:
-                pred = predict(exp, data, base, eff)
-            except (FloatingPointError, ZeroDivisionError, ValueError):
-                return np.full(data.n * len(exp.channels), _BAD)
-            z = np.concatenate([(data[c] - pred[c]) / sigma[c] for c in exp.channels])
-            return np.where(np.isfinite(z), z, _BAD)
-
-        return fun
-
-    # start candidates: the given/default start, then each effect's extra starts (zipped)
-    starts = [x0]
-    if multistart:
-        extra = [
-            (i, p.starts)
-            for i, (_, p, owner) in enumerate(specs)
-            if owner is not None and p.starts and specs[i][0] not in start
-        ]
-        for k in range(max((len(st) for _, st in extra), default=0)):
-            x = x0.copy()
-            for i, st in extra:
-                x[i] = np.clip(st[min(k, len(st) - 1)], specs[i][1].lower, specs[i][1].upper)
-            starts.append(x)
-    per_param = int(fo.pop("max_nfev_per_param", 100))
-    if nfev_per_param:
-        per_param = min(per_param, int(nfev_per_param))
-    fd_step = fo.pop("diff_step", None)
-    kw = dict(method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10, x_scale=1.0)
-    kw.update(fo)
-    kw["max_nfev"] = max_nfev or kw.get("max_nfev") or per_param * (len(specs) + 1)
-
-    n_res = data.n * len(exp.channels)
-
-    def sigma_rows(sigma):
-        return np.concatenate([np.broadcast_to(np.asarray(sigma[c], float), (data.n,)) for c in exp.channels])
-
-    def seed(sens, sigma, x):
-        """Whitened, scaled start Jacobian from known sensitivities d(predicted)/d(parameter) (NaN: unknown)."""
-        if not secant or not sens:
-            return None
-        J0 = np.full((n_res, len(specs)), np.nan)
-        dxdu = co.dx_du(co.to_u(np.asarray(x, float)))
-        rows = sigma_rows(sigma)
-        for i, (full, _, _) in enumerate(specs):
-            col = sens.get(full)
-            if col is not None and np.shape(col) == (n_res,):
-                J0[:, i] = -np.asarray(col, float) * dxdu[i] / rows
-        return J0 if np.isfinite(J0).any() else None
-
-    def solve(sigma, candidates, J0=None):
-        best = None
-        fun0 = make_fun(sigma)
-        nfev = runs = 0
-        for k, x in enumerate(candidates):
-            u0 = co.start(x, lo, hi) if secant else np.clip(x / scale, lo, hi)
-            fj = None
-            fun = fun0
-            if fd_step:
-                fj = _FEJacobian(fun0, float(fd_step), lo, hi, secant=secant, J0=J0 if k == 0 and secant else None)
-                fun, kw["jac"] = fj.value, fj.jac
-            kw_k = kw
-            min_dec = POLISH_MIN_DECREASE if secant and noise is not None else 0.0
-            if min_dec:
-                # a noise model given: the cost is half the chi-square, and a decrease below min_dec is no
-                # reason for more FE runs (see _polish); scipy's ftol is relative to the current cost,
-                # bounded here by the start's (the start's run is the fit's first evaluation anyway)
-                f0 = fun(u0)
-                kw_k = {**kw, "ftol": max(float(kw.get("ftol", 1e-8)), min_dec / max(0.5 * float(f0 @ f0), 1e-300))}
-            with np.errstate(all="ignore"):
-                sol = least_squares(fun, u0, bounds=(lo, hi), **kw_k)
-            nfev += sol.nfev
-            if fj is not None:
-                if secant:
-                    sol = _polish(sol, fj, fun, lo, hi, kw, min_dec)
-                nfev += getattr(sol, "nfev_polish", 0)
-                runs += fj.runs
-            if best is None or sol.cost < best.cost:
-                best = sol
-        best.nfev_total = nfev
-        best.fe_runs = runs if fd_step else nfev
-        return best
-
+    pb = FitProblem(exp, data, specs, start, given_start_clip, max_nfev, nfev_per_param)
+    starts = pb.starts(multistart, start or {})
     if noise is None:
-        base, eff = _split(specs, x0)
-        sigma0 = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
-        sol = solve(sigma0, starts, seed(start_sensitivity, sigma0, x0))
-        base, eff = _split(specs, co.to_x(sol.x))
-        sigma = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
-        if secant and len(exp.channels) == 1:
-            # one channel, one noise level: the whitened residual only changes by a constant factor, so
-            # the minimiser and the covariance are the same; rescale instead of refitting
-            f = sigma0[exp.channels[0]] / sigma[exp.channels[0]]
-            sol.fun, sol.jac, sol.cost = sol.fun * f, sol.jac * f, sol.cost * f * f
-        else:
-            ratio = sigma_rows(sigma0) / sigma_rows(sigma)  # warm start: the last Jacobian, rows re-weighted
-            sol2 = solve(sigma, [co.to_x(sol.x)], sol.jac * ratio[:, None] if secant else None)
-            sol2.nfev_total += sol.nfev_total
-            sol2.fe_runs += sol.fe_runs
-            sol = sol2
+        if rows is not None:
+            raise ModelError("a fit on some rows (rows=...) needs the noise of every channel (noise=...)")
+        sol, sigma = pb.solve_estimating_noise(starts, start_sensitivity)
     else:
         sigma = {c: _sigma_of(noise, c, data.n) for c in exp.channels}
-        sol = solve(sigma, starts, seed(start_sensitivity, sigma, x0))
-    x = co.to_x(sol.x)
-    dxdu = co.dx_du(sol.x)
+        if rows is not None:  # rows not fitted weigh nothing: an infinite noise
+            rows = np.asarray(rows, bool)
+            sigma = {c: np.where(rows, np.broadcast_to(v, (data.n,)), np.inf) for c, v in sigma.items()}
+        sol = pb.solve(sigma, starts, pb.seed(start_sensitivity, sigma, pb.x0), noise_given=True)
+    return _fitted(pb, sol, sigma, [i[0] for i in impls])
+
+
+def _fitted(pb, sol, sigma, effect_names) -> OptimizeResult:
+    """The fit result at the solution ``sol`` of a :class:`FitProblem`: covariance, prediction,
+    the parameter sets skipped, the sensitivities (which seed later fits' Jacobians)."""
+    exp, data, specs = pb.exp, pb.data, pb.specs
+    x = pb.co.to_x(sol.x)
+    dxdu = pb.co.dx_du(sol.x)
     stderr, cov, note = _covariance(sol.jac, sol.cost, sol.fun.size, dxdu)
     if note:
         idx = [int(i) for i in note.split(": ")[1].split(", ")]
@@ -428,24 +342,16 @@ def fit(
     base, eff = _split(specs, x)
     predicted = predict(exp, data, base, eff)
     msg = sol.message.rstrip(".") + (f"; {note}" if note else "")
+    if pb.skipped:
+        msg += f"; {len(pb.skipped)} parameter set(s) skipped, the model failed there (first: {pb.skipped[0][1]})"
     out = _result(
-        exp,
-        data,
-        specs,
-        x,
-        stderr,
-        cov,
-        sigma,
-        predicted,
-        True,
-        bool(sol.success),
-        msg,
-        sol.nfev_total,
-        [i[0] for i in impls],
+        exp, data, specs, x, stderr, cov, sigma, predicted, True, bool(sol.success), msg, sol.nfev_total, effect_names
     )
-    rows = sigma_rows(sigma)
-    out.sensitivity = {full: -sol.jac[:, i] * rows / dxdu[i] for i, (full, _, _) in enumerate(specs)}
+    sr = pb.sigma_rows(sigma)
+    with np.errstate(invalid="ignore"):  # rows not fitted: their columns stay NaN (unknown)
+        out.sensitivity = {full: -sol.jac[:, i] * sr / dxdu[i] for i, (full, _, _) in enumerate(specs)}
     out.fe_runs = int(sol.fe_runs)
+    out.skipped = len(pb.skipped)
     out.fe_reference = exp.options.get("fe_reference")  # the reference run of the fit's FE runs, or None
     return out
 

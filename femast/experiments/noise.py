@@ -1,8 +1,22 @@
-"""Noise model of each channel for ``diagnose``: white, heteroscedastic, serially correlated or given.
+"""The noise model of each channel, one for ``compare`` and ``diagnose``, reported with its source.
 
-The noise is estimated from the differences of a model's residual along the path (the response
-changes little from one row to the next, the noise does; see
-:func:`~femast.experiments.residuals.noise_floor`), one channel at a time:
+Where the level comes from, in order of preference:
+
+1. **given** -- the user's sensor uncertainty: a ``sigma_<channel>`` column (per row) or a value per
+   channel (``sigma={"dx_m": 2e-5}`` in Python, ``--sigma dx_m=2e-5`` on the command line, e.g. from
+   the sensor's datasheet); used as it is;
+2. **repeatability** -- rows that repeat their inputs in a hold (:func:`repeated_points`: the
+   difference of two readings of the same state is noise only), at least 30 pairs; or repeated passes
+   of the path (below), which only ever lower the residual's estimate;
+3. **residual** -- the fallback: the differences of a model's residual along the path (the
+   response changes little from one row to the next, the noise does; see
+   :func:`~femast.experiments.residuals.noise_floor`), white, heteroscedastic or serially correlated.
+
+All three are computed where the data allow; the report prints them side by side when they
+disagree by more than ``DISAGREE`` = 1.5x (a datasheet value far above the repeatability says the
+sensor is better than its specification, or that its error is a bias the residual cannot see; a
+residual estimate far above both says the model's error is taken for noise).  The residual-based
+estimate, channel by channel:
 
 * **serial correlation** -- ``phi`` is the lag-1 autocorrelation of the (standardised) residual
   of the *best* model of the diagnosis (a smooth model error would pass for correlated noise in
@@ -29,7 +43,7 @@ changes little from one row to the next, the noise does; see
   negative ``A`` put the noise of the rows near zero load at a tenth of its true value and a
   3-sigma row at 20 "sigma"), and no row's variance below ``VAR_FLOOR`` = 0.04 of the mean (sigma
   at least 0.2 of its RMS: a few second differences near the end of the covariate's range cannot
-  establish a noise 5x below the typical; seed 001 Eq. 15's range on the seed's latch is 0.45).  The model is kept when
+  establish a noise 5x below the typical; Stohlman & Pellegrino, Eq. 15's range on the paper's latch is 0.45).  The model is kept when
   its likelihood-ratio statistic against one level exceeds ``HETERO_LR`` = 18.5, the 99th
   percentile of that statistic on white noise (Monte Carlo, 2000 draws of 100-1500 rows along
   signed and unsigned covariates: 16.0-19.8; the second differences are correlated, so it exceeds
@@ -57,19 +71,29 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import lsq_linear
 
 from ..errors import DataFileError, ModelError
+from .noise_estimators import (  # noqa: F401  (re-exported: the estimators of the model)
+    CYCLE_MIN_PAIRS,
+    HETERO_LR,
+    MIN_ROWS,
+    MIN_ROWS_STRUCTURE,
+    VAR_FLOOR,
+    ar1_factor,
+    ar1_threshold,
+    cycle_scatter,
+    difference_phi,
+    effective_n,
+    heteroscedastic_fit,
+    informative_rows,
+    lag1,
+    repeated_points,
+    robust_rms,
+)
 
-MIN_ROWS = 8
-MIN_ROWS_STRUCTURE = 60
 HETERO_MIN_RANGE = 1.3
-HETERO_LR = 18.5
-CYCLE_MIN_PAIRS = 30  # fewest rows compared across repeated passes for a level (its scatter then <= 13 %)
-VAR_FLOOR = 0.04  # smallest variance of a row / the mean variance: sigma >= 0.2 of its RMS (module docstring)
-QUANTILE = 0.99
-_MAD = 1.482602218505602  # 1 / Phi^-1(3/4): MAD -> standard deviation of a normal variable
-_SEED = 20241124
+DISAGREE = 1.5  # sources of the level that differ by more than this are printed side by side
+CYCLE_MIN_RATIO = 0.05  # repeated passes that agree to below this share of the level are not noise
 
 
 @dataclass
@@ -84,13 +108,24 @@ class ChannelNoise:
     covariate: str | None = None
     reason: str = ""
     extra: dict = field(default_factory=dict)
+    source: str = "residual"
+    levels: dict = field(default_factory=dict)
 
     @property
     def sigma_rms(self) -> float:
         return float(np.sqrt(np.mean(self.sigma**2)))
 
+    @property
+    def disagree(self) -> bool:
+        """True if the sources of the level differ by more than ``DISAGREE``."""
+        v = [x for x in self.levels.values() if x > 0]
+        return len(v) > 1 and max(v) > DISAGREE * min(v)
+
     def to_json(self) -> dict:
         return {
+            "source": self.source,
+            "levels": dict(self.levels),
+            "disagree": self.disagree,
             "kind": self.kind,
             "sigma_rms": self.sigma_rms,
             "sigma_min": float(np.min(self.sigma)),
@@ -101,139 +136,6 @@ class ChannelNoise:
             "reason": self.reason,
             **{k: v for k, v in self.extra.items() if k != "level_reason"},
         }
-
-
-def informative_rows(r) -> np.ndarray:
-    """(n,) bool: rows of a residual r (n,) that carry noise -- not zero and not repeating a neighbour
-    exactly (to 1e-12 of the largest |r|): a noisy measurement never does, a model that admits an
-    interval and predicts the measured value inside it (a pinned row) does.  All True when fewer than
-    ``MIN_ROWS`` rows would be left."""
-    r = np.asarray(r, float)
-    tol = 1e-12 * float(np.max(np.abs(r), initial=0.0))
-    pinned = np.abs(r) <= tol
-    tie = np.abs(np.diff(r)) <= tol
-    pinned[1:] |= tie
-    pinned[:-1] |= tie
-    keep = ~pinned
-    return keep if keep.sum() >= MIN_ROWS else np.ones(r.size, bool)
-
-
-def _mad(x) -> float:
-    x = np.asarray(x, float)
-    return _MAD * float(np.median(np.abs(x - np.median(x)))) if x.size else 0.0
-
-
-def lag1(r) -> float:
-    """Lag-1 autocorrelation of a series r (n,) (mean removed); 0 for fewer than 3 values."""
-    r = np.asarray(r, float)
-    if r.size < 3:
-        return 0.0
-    r = r - r.mean()
-    den = float(r @ r)
-    return float(np.clip((r[1:] @ r[:-1]) / den, -0.99, 0.99)) if den > 0 else 0.0
-
-
-def _trimmed_ms(x) -> float:
-    s = _mad(x)
-    x = np.asarray(x, float)
-    k = np.abs(x) < 5.0 * s if s > 0 else np.ones(x.size, bool)
-    return float(np.mean(x[k] ** 2)) if k.any() else 0.0
-
-
-def difference_phi(r) -> float:
-    """``3 - Var(d2) / Var(d1)`` of a series r (n,): the AR(1) coefficient of noise, nearly blind to a
-    smooth model error (trimmed mean squares; standard error about 1.9 / sqrt(n))."""
-    r = np.asarray(r, float)
-    m1, m2 = _trimmed_ms(np.diff(r)), _trimmed_ms(np.diff(r, 2))
-    return float(np.clip(3.0 - m2 / m1, -0.99, 0.99)) if m1 > 0 else 0.0
-
-
-def ar1_threshold(n: int) -> float:
-    """99th percentile of :func:`lag1` on white noise of ``n`` rows, ``2.33 / sqrt(n)`` (normal limit)."""
-    return 2.326 / math.sqrt(max(int(n), 1))
-
-
-def ar1_factor(phi: float) -> float:
-    """``Var(d2) / (6 sigma^2)`` of AR(1) noise: ``(1 - phi)(3 - phi) / 3`` (1 when white)."""
-    return (1.0 - phi) * (3.0 - phi) / 3.0
-
-
-def effective_n(n: int, phi: float) -> float:
-    """Effective sample size of n rows of AR(1) noise, ``n (1 - phi) / (1 + phi)`` (n for phi <= 0)."""
-    return float(n) * (1.0 - phi) / (1.0 + phi) if phi > 0 else float(n)
-
-
-def _g3(g2):
-    """(g2[i-1] + 4 g2[i] + g2[i+1]) / 6 at the interior rows: the covariate of a second difference."""
-    return (g2[:-2] + 4.0 * g2[1:-1] + g2[2:]) / 6.0
-
-
-def _fit_variance(d2sq, X, iters: int = 10):
-    """Maximum-likelihood ``beta`` of ``d2^2 ~ v chi^2_1``, ``v = X beta`` (design X (m, k)), batched over
-    the leading axis of ``d2sq`` (draws, m), by Fisher scoring (weighted least squares of d2^2 on X,
-    weights 1 / v^2) with ``A, D >= 0`` (a variance at zero covariate, a growth far out); v is kept
-    above ``VAR_FLOOR`` of the mean d2^2 and rows beyond 36 v are left out.
-    Returns (beta (draws, k), v (draws, m), keep, log-likelihood (draws,))."""
-    floor = VAR_FLOOR * np.mean(d2sq, axis=-1, keepdims=True)
-    v = np.broadcast_to(np.median(d2sq, axis=-1, keepdims=True) / 0.4549, d2sq.shape)  # median of chi^2_1
-    beta = None
-    lo = np.array([0.0, -np.inf, 0.0])[: X.shape[1]]
-    for _ in range(iters):
-        keep = d2sq < 36.0 * v
-        w = keep / v**2
-        XtW = X.T[None, :, :] * w[:, None, :]
-        M = XtW @ X + 1e-12 * np.eye(X.shape[1])
-        beta = np.linalg.solve(M, (XtW @ d2sq[..., None]))[..., 0]
-        for j in np.flatnonzero(np.any(beta < lo, axis=-1)):  # A, D >= 0: bounded weighted least squares
-            sw = np.sqrt(w[j])
-            sc = np.sqrt(np.sum((X * sw[:, None]) ** 2, axis=0)) + 1e-300
-            beta[j] = lsq_linear(X * sw[:, None] / sc, d2sq[j] * sw, bounds=(lo * sc, np.inf)).x / sc
-        v = np.maximum(beta @ X.T, floor)
-    keep = d2sq < 36.0 * v
-    ll = -0.5 * np.sum(keep * (d2sq / v + np.log(v)), axis=-1)
-    return beta, v, keep, ll
-
-
-def _fit_constant(d2sq, keep):
-    A = np.sum(d2sq * keep, axis=-1) / np.maximum(keep.sum(axis=-1), 1)
-    ll = -0.5 * np.sum(keep * (d2sq / A[:, None] + np.log(A[:, None])), axis=-1)
-    return A, ll
-
-
-def _design(g):
-    """Design of the variance of a second difference for ``v_i = A + B g_i + D g_i^2``: columns
-    ``[1, g3(g), g3(g^2)]`` (:func:`_g3`)."""
-    return np.column_stack([np.ones(g.size - 2), _g3(g), _g3(g * g)])
-
-
-def _lr(d2sq, X):
-    beta, v, keep, ll1 = _fit_variance(d2sq, X)
-    _, ll0 = _fit_constant(d2sq, keep)
-    return 2.0 * (ll1 - ll0), beta, v
-
-
-def heteroscedastic_fit(r, g, phi: float = 0.0) -> dict:
-    """Fit ``Var(noise_i) = A + B g_i + D g_i^2`` to a residual r (n,) with covariate g (n,) (signed or
-    not; module docstring).  For the latch-pull covariate (the signed slope s of the law) this is
-    seed 001 Eq. 15's ``sigma_T^2 (1 + s C)^2 + s^2 sigma_d^2``.  Returns ``{coef (A, B, D) in the
-    units of r^2 and g, lr, threshold, sigma (n,), range}``; ``range`` is max/min sigma."""
-    r, g = np.asarray(r, float), np.asarray(g, float)
-    gs = float(np.max(np.abs(g))) or 1.0
-    u = g / gs
-    c = ar1_factor(phi)  # Var(d2) = 6 c v for AR(1) noise
-    d2 = r[2:] - 2.0 * r[1:-1] + r[:-2]
-    lr, beta, _ = _lr((d2**2)[None, :], _design(u))
-    A, B, D = (float(x) / (6.0 * c) for x in beta[0])
-    v = A + B * u + D * u * u
-    v = np.maximum(v, VAR_FLOOR * max(float(np.mean(v)), 1e-300))
-    sigma = np.sqrt(v)
-    return {
-        "coef": (A, B / gs, D / gs**2),
-        "lr": float(lr[0]),
-        "threshold": HETERO_LR,
-        "sigma": sigma,
-        "range": float(sigma.max() / sigma.min()),
-    }
 
 
 def given_sigma(data, channel: str) -> np.ndarray | None:
@@ -387,13 +289,21 @@ def with_correlation(model: ChannelNoise, r, pinned=None) -> ChannelNoise:
     )
 
 
-def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = True, pinned=None) -> dict:
-    """``{channel: ChannelNoise}`` from a fit's residuals (``diagnose``: first the baseline's without the
-    correlation test and with the experiment's own covariates only -- a structured residual would pass
-    for noise growing with the reading --, for the weights of the refits; then the best model's, for
-    the verdict).  generic : also test the size of the reading as a covariate.  pinned :
-    ``{channel: (n,) bool}`` rows to leave out besides the fit's own pinned rows (:func:`pinned_rows`
-    of another fit)."""
+def noise_model(
+    exp, data, fit_result, correlate: bool = True, generic: bool = True, pinned=None, sigma=None, judged: bool = True
+) -> dict:
+    """``{channel: ChannelNoise}`` of a model run or fit (module docstring): the given level, else the
+    repeatability, else the residual-based model, with every source's level in ``levels``.
+
+    correlate : test the residual for serial correlation and check it against repeated passes
+    (``diagnose`` first estimates the baseline's without them and with the experiment's own
+    covariates only -- a structured residual would pass for noise growing with the reading --, for
+    the weights of its refits; then the best model's, for the verdict).  generic : also test the
+    size of the reading as a covariate.  pinned : ``{channel: (n,) bool}`` rows to leave out besides
+    the fit's own pinned rows (:func:`pinned_rows` of another fit).  sigma : ``{channel: level}`` the
+    user's sensor uncertainty (channel unit), or None.  judged : the model a run is judged by: a
+    varying level or serial correlation estimated from the residual is kept only where the residual
+    whitened by it shows no structure (:func:`plain_unless_noise`)."""
     covs = {}
     pred = fit_result.predicted
     for c in exp.channels:
@@ -403,14 +313,128 @@ def noise_model(exp, data, fit_result, correlate: bool = True, generic: bool = T
         for c, d in extra.items():
             covs.setdefault(c, {}).update(d)
     coord = path_coordinate(exp, data) if correlate else None
+    inputs = input_matrix(exp, data)
+    user = check_sigma(exp, sigma)
     out = {}
     for c in exp.channels:
-        out[c] = channel_noise(
-            c, fit_result.residuals[c], data.n, covs.get(c), given_sigma(data, c), correlate, (pinned or {}).get(c)
-        )
+        r = fit_result.residuals[c]
+        pin = (pinned or {}).get(c)
+        given = given_sigma(data, c)
+        if data.n < MIN_ROWS and (given is not None or c in user):  # too few rows to estimate, a level given
+            g = given if given is not None else np.full(data.n, user[c])
+            out[c] = _fixed(None, c, g, "given", "given; too few rows for any other estimate")
+            out[c].levels = {"given": out[c].sigma_rms}
+            continue
+        model = channel_noise(c, r, data.n, covs.get(c), None, correlate, pin)
+        if judged:
+            model = plain_unless_noise(model, r, pin)
         if coord is not None:
-            out[c] = with_cycles(out[c], coord, fit_result.residuals[c], (pinned or {}).get(c))
+            model = with_cycles(model, coord, r, pin)
+        levels = {"residual": model.sigma_rms}
+        if "cycle_ratio" in model.extra:
+            rho = model.extra["cycle_ratio"]
+            if model.kind.endswith("+cycles"):  # the level was brought down to the passes'
+                levels = {"residual": model.sigma_rms / rho, "repeated passes": model.sigma_rms}
+            else:
+                levels["repeated passes"] = rho * model.sigma_rms
+        rep = repeated_points(inputs, r, _keep(r, pin)) if inputs is not None else None
+        if rep is not None:
+            levels["repeated points"] = rep[0]
+        if given is not None:
+            model = _fixed(model, c, given, "given", f"sigma_{c} column: the per-row uncertainty given with the data")
+            levels["given"] = model.sigma_rms
+        elif c in user:
+            model = _fixed(model, c, np.full(data.n, user[c]), "given", "the sensor uncertainty given for the channel")
+            levels["given"] = user[c]
+        elif rep is not None:
+            model = _fixed(
+                model,
+                c,
+                np.full(data.n, rep[0]),
+                "repeated points",
+                f"repeatability: {rep[1]} pairs of rows that repeat their inputs in a hold",
+            )
+        elif model.kind.endswith("+cycles"):
+            model.source = "repeated passes"
+        model.levels = levels
+        out[c] = model
     return out
+
+
+def plain_unless_noise(model: ChannelNoise, r, pinned=None) -> ChannelNoise:
+    """``model``, or the white level from the residual's second differences where the residual,
+    whitened by ``model``, still shows smooth structure along the path.
+
+    A level growing with a covariate and serial correlation are estimated from the residual of a
+    model; where that model misses a mechanism, its error lasts along the path and grows with the
+    load, and passes for noise growing with the reading or for correlated noise (a baseline's misfit
+    at the largest loads would raise the noise there and lower every ratio).  Smooth structure shows
+    as a lag-1 autocorrelation of the whitened residual above the one its differences allow
+    (:func:`difference_phi`: nearly blind to smooth structure, not to correlated noise) by more than
+    twice their scatter (``2 x 1.9 / sqrt(n)``).  Then the plain level -- second differences, nearly
+    blind to the model's error -- is the honest one; otherwise ``model`` stands (on latch-pull data
+    without a hidden effect the lag-1 autocorrelation is -0.07 to -0.03 and the difference estimate
+    -0.09 to 0.15; with a hidden latch hysteresis or friction 0.64-0.69 against 0.05)."""
+    from .residuals import noise_floor
+
+    if model.kind in ("white", "given"):
+        return model
+    r = np.asarray(r, float)
+    keep = _keep(r, pinned)
+    u = (r / model.sigma)[keep]
+    m = u.size
+    if m < MIN_ROWS_STRUCTURE:
+        return model
+    rho, dphi = lag1(u), difference_phi(u)
+    if rho <= max(dphi, 0.0) + 2.0 * 1.9 / math.sqrt(m):
+        return model
+    level = max(noise_floor(r[keep]), 1e-300)
+    return ChannelNoise(
+        model.channel,
+        "white",
+        np.full(r.size, level),
+        0.0,
+        float(r.size),
+        None,
+        f"constant level: whitened by the {model.kind} model the residual keeps a lag-1 autocorrelation of "
+        f"{rho:.2f} where its differences allow {max(dphi, 0.0):.2f}: what that model takes for a varying or "
+        "correlated noise is structure the model misses",
+    )
+
+
+def _fixed(model: ChannelNoise, channel: str, sigma, source: str, reason: str) -> ChannelNoise:
+    """A model whose level is not estimated from the residual (given, repeatability): white, kept."""
+    sigma = np.asarray(sigma, float)
+    return ChannelNoise(
+        channel, "given" if source == "given" else "white", sigma, 0.0, float(sigma.size), None, reason, {}, source
+    )
+
+
+def check_sigma(exp, sigma) -> dict:
+    """``{channel: level > 0}`` of the user's sensor uncertainties, checked (channel names, values)."""
+    out = {}
+    for c, v in dict(sigma or {}).items():
+        if c not in exp.channels:
+            raise ModelError(
+                f"sensor uncertainty for '{c}': not a compared channel of {exp.name}; its channels: "
+                f"{', '.join(exp.channels)}"
+            )
+        try:
+            v = float(v)
+        except (TypeError, ValueError):
+            raise ModelError(f"sensor uncertainty of {c}: {v!r} is not a number (in {exp.unit_of(c)})") from None
+        if not (math.isfinite(v) and v > 0):
+            raise ModelError(f"sensor uncertainty of {c}: {v!r} {exp.unit_of(c)}; give a finite value > 0")
+        out[c] = v
+    return out
+
+
+def input_matrix(exp, data):
+    """(n, k) the experiment's input columns in the data (not channels, time, ``sigma_`` or group), or None."""
+    skip = set(exp.channels) | {"t_s", "group"}
+    cols = [c.name for c in exp.columns if c.name not in skip and c.name in data.columns]
+    cols = [c for c in cols if not c.startswith("sigma_")]
+    return np.column_stack([data[c] for c in cols]) if cols else None
 
 
 def path_coordinate(exp, data) -> np.ndarray | None:
@@ -431,60 +455,6 @@ def pinned_rows(fit_result, channels) -> dict:
     return {c: ~informative_rows(fit_result.residuals[c]) for c in channels}
 
 
-def cycle_scatter(coord, r, keep=None, sigma=None, min_pairs: int = CYCLE_MIN_PAIRS):
-    """Noise level from repeated passes along a path coordinate (module docstring, "repeated cycles").
-
-    coord : (n,) the quantity the test drives (latch-pull: the bead position; mast-top: the load),
-    r : (n,) residual (or measurement), keep : (n,) bool rows that carry noise, sigma : (n,) a noise
-    model's per-row level (default 1: the level itself is returned).  Passes are the
-    monotone runs of coord (turning points confirmed by 5 % of its range); each row of a pass is
-    compared with the later passes in the same direction that cover its coordinate: ``d = r_a -
-    interp(r_b)`` has variance ``sigma^2 (1 + w^2 + (1 - w)^2)`` for independent noise (w the
-    interpolation weight), while anything that repeats with the coordinate -- the model's error,
-    a ripple -- cancels.  Rows where the other pass is not sampled (its neighbours further apart
-    than 3 of its median steps, or equal) are left out.  Returns ``(level, pairs)`` -- the robust RMS
-    of ``d`` whitened by the variance sigma gives it (so the level relative to sigma) -- or ``None``
-    with fewer than ``min_pairs`` compared rows."""
-    from .residuals import turning_points
-
-    coord, r = np.asarray(coord, float), np.asarray(r, float)
-    n = coord.size
-    keep = np.ones(n, bool) if keep is None else np.asarray(keep, bool)
-    sg = np.ones(n) if sigma is None else np.broadcast_to(np.asarray(sigma, float), (n,))
-    span = float(np.ptp(coord)) if n else 0.0
-    if n < MIN_ROWS_STRUCTURE or span <= 0.0:
-        return None
-    tps, direction = turning_points(coord, 0.05 * span)
-    bounds = [0, *(int(t) + 1 for t in tps), n]
-    runs = [(np.arange(a, b), float(direction[a])) for a, b in zip(bounds[:-1], bounds[1:]) if b - a >= 3]
-    out = []
-    for i, (ra, da) in enumerate(runs):
-        for rb, db in runs[i + 1 :]:
-            if db != da:
-                continue
-            rb = rb[keep[rb]]
-            if rb.size < 3:
-                continue
-            order = np.argsort(coord[rb], kind="stable")
-            cb, vb, sb = coord[rb][order], r[rb][order], sg[rb][order]
-            step = np.diff(cb)
-            med = float(np.median(step[step > 0])) if np.any(step > 0) else 0.0
-            if med <= 0.0:
-                continue
-            rows = ra[keep[ra] & (coord[ra] > cb[0]) & (coord[ra] < cb[-1])]
-            j = np.clip(np.searchsorted(cb, coord[rows]) - 1, 0, cb.size - 2)
-            h = step[j]
-            ok = (h > 0) & (h <= 3.0 * med)
-            rows, j, h = rows[ok], j[ok], h[ok]
-            w = (coord[rows] - cb[j]) / h
-            d = r[rows] - ((1.0 - w) * vb[j] + w * vb[j + 1])
-            out.append(d / np.sqrt(sg[rows] ** 2 + (w * sb[j + 1]) ** 2 + ((1.0 - w) * sb[j]) ** 2))
-    d = np.concatenate(out) if out else np.zeros(0)
-    if d.size < min_pairs:
-        return None
-    return math.sqrt(_trimmed_ms(d)), int(d.size)
-
-
 def with_cycles(model: ChannelNoise, coord, r, pinned=None) -> ChannelNoise:
     """``model`` checked against the level of the repeated passes (:func:`cycle_scatter`): where its
     RMS level exceeds that level beyond the estimate's scatter (``1 + 3 / sqrt(2 m)`` for m compared
@@ -500,6 +470,8 @@ def with_cycles(model: ChannelNoise, coord, r, pinned=None) -> ChannelNoise:
     if cyc is None:
         return model
     rho, m = cyc
+    if rho < CYCLE_MIN_RATIO:  # the passes agree far better than any noise: rows the model admits exactly
+        return model
     # scatter of the two estimates: 1 / (2 m) for the passes' RMS, ~2 / n for the difference estimate
     # (the MAD's relative variance 1.36 / n on n - 2 correlated second differences)
     limit = 1.0 + 3.0 * math.sqrt(1.0 / (2.0 * m) + 2.0 / max(int(keep.sum()), 1))

@@ -18,9 +18,9 @@ from scipy.optimize import OptimizeResult
 
 from .. import progress
 from ..effects.base import load_script
-from ..errors import FemastError, ModelError
-from .core import Experiment, Measured
-from .fitting import fit
+from ..errors import ModelError
+from .core import Experiment
+from .fitting import MODEL_FAILURES, fit
 
 _START_METHOD = None  # multiprocessing start method of the local pool (None: the platform's default)
 REFIT_NFEV = 25  # evaluations per parameter and start of a refit (a converging refit needs 5-20; a direction the
@@ -37,7 +37,7 @@ def _refit_task(payload: dict) -> OptimizeResult:
     for script in payload["scripts"]:
         load_script(script)
     exp = experiment_from_source(payload["source"], payload["options"])
-    data = Measured(payload["data_experiment"], payload["columns"], payload["path"], payload["lines"])
+    data = payload["data"]
     res = _safe_fit(
         exp,
         data,
@@ -45,12 +45,13 @@ def _refit_task(payload: dict) -> OptimizeResult:
         start=payload["start"],
         noise=payload["noise"],
         sensitivity=payload.get("sensitivity"),
+        rows=payload.get("rows"),
     )
     res.pid = os.getpid()
     return res
 
 
-def _safe_fit(exp, data, effects, start, noise, sensitivity=None) -> OptimizeResult:
+def _safe_fit(exp, data, effects, start, noise, sensitivity=None, rows=None) -> OptimizeResult:
     """:func:`fit`, or a result with ``failed = True`` and the error as ``message`` when the model
     cannot be evaluated even at the start of the refit (an FE run that does not converge with the
     effect's default parameters): one failed candidate must not end the whole diagnosis."""
@@ -63,9 +64,10 @@ def _safe_fit(exp, data, effects, start, noise, sensitivity=None) -> OptimizeRes
             noise=noise,
             given_start_clip=True,
             nfev_per_param=REFIT_NFEV,
-            start_sensitivity=sensitivity,
-        )  # the baseline's derivatives seed the refit's (issue 21)
-    except (ValueError, FemastError, FloatingPointError, ZeroDivisionError) as e:
+            start_sensitivity=sensitivity if rows is None else None,
+            rows=rows,
+        )  # the baseline's derivatives seed the refit's
+    except (*MODEL_FAILURES, ArithmeticError) as e:
         return OptimizeResult(failed=True, success=False, message=f"{type(e).__name__}: {e}", effects=tuple(effects))
 
 
@@ -154,7 +156,7 @@ def _run_tasks(payloads, workers, scheduler, while_waiting=None):
 def frozen_heap():
     """The garbage collector's view of this process's heap frozen while forked children run: a child's
     collections then skip the inherited objects instead of visiting them all, which copies every page
-    they touch (copy-on-write) -- 8-17 % of the CPU of diagnose's refit processes on the bay (issue 21).
+    they touch (copy-on-write) -- 8-17 % of the CPU of diagnose's refit processes on the bay.
     Objects made meanwhile are collected as usual; the frozen ones return to the collector after."""
     import gc
 
@@ -173,7 +175,7 @@ def _quietly(fn):
 
 
 def _candidate(payload) -> str:
-    return payload["effects"][-1]
+    return payload.get("label") or (payload["effects"] or ["the baseline"])[-1]
 
 
 def _serial_refits(payloads):
@@ -192,7 +194,15 @@ def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base, whi
     if not _rebuildable(exp):
         return (
             [
-                _safe_fit(exp, data, p["effects"], start=p["start"], noise=sigma, sensitivity=p.get("sensitivity"))
+                _safe_fit(
+                    exp,
+                    data,
+                    p["effects"],
+                    start=p["start"],
+                    noise=p.get("noise", sigma),
+                    sensitivity=p.get("sensitivity"),
+                    rows=p.get("rows"),
+                )
                 for p in payloads
             ],
             "serial (experiment defined in memory: worker processes cannot rebuild it)",
@@ -203,6 +213,6 @@ def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base, whi
     if workers is None and scheduler is None and exp.fit_options.get("expensive"):
         # a process per refit (up to OVERSUBSCRIBE x the CPUs): the refits of the FE experiments take
         # 6-15 FE runs each, and a pool of one process per CPU ends with one CPU idle while the
-        # longest refits finish; more processes than CPUs share them to the end (issue 21)
+        # longest refits finish; more processes than CPUs share them to the end
         workers = max(1, min(len(payloads), OVERSUBSCRIBE * (os.cpu_count() or 1)))
     return _run_tasks(payloads, workers, scheduler, while_waiting)

@@ -16,6 +16,16 @@ from ..errors import ModelError, did_you_mean
 from .core import Experiment
 
 _EXPERIMENTS: dict[str, Experiment] = {}
+_BUILTIN_LOADED = False
+
+
+def _load_builtin() -> None:
+    """Register the built-in rigs (:mod:`femast.experiments.rigs`) on first use: they are written
+    against this package's public API, so they are imported after it, not by it."""
+    global _BUILTIN_LOADED
+    if not _BUILTIN_LOADED:
+        _BUILTIN_LOADED = True
+        from . import rigs  # noqa: F401  (registers them)
 
 
 def register_experiment(experiment: Experiment, replace_existing: bool = False) -> Experiment:
@@ -23,6 +33,7 @@ def register_experiment(experiment: Experiment, replace_existing: bool = False) 
 
     A name already taken raises unless ``replace_existing`` or the registered one is pending a
     model (so the FE experiments can be plugged in over their placeholders)."""
+    _load_builtin()
     if not isinstance(experiment, Experiment):
         raise ModelError(f"register_experiment needs an Experiment, got {type(experiment).__name__}")
     old = _EXPERIMENTS.get(experiment.name)
@@ -39,6 +50,7 @@ def register_experiment(experiment: Experiment, replace_existing: bool = False) 
 
 def list_experiments() -> tuple:
     """All registered experiments (built-in first)."""
+    _load_builtin()
     return tuple(_EXPERIMENTS.values())
 
 
@@ -58,6 +70,7 @@ def get_experiment(name_or_path, **options) -> Experiment:
 
     options : changes to the experiment's options (geometry...); unknown names raise ModelError.
     """
+    _load_builtin()
     key = str(name_or_path)
     if key.endswith(".py") or Path(key).suffix == ".py":
         if not Path(key).is_file():

@@ -1,4 +1,4 @@
-"""Self-contained HTML reports of ``compare`` and ``diagnose`` (issue 17): one file a team can
+"""Self-contained HTML reports of ``compare`` and ``diagnose``: one file a team can
 share and open offline -- the verdict, the tables, the figures inlined as base64 PNG, and the
 history of the model versions.  No script, no external link, no web font.
 """
@@ -72,6 +72,15 @@ def _params_rows(params: dict):
     return rows
 
 
+def _sources(noise: dict, unit: str) -> str:
+    """The source of a channel's noise level, and the others' levels where they disagree."""
+    text = noise["source"]
+    if noise.get("disagree"):
+        f, ul = display_scale(unit)
+        text += " (" + ", ".join(f"{k} {num(f * v, 3)} {ul}" for k, v in noise["levels"].items()) + ")"
+    return text
+
+
 def _history_section(folder: Path, exp) -> str:
     from .history import read_history
 
@@ -124,18 +133,19 @@ def compare_report(exp, data, result, folder) -> Path:
         (
             "Error",
             table(
-                ["channel", "RMS", "noise", "x noise", "unit"],
+                ["channel", "RMS", "noise", "noise from", "x noise", "unit"],
                 [
                     [
                         c,
                         num(display_scale(v["unit"])[0] * v["rms"], 4),
                         num(display_scale(v["unit"])[0] * v["noise"], 4),
-                        num(v["rms"] / v["noise"], 3) if v["noise"] else "",
+                        _sources(result.report["noise_model"][c], v["unit"]),
+                        num(v.get("ratio", v["rms"] / v["noise"] if v["noise"] else float("nan")), 3),
                         display_scale(v["unit"])[1],
                     ]
                     for c, v in result.report["channels"].items()
                 ],
-                numeric=(1, 2, 3),
+                numeric=(1, 2, 4),
             )
             + f"<p>overall RMS error {num(f * result.rms, 4)} {esc(ul)}; noise floor "
             f"{num(f * result.noise_rms, 4)} {esc(ul)}.</p>",

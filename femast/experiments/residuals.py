@@ -62,6 +62,42 @@ def noise_floor(r) -> float:
     return float(sigma)
 
 
+#: Share of the largest whitened residuals a ratio leaves out (:func:`robust_rms`).
+TRIM = 0.02
+
+
+def robust_rms(z) -> float:
+    """RMS of a whitened residual z (any shape), robust to spikes and heavy tails.
+
+    The ``TRIM`` (2 %) largest ``|z|`` are left out (at least one value from 25 values on) and the
+    mean square of the rest is divided by its expectation for Gaussian noise, so white Gaussian
+    noise of unit level gives 1.  Ratios of a model's error to the noise use it for their numerator,
+    as the noise level uses a robust scale for its denominator (:func:`noise_floor`): spikes or a
+    heavy tail make a model at the noise look much less above it (Student-t noise with 3 degrees
+    of freedom, 66 rows: 1.14 on average, 95th percentile 1.52, where the plain RMS gives 1.29 and
+    1.86; 500 rows: 1.08 and 1.18 against 1.30 and 1.59), while structure that acts on more than
+    2 % of the rows -- a mechanism -- still shows (5 % would bring Student-t to 1.06 and 1.38 at 66
+    rows but hide a latch hysteresis acting near the seated bead only).  Gaussian noise: 95th
+    percentile 1.27 (66 rows), 1.10 (500 rows), which :func:`at_noise_threshold` allows for."""
+    a = np.sort(np.abs(np.asarray(z, dtype=float).ravel()))
+    n = a.size
+    if n == 0:
+        return 0.0
+    k = int(TRIM * n) if n >= 25 else 0
+    if k == 0:
+        return float(np.sqrt(np.mean(a * a)))
+    q = 1.0 - k / n  # kept share; Gaussian E[z^2 | |z| < c] with P(|z| < c) = q
+    c = _norm_ppf(0.5 + 0.5 * q)
+    m2 = 1.0 - 2.0 * c * np.exp(-0.5 * c * c) / np.sqrt(2.0 * np.pi) / q
+    return float(np.sqrt(np.mean(a[: n - k] ** 2) / m2))
+
+
+def _norm_ppf(p: float) -> float:
+    from scipy.special import ndtri
+
+    return float(ndtri(p))
+
+
 #: Smallest threshold of "at the noise floor" (RMS error / estimated noise), see :func:`at_noise_threshold`.
 AT_NOISE = 1.2
 #: Fraction of pure-noise data sets of a given size that :func:`at_noise_threshold` calls "at the noise".
@@ -73,8 +109,8 @@ def at_noise_threshold(n_rows: int, n_channels: int = 1) -> float:
     """Ratio RMS / estimated noise below which a model counts as *at the noise floor* for a data set
     of ``n_rows`` rows and ``n_channels`` channels: ``AT_NOISE`` (1.2), or more for short data sets.
 
-    The noise is estimated from the residual itself (:func:`noise_floor`), so even a perfect model's
-    ratio scatters: for 45 rows of one channel it exceeds 1.2 in 17 % of data sets (1.38 at the
+    The noise is estimated from the residual itself (:func:`noise_floor`) and the ratio is
+    :func:`robust_rms` of the whitened residual, so even a perfect model's ratio scatters: for 45 rows of one channel it exceeds 1.2 in 17 % of data sets (1.38 at the
     95th percentile), for 500 rows in none.  The threshold is the larger of ``AT_NOISE`` and the
     ``AT_NOISE_QUANTILE`` (95 %) quantile of that ratio for white noise of this size (Monte Carlo,
     2000 draws, fixed seed; from 400 rows on it is below 1.2 and not computed).  Long data sets
@@ -88,7 +124,7 @@ def at_noise_threshold(n_rows: int, n_channels: int = 1) -> float:
     d2 = z[..., 2:] - 2.0 * z[..., 1:-1] + z[..., :-2]
     mad = np.median(np.abs(d2 - np.median(d2, axis=-1, keepdims=True)), axis=-1)
     sigma = 1.4826 * mad / np.sqrt(6.0)  # noise_floor, vectorised (white noise: no zero MAD)
-    ratio = np.sqrt(np.mean((z / sigma[..., None]) ** 2, axis=(1, 2)))
+    ratio = np.array([robust_rms(zi / si[:, None]) for zi, si in zip(z, sigma)])
     return float(max(AT_NOISE, np.quantile(ratio, AT_NOISE_QUANTILE)))
 
 

@@ -21,6 +21,7 @@ import warnings
 import numpy as np
 
 from .data import DataWarning
+from .units import CONFIRMED
 
 MAX_ROWS = 10_000  # rows compare and diagnose use at most (every k-th row above)
 
@@ -42,4 +43,6 @@ def thin(data, max_rows: int | None = None, what: str = "compare"):
         DataWarning,
         stacklevel=3,
     )
-    return data.subset(rows)
+    sub = data.subset(rows)
+    sub.cache.update({k: v for k, v in data.cache.items() if k == CONFIRMED})  # --units dx_m=m still holds
+    return sub

@@ -1,7 +1,9 @@
-"""Scoring of model variants and the verdict of ``diagnose`` (issue 14).
+"""Scoring of model variants and the verdict of ``diagnose``.
 
 Every fit of a diagnosis is scored with the same noise model (:mod:`femast.experiments.noise`):
-``ratio`` is the RMS of the residuals whitened by the per-row noise, ``ic`` the information
+``ratio`` is the robust RMS of the residuals whitened by the per-row noise
+(:func:`~femast.experiments.residuals.robust_rms`: the 5 % largest left out, as the noise level is
+a robust estimate too), ``ic`` the information
 criterion with the effective sample sizes (:func:`~femast.experiments.noise.information_criterion`),
 ``delta_bic = ic - ic(baseline)`` and ``explained_fraction`` the share of the baseline's excess
 error ``ratio0^2 - 1`` that the variant removes.
@@ -18,7 +20,7 @@ A candidate is *significant* when both
 * ``explained_fraction >= MIN_SHARE`` (10 %).  With hundreds of residuals a change of shape that
   removes 2 % of a large excess error passes any information criterion, yet it is not the missing
   mechanism: such gains come from a flexible effect bending into a structure it does not model
-  (issue 14: "beam flexibility" with no beam).  10 % of the excess is the smallest share whose
+  ("beam flexibility" with no beam).  10 % of the excess is the smallest share whose
   removal is visible in the residual plot (the RMS of the excess falls by 5 %), and the
   smallest share a second mechanism of a pair contributes in the generalisation benchmark.
 
@@ -48,6 +50,7 @@ from __future__ import annotations
 import numpy as np
 
 from .noise import information_criterion
+from .residuals import robust_rms
 
 SIGNIFICANT_DBIC = -10.0
 MIN_SHARE = 0.10
@@ -60,7 +63,7 @@ def score(fit, models: dict, channels, n_rows: int) -> dict:
     """``{ratio, rss, ic, z}`` of a fit under the noise ``models`` ({channel: ChannelNoise})."""
     z = np.concatenate([fit.residuals[c] / models[c].sigma for c in channels])
     return {
-        "ratio": float(np.sqrt(np.mean(z**2))),
+        "ratio": robust_rms(z),
         "rss": float(z @ z),
         "ic": information_criterion(z, n_rows, {c: models[c] for c in channels}, int(fit.n_params)),
         "z": z,

@@ -100,8 +100,8 @@ def test_bay_runs_with_a_reference_are_cached_under_their_own_key_and_agree():
     N m on the example; 1e-3 N m is 1/200 of the example's noise), and a changed drive path runs
     without the reference."""
     from femast import examples
-    from femast.experiments import bay_torsion as bt
     from femast.experiments import fe_cache, fe_reference, get_experiment, read_data
+    from femast.experiments.rigs import bay_torsion as bt
 
     exp = get_experiment("bay-torsion")
     data = read_data(exp, examples.for_experiment("bay-torsion"))

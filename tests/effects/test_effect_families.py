@@ -10,7 +10,7 @@ from femast.effects.latch import fade
 from femast.effects.operators import IWAN_ELEMENTS, iwan, iwan_strengths, jenkins, proportional_iwan, proportional_play
 from femast.errors import ModelError
 from femast.experiments import Parameter, fit, get_experiment, predict
-from femast.experiments.synthetic import latch_pull_data, mast_top_data, mast_top_path
+from femast.experiments.rigs.synthetic import latch_pull_data, mast_top_data, mast_top_path
 
 CYCLE = np.concatenate([np.linspace(0, 10, 101), np.linspace(10, -10, 201), np.linspace(-10, 4, 141)])
 
@@ -90,16 +90,17 @@ def test_proportional_iwan_uniform_coefficients_follow_the_closed_form_return_br
 
 def test_forms_are_listed_and_selected_by_name():
     exp = get_experiment("mast-top")
-    assert forms_of("friction_hysteresis", "mast-top") == (
+    assert forms_of("friction_hysteresis", exp) == (
         "friction_hysteresis",
         "friction_hysteresis/jenkins",
         "friction_hysteresis/iwan",
+        "friction_hysteresis/per_axis",
     )
     ((name, impl),) = resolve(exp, ["friction_hysteresis/iwan"])
     assert name == "friction_hysteresis/iwan" and [p.name for p in impl.parameters] == ["M_f", "beta", "alpha"]
     ((name, impl),) = resolve(exp, ["friction_hysteresis/play"])  # the default form by its name
     assert name == "friction_hysteresis"
-    with pytest.raises(ModelError, match="unknown form 'dahl'.*play, jenkins, iwan"):
+    with pytest.raises(ModelError, match="unknown form 'dahl'.*play, jenkins, iwan, per_axis"):
         resolve(exp, ["friction_hysteresis/dahl"])
 
 
@@ -120,16 +121,24 @@ def test_generalised_forms_reduce_exactly_to_the_default_forms_mast_top():
         a, b = predict(exp, data, base, old), predict(exp, data, base, new)
         for c in exp.channels:
             np.testing.assert_array_equal(a[c], b[c])
-    # clearance: the smooth form with m_c = the default form's 1 % of max |m_k|, joint by joint
+    # clearance: the smooth form with M_c = the default form's 1 % of max |m_k|, joint by joint; the
+    # per-axis form with equal gaps
     m = exp.prepared(data)["m"][:, :2]
+    impl = get_effect("joint_clearance").implementation(exp)
+    ctx = {"load": m, "quantities": exp.quantities}
     for j in range(2):
-        theta0 = np.zeros((data.n, 3))
-        ctx = {"prep": exp.prepared(data)}
-        impl = get_effect("joint_clearance").implementation("mast-top")
+        theta0 = np.zeros((data.n, 2))
         a = impl.apply(theta0, {"c": 2e-4}, ctx)[:, j]
-        b = impl.forms["smooth"].apply(theta0, {"c": 2e-4, "m_c": float(ms[j])}, ctx)[:, j]
+        b = impl.forms["smooth"].apply(theta0, {"c": 2e-4, "M_c": float(ms[j])}, ctx)[:, j]
         np.testing.assert_allclose(a, b, rtol=1e-15, atol=0)
         assert np.all(np.abs(b - 2e-4 * np.tanh(m[:, j] / ms[j])) < 1e-18)
+    for old, new in [
+        ({"joint_clearance": {"c": 2e-4}}, {"joint_clearance/per_axis": {"c_x": 2e-4, "c_y": 2e-4}}),
+        ({"friction_hysteresis": {"M_f": 7.0}}, {"friction_hysteresis/per_axis": {"M_f_x": 7.0, "M_f_y": 7.0}}),
+    ]:
+        a, b = predict(exp, data, base, old), predict(exp, data, base, new)
+        for c in exp.channels:
+            np.testing.assert_array_equal(a[c], b[c])
     # pretension: saturating -> linear as t_c -> inf: 1 - exp(-tau/t) ~ tau/t (1 - tau/2t): error <= 1/(2 t_c)
     a = predict(exp, data, base, {"pretension_loss": {"lam": 0.2}})
     b = predict(exp, data, base, {"pretension_loss/saturating": {"lam": 0.2, "t_c": 100.0}})

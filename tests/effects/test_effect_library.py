@@ -20,7 +20,7 @@ from femast.effects import (
 )
 from femast.errors import ModelError
 from femast.experiments import Parameter, get_experiment, list_experiments, predict
-from femast.experiments.synthetic import mast_top_data, mast_top_path
+from femast.experiments.rigs.synthetic import mast_top_data, mast_top_path
 
 ROOT = Path(__file__).resolve().parents[2]
 REQUIRED = (
@@ -61,16 +61,20 @@ def test_every_effect_is_documented_with_units_bounds_and_applicability():
     for n in REQUIRED:
         assert n in names
     for e in map(get_effect, BUILT_IN):
-        assert e.title and len(e.physics) > 80 and e.signature and e.implementations, e.name
-        for exp, impl in e.implementations.items():
-            assert impl.hook, (e.name, exp)
-            for p in impl.parameters:
-                assert p.unit and p.doc and p.lower <= p.default <= p.upper, (e.name, exp, p.name)
+        assert e.title and len(e.physics) > 80 and e.signature and (e.implementations or e.mechanism), e.name
+        for exp in list_experiments():
+            impl = e.implementation(exp)
+            if impl is None:
+                continue
+            assert impl.hook, (e.name, exp.name)
+            for im in (impl, *impl.forms.values()):
+                for p in im.parameters:
+                    assert p.unit and p.doc and p.lower <= p.default <= p.upper, (e.name, exp.name, p.name)
 
 
 def test_applicability_of_the_built_in_effects():
-    mt = {e.name for e in applicable_effects("mast-top")}
-    lp = {e.name for e in applicable_effects("latch-pull")}
+    mt = {e.name for e in applicable_effects(get_experiment("mast-top"))}
+    lp = {e.name for e in applicable_effects(get_experiment("latch-pull"))}
     assert {
         "joint_clearance",
         "friction_hysteresis",
@@ -81,8 +85,8 @@ def test_applicability_of_the_built_in_effects():
     } <= mt
     assert {"latch_hysteresis", "friction_hysteresis", "stretch_error", "cable_hysteresis"} <= lp
     # the FE experiments (their own tests: tests/experiments/test_experiments_fe.py)
-    bt = {e.name for e in applicable_effects("bay-torsion")}
-    tc = {e.name for e in applicable_effects("tip-cycle")}
+    bt = {e.name for e in applicable_effects(get_experiment("bay-torsion"))}
+    tc = {e.name for e in applicable_effects(get_experiment("tip-cycle"))}
     assert bt == {"ball_joint_friction", "latch_hysteresis", "pretension_loss", "off_axis_motion"}
     assert tc == {"ball_joint_friction", "latch_hysteresis", "pretension_loss"}
     with pytest.raises(ModelError, match=r"effect 'joint_clearance' does not apply to bay-torsion"):
@@ -118,7 +122,7 @@ def test_register_a_user_effect_and_extend_an_existing_one():
     try:
         with pytest.raises(ModelError, match="already registered"):
             register_effect(Effect(name="test_offset", title="x", physics="y"))
-        assert "test_offset" in {e.name for e in applicable_effects("mast-top")}  # now a diagnose candidate
+        assert "test_offset" in {e.name for e in applicable_effects(get_experiment("mast-top"))}  # a candidate now
         data, _ = mast_top_data(path=mast_top_path(n=50, seed=1), noise_m=0.0)
         base = predict(get_experiment("mast-top"), data)
         moved = predict(get_experiment("mast-top"), data, effects={"test_offset": {"a": 1e-3}})

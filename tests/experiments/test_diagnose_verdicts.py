@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from femast.experiments import Measured, diagnose, get_experiment
-from femast.experiments.synthetic import mast_top_path
+from femast.experiments.rigs.synthetic import mast_top_path
 from femast.experiments.verdict import MIN_SHARE, conclude, flags, share
 from femast.guyed.mast_3r import jacobian_3r
 
@@ -126,13 +126,13 @@ def test_piecewise_linear_clearance_is_found_with_its_closing_scale():
     assert d.verdict["kind"] == "missing_effect" and d.verdict["missing_effect"] == "joint_clearance"
     top = d.ranking[0]
     assert top["form"] == "smooth" and top["ratio"] <= d.at_noise
-    # tanh(m / m_c) against clip(m / 20): the fitted closing scale is of the order of 20 N m
-    assert 5.0 < top["params"]["m_c"]["value"] < 40.0
+    # tanh(m / M_c) against clip(m / 20): the fitted closing scale is of the order of 20 N m
+    assert 5.0 < top["params"]["M_c"]["value"] < 40.0
 
 
 @pytest.mark.slow
 def test_latch_pull_null_redraws_with_eq15_noise_and_a_small_friction():
-    from femast.experiments.synthetic import latch_pull_data
+    from femast.experiments.rigs.synthetic import latch_pull_data
 
     exp = get_experiment("latch-pull")
     for seed in range(5):  # docs/experiments.md "Limits": 5 of 5 nothing missing

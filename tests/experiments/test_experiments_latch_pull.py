@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from femast.experiments import AT_NOISE, compare, diagnose, from_arrays, get_experiment, predict, run_model
-from femast.experiments.synthetic import latch_pull_data
+from femast.experiments.rigs.synthetic import latch_pull_data
 from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
 
 EXP = get_experiment("latch-pull")
@@ -59,7 +59,7 @@ def test_hidden_effect_is_localised_ranked_first_and_identified(
         base, {effect: truth}, passes=passes, noise_N=noise_N, noise_mm=noise_mm, seed=seed, x_far_mm=(4.0, 3.3)
     )
     c = compare(EXP, data, fit=True)
-    assert c.ratio > 1.4  # the hidden effect is well above the noise
+    assert c.ratio > 1.3 > c.at_noise  # the hidden effect is above the noise
     w = c.worst[0]
     rows = slice(w["start_row"], w["end_row"] + 1)
     oracle = predict(EXP, data, base, {effect: truth})["dT_N"]

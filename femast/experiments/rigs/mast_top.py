@@ -1,4 +1,4 @@
-"""Built-in experiment ``mast-top``: wrench on a mast top and its measured displacement (seed 000).
+"""Built-in experiment ``mast-top``: wrench on a mast top and its measured displacement (Rocaspect guyed mast).
 
 Data format
 -----------
@@ -17,12 +17,12 @@ dz_m       m     ... z
 t_s        s     optional time
 =========  ====  ===========================================================================
 
-The wrench change ``dw`` is taken from a reference state (seed 000 Sec. IV-C: the initial
+The wrench change ``dw`` is taken from a reference state (the Rocaspect paper, Sec. IV-C: the initial
 pose of the platform), as is the displacement ``dc``.
 
 Baseline model
 --------------
-The 3R model of seed 000 (Eqs. 4-7, Eq. 6 with the corrected sign, :mod:`femast.guyed.mast_3r`):
+The 3R model of the Rocaspect paper (Eqs. 4-7, Eq. 6 with the corrected sign, :mod:`femast.guyed.mast_3r`):
 a rigid mast on three elastic base joints about the base axes,
 ``dc = J K^-1 J^T dw``.  The moments driving the joints are ``m = J^T dw`` (N m about the base
 point O, along the base axes); the joint rotations ``theta = m / k``; the top translation
@@ -30,53 +30,62 @@ point O, along the base axes); the joint rotations ``theta = m / k``; the top tr
 The torsion joint (``k_theta3`` option, default rigid) does not move the top point.
 
 Options: ``r_oc_m`` vector from the base O to the top C (m), default ``(0, 0, 3.651)`` (a
-vertical mast from the origin, seed 000's L); ``k_theta3_Nm_per_rad`` (inf); the mast tube for
+vertical mast from the origin, the Rocaspect paper's L); ``k_theta3_Nm_per_rad`` (inf); the mast tube for
 the beam effect ``s_out_m`` = 0.1, ``s_in_m`` = 0.094, ``nu`` = 0.3.
 
-Hooks (where effects act)
--------------------------
-* ``joint_moment`` -- value ``m`` (n, 3) N m, the moments the elastic joints see (friction and
-  hysteresis operators replace it);
-* ``joint_rotation`` -- value ``theta`` (n, 3) rad (clearance, progressive stiffness, pretension);
-* ``top_displacement`` -- value ``dc_T`` (n, 3) m (beam flexibility, user additions).
+Quantities and hooks (where effects act)
+----------------------------------------
+* ``load`` -- the moments ``m`` (n, 2) N m about x and y on the two bending joints (friction and
+  hysteresis operators replace them); scale 1 kN m;
+* ``displacement`` -- their rotations ``theta`` (n, 2) rad (clearance, progressive stiffness,
+  stiffness loss); scale 1 mrad;
+* ``top_displacement`` -- this rig's own hook: the top translation ``dc_T`` (n, 3) m (beam
+  flexibility, user additions).
 
 Every hook call passes ``data``, ``options``, ``params`` (baseline) and ``prep`` (``dw`` (n, 6),
-``J`` (6, 3), ``m`` (n, 3) the unmodified joint moments, ``m_smooth`` (3,) 1 % of max |m| per
-joint, ``tau`` normalised time) and, from ``joint_rotation`` on, ``k`` (3,) and ``m_eff``.
+``J`` (6, 3), ``m`` (n, 3) the unmodified joint moments, ``tau`` normalised time) besides what
+the framework gives every effect (``load``, ``time``, ...; :mod:`femast.effects.base`), and from
+``displacement`` on ``k`` (the joint stiffnesses).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..guyed.mast_3r import jacobian_3r
-from .core import Column, Experiment, Measured, Parameter, prepared
+from femast.effects import Quantity
+from femast.experiments import Column, Experiment, Measured, Parameter, prepared
+from femast.guyed.mast_3r import jacobian_3r
 
 WRENCH = ("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm")
 DISPLACEMENT = ("dx_m", "dy_m", "dz_m")
-L_SEED = 3.651  # m, seed 000 Sec. IV-B-2
+L_SEED = 3.651  # m, the Rocaspect paper, Sec. IV-B-2
 
 
 def _prepare(data: Measured, options: dict) -> dict:
     dw = np.column_stack([data[c] for c in WRENCH])
     J = jacobian_3r(np.asarray(options["r_oc_m"], dtype=float), seed_sign=bool(options.get("seed_sign", False)))
     m = dw @ J
-    m_smooth = np.maximum(0.01 * np.max(np.abs(m), axis=0), 1e-12)
-    return {"dw": dw, "J": J, "m": m, "m_smooth": m_smooth, "tau": data.tau}
+    return {"dw": dw, "J": J, "m": m, "tau": data.tau}
 
 
 def model(params: dict, data: Measured, effects, options: dict) -> dict:
-    """3R mast-top model (seed 000 Eqs. 4-7) with effect hooks; returns ``{dx_m, dy_m, dz_m}`` in m."""
+    """3R mast-top model (Rocaspect paper, Eqs. 4-7) with effect hooks; returns ``{dx_m, dy_m, dz_m}`` in m.
+
+    The bending joints' moments (about x and y) are the load of the effects, their rotations the
+    displacement; the torsion joint is rigid and does not move the top point."""
     prep = prepared(data, _prepare, options)
     k = np.array([params["k_theta1"], params["k_theta2"], float(options["k_theta3_Nm_per_rad"])])
     ctx = dict(data=data, options=options, params=params, prep=prep)
-    m_eff = effects.apply("joint_moment", prep["m"], **ctx) if effects else prep["m"]
+    m_eff = prep["m"]
+    if effects:
+        m_eff = m_eff.copy()
+        m_eff[:, :2] = effects.apply("load", prep["m"][:, :2], **ctx)
     theta = m_eff / k
     if effects:
-        theta = effects.apply("joint_rotation", theta, k=k, m_eff=m_eff, **ctx)
-    d = theta @ prep["J"][:3].T
-    if effects:
-        d = effects.apply("top_displacement", d, k=k, m_eff=m_eff, theta=theta, **ctx)
+        theta[:, :2] = effects.apply("displacement", theta[:, :2], k=k[:2], **ctx)
+        d = effects.apply("top_displacement", theta @ prep["J"][:3].T, k=k, m_eff=m_eff, theta=theta, **ctx)
+    else:
+        d = theta @ prep["J"][:3].T
     return {"dx_m": d[:, 0], "dy_m": d[:, 1], "dz_m": d[:, 2]}
 
 
@@ -92,19 +101,13 @@ def initial_guess(data: Measured, options: dict) -> dict:
 
 
 def load_measure(data: Measured, options: dict) -> np.ndarray:
-    """Signed bending moment at the base (N m): the joint moments (m1, m2) projected on their
-    principal direction, the sign chosen so that the largest |value| is positive."""
-    prep = prepared(data, _prepare, options)
-    m = prep["m"][:, :2]
-    if not np.any(m):
-        return np.zeros(data.n)
-    _, _, Vt = np.linalg.svd(m - 0.0, full_matrices=False)
-    s = m @ Vt[0]
-    return s if s[np.argmax(np.abs(s))] > 0 else -s
+    """The bending moments at the base (N m), (n, 2): the joint moments (m1, m2); the segmentation
+    takes them along their principal direction."""
+    return prepared(data, _prepare, options)["m"][:, :2]
 
 
 def noise_covariates(data: Measured, params: dict, options: dict, fit=None) -> dict:
-    """What the displacement noise may vary with (issue 14): the size of the load, the bending moment
+    """What the displacement noise may vary with: the size of the load, the bending moment
     at the base ``|(m1, m2)|`` (N m).  The wrench is measured too (load cells, whose error is
     commonly a share of the reading) and its error enters the displacement residual through the
     compliance; a loaded mast top also vibrates more.  Tested by ``diagnose``'s noise model
@@ -116,7 +119,7 @@ def noise_covariates(data: Measured, params: dict, options: dict, fit=None) -> d
 
 
 def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: dict) -> None:
-    """Top view of the top's path, measured against model (seed 000 Fig. 6 style), mm."""
+    """Top view of the top's path, measured against model (the Rocaspect paper, Fig. 6 style), mm."""
     ax.plot(1e3 * data["dx_m"], 1e3 * data["dy_m"], ".", ms=2.5, color="0.35", label="measured")
     ax.plot(1e3 * predicted["dx_m"], 1e3 * predicted["dy_m"], "-", lw=1.2, color="C3", label="model")
     ax.set_xlabel("dx (mm)")
@@ -128,7 +131,7 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
 
 _EXPERIMENT = Experiment(
     name="mast-top",
-    title="mast-top wrench and displacement (seed 000, 3R model)",
+    title="mast-top wrench and displacement (the Rocaspect paper, 3R model)",
     columns=tuple(
         Column(c, u, d)
         for c, u, d in (
@@ -157,10 +160,10 @@ _EXPERIMENT = Experiment(
         "nu": 0.3,
         "seed_sign": False,
     },
-    hooks={
-        "joint_moment": "m (n, 3) N m: moments about the base axes that drive the elastic joints",
-        "joint_rotation": "theta (n, 3) rad: rotations of the base joints",
-        "top_displacement": "dc_T (n, 3) m: translation of the top point",
+    hooks={"top_displacement": "dc_T (n, 3) m: translation of the top point"},
+    quantities={
+        "load": Quantity("N m", axes=("x", "y"), symbol="M", scale=1e3, doc="moment on the base joint"),
+        "displacement": Quantity("rad", axes=("x", "y"), scale=1e-3, doc="rotation of the base joint"),
     },
     doc=__doc__,
     prepare=_prepare,

@@ -1,5 +1,5 @@
 """Built-in experiment ``vibration``: measured natural frequencies against the prestressed modal
-analysis (issue 18; seed 001 Sec. IV).
+analysis (Stohlman & Pellegrino, Sec. IV).
 
 Data format
 -----------
@@ -19,7 +19,7 @@ Rows with the same (pretension, load) share one static state and one modal analy
 
 Baseline model
 --------------
-By default the mock bay side of seed 001 Fig. 11 (:func:`femast.adam.vibration.mock_bay_side`:
+By default the mock bay side of Stohlman & Pellegrino, Fig. 11 (:func:`femast.adam.vibration.mock_bay_side`:
 the cable/pulley/latch assembly of an ADAM bay side, four ends anchored, the unit's point mass,
 the cables' lumped mass), brought to equilibrium under the row's load, then its modes
 (:func:`femast.modal.modal_analysis`); mode 1 is the latch's out-of-plane mode of Sec. IV.
@@ -35,7 +35,7 @@ Parameters (which ones are fitted: option ``fit``)
 * ``unit_mass`` (kg): the point mass at the drive node (the latch unit).
 
 The out-of-plane mode alone depends on T / m only: ``fit="pretension"`` (default: the deployed
-mast, mass known, option ``unit_mass_kg``) or ``fit="mass"`` (the seed's calibration: tensions
+mast, mass known, option ``unit_mass_kg``) or ``fit="mass"`` (the paper's calibration: tensions
 known from the settings, option ``pretension_N`` for rows without a setting); ``fit="both"``
 needs data that separates them (modes whose stiffness is not the tension's).
 
@@ -57,11 +57,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis import Analysis
-from ..effects.base import load_script
-from ..errors import ModelError
-from ..modal import modal_analysis
-from .core import Column, Experiment, Measured, Parameter, prepared
+from femast.analysis import Analysis
+from femast.effects import load_script
+from femast.errors import ModelError
+from femast.experiments import Column, Experiment, Measured, Parameter, prepared
+from femast.modal import modal_analysis
 
 FITS = {"pretension": ("pretension",), "mass": ("unit_mass",), "both": ("pretension", "unit_mass")}
 
@@ -132,7 +132,7 @@ def _state_model(T, m, load, options):
         model, drive = build(T, m, load, options)
         direction = np.asarray(options["drive_direction"], float)
     else:
-        from ..adam.vibration import mock_bay_side
+        from femast.adam.vibration import mock_bay_side
 
         side = mock_bay_side(T, options.get("bay"), m, options.get("cable_mass_kg_per_m"))
         model, drive, direction = side.model, side.unit, side.normal
@@ -215,7 +215,7 @@ class VibrationExperiment(Experiment):
     """The ``vibration`` experiment: its fitted parameters follow the option ``fit``."""
 
     def __post_init__(self):
-        from ..adam.mass import UNIT_MASS
+        from femast.adam.mass import UNIT_MASS
 
         opts = dict(self.options)
         if opts.get("unit_mass_kg") is None:
@@ -235,7 +235,7 @@ class VibrationExperiment(Experiment):
 
 EXPERIMENT = VibrationExperiment(
     name="vibration",
-    title="natural frequencies against the prestressed modal analysis (seed 001 Sec. IV)",
+    title="natural frequencies against the prestressed modal analysis (Stohlman & Pellegrino, Sec. IV)",
     columns=(
         Column("mode", "-", "mode number, 1 = lowest of the model"),
         Column("f_Hz", "Hz", "measured natural frequency"),

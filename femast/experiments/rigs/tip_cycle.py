@@ -1,4 +1,4 @@
-"""Built-in experiment ``tip-cycle``: ADAM mast under tip load cycles (seed 001 Sec. VII, Table 1).
+"""Built-in experiment ``tip-cycle``: ADAM mast under tip load cycles (Stohlman & Pellegrino, Sec. VII, Table 1).
 
 Data format
 -----------
@@ -27,7 +27,7 @@ between the states (a load cycle recorded at 10-50 points).
 
 Baseline model
 --------------
-The FE mast of issue 5 (:func:`femast.adam.build_mast`: ``n_bays`` bays, alternate folding,
+The FE ADAM mast (:func:`femast.adam.build_mast`: ``n_bays`` bays, alternate folding,
 friction ball joints, one cable/pulley/latch assembly per side and bay), base frame fixed,
 cables pretensioned to equilibrium (:func:`femast.adam.steps.add_initial_steps`), then one
 load-controlled step per row that changes the load (a row equal to the one before it repeats
@@ -35,16 +35,16 @@ its motion).  Predicted: the control node's displacement ``U`` and rotation ``UR
 the pretensioned state.
 
 As for ``bay-torsion``, the baseline has frictionless ball joints (option ``ball_mu`` = 0; the
-seed's model has 0.5), no latch hysteresis and the nominal pretension.  Fitted: the cable axial
-rigidity ``cable_EA`` (N), one of the two bay parameters the seed does not give and issue 5
+paper's model has 0.5), no latch hysteresis and the nominal pretension.  Fitted: the cable axial
+rigidity ``cable_EA`` (N), one of the two bay parameters the paper does not give and docs/adam_mast.md
 identified from Table 1.  The other, the longeron wall, is an option (``longeron_t_m``): the tip
 motion hardly depends on it -- the mast carries a tip shear mostly by shear of its cable net -- so
 tip data cannot determine it (10 % of wall changes ux by 0.02 % (2 bays) to 0.07 % (8 bays) and
 only ry, itself 1e-6 to 1e-4 rad, by 6 %; 10 % of EA changes ux and rz by 9 %).  Fitting it along
 made the fits ill-conditioned and the effects' uncertainties infinite.
 
-Options: ``n_bays`` (40: the seed's 6.84 m mast; 2-8 for fast studies), ``fold`` (+1),
-``alternate`` (True), ``longeron_t_m`` (the issue-5 value), ``pretension_N`` (170), ``ball_mu`` (0),
+Options: ``n_bays`` (40: the paper's 6.84 m mast; 2-8 for fast studies), ``fold`` (+1),
+``alternate`` (True), ``longeron_t_m`` (the value identified from Table 1), ``pretension_N`` (170), ``ball_mu`` (0),
 ``ball_B_m`` (4e-3), ``latch_hysteresis_length_m`` (3e-4), ``increments_per_row`` (1), ``bay``
 (dict of further :class:`~femast.adam.BayParameters` changes), ``max_fe_rows`` (60: longer files are run through
 the turning points of the load and rows spread along the path, and interpolated between them),
@@ -72,14 +72,14 @@ import time
 
 import numpy as np
 
-from .. import progress
-from ..errors import ConvergenceError, FemastError, ModelError
-from .bay_torsion import LATCH_FIELDS, bay_parameters
-from .core import Column, Experiment, Measured, Parameter, prepared
-from .fe_cache import cached, kernel_threads
-from .residuals import turning_points
+from femast import progress
+from femast.errors import ConvergenceError, FemastError, ModelError
+from femast.experiments import Column, Experiment, Measured, Parameter, prepared, turning_points
+from femast.experiments.fe_cache import cached, kernel_threads
 
-L_MAST_40 = 6.84  # m, the 40-bay mast of seed 001 Sec. VII
+from .bay_torsion import LATCH_FIELDS, bay_parameters
+
+L_MAST_40 = 6.84  # m, the 40-bay mast of Stohlman & Pellegrino, Sec. VII
 LOADS = ("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm")
 MOTION = ("ux_m", "uy_m", "uz_m", "rx_rad", "ry_rad", "rz_rad")
 
@@ -118,7 +118,7 @@ def _prepare(data: Measured, options: dict) -> dict:
 # --------------------------------------------------------------------------- FE run
 def mast_inputs(params: dict, options: dict) -> dict:
     """The dict passed through the ``bay_parameters`` hook (baseline inputs of every bay, SI)."""
-    from ..adam.parameters import BayParameters
+    from femast.adam.parameters import BayParameters
 
     base = BayParameters()
     d = {
@@ -152,9 +152,9 @@ def run_mast(
     Returns ``motion`` (m, 6) = [ux, uy, uz (m), rx, ry, rz (rad)] of the control node relative to
     the pretensioned state, ``bead`` (m, n_bays, 4) bead positions (m), ``zone`` (m, n_bays, 4),
     ``increments``, ``iterations``, ``wall_time``."""
-    from ..adam import build_mast
-    from ..adam.steps import CONVERGENCE, add_initial_steps
-    from ..analysis import Analysis
+    from femast.adam import build_mast
+    from femast.adam.steps import CONVERGENCE, add_initial_steps
+    from femast.analysis import Analysis
 
     t0 = time.perf_counter()
     am = build_mast(int(n_bays), bay_parameters(inputs), fold=int(fold), alternate=bool(alternate))
@@ -270,7 +270,7 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
 
 def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: dict) -> None:
     """Tip displacement x and tip twist (as L rz, L the mast height) against the signed tip load, mm."""
-    from ..adam.parameters import SEED_BAY_HEIGHT
+    from femast.adam.parameters import SEED_BAY_HEIGHT
 
     s = prepared(data, _prepare, options)["load"]
     L = int(options["n_bays"]) * float(dict(options.get("bay") or {}).get("l", SEED_BAY_HEIGHT))
@@ -287,7 +287,7 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
 
 
 def _defaults():
-    from ..adam.parameters import BayParameters
+    from femast.adam.parameters import BayParameters
 
     p = BayParameters()
     return float(p.cable_EA), float(p.longeron_t)
@@ -297,7 +297,7 @@ _EA, _T = _defaults()
 
 EXPERIMENT = Experiment(
     name="tip-cycle",
-    title="ADAM mast under tip load cycles (seed 001 Sec. VII, Table 1; FE mast of issue 5)",
+    title="ADAM mast under tip load cycles (Stohlman & Pellegrino, Sec. VII, Table 1; FE mast)",
     columns=tuple(
         Column(n, u, f"applied tip {'force' if u == 'N' else 'moment about the tip control node'}, base frame, {a}")
         for n, u, a in zip(LOADS, ("N",) * 3 + ("N m",) * 3, "xyzxyz")
@@ -313,7 +313,7 @@ EXPERIMENT = Experiment(
     ),
     channels=MOTION,
     parameters=(
-        Parameter("cable_EA", "N", _EA, 2e3, 2e6, "axial rigidity of the bay cables (not in the seed)", scale=_EA),
+        Parameter("cable_EA", "N", _EA, 2e3, 2e6, "axial rigidity of the bay cables (not in the paper)", scale=_EA),
     ),
     model=model,
     options={

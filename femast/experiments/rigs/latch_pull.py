@@ -1,12 +1,12 @@
-"""Built-in experiment ``latch-pull``: pull test of one roller latch (seed 001, Sec. III.B-C).
+"""Built-in experiment ``latch-pull``: pull test of one roller latch (Stohlman & Pellegrino, Sec. III.B-C).
 
 Data format
 -----------
 ======  ====  =================================================================================
 column  unit  meaning
 ======  ====  =================================================================================
-x_mm    mm    bead position, cable stretch removed (seed 001 Eq. 15), positive outside the latch
-              ("distance to latch" of seed 001 Figs. 6 and 10; the backstop is at -x_backstop)
+x_mm    mm    bead position, cable stretch removed (Stohlman & Pellegrino, Eq. 15), positive outside the latch
+              ("distance to latch" of Stohlman & Pellegrino, Figs. 6 and 10; the backstop is at -x_backstop)
 dT_N    N     force jump across the latch ``dT = T2 - T1`` (Eq. 5; > 0 pulls the bead out)
 side    -     optional: the loaded cable of the pass, ``out`` (or +1: the outer cable pulls, the
               unlatching rig, ``dT >= 0``) or ``in`` (or -1: the inner cable through the backstop
@@ -20,7 +20,7 @@ cable's grip is taken from the x path: a reversal is confirmed when x moves back
 ``max(5 noise, 5 % of its range)`` (or the ``turn_threshold_m`` option); the bead counts as
 possibly at rest within ``max(3 noise, 1 % of the range)`` of the turning point.
 
-The loaded side is a property of the test pass, not of the direction of motion (seed 001 Sec.
+The loaded side is a property of the test pass, not of the direction of motion (Stohlman & Pellegrino, Sec.
 III.B: "only two diagonally opposed cables were loaded at a time, leaving the cable on the other
 side of the latch slack").  Without a ``side`` column it is inferred from the sign of dT
 (:func:`infer_side`): each row with ``|dT|`` above 5 noise and 5 % of the peak names its side; a change
@@ -29,8 +29,8 @@ innermost after an inner-cable one).
 
 Baseline model
 --------------
-The latch law of seed 001 Eqs. 12-14 (:mod:`femast.latch`) with ``r``, ``x_backstop``, ``k``,
-``mu`` fitted and ``h``, ``R`` options (measured; defaults 1.5 mm and 2.4 mm as in the seed).
+The latch law of Stohlman & Pellegrino, Eqs. 12-14 (:mod:`femast.latch`) with ``r``, ``x_backstop``, ``k``,
+``mu`` fitted and ``h``, ``R`` options (measured; defaults 1.5 mm and 2.4 mm as in the paper).
 Each sample is compared with the nearest state the law allows along the path
 (:func:`admissible_band`):
 
@@ -38,7 +38,7 @@ Each sample is compared with the nearest state the law allows along the path
   moving in, ``dT_out(x)`` moving out -- whichever the loaded cable is.  An outer cable reversed
   behind the roller axis (zone (b)) holds the bead back on the latching branch ``dT_in > 0``; an
   inner cable reversed in front of ``x = mu y`` (zone (c)) holds it on ``dT_out < 0``;
-* with ``one_sided`` (the seed's rig, default) the loaded cable can only pull: both branches are
+* with ``one_sided`` (the paper's rig, default) the loaded cable can only pull: both branches are
   clipped to its half-line (``dT >= 0`` outer, ``<= 0`` inner).  Where the cable would have to
   push, it goes slack (``dT = 0``) and the bead is held by the rollers' static friction where it
   stopped, or runs ahead of the cable to where it is held or onto the backstop; the cable takes
@@ -47,7 +47,7 @@ Each sample is compared with the nearest state the law allows along the path
   (Eq. 9, third case), clipped to the loaded side;
 * bead on the backstop: any ``dT <= dT_out(-x_backstop)`` (clipped to the loaded side); a sample
   off the backstop by ``dx`` counts ``backstop_N_per_m * dx`` of error (default 5e4 N/m = 0.5 N
-  per 0.01 mm, the ratio of the force and position noise of the seed's rig).
+  per 0.01 mm, the ratio of the force and position noise of the paper's rig).
 
 The predicted ``dT_N`` is the force of that nearest admissible state, so ``dT_N - predicted`` is
 the error of the sample in N.  The FE cable/latch element (:mod:`femast.elements.cable_latch`)
@@ -73,10 +73,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..errors import DataFileError
-from ..latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force, latch_zone
-from .core import Column, Experiment, Measured, Parameter, prepared
-from .residuals import noise_floor, turning_points
+from femast.errors import DataFileError
+from femast.experiments import Column, Experiment, Measured, Parameter, noise_floor, prepared, turning_points
+from femast.latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force, latch_zone
 
 SIDE_OUT = 1  # the outer cable (section 2) is loaded: unlatching rig, dT = T2 >= 0
 SIDE_IN = -1  # the inner cable (section 1, through the backstop) is loaded: latching rig, dT = -T1 <= 0
@@ -97,7 +96,7 @@ def infer_side(x, dT) -> np.ndarray:
 
     x : bead positions (n,), m.  dT : force jumps (n,), N.
     A one-sided rig can only give ``dT >= 0`` with the outer cable loaded and ``dT <= 0`` with
-    the inner one (seed 001 Sec. III.B), so every row with ``|dT|`` above 5 noise (the noise of dT
+    the inner one (Stohlman & Pellegrino, Sec. III.B), so every row with ``|dT|`` above 5 noise (the noise of dT
     from its second differences) and above 5 % of the largest ``|dT|`` names its side (the second
     differences see only a third of the variance of serially correlated noise -- AR(1), phi = 0.6 --,
     whose excursions out of contact then passed "5 noise" and turned the side in mid-pass; a loaded
@@ -197,7 +196,7 @@ def admissible_band(x, sigma, rest, side, D, one_sided, h_rest, x_stop, x_turn):
 
     x (n,) m, sigma (n,) direction of motion of the loaded cable's end (+1 out, -1 in), rest (n,)
     bool (just after a reversal), side (n,) loaded side (+1 outer, -1 inner cable), D (n, 2) N the
-    branches [dT_in, dT_out] at x (Eq. 14 with effects), one_sided (the seed's rig), h_rest (m)
+    branches [dT_in, dT_out] at x (Eq. 14 with effects), one_sided (the paper's rig), h_rest (m)
     the position noise within which a slack cable may be taking up again, x_stop = -x_backstop (m),
     x_turn (n,) m the position at the last turning point of the grip (the bead's when it stuck).
 
@@ -270,7 +269,7 @@ def admissible_band(x, sigma, rest, side, D, one_sided, h_rest, x_stop, x_turn):
 
 
 def model(params: dict, data: Measured, effects, options: dict) -> dict:
-    """Latch law (seed 001 Eqs. 12-14) along the measured path with effect hooks; returns ``{dT_N}`` in N."""
+    """Latch law (Stohlman & Pellegrino, Eqs. 12-14) along the measured path with effect hooks; returns ``{dT_N}`` in N."""
     prep = prepared(data, _prepare, options)
     r, xb, k, mu = (float(params[n]) for n in ("r", "x_backstop", "k", "mu"))
     p = np.array([r, xb, k, mu, float(options["h_m"]), float(options["R_m"])])
@@ -338,7 +337,7 @@ ZONE_KINDS = (
 
 
 def extra_segments(data: Measured, params: dict, options: dict):
-    """Latch zones of seed 001 Fig. 6 along the path (from the fitted law) and the direction of motion."""
+    """Latch zones of Stohlman & Pellegrino, Fig. 6 along the path (from the fitted law) and the direction of motion."""
     prep = prepared(data, _prepare, options)
     p = LatchParameters(
         r=params["r"],
@@ -358,7 +357,7 @@ def extra_segments(data: Measured, params: dict, options: dict):
 
 
 def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: dict) -> None:
-    """dT against bead position, measured against model (seed 001 Fig. 10 style)."""
+    """dT against bead position, measured against model (Stohlman & Pellegrino, Fig. 10 style)."""
     prep = prepared(data, _prepare, options)
     up = prep["sigma"] > 0
     out = prep["side"] > 0
@@ -385,7 +384,7 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
 
 
 def noise_covariates(data: Measured, params: dict, options: dict, fit=None) -> dict:
-    """What the force noise varies with (issue 14): the signed slope s = d dT / dx (N/m) of the fitted
+    """What the force noise varies with: the signed slope s = d dT / dx (N/m) of the fitted
     law's branch in the direction of motion at each sample.  Eq. 15 removes the cable stretch C T
     from the measured distance with the measured force, so the load-cell noise e_T enters x as
     well: a row's residual is e_T (1 + s C) - s e_d (e_d the distance noise), a variance quadratic
@@ -412,7 +411,7 @@ def path_coordinate(data: Measured, options: dict) -> np.ndarray:
 
 EXPERIMENT = Experiment(
     name="latch-pull",
-    title="latch pull test (seed 001 Eqs. 12-15)",
+    title="latch pull test (Stohlman & Pellegrino, Eqs. 12-15)",
     columns=(
         Column("x_mm", "mm", "bead position, cable stretch removed (Eq. 15), positive outside the latch"),
         Column("dT_N", "N", "force jump across the latch T2 - T1 (Eq. 5)"),

@@ -5,7 +5,7 @@ out-of-library case, a slow drift that no effect models), sampled along a load p
 Gaussian noise.  A diagnosis of such data must find the hidden effect.
 
 * :func:`mast_top_path` -- wrench paths on a mast top (cycles, ramps with partial unloading,
-  rotating direction, the seed 000 Fig. 5a trajectory);
+  rotating direction, the the Rocaspect paper, Fig. 5a trajectory);
 * :func:`mast_top_data` -- top displacements from the 3R model with hidden effects;
 * :func:`latch_pull_data` -- pull-test passes (holds on the backstop, unlatching, latching)
   from the latch law with hidden effects.
@@ -15,11 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..effects.base import resolve
-from ..errors import ModelError
-from ..latch import LATCHING, UNLATCHING, latch_force
-from .core import EffectStack, Measured
-from .fitting import predict
+from femast.effects import resolve
+from femast.errors import ModelError
+from femast.experiments import EffectStack, Measured, predict
+from femast.latch import LATCHING, UNLATCHING, latch_force
 
 
 def _stack(exp, effects):
@@ -47,7 +46,7 @@ def mast_top_path(
     kind : ``"cycles"`` (zero-mean force cycles along ``angle_deg`` with an amplitude that varies
         from cycle to cycle), ``"ramps"`` (piecewise-linear ramps with random turning loads, partial
         unloading and reversals away from zero), ``"rotating"`` (a force of varying magnitude whose
-        direction turns), ``"seed000"`` (the mast-1 wrench along the seed 000 Fig. 5a trajectory,
+        direction turns), ``"seed000"`` (the mast-1 wrench along the the Rocaspect paper, Fig. 5a trajectory,
         repeated ``cycles`` times).
     moment_Nm : amplitude of top moments out of phase with the force (an offset attachment);
         needed to separate beam bending from joint rotation.
@@ -72,8 +71,8 @@ def mast_top_path(
         F = mag * np.sin(2 * np.pi * cycles * t)
         fx, fy = F * np.cos(ang), F * np.sin(ang)
     elif kind == "seed000":
-        from ..guyed.cdpr import trajectory_loads
-        from ..guyed.rocaspect import fig5a_trajectory, rocaspect_geometry
+        from femast.guyed.cdpr import trajectory_loads
+        from femast.guyed.rocaspect import fig5a_trajectory, rocaspect_geometry
 
         _, wr = trajectory_loads(rocaspect_geometry(), fig5a_trajectory(12))
         dw = wr[:, 0] - wr[0, 0]
@@ -96,13 +95,13 @@ def mast_top_data(
 ) -> tuple:
     """Synthetic mast-top data: the 3R model with hidden ``effects`` along ``path``, plus noise.
 
-    params : baseline ``{k_theta1, k_theta2}`` (N m/rad; default 2.7e5, 2.3e5 as seed 000 Table III).
+    params : baseline ``{k_theta1, k_theta2}`` (N m/rad; default 2.7e5, 2.3e5 as the Rocaspect paper, Table III).
     effects : ``{effect: {param: value}}`` hidden in the truth.
     path : wrench dict (:func:`mast_top_path`; default cycles).  noise_m : noise of each displacement, m.
     drift_m : amplitude of a slow thermal drift of the top (m) that no effect models.
     Returns ``(data, truth)`` with ``truth`` the noise-free displacements ``{dx_m, dy_m, dz_m}``.
     """
-    from .registry import get_experiment
+    from femast.experiments import get_experiment
 
     exp = experiment or get_experiment("mast-top")
     rng = np.random.default_rng(seed + 1000)
@@ -137,17 +136,17 @@ def latch_pull_data(
     seed: int = 0,
     experiment=None,
 ) -> tuple:
-    """Synthetic latch pull tests: the latch law (seed 001 Eq. 14) with hidden ``effects``, plus noise.
+    """Synthetic latch pull tests: the latch law (Stohlman & Pellegrino, Eq. 14) with hidden ``effects``, plus noise.
 
     Each pass: the bead sits latched on the backstop while the latching cable pulls it in to
     ``T_hold_N`` and releases (hold), the unlatching cable loads it until it moves (stick on the
     backstop) and pulls it out to ``x_far_mm`` (unlatching), then the latching cable pulls it back
     in to the backstop (latching).  ``n_move`` samples per pass direction, ``n_hold`` per hold.
-    params : baseline ``{r, x_backstop, k, mu}`` (SI; default the seed's fit).
+    params : baseline ``{r, x_backstop, k, mu}`` (SI; default the paper's fit).
     drift_N : a slow drift of the load cell (N) that no effect models.
     Returns ``(data, truth)`` with the true bead positions (m) and force jumps (N).
     """
-    from .registry import get_experiment
+    from femast.experiments import get_experiment
 
     exp = experiment or get_experiment("latch-pull")
     o = exp.options
@@ -220,7 +219,7 @@ def bay_torsion_path(
         back to 45-60 % of it, out again to 80-100 %, back to 0: reversals away from zero),
         ``"release"`` (0 -> theta_max -> 0 with rows twice as dense near 0 and through the
         release of the latches, 1.9-2.8 degrees).
-    offaxis_mm : a measured drift of the top-frame centre (the seed's up to 1 cm), growing with
+    offaxis_mm : a measured drift of the top-frame centre (the paper's up to 1 cm), growing with
         the twist: ``u = offaxis (sin(0.7 + seed), cos(0.7 + seed)) (theta / theta_max)^2``.
     """
     rng = np.random.default_rng(seed)
@@ -255,10 +254,10 @@ def bay_torsion_data(
     """Synthetic single-bay torsion data: the FE bay (the experiment's own model) with hidden
     ``effects`` along ``path`` (:func:`bay_torsion_path`), plus Gaussian noise ``noise_Nm`` on Mz.
 
-    params : baseline ``{latch_k, latch_mu}`` (default the seed's pull-test fit).
+    params : baseline ``{latch_k, latch_mu}`` (default the paper's pull-test fit).
     drift_Nm : amplitude of a slow drift of the load cell (N m) that no effect models.
     Returns ``(data, truth)`` with ``truth`` the noise-free ``{Mz_Nm}``."""
-    from .registry import get_experiment
+    from femast.experiments import get_experiment
 
     exp = experiment or get_experiment("bay-torsion")
     path = dict(path or bay_torsion_path(seed=seed))
@@ -282,7 +281,7 @@ def tip_cycle_path(
     seed: int = 0,
 ) -> dict:
     """Tip load paths ``{fx_N, ..., mz_Nm}``: the sequence 0, +P, 0, -P, 0 ... with ``P`` = M about z and
-    F along x (seed 001 Table 1), ``cycles`` times, each ramp sampled at ``points_per_ramp`` rows.
+    F along x (Stohlman & Pellegrino, Table 1), ``cycles`` times, each ramp sampled at ``points_per_ramp`` rows.
     hold : extra rows at every turning load and at every return to zero (the load held while the
     tip is measured, as in Table 1; the FE model repeats the state, so they cost nothing).
 
@@ -335,7 +334,7 @@ def tip_cycle_data(
 
     params : baseline ``{cable_EA}``.  drift_m : a slow drift of the tip along x and y
     (m) that no effect models.  Returns ``(data, truth)`` with the noise-free channels."""
-    from .registry import get_experiment
+    from femast.experiments import get_experiment
 
     exp = experiment or get_experiment("tip-cycle")
     path = dict(path or tip_cycle_path(seed=seed))

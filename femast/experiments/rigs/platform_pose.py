@@ -1,5 +1,5 @@
 """Built-in experiment ``platform-pose``: commanded pose, tensions and measured pose of the Rocaspect
-platform on its compliant masts (seed 000 Fig. 7; issue 19 item 4).
+platform on its compliant masts (the Rocaspect paper, Fig. 7).
 
 Data format
 -----------
@@ -35,7 +35,7 @@ Mast effects
 ------------
 The effects of ``mast-top`` apply (``effects_from="mast-top"``) with the 3R baseline: after a pass
 with the linear masts, each mast's wrench history (from calibration) runs through the ``mast-top``
-model with the effects (hooks ``joint_moment``, ``joint_rotation``, ``top_displacement``); the
+model with the effects (its quantities ``load``, ``displacement`` and hook ``top_displacement``); the
 difference of its top translations from the linear 3R ones is fed back into the equilibrium, and
 the pass repeated until the tops move by less than 1 um (as the FE masts are).
 """
@@ -44,10 +44,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
+from femast.errors import ModelError
+from femast.experiments import Column, Experiment, Measured, Parameter, from_arrays
+
 from . import mast_top
-from .core import Column, Experiment, Measured, Parameter
-from .data import from_arrays
 
 POSE_IN = ("x_cmd_m", "y_cmd_m", "z_cmd_m", "roll_cmd_rad", "pitch_cmd_rad", "yaw_cmd_rad")
 TENSIONS = tuple(f"tau{j}_N" for j in range(1, 9))
@@ -56,7 +56,7 @@ _CACHE: dict = {}
 
 
 def _masts(options):
-    from ..guyed.mast_sets import mast_set
+    from femast.guyed.mast_sets import mast_set
 
     key = (options["mast_model"], float(options["pretension_N"]))
     if key not in _CACHE:
@@ -75,7 +75,7 @@ def _inputs(data: Measured):
 
 def _mast_top_response(w_hist, w_cal, k_theta, effects, i):
     """Top translations (k, 3) of mast i by the mast-top model (3R + effects) for its wrench history."""
-    from ..guyed.rocaspect import mast_bases, mast_tops
+    from femast.guyed.rocaspect import mast_bases, mast_tops
 
     dw = w_hist - w_cal
     cols = dict(zip(mast_top.WRENCH, dw.T))
@@ -90,9 +90,9 @@ def _mast_top_response(w_hist, w_cal, k_theta, effects, i):
 
 def model(params: dict, data: Measured, effects, options: dict) -> dict:
     """Platform pose on compliant masts (module docstring); returns ``{x_m, y_m, z_m}`` in m."""
-    from ..guyed.mast_sets import _TEST_OF
-    from ..guyed.platform_pose import CableRobot, MastSet, pose_trajectory
-    from ..guyed.rocaspect import TABLE_III, rocaspect_geometry
+    from femast.guyed.mast_sets import _TEST_OF
+    from femast.guyed.platform_pose import CableRobot, MastSet, pose_trajectory
+    from femast.guyed.rocaspect import TABLE_III, rocaspect_geometry
 
     poses, tau = _inputs(data)
     base = _masts(options)
@@ -151,7 +151,7 @@ def load_measure(data: Measured, options: dict) -> np.ndarray:
 
 EXPERIMENT = Experiment(
     name="platform-pose",
-    title="CDPR platform pose on compliant masts (seed 000 Fig. 7)",
+    title="CDPR platform pose on compliant masts (the Rocaspect paper, Fig. 7)",
     columns=(
         Column("x_cmd_m", "m", "commanded platform position, base frame, x"),
         Column("y_cmd_m", "m", "commanded platform position, y"),
@@ -181,7 +181,8 @@ EXPERIMENT = Experiment(
     ),
     model=model,
     options={"mast_model": "3R", "pretension_N": 1200.0, "EA_N": 1.0e6, "pulley_radius_m": 0.03, "mass_kg": 50.0},
-    hooks=dict(mast_top.EXPERIMENT.hooks),
+    hooks={"top_displacement": mast_top.EXPERIMENT.hooks["top_displacement"]},
+    quantities=dict(mast_top.EXPERIMENT.quantities),
     doc=__doc__,
     load_measure=load_measure,
     load_label="distance from the calibration pose (m)",

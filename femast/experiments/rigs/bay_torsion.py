@@ -1,4 +1,4 @@
-"""Built-in experiment ``bay-torsion``: moment-rotation test of one ADAM bay (seed 001 Secs. V-VI).
+"""Built-in experiment ``bay-torsion``: moment-rotation test of one ADAM bay (Stohlman & Pellegrino, Secs. V-VI).
 
 Data format
 -----------
@@ -6,11 +6,11 @@ Data format
 column     unit  meaning
 =========  ====  ===========================================================================
 theta_deg  deg   rotation of the top batten frame about the bay axis z from the deployed,
-                 pretensioned state (seed 001 Fig. 3 ``theta_t``; > 0 about +z)
-ux_m       m     optional: measured translation of the top-frame centre, x (the seed's
+                 pretensioned state (Stohlman & Pellegrino, Fig. 3 ``theta_t``; > 0 about +z)
+ux_m       m     optional: measured translation of the top-frame centre, x (the paper's
                  "actual path", Fig. 17); both or neither of ux_m, uy_m
 uy_m       m     optional: ... y
-Mz_Nm      N m   moment about z in the sign of seed 001 Figs. 16-17: the moment the bay exerts
+Mz_Nm      N m   moment about z in the sign of Stohlman & Pellegrino, Figs. 16-17: the moment the bay exerts
                  on the loading rig, i.e. minus the moment applied to the top frame (negative
                  while the latched bay resists a twist in its folding sense)
 t_s        s     optional time
@@ -20,7 +20,7 @@ Rows are in time order, starting from (or near) the deployed state ``theta = 0``
 
 Baseline model
 --------------
-The FE single bay of issue 5 (:func:`femast.adam.build_bay`: corotational longerons and
+The FE single ADAM bay (:func:`femast.adam.build_bay`: corotational longerons and
 battens, rigid corner pieces, ball joints, one cable/pulley/latch assembly per side), bottom
 frame fixed, cables pretensioned to equilibrium (:func:`femast.adam.steps.add_initial_steps`),
 then the control node at the top-frame centre driven through the measured rows: rz =
@@ -29,16 +29,16 @@ idealised path of Fig. 16); z and the tilts are free.  One increment ends at eve
 (cut back where Newton needs it).  The predicted ``Mz_Nm`` is minus the reaction moment about
 z at the control node.
 
-The baseline is the seed's bay *without* the physics the seed itself questions: frictionless
-ball joints (option ``ball_mu`` = 0; the seed's Abaqus model has 0.5), no latch hysteresis, the
+The baseline is the paper's bay *without* the physics the paper itself questions: frictionless
+ball joints (option ``ball_mu`` = 0; the paper's Abaqus model has 0.5), no latch hysteresis, the
 rotation axis on the bay axis, the nominal pretension.  Those are the candidate effects.
 
 Fitted: the latch law as it acts in the bay, ``latch_k`` (N/m, one roller's cantilever) and
-``latch_mu`` (-, roller-bead friction), starting from the pull-test fit of seed 001 Sec. III.C
+``latch_mu`` (-, roller-bead friction), starting from the pull-test fit of Stohlman & Pellegrino, Sec. III.C
 (100 N/mm, 0.07).  They set the peak moment and the width of the loop while the latches hold
 (0.1 of k moves the curve by up to 2.7 N m, 0.01 of mu by up to 1 N m, on a 3.2-degree cycle),
 whereas a 10 % change of cable EA moves it by 0.4 N m and 20 N of pretension by 0.6 N m, mostly
-after release: EA (``cable_EA_N``, identified from Table 1 in issue 5) and the pretension
+after release: EA (``cable_EA_N``, identified from Table 1 (docs/adam_mast.md)) and the pretension
 (``pretension_N``, measured by vibration, seed Eq. 16) are options, and a pretension error is a
 candidate effect.
 
@@ -52,7 +52,7 @@ cache shared by the worker processes of ``diagnose``).
 
 Options
 -------
-``pretension_N`` (170), ``cable_EA_N`` (issue-5 value), ``ball_mu`` (0, baseline joint
+``pretension_N`` (170), ``cable_EA_N`` (the value identified from Table 1), ``ball_mu`` (0, baseline joint
 friction), ``ball_B_m`` (4e-3, ball end radius used by ``ball_joint_friction``),
 ``latch_hysteresis_length_m`` (3e-4, fade-out length of ``latch_hysteresis``), ``fold`` (+1: the
 bay folds under a positive twist), ``off_axis_side`` (0: ``off_axis_motion`` moves the axis
@@ -83,12 +83,11 @@ import time
 
 import numpy as np
 
-from .. import progress
-from ..errors import ConvergenceError, FemastError, ModelError
-from .core import Column, Experiment, Measured, Parameter, prepared
-from .fe_cache import kernel_threads
-from .fe_reference import cached_run
-from .residuals import turning_points
+from femast import progress
+from femast.errors import ConvergenceError, FemastError, ModelError
+from femast.experiments import Column, Experiment, Measured, Parameter, prepared, turning_points
+from femast.experiments.fe_cache import kernel_threads
+from femast.experiments.fe_reference import cached_run
 
 ZONE_KINDS = (
     "zone (a) at backstop",
@@ -148,7 +147,7 @@ def _prepare(data: Measured, options: dict) -> dict:
 # --------------------------------------------------------------------------- FE run
 def bay_inputs(params: dict, options: dict) -> dict:
     """The dict passed through the ``bay_parameters`` hook: baseline inputs of the FE bay (SI)."""
-    from ..adam.parameters import BayParameters
+    from femast.adam.parameters import BayParameters
 
     base = BayParameters()
     d = {
@@ -170,8 +169,8 @@ def bay_inputs(params: dict, options: dict) -> dict:
 
 def bay_parameters(inputs: dict):
     """:class:`~femast.adam.BayParameters` from a ``bay_parameters`` hook dict (validated)."""
-    from ..adam.parameters import BayParameters
-    from ..latch import LatchParameters
+    from femast.adam.parameters import BayParameters
+    from femast.latch import LatchParameters
 
     latch = LatchParameters(**{f: float(inputs[f"latch_{f}"]) for f in LATCH_FIELDS})
     rest = {k: v for k, v in inputs.items() if not k.startswith("latch_")}
@@ -194,9 +193,9 @@ def run_bay(
     Returns ``Mz`` (m,) N m (seed sign), ``zone`` and ``bead`` (m) (m, 4) of the four latches,
     ``uz`` (m,), ``increments``, ``iterations``, ``wall_time``.  (The latches' tension jumps ``dT``
     are no longer recorded: they were not used, and reading any element output costs 20 % of a run.)"""
-    from ..adam import build_bay
-    from ..adam.steps import CONVERGENCE, add_initial_steps
-    from ..analysis import Analysis
+    from femast.adam import build_bay
+    from femast.adam.steps import CONVERGENCE, add_initial_steps
+    from femast.analysis import Analysis
 
     t0 = time.perf_counter()
     am = build_bay(bay_parameters(inputs), fold=int(fold))
@@ -228,7 +227,7 @@ def run_bay(
 
     def record(fr):
         # the bead positions from the committed state of the latch family (reading an element output
-        # would build the family's whole output dict: 20 % of a run; issue 21); zones after the run
+        # would build the family's whole output dict: 20 % of a run); zones after the run
         rec.append(
             (
                 str(fr["step"]),
@@ -267,10 +266,10 @@ def run_bay(
 
 
 def _latch_outputs(family, bead) -> dict:
-    """``bead`` (m) and ``zone`` (seed Fig. 6) of the latches at the driven rows from their committed
+    """``bead`` (m) and ``zone`` (Stohlman & Pellegrino, Fig. 6) of the latches at the driven rows from their committed
     bead positions (rows, elements), as the latch family's outputs ``bead_position`` and
     ``latch_zone`` give them (NaN and -1 for an element without a latch)."""
-    from ..latch import latch_zone
+    from femast.latch import latch_zone
 
     has = np.asarray(family.latch_node) > 0
     return {"bead": np.where(has, bead, np.nan), "zone": np.where(has, latch_zone(bead, family.latch), -1).astype(int)}
@@ -331,11 +330,11 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
 
 
 def latch_zones(params: dict, data: Measured, options: dict, effects=None) -> np.ndarray:
-    """(n, 4) zones of seed Fig. 6 of the four latches at every row (nearest driven row), from the
+    """(n, 4) zones of Stohlman & Pellegrino, Fig. 6, of the four latches at every row (nearest driven row), from the
     (cached) FE run of the model with ``params``."""
-    from .core import NO_EFFECTS
+    from femast.experiments import EffectStack
 
-    prep, _, _, _, fe = _run(params, data, effects or NO_EFFECTS, options)
+    prep, _, _, _, fe = _run(params, data, effects or EffectStack(), options)
     rows = prep["rows"]
     j = np.clip(np.searchsorted(prep["s"][rows], prep["s"]), 0, rows.size - 1)
     jm = np.clip(j - 1, 0, rows.size - 1)
@@ -347,7 +346,7 @@ RELEASE_KIND = "latch release/relatch"
 
 
 def extra_segments(data: Measured, params: dict, options: dict):
-    """Rows where any latch of the fitted baseline is in each zone of seed Fig. 6, and the rows around
+    """Rows where any latch of the fitted baseline is in each zone of Stohlman & Pellegrino, Fig. 6, and the rows around
     a release or relatch (a latch passing between zones (c) and (d): two rows either side of the
     change), where an asymmetric release (off-axis motion) shows first."""
     try:
@@ -365,7 +364,7 @@ def extra_segments(data: Measured, params: dict, options: dict):
 
 
 def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: dict) -> None:
-    """Moment against twist, measured against model (seed 001 Figs. 16-17 style)."""
+    """Moment against twist, measured against model (Stohlman & Pellegrino, Figs. 16-17 style)."""
     ax.plot(data["theta_deg"], data["Mz_Nm"], ".", ms=4, color="0.35", label="measured")
     ax.plot(data["theta_deg"], predicted["Mz_Nm"], "-", lw=1.3, color="C3", label="model (path order)")
     ax.axhline(0.0, color="0.7", lw=0.8)
@@ -376,20 +375,20 @@ def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: di
 
 
 def _default_EA() -> float:
-    from ..adam.parameters import BayParameters
+    from femast.adam.parameters import BayParameters
 
     return float(BayParameters().cable_EA)
 
 
 EXPERIMENT = Experiment(
     name="bay-torsion",
-    title="single-bay moment-rotation test (seed 001 Secs. V-VI, Figs. 16-17; FE bay of issue 5)",
+    title="single-bay moment-rotation test (Stohlman & Pellegrino, Secs. V-VI, Figs. 16-17; FE bay)",
     columns=(
         Column(
             "theta_deg",
             "deg",
             "rotation of the top batten frame about the bay axis z from the deployed state "
-            "(seed 001 Fig. 3 theta_t), > 0 about +z",
+            "(Stohlman & Pellegrino, Fig. 3 theta_t), > 0 about +z",
         ),
         Column(
             "ux_m",
@@ -402,7 +401,7 @@ EXPERIMENT = Experiment(
         Column(
             "Mz_Nm",
             "N m",
-            "moment about z, seed Figs. 16-17 sign: the moment of the bay on the rig (minus the "
+            "moment about z, Stohlman & Pellegrino, Figs. 16-17 sign: the moment of the bay on the rig (minus the "
             "moment applied to the top frame)",
         ),
     ),
@@ -450,7 +449,7 @@ EXPERIMENT = Experiment(
     min_rows=10,
     # dogbox: the candidates' parameters often end on a bound (no off-axis motion, e = 0), which trf's
     # scaling approaches by about halving the distance per step (11 FE runs for off_axis_motion); dogbox's
-    # active set lands on it in one (issue 21: 45 -> 33 runs in the diagnosis' refits)
+    # active set lands on it in one (45 -> 33 runs in the diagnosis' refits)
     fit_options={
         "diff_step": 1e-3,
         "xtol": 1e-4,
