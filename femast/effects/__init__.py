@@ -27,7 +27,7 @@ added_mass, joint_stick  natural-frequency effects                  vibration
 them beside its own effects.
 """
 
-from . import joints, structure, cables, latch, vibration  # noqa: F401,I001  (register the built-in effects, in this order)
+from . import joints, structure, cables, latch, vibration, connections  # noqa: F401,I001  (register the built-in effects, in this order)
 from .base import (
     Effect,
     Implementation,

@@ -38,6 +38,7 @@ BY_EXPERIMENT = {
     "tip-cycle": "tip_cycle_seed001_table1.csv",
     "vibration": "vibration_example.csv",
     "platform-pose": "platform_pose_example.csv",
+    "joint-test": "joint_test_spc1.csv",
 }
 
 

@@ -18,7 +18,7 @@ The registry imports this package on first use; it registers each rig's ``EXPERI
 
 from femast.experiments import register_experiment
 
-from . import bay_torsion, latch_pull, mast_top, platform_pose, tip_cycle, vibration
+from . import bay_torsion, joint_test, latch_pull, mast_top, platform_pose, tip_cycle, vibration
 
-for _rig in (mast_top, latch_pull, bay_torsion, tip_cycle, vibration, platform_pose):
+for _rig in (mast_top, latch_pull, bay_torsion, tip_cycle, vibration, platform_pose, joint_test):
     register_experiment(_rig.EXPERIMENT)
