@@ -157,6 +157,8 @@ def _examples(args):
         dest.mkdir(parents=True, exist_ok=True)
         for n in examples.names():
             shutil.copy(examples.path(n), dest / n)
+            for c in examples.companions(n):  # the licence and notice of data made by others
+                shutil.copy(c, dest / c.name)
         print(f"copied {len(examples.names())} example files to {dest}")
         return
     by_file = {v: k for k, v in examples.BY_EXPERIMENT.items()}

@@ -34,6 +34,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ModelError
+
 MIN_HOLD_ROWS = 6  # rows of a hold: its first and last thirds need two rows each
 HOLD_TOL = 3.0  # a hold: the load within 3 noise of its first value
 MIN_HOLDS = 4
@@ -107,6 +109,29 @@ def time_check(load, measured: dict, sigma: dict) -> dict:
     return hold_drift(s, measured, sigma, noise_load=noise_floor(s))
 
 
+def reads_time(exp, name: str) -> bool:
+    """True if the effect ``name`` (``effect`` or ``effect/form``) changes with time on ``exp``: its
+    implementation there, or its mechanism on physical quantities, reads the time."""
+    from ..effects.base import get_effect, split_form
+
+    base, form = split_form(name)
+    try:
+        eff = get_effect(base)
+    except ModelError:  # a name the registry no longer knows (a user script's effect): not claimed
+        return False
+    impls = [eff.implementation(exp), eff.mechanism]
+    for impl in impls:
+        if impl is None:
+            continue
+        try:
+            impl = impl.variant(form)
+        except ModelError:
+            pass
+        if "time" in impl.needs:
+            return True
+    return False
+
+
 def creep_overrules(verdict: dict, check: dict, time_dependent) -> dict:
     """The verdict of ``diagnose`` once the holds have spoken (module docstring).
 
@@ -119,7 +144,10 @@ def creep_overrules(verdict: dict, check: dict, time_dependent) -> dict:
     Returns a new dict (``verdict`` is not changed).
     """
     v = dict(verdict)
-    v["time_dependence"] = {k: check.get(k) for k in ("holds", "t", "drift", "creep")}
+    v["time_dependence"] = {
+        k: (None if isinstance(check.get(k), float) and not np.isfinite(check[k]) else check.get(k))
+        for k in ("holds", "t", "drift", "creep")
+    }
     if not check.get("creep"):
         return v
     named = list(v.get("missing_effects") or ([v["mechanism"]] if v.get("mechanism") else []))

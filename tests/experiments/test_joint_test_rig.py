@@ -97,3 +97,11 @@ def test_the_real_example_ships_with_its_licence_and_citation():
     for words in ("not made by femast", "Tannert", "World Conference on Timber Engineering", "cslotboom/hysteresis"):
         assert words in notice
     assert "not made by femast" in lines[1]
+
+
+def test_copying_the_examples_keeps_the_licence_beside_the_real_data(tmp_path):
+    from femast.cli import main
+
+    assert main(["examples", "--copy", str(tmp_path)]) in (0, None)
+    assert (tmp_path / "joint_test_spc1.csv").is_file()
+    assert (tmp_path / "NOTICE-SPC1.txt").is_file() and (tmp_path / "LICENSE-SPC1-Apache-2.0.txt").is_file()

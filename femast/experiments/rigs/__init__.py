@@ -10,6 +10,7 @@ module                  rig
 ``tip_cycle``           ADAM mast under tip load cycles (FE)
 ``vibration``           natural frequencies of a prestressed bay side (FE modal)
 ``platform_pose``       cable-robot platform on compliant masts (Rocaspect)
+``joint_test``          a connection's cyclic test: force (moment) in, displacement (rotation) out
 ======================  ======================================================================
 
 :mod:`femast.experiments.rigs.synthetic` generates data with hidden effects from their models.

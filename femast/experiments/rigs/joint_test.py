@@ -82,8 +82,14 @@ def _plot_measured(load_label: str, disp_label: str, load_factor: float, disp_fa
         F = prepared(data, _prepare, options)["F"]
         u = data[options["displacement_column"]]
         ax.plot(disp_factor * u, load_factor * F, "-", lw=0.5, color="0.55", label="measured")
-        ax.plot(disp_factor * predicted[options["displacement_column"]], load_factor * F, "-", lw=0.7, color="C3",
-                label="model")
+        ax.plot(
+            disp_factor * predicted[options["displacement_column"]],
+            load_factor * F,
+            "-",
+            lw=0.7,
+            color="C3",
+            label="model",
+        )
         ax.set_xlabel(disp_label)
         ax.set_ylabel(load_label)
         ax.set_title("connection: load against displacement")
@@ -111,21 +117,30 @@ def joint_test(
         or save ``experiment = joint_test(...)`` in a script and pass the script's path.
     """
     lu, du = ("N m", "rad") if moment else ("N", "m")
-    L = Quantity(lu, symbol="M" if moment else "F", scale=load_scale or (1e3 if moment else 1e4),
-                 doc="moment through the connection" if moment else "force through the connection")
-    D = Quantity(du, scale=displacement_scale or 1e-2, doc="rotation of the connection" if moment else
-                 "displacement of the connection")
+    L = Quantity(
+        lu,
+        symbol="M" if moment else "F",
+        scale=load_scale or (1e3 if moment else 1e4),
+        doc="moment through the connection" if moment else "force through the connection",
+    )
+    D = Quantity(
+        du,
+        scale=displacement_scale or 1e-2,
+        doc="rotation of the connection" if moment else "displacement of the connection",
+    )
     exp = Experiment(
         name=name,
         title=title or f"{'moment-rotation' if moment else 'force-displacement'} test of a connection",
         columns=(
             Column(load_column, lu, "moment on the connection" if moment else "force on the connection"),
-            Column(displacement_column, du, "rotation it drives (compared)" if moment else "displacement it drives (compared)"),
+            Column(
+                displacement_column,
+                du,
+                "rotation it drives (compared)" if moment else "displacement it drives (compared)",
+            ),
         ),
         channels=(displacement_column,),
-        parameters=(
-            Parameter("k", f"{lu}/{du}", 1e6, 1e-3, 1e15, "elastic stiffness of the connection", scale=1e6),
-        ),
+        parameters=(Parameter("k", f"{lu}/{du}", 1e6, 1e-3, 1e15, "elastic stiffness of the connection", scale=1e6),),
         model=model,
         options={"load_column": load_column, "displacement_column": displacement_column},
         hooks={"damage": f"F (n,) {lu}: the load every mechanism of the connection sees (degradation)"},
@@ -135,8 +150,10 @@ def joint_test(
         initial_guess=initial_guess,
         load_label=f"{'moment' if moment else 'force'} ({lu})",
         plot_measured=_plot_measured(
-            "moment (N m)" if moment else "force (kN)", "rotation (mrad)" if moment else "displacement (mm)",
-            1.0 if moment else 1e-3, 1e3,
+            "moment (N m)" if moment else "force (kN)",
+            "rotation (mrad)" if moment else "displacement (mm)",
+            1.0 if moment else 1e-3,
+            1e3,
         ),
         error_unit=du,
         min_rows=10,
