@@ -8,14 +8,18 @@ can leave a residual that follows the loops of a cyclic test, so the shape of th
 tell them apart; the holds do.
 
 :func:`holds` finds them: runs of at least ``MIN_HOLD_ROWS`` rows over which the load stays within
-``HOLD_TOL`` noise of its first value.  :func:`hold_drift` measures, in each hold, the change of a
-channel (measured, or the residual of any rate-independent model: the same within a hold) from the
-hold's first third to its last third, in units of its noise, signed by the direction of the load
-change that led into the hold (creep goes on that way).  Over ``H`` holds the mean of those signed
-changes divided by its standard error across the holds is ``t``, Student-t with ``H - 1`` degrees
-of freedom when nothing moves at constant load; it does not depend on the noise level or its
-correlation, which the scatter between holds carries.  ``t > CREEP_T`` (4: p < 0.002 one-sided for
-the fewest holds, ``MIN_HOLDS`` = 4) says the displacement keeps moving at constant load.
+``HOLD_TOL`` noise of its first value. A hold must be a pause of the test: a load that stays flat
+while the response moves on (by more than 3 noise) as fast as the ramp into it drove it (more than
+``PAUSE_RATE`` = 0.5 of that rate) is a plateau -- a connection yielding under displacement
+control -- and is not counted.
+:func:`hold_drift` measures, in each hold, the change of a channel (measured, or the residual of
+any rate-independent model: the same within a hold) from the hold's first third to its last third,
+in units of its noise, signed by the direction of the load change that led into the hold (creep
+goes on that way). Over ``H`` holds the mean of those signed changes divided by its standard error
+across the holds is ``t``, Student-t with ``H - 1`` degrees of freedom when nothing moves at
+constant load; it does not depend on the noise level or its correlation, which the scatter between
+holds carries. ``t > CREEP_T`` (4: p < 0.002 one-sided for the fewest holds, ``MIN_HOLDS`` = 4)
+says the displacement keeps moving at constant load.
 
 In ``diagnose`` (:func:`creep_overrules`, on :func:`time_check` of the measured channels): where the
 response keeps moving at constant load, a verdict that names only rate-independent effects is
@@ -40,6 +44,7 @@ MIN_HOLD_ROWS = 6  # rows of a hold: its first and last thirds need two rows eac
 HOLD_TOL = 3.0  # a hold: the load within 3 noise of its first value
 MIN_HOLDS = 4
 CREEP_T = 4.0
+PAUSE_RATE = 0.5  # a hold is a pause: the response moves at most half as fast as on the ramp into it
 
 
 def holds(load, noise: float = 0.0, min_rows: int = MIN_HOLD_ROWS) -> list[tuple[int, int]]:
@@ -88,7 +93,12 @@ def hold_drift(load, measured: dict, sigma: dict, noise_load: float = 0.0) -> di
             if into == 0:
                 continue
             m = (b - a + 1) // 3
-            z = (Z[b - m + 1 : b + 1].mean() - Z[a : a + m].mean()) / np.sqrt(2.0 / m)
+            change = Z[b - m + 1 : b + 1].mean() - Z[a : a + m].mean()
+            z = change / np.sqrt(2.0 / m)
+            L = min(b - a + 1, a)  # the ramp into the hold, as many rows as the hold
+            ramp_rate = abs(Z[a : a + m].mean() - Z[a - L : a - L + m].mean()) / L
+            if abs(z) > 3.0 and abs(change) / (b - a + 1 - m) > PAUSE_RATE * ramp_rate:
+                continue  # the response moves on as fast as the ramp drove it: a plateau of the load, no pause
             per.append(float(np.sign(into) * z))
     out = {"holds": len(per), "t": None, "drift": None, "creep": False, "per_hold": per}
     if len(per) >= MIN_HOLDS:

@@ -112,3 +112,13 @@ def test_which_effects_read_the_time():
     assert reads_time(exp, "pretension_loss")
     assert not reads_time(exp, "friction_hysteresis") and not reads_time(exp, "friction_hysteresis/iwan")
     assert not reads_time(exp, "no_such_effect")
+
+
+def test_a_yield_plateau_under_displacement_control_is_no_hold():
+    # a connection driven through displacement cycles: past yield its force stays nearly flat while
+    # the displacement moves on at the drive's rate -- rate-independent, no creep
+    case = get_case("jt_bwbn_plain")
+    for seed in range(3):
+        cols = generate(case, seed)
+        out = hold_drift(cols["F_N"], {"u_m": cols["u_m"]}, {"u_m": 20e-6}, noise_load=20.0)
+        assert not out["creep"], (seed, out)
