@@ -217,7 +217,7 @@ DEGRADATION = register_effect(
         title="stiffness and strength degradation (damage with cumulative slip or dissipated energy)",
         physics=(
             "Cycling wears and crushes the contacts of a connection: its stiffness and the strength of its slip "
-            "mechanisms fall together, as a damage D in [0, 1) that makes the undamaged connection carry the "
+            "mechanisms fall together, as a damage D (0 <= D < 1) that makes the undamaged connection carry the "
             "effective load L / (1 - D) (continuum damage mechanics).  D grows with the cumulative slip (form "
             "slip) or with the energy dissipated by slip (form energy) and saturates at D_max: the trailing "
             "cycles at one amplitude reach less load with a softer reloading (femast.effects.damage)."
