@@ -20,7 +20,7 @@ stretch_error          pull-test stretch-removal error              latch-pull
 latch_hysteresis       friction band near the latched state         latch-pull, bay-torsion, tip-cycle
 ball_joint_friction    |M| = mu B |F| of the ADAM ball joints       bay-torsion, tip-cycle
 off_axis_motion        bay top leaves its axis                      bay-torsion
-pinching               slip through a gap with friction (embedment) load + displacement
+pinching               slip through a gap with friction (embedment) joint-test (connection rigs)
 degradation            damage with cumulative slip or energy        joint-test (its damage hook)
 added_mass, joint_stick  natural-frequency effects                  vibration
 =====================  ==========================================  =====================================

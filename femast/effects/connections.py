@@ -1,16 +1,20 @@
 """Connection effects: pinching (slip through a gap with friction) and degradation (a damage law).
 
-* ``pinching`` -- a mechanism on the load through a connection and the displacement it drives
-  (:mod:`femast.effects.quantities`): it applies to every experiment that declares them (the
-  ``joint-test`` rig, a user's own connection rig, the ``mast-top`` base joints).  Its law is
-  :mod:`femast.effects.gap_slip`.
+* ``pinching`` -- acts on the displacement a connection's load drives (its law:
+  :mod:`femast.effects.gap_slip`), its parameters named and sized by the rig's load and
+  displacement quantities (``F_y`` on a force, ``M_y`` on a moment).
 * ``degradation`` -- stiffness and strength falling with the slip history (the damage law of
   :mod:`femast.effects.damage`).  A damage changes the load every mechanism of the connection sees
   (``F / (1 - D)``) and depends on their slip, so the model must run its mechanisms again for a
   trial damage: it acts on a rig's own ``damage`` hook, which a rig provides by passing its load
   through ``effects.apply("damage", load, respond=..., k=...)`` before the rest of its model, with
   ``respond(load) -> displacement`` the rest of its model (every other effect included) and ``k``
-  its elastic stiffness (docs/joint_test.md, "Degradation in your own rig").  Built in: ``joint-test``.
+  its elastic stiffness (docs/joint_test.md, "Your own connection test").
+
+Both are connection mechanisms: they apply to the rigs that say they test a connection --
+``joint-test``, the rigs made by :func:`~femast.experiments.rigs.joint_test.joint_test`, and any
+rig that calls :func:`add_connection_effects` with its name and quantities -- not to every rig
+with a load and a displacement (a mast top's base joints are not dowelled timber).
 """
 
 from __future__ import annotations
@@ -84,6 +88,18 @@ def _pinching_params(q):
     )
 
 
+# the pinching of a connection rig (add_connection_effects): parameters from its quantities
+PINCHING_IMPLEMENTATION = Implementation(
+    hook="displacement",
+    needs=("load",),
+    order=35,
+    parameters=_pinching_params,
+    apply=_pinching,
+    doc="u += s, s the connector's slip through its gap (femast.effects.gap_slip): hole edges at +e_p, -e_n "
+    "grown by embedment, e = <L - L_y> / k_e; inside the gap at rest where |L - k_g s| <= L_f (L_y, L_f "
+    "named F_y, F_f on a force, M_y, M_f on a moment).",
+)
+
 PINCHING = register_effect(
     Effect(
         name="pinching",
@@ -99,16 +115,7 @@ PINCHING = register_effect(
         "sign (a soft, nearly flat stretch of the loop through zero load) and the envelope bends over past a load",
         acts_where=("near-zero load", "reversal", "peak"),
         seed="dowel-type connections of timber engineering (embedment and slack)",
-        mechanism=Implementation(
-            hook="displacement",
-            needs=("load",),
-            order=35,
-            parameters=_pinching_params,
-            apply=_pinching,
-            doc="u += s, s the connector's slip through its gap (femast.effects.gap_slip): hole edges at +e_p, -e_n "
-            "grown by embedment, e = <L - L_y> / k_e; inside the gap at rest where |L - k_g s| <= L_f (L_y, L_f "
-            "named F_y, F_f on a force, M_y, M_f on a moment).",
-        ),
+        implementations={},
     )
 )
 
@@ -203,12 +210,15 @@ def damage_hook(quantities: dict, form: str = "slip") -> Implementation:
     return slip if form == "slip" else slip.forms[form]
 
 
-def add_degradation(experiment: str, quantities: dict) -> None:
-    """Make ``degradation`` apply to the rig named ``experiment`` (its model provides the ``damage``
-    hook; module docstring), its parameters from the rig's ``quantities``."""
+def add_connection_effects(experiment: str, quantities: dict, degradation: bool = True) -> None:
+    """Make ``pinching`` (and ``degradation`` unless False: the rig's model must provide the
+    ``damage`` hook, module docstring) apply to the rig named ``experiment``, their parameters from
+    the rig's ``quantities`` (``{"load": Quantity, "displacement": Quantity}``)."""
     from .base import add_implementation
 
-    add_implementation("degradation", experiment, damage_hook(quantities))
+    add_implementation("pinching", experiment, PINCHING_IMPLEMENTATION)
+    if degradation:
+        add_implementation("degradation", experiment, damage_hook(quantities))
 
 
 DEGRADATION = register_effect(

@@ -41,7 +41,7 @@ from __future__ import annotations
 import numpy as np
 
 from femast.effects import Quantity
-from femast.effects.connections import add_degradation
+from femast.effects.connections import add_connection_effects
 from femast.experiments import Column, Experiment, Measured, Parameter, prepared
 
 NAME = "joint-test"
@@ -159,7 +159,7 @@ def joint_test(
         min_rows=10,
         source=NAME if name == NAME else "",
     )
-    add_degradation(name, exp.quantities)
+    add_connection_effects(name, exp.quantities)
     return exp
 
 
