@@ -1,9 +1,9 @@
-"""Minimal reproductions of FE-core behaviours met while building the ADAM models (issue 5).
+"""Minimal reproductions of FE-core behaviours met while building the ADAM models.
 
     femast run benchmarks/adam_core_issues.py
 
 The ADAM code works around each of them (femast/adam/steps.py); they are reported here for the
-owners of analysis.py / solvers/ (not edited by issue 5).
+analysis (the ADAM code does not change the analysis).
 
 1. Stabilize: damping from diag(K) is dominated by penalty stiffnesses (ball joints, k_pen =
    1e3-1e4 EA/l), so a stabilised initial step ends far from equilibrium while the reported

@@ -1,4 +1,4 @@
-"""Latch hysteresis near the latched state (seed 001 Sec. VIII: the missing physics).
+"""Latch hysteresis near the latched state (Stohlman & Pellegrino, Sec. VIII: the missing physics).
 
     femast run benchmarks/adam_hysteresis.py [--target 0.10] [--length 1e-3] [--force F_h]
                                              [--skip-mast] [--docs] [--no-progress]
@@ -42,7 +42,7 @@ DOCS = ROOT / "docs" / "figures"
 
 def bay_cycle(Fh: float, ell: float, theta_max_deg: float = 3.5, keep: Path | None = None, inc: float = 0.01):
     """Idealised single-bay cycle; returns (residual rotation at zero moment in deg, curve, summary)."""
-    am = build_bay(hysteresis_force=Fh, hysteresis_length=ell)
+    am = build_bay(hysteresis_force=Fh, hysteresis_length=ell, seat="tied")  # the paper's joints
     add_initial_steps(am, hold_control=("ux", "uy"))
     add_idealised_torsion(am, np.radians(theta_max_deg), max_increment=inc)
     folder = keep if keep is not None else Path(tempfile.mkdtemp())
@@ -53,7 +53,7 @@ def bay_cycle(Fh: float, ell: float, theta_max_deg: float = 3.5, keep: Path | No
 
 
 def mast_cycles(Fh: float, ell: float, progress: bool, cycles: int = 3):
-    am = build_mast(40, hysteresis_force=Fh, hysteresis_length=ell)
+    am = build_mast(40, hysteresis_force=Fh, hysteresis_length=ell, seat="tied")
     add_initial_steps(am)
     add_table1_steps(am, cycles=cycles)
     with tempfile.TemporaryDirectory() as out:
@@ -83,7 +83,7 @@ def main(argv=None):
     r0, c0, s0 = bay_cycle(0.0, ell, keep=out / "bay_off")
     print(
         f"single bay, idealised path to 3.5 deg and back, then M -> 0: residual rotation {r0:.4f} deg "
-        f"without hysteresis (ball-joint friction only; seed's model: 0)"
+        f"without hysteresis (ball-joint friction only; the paper's model: 0)"
     )
     if args.force is None:
         evals = []
@@ -101,7 +101,7 @@ def main(argv=None):
     r1, c1, s1 = bay_cycle(Fh, ell, keep=out / "bay_on")
     print(
         f"with latch hysteresis F_h = {Fh:.1f} N, ell = {ell * 1e3:g} mm: residual rotation {r1:.4f} deg "
-        f"(seed's bay test: about 0.10 deg)"
+        f"(Stohlman & Pellegrino's bay test: about 0.10 deg)"
     )
     summary.update({"F_h_N": Fh, "bay_residual_off_deg": r0, "bay_residual_on_deg": r1})
     # residual against the largest twist: nothing until a bead leaves its backstop
@@ -116,29 +116,29 @@ def main(argv=None):
     import matplotlib
 
     matplotlib.use("Agg")
-    from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+    from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
     plotstyle.use()
     import matplotlib.pyplot as plt
 
     fig, axs = plt.subplots(1, 3, figsize=(14.0, 4.6))
     for c, lab, col in (
-        (c0, "seed's latch law (no hysteresis)", "#2c7bb6"),
+        (c0, "the paper's latch law (no hysteresis)", "#2c7bb6"),
         (c1, f"hysteresis F_h = {Fh:.0f} N, ell = {ell * 1e3:g} mm", "#c0392b"),
     ):
         mv = np.array(["twist" in s for s in c["step"]])
         for ax in axs[:2]:
             ax.plot(np.degrees(c["theta"][mv]), c["M"][mv], "-", color=col, lw=1.4, label=lab)
-    axs[0].set_title("single bay, idealised path (seed Fig. 16)")
+    axs[0].set_title("single bay, idealised path (cf. Stohlman & Pellegrino Fig. 16)")
     axs[1].set_xlim(-0.02, 0.4)
     axs[1].set_ylim(-45, 45)
     axs[1].axvline(r1, color="#c0392b", ls="--", lw=1)
     axs[1].axvline(args.target, color="k", ls=":", lw=1)
-    axs[1].set_title(f"near the latched state: residual {r1:.3f} deg at M = 0\n(dotted: seed's 0.10 deg)")
+    axs[1].set_title(f"near the latched state: residual {r1:.3f} deg at M = 0\n(dotted: the measured 0.10 deg)")
     for ax in axs[:2]:
         ax.axhline(0, color="0.6", lw=0.8)
         ax.set_xlabel("z-axis rotation (degrees)")
-        ax.set_ylabel("Moment about z-axis (N m, seed sign)")
+        ax.set_ylabel("Moment of the bay on the rig, about z (N m)")
         ax.grid(alpha=0.3)
     axs[0].legend(fontsize=8, loc="lower right")
     sw = np.array(sweep)
@@ -165,7 +165,7 @@ def main(argv=None):
             )
         d = res["on"][0][-1, 5] - res["off"][0][-1, 5]
         print(
-            f"difference made by the latch hysteresis: {d:.3g} arcsec; seed's scaling estimate 2.0 deg "
+            f"difference made by the latch hysteresis: {d:.3g} arcsec; the paper's scaling estimate 2.0 deg "
             f"= {2.0 * 3600:.0f} arcsec (20 bays x 0.10 deg)"
         )
         summary["mast"] = {k: {"table": v[0].tolist(), "bead_travel_m": v[1]} for k, v in res.items()}

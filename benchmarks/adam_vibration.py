@@ -1,4 +1,4 @@
-"""Seed 001 Sec. IV reproduced (issue 18): the mock bay side's out-of-plane latch resonance
+"""Stohlman & Pellegrino's Sec. IV reproduced: the mock bay side's out-of-plane latch resonance
 against the average cable tension, the unit's effective mass identified from Eq. 16, the model
 curve against Eq. 16 (deviation in N against the fit's scatter) and the inverse use.
 
@@ -81,7 +81,7 @@ def main():
     )
     ax.set_xlabel("out-of-plane resonance of the latch (Hz)")
     ax.set_ylabel("average cable tension (N)")
-    ax.set_title("Seed 001 Sec. IV: mock bay side")
+    ax.set_title("ADAM mock bay side (Stohlman & Pellegrino, Sec. IV)")
     ax.legend(fontsize=8)
     ax = axes[1]
     ax.axhspan(-v.EQ16_SD_N, v.EQ16_SD_N, color="0.85", label="+- 8.9 N (2 lbf)")

@@ -1,4 +1,4 @@
-"""Arc-length control (issue 3): the von Mises truss, Lee's frame and Williams' toggle against
+"""Arc-length control: the von Mises truss, Lee's frame and Williams' toggle against
 their independent references; writes benchmarks/out/arc_length.png and prints the errors.
 
     python benchmarks/arc_length.py
@@ -9,7 +9,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
 plotstyle.use()
 import matplotlib.pyplot as plt

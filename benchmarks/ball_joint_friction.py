@@ -1,4 +1,4 @@
-"""Friction ball joint (seed 001, Sec. II.B.1): moment-rotation loops and dissipated energy.
+"""Friction ball joint (Stohlman & Pellegrino, Sec. II.B.1): moment-rotation loops and dissipated energy.
 
 Three panels, all computed with ``fm.solve`` (real analyses, not the kernel alone):
 
@@ -27,7 +27,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
 plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402
@@ -38,7 +38,7 @@ from femast.elements.ball_joint import add_ball_joints, friction_loop_energy  # 
 
 OUT = Path(__file__).resolve().parent / "out"
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "figures"
-MU, B = 0.5, 0.004  # seed 001, Sec. II.B.1
+MU, B = 0.5, 0.004  # Stohlman & Pellegrino, Sec. II.B.1
 A, K_STICK = 0.03, 200.0  # rotation amplitude (rad), stick stiffness (N m/rad)
 FORCES = (250.0, 500.0, 1000.0)
 TABLE_T = [0.0, 1.0, 3.0, 5.0, 7.0, 9.0]  # step times of the turning points

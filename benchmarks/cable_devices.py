@@ -1,10 +1,10 @@
-"""Cable over devices (issue 19 items 1-2): the verification figures and errors of docs/cable_devices.md.
+"""Cable over devices: the verification figures and errors of docs/cable_devices.md.
 
     PYTHONPATH=$PWD python benchmarks/cable_devices.py [--out docs/figures]
 
 1. A capstan pulley (mu = 0.3, wrap pi/2 from the geometry): one end pulled out then back in; the
    tension ratio T_out/T_in against the band exp(+-mu phi) (Euler-Eytelwein).
-2. Two latches on one cable (seed 001 law, k = 100 and 30 N/mm): pulled until both release; the
+2. Two latches on one cable (Stohlman & Pellegrino's latch law, k = 100 and 30 N/mm): pulled until both release; the
    jumps T_{i+1} - T_i against the peaks of Eq. 14.
 3. A frictionless pulley of radius 0.2 m moved along a path: cable length conserved and the
    tension against T = EA (L_geom/L0 - 1) with the closed-form wrapped length.
@@ -25,7 +25,7 @@ import numpy as np  # noqa: E402
 
 from femast.elements.base import IncrementContext  # noqa: E402
 from femast.elements.cable_devices import CableDeviceFamily, Latch, Pulley  # noqa: E402
-from femast.latch import LatchParameters, latch_force  # noqa: E402
+from femast.elements.latch_law import LatchParameters, latch_force  # noqa: E402
 
 EA = 1.0e5
 

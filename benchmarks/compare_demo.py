@@ -4,7 +4,7 @@
     python benchmarks/compare_demo.py --data     # (re)generate the example data in femast/examples (package data)
 
 The example data sets are synthetic (deterministic seeds) with hidden effects; what is hidden
-is stated at the end of the tutorial.  The tip-cycle file holds the seed 001 Table 1 FE
+is stated at the end of the tutorial.  The tip-cycle file holds Stohlman & Pellegrino's Table 1 FE
 prediction (not a measurement) in the tip-cycle format; the bay-torsion file only illustrates
 the format (schematic values).
 """
@@ -79,7 +79,7 @@ def make_data() -> None:
             "x_mm: bead position with the cable stretch removed (Eq. 15); dT_N = T2 - T1 (Eq. 5).",
         ),
     )
-    # tip-cycle: seed 001 Table 1 (FE prediction of the 40-bay mast), SI units
+    # tip-cycle: Stohlman & Pellegrino, Table 1 (FE prediction of the 40-bay mast), SI units
     seq = [0, 1, 0, -1, 0, 1, 0, -1, 0, 1, 0, -1, 0]
     um = 1e-6
     arcsec = np.pi / (180 * 3600)
@@ -97,7 +97,7 @@ def make_data() -> None:
         cols[k] = np.array(v) * (um if k.endswith("_m") else arcsec)
     exp = get_experiment("tip-cycle")
     write_data(
-        DATA / "tip_cycle_seed001_table1.csv",
+        DATA / "tip_cycle_table1.csv",
         Measured("tip-cycle", cols),
         exp,
         fmt="%.6g",

@@ -1,4 +1,4 @@
-"""How far from equilibrium the accepted increments are, strict and predicted correction test (issue 21).
+"""How far from equilibrium the accepted increments are, strict and predicted correction test.
 
     python benchmarks/convergence_acceptance.py [--bays 40 400 1000] [--docs]
 

@@ -1,11 +1,11 @@
-"""Does ``femast diagnose`` hold on data it has never seen?  (issue 14, item 4)
+"""Does ``femast diagnose`` hold on data it has never seen?
 
 Runs ``diagnose`` on every case of :mod:`generalisation.cases` -- mast-top and latch-pull data
 made by an independent generator (``benchmarks/generalisation/``, numpy only, no femast code)
 whose mechanisms are written in other functional forms than femast's effects (Dahl, Bouc-Wen,
 Jenkins friction; tanh, Hertz, piecewise-linear clearance; cubic and asinh stiffening;
 zero-closing cable loops; creep and slip pretension loss; Timoshenko and stepped beams;
-Gaussian, linear and Lorentzian latch bands; ...), under white, heteroscedastic (seed 001
+Gaussian, linear and Lorentzian latch bands; ...), under white, heteroscedastic (Stohlman & Pellegrino
 Eq. 15) and AR(1) noise, with pairs of mechanisms, out-of-library mechanisms and 20 noise
 redraws of each null case -- then prints a confusion table and the score, writes figures and a
 JSON of per-run results to ``benchmarks/out/diagnose_generalisation/``.
@@ -27,7 +27,7 @@ when the report has them, else the conclusion text).
 
 ``score`` = (right non-null cases + sum over null cases of the fraction of their redraws that are
 right) / (non-null cases + null cases): each null case weighs as one case.  ``false-alarm rate``
-= wrong null redraws / all null redraws.  Targets (issue 14): score >= 95 %, false alarms <= 5 %.
+= wrong null redraws / all null redraws.  Targets: score >= 95 %, false alarms <= 5 %.
 Each run diagnoses the baseline model once (no effects added: one round, as a new user would).
 
 Usage::

@@ -1,4 +1,4 @@
-"""Speed of ``diagnose`` (issue 14 targets): a 500-sample mast-top data set with every applicable
+"""Speed of ``diagnose`` (targets): a 500-sample mast-top data set with every applicable
 effect as a candidate (every form of those that gain) and the pair stage, under 15 s on 2 cores;
 the bay-torsion example diagnose under 20 s.
 

@@ -1,4 +1,4 @@
-"""Figure of the effect families of issue 14: the loop or curve each form of an effect draws.
+"""Figure of the effect families: the loop or curve each form of an effect draws.
 
     python benchmarks/effect_families.py        # writes docs/figures/effect_families.png
 

@@ -1,4 +1,4 @@
-"""Time of the short FE runs behind compare, diagnose and the guyed-mast identification (issue 8).
+"""Time of the short FE runs behind compare, diagnose and the guyed-mast identification.
 
     python benchmarks/experiment_runs.py [--repeat 20]
 

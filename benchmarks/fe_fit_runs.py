@@ -1,4 +1,4 @@
-"""How many FE runs (and how much time) the FE experiments' fits take (issue 21, item 6).
+"""How many FE runs (and how much time) the FE experiments' fits take.
 
     python benchmarks/fe_fit_runs.py [--cases bay-compare bay-diagnose tip-diagnose] [--workers N]
                                      [--save FILE.json] [--before FILE.json] [--other CHECKOUT --repeat K]
@@ -9,7 +9,7 @@ set, so that every FE run any process computes is counted (femast/experiments/fe
 
 * ``bay-compare``: ``femast compare bay-torsion example --fit``;
 * ``bay-diagnose``: ``femast diagnose bay-torsion example --workers W``;
-* ``tip-diagnose``: ``femast diagnose tip-cycle example --workers W`` (the 40-bay mast of seed 001
+* ``tip-diagnose``: ``femast diagnose tip-cycle example --workers W`` (the 40-bay mast of Stohlman & Pellegrino
   Table 1).
 
 Printed per case: FE runs, the seconds spent in them (summed over the processes), wall time, CPU

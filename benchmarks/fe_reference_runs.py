@@ -1,4 +1,4 @@
-"""Reference runs as the predictor of the bay-torsion FE runs (issue 21, item 6).
+"""Reference runs as the predictor of the bay-torsion FE runs.
 
     python benchmarks/fe_reference_runs.py [--repeat 7]
 

@@ -1,4 +1,4 @@
-"""FE mast versus the analytic complete-mast model of seed 000 (issue 6, item 3).
+"""FE mast versus the analytic complete-mast model of the Rocaspect paper.
 
 1. Term by term at the pretensioned equilibrium (400 N and 1200 N): K_beam, K_p, K_a of the FE
    (condensed tangent, shroud tangent switched part by part) against Eqs. 8-18, 24, 26.
@@ -24,7 +24,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
 plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402

@@ -1,4 +1,4 @@
-"""Mast-1 top displacement of the Rocaspect robot predicted by the seed's mast models (seed 000, Figs. 5-6).
+"""Mast-1 top displacement of the Rocaspect robot predicted by the Rocaspect paper's mast models (Figs. 5-6).
 
 The platform follows a trajectory like the seed's Fig. 5a (:func:`femast.guyed.rocaspect.fig5a_trajectory`).
 At each pose the cable tensions come from the barycentric tension distribution, the cable
@@ -42,7 +42,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
 plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402
@@ -105,7 +105,7 @@ def predict_3r(case: Case, dw):
 
 
 def predict_beam(case: Case, dw):
-    """Cantilever model (Eqs. 8-15) with the case's E (identified from the 3R curve if the seed gives none)."""
+    """Cantilever model (Eqs. 8-15) with the case's E (identified from the 3R curve if the paper gives none)."""
     if case.E_beam is None:
         fit = fit_beam_E(dw, predict_3r(case, dw), L=L_BEAM, rows=(0, 1, 2))
         case.E_beam = float(fit.x[0])
@@ -194,7 +194,7 @@ def plot(res, path: Path):
         xlabel="x (m)",
         ylabel="y (m)",
         zlabel="z (m)",
-        title="(a) platform trajectory (cf. seed Fig. 5a)",
+        title="(a) platform trajectory (cf. Rocaspect paper Fig. 5a)",
         zlim=(0, 4.2),
     )
     ax.set_box_aspect((8.3, 6.8, 4.0))
@@ -218,7 +218,7 @@ def plot(res, path: Path):
         )
         a.grid(alpha=0.3)
         a.legend()
-    fig.suptitle("Seed 000: mast-1 top displacement from the initial pose, analytic and FE models (cf. Fig. 6)")
+    fig.suptitle("Rocaspect mast 1: top displacement from the initial pose, analytic and FE models (cf. Fig. 6)")
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     plotstyle.save(fig, path, dpi=110)
@@ -238,7 +238,7 @@ def main(argv=None):
     print(
         "beam E per case (Pa): "
         + ", ".join(f"{c.name}: {c.E_beam:.3g}" for c in res["cases"])
-        + "  (400 N: identified from the 3R curve; the seed gives none)"
+        + "  (400 N: identified from the 3R curve; the paper gives none)"
     )
     print(table(res))
     if any(c.fe_tension is not None and c.fe_tension.size for c in res["cases"]):

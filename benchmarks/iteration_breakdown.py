@@ -32,24 +32,24 @@ PARTS = [  # (module, attribute path, label); an indented label is part of the o
     ("femast.analysis.system", "System.residual", "residual assembly (internal forces - loads)"),
     ("femast.analysis.assembly", "Assembler.tangent_into", "tangent assembly into the solver's matrix"),
     ("femast.analysis.assembly", "Assembler.tangent", "tangent assembly into CSR"),
-    ("femast.analysis.solvers.linear", "SparseLU.factorize_values", "factorisation (from the solver's matrix)"),
-    ("femast.analysis.solvers.banded", "_fill_split", "  band: symmetric part + asymmetry (_fill_split)"),
-    ("femast.analysis.solvers.banded", "lapack.dpbtrf", "  band: Cholesky (dpbtrf)"),
-    ("femast.analysis.solvers.banded", "lapack.dgbtrf", "  band: LU (dgbtrf)"),
-    ("femast.analysis.solvers.linear", "SparseLU.factorize", "factorisation (CSR path)"),
-    ("femast.analysis.solvers.linear", "SparseLU.solve", "solve (incl. refinement)"),
-    ("femast.analysis.solvers.banded", "lapack.dpbtrs", "  band: Cholesky solves (dpbtrs)"),
-    ("femast.analysis.solvers.banded", "_residual_split", "  band: refinement residual (_residual_split)"),
+    ("femast.analysis.linalg.linear", "SparseLU.factorize_values", "factorisation (from the solver's matrix)"),
+    ("femast.analysis.linalg.banded", "_fill_split", "  band: symmetric part + asymmetry (_fill_split)"),
+    ("femast.analysis.linalg.banded", "lapack.dpbtrf", "  band: Cholesky (dpbtrf)"),
+    ("femast.analysis.linalg.banded", "lapack.dgbtrf", "  band: LU (dgbtrf)"),
+    ("femast.analysis.linalg.linear", "SparseLU.factorize", "factorisation (CSR path)"),
+    ("femast.analysis.linalg.linear", "SparseLU.solve", "solve (incl. refinement)"),
+    ("femast.analysis.linalg.banded", "lapack.dpbtrs", "  band: Cholesky solves (dpbtrs)"),
+    ("femast.analysis.linalg.banded", "_residual_split", "  band: refinement residual (_residual_split)"),
     ("femast.analysis.system", "System.converged", "convergence test"),
     ("femast.analysis.system", "System.update", "configuration update"),
     ("femast.analysis.system", "System.commit", "commit (per increment)"),
     ("femast.analysis.output", "ResultsObserver.converged", "results frame (per increment)"),
-    # older femast (issue 8): the same parts under their names of then
+    # older femast: the same parts under their names of then
     ("femast.analysis", "Analysis._residual", "residual assembly"),
     ("femast.analysis", "Analysis._converged", "convergence test"),
     ("femast.analysis", "Analysis._update", "configuration update"),
     ("femast.analysis", "Analysis._write", "results frame (gather + hand-over)"),
-    ("femast.analysis.solvers.linear", "SparseLU._factor_permuted", "  of which SuperLU factorisations (all)"),
+    ("femast.analysis.linalg.linear", "SparseLU._factor_permuted", "  of which SuperLU factorisations (all)"),
 ]
 
 
@@ -174,7 +174,7 @@ def plot(results, path):
     import matplotlib
 
     matplotlib.use("Agg")
-    from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+    from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
     plotstyle.use()
     import matplotlib.pyplot as plt
@@ -212,7 +212,7 @@ def plot(results, path):
             label="the rest (Python between the parts)" if y == 0 else None,
         )
         ax.text(r["whole"] / r["superlu"] + 0.02, y, f"{r['whole'] / r['superlu']:.2f}", va="center")
-    ax.axvline(1.3, color="r", ls=":", label="target 1.3 (issue 21)")
+    ax.axvline(1.3, color="r", ls=":", label="target 1.3")
     ax.set(
         yticks=range(len(results)),
         yticklabels=[f"{r['bays']} bays" for r in results],

@@ -1,4 +1,4 @@
-"""Latch identification from pull tests (seed 001, Figs. 9-10, Eq. 15), on synthetic data.
+"""Latch identification from pull tests (Stohlman & Pellegrino, Figs. 9-10, Eq. 15), on synthetic data.
 
 The "measured" tests are simulated with the cable/latch element for a known latch
 (the seed's fit), with noise on the cable end distance (5 um) and the tension
@@ -18,13 +18,13 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
 plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force  # noqa: E402
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force  # noqa: E402
 from femast.latch_identification import fit_pull_tests, simulate_pull_test  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "out"

@@ -1,4 +1,4 @@
-"""Reproduce seed 001, Fig. 10 (with the zones of Fig. 6): latch force jump vs bead position.
+"""Reproduce Stohlman & Pellegrino, Fig. 10 (with the zones of Fig. 6): latch force jump vs bead position.
 
 Plots, for the seed's fitted latch (r = 1.1 mm, x_backstop = 2.0 mm, k = 100 N/mm,
 mu = 0.07, h = 1.5 mm, R = 2.4 mm):
@@ -23,13 +23,13 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
 plotstyle.use()
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from femast.latch import (  # noqa: E402
+from femast.elements.latch_law import (  # noqa: E402
     LATCHING,
     UNLATCHING,
     LatchParameters,

@@ -1,10 +1,10 @@
-"""Latch pull tests reversed part-way (issue 22): the latch-pull model against independent rig data
+"""Latch pull tests reversed part-way: the latch-pull model against independent rig data
 and against an FE run of one cable/latch element; writes docs/figures/latch_pull_partial_reversal.png.
 
     python benchmarks/latch_pull_partial.py
 
 Data: ``benchmarks/latch_rig.py`` (quasi-static rig from the seed's Eqs. 7-11, no femast code),
-0.5 N and 2 um noise.  FE: a femast Model with one cable/latch element (seed 001 Eqs. 2-5, two
+0.5 N and 2 um noise.  FE: a femast Model with one cable/latch element (Stohlman & Pellegrino, Eqs. 2-5, two
 sections, latch at the middle node on a 1e9 N/m mount), the outer grip driven by a prescribed
 displacement, the inner section slack.  Prints the RMS error / noise of each null case for the
 model with the loaded side (this issue) and with the old rule (clipping by the direction of motion).
@@ -36,7 +36,7 @@ def fe_partial_unlatching(
     ``status`` latch status (0 stick, +1 slip out, -1 slip in, 2 backstop)."""
     import femast as fm
     from femast.elements.cable_latch import CableLatchFamily
-    from femast.latch import LatchParameters, latch_force
+    from femast.elements.latch_law import LatchParameters, latch_force
 
     P = LatchParameters.seed_fit()
     m = fm.Model("latch pull test")
@@ -69,9 +69,9 @@ def fe_partial_unlatching(
 
 
 def direction_rule(x, dT, params):
-    """The latch-pull prediction before issue 22 for a moving bead: branch of the direction of motion
+    """The latch-pull prediction of the direction of motion for a moving bead: branch of the direction of motion
     clipped to that direction's sign (for the figure only)."""
-    from femast.latch import latch_force
+    from femast.elements.latch_law import latch_force
 
     p = np.array([params["r"], params["x_backstop"], params["k"], params["mu"], 1.5e-3, 2.4e-3])
     sig = np.sign(np.gradient(x))
@@ -90,7 +90,7 @@ def main():
 
     exp = get_experiment("latch-pull")
     latch = SeedLatch()
-    print("null cases (independent rig data, 0.5 N / 2 um noise, seed fit):")
+    print("null cases (independent rig data, 0.5 N / 2 um noise, the published latch fit):")
     print(f"  {'case':32s} {'rows':>5s} {'RMS/noise drawn':>16s} {'RMS/noise est.':>15s}")
     runs = {}
     for name, (knots, side, x0) in paths(latch).items():
@@ -116,7 +116,7 @@ def main():
     ):
         run, cols, p = runs[name]
         ax.plot(cols["x_mm"], cols["dT_N"], ".", ms=2, color="0.6", label="independent rig data (0.5 N noise)")
-        ax.plot(cols["x_mm"], p, "-", lw=1.0, color="C3", label="latch-pull model, loaded side (issue 22)")
+        ax.plot(cols["x_mm"], p, "-", lw=1.0, color="C3", label="latch-pull model, loaded side")
         ax.plot(
             1e3 * run["x_meas"],
             direction_rule(run["x_meas"], run["dT"], SEED),

@@ -1,6 +1,6 @@
-"""Independent simulator of the seed-001 latch pull-test rig (Sec. III.B, Fig. 8), for test data.
+"""Independent simulator of the latch pull-test rig of Stohlman & Pellegrino (Sec. III.B, Fig. 8), for test data.
 
-Written from the seed's equations without :mod:`femast.latch` or the ``latch-pull`` experiment,
+Written from the seed's equations without :mod:`femast.elements.latch_law` or the ``latch-pull`` experiment,
 so that data with partial reversals can test that model.  Differences in form on purpose:
 
 * the latch law is evaluated in the seed's angle form, Eqs. 7-11 (``cos(theta) = x / (r + R)``,
@@ -26,7 +26,7 @@ import numpy as np
 
 
 class SeedLatch:
-    """Roller latch of seed 001 Sec. III.A (SI): r, R, h (m), k (N/m, one roller), mu (-), x_backstop (m)."""
+    """Roller latch of Stohlman & Pellegrino, Sec. III.A (SI): r, R, h (m), k (N/m, one roller), mu (-), x_backstop (m)."""
 
     def __init__(self, r=1.1e-3, x_backstop=2.0e-3, k=1e5, mu=0.07, h=1.5e-3, R=2.4e-3):
         self.r, self.xb, self.k, self.mu, self.h, self.R = r, x_backstop, k, mu, h, R

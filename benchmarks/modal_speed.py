@@ -1,4 +1,4 @@
-"""Speed of the prestressed modal analysis (issue 18): the first 10 modes of the 40-bay ADAM mast
+"""Speed of the prestressed modal analysis: the first 10 modes of the 40-bay ADAM mast
 after its pretension step (target: under 1 s), and a 400-bay mast reported.
 
     python benchmarks/modal_speed.py [--bays 40 400] [--out benchmarks/out/modal_speed]

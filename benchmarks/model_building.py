@@ -1,4 +1,4 @@
-"""Model building: a Python call per element against one call from arrays (issue 21, item 4).
+"""Model building: a Python call per element against one call from arrays.
 
     python benchmarks/model_building.py [--bays 40 200 400 1000] [--repeat 5] [--docs]
 

@@ -1,4 +1,4 @@
-"""The floor of the Newton loop: femast's own parts in a loop written for one model (issue 8).
+"""The floor of the Newton loop: femast's own parts in a loop written for one model.
 
     python benchmarks/newton_floor.py [--bays 40] [--repeat 3]
 
@@ -37,9 +37,9 @@ def minimal_run(mast, n_inc):
     from femast.analysis import Analysis
     from femast.analysis.assembly import _scatter_matrix, _scatter_vector
     from femast.analysis.configuration import update_configuration
-    from femast.analysis.solvers.convergence import Convergence, force_moment_abs_max
-    from femast.analysis.solvers.linear import _unpermute
-    from femast.analysis.solvers.ordering import permuted_positions
+    from femast.analysis.convergence import Convergence, force_moment_abs_max
+    from femast.analysis.linalg.linear import _unpermute
+    from femast.analysis.linalg.ordering import permuted_positions
     from femast.elements.beam_corot import beam_family_kernel
     from femast.post.results import ResultsWriter
     from femast.rotations import rotation_vectors

@@ -1,4 +1,4 @@
-"""Newton variants: factorisations and wall time per increment (issue 21, item 2).
+"""Newton variants: factorisations and wall time per increment.
 
     python benchmarks/newton_variants.py [--bays 40 400] [--png docs/figures/newton_variants.png]
 
@@ -119,7 +119,7 @@ def run_adam_bay(tangent):
 
 
 def plot(all_runs, png):
-    from femast import plotstyle
+    from femast.post import plotstyle
 
     plt = plotstyle.pyplot()
     models = list(all_runs)

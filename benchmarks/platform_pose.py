@@ -1,4 +1,4 @@
-"""Pose error of the Rocaspect platform on compliant masts (issue 19 item 3; seed 000, Figs. 5a and 7).
+"""Pose error of the Rocaspect platform on compliant masts (the Rocaspect paper, Figs. 5a and 7).
 
     PYTHONPATH=$PWD python benchmarks/platform_pose.py [--out docs/figures] [--n 25] [--no-speed]
 

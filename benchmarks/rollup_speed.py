@@ -1,4 +1,4 @@
-"""Speed of the FE core (issue 2): a 1000-element cantilever rolled into a full circle by
+"""Speed of the FE core: a 1000-element cantilever rolled into a full circle by
 M = 2 pi EI/L in 20 load increments.  Prints wall time, Newton iterations, time per
 iteration and the split between assembly (element kernels + scatter into CSR) and the
 sparse linear solve (factorisation + back-substitution) of the same matrices.

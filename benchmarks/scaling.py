@@ -1,5 +1,5 @@
 """How femast's cost grows with model size, and how close a Newton iteration is to the linear
-solve (issue 8, item 2).
+solve.
 
     python benchmarks/scaling.py [--bays 40 100 200 400 700 1000] [--increments 10] [--repeat 3] [--sweeps 2]
 
@@ -421,7 +421,7 @@ def plot(rows, path):
     import matplotlib
 
     matplotlib.use("Agg")
-    from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+    from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
     plotstyle.use()
     import matplotlib.pyplot as plt

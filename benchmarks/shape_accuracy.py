@@ -1,12 +1,12 @@
-"""Shape accuracy of the ADAM mast under manufacturing and assembly scatter (issue 20 item 4;
-seed 001): how far is the tip from where it should be, after deployment and after the Table 1
+"""Shape accuracy of the ADAM mast under manufacturing and assembly scatter (Stohlman &
+Pellegrino): how far is the tip from where it should be, after deployment and after the Table 1
 load cycles, which inputs drive it, and how does it grow with the number of bays?
 
     femast run benchmarks/shape_accuracy.py [--bays 10 20] [--samples 32 32] [--plain-bays 40]
                                             [--plain-samples 64] [--big 350] [--big-samples 4]
                                             [--workers 2] [--out DIR] [--report-only] [--docs]
 
-For each mast (n bays of seed 001's bay, femast.adam defaults) a study of ``femast.studies`` draws
+For each mast (n bays of Stohlman & Pellegrino's bay, femast.adam defaults) a study of ``femast.studies`` draws
 samples of the stated scatter (femast/adam/shape_study.py SCATTER, every value independent per
 element, uniform):
 
@@ -49,7 +49,7 @@ from femast.post import plotstyle
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs" / "figures"
 ARCSEC = 180.0 / np.pi * 3600.0
-ATK_LENGTH_M = 1.3e-3  # seed 001 Sec. I: ATK's length accuracy and repeatability, +- m over 60 m
+ATK_LENGTH_M = 1.3e-3  # Stohlman & Pellegrino, Sec. I: ATK's length accuracy and repeatability, +- m over 60 m
 ATK_ROT_RAD = np.radians(0.02)  # +- 0.02 deg of rotational misalignment over 60 m
 ATK_BAYS = 350  # 350 bays of 0.171 m: 59.9 m, ATK's 60 m
 SEED_BAY_RESIDUAL_RAD = np.radians(0.10)  # seed Sec. VIII: residual rotation of one bay at zero moment

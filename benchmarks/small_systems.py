@@ -1,25 +1,25 @@
-"""Linear solves of small tangents: SuperLU, the band back-end and a dense LAPACK LU (issue 21, item 3).
+"""Linear solves of small tangents: SuperLU, the band back-end and a dense LAPACK LU.
 
     python benchmarks/small_systems.py [--rounds 5] [--png benchmarks/out/small_systems.png]
 
 For a model of a few dozen to a few hundred DOFs the factorisation's arithmetic is microseconds;
 the cost is the bookkeeping around it.  Each model is run once with SuperLU, its tangents are kept,
 and the tangent of the middle iteration is factorised and solved through
-:class:`~femast.analysis.solvers.linear.SparseLU` (the path of an analysis: the values gathered into
+:class:`~femast.analysis.linalg.linear.SparseLU` (the path of an analysis: the values gathered into
 the permuted matrix, the back-end's factorisation, a solve with its permutation and checks) by
 
 * ``superlu``: scipy's SuperLU;
 * ``banded``: the band back-end as the automatic rule uses it on masts (the Cholesky of the
   symmetric part refined against the tangent, or the band LU);
 * ``banded-lu``: the band back-end's LU alone (``dgbtrf``: no refinement);
-* ``dense``: the dense LU (``dgetrf``/``dgetrs``, :mod:`femast.analysis.solvers.dense`).
+* ``dense``: the dense LU (``dgetrf``/``dgetrs``, :mod:`femast.analysis.linalg.dense`).
 
 Models: the 45-degree bend of benchmarks/peers/bend45.py with 4, 8, 16 and 32 elements (a chain:
 24-192 DOFs, RCM half-band 11), the truss mast of benchmarks/peers with 2, 5 and 10 bays (72-264
 DOFs), a compact beam grid (3 x 3 x 3 nodes: a wide band) and the ADAM bay of the bay-torsion
 experiment (a constrained model).  Printed per tangent and back-end: CPU time of a
 factorisation + solve (best of ``--rounds`` interleaved rounds, each the mean of many calls) and
-the normwise backward error; then the automatic choice (:func:`femast.analysis.solvers.backends.choose`).
+the normwise backward error; then the automatic choice (:func:`femast.analysis.linalg.backends.choose`).
 The figure plots the CPU time against the DOFs.
 """
 
@@ -40,8 +40,8 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from solver_backends import Capture, adam_bay_tangents, backward_error  # noqa: E402
 
-from femast.analysis.solvers import backends, linear  # noqa: E402
-from femast.analysis.solvers.banded import BandedFactor, band_of  # noqa: E402
+from femast.analysis.linalg import backends, linear  # noqa: E402
+from femast.analysis.linalg.banded import BandedFactor, band_of  # noqa: E402
 
 ENGINES = ("superlu", "banded", "banded-lu", "dense")
 

@@ -1,10 +1,10 @@
-"""Linear-solver back-ends on femast's own tangents (issue 21, item 1).
+"""Linear-solver back-ends on femast's own tangents.
 
     python benchmarks/solver_backends.py [--bays 40 400 1000] [--reps 7] [--png docs/figures/solver_backends.png]
 
 Each model is run once with SuperLU, every factorised tangent is kept, and the tangent of the
 middle iteration (a mid-increment, out-of-balance state) is factorised and solved ``--reps``
-times by each back-end (:mod:`femast.analysis.solvers.backends`):
+times by each back-end (:mod:`femast.analysis.linalg.backends`):
 
 * the corotational truss mast of benchmarks/peers (40, 400, 1000 bays: 960 to 24 000 DOFs);
 * the ADAM bay with ball-joint friction and latches, along the bay-torsion example path (a
@@ -37,7 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks" / "peers"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from femast.analysis.solvers import (
+from femast.analysis.linalg import (
     backends,  # noqa: E402
     linear,  # noqa: E402
 )
@@ -177,7 +177,7 @@ def near_singular(K, rhs):
 
 
 def plot(rows, png):
-    from femast import plotstyle
+    from femast.post import plotstyle
 
     plt = plotstyle.pyplot()
     models = list(rows)

@@ -1,4 +1,4 @@
-"""Stabilised initial step (issue 3, item 3): the guyed pin-based mast of docs/stabilize.md;
+"""Stabilised initial step: the guyed pin-based mast of docs/stabilize.md;
 plots the strain and stabilisation energies and their ratio per increment.
 
     python benchmarks/stabilize_energy.py
@@ -9,7 +9,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
 plotstyle.use()
 import matplotlib.pyplot as plt

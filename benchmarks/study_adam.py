@@ -1,10 +1,10 @@
-"""A study script: the tip of an ADAM mast (seed 001) over the scatter of its joint friction,
+"""A study script: the tip of an ADAM mast (Stohlman & Pellegrino) over the scatter of its joint friction,
 cable pretension and longeron lengths, after pretensioning and one Table 1 cycle.
 
     femast study benchmarks/study_adam.py --samples 64 --workers 2     # 10 bays (ADAM_BAYS=40: 40)
 
 Used by benchmarks/study_throughput.py (``adam_study(n_bays)``).  The scatter is illustrative
-(issue 20 item 4 states the seed's): friction coefficient mu uniform 0.4-0.6, pretension
+(the shape-accuracy study states the paper's): friction coefficient mu uniform 0.4-0.6, pretension
 uniform +-10 % of 170 N, each longeron's unstressed length off by a normal 0.025 mm standard
 deviation truncated at +-0.05 mm.
 """

@@ -1,5 +1,5 @@
-"""A study script: where the top of a guyed Rocaspect mast (seed 000) ends up over the scatter of
-its shroud lengths, shroud pretensions and the temperature (issue 20).
+"""A study script: where the top of a guyed Rocaspect mast ends up over the scatter of
+its shroud lengths, shroud pretensions and the temperature.
 
     femast study benchmarks/study_guyed.py --samples 128 --workers 2     # the study + its report
     python benchmarks/study_guyed.py [--samples 128] [--workers 2]      # the same, plus the error figure
@@ -16,7 +16,7 @@ Scatter (stated here; the seed gives none):
   deviation (read on a tension gauge); it sets the rope's unstretched length in the nominal geometry
   (:func:`femast.elements.shroud_cable.unstretched_length`), to which the length error adds;
 * temperature change ``dT`` from the installation: uniform -20..+20 K (a day outdoors), with
-  Dyneema's -12e-6 /K along the fibre and aluminium's +23e-6 /K (seed 000 gives no expansion).
+  Dyneema's -12e-6 /K along the fibre and aluminium's +23e-6 /K (the Rocaspect paper gives no expansion).
 
 Outputs: the top displacement ``top_u`` (m) and spin ``top_rot`` (rad) from the initial geometry at
 the end of the steps ``thermal`` (the unloaded mast) and ``load``; the error is their difference
@@ -123,7 +123,7 @@ def error_figure(folder, png):
     for a in ax:
         a.grid(alpha=0.3)
         a.legend(fontsize=8)
-    fig.suptitle("Guyed Rocaspect mast 1: top position minus the nominal mast's (FE, seed 000 shroud law)")
+    fig.suptitle("Guyed Rocaspect mast 1: top position minus the nominal mast's (FE, Rocaspect Dyneema law)")
     fig.tight_layout()
     fig.savefig(png, dpi=110)
     plt.close(fig)

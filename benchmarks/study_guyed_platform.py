@@ -1,5 +1,5 @@
-"""A study script: the platform error of the Rocaspect cable robot (seed 000, Fig. 7) over the
-scatter of its 12 shroud lengths, 12 shroud pretensions and the temperature (issue 20).
+"""A study script: the platform error of the Rocaspect cable robot (the Rocaspect paper, Fig. 7) over the
+scatter of its 12 shroud lengths, 12 shroud pretensions and the temperature.
 
     femast study benchmarks/study_guyed_platform.py --samples 64 --workers 2
     python benchmarks/study_guyed_platform.py [--samples 64] [--workers 2]   # + the figure

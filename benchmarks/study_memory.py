@@ -1,4 +1,4 @@
-"""Memory of a large study (issue 20, item 3): a 100 000-sample study never holds everything in
+"""Memory of a large study: a 100 000-sample study never holds everything in
 memory.  Runs a study of a cheap function (3 inputs, 2 outputs of which one an array of 8) for
 10 000 and for 100 000 samples, each in a fresh process, and prints the peak resident memory
 (ru_maxrss) of the run and of the report (percentiles, convergence, figures): if the results

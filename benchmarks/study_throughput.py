@@ -1,4 +1,4 @@
-"""Throughput of femast.studies (issue 20, item 5): runs per second per core for the 10- and
+"""Throughput of femast.studies: runs per second per core for the 10- and
 40-bay ADAM masts (benchmarks/study_adam.py: pretension + one Table 1 cycle), the speed-up from 1
 to 2 local worker processes, the overhead per sample of the dask path against local processes,
 and the 1000-sample 10-bay study against its target (under 10 minutes on 2 cores).

@@ -1,4 +1,4 @@
-"""Verification of the FE core (issue 2): prints the table of every case (reference, femast,
+"""Verification of the FE core: prints the table of every case (reference, femast,
 error) and writes load-displacement plots against the references and a VTK series.
 
     python benchmarks/verification.py [--out benchmarks/out/verification]
@@ -11,7 +11,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-from femast.post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+from femast.post import plotstyle  # noqa: E402  (the one femast figure style)
 
 plotstyle.use()
 import matplotlib.pyplot as plt
@@ -148,7 +148,7 @@ def main():
 
 
 def modal_cases(out):
-    """Issue 18: modal analysis against closed forms; figure modal_verification.png."""
+    """Modal analysis against closed forms; figure modal_verification.png."""
     from femast.verification import modal as vm
 
     rows = []

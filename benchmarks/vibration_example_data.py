@@ -1,5 +1,5 @@
-"""Writes femast/examples/vibration_example.csv (package data): the seed's calibration on the mock bay side
-(issue 18), nine pretension settings 120-200 N, the latch's out-of-plane resonance, with a
+"""Writes femast/examples/vibration_example.csv (package data): the seed's calibration on the mock bay side,
+nine pretension settings 120-200 N, the latch's out-of-plane resonance, with a
 hidden pretension loss of 15 N (the cables carry 15 N less than the settings say) and 0.12 Hz of
 measurement noise.
 

@@ -12,17 +12,13 @@ Quick start::
     print(res.node_history(b, "uz"))
 """
 
-from . import _aliases, numba_cache
+from . import _moved, numba_cache
 
 numba_cache.configure()  # a source checkout: numba's cache in a folder keyed by the kernels' sources
 
-_aliases.install()  # the import paths of before the package move (issue 15) keep working
-
 from .analysis import Analysis, solve
-from .analysis.solvers.arclength import ArcLength
-from .analysis.solvers.control import DisplacementControl, LoadControl
-from .analysis.solvers.convergence import Convergence
-from .analysis.solvers.stabilize import Stabilize
+from .analysis.control import ArcLength, DisplacementControl, LoadControl, Stabilize
+from .analysis.convergence import Convergence
 from .errors import ConvergenceError, DataFileError, EquilibriumError, FemastError, ModelError, SingularModelError
 from .model import Model
 from .model.amplitudes import Amplitude
@@ -56,8 +52,12 @@ __all__ = [
 __version__ = "0.1.0"
 
 
-def __getattr__(name):  # fm.results, fm.sections...: the old top-level modules, imported on first use
-    return _aliases.attribute(name)
+def __getattr__(name):  # fm.results, fm.sections...: the old top-level modules (they warn: femast._moved)
+    if name in _moved.OLD_TOP_LEVEL:
+        import importlib
+
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 from .jit import watch as _watch_compile

@@ -233,12 +233,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=_warmup)
     try:
-        from .cli_experiments import register  # compare / diagnose (issue 7), when present
+        from .cli_experiments import register  # compare / diagnose, when present
     except ImportError:
         register = None
     if register is not None:
         register(sub, _Help)
-    from .studies.cli import register as register_study  # femast study (issue 20)
+    from .studies.cli import register as register_study  # femast study
 
     register_study(sub, _Help)
     for name, sp in sub.choices.items():  # --quiet also after the command (SUPPRESS: keeps the main one's value)

@@ -269,7 +269,7 @@ def _diagnose(args):
         exclude=_effect_names(args.exclude),
         base_effects=effects,
         sigma=_sigmas(args.sigma),
-        workers=args.workers,
+        workers="auto" if args.workers is None else args.workers,
         scheduler=args.scheduler,
         out=out,
         max_rows=args.max_rows,

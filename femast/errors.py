@@ -17,6 +17,12 @@ class SingularModelError(FemastError):
     """The tangent stiffness is singular: the model has a mechanism or rigid-body mode."""
 
 
+class ElementConvergenceError(FemastError, FloatingPointError):
+    """An element's own equations (a cable's device equations) did not converge at a trial
+    configuration.  The analysis treats it as a failed attempt and cuts the increment back (it is a
+    FloatingPointError for the Newton loop); called directly, it says what to change."""
+
+
 class ConvergenceError(FemastError):
     """The solver gave up on a step after cutting the increment back to its minimum."""
 

@@ -45,9 +45,9 @@ SETUP_PYTHON_MAX = 20_000  # inner-loop iterations (~10 ms of Python)
 # Set-up kernels that return new arrays computed from their arguments alone and write none of them
 # (qualified names): on the plain-Python path their results are remembered by a digest of the
 # arguments, so a process that builds the same small model again and again (the FE fits of
-# femast.experiments: 50-60 runs of one bay in a diagnosis) computes its pattern once (issue 21:
-# the bay's assembly pattern is 12 ms of its 82 ms per run in Python).
-MEMO_KERNELS = frozenset({"femast.analysis.assembly._pattern_kernel", "femast.analysis.solvers.ordering._permuted_csc"})
+# femast.experiments: 50-60 runs of one bay in a diagnosis) computes its pattern once
+# (the bay's assembly pattern is 12 ms of its 82 ms per run in Python).
+MEMO_KERNELS = frozenset({"femast.analysis.assembly._pattern_kernel", "femast.analysis.linalg.ordering._permuted_csc"})
 MEMO_ENTRIES = 16
 _MEMO: dict = {}
 _MEMO_LOCK = threading.Lock()  # (models built in threads: a Study on dask threads)

@@ -1,4 +1,4 @@
-"""Identification of the latch law from pull tests (seed 001, Section III.B-C, Eq. 15).
+"""Identification of the latch law from pull tests (Stohlman & Pellegrino, Section III.B-C, Eq. 15).
 
 A pull test (seed Fig. 8) pulls the bead into (latching) or out of (unlatching) the
 latch with one cable while the cable on the other side of the latch is slack, and
@@ -15,7 +15,7 @@ records the cable end-to-end distance ``d_i`` (m) and the tension ``T_i`` (N).
    the seed's form) and -1 when it grows as the bead moves in (latching rig, Fig.
    8a); ``d0`` is the zero-tension distance with the bead on the roller axis.  The
    measured force jump is ``dT_i = direction * T_i`` (direction +1 unlatching, -1
-   latching; see :mod:`femast.latch` for the signs).
+   latching; see :mod:`femast.elements.latch_law` for the signs).
 2. Fit r, x_backstop, k, mu (h and R measured) by ``scipy.optimize.least_squares``.
    Each point is compared with the *graph* of its branch of Eq. 14: the curve
    ``dT_sigma(x)`` for ``x > -x_backstop`` and the vertical segment of the backstop,
@@ -34,8 +34,8 @@ import numpy as np
 from scipy.optimize import OptimizeResult, least_squares
 
 from .elements.cable_latch import CableLatchFamily
+from .elements.latch_law import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force
 from .errors import ModelError
-from .latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force
 
 FIT_NAMES = ("r", "x_backstop", "k", "mu")
 _REF = np.array([1e-3, 1e-3, 1e5, 0.1])  # scales of the fitted parameters (m, m, N/m, -)
@@ -72,7 +72,7 @@ class PullTest:
 
 
 def remove_cable_stretch(d, T, EA, L_cable, d0=0.0, sign=1):
-    """Bead position from the cable end distance, seed 001 Eq. 15 (m).
+    """Bead position from the cable end distance, Stohlman & Pellegrino, Eq. 15 (m).
 
     d : cable end-to-end distance, m.  T : tension, N.  EA : axial rigidity, N.
     L_cable : unstretched length of the loaded cable, m.  d0 : offset, m.

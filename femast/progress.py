@@ -1,4 +1,4 @@
-"""Progress for waits a person sits through (issue 17): tqdm bars on stderr, erased when done.
+"""Progress for waits a person sits through: tqdm bars on stderr, erased when done.
 
 Bars show only when stderr is a terminal and femast is not quiet (``femast --quiet``,
 :func:`set_quiet`, or the environment variable ``FEMAST_QUIET=1``), so logs, pipes and test
@@ -10,6 +10,9 @@ never mixed into the error message.
   as they happen (:func:`tick` ``("FE runs")`` from the FE experiments).
 * :func:`items` -- a bar over a known list (the cases of a benchmark, the refits of diagnose),
   naming the item being worked on.
+* :class:`Relays` and :func:`relay_to` -- progress from worker processes: a worker's :func:`tick`
+  calls go to a small file of its task, which the parent reads while it waits, so a bar over
+  tasks that run elsewhere (diagnose's refits) moves with every model run inside them.
 
 A terminal that reports no width (``script``, some CI consoles: 0 columns) cannot draw a bar; there,
 and wherever ``FEMAST_PROGRESS=plain`` is set (a log file), progress is plain text instead: a line
@@ -21,10 +24,13 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import sys
+import tempfile
 
 _QUIET = False
 _ACTIVE = []  # stack of (bar, counts) of the open tasks, innermost last
+_RELAY = None  # file this process's ticks are also appended to (a worker's task), or None
 
 
 def set_quiet(quiet: bool = True) -> None:
@@ -98,7 +104,8 @@ class PlainProgress:
     def line(self) -> str:
         """The progress line as it stands."""
         now = self._time() - self.start
-        count = f"{self.n}/{self.total}" if self.total else f"{self.n}"
+        n = f"{self.n:.1f}" if self.n != int(self.n) else f"{int(self.n)}"  # tasks partly done: 3.4/12
+        count = f"{n}/{self.total}" if self.total else n
         when = f"{_clock(now)} elapsed"
         if self.total and 0 < self.n < self.total:
             when += f", ~{_clock(now * (self.total - self.n) / self.n)} left"
@@ -153,7 +160,14 @@ def task(desc: str, unit: str = "evaluations", delay: float = 0.0):
 
 def tick(kind: str | None = None) -> None:
     """One unit of work done: the innermost :func:`task` counts it (``kind`` None) or shows the
-    running count of ``kind`` (e.g. "FE runs") beside its own.  No-op outside a task."""
+    running count of ``kind`` (e.g. "FE runs") beside its own; a worker relaying to its parent
+    (:func:`relay_to`) also appends it to its relay file.  No-op outside a task and a relay."""
+    if _RELAY is not None:
+        try:
+            with open(_RELAY, "ab") as fh:  # one byte per tick: an append of this size is atomic
+                fh.write(b"e" if kind is None else b"f")
+        except OSError:  # the parent has gone or removed its folder: progress is not worth an error
+            pass
     if not _ACTIVE:
         return
     bar, counts = _ACTIVE[-1]
@@ -174,6 +188,105 @@ def items(seq, desc: str, name=str, unit: str = "it"):
             bar.set_postfix_str(str(name(item)), refresh=True)
             yield item
             bar.update(1)
+    finally:
+        bar.close()
+
+
+def relay_to(path) -> None:
+    """From now on append this process's :func:`tick` calls to the file ``path`` (a path from
+    :meth:`Relays.path` in the parent); ``None`` stops."""
+    global _RELAY
+    _RELAY = None if path is None else str(path)
+
+
+class Relays:
+    """The parent's side of :func:`relay_to`: one small file per task in a private temporary folder
+    (removed by :meth:`close`), counted on demand.  Use as a context manager."""
+
+    def __init__(self):
+        self.folder = tempfile.mkdtemp(prefix="femast-progress-")
+
+    def path(self, key) -> str:
+        """The relay file of task ``key`` (give it to the task, which calls :func:`relay_to`)."""
+        return os.path.join(self.folder, f"{key}.ticks")
+
+    def counts(self, key) -> tuple[int, int]:
+        """(model evaluations, FE runs) task ``key`` has reported so far."""
+        try:
+            with open(self.path(key), "rb") as fh:
+                data = fh.read()
+        except OSError:
+            return 0, 0
+        return data.count(b"e"), data.count(b"f")
+
+    def close(self) -> None:
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+
+def task_fraction(done: int, expected: float, cap: float = 0.9) -> float:
+    """Share of a running task done after ``done`` of about ``expected`` units, at most ``cap``
+    (a task is finished only when it says so)."""
+    if done <= 0 or not expected or expected <= 0:
+        return 0.0
+    return min(cap, done / float(expected))
+
+
+def as_completed(futures, desc: str, unit: str = "tasks", relays=None, name=None, poll_s: float = 0.5):
+    """Yield ``futures`` (:mod:`concurrent.futures`) as they finish, with a bar of ``len(futures)``
+    steps that also moves while they run: with ``relays`` (:class:`Relays`, task ``i`` relaying to
+    ``relays.path(i)``), a running task counts as the share of its model evaluations in the
+    evaluations a finished task took on average (at most 0.9 of a step; before any has finished, the
+    share of the most any running task has done), so the bar and its estimate of the time left
+    advance with every inner model run, not only when a whole task ends.  ``name(i)``: the label of
+    task ``i`` shown when it finishes."""
+    import concurrent.futures as cf
+
+    futures = list(futures)
+    index = {id(f): i for i, f in enumerate(futures)}
+    pending, done_evals, shown, last = set(futures), [], 0.0, ""
+    bar = _bar(
+        desc=desc,
+        total=len(futures),
+        unit=f" {unit}",
+        bar_format="{desc}: {percentage:3.0f}%|{bar}| {postfix} [{elapsed}<{remaining}]",
+    )
+    try:
+        while pending:
+            finished, pending = cf.wait(pending, timeout=poll_s, return_when=cf.FIRST_COMPLETED)
+            counts = [relays.counts(i) for i in range(len(futures))] if relays is not None else []
+            done_evals += [counts[index[id(f)]][0] for f in finished if counts]
+            if finished and name is not None:
+                last = f"last: {name(index[id(finished.copy().pop())])}"
+            partial = 0.0
+            if counts and pending:
+                running = [counts[index[id(f)]][0] for f in pending]
+                expected = sum(done_evals) / len(done_evals) if done_evals else 2.0 * max(running)
+                partial = sum(task_fraction(n, expected) for n in running)
+            position = len(futures) - len(pending) + partial
+            if position > shown:
+                bar.update(position - shown)
+                shown = position
+            runs = f"{sum(c[0] for c in counts)} model runs" if counts else ""
+            fe = sum(c[1] for c in counts)
+            post = ", ".join(
+                s
+                for s in (
+                    f"{len(futures) - len(pending)} of {len(futures)} finished",
+                    runs,
+                    fe and f"{fe} FE runs",
+                    last,
+                )
+                if s
+            )
+            bar.set_postfix_str(post, refresh=True)
+            yield from finished
     finally:
         bar.close()
 

@@ -124,8 +124,8 @@ def logm_so3_small_into(R, out):
     """:func:`logm_so3_into` for rotations that are mostly small (a corotational element's local
     rotations): below |v| = 0.02 rad, 2 atan(x) / (x q0) with x = tan(|v| / 2) = |q| / q0 by its
     series to x^8 (truncation x^10 / 11 < 1e-20 relative; against an exact logarithm of the same
-    matrices both are within 6e-16), instead of atan2, which was 1/8 of the beam kernel's time
-    (issue 21); larger rotations go to :func:`logm_so3_into`."""
+    matrices both are within 6e-16), instead of atan2, which was 1/8 of the beam kernel's time;
+    larger rotations go to :func:`logm_so3_into`."""
     q0, q1, q2, q3 = _quaternion(R)
     v2 = q1 * q1 + q2 * q2 + q3 * q3
     if v2 < 1e-4 * (q0 * q0):

@@ -54,7 +54,7 @@ def _warm_laws():
     import numpy as np
 
     from femast.effects.operators import play, proportional_play
-    from femast.latch import latch_force
+    from femast.elements.latch_law import latch_force
 
     x = np.linspace(-1e-3, 1e-3, 5)
     latch_force(x, 1.0, derivative=True)

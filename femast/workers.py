@@ -47,8 +47,7 @@ API (a :class:`concurrent.futures.Executor`)::
   work under ``if __name__ == "__main__":`` (Python's rule for ``spawn``/``forkserver``: a worker
   imports the main script); ``femast study`` scripts need not.
 
-A study's samples (:mod:`femast.studies`), diagnose's refits and a fit's finite-difference
-columns all run on this pool.
+A study's samples (:mod:`femast.studies`) and diagnose's refits run on this pool.
 """
 
 from __future__ import annotations

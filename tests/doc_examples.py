@@ -13,7 +13,7 @@ def run_python_blocks(page: str, cwd=None) -> str:
     ``cwd`` (default: the current one); returns the page's text.  Fails if the page has none.
 
     A block followed by a quoted ``Output:`` (a fenced or indented block) must print those lines,
-    number by number (:func:`check_output`), so that quoted output cannot drift (issue 17)."""
+    number by number (:func:`check_output`), so that quoted output cannot drift."""
     import contextlib
     import io
     import sys

@@ -1,4 +1,4 @@
-"""Independent data generator for the diagnose generalisation benchmark (issue 14, item 4).
+"""Independent data generator for the diagnose generalisation benchmark.
 
 Why here, outside the ``femast`` package
 ----------------------------------------
@@ -13,8 +13,8 @@ part of the installed library, which has no use for fake data with hidden mechan
 Modules (numpy only; ``gallery`` also draws with matplotlib):
 
 * :mod:`.mechanisms` -- hysteresis operators, contact and stiffening laws, fades;
-* :mod:`.noise` -- white, AR(1) and heteroscedastic noise; the seed 001 Eq. 15 procedure;
-* :mod:`.rigs` -- the two rigs: mast top (seed 000 3R model) and latch pull test (seed 001
+* :mod:`.noise` -- white, AR(1) and heteroscedastic noise; the procedure of Stohlman & Pellegrino, Eq. 15;
+* :mod:`.rigs` -- the two rigs: mast top (the Rocaspect paper's 3R model) and latch pull test (Stohlman & Pellegrino
   Eqs. 6-15), load paths included;
 * :mod:`.cases` -- the catalogue of benchmark cases with the verdict each one should get;
 * :mod:`.scoring` -- reading a diagnose JSON report as a verdict, and the scoring rule;

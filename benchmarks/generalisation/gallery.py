@@ -56,8 +56,8 @@ def gallery(path) -> str:
     s = x + 2e-3
     for form, F, ell in (("gauss", 8.0, 4e-4), ("linear", 7.0, 6e-4), ("lorentz", 8.0, 2.5e-4)):
         a.plot(1e3 * x, np.maximum(latch_law(x, 1) + F * mech.fade(s, ell, form), 0), label=f"band, {form} fade")
-    a.plot(1e3 * x, np.maximum(latch_law(x, 1), 0), "k:", lw=0.8, label="seed law, unlatching")
-    a.plot(1e3 * x, np.minimum(latch_law(x, -1), 0), "k--", lw=0.8, label="seed law, latching")
+    a.plot(1e3 * x, np.maximum(latch_law(x, 1), 0), "k:", lw=0.8, label="published latch law, unlatching")
+    a.plot(1e3 * x, np.minimum(latch_law(x, -1), 0), "k--", lw=0.8, label="published latch law, latching")
     a.set_xlim(-2.1, 1.0)
     a.set_title("latch hysteresis near the latched state")
     a.set_xlabel("x (mm)")

@@ -1,11 +1,11 @@
-"""Measurement noise models (numpy only): white, AR(1), heteroscedastic, and seed 001 Eq. 15.
+"""Measurement noise models (numpy only): white, AR(1), heteroscedastic, and Stohlman & Pellegrino, Eq. 15.
 
 * ``white(rng, n, sigma)``: independent N(0, sigma^2).
 * ``ar1(rng, n, sigma, phi)``: stationary AR(1), ``e_t = phi e_{t-1} + sqrt(1 - phi^2) sigma w_t``
   with ``e_0 ~ N(0, sigma^2)``: variance sigma^2 at every t, lag-k autocorrelation ``phi^k``
   (slow drift of a tracker or a load cell between samples).
 * ``heteroscedastic(rng, scale, sigma)``: N(0, (sigma scale_t)^2), a per-sample standard deviation.
-* ``eq15_measurement(rng, x, dT, ...)``: the latch pull procedure of seed 001 Sec. III.B: the
+* ``eq15_measurement(rng, x, dT, ...)``: the latch pull procedure of Stohlman & Pellegrino, Sec. III.B: the
   machine measures the end-to-end distance ``d = x + C T + d0`` and the tension ``T``, each with
   its own noise, and the bead position is recovered by Eq. 15, ``x = d - C T - d0``.  The
   recovered position therefore carries ``e_d - C e_T``, correlated with the force noise ``e_T``:

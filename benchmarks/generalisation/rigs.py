@@ -1,16 +1,16 @@
 """The two rigs of the benchmark, written from the seeds (numpy only).
 
-Mast top (seed 000, Sec. III-A, Eqs. 4-7)
+Mast top (the Rocaspect paper, Sec. III-A, Eqs. 4-7)
 -----------------------------------------
 A rigid mast of height L = 3.651 m on three elastic joints at its base O.  A wrench change
 ``(f, m_C)`` on the top C (forces N, moments N m about C, base frame) loads the joints with the
 moment about O, ``M = m_C + r_OC x f`` (N m); a joint rotation ``theta`` (rad, about the base
 axes) moves the top by ``theta x r_OC`` (m).  Bending joint stiffnesses 2.7e5 and 2.3e5 N m/rad
-(seed 000 Table III, 1200 N of shroud pretension); the torsion joint is rigid.  A mechanism
+(the Rocaspect paper, Table III, 1200 N of shroud pretension); the torsion joint is rigid.  A mechanism
 changes how a joint rotation follows its moment (``theta_j = g_j(M_j history)``), or adds a top
 translation (beam, drift).
 
-Latch pull test (seed 001, Sec. III, Eqs. 6-15)
+Latch pull test (Stohlman & Pellegrino, Sec. III, Eqs. 6-15)
 -----------------------------------------------
 Roller latch law (Eqs. 6-14), ``x`` the bead position (m, positive outside, backstop at
 ``-x_b``), ``delta = sqrt((r + R)^2 - x^2) - h - r`` the roller opening (contact while > 0),
@@ -31,9 +31,9 @@ from __future__ import annotations
 
 import numpy as np
 
-L_MAST = 3.651  # m, seed 000 Sec. IV-B-2
-K_JOINTS = (2.7e5, 2.3e5)  # N m/rad, seed 000 Table III (1200 N)
-LATCH = {"r": 1.1e-3, "xb": 2.0e-3, "k": 1e5, "mu": 0.07, "h": 1.5e-3, "R": 2.4e-3}  # seed 001 Sec. III.C
+L_MAST = 3.651  # m, the Rocaspect paper, Sec. IV-B-2
+K_JOINTS = (2.7e5, 2.3e5)  # N m/rad, the Rocaspect paper, Table III (1200 N)
+LATCH = {"r": 1.1e-3, "xb": 2.0e-3, "k": 1e5, "mu": 0.07, "h": 1.5e-3, "R": 2.4e-3}  # Stohlman & Pellegrino, Sec. III.C
 
 
 # =========================================================================== mast top

@@ -1,7 +1,7 @@
 """Reading a ``diagnose`` JSON report as a verdict, and the scoring rule of the benchmark.
 
-The adapter reads the report of before issue 14 (``verdict.missing_effect`` / ``explained`` /
-``best_candidate`` / ``conclusion``) and the fields issue 14 adds: ``verdict.kind`` in
+The adapter reads the older report (``verdict.missing_effect`` / ``explained`` /
+``best_candidate`` / ``conclusion``) and the newer fields: ``verdict.kind`` in
 ``nothing_missing``, ``missing_effect``, ``missing_pair``, ``form_imperfect``, ``better_form``,
 ``not_explained``; ``verdict.missing_effects`` ([X] or [X, Y]); ``verdict.mechanism`` (the X of
 a form-imperfect verdict).  The structured fields are used when present, else the conclusion
@@ -27,7 +27,7 @@ Scoring rule (also in the benchmark's docstring and the docs page)
 Score = (number of right effect/pair/ool cases + sum over null cases of the fraction of its
 redraws that are right) / (number of effect/pair/ool cases + number of null cases): every
 null case weighs as much as one other case, its redraws share that weight.  False-alarm rate =
-wrong null redraws / all null redraws.  Targets (issue 14): score >= 0.95, false alarms <= 0.05.
+wrong null redraws / all null redraws.  Targets: score >= 0.95, false alarms <= 0.05.
 """
 
 from __future__ import annotations

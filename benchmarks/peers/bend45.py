@@ -1,5 +1,5 @@
 """The Bathe-Bolourchi 45-degree bend, a small model with many increments, in femast and OpenSeesPy
-(issue 21, item 3: the fixed cost per increment).
+(the fixed cost per increment).
 
     python benchmarks/peers/bend45.py [--elements 8] [--increments 180] [--repeat 5] [--no-folder] [--strict] [--profile] [--parts] [--docs]
 
@@ -11,7 +11,7 @@ increment (its default); OpenSees records the tip displacement after each increm
 ``out=None`` and an ``on_frame`` recorder).  Both run --repeat times, interleaved; the script
 prints best and median wall time, CPU time of this process, Newton iterations, the femast/OpenSees
 ratio of the best and of the median runs (target <= 0.5), and the tip positions at P = 300, 450,
-600 against the Kirchhoff-rod solution (femast.references.bend45_tip_position) and against each other.
+600 against the Kirchhoff-rod solution (femast.verification.references.bend45_tip_position) and against each other.
 ``--profile`` prints femast's cProfile of one run; ``--parts`` femast's CPU time per increment by
 part (set-up, Newton, increment plan, frames, ...) instead of the comparison.  Writes
 ``benchmarks/out/bend45_peer.png`` (``--no-folder``: ``bend45_peer_nofolder.png``; ``--docs``: also
@@ -41,7 +41,7 @@ import opensees_mast  # noqa: E402  (its optional import of openseespy)
 
 import femast as fm  # noqa: E402
 from femast.analysis import Analysis  # noqa: E402
-from femast.analysis.solvers.convergence import Convergence  # noqa: E402
+from femast.analysis.convergence import Convergence  # noqa: E402
 
 R, E, G, J, A, I = 100.0, 1.0e7, 0.5e7, 0.140577, 1.0, 1.0 / 12
 P_END = 600.0
@@ -95,11 +95,11 @@ PARTS = (  # (module, attribute path, label) timed by --parts
     ("femast.analysis.analysis", "Analysis.__init__", "analysis set-up (Analysis())"),
     ("femast.analysis.output", "ResultsOutput.started", "results folder set-up + initial frame"),
     ("femast.analysis.newton", "Newton.solve", "Newton iterations (Newton.solve)"),
-    ("femast.analysis.controls", "TimeIncrements.propose", "increment plan (propose/accept/grow/...)"),
-    ("femast.analysis.controls", "TimeIncrements.accept", "increment plan (propose/accept/grow/...)"),
-    ("femast.analysis.controls", "TimeIncrements.grow", "increment plan (propose/accept/grow/...)"),
-    ("femast.analysis.controls", "TimeIncrements.next_increment", "increment plan (propose/accept/grow/...)"),
-    ("femast.analysis.controls", "TimeIncrements.done", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.control", "TimeIncrements.propose", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.control", "TimeIncrements.accept", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.control", "TimeIncrements.grow", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.control", "TimeIncrements.next_increment", "increment plan (propose/accept/grow/...)"),
+    ("femast.analysis.control", "TimeIncrements.done", "increment plan (propose/accept/grow/...)"),
     ("femast.analysis.output", "ResultsOutput.converged", "frame + status line (analysis thread)"),
     ("femast.analysis.output", "ResultsOutput.finished", "close + final summary"),
     ("femast.analysis.analysis", "Results", "Results(out) returned by run()"),
@@ -218,7 +218,7 @@ def main(argv=None):
         "--strict",
         action="store_true",
         help="femast's strict correction test only "
-        "(Convergence(predicted=False), the rule before issue 21's predicted correction)",
+        "(Convergence(predicted=False), the rule before the predicted correction)",
     )
     ap.add_argument("--docs", action="store_true")
     args = ap.parse_args(argv)
@@ -255,7 +255,7 @@ def main(argv=None):
         f"({min(fw) / K * 1e6:.0f} us per increment); CPU best {min(r['cpu'] for r in fr) * 1e3:.1f} ms; "
         f"{fr[0]['iterations']} iterations, {fr[0]['increments']} increments"
     )
-    from femast.references import bend45_tip_position
+    from femast.verification.references import bend45_tip_position
 
     ex = bend45_tip_position((300.0, 450.0, 600.0))
     exact = np.array([ex[p] for p in (300.0, 450.0, 600.0)])

@@ -1,4 +1,4 @@
-"""femast against OpenSees on the same corotational truss mast (issue 8, items 1-2; issue 21, item 5).
+"""femast against OpenSees on the same corotational truss mast.
 
     python benchmarks/peers/compare_opensees.py [--bays 40 400 1000] [--increments 10] [--repeat 5]
                                                 [--systems UmfPack SparseGeneral SparseSYM ProfileSPD]
@@ -14,12 +14,12 @@ kernels are compiled (or loaded from the cache) on a 2-bay mast first; that JIT 
 separately.  From 700 bays on only the OpenSees system fastest at the largest smaller size runs
 (one OpenSees run of the 1000-bay mast takes ~30 s).
 
-Targets (issue 21, item 5), printed with their verdict:
+Targets, printed with their verdict:
 
 * femast / OpenSees <= 0.08 at 40 bays and <= 0.06 at 400 and 1000 bays (best of the runs and
   median of the runs, CPU time and wall time);
 * time per Newton iteration <= 1.3 x the fastest factorisation + solve of the same tangent among
-  the installed back-ends (:mod:`femast.analysis.solvers.backends`), timed in isolation on the converged
+  the installed back-ends (:mod:`femast.analysis.linalg.backends`), timed in isolation on the converged
   tangent (median of 7);
 * growth of the time per iteration from the smallest to the largest size at most linear: the
   exponent p of t ~ n^p is printed (target p <= 1).
@@ -35,7 +35,7 @@ it is the looser of the two): it shows how much of the difference in iterations 
 On the 1000-bay mast the force test alone is not enough (the tip then differs by ~1e-3: a soft mode
 carries a large displacement for a small residual), which is why it is not femast's default.
 femast accepts an iteration on its predicted next correction (``Convergence(predicted=True)``, the
-default since issue 21: the simplified Newton correction, one more solve); ``--femast-strict``
+default: the simplified Newton correction, one more solve); ``--femast-strict``
 runs the strict correction test alone (the rule before).
 
 If openseespy is not installed (or cannot load libblas/liblapack), femast's numbers are printed

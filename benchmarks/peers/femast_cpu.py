@@ -1,4 +1,4 @@
-"""CPU time of femast alone on the peer mast (issue 21, item 5): for interleaved before/after runs.
+"""CPU time of femast alone on the peer mast: for interleaved before/after runs.
 
     python benchmarks/peers/femast_cpu.py [--bays 40 400 1000] [--repeat 3] [--strict]
 

@@ -1,4 +1,4 @@
-"""ADAM-type deployable mast bays and masts (seed 001): builders, load paths, post-processing
+"""ADAM-type deployable mast bays and masts (Stohlman & Pellegrino): builders, load paths, post-processing
 and identification.  See ``docs/adam_bay.md`` and ``docs/adam_mast.md``.
 
     from femast.adam import BayParameters, build_bay, build_mast

@@ -1,10 +1,12 @@
-"""Builders of ADAM-type bays and masts (seed 001, Secs. II and VII) for model scripts.
+"""Builders of ADAM-type bays and masts (Stohlman & Pellegrino, Secs. II and VII) for model scripts.
 
 A mast of ``n_bays`` bays has ``n_bays + 1`` square batten frames (side ``b``) at heights
 ``0, l, 2 l, ...``.  Each frame has four rigid corner pieces; each bay has
 
-* four longerons (corotational beams) from the bottom to the top corner pieces, tied to them by
-  friction ball joints (seed Sec. II.B.1: |M| <= mu B |F|) at the ball centres;
+* four longerons (corotational beams) from the bottom to the top corner pieces, joined to them by
+  friction ball joints (seed Sec. II.B.1: |M| <= mu B |F|) at the ball centres: seated by default
+  (the ball sits in its socket, held there by the cables' preload: the seat carries compression and
+  opens in tension; ``BayParameters.seat``), or tied (``seat="tied"``: the paper's two-way tie);
 * on each of its four sides one cable/pulley/latch assembly (seed Sec. II.B.2, Fig. 4): a unit at
   the centre of the side through which
 
@@ -113,17 +115,23 @@ def _check_fold(fold, where):
 
 
 def build_bay(
-    params: BayParameters | None = None, fold: int = 1, name: str = "ADAM bay", cables: bool = True, **changes
+    params: BayParameters | None = None,
+    fold: int = 1,
+    name: str = "ADAM bay",
+    cables: bool = True,
+    scatter=None,
+    **changes,
 ) -> AdamModel:
-    """One ADAM bay (seed 001 Sec. II): bottom frame fixed, top frame rigid with the control node.
+    """One ADAM bay (Stohlman & Pellegrino, Sec. II): bottom frame fixed, top frame rigid with the control node.
 
     params : :class:`BayParameters` (default: the documented choices); keyword ``changes``
         override single parameters, e.g. ``build_bay(b=0.3, cable_EA=5e4)``.
     fold : +1 (the bay folds under a positive twist about z) or -1.
     cables : False leaves out the cable/pulley/latch assemblies (frames, longerons and joints only:
         the deployment kinematics of Eq. 1).
+    scatter : per-element values of the bay (:func:`build_mast`).
     Returns an :class:`AdamModel`; add steps to ``.model``."""
-    return build_mast(1, params, fold=fold, alternate=False, name=name, cables=cables, **changes)
+    return build_mast(1, params, fold=fold, alternate=False, name=name, cables=cables, scatter=scatter, **changes)
 
 
 def build_mast(
@@ -136,7 +144,7 @@ def build_mast(
     scatter=None,
     **changes,
 ) -> AdamModel:
-    """A mast of ``n_bays`` identical ADAM bays (seed 001 Sec. VII: 40 bays, 6.84 m).
+    """A mast of ``n_bays`` identical ADAM bays (Stohlman & Pellegrino, Sec. VII: 40 bays, 6.84 m).
 
     params : :class:`BayParameters`; keyword ``changes`` override single parameters.
     fold : folding sense of the first (bottom) bay, +1 or -1.
@@ -146,7 +154,7 @@ def build_mast(
     is the control node at its centre.  ``cables=False`` leaves out the cable assemblies.
     scatter : per-element values (:class:`~femast.adam.scatter.MastScatter` or a dict of its
         fields): friction per ball joint, latch k and mu per latch, pretension per bay side, length
-        error per member (issue 20).  Default: every bay exactly ``params``.
+        error per member.  Default: every bay exactly ``params``.
     Returns an :class:`AdamModel`."""
     try:
         n_ok = int(n_bays) == n_bays and int(n_bays) >= 1 and not isinstance(n_bays, bool)
@@ -216,14 +224,22 @@ def build_mast(
             )
             longerons[j, k] = (a, c)
             pairs += [(a, bot), (c, top)]
+    mu_s = sc["mu"].ravel()
+    seat = (
+        dict(seat="seated", clearance_radial=p.seat_clearance_radial, clearance_axial=p.seat_clearance_axial)
+        if p.seat == "seated"
+        else {}
+    )
     add_ball_joints(
         m,
         pairs,
-        mu=sc["mu"].ravel(),
+        mu_s=mu_s,
+        mu_k=None if p.mu_k is None else mu_s * (p.mu_k / p.mu if p.mu > 0 else 0.0),
         B=p.B,
         penalty_factor=p.joint_penalty_factor,
         stick_factor=p.joint_stick_factor,
         name=JOINT_FAMILY,
+        **seat,
     )
     if p.joint_spring > 0:
         m.add_family(JointSprings(pairs, p.joint_spring, name=SPRING_FAMILY))
@@ -280,6 +296,7 @@ def build_mast(
             hysteresis_length=p.hysteresis_length,
             length_error=sc["cable_dL"].reshape(-1, 2),
             name=LATCH_FAMILY,
+            mu_k=None if p.latch_mu_k is None else np.minimum(p.latch_mu_k, latch_array(sc, p)[:, 3]),
         )
     )
     if fam is not None:

@@ -1,4 +1,4 @@
-"""Identification of the unknown bay parameters from the 40-bay tip response of seed 001, Table 1.
+"""Identification of the unknown bay parameters from the 40-bay tip response of Stohlman & Pellegrino, Table 1.
 
 The seed gives the elastic tip response of its 40-bay model under M + F (M = 6.8 N m about z,
 F = 14 N along x): x = 1740 um and theta_z = 3030 arcsec.  It does not give the cable EA nor the
@@ -25,7 +25,7 @@ from .parameters import BayParameters
 from .post import ARCSEC
 from .steps import CONVERGENCE, TABLE1_F, TABLE1_M, add_initial_steps
 
-#: Table 1 of seed 001 under M + F: x (m) and theta_z (rad).
+#: Table 1 of Stohlman & Pellegrino under M + F: x (m) and theta_z (rad).
 TABLE1_TARGET = {"x": 1740e-6, "theta_z": 3030.0 / ARCSEC}
 
 #: Parameters that may be fitted, their units and default bounds (SI).

@@ -1,4 +1,4 @@
-"""Deployment kinematics of an ADAM bay (seed 001, Sec. II.A, Eq. 1).
+"""Deployment kinematics of an ADAM bay (Stohlman & Pellegrino, Sec. II.A, Eq. 1).
 
 With rigid longerons of length l (ball centre to ball centre) between square frames of side b
 whose top frame turns by theta_t about the bay axis, a top corner moves on a circle of radius

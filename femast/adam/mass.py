@@ -1,7 +1,7 @@
-"""Mass of ADAM-type models (issue 18): densities of the members, mass per length of the cables,
+"""Mass of ADAM-type models: densities of the members, mass per length of the cables,
 the pulley-and-latch units and the corner pieces, added to a built :class:`AdamModel`.
 
-Seed 001 gives no mass.  The defaults are stated choices (SI):
+Stohlman & Pellegrino give no mass.  The defaults are stated choices (SI):
 
 * members: carbon-fibre tubes (E = 120 GPa in :class:`BayParameters`), rho = 1550 kg/m^3;
 * cables: stranded steel, mass per length = 7850 kg/m^3 x EA / 200 GPa (the cable EA of the
@@ -21,7 +21,7 @@ from ..errors import ModelError
 RHO_CFRP = 1550.0  # kg/m^3
 RHO_STEEL = 7850.0  # kg/m^3
 E_STEEL = 200e9  # Pa
-#: Effective mass of a pulley-and-latch unit, kg: identified from seed 001 Eq. 16 by
+#: Effective mass of a pulley-and-latch unit, kg: identified from Stohlman & Pellegrino, Eq. 16 by
 #: ``benchmarks/adam_vibration.py`` (femast.adam.vibration.identify_unit_mass).
 UNIT_MASS = 0.0211
 CORNER_MASS = 0.02  # kg

@@ -1,4 +1,4 @@
-"""Parameters of an ADAM-type bay (seed 001): every dimension, section, material, pretension and
+"""Parameters of an ADAM-type bay (Stohlman & Pellegrino): every dimension, section, material, pretension and
 latch parameter, in SI units, with the source of each default value.
 
 The seed gives the bay height (6.84 m / 40 bays = 0.171 m), the ball joints (mu = 0.5, B = 4 mm),
@@ -14,11 +14,11 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, fields, replace
 
+from ..elements.latch_law import LatchParameters, contact_half_width, validate_latch_array
 from ..errors import ModelError
-from ..latch import LatchParameters, contact_half_width, validate_latch_array
 from ..model.sections import Section, circular_tube
 
-#: Bay height of seed 001, Sec. VII: 40 bays make a 6.84 m mast.
+#: Bay height of Stohlman & Pellegrino, Sec. VII: 40 bays make a 6.84 m mast.
 SEED_BAY_HEIGHT = 6.84 / 40
 
 
@@ -46,13 +46,24 @@ class BayParameters:
     cable_EA : axial rigidity of the cables, N.  Not in the seed: identified from Table 1.
     pretension : cable tension of the deployed, latched bay before it comes to equilibrium, N
         (Figs. 13-14: 125-210 N).
-    latch : :class:`~femast.latch.LatchParameters` (seed Sec. III.C fit by default).
+    latch : :class:`~femast.elements.latch_law.LatchParameters` (seed Sec. III.C fit by default).
     hysteresis_force, hysteresis_length : latch hysteresis near the latched state (N, m); 0
         switches it off (the seed's model).  See ``docs/cable_latch_element.md``.
+    latch_mu_k : kinetic friction of the latch rollers (-); None (default): the latch's ``mu``, the
+        paper's one coefficient (Sec. III.A: "the kinetic and static coefficients ... are assumed to
+        be equal").  Below it, ``latch.mu`` is the static coefficient: a bead starts to slide at
+        ``latch.mu`` and slides on at ``latch_mu_k``.
 
     Joints
     ------
+    seat : ``"seated"`` (default: the ball sits in its socket, held by the preload; the seat carries
+        compression and opens in tension) or ``"tied"`` (the paper's two-way tie, a captive ball: the
+        reproductions of the paper's figures use it).  See ``docs/ball_joint.md``.
+    seat_clearance_radial : seated joints: radial play of the ball in its socket, m (default 0).
+    seat_clearance_axial : seated joints: axial play from the seat to a retainer, m; None (default):
+        no retainer, the seat opens freely in tension.
     mu, B : ball joint friction coefficient and ball end radius, m (seed Sec. II.B.1: 0.5, 4 mm).
+    mu_k : kinetic friction coefficient of the ball joints; None: the same as ``mu`` (the paper).
     joint_penalty_factor, joint_stick_factor : numerical stiffness factors of the ball joints
         (:func:`femast.elements.ball_joint.add_ball_joints`): k_pen = factor x EA/l and
         k_stick = factor x 4EI/l of the longeron.  1e3 (not the element's 1e4) keeps the round-off
@@ -82,8 +93,13 @@ class BayParameters:
     latch: LatchParameters = field(default_factory=LatchParameters.seed_fit)
     hysteresis_force: float = 0.0
     hysteresis_length: float = 3e-4
+    latch_mu_k: float | None = None
     mu: float = 0.5
     B: float = 0.004
+    mu_k: float | None = None
+    seat: str = "seated"
+    seat_clearance_radial: float = 0.0
+    seat_clearance_axial: float | None = None
     joint_penalty_factor: float = 1e3
     joint_stick_factor: float = 0.3
     joint_spring: float = 10.0
@@ -107,8 +123,13 @@ class BayParameters:
         "latch": "SI",
         "hysteresis_force": "N",
         "hysteresis_length": "m",
+        "latch_mu_k": "-",
         "mu": "-",
         "B": "m",
+        "mu_k": "-",
+        "seat": "-",
+        "seat_clearance_radial": "m",
+        "seat_clearance_axial": "m",
         "joint_penalty_factor": "-",
         "joint_stick_factor": "-",
         "joint_spring": "N m/rad",
@@ -141,10 +162,25 @@ class BayParameters:
             v = getattr(self, name)
             if not _is_number(v) or not (v > 0 and math.isfinite(v)):
                 raise ModelError(f"BayParameters: {name} = {v!r} {self.UNITS[name]} must be a finite number > 0")
-        for name in ("corner", "pretension", "mu", "hysteresis_force", "joint_spring"):
+        for name in ("corner", "pretension", "mu", "hysteresis_force", "joint_spring", "seat_clearance_radial"):
             v = getattr(self, name)
             if not _is_number(v) or not (v >= 0 and math.isfinite(v)):
                 raise ModelError(f"BayParameters: {name} = {v!r} {self.UNITS[name]} must be a finite number >= 0")
+        if self.seat not in ("seated", "tied"):
+            raise ModelError(f"BayParameters: seat = {self.seat!r}; use 'seated' (the physical default) or 'tied'")
+        if self.mu_k is not None and (not _is_number(self.mu_k) or not (0 <= self.mu_k <= self.mu)):
+            raise ModelError(
+                f"BayParameters: mu_k = {self.mu_k!r} must lie in [0, mu = {self.mu:g}] (kinetic <= static), or be None"
+            )
+        ca = self.seat_clearance_axial
+        if ca is not None and (not _is_number(ca) or not (ca >= 0 and math.isfinite(ca))):
+            raise ModelError(f"BayParameters: seat_clearance_axial = {ca!r} m must be a finite number >= 0, or None")
+        for name in ("seat_clearance_radial", "seat_clearance_axial"):
+            v = getattr(self, name) or 0.0
+            if v > 0.05 * self.l:
+                raise ModelError(f"BayParameters: {name} = {v:g} m is implausible for a joint; clearances are in m")
+            if v > 0 and self.seat == "tied":
+                raise ModelError(f"BayParameters: {name} = {v:g} m needs seat='seated' (a tied joint has no play)")
         for name in ("longeron_nu", "batten_nu"):
             v = getattr(self, name)
             if not _is_number(v) or not (-1.0 < v < 0.5):
@@ -173,9 +209,14 @@ class BayParameters:
             )
         if not isinstance(self.latch, LatchParameters):
             raise ModelError(
-                f"BayParameters: latch must be a femast.latch.LatchParameters, got {type(self.latch).__name__}"
+                f"BayParameters: latch must be a femast.elements.latch_law.LatchParameters, got {type(self.latch).__name__}"
             )
         validate_latch_array(self.latch.as_array(), "BayParameters.latch")
+        v = self.latch_mu_k
+        if v is not None and (not _is_number(v) or not (0.0 <= v <= self.latch.mu)):
+            raise ModelError(
+                f"BayParameters: latch_mu_k = {v!r} must lie in [0, latch.mu = {self.latch.mu:g}] (kinetic <= static) or be None"
+            )
         if self.hysteresis_force > 0 and self.latch.x_backstop >= contact_half_width(self.latch):
             raise ModelError(
                 "BayParameters: latch hysteresis needs the backstop inside the roller contact "

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..latch import ZONE_BACKSTOP, ZONE_BEHIND_AXIS, ZONE_FREE, ZONE_IN_FRONT, ZONE_LABELS
+from ..elements.latch_law import ZONE_BACKSTOP, ZONE_BEHIND_AXIS, ZONE_FREE, ZONE_IN_FRONT, ZONE_LABELS
 from ..post.results import Results
 from .build import AdamModel
 
@@ -25,8 +25,8 @@ def bay_curve(res: Results, am: AdamModel, bay: int = -1) -> dict:
 
     Returns a dict of arrays, one value per frame: ``step`` (name), ``time`` (total time, s),
     ``theta`` (rz of the control node, rad), ``ux``, ``uy``, ``uz`` (m), ``M`` (moment about z,
-    N m, *seed sign*: the moment of the bay on the loading rig, i.e. minus the moment applied to
-    the bay; the rig holds the bay against stowing with a negative moment), ``M_applied`` (N m),
+    N m, in the sign of Stohlman & Pellegrino: the moment of the bay on the loading rig, i.e. minus
+    the moment applied to the bay; the rig holds the bay against stowing with a negative moment), ``M_applied`` (N m),
     ``bead`` (n, 4) bead positions (m), ``zone`` (n, 4) zones of Fig. 6, ``dT`` (n, 4) N,
     ``tension`` (n, 4, 2) N (sections 1 and 2 of each latch cable)."""
     j = range(am.n_bays)[bay]
@@ -63,7 +63,7 @@ def write_curve_csv(curve: dict, path) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     head = (
-        ["step", "total_time_s", "theta_z_deg", "Mz_Nm_seed_sign", "ux_m", "uy_m", "uz_m"]
+        ["step", "total_time_s", "theta_z_deg", "Mz_Nm", "ux_m", "uy_m", "uz_m"]
         + [f"bead{k}_m" for k in range(4)]
         + [f"zone{k}" for k in range(4)]
         + [f"dT{k}_N" for k in range(4)]
@@ -71,7 +71,8 @@ def write_curve_csv(curve: dict, path) -> Path:
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         fh.write(
-            "# ADAM bay torsion (seed 001 Figs. 16-17). Mz: moment of the bay on the rig (seed sign). "
+            "# ADAM bay torsion (Stohlman & Pellegrino, Figs. 16-17). Mz: moment of the bay on the rig "
+            "(minus the moment applied to the top frame). "
             "zone: Fig. 6, 0 (a) backstop, 1 (b) behind roller axis, 2 (c) in front, 3 (d) free\n"
         )
         w.writerow(head)
@@ -124,7 +125,7 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
     import matplotlib
 
     matplotlib.use("Agg")
-    from ..post import plotstyle  # noqa: E402  (the one femast figure style, issue 17)
+    from ..post import plotstyle  # noqa: E402  (the one femast figure style)
 
     plotstyle.use()
     import matplotlib.pyplot as plt
@@ -187,7 +188,7 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
 
 
 # ---------------------------------------------------------------------------- Table 1
-#: Seed 001 Table 1, rows 0, M+F, 0, -M-F, 0, ... (x, y, z in um; theta_x, theta_y, theta_z in
+#: Stohlman & Pellegrino, Table 1, rows 0, M+F, 0, -M-F, 0, ... (x, y, z in um; theta_x, theta_y, theta_z in
 #: arcsec).  The extracted table prints the x displacement under -M-F as "-1.740" and under M+F
 #: after the first cycle as "1.740": read here as -1740 and 1740 um (a thousands separator).
 SEED_TABLE1 = np.array(
@@ -238,7 +239,7 @@ def format_table1(labels, model_vals, seed=SEED_TABLE1, note_width: int = 0) -> 
     """The tip table in the paper's layout, model value beside the seed's value (um, arcsec)."""
     n = min(len(labels), len(seed))
     head = f"{'load':>6} | " + " | ".join(f"{c:^21}" for c in TABLE1_COLUMNS)
-    sub = f"{'':>6} | " + " | ".join(f"{'femast':>10} {'seed':>10}" for _ in TABLE1_COLUMNS)
+    sub = f"{'':>6} | " + " | ".join(f"{'femast':>10} {'paper':>10}" for _ in TABLE1_COLUMNS)
     lines = [head, sub, "-" * len(head)]
     for i in range(n):
         cells = []

@@ -1,4 +1,4 @@
-"""Per-element scatter of an ADAM mast (issue 20, item 1): each ball joint's friction coefficient,
+"""Per-element scatter of an ADAM mast: each ball joint's friction coefficient,
 each latch's stiffness and friction, each bay side's cable pretension, and each member's length
 error (lack of fit), around the nominal :class:`~femast.adam.parameters.BayParameters`.
 

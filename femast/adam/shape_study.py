@@ -1,11 +1,11 @@
-"""Shape accuracy of ADAM masts under manufacturing and assembly scatter (issue 20, item 4): the
+"""Shape accuracy of ADAM masts under manufacturing and assembly scatter: the
 model factory of the studies in ``benchmarks/shape_accuracy.py`` (``docs/shape_accuracy.md``).
 
 A sample is a dict of per-element values (the fields of :class:`~femast.adam.scatter.MastScatter`);
 :func:`sample_scatter` draws them from the stated scatter :data:`SCATTER` given uniform numbers in
 [0, 1) per *group* of inputs (so that a study can vary one group at a time for group sensitivity
 indices); :func:`tip_history` builds the mast with them, brings it to its pretensioned equilibrium
-(the deployed state, seed 001 Sec. II.C) and applies the Table 1 load cycles (Sec. VII), and
+(the deployed state, Stohlman & Pellegrino, Sec. II.C) and applies the Table 1 load cycles (Sec. VII), and
 returns the tip (control node) position and rotation after deployment and at each load level.
 
 Units: SI inside (m, rad, N); the returned ``u_*`` in m and ``theta_*`` in rad (rotation vector
@@ -24,7 +24,7 @@ from .parameters import BayParameters
 from .scatter import MastScatter
 from .steps import CONVERGENCE, TABLE1_F, TABLE1_M, add_initial_steps, add_table1_steps
 
-#: The stated scatter (issue 20 item 4): every value uniform in [nominal - half, nominal + half],
+#: The stated scatter: every value uniform in [nominal - half, nominal + half],
 #: independent from element to element.  (group, MastScatter field, kind, half width, unit)
 #: kind "rel": half width relative to the nominal value; "abs": absolute (lengths, m).
 SCATTER = (
@@ -38,6 +38,10 @@ SCATTER = (
     ("member lengths", "cable_dL", "abs", 0.05e-3, "m"),
 )
 GROUPS = tuple(dict.fromkeys(g for g, *_ in SCATTER))
+#: The bay of the published study (docs/shape_accuracy.md): the paper's tied ball joints.  The
+#: study on seated joints (the physical default of BayParameters) is the next one; pass
+#: ``params=BayParameters()`` to run it.
+STUDY_PARAMS = BayParameters(seat="tied")
 
 
 def n_uniforms(n_bays: int) -> dict:
@@ -107,7 +111,7 @@ def mast_model(n_bays: int, cycles: int = 1, params: BayParameters | None = None
     """The mast with per-element ``values`` (MastScatter fields, flat or shaped arrays) and its load
     history (pretension step, ``cycles`` Table 1 cycles): a :class:`~femast.model.Model` with steps,
     for a study's model factory.  Returns (model, control node label)."""
-    am = build_mast(n_bays, params, scatter=as_scatter(values, n_bays))
+    am = build_mast(n_bays, params or STUDY_PARAMS, scatter=as_scatter(values, n_bays))
     add_initial_steps(am)
     add_table1_steps(am, cycles=cycles)
     return am.model, am.control
@@ -137,7 +141,7 @@ def tip_history(
     without ``settle``), then one level per load step, all relative to the initial (design)
     geometry: the control node's displacement and rotation vector at the end of each step."""
     t0 = time.process_time()
-    am = build_mast(n_bays, params, scatter=None if values is None else as_scatter(values, n_bays))
+    am = build_mast(n_bays, params or STUDY_PARAMS, scatter=None if values is None else as_scatter(values, n_bays))
     add_initial_steps(am, settle=settle)
     add_table1_steps(am, cycles=cycles, M=M, F=F)
     row = am.model.index(am.control)

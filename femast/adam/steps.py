@@ -1,4 +1,4 @@
-"""Steps and load paths of the seed-001 analyses: the initial (pretension) step, the single-bay
+"""Steps and load paths of the ADAM analyses (Stohlman & Pellegrino): the initial (pretension) step, the single-bay
 torsion paths (Figs. 16-17) and the 40-bay load sequence (Table 1).
 
 All angles in rad unless the name says ``_deg``; lengths in m, forces in N, moments in N m.
@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.solvers.convergence import Convergence
-from ..analysis.solvers.stabilize import Stabilize
+from ..analysis.control.stabilize import Stabilize
+from ..analysis.convergence import Convergence
 from ..errors import ModelError
 from .build import AdamModel
 
@@ -23,7 +23,7 @@ from .build import AdamModel
 #: of the penalty forces (k_pen x 1 ulp of a coordinate, ~2e-4 N).
 CONVERGENCE = Convergence(force_tol=1e-9, disp_tol=1e-6, max_iterations=25)
 
-#: Table 1 of seed 001: tip torsion and shear of the pointing manoeuvre (Sec. VII).
+#: Table 1 of Stohlman & Pellegrino: tip torsion and shear of the pointing manoeuvre (Sec. VII).
 TABLE1_M = 6.8  # N m about z
 TABLE1_F = 14.0  # N along x
 
@@ -31,7 +31,7 @@ TABLE1_F = 14.0  # N along x
 def stabilize_for(am: AdamModel, fraction: float = 1e-4, dt0: float = 1.0) -> Stabilize:
     """Viscous stabilisation for the initial step of an ADAM model.
 
-    femast's :class:`~femast.analysis.solvers.stabilize.Stabilize` scales the damping of each DOF by the
+    femast's :class:`~femast.analysis.control.stabilize.Stabilize` scales the damping of each DOF by the
     diagonal of the tangent.  Here the largest diagonal terms are the ball-joint penalties
     (``joint_penalty_factor`` x EA/l of a longeron), 1e5-1e6 times the stiffness of the cable net
     that sets the prestressed shape; with the default energy fraction the step would end far from
@@ -49,7 +49,7 @@ def stabilize_for(am: AdamModel, fraction: float = 1e-4, dt0: float = 1.0) -> St
 def add_initial_steps(
     am: AdamModel, stabilize: Stabilize | None = None, hold_control: tuple = (), settle: bool = False
 ):
-    """The initial step of seed 001 Sec. II.C: the deployed, pretensioned structure comes to
+    """The initial step of Stohlman & Pellegrino, Sec. II.C: the deployed, pretensioned structure comes to
     equilibrium with its cable pretensions under viscous stabilisation (step ``pretension``); the
     steps added after it have no stabilisation (the seed: "no stabilization is used after the
     initial stable state is achieved").
@@ -82,14 +82,14 @@ def add_idealised_torsion(
     in the bay's folding sense and back to 0, with x and y held (z and the tilts free).
 
     The twist is driven by displacement control of the control node's rz with a moment about z
-    as the reference load (:class:`~femast.analysis.solvers.control.DisplacementControl`), so rz stays a
+    as the reference load (:class:`~femast.analysis.control.DisplacementControl`), so rz stays a
     free DOF and the moment is the load factor: step ``<name>-out`` (0 -> theta_max) and
     ``<name>-back`` (theta_max -> 0; its reference moment is a large fixed value, so that the
     pattern never vanishes whatever moment the bay holds at theta_max).  With ``unload`` a last,
     load-controlled step ``<name>-unload`` brings the moment to zero: the bay settles at its
     residual rotation at zero moment (seed Sec. VIII).  ``max_increment``: fraction of each step.
     Returns the steps."""
-    from ..analysis.solvers.control import DisplacementControl
+    from ..analysis.control import DisplacementControl
 
     if not (0 < theta_max < am.params.stowed_angle):
         raise ModelError(
@@ -128,7 +128,7 @@ class MeasuredPath:
 
     def to_csv(self, path) -> None:
         """Write ``theta_deg, ux_m, uy_m`` (the experiments' bay-torsion format) plus the step time."""
-        head = "# measured-style path of the ADAM bay's control node (seed 001 Sec. VI.B). " + (
+        head = "# measured-style path of the ADAM bay's control node (Stohlman & Pellegrino, Sec. VI.B). " + (
             "SYNTHETIC: " + self.note if self.synthetic else self.note
         )
         data = np.column_stack([self.t, np.degrees(self.theta), self.x, self.y])

@@ -1,4 +1,4 @@
-"""Seed 001's pretension-by-vibration method (Sec. IV, Eq. 16) reproduced with the modal analysis.
+"""Stohlman & Pellegrino's pretension-by-vibration method (Sec. IV, Eq. 16) reproduced with the modal analysis.
 
 The mock bay side (seed Fig. 11) holds one cable/pulley/latch assembly in the geometry of a bay
 side: the latch cable from one bottom corner through the unit (pulley and latch) to the other,
@@ -51,7 +51,7 @@ LATCH_FAMILY = "mock_latch"
 
 
 def eq16_printed(f_hz):
-    """Seed 001 Eq. 16 exactly as printed: 0.012 f^2 - 0.58 f + 17 (f in Hz; see module)."""
+    """Stohlman & Pellegrino, Eq. 16 exactly as printed: 0.012 f^2 - 0.58 f + 17 (f in Hz; see module)."""
     f = np.asarray(f_hz, dtype=float)
     a, b, c = EQ16
     return a * f * f + b * f + c

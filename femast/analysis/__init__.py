@@ -4,9 +4,11 @@
 * :mod:`.system`: DOF numbering, constraints, assembly, linear solver (:class:`System`);
 * :mod:`.state`: everything an increment commits, with commit / rollback / save / load (:class:`State`);
 * :mod:`.newton`: the one Newton loop, for every control (:class:`Newton`, :class:`Increment`);
-* :mod:`.controls`: how each control strategy walks a step (increment plans);
+* :mod:`.convergence`: the convergence test of Newton iterations (:class:`Convergence`);
+* :mod:`.control`: the control strategies, each with its increment plan (load, displacement, arc
+  length, stabilisation);
 * :mod:`.stepping`: the step loop (increments, cutbacks, observers);
-* :mod:`.viscous`: the viscous term of a stabilised step;
+* :mod:`.linalg`: the linear solvers of the tangent (sparse LU, orderings, LAPACK back-ends);
 * :mod:`.output`: output as an observer (results writer, ``on_frame`` recorders);
 * :mod:`.families`, :mod:`.summary`: element families from a model; the run summary.
 """

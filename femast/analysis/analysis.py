@@ -25,11 +25,11 @@ from ..jit import prepare as prepare_kernels
 from ..model import validation
 from ..model.thermal import FieldLoads, check_controls, has_fields
 from ..post.results import Results, run_outcome
+from .convergence import Convergence, validate
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
 from .restart import RestartOutput, load_restart, restart_folder, restore
-from .solvers.convergence import Convergence
 from .state import State
 from .stepping import run_step
 from .summary import AnalysisSummary
@@ -43,7 +43,8 @@ class Analysis:
         frame then only goes to ``on_frame``, and :meth:`run` returns None.  For scripts and fits
         that keep what they need in memory (an FE experiment's many short runs).
 
-    convergence : :class:`~femast.analysis.solvers.convergence.Convergence` (tolerances, max iterations).
+    convergence : :class:`~femast.analysis.convergence.Convergence` (tolerances, max iterations), or a
+        convergence test of your own (the contract: :mod:`femast.analysis.convergence`).
     progress : show a tqdm progress bar per step.
     cutback : factor applied to a failed increment (Abaqus: 0.25).
     growth : factor applied after two easy increments (Abaqus: 1.5).
@@ -69,7 +70,7 @@ class Analysis:
         default None: none (a restarted run goes on saving them as before).
     restart : the results folder of an earlier run of the same model to continue from its last
         restart point (``femast run SCRIPT --restart FOLDER`` sets it for every analysis of a script).
-    linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.solvers.backends`):
+    linear_solver : the back-end that factorises the tangent (:mod:`femast.analysis.linalg.backends`):
         "auto" (default: LAPACK's dense LU up to 64 DOFs; LAPACK's band solver for a narrow reverse
         Cuthill-McKee band, as in a mast; PARDISO, if installed, for other models of 1000 DOFs or
         more; else SuperLU), or one forced by name: "superlu", "banded", "dense", "cholmod", "pardiso".
@@ -108,7 +109,7 @@ class Analysis:
                 "(Analysis.x, .R, .summary) remains",
                 stacklevel=2,
             )
-        self.convergence = convergence or Convergence()
+        self.convergence = Convergence() if convergence is None else validate(convergence)
         self.progress = progress
         self.cutback = cutback
         self.growth = growth
@@ -120,18 +121,18 @@ class Analysis:
             raise ModelError(f"model '{model.name}' has no steps; add one with model.step()")
         if not (model.beams or model.trusses or model.families):
             raise ModelError(f"model '{model.name}' has no elements")
-        for s in model.steps:  # (again: a step's fields may have been set after model.step(); issue 16)
+        for s in model.steps:  # (again: a step's fields may have been set after model.step())
             validation.step_increments(s)
         self.families = build_families(model)
         check_controls(model)
-        # length errors and temperatures (issue 20): None when the model has neither
+        # length errors and temperatures: None when the model has neither
         self.fields = FieldLoads(model, self.families) if has_fields(model) else None
         self.summary = AnalysisSummary()
         self.system = System(model, self.families, self.summary, linear_solver=linear_solver)
         self.state = State.initial(self.system.X0, self.families)
         self.output = ResultsOutput(out, [on_frame])
         self.observers = [self.output, *observers]
-        # restart (issue 16, restart.py): save a restart point every n increments; continue from one
+        # restart (restart.py): save a restart point every n increments; continue from one
         self.restart = restart_folder(out, restart)
         self.resume = None
         if restart_every is not None:
@@ -255,15 +256,14 @@ class Analysis:
                 if k < first:
                     continue
                 self._state.step = k
-                if getattr(step, "kind", "static") == "frequency":  # modes of the state (issue 18)
-                    from ..modal.step import run_frequency_step
-
-                    run_frequency_step(self, step)
+                runner = getattr(step, "runner", None)  # a step of another kind runs itself (e.g. modes)
+                if runner is not None:
+                    step_runner(runner)(self, step)
                 else:
                     inside = self.resume is not None and k == self.resume["step"] and not self.resume["step_done"]
                     run_step(self, step, resume=self.resume if inside else None)
             self.summary.status, self.summary.completed = "completed", True
-        except BaseException as exc:  # the summary says how the run ended (issue 16), then the error goes on
+        except BaseException as exc:  # the summary says how the run ended, then the error goes on
             self.summary.status, self.summary.message = run_outcome(exc)
             if isinstance(exc, ConvergenceError):
                 for obs in self.observers:
@@ -308,3 +308,13 @@ def solve(model, out="results", **options) -> Results | None:
     with ``out=None``, see :class:`Analysis`).
     Options are those of :class:`Analysis`."""
     return Analysis(model, out, **options).run()
+
+
+def step_runner(path: str):
+    """The function ``"module:function"`` that runs a step of a kind of its own (a step class's
+    ``runner``, e.g. the frequency step's ``femast.modal.step:run_frequency_step``), called as
+    ``function(analysis, step)``: the analysis imports no package above it."""
+    import importlib
+
+    module, _, name = path.partition(":")
+    return getattr(importlib.import_module(module), name)

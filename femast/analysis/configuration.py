@@ -1,4 +1,4 @@
-"""The configuration update of a Newton iteration, compiled (issue 8).
+"""The configuration update of a Newton iteration, compiled.
 
 Nodal positions are updated additively, nodal rotations multiplicatively by the spatial spins
 (R <- exp(skew(dw)) R, :func:`femast.rotations.apply_spins`), and the accumulated spin (the

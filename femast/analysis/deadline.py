@@ -1,4 +1,4 @@
-"""A wall-clock deadline for the analyses run by this thread (issue 20: ``Study(timeout_s=)`` on
+"""A wall-clock deadline for the analyses run by this thread (``Study(timeout_s=)`` on
 dask workers, whose samples run in threads where a SIGALRM timer cannot reach).
 
 ``with deadline(60.0):`` gives every analysis this thread runs inside the block

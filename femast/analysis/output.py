@@ -155,7 +155,7 @@ class ResultsOutput(Observer):
         }
         data = dict(zip(SCALARS, scalars))
         if isinstance(self.writer, NullWriter):
-            # recorders only (out=None): a frame that computes what a recorder reads (issue 21: an FE
+            # recorders only (out=None): a frame that computes what a recorder reads (an FE
             # experiment reads a few arrays of each increment); one kept by a recorder is completed
             frame = LazyFrame(data, state, outputs)
             self.writer.frame()

@@ -1,4 +1,4 @@
-"""A reference run's converged increments as the predictor of a nearby run (issue 21, item 6).
+"""A reference run's converged increments as the predictor of a nearby run.
 
 A fit of an FE experiment runs the same model along the same path many times with slightly
 different parameters.  The converged increments of one run (the free DOFs' increment ``Du`` of

@@ -8,8 +8,7 @@ increments, has the algorithm (newton.py) solve each one, retries failed attempt
 from __future__ import annotations
 
 from .. import progress as _progress
-from .controls import plan_for
-from .solvers.control import LoadControl
+from .control import LoadControl, plan_for
 
 
 def run_step(analysis, step, resume=None):

@@ -14,7 +14,7 @@ class AnalysisSummary:
     """What a run did: counts, wall time and where it stopped."""
 
     completed: bool = False  # True only once every step has run (status "completed")
-    status: str = "running"  # "running", then "completed", "failed" or "interrupted" (issue 16)
+    status: str = "running"  # "running", then "completed", "failed" or "interrupted"
     increments: int = 0
     iterations: int = 0
     cutbacks: int = 0

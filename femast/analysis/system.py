@@ -23,10 +23,10 @@ from ..model import validation
 from ..model.constraints import Constraints, transpose_times
 from .assembly import Assembler, assigning_positions
 from .configuration import update_configuration
+from .convergence import all_finite, evaluate, force_moment_abs_max, scaled_size
 from .dofs import number_dofs
+from .linalg.linear import SparseLU, mechanism_dofs
 from .reduction import ReducedTangent
-from .solvers.convergence import all_finite, force_moment_abs_max, scaled_size
-from .solvers.linear import SparseLU, mechanism_dofs
 
 
 @njit(cache=True)
@@ -99,7 +99,7 @@ class System:
         )
         if self.dofmap.n_free == 0:
             raise ModelError(f"model '{model.name}' has no free DOFs")
-        validation.loads_on_active_dofs(model, self.dofmap)  # a load nothing stiffens: an error (issue 16)
+        validation.loads_on_active_dofs(model, self.dofmap)  # a load nothing stiffens: an error
         self.check_balance = validation.self_equilibrated(self.families)
         self._constrained = self.constraints.active  # fixed from here on (asked every iteration)
         self.assembler = Assembler(self.dofmap, self.families, full=self._constrained)
@@ -310,8 +310,8 @@ class System:
     def converged(self, convergence, r, du, Du, responses, P, iteration=0):
         """Force/moment residual against the largest element nodal force/moment or applied load
         (Abaqus' 'flux' magnitude), displacement correction against the increment:
-        (converged, residual ratio, force test passed, scaled correction), see
-        :meth:`~femast.analysis.solvers.convergence.Convergence.measure`."""
+        (converged, residual ratio, force test passed, scaled correction), as the convergence test
+        answers them (:func:`~femast.analysis.convergence.evaluate`)."""
         fmax, mmax = force_moment_abs_max(P)
         for resp in responses:
             ff, mm = force_moment_abs_max(resp.f)
@@ -320,11 +320,11 @@ class System:
         L = self.length
         ref_f = max(fmax, 1e-2 * mmax / L, self.zero_force)
         ref_m = max(mmax, 1e-2 * fmax * L, self.zero_force * L)
-        return convergence.measure(r, du, Du, self.is_rot, ref_f, ref_m, L, iteration)
+        return evaluate(convergence, r, du, Du, self.is_rot, ref_f, ref_m, L, iteration)
 
     def scaled_size(self, v, Du):
         """The correction test's measure of a correction ``v`` given the increment so far ``Du``
-        (:func:`~femast.analysis.solvers.convergence.scaled_size`)."""
+        (:func:`~femast.analysis.convergence.scaled_size`)."""
         return scaled_size(v, Du, self.is_rot, self.length)
 
     def commit(self, responses, P, res, lam, equilibrium=True):
@@ -343,7 +343,7 @@ class System:
             float(sum(np.sum(r.energy) for r in responses if r.energy is not None)),
             equilibrium,
         )
-        if equilibrium and self.check_balance:  # issue 16: the reactions balance the loads
+        if equilibrium and self.check_balance:  # the reactions balance the loads
             validation.check_equilibrium(
                 st.x,
                 P,

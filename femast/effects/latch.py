@@ -143,7 +143,7 @@ LATCH_HYSTERESIS = register_effect(
                         ),
                     ),
                     apply=_latch_hysteresis_fe,
-                    doc="the FE latches (cable/latch element, femast.latch hysteresis option) get hysteresis_force = F_h, "
+                    doc="the FE latches (cable/latch element, femast.elements.latch_law hysteresis option) get hysteresis_force = F_h, "
                     "fading over the option latch_hysteresis_length_m (3e-4 m); it acts only on beads that have left "
                     "the backstop.",
                 )

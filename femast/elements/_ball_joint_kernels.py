@@ -41,9 +41,78 @@ MAX_INCREMENT = 3.0  # rad
 
 
 @njit(cache=True)
-def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out, prev, has_prev):
+def relative_increment(Ra, Rb, st):
+    """Finite relative-rotation increment ``theta = log(Q_c^T Q)``, Q = R_a^T R_b (right, body-b
+    form: Q = Q_c exp(theta)), Q_c the committed Q of state row ``st``; returns (theta, error code)."""
+    Q = Ra.T @ Rb
+    Qc = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            Qc[i, j] = st[I_Q + 3 * i + j]
+    th = logm_so3(Qc.T @ Q)
+    tn = math.sqrt(th[0] ** 2 + th[1] ** 2 + th[2] ** 2)
+    return th, (ERR_BIG_INCREMENT if tn > MAX_INCREMENT else OK)
+
+
+@njit(cache=True)
+def friction_return(st, th, k_s, Ys, Yk, prev, has_prev, m, C, nv):
+    """Static/kinetic Coulomb friction of a joint's moment: elastic predictor and radial return.
+
+    st : the committed state row (moment ``st[I_M:I_M+3]`` and slip flag ``st[I_SLIP]``).
+    th : (3) relative-rotation increment of the increment (body frame of node b), rad.
+    Ys, Yk : static and kinetic limits mu_s B |F|, mu_k B |F| (N m), Ys >= Yk.
+    Fills ``m`` (3, the moment, body frame of b), ``C`` (3x3, dm/dth) and, when slipping, ``nv``
+    (3, the slip direction m_tr / |m_tr|).
+    Returns (slip flag of the trial state, slip increment dgamma (rad), dissipation (J), limit (N m)).
+
+    The limit that must be exceeded to slip is Yk if the joint slipped in the committed increment
+    and keeps turning the same way (``m_c . th >= 0``: the straight elastic path from m_c stays
+    outside |m| < Yk), Ys otherwise (it was stuck, or turned back into the stick region: a reversal).
+    A slip returns to Yk (radial return: m = Yk n, dgamma = (|m_tr| - Yk) / k_s).  At a slip onset
+    from Ys the dissipation adds (Ys - Yk)^2 / (2 k_s): the elastic energy released by the drop
+    from Ys to Yk (so that work = stored energy + dissipation holds exactly in one-axis motion).
+    With Ys = Yk this is the seed's one-coefficient law, to the bit.  ``prev``: see
+    :func:`ball_joint_element` (slip reversal between Newton iterations)."""
+    mtr = np.empty(3)
+    for i in range(3):
+        mtr[i] = st[I_M + i] + k_s * th[i]
+    nm = math.sqrt(mtr[0] ** 2 + mtr[1] ** 2 + mtr[2] ** 2)
+    Y = Ys
+    if Yk != Ys and st[I_SLIP] == 1.0 and st[I_M] * th[0] + st[I_M + 1] * th[1] + st[I_M + 2] * th[2] >= 0.0:
+        Y = Yk  # slipping on: the kinetic limit
+    # slip reversed since the previous iteration: stuck for this iteration (see ball_joint_element)
+    reversed_ = False
+    if has_prev and prev[I_SLIP] == 1.0 and nm > Y * (1.0 + 1e-12):
+        reversed_ = mtr[0] * prev[I_M] + mtr[1] * prev[I_M + 1] + mtr[2] * prev[I_M + 2] < 0.0
+    for i in range(3):
+        for j in range(3):
+            C[i, j] = 0.0
+    # relative tolerance: a point on the slip surface (|m_tr| = Y to round-off) sticks
+    if nm <= Y * (1.0 + 1e-12) or reversed_:
+        for i in range(3):
+            m[i] = mtr[i]
+            C[i, i] = k_s
+        return (REVERSED if reversed_ else 0.0), 0.0, 0.0, Ys
+    # return mapping (radial return = backward Euler on the circular slip surface)
+    n = mtr / nm
+    dgam = (nm - Yk) / k_s
+    r = Yk * k_s / nm
+    for i in range(3):
+        nv[i] = n[i]
+        m[i] = Yk * n[i]
+        for j in range(3):
+            C[i, j] = r * ((1.0 if i == j else 0.0) - n[i] * n[j])
+    dD = Yk * dgam
+    if Y != Yk:
+        dD += (Y - Yk) ** 2 / (2.0 * k_s)  # onset: the drop from the static to the kinetic limit
+    return 1.0, dgam, dD, Yk
+
+
+@njit(cache=True)
+def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu_s, mu_k, B, st, f, K, new, out, prev, has_prev):
     """Forces ``f`` (12), tangent ``K`` (12x12), trial state ``new`` (15) and output ``out``
-    (11: M (3, global), F (3, global), |F|, limit, slip, gamma, D) of one joint.
+    (11: M (3, global), F (3, global), |F|, limit, slip, gamma, D) of one tied joint (the seed's
+    two-way tie); static and kinetic coefficients ``mu_s``, ``mu_k`` (:func:`friction_return`).
 
     ``prev`` (15): the joint's trial state at the previous Newton iteration (``has_prev``).  A
     joint that slipped there and would now slip the opposite way (trial moment against the
@@ -59,54 +128,20 @@ def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out
     d = xb - xa - c
     F = k_pen * d
     Fn = math.sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2])
-    Y = mu * B * Fn
     if not (math.isfinite(Fn) and math.isfinite(Ra.sum()) and math.isfinite(Rb.sum())):
         return 0.0, ERR_NOT_FINITE
-    Q = Ra.T @ Rb
-    Qc = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            Qc[i, j] = st[I_Q + 3 * i + j]
-    # finite relative-rotation increment, right (body-b) form: Q = Qc exp(th)
-    th = logm_so3(Qc.T @ Q)
-    tn = math.sqrt(th[0] ** 2 + th[1] ** 2 + th[2] ** 2)
-    err = OK
-    if tn > MAX_INCREMENT:
-        err = ERR_BIG_INCREMENT
-    # elastic predictor
-    mtr = np.empty(3)
-    for i in range(3):
-        mtr[i] = st[I_M + i] + k_s * th[i]
-    nm = math.sqrt(mtr[0] ** 2 + mtr[1] ** 2 + mtr[2] ** 2)
-    C = np.zeros((3, 3))
-    G = np.zeros((3, 3))  # dm/dd (slip only): n (mu B dFn/dd)^T
+    th, err = relative_increment(Ra, Rb, st)
+    C = np.empty((3, 3))
     m = np.empty(3)
-    # slip reversed since the previous iteration: stuck for this iteration (see docstring)
-    reversed_ = False
-    if has_prev and prev[I_SLIP] == 1.0 and nm > Y * (1.0 + 1e-12):
-        reversed_ = mtr[0] * prev[I_M] + mtr[1] * prev[I_M + 1] + mtr[2] * prev[I_M + 2] < 0.0
-    # relative tolerance: a point on the slip surface (|m_tr| = Y to round-off) sticks
-    if nm <= Y * (1.0 + 1e-12) or reversed_:
-        slip = REVERSED if reversed_ else 0.0
-        dgam = 0.0
+    n = np.empty(3)
+    G = np.zeros((3, 3))  # dm/dd (slip only): n (mu_k B dFn/dd)^T
+    slip, dgam, dD, Y = friction_return(st, th, k_s, mu_s * B * Fn, mu_k * B * Fn, prev, has_prev, m, C, n)
+    if slip == 1.0 and Fn > 0.0:
+        g = (mu_k * B * k_pen / Fn) * F  # d|F|/dd * mu_k B
         for i in range(3):
-            m[i] = mtr[i]
-            C[i, i] = k_s
-    else:
-        # return mapping (radial return = backward Euler on the circular slip surface)
-        slip = 1.0
-        n = mtr / nm
-        dgam = (nm - Y) / k_s
-        r = Y * k_s / nm
-        for i in range(3):
-            m[i] = Y * n[i]
             for j in range(3):
-                C[i, j] = r * ((1.0 if i == j else 0.0) - n[i] * n[j])
-        if Fn > 0.0:
-            g = (mu * B * k_pen / Fn) * F  # d|F|/dd * mu B
-            for i in range(3):
-                for j in range(3):
-                    G[i, j] = n[i] * g[j]
+                G[i, j] = n[i] * g[j]
+    Q = Ra.T @ Rb
     M = Rb @ m
     # dm/dw_b = C Ts^-T(th) Rb^T = -dm/dw_a ; spatial A = Rb C Ts^-T Rb^T
     A = Rb @ (C @ (ts_inv(th).T @ Rb.T))
@@ -152,7 +187,7 @@ def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out
         new[I_M + i] = m[i]
     new[I_SLIP] = slip
     new[I_GAMMA] = st[I_GAMMA] + dgam
-    new[I_DISS] = st[I_DISS] + Y * dgam
+    new[I_DISS] = st[I_DISS] + dD
     for i in range(3):
         for j in range(3):
             new[I_Q + 3 * i + j] = Q[i, j]
@@ -169,7 +204,9 @@ def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu, B, st, f, K, new, out
 
 
 @njit(cache=True)
-def ball_joint_family_kernel(nodes, x, R, d0, k_pen, k_s, mu, B, state, f, K, new, out, energy, err, prev, has_prev):
+def ball_joint_family_kernel(
+    nodes, x, R, d0, k_pen, k_s, mu_s, mu_k, B, state, f, K, new, out, energy, err, prev, has_prev
+):
     """All joints of a family at once (see :func:`ball_joint_element`); ``prev`` (n_el, 15):
     the previous iteration's trial states (read only if ``has_prev``)."""
     for e in range(nodes.shape[0]):
@@ -183,7 +220,8 @@ def ball_joint_family_kernel(nodes, x, R, d0, k_pen, k_s, mu, B, state, f, K, ne
             d0[e],
             k_pen[e],
             k_s[e],
-            mu[e],
+            mu_s[e],
+            mu_k[e],
             B[e],
             state[e],
             f[e],

@@ -1,5 +1,5 @@
 """numba kernels: section lengths, their gradients and Hessians, and device wrap angles of a cable
-over point devices and pulleys of finite radius (issue 19; seed 001 Sec. II.B.2 names "the size of
+over point devices and pulleys of finite radius (Stohlman & Pellegrino, Sec. II.B.2 names "the size of
 the pulley" as a limitation of its point-pulley model).
 
 Private module: the public face is :mod:`femast.elements.cable_devices`.

@@ -1,4 +1,4 @@
-"""numba kernels of the cable/pulley/latch element (seed 001, Eqs. 2-5 and 14).
+"""numba kernels of the cable/pulley/latch element (Stohlman & Pellegrino, Eqs. 2-5 and 14).
 
 Private module: the public face is :mod:`femast.elements.cable_latch`.
 
@@ -47,7 +47,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..latch import latch_dT_scalar, latch_opening_scalar
+from .latch_law import latch_dT_scalar, latch_opening_scalar
 
 STICK = 0
 SLIP_OUT = 1
@@ -85,7 +85,13 @@ def hysteresis_scalar(x, xb, Fh, ell):
 def branch_scalar(x, sigma, p, Fh, ell):
     """Force jump of a bead moving in direction sigma (N) and its x-derivative (N/m): Eq. 14
     plus sigma H(x) of the hysteresis option (exactly Eq. 14 when Fh = 0)."""
-    D, dD = latch_dT_scalar(x, sigma, p[0], p[1], p[2], p[3], p[4], p[5])
+    return branch_scalar_mu(x, sigma, p, p[3], Fh, ell)
+
+
+@njit(cache=True)
+def branch_scalar_mu(x, sigma, p, mu, Fh, ell):
+    """:func:`branch_scalar` with the friction coefficient ``mu`` given (static or kinetic)."""
+    D, dD = latch_dT_scalar(x, sigma, p[0], p[1], p[2], mu, p[4], p[5])
     if Fh > 0.0:
         H, dH = hysteresis_scalar(x, p[1], Fh, ell)
         D += sigma * H
@@ -219,10 +225,20 @@ def first_root(sigma, x_start, x_end, Lb, LA, LB, EA, L0, p, Fh, ell):
 
 
 @njit(cache=True)
-def solve_latch(LA, LB, EA, L0, Lb, has_latch, p, x_c, Fh=0.0, ell=1.0):
+def solve_latch(LA, LB, EA, L0, Lb, has_latch, p, x_c, Fh=0.0, ell=1.0, mu_k=-1.0, status_c=0):
     """Solve the reduced cable equation for one element (Fh, ell: hysteresis option, N and m).
 
+    mu_k : kinetic friction (< 0: the static p[3]); status_c : the committed status.  The static
+    band uses p[3], except on the side of a bead that was sliding (it slides on at mu_k until it
+    stops or reverses); a sliding bead follows Eq. 14 at mu_k.
+
     Returns x (m, bead position), s = Lb - x (m), status, tA, tB (N), ds/dLA, ds/dLB (-)."""
+    if mu_k >= 0.0 and mu_k != p[3]:
+        pk = p.copy()  # the law of a sliding bead
+        pk[3] = mu_k
+    else:
+        pk = p
+        mu_k = p[3]
     if not has_latch:
         tA, _, _, tB, _, _ = group_tensions(0.0, 0.0, LB, EA, L0)
         return x_c, 0.0, STICK, 0.0, tB, 0.0, 0.0
@@ -232,8 +248,8 @@ def solve_latch(LA, LB, EA, L0, Lb, has_latch, p, x_c, Fh=0.0, ell=1.0):
     tA, dtA_ds, dtA_dLA, tB, dtB_ds, dtB_dLB = group_tensions(s_c, LA, LB, EA, L0)
     C = tB - tA
     at_stop = x_c <= -xb * (1.0 - 1e-12)
-    D_in, _ = branch_scalar(x_c, -1.0, p, Fh, ell)
-    D_out, _ = branch_scalar(x_c, 1.0, p, Fh, ell)
+    D_in, _ = branch_scalar_mu(x_c, -1.0, p, mu_k if status_c == SLIP_IN else p[3], Fh, ell)
+    D_out, _ = branch_scalar_mu(x_c, 1.0, p, mu_k if status_c == SLIP_OUT else p[3], Fh, ell)
     lo = -np.inf if at_stop else D_in
     hi = D_out
     free = (not at_stop) and latch_opening_scalar(x_c, r, p[4], p[5]) <= 0.0
@@ -252,20 +268,20 @@ def solve_latch(LA, LB, EA, L0, Lb, has_latch, p, x_c, Fh=0.0, ell=1.0):
         x = x_c  # taut cable already balanced on a free bead
     elif sigma > 0:
         x_end = Lb - S_EPS * L0
-        x, _ = first_root(1.0, x_c, x_end, Lb, LA, LB, EA, L0, p, Fh, ell)
+        x, _ = first_root(1.0, x_c, x_end, Lb, LA, LB, EA, L0, pk, Fh, ell)
     else:
         x_end = Lb - (1.0 - S_EPS) * L0
         stop = -xb
         if stop > x_end:
             x_end = stop
-        x, hit = first_root(-1.0, x_c, x_end, Lb, LA, LB, EA, L0, p, Fh, ell)
+        x, hit = first_root(-1.0, x_c, x_end, Lb, LA, LB, EA, L0, pk, Fh, ell)
         if hit and x_end == stop:
             s = Lb - x
             tA, _, _, tB, _, _ = group_tensions(s, LA, LB, EA, L0)
             return x, s, BACKSTOP, tA, tB, 0.0, 0.0
     s = Lb - x
     tA, dtA_ds, dtA_dLA, tB, dtB_ds, dtB_dLB = group_tensions(s, LA, LB, EA, L0)
-    _, dD = branch_scalar(x, float(sigma), p, Fh, ell)
+    _, dD = branch_scalar(x, float(sigma), pk, Fh, ell)
     phi_s = dtB_ds - dtA_ds + dD
     scale = dtA_dLA + dtB_dLB + abs(dD) + dtB_ds - dtA_ds
     ds_dLA = 0.0
@@ -278,11 +294,12 @@ def solve_latch(LA, LB, EA, L0, Lb, has_latch, p, x_c, Fh=0.0, ell=1.0):
 
 
 @njit(cache=True)
-def cable_latch_kernel(X, EA, L0, Lb, jl, P, Hy, state, f, K, state_new, T, dT, energy, err):
+def cable_latch_kernel(X, EA, L0, Lb, jl, P, MuK, Hy, state, f, K, state_new, T, dT, energy, err):
     """All elements: nodal forces f (n_el, 6(n+1)), tangent K, trial state, tensions.
 
     X (n_el, n+1, 3) m; EA (N), L0 (m), Lb (m) per element; jl latch node (local
-    index 1..n-1, 0 for none); P (n_el, 6) latch parameters; Hy (n_el, 2) hysteresis
+    index 1..n-1, 0 for none); P (n_el, 6) latch parameters (mu: static); MuK (n_el,) kinetic
+    friction; Hy (n_el, 2) hysteresis
     option [Fh (N), ell (m)] (Fh = 0: off); state (n_el, n+2)
     committed [x_bead, status, L0_1..L0_n] (read only)."""
     n_el = X.shape[0]
@@ -338,7 +355,7 @@ def cable_latch_kernel(X, EA, L0, Lb, jl, P, Hy, state, f, K, state_new, T, dT, 
             continue
         p = P[el]
         x_new, s, status, tA, tB, ds_dLA, ds_dLB = solve_latch(
-            LA, LB, EA[el], L0[el], Lb[el], has_latch, p, x_c, Hy[el, 0], Hy[el, 1]
+            LA, LB, EA[el], L0[el], Lb[el], has_latch, p, x_c, Hy[el, 0], Hy[el, 1], MuK[el], int(state[el, 1])
         )
         tA, dtA_ds, dtA_dLA, tB, dtB_ds, dtB_dLB = group_tensions(s, LA, LB, EA[el], L0[el])
         # total derivatives of the group tensions w.r.t. the group chord lengths

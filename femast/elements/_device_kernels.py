@@ -1,4 +1,4 @@
-"""numba kernel of the cable over an ordered list of devices (issue 19; seed 001 Sec. II.B.2).
+"""numba kernel of the cable over an ordered list of devices (Stohlman & Pellegrino, Sec. II.B.2).
 
 Private module: the public face is :mod:`femast.elements.cable_devices`.
 
@@ -36,11 +36,14 @@ from numba import njit
 
 from ._cable_geometry import GEO_OK, cable_geometry
 from ._cable_kernels import latch_opening_scalar
+from ._device_algebra import cable_forces_and_tangent
+from ._device_algebra import section_tensions as _sections
+from ._device_algebra import solve_small as _solve_small
 from ._device_laws import CLAMP, FREE, LATCH, builtin_law, max_step, s_max_of
 
 _law = builtin_law
 """The device law the kernels call (a module global, so that the kernels cache; a family with a user
-law runs a copy of this module with ``_law`` replaced, see :func:`kernel_for_law`)."""
+law runs a copy of this module with ``_law`` replaced, see :mod:`._device_user_kernels`)."""
 
 STICK = 0
 SLIP_OUT = 1  # sigma = +1: the out side pulls (dS < 0)
@@ -55,59 +58,6 @@ ERR_ACTIVE_SET = 12  # the stick/slip set cycled
 
 MAX_NEWTON = 800
 MAX_SET = 60
-
-
-@njit(cache=True)
-def _solve_small(A, b, x):
-    """Solve A x = b (small dense, partial pivoting); returns False if A is singular."""
-    m = b.shape[0]
-    M = A.copy()
-    y = b.copy()
-    scale = 0.0
-    for i in range(m):
-        for j in range(m):
-            scale = max(scale, abs(M[i, j]))
-    if scale == 0.0:
-        return m == 0
-    for c in range(m):
-        piv = c
-        for r in range(c + 1, m):
-            if abs(M[r, c]) > abs(M[piv, c]):
-                piv = r
-        if abs(M[piv, c]) <= 1e-14 * scale:
-            return False
-        if piv != c:
-            for j in range(m):
-                M[c, j], M[piv, j] = M[piv, j], M[c, j]
-            y[c], y[piv] = y[piv], y[c]
-        for r in range(c + 1, m):
-            fct = M[r, c] / M[c, c]
-            if fct != 0.0:
-                for j in range(c, m):
-                    M[r, j] -= fct * M[c, j]
-                y[r] -= fct * y[c]
-    for c in range(m - 1, -1, -1):
-        acc = y[c]
-        for j in range(c + 1, m):
-            acc -= M[c, j] * x[j]
-        x[c] = acc / M[c, c]
-    return True
-
-
-@njit(cache=True)
-def _sections(S, L, EA, T, dT_dl0, de_dl0, e):
-    """Tensions T (N), strains e and their derivatives with respect to l0 (N/m, 1/m)."""
-    n = L.shape[0]
-    for i in range(n):
-        l0 = S[i + 1] - S[i]
-        e[i] = L[i] / l0 - 1.0
-        de_dl0[i] = -L[i] / (l0 * l0)
-        if e[i] > 0.0:
-            T[i] = EA * e[i]
-            dT_dl0[i] = EA * de_dl0[i]
-        else:
-            T[i] = 0.0
-            dT_dl0[i] = 0.0
 
 
 @njit(cache=True)
@@ -143,7 +93,7 @@ def _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi, T, dT
             A[d, d] = c
         else:
             sigma = float(mode)
-            r, rTi, rTo, rs, rphi = _law(kinds[d], sigma, T[i_in], T[i_out], S[d + 1], phi[d], P[d])
+            r, rTi, rTo, rs, rphi = _law(kinds[d], sigma, T[i_in], T[i_out], S[d + 1], phi[d], P[d], False)
             R[d] = r
             if d >= 1:
                 A[d, d - 1] += -rTi * dT_dl0[i_in]
@@ -215,7 +165,7 @@ def _newton(S, L, phi, EA, L0, kinds, P, modes, targets, smax, bufs):
                 S[d + 1] += dS[d]
             _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi, T, dT_dl0, de_dl0, e)
             return 0
-        # sliding latches: the first equilibrium in the direction of motion (seed 001 Sec. II.B.2).
+        # sliding latches: the first equilibrium in the direction of motion (Stohlman & Pellegrino, Sec. II.B.2).
         # Per device a bracket [back, front] along the motion: back = the furthest point where the
         # device is still pushed, front = the nearest where it is pushed back; Newton steps are kept
         # inside it and below one grid cell, else a cell forward (front unknown) or bisection.
@@ -276,6 +226,104 @@ def _newton(S, L, phi, EA, L0, kinds, P, modes, targets, smax, bufs):
 
 
 @njit(cache=True)
+def _relax(S, L, phi, EA, L0, kinds, P, modes, targets, smax, bufs):
+    """Pseudo-transient continuation of the device equations (the fallback of :func:`_newton` when
+    several devices slide at once): each sliding device moves with the flow ``dS/dtau = -c r(S)``
+    (its unbalanced force pushes it along its direction), integrated by implicit Euler steps
+
+        r_d(S) + (D_d / beta) (S_d - S_d^k) = 0   (sliding d),   the other rows as in _newton,
+
+    D_d = EA / l0_in + EA / l0_out, with beta growing x4 after a step and shrinking /4 after a failed
+    one or a step that takes a sliding latch more than one grid cell (:func:`max_step`).  Implicit
+    Euler does not pass a stable root of the flow, so the march stops at the first equilibrium the
+    coupled devices meet, as the grid march of the single-latch element.  Same return codes."""
+    R, A, RL, Rphi, T, dT_dl0, de_dl0, e, dS = bufs
+    n = L.shape[0]
+    m = n - 1
+    Sk = np.empty(m)
+    Dd = np.zeros(m)
+    rhs = np.empty(m)
+    beta = 0.25
+    for _outer in range(400):
+        for d in range(m):
+            Sk[d] = S[d + 1]
+        _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi, T, dT_dl0, de_dl0, e)
+        sliding = False
+        for d in range(m):
+            if modes[d] == SLIP_OUT or modes[d] == SLIP_IN:
+                sliding = True
+                Dd[d] = EA / (S[d + 1] - S[d]) + EA / (S[d + 2] - S[d + 1])
+        if not sliding:
+            return 1000 + ERR_NO_CONVERGENCE
+        ok = False
+        for _inner in range(40):
+            _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi, T, dT_dl0, de_dl0, e)
+            for d in range(m):
+                rhs[d] = -R[d]
+                if modes[d] == SLIP_OUT or modes[d] == SLIP_IN:
+                    rhs[d] -= Dd[d] / beta * (S[d + 1] - Sk[d])
+                    A[d, d] += Dd[d] / beta
+            if not _solve_small(A, rhs, dS):
+                break
+            alpha = 1.0
+            for i in range(n):
+                l0 = S[i + 1] - S[i]
+                dl = (dS[i] if i < m else 0.0) - (dS[i - 1] if i >= 1 else 0.0)
+                if dl < -0.9 * l0:
+                    alpha = min(alpha, 0.9 * l0 / (-dl))
+            raw = 0.0
+            for d in range(m):
+                S[d + 1] += alpha * dS[d]
+                raw = max(raw, abs(dS[d]))
+            if raw <= 1e-13 * L0:
+                ok = True
+                break
+        # a step that crosses more than one cell of a sliding latch, or leaves a stop, is too long
+        if ok:
+            for d in range(m):
+                if modes[d] == SLIP_OUT or modes[d] == SLIP_IN:
+                    if abs(S[d + 1] - Sk[d]) > max_step(kinds[d], Sk[d], P[d]):
+                        ok = False
+                    if modes[d] == SLIP_IN and S[d + 1] > smax[d] * (1.0 + 1e-14):
+                        ok = False
+        if not ok:
+            for d in range(m):
+                S[d + 1] = Sk[d]
+            beta *= 0.25
+            if beta < 1e-14:
+                return 1000 + ERR_NO_CONVERGENCE
+            continue
+        # an accepted step: a device at its stop and still pushed stays there
+        _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi, T, dT_dl0, de_dl0, e)
+        for d in range(m):
+            if modes[d] == SLIP_IN and S[d + 1] >= smax[d] * (1.0 - 1e-14) and -R[d] > 0.0:
+                modes[d] = STOP
+                targets[d] = smax[d]
+                S[d + 1] = smax[d]
+        # converged when a plain Newton step is round-off
+        moved = 0.0
+        for d in range(m):
+            moved = max(moved, abs(S[d + 1] - Sk[d]))
+        if beta >= 1e8 and moved <= 1e-12 * L0:
+            _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi, T, dT_dl0, de_dl0, e)
+            for d in range(m):
+                rhs[d] = -R[d]
+            if _solve_small(A, rhs, dS):
+                raw = 0.0
+                for d in range(m):
+                    raw = max(raw, abs(dS[d]))
+                if raw <= 1e-12 * L0:
+                    for d in range(m):
+                        S[d + 1] += dS[d]
+                    _assemble(S, L, phi, EA, L0, kinds, P, modes, targets, R, A, RL, Rphi, T, dT_dl0, de_dl0, e)
+                    return 0
+            else:
+                return 0  # a flat residual (a slack device): the flow has stopped
+        beta = min(beta * 4.0, 1e12)
+    return 1000 + ERR_NO_CONVERGENCE
+
+
+@njit(cache=True)
 def solve_devices(L, phi, EA, L0, kinds, P, S_c, modes_c, S, modes, bufs):
     """Active-set return mapping of one cable (module note).  S (n+1,) and modes (n-1,) are
     outputs (S[0] = 0, S[n] = L0).  Returns an error code (ERR_*)."""
@@ -297,6 +345,8 @@ def solve_devices(L, phi, EA, L0, kinds, P, S_c, modes_c, S, modes, bufs):
         else:
             modes[d] = STICK
     tol_s = 1e-12 * L0
+    S_start = np.empty(n + 1)
+    modes_start = np.empty(m, dtype=np.int64)
     for _it in range(MAX_SET):
         for d in range(m):  # sliding devices start from the last solution
             if modes[d] == STICK:
@@ -304,7 +354,13 @@ def solve_devices(L, phi, EA, L0, kinds, P, S_c, modes_c, S, modes, bufs):
                 targets[d] = S_c[d]
             elif modes[d] == STOP:
                 S[d + 1] = targets[d]
+        S_start[:] = S
+        modes_start[:] = modes[:m]
         code = _newton(S, L, phi, EA, L0, kinds, P, modes, targets, smax, bufs)
+        if code == 1000 + ERR_NO_CONVERGENCE:  # several devices sliding at once: the continuation
+            S[:] = S_start
+            modes[:m] = modes_start
+            code = _relax(S, L, phi, EA, L0, kinds, P, modes, targets, smax, bufs)
         if code < 0:
             modes[-code - 1] = STICK  # both sides slack: nothing drives the device
             continue
@@ -334,14 +390,16 @@ def solve_devices(L, phi, EA, L0, kinds, P, S_c, modes_c, S, modes, bufs):
                 continue
             if kinds[d] == CLAMP or kinds[d] == FREE:
                 continue
-            rp = _law(kinds[d], 1.0, T[d], T[d + 1], S[d + 1], phi[d], P[d])[0]
+            # static friction for a device at rest; one that slid in the last increment goes on at
+            # the kinetic law in its direction (it sticks again on arrest or reversal)
+            rp = _law(kinds[d], 1.0, T[d], T[d + 1], S[d + 1], phi[d], P[d], modes_c[d] != SLIP_OUT)[0]
             if rp > tol_f and rp > worst:
                 worst = rp
                 wd = d
                 wmode = SLIP_OUT
             if modes[d] == STOP:
                 continue  # the stop holds any pull from the in side
-            rm = _law(kinds[d], -1.0, T[d], T[d + 1], S[d + 1], phi[d], P[d])[0]
+            rm = _law(kinds[d], -1.0, T[d], T[d + 1], S[d + 1], phi[d], P[d], modes_c[d] != SLIP_IN)[0]
             if rm < -tol_f and -rm > worst:
                 worst = -rm
                 wd = d
@@ -425,63 +483,4 @@ def device_kernel(X, radius, EA, L0, kinds, P, state, f, K, state_new, T_out, ph
                 dlt = latch_opening_scalar(p[6] - S[d + 1], p[0], p[4], p[5])
                 en += p[2] * dlt * dlt
         energy[el] = en
-        # dS/dx = -A^-1 (RL G + Rphi dphi)
-        Y = np.zeros((m, 3 * nn))
-        if m > 0:
-            rhs = np.empty(m)
-            col = np.empty(m)
-            for a in range(3 * nn):
-                for d in range(m):
-                    acc = Rphi[d] * dphi[d, a]
-                    for i in range(n):
-                        acc += RL[d, i] * G[i, a]
-                    rhs[d] = -acc
-                if _solve_small(A, rhs, col):
-                    for d in range(m):
-                        Y[d, a] = col[d]
-        # dT_i/dx = dT/dL G_i + dT/dS_i Y_{i-1} + dT/dS_{i+1} Y_i
-        for i in range(n):
-            l0 = S[i + 1] - S[i]
-            dTdL = EA[el] / l0 if T[i] > 0.0 else 0.0
-            for a in range(3 * nn):
-                v = dTdL * G[i, a]
-                if i >= 1:
-                    v -= dT_dl0[i] * Y[i - 1, a]  # dl0_i/dS_i = -1
-                if i < m:
-                    v += dT_dl0[i] * Y[i, a]  # dl0_i/dS_{i+1} = +1
-                dTdx[i, a] = v
-        for i in range(n):
-            for a in range(nn):
-                for c in range(3):
-                    f[el, 6 * a + c] += T[i] * G[i, 3 * a + c]
-        for a in range(nn):
-            for c in range(3):
-                ra = 3 * a + c
-                for b in range(nn):
-                    for d2 in range(3):
-                        rb = 3 * b + d2
-                        v = 0.0
-                        for i in range(n):
-                            v += T[i] * H[i, ra, rb] + G[i, ra] * dTdx[i, rb]
-                        K[el, 6 * a + c, 6 * b + d2] = v
-
-
-_USER_KERNELS = {}
-
-
-def kernel_for_law(law):
-    """:func:`device_kernel` calling ``law`` (same signature as :func:`._device_laws.builtin_law`)
-    instead of the built-in laws: a copy of this module's kernels, compiled on first use (not cached
-    on disk: the law is the user's)."""
-    if law not in _USER_KERNELS:
-        import inspect
-        import sys
-        import types
-
-        src = inspect.getsource(sys.modules[__name__]).replace("@njit(cache=True)", "@njit")
-        mod = types.ModuleType(__name__ + "_user")
-        mod.__package__ = __package__
-        exec(compile(src, f"<{__name__} with user law {getattr(law, '__name__', law)}>", "exec"), mod.__dict__)
-        mod._law = law
-        _USER_KERNELS[law] = mod.device_kernel
-    return _USER_KERNELS[law]
+        cable_forces_and_tangent(S, G, H, dphi, A, RL, Rphi, T, dT_dl0, EA[el], f[el], K[el], dTdx)

@@ -4,7 +4,7 @@
 memory is an ``alloca`` in the function's entry block: no allocation per call, and LLVM knows it
 aliases neither the kernel's input nor its output arrays, so it keeps values in registers across
 stores to the outputs.  With every scratch matrix of the beam kernel on the stack (and its helpers
-inlined) the kernel runs 1.6x faster than with heap scratch, bit for bit the same (issue 8).
+inlined) the kernel runs 1.6x faster than with heap scratch, bit for bit the same.
 
 The array must not outlive the function that calls ``stack_buffer`` (never return it or store it
 in a heap array); a helper that should use one must be ``inline='always'``.

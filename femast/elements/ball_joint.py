@@ -1,10 +1,21 @@
-"""Ball joint with Coulomb friction: seed 001, Section II.B.1 (|M| <= mu B |F|).
+"""Ball joint with Coulomb friction: Stohlman & Pellegrino, Sec. II.B.1 (|M| <= mu B |F|).
 
-A joint ties a longeron end node *a* to a coincident corner node *b*.  Translations are
-tied by a stiff penalty; the relative rotation is resisted by a friction moment whose
-magnitude cannot exceed ``mu B |F|``, with F the force the joint transmits, mu the
-friction coefficient and B the radius of the longeron ball end (seed: mu = 0.5, B = 4 mm,
-same static and kinetic coefficient).  The derivation is in ``docs/ball_joint.md``.
+A joint connects a longeron end node *a* (the ball) to a coincident corner node *b* (the
+socket).  The relative rotation is resisted by a friction moment whose magnitude cannot exceed
+``mu B |F|``, with F the force pressing the ball into its socket, mu the friction coefficient and
+B the radius of the longeron ball end (ADAM: mu = 0.5, B = 4 mm, the same static and kinetic
+coefficient; here ``mu_s`` >= ``mu_k`` may differ).  Two seats (``seat=``):
+
+* ``"tied"``: the paper's joint, a captive ball (a rod end, a retained socket): translations tied
+  by a stiff penalty in every direction, tension as well as compression; F is the tie force.
+* ``"seated"``: a ball held in its seat by preload.  The seat carries compression along the seat
+  axis and opens in tension (optionally a retainer catches the ball after an axial clearance
+  ``clearance_axial``); radially the ball is held by the socket wall, with an optional play
+  ``clearance_radial``.  Friction acts on the seat's normal force N only: ``|M| <= mu B N``, zero
+  once the seat opens.  Penalty contact (the same k_pen as the tie; the kernels are in
+  :mod:`femast.elements._ball_seat_kernels`): see ``docs/ball_joint.md`` for why.
+
+The derivation is in ``docs/ball_joint.md``.  Below, the tied joint.
 
 Equations (SI: N, m, rad)
 -------------------------
@@ -17,16 +28,18 @@ Equations (SI: N, m, rad)
   in the state.
 * Elastic predictor (regularised stick): ``m_tr = m_c + k_stick theta`` (m in the body
   frame of node b, so a stuck moment turns with the joint).
-* Limit ``Y = mu B |F|``.  Stick if ``|m_tr| <= Y``: ``m = m_tr``.  Otherwise slip, radial
-  return (backward Euler on the circle |m| = Y): ``m = Y n``, ``n = m_tr / |m_tr|``,
-  slip increment ``dgamma = (|m_tr| - Y) / k_stick``, dissipation ``dD = Y dgamma``.
+* Limits ``Y_s = mu_s B |F|`` (to start slipping) and ``Y_k = mu_k B |F|`` (to keep slipping:
+  the joint slipped in the last increment and turns on the same way).  Stick if ``|m_tr| <= Y``:
+  ``m = m_tr``.  Otherwise slip, radial return (backward Euler on the circle |m| = Y_k):
+  ``m = Y_k n``, ``n = m_tr / |m_tr|``, slip increment ``dgamma = (|m_tr| - Y_k) / k_stick``,
+  dissipation ``dD = Y_k dgamma`` (+ ``(Y_s - Y_k)^2 / (2 k_stick)`` at an onset).
 * Transmitted moment ``M = R_b m`` (global); internal moments ``-M`` on a, ``+M`` on b.
 
 Consistent tangent (exact derivative, checked against finite differences by the tests),
 with ``C = k_stick I`` (stick) or ``C = (Y k_stick / |m_tr|) (I - n n^T)`` (slip):
 
     dM = R_b C Ts^-T(theta) R_b^T (dw_b - dw_a) - [M]x dw_b
-         + R_b n (mu B k_pen F^T / |F|) (dx_b - dx_a + [R_a d0]x dw_a)      (slip only)
+         + R_b n (mu_k B k_pen F^T / |F|) (dx_b - dx_a + [R_a d0]x dw_a)    (slip only)
 
 The last term is how the limit changes with F; it makes the tangent non-symmetric while
 the joint slips (``symmetric = False``).
@@ -37,8 +50,10 @@ committed state is never modified: the trial state is returned and the analysis 
 it on convergence or drops it on a cutback.
 
 Output per element: ``moment`` (3, global, N m, the moment on node b is -moment),
-``force`` (3, global, N), ``F`` = |F| (N), ``limit`` = mu B |F| (N m), ``slip`` (1 slipping,
-0 sticking), ``slip_angle`` (accumulated, rad), ``dissipated`` (J), ``moment_norm`` (N m).
+``force`` (3, global, N), ``F`` = |F| (N), ``limit`` (N m: mu_s B |F| stuck, mu_k B |F| slipping),
+``slip`` (1 slipping, 0 sticking), ``slip_angle`` (accumulated, rad), ``dissipated`` (J),
+``moment_norm`` (N m); seated joints also ``normal_force`` (N, the seat's or retainer's), ``gap``
+(axial opening, m, > 0 lifted off) and ``contact`` (1 seated, 0 open, 2 on the retainer).
 """
 
 from __future__ import annotations
@@ -46,235 +61,32 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
-from ._ball_joint_kernels import (
-    ERR_BIG_INCREMENT,
-    ERR_NOT_FINITE,
-    I_DISS,
-    I_GAMMA,
-    I_M,
-    I_Q,
-    I_SLIP,
-    MAX_INCREMENT,
-    N_STATE,
-    REVERSED,
-    ball_joint_family_kernel,
+from .ball_joint_family import (
+    MAX_CLEARANCE_FRACTION,
+    OPEN_FACTOR,
+    PENALTY_FACTOR,
+    SEATS,
+    SEED_B,
+    SEED_MU,
+    STICK_FACTOR,
+    TOL_FACTOR,
+    BallJointFamily,
 )
-from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput
 
 __all__ = [
     "BallJointFamily",
     "add_ball_joints",
     "default_stiffnesses",
+    "seat_axes",
     "friction_loop_energy",
+    "stick_slip_loop_energy",
     "PENALTY_FACTOR",
     "STICK_FACTOR",
+    "OPEN_FACTOR",
+    "SEATS",
     "SEED_MU",
     "SEED_B",
 ]
-
-SEED_MU = 0.5  # seed 001, Sec. II.B.1: static = kinetic friction coefficient
-SEED_B = 0.004  # seed 001, Sec. II.B.1: longeron ball end radius, m
-# Default penalty k_pen = PENALTY_FACTOR * (largest EA/L of the members at the joint): the tie
-# gap |F|/k_pen is 1e-4 of the stretch of the stiffest connected member under the same force.
-PENALTY_FACTOR = 1e4
-# Default stick stiffness k_stick = STICK_FACTOR * (largest 4EI/L or GJ/L of the beams at the
-# joint): the elastic 'stick' rotation is 1e-3 of the end rotation of the stiffest connected beam.
-STICK_FACTOR = 1e3
-# Default coincidence tolerance, as a fraction of the model's size.
-TOL_FACTOR = 1e-6
-
-
-_NO_PREV = np.zeros((1, N_STATE))
-
-
-def _per_joint(value, n, what, name):
-    try:
-        a = np.broadcast_to(np.asarray(value, dtype=float), (n,)).astype(float).copy()
-    except (TypeError, ValueError):
-        raise ModelError(
-            f"ball joints '{name}': {what} must be a number or one number per joint ({n}), got {value!r}"
-        ) from None
-    return a
-
-
-class BallJointFamily(ElementFamily):
-    """A batch of friction ball joints (seed 001, Sec. II.B.1).
-
-    Parameters
-    ----------
-    nodes : (n_el, 2) node labels (a = longeron end, b = corner) when added with
-        :meth:`Model.add_family` (the analysis converts them to indices).
-    k_pen : translational penalty stiffness of the tie, N/m (scalar or per joint).
-    k_stick : rotational stick stiffness (regularised Coulomb), N m/rad.
-    mu : friction coefficient (>= 0), default 0.5 (seed).
-    B : ball end radius, m (> 0), default 0.004 (seed).
-    X : optional (n_el, 2, 3) initial coordinates of nodes a and b; the joint checks that
-        they coincide within ``tol`` and ties the small offset rigidly to node a.
-    tol : coincidence tolerance, m (default 1e-6 of the joints' extent, at least 1e-9 m).
-    labels : joint labels for results and messages (default 1..n).
-    name : family name (results key, messages).
-    """
-
-    active_dofs = (0, 1, 2, 3, 4, 5)
-    n_state = N_STATE
-    symmetric = False
-
-    def __init__(
-        self, nodes, k_pen, k_stick, mu=SEED_MU, B=SEED_B, *, X=None, tol=None, labels=None, name: str = "ball_joint"
-    ):
-        self.name = name
-        nodes = np.asarray(nodes)
-        if nodes.ndim == 1 and nodes.size == 2:
-            nodes = nodes[None, :]
-        if nodes.ndim != 2 or nodes.shape[1] != 2 or not np.issubdtype(nodes.dtype, np.integer):
-            raise ModelError(
-                f"ball joints '{name}': nodes must be an (n, 2) array of integer node labels "
-                f"(longeron end, corner), got shape {nodes.shape} of {nodes.dtype}"
-            )
-        self.nodes = np.ascontiguousarray(nodes, dtype=np.int64)
-        n = self.nodes.shape[0]
-        self.labels = np.arange(1, n + 1) if labels is None else np.asarray(labels).ravel()
-        if self.labels.size != n:
-            raise ModelError(f"ball joints '{name}': {self.labels.size} labels for {n} joints")
-        same = np.flatnonzero(self.nodes[:, 0] == self.nodes[:, 1])
-        if same.size:
-            raise ModelError(
-                f"{self._who(same[0])}: both ends are the same node; a ball joint connects a "
-                "longeron end node to a different, coincident corner node"
-            )
-        self.k_pen = _per_joint(k_pen, n, "k_pen (N/m)", name)
-        self.k_stick = _per_joint(k_stick, n, "k_stick (N m/rad)", name)
-        self.mu = _per_joint(mu, n, "mu", name)
-        self.B = _per_joint(B, n, "B (m)", name)
-        for what, arr, ok, rule in (
-            ("k_pen", self.k_pen, self.k_pen > 0, "must be finite and > 0 N/m"),
-            ("k_stick", self.k_stick, self.k_stick > 0, "must be finite and > 0 N m/rad"),
-            ("mu", self.mu, self.mu >= 0, "is a friction coefficient: it must be finite and >= 0"),
-            ("B", self.B, self.B > 0, "is the ball end radius: it must be finite and > 0 m (seed: 0.004)"),
-        ):
-            bad = np.flatnonzero(~(np.isfinite(arr) & ok))
-            if bad.size:
-                raise ModelError(f"{self._who(bad[0])}: {what} = {float(arr[bad[0]])!r} {rule}")
-        self.d0 = np.zeros((n, 3))
-        self.tol = None
-        if X is not None:
-            X = np.asarray(X, dtype=float)
-            if X.shape != (n, 2, 3):
-                raise ModelError(f"ball joints '{name}': X must have shape ({n}, 2, 3), got {X.shape}")
-            d0 = X[:, 1] - X[:, 0]
-            if tol is None:
-                ext = float(np.ptp(X.reshape(-1, 3), axis=0).max()) if n > 1 else 0.0
-                tol = max(TOL_FACTOR * ext, 1e-9)
-            tol = float(tol)
-            if not (tol >= 0 and np.isfinite(tol)):
-                raise ModelError(f"ball joints '{name}': tol = {tol!r} m must be finite and >= 0")
-            gap = np.linalg.norm(d0, axis=1)
-            bad = np.flatnonzero(~(gap <= tol))
-            if bad.size:
-                el = bad[0]
-                raise ModelError(
-                    f"{self._who(el)}: nodes {self.nodes[el, 0]} at {tuple(X[el, 0])} and "
-                    f"{self.nodes[el, 1]} at {tuple(X[el, 1])} are {gap[el]:.3g} m apart, more than "
-                    f"the tolerance {tol:.3g} m; a ball joint connects coincident nodes (check the "
-                    "node labels, or pass a larger tol=)"
-                )
-            self.d0 = np.ascontiguousarray(d0)
-            self.tol = tol
-
-    def _who(self, el):
-        return f"ball joint {self.labels[el]} (nodes {self.nodes[el, 0]}-{self.nodes[el, 1]}) of family '{self.name}'"
-
-    # ------------------------------------------------------------------ contract
-    def initial_state(self) -> np.ndarray:
-        """Zero moment, sticking, no slip, no dissipation, Q = I (nodal rotations start at I)."""
-        st = np.zeros((self.n_elements, N_STATE))
-        st[:, I_Q : I_Q + 9] = np.eye(3).ravel()
-        return st
-
-    def evaluate(self, x, R, state, ctx: IncrementContext | None = None) -> ElementResponse:
-        """Forces, tangent, trial state and output of all joints (see module docstring).
-
-        x : (n_nodes, 3) positions, m.  R : (n_nodes, 3, 3) nodal rotations.
-        state : (n_el, 15) committed state (not modified).  ctx : its ``previous_state`` (the
-        previous Newton iteration's trial states) is used to see slip reversals; the committed
-        relative rotation is part of the state.
-        """
-        n = self.n_elements
-        f = np.empty((n, 12))
-        K = np.empty((n, 12, 12))
-        new = np.empty((n, N_STATE))
-        out = np.empty((n, 11))
-        energy = np.empty(n)
-        err = np.zeros(n, dtype=np.int64)
-        prev = ctx.previous_state(self) if hasattr(ctx, "previous_state") else None
-        has_prev = prev is not None and prev.shape == (n, N_STATE)
-        ball_joint_family_kernel(
-            self.nodes,
-            np.ascontiguousarray(x, dtype=float),
-            np.ascontiguousarray(R, dtype=float),
-            self.d0,
-            self.k_pen,
-            self.k_stick,
-            self.mu,
-            self.B,
-            np.ascontiguousarray(state, dtype=float),
-            f,
-            K,
-            new,
-            out,
-            energy,
-            err,
-            np.ascontiguousarray(prev, dtype=float) if has_prev else _NO_PREV,
-            has_prev,
-        )
-        bad = np.flatnonzero(err)
-        if bad.size:
-            el = bad[0]
-            if err[el] == ERR_NOT_FINITE:
-                # the analysis cuts the increment back on FloatingPointError
-                raise FloatingPointError(f"{self._who(el)}: nodal positions or rotations are not finite")
-            if err[el] == ERR_BIG_INCREMENT:
-                raise FloatingPointError(
-                    f"{self._who(el)}: relative rotation increment above "
-                    f"{MAX_INCREMENT} rad in one increment; use smaller increments"
-                )
-        output = LazyOutput(
-            lambda: {
-                "moment": out[:, 0:3].copy(),
-                "force": out[:, 3:6].copy(),
-                "F": out[:, 6].copy(),
-                "limit": out[:, 7].copy(),
-                "slip": out[:, 8].copy(),
-                "slip_angle": out[:, 9].copy(),
-                "dissipated": out[:, 10].copy(),
-                "moment_norm": np.linalg.norm(out[:, 0:3], axis=1),
-            }
-        )
-        return ElementResponse(
-            f=f,
-            k=K,
-            state=new,
-            output=output,
-            energy=energy,
-            provisional=bool(has_prev and np.any(new[:, I_SLIP] == REVERSED)),
-        )
-
-    # ------------------------------------------------------------------ helpers
-    @staticmethod
-    def state_moment(state):
-        """Committed friction moments (n, 3) in the body frame of node b, N m."""
-        return np.asarray(state)[:, I_M : I_M + 3]
-
-    @staticmethod
-    def state_dissipated(state):
-        """Dissipated energy (n,) in the committed state, J."""
-        return np.asarray(state)[:, I_DISS]
-
-    @staticmethod
-    def state_slip(state):
-        """(slip flag, accumulated slip angle in rad) of the committed state."""
-        st = np.asarray(state)
-        return st[:, I_SLIP], st[:, I_GAMMA]
 
 
 def friction_loop_energy(mu, B, F, amplitude, k_stick):
@@ -286,19 +98,22 @@ def friction_loop_energy(mu, B, F, amplitude, k_stick):
     return 4.0 * Y * np.maximum(amplitude - Y / k_stick, 0.0)
 
 
+def stick_slip_loop_energy(mu_s, mu_k, B, F, amplitude, k_stick):
+    """As :func:`friction_loop_energy` with a static coefficient mu_s above the kinetic mu_k: each
+    half cycle sticks from -Y_k to +Y_s, drops to Y_k (releasing (Y_s - Y_k)^2 / (2 k_stick)) and
+    slides at Y_k, so ``(Y_s - Y_k)^2 / k_stick + 4 Y_k (amplitude - Y_k / k_stick)`` per cycle
+    (J), valid when each half cycle reaches the onset, 2 amplitude >= (Y_s + Y_k) / k_stick."""
+    Ys, Yk = mu_s * B * np.abs(F), mu_k * B * np.abs(F)
+    return (Ys - Yk) ** 2 / k_stick + 4.0 * Yk * (amplitude - Yk / k_stick)
+
+
 def _model_extent(model):
     X = model.coordinates
     return float(np.ptp(X, axis=0).max()) if len(X) > 1 else 0.0
 
 
-def default_stiffnesses(model, pairs, penalty_factor=PENALTY_FACTOR, stick_factor=STICK_FACTOR):
-    """Default ``(k_pen, k_stick)`` per joint from the members at its two nodes.
-
-    k_pen = penalty_factor * max EA/L (beams and trusses at either node), N/m;
-    k_stick = stick_factor * max(4 EIy/L, 4 EIz/L, GJ/L) (beams at either node), N m/rad.
-    A joint with no such member at its nodes (e.g. a corner inside a rigid body) takes the
-    largest value over the whole model.  Raises ModelError if the model has no beam (for
-    k_stick) or no member at all (for k_pen): then give k_pen / k_stick explicitly."""
+def _member_lengths(model):
+    """{node: (largest EA/L, largest 4EI/L or GJ/L)} of the beams and trusses at each node."""
     X = {lab: model.xyz(lab) for lab in model.node_labels}
     kt, kr = {}, {}
     for b in model.beams:
@@ -313,6 +128,18 @@ def default_stiffnesses(model, pairs, penalty_factor=PENALTY_FACTOR, stick_facto
         L = tr.L0 or float(np.linalg.norm(X[tr.nodes[1]] - X[tr.nodes[0]]))
         for nd in tr.nodes:
             kt[nd] = max(kt.get(nd, 0.0), tr.EA / L)
+    return kt, kr
+
+
+def default_stiffnesses(model, pairs, penalty_factor=PENALTY_FACTOR, stick_factor=STICK_FACTOR):
+    """Default ``(k_pen, k_stick)`` per joint from the members at its two nodes.
+
+    k_pen = penalty_factor * max EA/L (beams and trusses at either node), N/m;
+    k_stick = stick_factor * max(4 EIy/L, 4 EIz/L, GJ/L) (beams at either node), N m/rad.
+    A joint with no such member at its nodes (e.g. a corner inside a rigid body) takes the
+    largest value over the whole model.  Raises ModelError if the model has no beam (for
+    k_stick) or no member at all (for k_pen): then give k_pen / k_stick explicitly."""
+    kt, kr = _member_lengths(model)
     kt_all = max(kt.values(), default=0.0)
     kr_all = max(kr.values(), default=0.0)
     k_pen, k_stick = [], []
@@ -334,27 +161,66 @@ def default_stiffnesses(model, pairs, penalty_factor=PENALTY_FACTOR, stick_facto
     return np.array(k_pen), np.array(k_stick)
 
 
+def seat_axes(model, pairs):
+    """(n, 3) default seat axes: from each joint's ball node *a* along the member that ends there
+    (beam or truss) towards that member's other node.  Raises ModelError naming the joint when its
+    ball node has no member or several in different directions: then give ``axis=``."""
+    X = {lab: model.xyz(lab) for lab in model.node_labels}
+    ends = {}
+    for el in list(model.beams) + list(model.trusses):
+        a, b = el.nodes[0], el.nodes[-1]
+        ends.setdefault(a, []).append(X[b] - X[a])
+        ends.setdefault(b, []).append(X[a] - X[b])
+    out = np.zeros((len(pairs), 3))
+    for i, (a, b) in enumerate(pairs):
+        dirs = [d / np.linalg.norm(d) for d in ends.get(int(a), []) if np.linalg.norm(d) > 0]
+        if not dirs or any(float(d @ dirs[0]) < 1 - 1e-9 for d in dirs[1:]):
+            what = "no beam or truss" if not dirs else "members in different directions"
+            raise ModelError(
+                f"ball joint {a}-{b}: its ball node {a} has {what}, so the seat axis is not known; "
+                "give axis= (from the seat into the member, per joint)"
+            )
+        out[i] = dirs[0]
+    return out
+
+
 def add_ball_joints(
     model,
     pairs,
-    mu=SEED_MU,
+    mu=None,
     B=SEED_B,
     *,
+    mu_s=None,
+    mu_k=None,
+    seat="tied",
+    axis=None,
+    clearance_radial=0.0,
+    clearance_axial=None,
     k_pen=None,
     k_stick=None,
+    k_open=None,
     penalty_factor=PENALTY_FACTOR,
     stick_factor=STICK_FACTOR,
+    open_factor=OPEN_FACTOR,
     tol=None,
     labels=None,
     name="ball_joint",
 ) -> BallJointFamily:
-    """Add friction ball joints (seed 001, Sec. II.B.1) between coincident node pairs.
+    """Add friction ball joints (Stohlman & Pellegrino, Sec. II.B.1) between coincident node pairs.
 
-    pairs : [(longeron_end, corner), ...] node labels.
-    mu, B : friction coefficient and ball end radius, m (seed: 0.5, 0.004); scalars or per joint.
-    k_pen, k_stick : penalty (N/m) and stick (N m/rad) stiffnesses; default from the members at
-        each joint (:func:`default_stiffnesses`, factors ``penalty_factor`` = 1e4 and
-        ``stick_factor`` = 1e3).
+    pairs : [(longeron_end, corner), ...] node labels (the ball, the socket).
+    mu : friction coefficient, static = kinetic (ADAM: 0.5); or ``mu_s`` and ``mu_k`` (static,
+        kinetic, mu_s >= mu_k).  B : ball end radius, m (ADAM: 0.004).  Scalars or per joint.
+    seat : ``"tied"`` (captive ball, the paper's two-way tie) or ``"seated"`` (carries compression,
+        opens in tension; see the module docstring).
+    axis : seated: seat axes (3,) or (n, 3); default along the member at each ball node, pointing
+        into it (:func:`seat_axes`).
+    clearance_radial, clearance_axial : seated: radial play (m, default 0) and axial play up to a
+        retainer (m; default None: no retainer).
+    k_pen, k_stick, k_open : penalty (N/m), stick (N m/rad) and open-seat (N/m) stiffnesses; default
+        from the members at each joint (:func:`default_stiffnesses`; factors ``penalty_factor`` = 1e4,
+        ``stick_factor`` = 1e3 and ``open_factor`` = 1e-5 of the largest EA/L; k_open is
+        ``open_factor / penalty_factor`` of k_pen when k_pen is given).
     tol : coincidence tolerance, m (default 1e-6 of the model's size, at least 1e-9 m).
     Returns the :class:`BallJointFamily` (already added to ``model``)."""
     pairs = np.asarray(pairs)
@@ -370,12 +236,30 @@ def add_ball_joints(
     pairs = pairs.astype(np.int64)
     if any(getattr(f, "name", None) == name for f in model.families):
         raise ModelError(f"the model already has an element family named '{name}'; pass another name=")
+    if seat not in SEATS:
+        raise ModelError(f"ball joints '{name}': seat = {seat!r}; use one of {', '.join(map(repr, SEATS))}")
+    seated = seat == "seated"
     if k_pen is None or k_stick is None:
         kp, ks = default_stiffnesses(model, pairs, penalty_factor, stick_factor)
         k_pen = kp if k_pen is None else k_pen
         k_stick = ks if k_stick is None else k_stick
+    if seated and k_open is None:  # open_factor x EA/L = open_factor / penalty_factor x the default k_pen
+        k_open = open_factor / penalty_factor * np.asarray(k_pen, dtype=float)
+    if seated and axis is None:
+        axis = seat_axes(model, pairs)
+    ext = _model_extent(model)
+    for what, v in (("clearance_radial", clearance_radial), ("clearance_axial", clearance_axial)):
+        big = np.asarray(v if v is not None else 0.0, dtype=float)
+        if seated and ext > 0 and np.any(big > MAX_CLEARANCE_FRACTION * ext):
+            raise ModelError(
+                f"ball joints '{name}': {what} = {float(big.max()):g} m is more than {MAX_CLEARANCE_FRACTION:g} of "
+                f"the model's size ({ext:g} m); clearances are in m (0.05 mm = 5e-5)"
+            )
     X = np.array([[model.xyz(a), model.xyz(b)] for a, b in pairs])
     if tol is None:
-        tol = max(TOL_FACTOR * _model_extent(model), 1e-9)
-    fam = BallJointFamily(pairs, k_pen, k_stick, mu, B, X=X, tol=tol, labels=labels, name=name)
+        tol = max(TOL_FACTOR * ext, 1e-9)
+    extra = dict(axis=axis, clearance_radial=clearance_radial, clearance_axial=clearance_axial, k_open=k_open)
+    fam = BallJointFamily(
+        pairs, k_pen, k_stick, mu, B, mu_s=mu_s, mu_k=mu_k, seat=seat, X=X, tol=tol, labels=labels, name=name, **extra
+    )
     return model.add_family(fam)

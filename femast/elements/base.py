@@ -79,7 +79,7 @@ class LazyOutput(Mapping):
 
     Only the response of a converged iteration is written to the results; building the outputs
     at every iteration took 60 % of the ADAM bay's cable/latch family evaluation (51 -> 21 us)
-    and 25 % of its ball joints' (24 -> 18 us; issue 8).  ``make`` must only read arrays that
+    and 25 % of its ball joints' (24 -> 18 us).  ``make`` must only read arrays that
     nobody modifies afterwards (the family's own fresh arrays of this evaluation)."""
 
     __slots__ = ("_make", "_data")

@@ -44,11 +44,11 @@ SECTION_FORCE_NAMES = ("N", "Vy", "Vz", "T", "My", "Mz")
 # (docs/beam_element.md, "The tangent in 3x3 blocks"): the spin of the corotated frame is a full
 # 3x3 block in the dd columns and of rank one (about e1) in the spin columns, and the chain
 # Ti^T (local stiffness) Ti + K_h Ti of the local rotations is collapsed into four 3x3 matrices
-# before it meets the frame's Jacobian (issue 21: ~1000 instead of ~1800 multiply-adds per element,
+# before it meets the frame's Jacobian (~1000 instead of ~1800 multiply-adds per element,
 # the tangent 1.5x faster, equal to the chain rule on 3x9 Jacobians to 2e-17 of max |K|).  Plain loops with fixed trip counts over scratch arrays on the
 # stack: no allocation per element.  What is the same for both ends is written once, in a loop
 # over the end a = 0, 1 with the end's arrays stacked (T[a], th[a], ...): numba's compile time
-# grows with the size of the kernel's body (issue 17: 23 % fewer IR statements and about 25 % less
+# grows with the size of the kernel's body (23 % fewer IR statements and about 25 % less
 # compile time than with each end written out and the rotation helpers inlined twice, bit for bit
 # the same results, as fast).
 
@@ -70,7 +70,7 @@ def beam_family_kernel(nodes, x, R, E0s, l0s, EAs, GJs, EIys, EIzs, length_facto
 
     One loop over the elements with the element's work written out in its body (not a call)
     and every scratch array on the stack (:mod:`._stack`): the compiler then keeps values in
-    registers (issue 8: 1.6x faster than a per-element function with heap scratch)."""
+    registers (1.6x faster than a per-element function with heap scratch)."""
     T = carray(stack_buffer(18), (2, 3, 3))  # nodal triads T_a = R_a E0
     Rr = carray(stack_buffer(9), (3, 3))  # corotated frame [e1 e2 e3]
     A = carray(stack_buffer(9), (3, 3))
@@ -411,7 +411,7 @@ class BeamFamily(ElementFamily):
     """
 
     name = "beam"
-    self_equilibrated = True  # internal nodal forces: zero resultant force and moment (issue 16 check)
+    self_equilibrated = True  # internal nodal forces: zero resultant force and moment (checked by the analysis)
     active_dofs = (0, 1, 2, 3, 4, 5)
     n_state = 0
     path_independent = True

@@ -1,5 +1,5 @@
-"""A cable over an ordered list of devices: pulleys (frictionless or capstan, point or sized),
-latches, clamps and user devices (issue 19; seed 001 Sec. II.B.2, Eqs. 2-5).
+"""A cable over an ordered list of devices: pulleys (frictionless), sheaves with bearing friction,
+capstan drums, latches, clamps and user devices (Stohlman & Pellegrino, Sec. II.B.2, Eqs. 2-5).
 
 Seed 001 writes the cable element for a cable over any number of pulleys, latches or other
 devices, each with its own law for the jump ``Delta T_i = T_{i+1} - T_i``.  One element here is
@@ -18,13 +18,10 @@ is unchanged; this family reproduces it (tests) and generalises it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from numba import njit
 
-from ..errors import ModelError
-from ..latch import LatchParameters, _as_param_array, validate_latch_array
+from ..errors import ElementConvergenceError, ModelError
 from ._cable_geometry import (
     GEO_ADJACENT_PULLEYS,
     GEO_INSIDE_PULLEY,
@@ -34,95 +31,35 @@ from ._cable_geometry import (
     GEO_ZERO_LENGTH,
     cable_geometry,
 )
-from ._device_kernels import ERR_ACTIVE_SET, ERR_SHORT, SLIDE_FREE, STOP, device_kernel, kernel_for_law
-from ._device_laws import CAPSTAN, CLAMP, FREE, LATCH, LATCH_LB, N_PARAM, USER, builtin_law
+from ._device_kernels import ERR_ACTIVE_SET, ERR_SHORT, SLIDE_FREE, STOP, device_kernel
+from ._device_laws import FREE, LATCH, LATCH_LB, N_PARAM, USER, builtin_law
+from ._device_user_kernels import kernel_for_law
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput, chain_nodes
+from .cable_device_specs import (  # noqa: F401  (the devices are imported from here)
+    Clamp,
+    Drum,
+    Latch,
+    Pulley,
+    Sheave,
+    UserDevice,
+    geometry_radius,
+    kind_and_params,
+    set_device_values,
+)
 
 MODE_NAMES = {0: "stick", 1: "slide (out side pulls)", -1: "slide (in side pulls)", 2: "at stop", 3: "frictionless"}
 
-__all__ = ["Pulley", "Latch", "Clamp", "UserDevice", "CableDeviceFamily", "MODE_NAMES", "wrap_geometry"]
-
-
-@dataclass(frozen=True)
-class Pulley:
-    """A pulley at a node.  radius : m (0: a point pulley; > 0: the cable leaves on the tangent
-    points and wraps the pulley, see :mod:`._cable_geometry`).  mu : Coulomb friction coefficient
-    between cable and pulley (0: frictionless; > 0: capstan law ``exp(-mu phi) <= T_out/T_in <=
-    exp(mu phi)`` with the wrap angle phi from the current geometry)."""
-
-    radius: float = 0.0
-    mu: float = 0.0
-
-
-@dataclass(frozen=True)
-class Latch:
-    """A roller latch of seed 001 (Eqs. 5, 14) at a node; the bead is on the cable.
-
-    params : :class:`~femast.latch.LatchParameters` (default the seed's fit).
-    bead : material coordinate Lb of the bead, m (unstretched length from node 0); ``None`` with
-        :meth:`CableDeviceFamily.pretensioned` puts it at ``x0`` in the initial geometry.
-    x0 : initial bead position, m (default ``-x_backstop``: latched, on the backstop).
-    hysteresis_force, hysteresis_length : the latch hysteresis option of :mod:`femast.latch` (N, m).
-    The section before the latch runs through the backstop (as in :class:`CableLatchFamily`)."""
-
-    params: LatchParameters | None = None
-    bead: float | None = None
-    x0: float | None = None
-    hysteresis_force: float = 0.0
-    hysteresis_length: float = 3e-4
-
-
-@dataclass(frozen=True)
-class Clamp:
-    """A clamp: the cable is fixed to the node (no sliding)."""
-
-
-@dataclass(frozen=True)
-class UserDevice:
-    """A device with a user law: a numba ``@njit`` function
-
-        law(sigma, T_in, T_out, s, phi, p) -> (r, dr/dT_in, dr/dT_out, dr/ds, dr/dphi)
-
-    (floats; N, m, rad) following the contract of :mod:`._device_laws`: r is the unbalanced force of
-    the branch on which the cable slides in direction sigma (+1: the out side pulls, ds < 0; -1: the
-    in side pulls); the device sticks while r(+1) <= 0 <= r(-1).  params : up to 10 floats, passed as
-    ``p``.  All user devices of one family share one law function (dispatch on ``p`` for several)."""
-
-    law: object
-    params: tuple = ()
-
-
-def _kind_and_params(dev, k, name):
-    p = np.zeros(N_PARAM)
-    if isinstance(dev, Pulley):
-        for what, v in (("radius", dev.radius), ("mu", dev.mu)):
-            if not (np.isfinite(v) and v >= 0.0):
-                raise ModelError(
-                    f"{name} device {k} (Pulley): {what} = {v!r} must be finite and >= 0 "
-                    f"({'m' if what == 'radius' else 'friction coefficient'})"
-                )
-        if dev.mu > 0.0:
-            p[0] = dev.mu
-            return CAPSTAN, p, float(dev.radius)
-        return FREE, p, float(dev.radius)
-    if isinstance(dev, Latch):
-        arr = _as_param_array(dev.params)
-        validate_latch_array(arr, f"{name} device {k} (Latch)")
-        p[:6] = arr
-        p[7] = dev.hysteresis_force
-        p[8] = dev.hysteresis_length
-        if not (np.isfinite(p[7]) and p[7] >= 0.0 and np.isfinite(p[8]) and p[8] > 0.0):
-            raise ModelError(f"{name} device {k} (Latch): hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
-        return LATCH, p, 0.0
-    if isinstance(dev, Clamp):
-        return CLAMP, p, 0.0
-    if isinstance(dev, UserDevice):
-        q = np.asarray(dev.params, dtype=float).ravel()
-        if q.size > N_PARAM or not np.all(np.isfinite(q)):
-            raise ModelError(f"{name} device {k} (UserDevice): give at most {N_PARAM} finite parameters")
-        p[: q.size] = q
-        return USER, p, 0.0
-    raise ModelError(f"{name} device {k}: {dev!r} is not a device; use Pulley, Latch, Clamp or UserDevice")
+__all__ = [
+    "Pulley",
+    "Sheave",
+    "Drum",
+    "Latch",
+    "Clamp",
+    "UserDevice",
+    "CableDeviceFamily",
+    "MODE_NAMES",
+    "wrap_geometry",
+]
 
 
 _COMBINED = {}
@@ -133,11 +70,11 @@ def _combined_law(user):
     if user not in _COMBINED:
 
         @njit
-        def law(kind, sigma, T_in, T_out, s, phi, p):
+        def law(kind, sigma, T_in, T_out, s, phi, p, static):
             if kind == USER:
                 r, a, b, c, d = user(sigma, T_in, T_out, s, phi, p)
                 return float(r), float(a), float(b), float(c), float(d)
-            return builtin_law(kind, sigma, T_in, T_out, s, phi, p)
+            return builtin_law(kind, sigma, T_in, T_out, s, phi, p, static)
 
         _COMBINED[user] = law
     return _COMBINED[user]
@@ -212,10 +149,11 @@ class CableDeviceFamily(ElementFamily):
     s0 : (n_el, n-1) or (n-1,) initial material coordinates of the cable at the devices, m
         (needed where the cable is gripped: capstans, clamps, user devices; a latch's comes from
         its bead: s = Lb - x0).  Use :meth:`pretensioned` to get them from a geometry.
-    device_values : per-element device parameters (issue 20: scatter per latch or pulley), a dict
+    device_values : per-element device parameters (scatter per latch or pulley), a dict
         ``{device index: {parameter: value or (n_el,) values}}``; parameters of a Latch: r,
-        x_backstop, k, mu, h, R (SI, :class:`~femast.latch.LatchParameters`), hysteresis_force,
-        hysteresis_length; of a capstan Pulley (mu > 0): mu.  Each element's values are validated.
+        x_backstop, k, mu, h, R (SI, :class:`~femast.elements.latch_law.LatchParameters`), hysteresis_force,
+        hysteresis_length, mu_s, mu_k; of a Drum (capstan Pulley) and of a Sheave with friction: mu,
+        mu_s, mu_k (``mu`` sets both).  Each element's values are validated.
     length_error : lack of fit per section, m, (n_el, n) or (n,) (default 0): the cable in section
         i is that much longer than nominal.  The sum lengthens the cable (L0); the errors of the
         sections before a device move the cable's material coordinate there (s0, a bead).
@@ -256,7 +194,7 @@ class CableDeviceFamily(ElementFamily):
         kinds, radius, P = [], np.zeros(nn), np.zeros((n_el, max(n - 1, 1), N_PARAM))
         users = set()
         for k, dev in enumerate(devices):
-            kind, p, r = _kind_and_params(dev, k, name)
+            kind, p, r = kind_and_params(dev, k, name)
             kinds.append(kind)
             radius[k + 1] = r
             P[:, k] = p
@@ -272,7 +210,7 @@ class CableDeviceFamily(ElementFamily):
         self.P = P
         self._law = _combined_law(users.pop()) if users else None
         if device_values:
-            self._set_device_values(device_values, devices)
+            set_device_values(self.P, self.kinds, devices, device_values, self.name)
         dL = np.zeros((n_el, n))
         if length_error is not None:
             try:
@@ -342,54 +280,6 @@ class CableDeviceFamily(ElementFamily):
             )
         self.S0 = S0
 
-    _LATCH_NAMES = ("r", "x_backstop", "k", "mu", "h", "R", None, "hysteresis_force", "hysteresis_length")
-
-    def _set_device_values(self, values, devices):
-        """Per-element device parameters (``device_values`` of the constructor), validated per element."""
-        n_el = self.nodes.shape[0]
-        if not isinstance(values, dict):
-            raise ModelError(f"{self.name}: device_values must be a dict {{device index: {{parameter: values}}}}")
-        for k, params in values.items():
-            if not (isinstance(k, (int, np.integer)) and 0 <= k < len(devices)):
-                raise ModelError(f"{self.name}: device_values has device {k!r}; the devices are 0..{len(devices) - 1}")
-            dev = devices[k]
-            if isinstance(dev, Latch):
-                cols = {nm: i for i, nm in enumerate(self._LATCH_NAMES) if nm}
-            elif isinstance(dev, Pulley) and self.kinds[k] == CAPSTAN:
-                cols = {"mu": 0}
-            else:
-                raise ModelError(
-                    f"{self.name} device {k} ({type(dev).__name__}): has no per-element parameters (a "
-                    "Latch and a Pulley with mu > 0 have)"
-                )
-            for nm, v in dict(params).items():
-                if nm not in cols:
-                    raise ModelError(
-                        f"{self.name} device {k} ({type(dev).__name__}): unknown parameter {nm!r}; use "
-                        f"{', '.join(cols)}"
-                    )
-                try:
-                    arr = np.broadcast_to(np.asarray(v, dtype=float), (n_el,))
-                except (TypeError, ValueError):
-                    raise ModelError(
-                        f"{self.name} device {k}: {nm} must be a number or one per element ({n_el}), "
-                        f"got shape {np.shape(v)}"
-                    ) from None
-                self.P[:, k, cols[nm]] = arr
-            for el in range(n_el):  # construction only, not a hot path
-                where = f"{self.name} device {k} ({type(dev).__name__}), element {el}"
-                if isinstance(dev, Latch):
-                    validate_latch_array(self.P[el, k, :6], where)
-                    if not (
-                        np.isfinite(self.P[el, k, 7])
-                        and self.P[el, k, 7] >= 0.0
-                        and np.isfinite(self.P[el, k, 8])
-                        and self.P[el, k, 8] > 0.0
-                    ):
-                        raise ModelError(f"{where}: hysteresis_force >= 0 N and hysteresis_length > 0 m needed")
-                elif not (np.isfinite(self.P[el, k, 0]) and self.P[el, k, 0] > 0.0):
-                    raise ModelError(f"{where}: capstan mu = {self.P[el, k, 0]!r} must be finite and > 0")
-
     def _per_element(self, value, what):
         a = np.asarray(value, dtype=float)
         try:
@@ -415,7 +305,7 @@ class CableDeviceFamily(ElementFamily):
             )
         radius = np.zeros(nn)
         for k, d in enumerate(devices):
-            radius[k + 1] = d.radius if isinstance(d, Pulley) else 0.0
+            radius[k + 1] = geometry_radius(d)
         EA_ = np.broadcast_to(np.asarray(EA, float), (n_el,))
         T0_ = np.broadcast_to(np.asarray(T0, float), (n_el,))
         if np.any(~(T0_ >= 0)):
@@ -476,7 +366,7 @@ class CableDeviceFamily(ElementFamily):
         bad = np.flatnonzero(err)
         if bad.size:
             el = bad[0]
-            self._raise(el, int(err[el]), int(where[el]), X[el])
+            self._raise(el, int(err[el]), int(where[el]), X[el], state)
         return ElementResponse(
             f=f,
             k=k,
@@ -485,7 +375,7 @@ class CableDeviceFamily(ElementFamily):
             output=LazyOutput(lambda: self._output(T, new, phi[:, :m], lf if scaled else None)),
         )
 
-    def _raise(self, el, code, where, X):
+    def _raise(self, el, code, where, X, state):
         name = f"{self.name} element {el}"
         if code < 10:
             raise ModelError(_geometry_message(code, where, name, self.nodes[el], self.radius, X))
@@ -496,9 +386,22 @@ class CableDeviceFamily(ElementFamily):
                 "coordinates, or build with CableDeviceFamily.pretensioned"
             )
         what = "cycled between stick and slip" if code == ERR_ACTIVE_SET else "did not converge"
-        raise ModelError(
-            f"{name}: the device equations {what} (devices {[type(d).__name__ for d in self.devices]}); "
-            "take smaller load increments"
+        m = self.n_sections - 1
+        where_latches = ""
+        cells = []
+        for k in np.flatnonzero(self.kinds == LATCH):
+            p = self.P[el, k]
+            xc = float(np.sqrt(max((p[0] + p[5]) ** 2 - (p[4] + p[0]) ** 2, 0.0)))
+            cells.append(2.0 * xc / 256.0)
+            where_latches += f"; latch {k}: bead at {1e3 * (p[LATCH_LB] - state[el, k]):.4g} mm"
+        step = f" (less than {1e3 * min(cells):.3g} mm, one cell of the rollers' contact zone)" if cells else ""
+        modes = ", ".join(MODE_NAMES.get(int(v), str(v)) for v in state[el, m:])
+        raise ElementConvergenceError(
+            f"{name}: the device equations {what} from the committed state (devices "
+            f"{[type(d).__name__ for d in self.devices]}: {modes}{where_latches}). In an analysis the "
+            "increment is cut back. If the step still gives up there: limit max_increment so that an "
+            f"increment moves the cable through a latch by little{step}; check the device parameters (SI: "
+            "k in N/m, radii in m) and that no sliding device has both of its sections slack"
         )
 
     def _output(self, T, new, phi, lf=None):

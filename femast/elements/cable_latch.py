@@ -1,9 +1,9 @@
-"""Cable over pulleys and a latch: the user element of seed 001, Section II.B.2 (Eqs. 2-5).
+"""Cable over pulleys and a latch: the user element of Stohlman & Pellegrino, Section II.B.2 (Eqs. 2-5).
 
 One element is one continuous cable divided into n straight sections by n+1
 anchor nodes.  Each interior node is a frictionless pulley, except (optionally)
 one, the *latch node*, where the cable passes through a roller latch that grips a
-bead fixed on the cable (latch law: :mod:`femast.latch`, Eqs. 6-14).  The element
+bead fixed on the cable (latch law: :mod:`femast.elements.latch_law`, Eqs. 6-14).  The element
 solves its 2n equations (n tensions, n unstretched lengths) internally and returns
 the nodal forces and the consistent tangent; see ``docs/cable_latch_element.md``.
 
@@ -43,8 +43,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
-from ..latch import LatchParameters, _as_param_array, latch_force, latch_zone, validate_latch_array
-from ..latch import hysteresis_force as hysteresis_force_law
 from ._cable_kernels import (
     BACKSTOP,
     ERR_BEAD_OFF_CABLE,
@@ -56,6 +54,8 @@ from ._cable_kernels import (
     cable_latch_kernel,
 )
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput, chain_nodes
+from .cable_latch_equations import cable_equations
+from .latch_law import LatchParameters, _as_param_array, latch_zone, validate_latch_array
 
 STATUS_NAMES = {STICK: "stick", SLIP_OUT: "slip out", SLIP_IN: "slip in", BACKSTOP: "backstop"}
 
@@ -97,8 +97,25 @@ def _hysteresis(hysteresis_force, hysteresis_length, latch, has, name):
     return np.ascontiguousarray(np.column_stack([np.where(has, Fh, 0.0), ell]))
 
 
+def _kinetic(mu_k, latch, has, name):
+    """(n_el,) kinetic roller friction of the latches, checked 0 <= mu_k <= mu (the static ``latch`` mu);
+    None: equal to the static one (the paper's one coefficient)."""
+    n_el = latch.shape[0]
+    if mu_k is None:
+        return latch[:, 3].copy()
+    mk = _per_element(mu_k, n_el, "mu_k", name)
+    bad = np.flatnonzero(has & ~(np.isfinite(mk) & (mk >= 0.0) & (mk <= latch[:, 3])))
+    if bad.size:
+        el = bad[0]
+        raise ModelError(
+            f"{name} element {el}: kinetic latch friction mu_k = {float(mk[el])!r} must lie in [0, mu_s = "
+            f"{float(latch[el, 3])!r}] (the latch's mu is the static coefficient: a bead starts at mu_s and slides at mu_k)"
+        )
+    return np.where(has, mk, latch[:, 3])
+
+
 class CableLatchFamily(ElementFamily):
-    """A batch of cable/pulley/latch elements (seed 001, Eqs. 2-5 and 14), all with n sections.
+    """A batch of cable/pulley/latch elements (Stohlman & Pellegrino, Eqs. 2-5 and 14), all with n sections.
 
     Parameters
     ----------
@@ -109,7 +126,7 @@ class CableLatchFamily(ElementFamily):
         (every interior node is then a frictionless pulley and the element is a cable
         over pulleys).  Scalar or per element (0 = no latch).
     bead : material coordinate Lb of the bead, m (unstretched length from node 0), Eq. 5.
-    latch : :class:`~femast.latch.LatchParameters` (or (n_el, 6) array, SI); default the seed's fit.
+    latch : :class:`~femast.elements.latch_law.LatchParameters` (or (n_el, 6) array, SI); default the seed's fit.
     x0 : initial bead position, m (default ``-x_backstop``: latched, against the backstop).
     max_strain : largest cable strain accepted in a committed configuration; beyond it the
         total unstretched length is reported as too short (default 0.1).
@@ -117,10 +134,14 @@ class CableLatchFamily(ElementFamily):
         element; default 0: off, the seed's law).  Near the latched state the static band
         widens to ``[dT_in - H, dT_out + H]`` and a sliding bead follows the widened branches,
         ``H = hysteresis_force * w(x)``, ``w = 1`` on the backstop fading to 0 at the roller axis
-        over ``hysteresis_length`` (see :func:`femast.latch.hysteresis_force`).
+        over ``hysteresis_length`` (see :func:`femast.elements.latch_law.hysteresis_force`).
+    mu_k : kinetic friction between rollers and bead (scalar or per element; default None: the
+        latch's ``mu``, the paper's one coefficient).  With ``mu_k < mu`` the latch's ``mu`` is the
+        static coefficient: a bead at rest starts to slide when the jump leaves the band of Eq. 14
+        at ``mu``, slides on along Eq. 14 at ``mu_k``, and grips again when it stops or reverses.
     length_error : lack of fit per section, m, shape (n_el, n) or (n,) (default 0): the cable
         that runs in section i is ``length_error[:, i]`` longer than its nominal unstretched length
-        (issue 20).  Their sum lengthens the cable (L0); those of the sections before the latch
+        (a lack of fit).  Their sum lengthens the cable (L0); those of the sections before the latch
         node move the bead along the cable (Lb).  A pretensioned cable over frictionless pulleys
         with a section too short by d then gains ``EA d / L0`` of tension (on rigid anchors).
     name : label used in messages and results.
@@ -152,6 +173,7 @@ class CableLatchFamily(ElementFamily):
         hysteresis_length=3e-4,
         length_error=None,
         name: str = "cable_latch",
+        mu_k=None,
     ):
         self.name = name
         self.nodes = chain_nodes(nodes, name)
@@ -211,6 +233,7 @@ class CableLatchFamily(ElementFamily):
             raise ModelError(f"{name}: max_strain = {max_strain!r} must be > 0")
         self.max_strain = float(max_strain)
         self.hysteresis = _hysteresis(hysteresis_force, hysteresis_length, self.latch, has, name)
+        self.mu_k = _kinetic(mu_k, self.latch, has, name)
         self.length_factor = np.ones(n_el)
         self.set_length_errors(np.zeros((n_el, self.n_sections)) if length_error is None else length_error)
 
@@ -373,6 +396,7 @@ class CableLatchFamily(ElementFamily):
             Lb,
             self.latch_node,
             self.latch,
+            getattr(self, "mu_k", self.latch[:, 3]),  # (families pickled before the option: one coefficient)
             hy,
             np.ascontiguousarray(state),
             f,
@@ -423,58 +447,6 @@ class CableLatchFamily(ElementFamily):
             "latch_zone": zone,
             "latch_dT": dT,
         }
-
-
-def cable_equations(
-    X,
-    T,
-    L0_sections,
-    EA,
-    L0,
-    *,
-    latch_node=None,
-    bead=None,
-    latch=None,
-    status=STICK,
-    x_committed=None,
-    hysteresis_force=0.0,
-    hysteresis_length=3e-4,
-):
-    """Residuals of the 2n equations of one element (seed 001, Eqs. 2-5), for checking a solution.
-
-    X : (n+1, 3) anchor positions, m.  T : (n,) tensions, N.  L0_sections : (n,) unstretched
-    lengths, m.  status : latch status (stick/backstop: the latch row is x - x_committed, m;
-    slipping: T_{j+1} - T_j - dT_sigma(x), N).
-
-    Returns (2n,) residuals: rows 0..n-1 the constitutive laws (N, Eqs. 2-3), row n the
-    length constraint (m, Eq. 4), rows n+1.. the jumps across nodes 1..n-1 (N; m for a
-    sticking latch).  hysteresis_force, hysteresis_length: the hysteresis option (N, m).
-    """
-    X = np.asarray(X, float)
-    T = np.asarray(T, float)
-    L0s = np.asarray(L0_sections, float)
-    n = T.size
-    L = np.linalg.norm(np.diff(X, axis=0), axis=1)
-    res = np.empty(2 * n)
-    res[:n] = T - EA * np.maximum(L - L0s, 0.0) / L0s
-    res[n] = L0s.sum() - L0
-    j = 0 if latch_node is None else int(latch_node)
-    for i in range(1, n):
-        if i != j:
-            res[n + i] = T[i] - T[i - 1]
-            continue
-        x = bead - L0s[:i].sum()
-        if status in (STICK, BACKSTOP):
-            res[n + i] = x - x_committed
-        else:
-            sigma = 1 if status == SLIP_OUT else -1
-            res[n + i] = (
-                T[i]
-                - T[i - 1]
-                - latch_force(x, sigma, latch)
-                - sigma * hysteresis_force_law(x, latch, hysteresis_force, hysteresis_length)
-            )
-    return res
 
 
 __all__ += ["LatchParameters"]

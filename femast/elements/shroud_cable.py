@@ -1,4 +1,4 @@
-"""Tension-only Dyneema shroud cable: two nodes, the tension-dependent rope law of seed 000 (Eq. 25).
+"""Tension-only Dyneema shroud cable: two nodes, the tension-dependent rope law of the Rocaspect paper (Eq. 25).
 
 One element is a straight rope between two end points.  Each end point may sit on a
 *rigid offset* from its node (a lever rigidly attached to the node, as the seed's
@@ -9,7 +9,7 @@ shroud attachment points C_ir are rigidly attached to the mast top C_i3):
 with R_a the node's total rotation.  Without offsets the element is a plain cable with
 translational DOFs only.
 
-Axial law (seed 000, Eqs. 25, 27, as corrected in :mod:`femast.elements.shroud_law`).  The strain is
+Axial law (the Rocaspect paper, Eqs. 25, 27, as corrected in :mod:`femast.elements.shroud_law`).  The strain is
 measured from the unstretched length L0, ``eps = l / L0 - 1``, and the tension is the root of
 ``tau = g(tau) eps`` with ``g = k0 + k1 tau + k2 tau^2`` (k0 in N, k1 dimensionless, k2 in 1/N):
 
@@ -42,7 +42,7 @@ Construction: :class:`ShroudCableFamily` takes the unstretched lengths; :func:`a
 adds shrouds to a :class:`~femast.model.Model` given either the unstretched length or the
 tension that each carries in the model's initial geometry.
 
-Sources of error (issue 20, as the cable families of :mod:`femast.model.thermal`): a *length error*
+Sources of error (as the cable families of :mod:`femast.model.thermal`): a *length error*
 dL per rope (lack of fit, m; ``length_error=``, :meth:`ShroudCableFamily.set_length_errors`) makes it
 stress free at ``L0 + dL``; a thermal strain scales that by the ``length_factor``
 ``s = 1 + alpha (T - T_init)`` the analysis writes from a step's temperatures
@@ -54,141 +54,15 @@ strain would differ by a factor ~ s on EA, below 1e-3 for any real error or temp
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-from numba import njit
 
 from ..errors import ModelError
+from ._shroud_kernels import _GW, _GX, ERR_BEYOND_LAW, ERR_ZERO_LENGTH, dyneema_tension, shroud_family_kernel  # noqa: F401
 from .base import ElementFamily, ElementResponse
+from .shroud_hysteresis import hysteresis_array
 from .shroud_law import DyneemaLaw, strain_from_tension
 
 PARTS = {"none": 0, "material": 1, "geometric": 2, "full": 3}
-
-ERR_ZERO_LENGTH = 1
-ERR_BEYOND_LAW = 2
-ERR_NOT_FINITE = 3
-
-# 5-point Gauss-Legendre rule on [0, 1] for the strain energy L0 * int_0^eps tau(e) de
-_GX = np.array([0.04691007703066800, 0.23076534494715845, 0.5, 0.76923465505284155, 0.95308992296933200])
-_GW = np.array(
-    [0.11846344252809454, 0.23931433524968324, 0.28444444444444444, 0.23931433524968324, 0.11846344252809454]
-)
-
-
-@njit(cache=True)
-def dyneema_tension(eps, k0, k1, k2):
-    """Tension (N) of the rope law at strain eps (Eq. 27 inverted; 0 for eps < 0).
-    Returns (tau, ok): ok False when eps is beyond the range where the law has a finite root."""
-    if eps <= 0.0:
-        return 0.0, True
-    a = 1.0 - k1 * eps
-    disc = a * a - 4.0 * k0 * k2 * eps * eps
-    if disc < 0.0:
-        return 0.0, False
-    den = a + math.sqrt(disc)
-    if den <= 0.0:
-        return 0.0, False
-    return 2.0 * k0 * eps / den, True
-
-
-@njit(cache=True)
-def dyneema_tangent_rigidity(tau, k0, k1, k2):
-    """EA_t = d tau / d eps = g^2 / (k0 - k2 tau^2), N (derivative of tau = g(tau) eps)."""
-    g = k0 + k1 * tau + k2 * tau * tau
-    return g * g / (k0 - k2 * tau * tau)
-
-
-@njit(cache=True)
-def shroud_family_kernel(nodes, x, R, offsets, L0, law, parts, gx, gw, f, K, tau_out, eps_out, len_out, energy, err):
-    """All shroud elements in one call: forces f (n, 12), tangent K (n, 12, 12), tension, strain,
-    length, strain energy and an error code per element (see module docstring).  Serial on purpose:
-    a family holds a few ropes (3 per mast), and ``parallel=True`` doubles the compile time (~11 s)."""
-    for el in range(nodes.shape[0]):
-        a = nodes[el, 0]
-        b = nodes[el, 1]
-        ra = R[a] @ offsets[el, 0]
-        rb = R[b] @ offsets[el, 1]
-        d = (x[b] + rb) - (x[a] + ra)
-        l = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-        if not math.isfinite(l):
-            err[el] = ERR_NOT_FINITE
-            continue
-        if l <= 1e-12 * L0[el]:
-            err[el] = ERR_ZERO_LENGTH
-            continue
-        e = d / l
-        k0 = law[el, 0]
-        k1 = law[el, 1]
-        k2 = law[el, 2]
-        eps = l / L0[el] - 1.0
-        if eps < 0.0:
-            tau = 0.0
-            kt = 0.0
-        else:
-            tau, ok = dyneema_tension(eps, k0, k1, k2)
-            if not ok:
-                err[el] = ERR_BEYOND_LAW
-                continue
-            kt = dyneema_tangent_rigidity(tau, k0, k1, k2) / L0[el]
-            if not (kt > 0.0):
-                err[el] = ERR_BEYOND_LAW
-                continue
-        tau_out[el] = tau
-        eps_out[el] = eps
-        len_out[el] = l
-        # strain energy L0 int_0^eps tau de (Gauss-Legendre, exact to ~1e-12 for this smooth law)
-        en = 0.0
-        if eps > 0.0:
-            for g in range(gx.shape[0]):
-                t, ok = dyneema_tension(gx[g] * eps, k0, k1, k2)
-                en += gw[g] * t
-            en *= eps * L0[el]
-        energy[el] = en
-        # D = [-G_a, G_b], G = [I, -[r]x]; B = D^T e
-        Dm = np.zeros((3, 12))
-        for i in range(3):
-            Dm[i, i] = -1.0
-            Dm[i, 6 + i] = 1.0
-        # -G_a rotation block = +[r_a]x ; G_b rotation block = -[r_b]x
-        Dm[0, 4] = -ra[2]
-        Dm[0, 5] = ra[1]
-        Dm[1, 3] = ra[2]
-        Dm[1, 5] = -ra[0]
-        Dm[2, 3] = -ra[1]
-        Dm[2, 4] = ra[0]
-        Dm[0, 10] = rb[2]
-        Dm[0, 11] = -rb[1]
-        Dm[1, 9] = -rb[2]
-        Dm[1, 11] = rb[0]
-        Dm[2, 9] = rb[1]
-        Dm[2, 10] = -rb[0]
-        B = Dm.T @ e
-        for i in range(12):
-            f[el, i] = tau * B[i]
-        Kel = np.zeros((12, 12))
-        if parts & 1:
-            for i in range(12):
-                for j in range(12):
-                    Kel[i, j] += kt * B[i] * B[j]
-        if parts & 2:
-            P = np.eye(3)
-            for i in range(3):
-                for j in range(3):
-                    P[i, j] -= e[i] * e[j]
-            Kel += (tau / l) * (Dm.T @ P @ Dm)
-            # arms turning with the nodes: tau [e]x[r]x = tau (r e^T - (e . r) I), sign -/+ for a/b
-            era = e[0] * ra[0] + e[1] * ra[1] + e[2] * ra[2]
-            erb = e[0] * rb[0] + e[1] * rb[1] + e[2] * rb[2]
-            for i in range(3):
-                for j in range(3):
-                    ia = ra[i] * e[j] - (era if i == j else 0.0)
-                    ib = rb[i] * e[j] - (erb if i == j else 0.0)
-                    Kel[3 + i, 3 + j] -= tau * ia
-                    Kel[9 + i, 9 + j] += tau * ib
-        for i in range(12):
-            for j in range(12):
-                K[el, i, j] = Kel[i, j]
 
 
 def _law_array(law, n_el, name):
@@ -231,7 +105,7 @@ def _per_element(value, n_el, name, what):
 
 
 class ShroudCableFamily(ElementFamily):
-    """A batch of tension-only Dyneema ropes (seed 000, Eq. 25), optionally on rigid end offsets.
+    """A batch of tension-only Dyneema ropes (the Rocaspect paper, Eq. 25), optionally on rigid end offsets.
 
     Parameters
     ----------
@@ -245,6 +119,11 @@ class ShroudCableFamily(ElementFamily):
         (a beam, a fix) -- keep offset-free ropes on translational-only nodes in another family.
     length_error : lack of fit per rope, m (scalar or per element; default 0): the rope is stress free
         at ``L0 + length_error`` (negative: cut short, so it pulls harder).
+    hysteresis : the loading/unloading option (Rocaspect paper Fig. 4a, :mod:`.shroud_hysteresis`):
+        the half-width eta (-, 0 <= eta < 1, scalar or per rope) of the loop between the loading
+        branch ``(1 + eta) tau(eps)`` and the unloading branch ``(1 - eta) tau(eps)`` about the law;
+        0 (default): the paper's single curve.
+    stick_rigidity : N, the friction element's stick rigidity k_s (default 10 k0 of each rope).
     name : label used in messages and results.
 
     Thermal strain: ``length_factor`` (n_el,), written by the analysis from the temperatures of a
@@ -254,10 +133,18 @@ class ShroudCableFamily(ElementFamily):
     ``length`` (m, between the end points), ``slack`` (1.0 when the rope carries nothing).
     """
 
-    n_state = 0
-    path_independent = True
-
-    def __init__(self, nodes, L0, law=None, offsets=None, labels=None, name: str = "shroud", length_error=None):
+    def __init__(
+        self,
+        nodes,
+        L0,
+        law=None,
+        offsets=None,
+        labels=None,
+        name: str = "shroud",
+        length_error=None,
+        hysteresis=0.0,
+        stick_rigidity=None,
+    ):
         self.name = name
         nodes = np.asarray(nodes)
         if nodes.ndim == 1:
@@ -292,6 +179,10 @@ class ShroudCableFamily(ElementFamily):
         self.tangent_parts = "full"
         self.length_factor = np.ones(n_el)
         self.set_length_errors(0.0 if length_error is None else length_error)
+        self.hysteresis = hysteresis_array(hysteresis, stick_rigidity, self.law, n_el, name)
+        # with the loading/unloading option the rope has a state [strain, friction tension (N)]
+        self.n_state = 2 if np.any(self.hysteresis[:, 0] > 0.0) else 0
+        self.path_independent = self.n_state == 0
 
     def set_length_errors(self, length_error) -> None:
         """Lack of fit per rope, m (scalar or one per element; replaces any given before): rope e is stress
@@ -347,6 +238,9 @@ class ShroudCableFamily(ElementFamily):
         energy = np.zeros(n)
         err = np.zeros(n, dtype=np.int64)
         L0 = np.ascontiguousarray(self.stress_free_lengths())
+        # (with the loading/unloading option and no state given: a rope loaded from slack)
+        st = np.ascontiguousarray(state, dtype=float) if self.n_state and state is not None else np.zeros((n, 2))
+        new = st.copy()
         shroud_family_kernel(
             self.nodes,
             x,
@@ -354,11 +248,14 @@ class ShroudCableFamily(ElementFamily):
             self.offsets,
             L0,
             self.law,
+            self.hysteresis,
+            st,
             PARTS[self.tangent_parts],
             _GX,
             _GW,
             f,
             K,
+            new,
             tau,
             eps,
             length,
@@ -388,7 +285,9 @@ class ShroudCableFamily(ElementFamily):
                 msg = "nodal coordinates are not finite"
             raise ModelError(f"{self.name} element {self.labels[el]}: {msg}")
         output = {"tension": tau, "strain": eps, "length": length, "slack": (eps < 0.0).astype(float)}
-        return ElementResponse(f=f, k=K, state=state, output=output, energy=energy)
+        if self.n_state:
+            output["friction_tension"] = new[:, 1].copy()
+        return ElementResponse(f=f, k=K, state=new if self.n_state else state, output=output, energy=energy)
 
 
 def unstretched_length(law, tension, length):
@@ -399,7 +298,16 @@ def unstretched_length(law, tension, length):
 
 
 def add_shrouds(
-    model, pairs, law=None, tension=None, L0=None, offsets=None, name: str = "shroud", length_error=None
+    model,
+    pairs,
+    law=None,
+    tension=None,
+    L0=None,
+    offsets=None,
+    name: str = "shroud",
+    length_error=None,
+    hysteresis=0.0,
+    stick_rigidity=None,
 ) -> ShroudCableFamily:
     """Add Dyneema shrouds between node-label pairs ``pairs`` ((n, 2)) to ``model``; returns the family.
 
@@ -407,7 +315,9 @@ def add_shrouds(
     in the model's *initial* geometry, including the offsets); neither means taut at zero tension.
     ``offsets`` (n, 2, 3) as in :class:`ShroudCableFamily`.  ``length_error`` (m, scalar or per rope): lack
     of fit added to the unstretched lengths so found (a rope meant to carry ``tension`` but cut
-    ``length_error`` too long).  Raises ModelError for coincident
+    ``length_error`` too long).  ``hysteresis``, ``stick_rigidity``: the loading/unloading option of
+    :class:`ShroudCableFamily` (``tension`` is then the tension of the law itself, the average
+    curve: the rope starts with no friction tension).  Raises ModelError for coincident
     attachment points, non-positive lengths or stiffness, and tensions outside the law's range.
     """
 
@@ -427,6 +337,7 @@ def add_shrouds(
         )
     if L0 is not None and tension is not None:
         raise ModelError(f"{name}: give the unstretched length L0 or the tension, not both")
+    eta = hysteresis_array(hysteresis, stick_rigidity, laws, n, name)[:, 0]
     if tension is not None:
         tau = _per_element(tension, n, name, "tension (N)")
         L0v = np.empty(n)
@@ -437,12 +348,21 @@ def add_shrouds(
                     f"{name} {k + 1}: tension {float(tau[k])!r} N must be >= 0 and below "
                     f"{lk.tau_max_valid:.4g} N, where the rope law is increasing"
                 )
-            L0v[k] = float(unstretched_length(lk, tau[k], length[k]))
+            # with the loading/unloading option the rope, tensioned by loading, is on its loading branch
+            # (1 + eta) tau_e: the law's tension there is tension / (1 + eta)
+            L0v[k] = float(unstretched_length(lk, tau[k] / (1.0 + eta[k]), length[k]))
     elif L0 is not None:
         L0v = _per_element(L0, n, name, "L0 (m)")
     else:
         L0v = length.copy()
     fam = ShroudCableFamily(
-        pairs, L0v, laws, offsets=None if offsets is None else off, name=name, length_error=length_error
+        pairs,
+        L0v,
+        laws,
+        offsets=None if offsets is None else off,
+        name=name,
+        length_error=length_error,
+        hysteresis=hysteresis,
+        stick_rigidity=stick_rigidity,
     )
     return model.add_family(fam)

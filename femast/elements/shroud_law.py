@@ -1,4 +1,4 @@
-"""Tension-dependent stiffness of the Dyneema shrouds (seed 000, Eqs. 23, 25, 27).
+"""Tension-dependent stiffness of the Dyneema shrouds (the Rocaspect paper, Eqs. 23, 25, 27).
 
 The constitutive law of the shroud element (:mod:`femast.elements.shroud_cable`), used also by the
 analytic guyed-mast models of :mod:`femast.guyed` (it was ``femast/guyed/shroud.py``; the old path
@@ -39,7 +39,7 @@ import numpy as np
 from ..errors import ModelError
 from .base import check_positive
 
-#: Seed 000 shroud coefficients [k0 (N), k1 (-), k2 (1/N)], Section IV-A.
+#: The Rocaspect paper's shroud coefficients [k0 (N), k1 (-), k2 (1/N)], Section IV-A.
 SEED_X_S = (935353.664, 144.320, -0.000465)
 
 

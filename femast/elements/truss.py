@@ -65,7 +65,7 @@ class TrussFamily(ElementFamily):
     stress-free length over ``L0`` (length errors and thermal strain, set by femast/model/thermal.py)."""
 
     name = "truss"
-    self_equilibrated = True  # equal and opposite forces along the chord (issue 16 check)
+    self_equilibrated = True  # equal and opposite forces along the chord (checked by the analysis)
     active_dofs = (0, 1, 2)
     n_state = 0
     path_independent = True

@@ -16,7 +16,7 @@ mast_top_example.csv           mast-top        500 samples of load cycles on a m
 latch_pull_example.csv         latch-pull      two latch pull cycles (synthetic)
 bay_torsion_example.csv        bay-torsion     moment-rotation test of one ADAM bay (synthetic)
 bay_torsion_format.csv         bay-torsion     the bay-torsion format, schematic values only
-tip_cycle_seed001_table1.csv   tip-cycle       Table 1 of Stohlman & Pellegrino (their FE prediction)
+tip_cycle_table1.csv           tip-cycle       Table 1 of Stohlman & Pellegrino (their FE prediction)
 vibration_example.csv          vibration       latch resonance at nine tension settings (synthetic)
 platform_pose_example.csv      platform-pose   commanded and measured platform poses (synthetic)
 joint_test_spc1.csv            joint-test      cyclic test of a timber connection (real: SPC1; licence and notice beside it)
@@ -36,7 +36,7 @@ BY_EXPERIMENT = {
     "mast-top": "mast_top_example.csv",
     "latch-pull": "latch_pull_example.csv",
     "bay-torsion": "bay_torsion_example.csv",
-    "tip-cycle": "tip_cycle_seed001_table1.csv",
+    "tip-cycle": "tip_cycle_table1.csv",
     "vibration": "vibration_example.csv",
     "platform-pose": "platform_pose_example.csv",
     "joint-test": "joint_test_spc1.csv",

@@ -40,6 +40,7 @@ same as ``compare``'s; the significance rule and the verdict kinds
 from __future__ import annotations
 
 import time
+from contextlib import nullcontext
 
 from scipy.optimize import OptimizeResult
 
@@ -51,23 +52,20 @@ from .compare import analyse, load_path
 from .core import Experiment, Measured
 from .diagnose_report import diagnosis_result, format_diagnose  # noqa: F401  (format_diagnose: re-exported)
 from .diagnosis import Diagnosis
-from .figure_process import FigureProcess
-from .fitting import predict
 from .heldout import heldout_check
 from .noise import noise_model, pinned_rows
 from .pairs import fit_pairs, score_pairs
 
-# the refits' executor (re-exported: diagnose.REFIT_NFEV, diagnose._mp_context, ... keep working)
+# the refits' executor (re-exported: diagnose.REFIT_NFEV, ... keep working)
 from .refits import (  # noqa: F401
-    _START_METHOD,
     REFIT_NFEV,
     SERIAL_BELOW_S,
     _dispatch,
-    _mp_context,
     _refit_task,
     _run_tasks,
     _safe_fit,
     _serial_refits,
+    refit_pool,
 )
 from .residuals import AT_NOISE, at_noise_threshold  # noqa: F401  (AT_NOISE: re-exported)
 from .rows import thin
@@ -101,9 +99,11 @@ def diagnose(
         give it per row): the noise model's first source (:mod:`femast.experiments.noise`).
     base_effects : effects already in the model being diagnosed (names or ``effect/form``); their
         other forms are refitted first (a shape mismatch).
-    workers : local worker processes (default: the number of CPUs, unless the refits are estimated
-        -- six times the baseline fit time each -- to take less than ``SERIAL_BELOW_S`` = 1 s in all,
-        which is less than starting the processes costs; 1 runs in this process).
+    workers : where the refits run: None (default) in this process; N on N worker processes
+        (:mod:`femast.workers`; a script run as ``python script.py`` keeps its work under ``if
+        __name__ == "__main__":``); ``"auto"`` (the default of ``femast diagnose``) one per CPU, or
+        this process when the refits are estimated -- six times the baseline fit time each -- to
+        take less than ``SERIAL_BELOW_S`` = 1 s in all (never for the FE experiments).
     scheduler : a dask.distributed scheduler address (``tcp://...``) or ``distributed.Client``.
     out : folder for ``diagnose.json``, ``diagnose.png`` and ``diagnose_report.html`` (self-contained,
         figures inlined; nothing written if None).
@@ -135,10 +135,10 @@ def diagnose(
     exp.require_model("diagnose")
     data = thin(data, max_rows, "diagnose")  # a long record: every k-th row (femast.experiments.rows)
     check_units(exp, data)  # a unit mistake (mm under an m header) stops here, naming the column
-    # the figure is drawn by a process forked now, which imports matplotlib while this one fits the
-    # baseline on the other CPU (FE experiments, local refits)
-    figs = FigureProcess.start() if out is not None and scheduler is None and exp.fit_options.get("expensive") else None
-    try:
+    # the refit workers of an FE experiment start now: they import femast and the rig while this
+    # process fits the baseline
+    pool = refit_pool(exp, workers, scheduler)
+    with pool if pool is not None else nullcontext():
         return _diagnose(
             exp,
             data,
@@ -151,20 +151,19 @@ def diagnose(
             out=out,
             pairs=pairs,
             heldout=heldout,
-            figs=figs,
+            pool=pool,
         )
-    finally:
-        if figs is not None:
-            figs.close()
 
 
 def _diagnose(
-    exp, data, candidates, *, exclude, base_effects, sigma, workers, scheduler, out, pairs, heldout, figs
+    exp, data, candidates, *, exclude, base_effects, sigma, workers, scheduler, out, pairs, heldout, pool
 ) -> OptimizeResult:
-    d = Diagnosis.of(exp, data, candidates, exclude, base_effects, sigma=sigma, workers=workers, scheduler=scheduler)
+    d = Diagnosis.of(
+        exp, data, candidates, exclude, base_effects, sigma=sigma, workers=workers, scheduler=scheduler, pool=pool
+    )
     _baseline(d)
-    # without a figure process, the report's matplotlib is imported while the worker processes refit
-    fit_candidates(d, while_waiting=_import_pyplot if out is not None and figs is None else None)
+    # the report's matplotlib is imported while the worker processes refit
+    fit_candidates(d, while_waiting=_import_pyplot if out is not None else None)
     rank(d)
     if pairs:
         fit_pairs(d)
@@ -172,7 +171,7 @@ def _diagnose(
     if heldout:
         heldout_check(d)
     _verdict(d)
-    return diagnosis_result(d, out, figs)
+    return diagnosis_result(d, out)
 
 
 def _baseline(d: Diagnosis) -> None:
@@ -183,10 +182,6 @@ def _baseline(d: Diagnosis) -> None:
     with progress.task(f"diagnose: fitting the baseline {exp.name}" + "".join(" + " + e for e in d.base_effects)):
         d.baseline, d.models = fit_with_noise(exp, data, d.base_effects, sigma=d.sigma)
     d.t_base = time.perf_counter() - t0
-    if exp.fit_options.get("expensive") and exp.options.get("fe_reference", False) is None:
-        # the refits' reference run (the baseline model at its solution, femast.experiments.fe_reference),
-        # here once: forked workers inherit it (and its converged path) instead of each running it
-        predict(exp, data, d.baseline.params)
     d.payload = {
         "source": exp.source,
         "options": exp.options,

@@ -34,9 +34,9 @@ PUBLIC = (
 )
 
 
-def diagnosis_result(d, out=None, figs=None) -> OptimizeResult:
+def diagnosis_result(d, out=None) -> OptimizeResult:
     """The result of a diagnosis (see :func:`~femast.experiments.diagnose.diagnose`), its files
-    written to ``out`` (the figure drawn by the forked ``figs`` process where there is one)."""
+    written to ``out``."""
     exp, data, chans = d.exp, d.data, d.channels
     sigma_w = d.weights
     base_table = params_table(d.baseline)
@@ -105,8 +105,7 @@ def diagnosis_result(d, out=None, figs=None) -> OptimizeResult:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         png = out / "diagnose.png"
-        if figs is None or not figs.draw(diagnose_figure, exp, data, result, png):
-            diagnose_figure(exp, data, result, png)
+        diagnose_figure(exp, data, result, png)
         result.files["png"] = str(png)
         result.files["json"] = str(out / "diagnose.json")
         result.files["html"] = str(out / "diagnose_report.html")

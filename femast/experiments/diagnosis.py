@@ -39,6 +39,7 @@ class Diagnosis:
     sigma: dict | None = None  # the user's sensor uncertainties
     workers: int | None = None
     scheduler: object = None
+    pool: object = None  # refit workers started with the diagnosis (femast.experiments.refits.refit_pool)
     # the baseline stage
     baseline: OptimizeResult | None = None
     models: dict = field(default_factory=dict)  # {channel: ChannelNoise}, the noise model of the moment
@@ -113,6 +114,7 @@ class Diagnosis:
             self.scheduler,
             self.t_base,
             while_waiting=while_waiting,
+            pool=self.pool,
         )
         self.how = self.how or how
         return list(fits)

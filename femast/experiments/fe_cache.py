@@ -239,8 +239,7 @@ class kernel_threads:
     kernel made a single-bay run 3x slower on a busy machine, and a parallel beam kernel gained
     at most 3 %, docs/performance.md); the setting matters for user elements with parallel
     kernels.  The FE experiments run on one thread: the refits of ``diagnose`` already use every
-    core.  Setting the count starts numba's thread pool, so ``diagnose`` then starts its workers
-    with forkserver (see ``diagnose._mp_context``)."""
+    core (its workers are spawned, so numba's thread pool in this process does not matter to them)."""
 
     def __init__(self, n: int | None = 1):
         self.n = n

@@ -10,11 +10,6 @@ and gives registered starts back bit for bit (so the run cache answers them).  U
 
 from __future__ import annotations
 
-import math
-import os
-import sys
-import time
-
 import numpy as np
 from scipy.optimize import least_squares
 
@@ -73,7 +68,7 @@ class _FEJacobian:
             points.append(up)
             steps.append(h)
         self.runs += len(points)
-        for i, h, f in zip(todo, steps, evaluate_many(self.fun, points, f0.size)):
+        for i, h, f in zip(todo, steps, [self.fun(p) for p in points]):
             J[:, i] = (f - f0) / h
         if known is None or not np.all(np.isfinite(known)):
             self.fd_at, self.fd_J = u.copy(), J.copy()
@@ -101,148 +96,6 @@ class _FEJacobian:
         if self.fd_at is not None and np.array_equal(self.fd_at, u):
             return self.fd_J, False
         return self.differences(u, self.value(u)), True
-
-
-FORK_COLUMNS = True  # evaluate a Jacobian's finite-difference columns in this process and a forked one
-
-
-def _fork_ok(n_points: int) -> bool:
-    """Columns may be split with a forked child: several to compute, a second CPU, Linux's fork, this
-    the main and only thread of a process that is not itself a worker of a pool (whose cores are taken:
-    the refits of diagnose), and numba not running GNU OpenMP threads (a forked child of those aborts)."""
-    if not FORK_COLUMNS or n_points < 2 or not hasattr(os, "fork") or (os.cpu_count() or 1) < 2:
-        return False
-    if not sys.platform.startswith("linux"):  # (where fork is multiprocessing's default; macOS: not safe)
-        return False
-    import multiprocessing
-    import threading
-
-    if multiprocessing.parent_process() is not None or threading.current_thread() is not threading.main_thread():
-        return False
-    if not _only_thread():
-        return False
-    try:
-        import numba
-
-        if numba.threading_layer() == "omp":
-            return False
-    except Exception:  # (ValueError while no parallel kernel has run: no threads)
-        pass
-    return True
-
-
-def _only_thread() -> bool:
-    """No other thread that might hold a lock the child needs (a Jupyter kernel's, a results writer's);
-    tqdm's monitor only wakes every 10 s to check the bars, which the child does not draw."""
-    import threading
-
-    me = threading.current_thread()
-    return all(t is me or type(t).__name__ == "TMonitor" for t in threading.enumerate())
-
-
-def evaluate_many(fun, points, size: int) -> list:
-    """``[fun(p) for p in points]`` (each a (size,) float array), the second half of the points in a
-    forked child process while this one computes the first (a fit's finite-difference
-    columns are independent FE runs, and during a fit in the main process the second CPU is idle; a
-    forked child inherits the loaded kernels, the reference path and the model).  The child sends the
-    values back as raw float64 bytes through a pipe and ends with ``os._exit``; if it fails, this process
-    computes its points itself.  Serial when :func:`_fork_ok` says no."""
-    if not _fork_ok(len(points)):
-        return [fun(p) for p in points]
-    import gc
-
-    k = (len(points) + 1) // 2
-    rd, wr = os.pipe()
-    gc.freeze()  # (the child's collections skip the inherited heap: fewer copied pages; see refits.frozen_heap)
-    try:
-        pid = os.fork()
-    except OSError:
-        gc.unfreeze()
-        os.close(rd)
-        os.close(wr)
-        return [fun(p) for p in points]
-    if pid == 0:  # the child: its points, then exit without running any of the parent's exit handlers
-        code = 1
-        try:
-            os.close(rd)
-            os.environ["FEMAST_BACKGROUND_COMPILE"] = "0"  # (no requests to the parent's compile worker)
-            from .. import progress
-
-            progress.set_quiet(True)
-            vals = [np.asarray(fun(p), dtype=np.float64).reshape(size) for p in points[k:]]
-            data = np.concatenate(vals).tobytes()
-            with os.fdopen(wr, "wb") as fh:
-                fh.write(data)
-            code = 0
-        finally:
-            os._exit(code)
-    os.close(wr)
-    mine = None
-    t0 = time.monotonic()
-    try:
-        mine = [fun(p) for p in points[:k]]
-    finally:
-        # an error or Ctrl-C here: the child's points are not wanted, it is ended at once (no wait for
-        # its runs, no orphan); else it gets CHILD_WAIT x this process's time for its share (a child
-        # stuck on a lock that fork copied: killed, and its points computed here)
-        wait_s = 0.0 if mine is None else max(CHILD_WAIT * (time.monotonic() - t0), CHILD_WAIT_MIN_S)
-        data, status = _child_answer(pid, rd, wait_s)
-        gc.unfreeze()
-    n = len(points) - k
-    if status == 0 and len(data) == 8 * size * n:
-        theirs = list(np.frombuffer(data, dtype=np.float64).reshape(n, size).copy())
-    else:
-        theirs = [fun(p) for p in points[k:]]
-    return mine + theirs
-
-
-CHILD_WAIT = 4.0  # the forked child's share may take this many times this process's share ...
-CHILD_WAIT_MIN_S = 300.0  # ... or this long (s), whichever is longer, before it is taken for stuck (a cold
-#                           child may compile kernels in the foreground: tens of seconds)
-
-
-def _child_answer(pid: int, rd: int, wait_s: float) -> tuple[bytes, int]:
-    """(bytes the child wrote to the pipe ``rd`` until it closed it, its wait status), the child reaped;
-    a child that has not closed the pipe within ``wait_s`` seconds (0: at once), or when this process
-    is interrupted while waiting, is killed first (status then not 0).  ``rd`` is closed."""
-    chunks = []
-    end = time.monotonic() + wait_s
-    closed = False
-    try:
-        while True:
-            left = end - time.monotonic()
-            if left <= 0.0 or not readable(rd, left):
-                break
-            chunk = os.read(rd, 1 << 16)
-            if not chunk:
-                closed = True
-                break
-            chunks.append(chunk)
-    finally:
-        if not closed:
-            _kill(pid)
-        os.close(rd)
-        _, status = os.waitpid(pid, 0)
-    return b"".join(chunks), status
-
-
-def readable(fd: int, wait_s: float) -> bool:
-    """``fd`` has data (or its other end was closed) within ``wait_s`` seconds (poll: no limit on the
-    descriptor's number, unlike select's 1024)."""
-    import select
-
-    p = select.poll()
-    p.register(fd, select.POLLIN | select.POLLHUP | select.POLLERR)
-    return bool(p.poll(max(0, math.ceil(1000.0 * wait_s))))
-
-
-def _kill(pid: int) -> None:
-    import signal
-
-    try:
-        os.kill(pid, signal.SIGKILL)
-    except ProcessLookupError:
-        pass
 
 
 def _forward_differences(fun, step: float, lo, hi):

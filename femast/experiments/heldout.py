@@ -13,7 +13,13 @@ Folds
 * else the **cycles** of the load path: ``K`` contiguous blocks of whole cycles (between every second
   turning point of the load measure, :func:`~femast.experiments.residuals.turning_points`), ``K`` =
   ``FOLDS`` (4) or the number of cycles;
-* else ``K`` contiguous blocks of rows.
+* else (one pass, fewer cycles than folds) ``K`` interleaved folds of short runs of rows
+  (``MIN_FOLD_ROWS`` rows each, dealt to the folds in turn): contiguous blocks of one pass would
+  each be a regime of its own (the latched zone of a latch pull, the peak of a ramp) that the
+  other blocks say nothing about, and every model, right or wrong, would fail to extrapolate into
+  it (a latch-pull pass with a hidden latch hysteresis: the baseline 6.7x the noise held out, the
+  right effect 6.8x, against 1.4x and 0.85x fitted); interleaved, each fold is predicted from its
+  neighbours on both sides, which tests the fit against the noise.
 
 Each fold's fit sees the other rows only (:func:`~femast.experiments.fitting.fit` with ``rows``),
 started from the fit on all the data; the model still runs along the whole path (its state at a
@@ -62,8 +68,8 @@ def folds(exp, data, k: int | None = None) -> list:
         k = len(edges) - 1
         kind = "cycles"
     else:
-        edges = [int(round(i * n / k)) for i in range(k + 1)]
-        kind = "rows"
+        chunk = np.arange(n) // MIN_FOLD_ROWS % k  # short runs of rows dealt to the folds in turn
+        return [(f"rows {i + 1} of every {k} runs of {MIN_FOLD_ROWS}", chunk == i) for i in range(k)]
     out = []
     for i in range(k):
         a, b = edges[i], edges[i + 1]

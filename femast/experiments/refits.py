@@ -1,32 +1,37 @@
-"""Refits of ``diagnose``: the candidate, form and pair fits run in this process, in local worker
-processes or on a dask.distributed cluster (see :mod:`femast.experiments.diagnose`).
+"""Refits of ``diagnose``: the candidate, form and pair fits run in this process, on worker
+processes (:class:`femast.workers.Pool`: spawned, never more than the CPUs unless asked, ended with
+the command however it ends) or on a dask.distributed cluster (see :mod:`femast.experiments.diagnose`).
 
-With the default number of workers a diagnosis whose refits are estimated to take under a second
-in all runs in the calling process: starting worker processes would cost more than it saves (the FE
-experiments are the ones that need the workers).
+``workers``: None (the default of the Python API) refits in the calling process, as femast
+computes in the user's process unless asked otherwise; a number N refits on N worker processes;
+``"auto"`` (the default of ``femast diagnose``) chooses: one worker per CPU, except for a diagnosis
+whose refits are estimated to take under a second in all, which runs in the calling process
+(starting worker processes would cost more than it saves; the FE experiments are the ones that
+need the workers).  For those, :func:`refit_pool` starts the workers when the diagnosis starts,
+so that they import femast and the rig while this process fits the baseline.  A refit whose worker dies or runs over its time-out comes back as a failed refit, named
+in the report; the other refits go on.
 """
 
 from __future__ import annotations
 
-import multiprocessing
 import os
 import threading
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from contextlib import contextmanager
+from concurrent.futures import as_completed
+from contextlib import nullcontext
 
 from scipy.optimize import OptimizeResult
 
 from .. import progress
-from ..effects.base import load_script
-from ..errors import ModelError
+from ..effects.base import load_script, loaded_scripts
+from ..errors import ModelError, TaskTimeout, WorkerDied
+from ..workers import Pool, worker_count
 from .core import Experiment
 from .fitting import MODEL_FAILURES, fit
 
-_START_METHOD = None  # multiprocessing start method of the local pool (None: the platform's default)
 REFIT_NFEV = 25  # evaluations per parameter and start of a refit (a converging refit needs 5-20; a direction the
 # data do not determine -- beam flexibility against the joint stiffness under top forces -- would use 100)
-OVERSUBSCRIBE = 3  # default workers of the expensive (FE) experiments: up to this many processes per CPU
-SERIAL_BELOW_S = 1.0  # default workers: refit in this process when the refits should take less than this (s)
+SERIAL_BELOW_S = 1.0  # workers="auto": refit in this process when the refits should take less than this (s)
+AUTO = "auto"  # workers: one per CPU unless the refits are quick (module docstring)
 
 
 # --------------------------------------------------------------------------- refit tasks
@@ -84,28 +89,49 @@ def _rebuildable(exp: Experiment) -> bool:
     return other.name == exp.name and other.model is exp.model
 
 
-def _mp_context():
-    """Start method of the local pool: ``_START_METHOD`` if set; else 'forkserver' once numba has
-    started GNU OpenMP threads in this process (the FE experiments' ``kernel_threads`` does, and so
-    would a parallel user kernel; forking after that aborts the child: "fork() called from a process
-    already using GNU OpenMP"); else the platform's default (fork on Linux: the fastest start)."""
-    if _START_METHOD:
-        return multiprocessing.get_context(_START_METHOD)
-    try:
-        import numba
+def _worker_setup(source: str, options: dict, scripts) -> None:
+    """Runs in each refit worker as it starts: the user's effect scripts and the experiment's rig
+    imported (and its model built) before the first refit arrives."""
+    from .registry import experiment_from_source
 
-        layer = numba.threading_layer()  # ValueError while no parallel kernel has run
-    except Exception:
-        layer = None
-    if layer == "omp" and "forkserver" in multiprocessing.get_all_start_methods():
-        return multiprocessing.get_context("forkserver")
-    return None
+    for script in scripts:
+        load_script(script)
+    experiment_from_source(source, options)
 
 
-def _run_tasks(payloads, workers, scheduler, while_waiting=None):
+def refit_pool(exp: Experiment, workers=None, scheduler=None):
+    """A :class:`~femast.workers.Pool` for the refits of ``exp``, started now, or None when they will
+    not run on local workers known now: in this process (``workers`` None or 1), a cluster, an
+    experiment the workers cannot rebuild, or ``"auto"`` for a cheap experiment (decided after the
+    baseline fit, by its time).  Its workers import femast and the rig while the caller fits the baseline; the caller
+    ends it (``with``)."""
+    if workers is None or scheduler is not None or not _rebuildable(exp):
+        return None
+    if workers == AUTO and not exp.fit_options.get("expensive"):
+        return None
+    n = _worker_number(workers)
+    if n <= 1:
+        return None
+    scripts = list(loaded_scripts())
+    return Pool(n, initializer=_worker_setup, initargs=(exp.source, exp.options, scripts), name="diagnose refits")
+
+
+def _worker_number(workers, tasks: int | None = None) -> int:
+    """Worker processes for ``workers`` (None: 1, this process; "auto": the CPUs; N), at most ``tasks``."""
+    if workers is None:
+        return 1
+    if workers == AUTO:
+        return worker_count(None, tasks)
+    if isinstance(workers, bool) or not isinstance(workers, (int, float)) or int(workers) != workers or workers < 1:
+        raise ModelError(f"workers = {workers!r}: give a whole number >= 1, or 'auto'")
+    return worker_count(int(workers), tasks)
+
+
+def _run_tasks(payloads, workers, scheduler, while_waiting=None, pool=None):
     """Run the refits; returns (results, how) with ``how`` describing the executor used.
     while_waiting : a callable run in a thread of this process while local worker processes refit
-    (started after they are forked, joined before the pool closes), e.g. an import the report needs."""
+    (joined before the pool closes), e.g. an import the report needs.  pool : workers already
+    started (:func:`refit_pool`), which the caller ends; else a pool is started and ended here."""
     if scheduler is not None:
         try:
             from distributed import Client
@@ -130,13 +156,13 @@ def _run_tasks(payloads, workers, scheduler, while_waiting=None):
             if own:
                 client.close()
         return list(results), f"dask.distributed at {address}"
-    n = (os.cpu_count() or 1) if workers is None else int(workers)
-    if n < 1:
-        raise ModelError(f"--workers must be >= 1, got {workers}")
-    n = min(n, len(payloads))
+    n = pool.workers if pool is not None else _worker_number(workers, len(payloads))
     if n <= 1:
-        return _serial_refits(payloads), "serial (1 process)"
-    with frozen_heap(), ProcessPoolExecutor(max_workers=n, mp_context=_mp_context()) as pool:
+        return _serial_refits(payloads), "serial (in this process)"
+    own = pool is None
+    if own:
+        pool = Pool(n, initializer=_worker_setup, initargs=_setup_args(payloads[0]), name="diagnose refits")
+    with pool if own else nullcontext():
         futures = [pool.submit(_refit_task, p) for p in payloads]
         helper = None
         if while_waiting is not None:
@@ -146,25 +172,24 @@ def _run_tasks(payloads, workers, scheduler, while_waiting=None):
             for fut in as_completed(futures):
                 bar.set_postfix_str(f"done: {_candidate(payloads[futures.index(fut)])}", refresh=False)
                 bar.update(1)
-        results = [fut.result() for fut in futures]
+        results = [_result(fut, p) for fut, p in zip(futures, payloads)]
         if helper is not None:
-            helper.join()  # (before any later fork: a thread holding the import lock must not be forked)
+            helper.join()
     return results, f"{n} local processes"
 
 
-@contextmanager
-def frozen_heap():
-    """The garbage collector's view of this process's heap frozen while forked children run: a child's
-    collections then skip the inherited objects instead of visiting them all, which copies every page
-    they touch (copy-on-write) -- 8-17 % of the CPU of diagnose's refit processes on the bay.
-    Objects made meanwhile are collected as usual; the frozen ones return to the collector after."""
-    import gc
-
-    gc.freeze()
+def _result(fut, payload) -> OptimizeResult:
+    """A refit's result; a worker that died or ran over its time-out gives a failed refit."""
     try:
-        yield
-    finally:
-        gc.unfreeze()
+        return fut.result()
+    except (WorkerDied, TaskTimeout) as e:
+        return OptimizeResult(
+            failed=True, success=False, message=f"{type(e).__name__}: {e}", effects=tuple(payload["effects"])
+        )
+
+
+def _setup_args(payload) -> tuple:
+    return payload["source"], payload["options"], payload["scripts"]
 
 
 def _quietly(fn):
@@ -187,7 +212,7 @@ def _serial_refits(payloads):
     return results
 
 
-def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base, while_waiting=None):
+def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base, while_waiting=None, pool=None):
     """Run refit payloads: in this process when cheap or not rebuildable, else on the executor."""
     if not payloads:
         return [], "no candidates"
@@ -208,11 +233,9 @@ def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base, whi
             "serial (experiment defined in memory: worker processes cannot rebuild it)",
         )
     est = 6.0 * t_base * len(payloads)
-    if workers is None and scheduler is None and not exp.fit_options.get("expensive") and est < SERIAL_BELOW_S:
-        return _serial_refits(payloads), f"serial (refits estimated at {est:.2f} s: cheaper than starting processes)"
-    if workers is None and scheduler is None and exp.fit_options.get("expensive"):
-        # a process per refit (up to OVERSUBSCRIBE x the CPUs): the refits of the FE experiments take
-        # 6-15 FE runs each, and a pool of one process per CPU ends with one CPU idle while the
-        # longest refits finish; more processes than CPUs share them to the end
-        workers = max(1, min(len(payloads), OVERSUBSCRIBE * (os.cpu_count() or 1)))
-    return _run_tasks(payloads, workers, scheduler, while_waiting)
+    if pool is None and workers == AUTO and scheduler is None and not exp.fit_options.get("expensive"):
+        if est < SERIAL_BELOW_S:
+            return _serial_refits(
+                payloads
+            ), f"serial (refits estimated at {est:.2f} s: cheaper than starting processes)"
+    return _run_tasks(payloads, workers, scheduler, while_waiting, pool)

@@ -1,4 +1,4 @@
-"""Guyed compliant masts of a cable-driven parallel robot (seed 000: Rocaspect).
+"""Guyed compliant masts of a cable-driven parallel robot (the Rocaspect paper).
 
 Modules, one concept each (SI units throughout):
 

@@ -11,7 +11,7 @@ from ..errors import ModelError
 
 
 def skew(v) -> np.ndarray:
-    """Cross-product matrix [v]x (Table I of seed 000): ``skew(a) @ b == np.cross(a, b)``.
+    """Cross-product matrix [v]x (Table I of the Rocaspect paper): ``skew(a) @ b == np.cross(a, b)``.
 
     Works on a (3,) vector or a stack (..., 3) -> (..., 3, 3).
     """

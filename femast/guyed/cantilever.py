@@ -1,4 +1,4 @@
-"""Cantilever beam model of the bare mast (seed 000, Eqs. 8-15).
+"""Cantilever beam model of the bare mast (the Rocaspect paper, Eqs. 8-15).
 
 The mast's metal beam is a square tube clamped at its base O_i and loaded at its
 top C_i3.  Its tip compliance in the beam frame F_be (x_be along the beam) is

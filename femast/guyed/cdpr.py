@@ -1,4 +1,4 @@
-"""Statics of the 8-cable suspended CDPR carried by four masts (seed 000, Eqs. 1-3 and 7).
+"""Statics of the 8-cable suspended CDPR carried by four masts (the Rocaspect paper, Eqs. 1-3 and 7).
 
 Conventions (SI units: m, N, kg, rad)
 -------------------------------------

@@ -1,4 +1,4 @@
-"""Complete mast model: beam plus three pretensioned shrouds in parallel (seed 000, Eqs. 16-26).
+"""Complete mast model: beam plus three pretensioned shrouds in parallel (the Rocaspect paper, Eqs. 16-26).
 
 The mast top C_i3 is a rigid body carrying the beam tip and the shrouds' upper
 attachment points C_ir = C_i3 + e_r; each shroud runs to a fixed lower point D_r.

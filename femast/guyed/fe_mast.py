@@ -1,4 +1,4 @@
-"""The Rocaspect mast in the FE core, checked against the analytic complete-mast model (seed 000, item 3 of issue 6).
+"""The Rocaspect mast in the FE core, checked against the analytic complete-mast model (the Rocaspect paper).
 
 Model (SI units)
 ----------------
@@ -12,7 +12,7 @@ Model (SI units)
     ``e_r = C_ir - C_i3`` of the top node, so the top is the rigid body the seed's model assumes.
   - ``attach="wall"``: shrouds 1 and 2 are tied to a beam node 0.25 m below the top through a 0.05 m
     rigid offset to the tube wall (the physical mast); the top segment of the tube is then flexible.
-* Sources of error (issue 20): ``length_error`` (m, per shroud) cuts the shrouds that much longer
+* Sources of error: ``length_error`` (m, per shroud) cuts the shrouds that much longer
   than the pretension asks (lack of fit; negative: shorter, tighter); ``temperature_change_K`` heats
   the shrouds and the tube by dT in a step ``"thermal"`` after the pretension, with the expansion
   coefficients ``shroud_alpha_per_K`` and ``beam_alpha_per_K`` (1/K; the seed gives none: Dyneema
@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..analysis import Analysis
-from ..analysis.solvers.convergence import Convergence
+from ..analysis.convergence import Convergence
 from ..elements.shroud_cable import ShroudCableFamily, unstretched_length
 from ..elements.shroud_law import DyneemaLaw
 from ..errors import ModelError
@@ -103,6 +103,10 @@ class MastFE:
     temperature_change_K : uniform temperature change of shrouds and tube in a step ``"thermal"``
         after the pretension, K (0: no such step); ``shroud_alpha_per_K``, ``beam_alpha_per_K``:
         their coefficients of thermal expansion, 1/K.
+    shroud_hysteresis : the shrouds' loading/unloading difference (Fig. 4a) as a law of the FE shroud
+        (:mod:`femast.elements.shroud_hysteresis`): the loop half-width eta (-, 0 <= eta < 1; 0: the
+        paper's single curve); ``shroud_stick_rigidity``: its stick rigidity, N (default 10 k0).
+        The pretension is then reached on the loading branch.
     """
 
     def __init__(
@@ -119,6 +123,8 @@ class MastFE:
         temperature_change_K: float = 0.0,
         shroud_alpha_per_K: float = 0.0,
         beam_alpha_per_K: float = 0.0,
+        shroud_hysteresis: float = 0.0,
+        shroud_stick_rigidity: float | None = None,
     ):
         if pretension is not None and not (np.isfinite(pretension) and pretension >= 0.0):
             raise ModelError(f"shroud pretension {pretension!r} N must be finite and >= 0 (None: no shrouds)")
@@ -137,11 +143,17 @@ class MastFE:
         self.base_point = mast_bases()[self.mast]
         self.top_point = mast_tops()[self.mast]
         self.shrouds_nominal = None if pretension is None else rocaspect_shrouds(self.mast, pretension, self.law)
+        if not (np.isfinite(shroud_hysteresis) and 0.0 <= shroud_hysteresis < 1.0):
+            raise ModelError(f"MastFE shroud_hysteresis = {shroud_hysteresis!r} must be in [0, 1) (0: off)")
+        self.shroud_hysteresis = float(shroud_hysteresis)
+        self.shroud_stick_rigidity = shroud_stick_rigidity
         self.L0 = None
         if self.shrouds_nominal is not None:
             sh = self.shrouds_nominal
             length = np.linalg.norm(sh.lower - sh.upper, axis=1)
-            self.L0 = np.asarray(unstretched_length(self.law, sh.tension, length), dtype=float)
+            # (on the loading branch the law's own tension is tension / (1 + eta))
+            tau_law = sh.tension / (1.0 + self.shroud_hysteresis)
+            self.L0 = np.asarray(unstretched_length(self.law, tau_law, length), dtype=float)
         if length_error is not None and self.shrouds_nominal is None:
             raise ModelError("length_error is given but the mast has no shrouds (pretension=None)")
         self.length_error = length_error
@@ -198,6 +210,8 @@ class MastFE:
                 offsets=np.array(offsets),
                 name=SHROUD_FAMILY,
                 length_error=self.length_error,
+                hysteresis=self.shroud_hysteresis,
+                stick_rigidity=self.shroud_stick_rigidity,
             )
             m.add_family(fam)
         m.step("pretension")
@@ -262,7 +276,8 @@ class MastFE:
             length = np.linalg.norm(d, axis=1)
             e = d / length[:, None]
             B = -np.vstack([e.T, np.cross(st.upper - st.top, e).T])  # (6, q): dl_r = B_r . du_top
-            EAt = axial_rigidity_tangent(self.law, st.tension)
+            eta = self.shroud_hysteresis  # on the loading branch: (1 + eta) of the law's slope
+            EAt = (1.0 + eta) * axial_rigidity_tangent(self.law, st.tension / (1.0 + eta))
             fam = self._family(SHROUD_FAMILY)
             Lf = fam.stress_free_lengths()  # (L0 + dL) s: with length errors and heat
             s = Lf / (self.L0 + fam.length_error)
@@ -331,7 +346,8 @@ class MastFE:
         sh = self._family(SHROUD_FAMILY)
         if sh is not None:
             p = sh.end_points(an.x, an.R)
-            tau = sh.evaluate(an.x, an.R, None).output["tension"]
+            committed = an.state.families[an.families.index(sh)]  # (the loading/unloading option's state)
+            tau = sh.evaluate(an.x, an.R, committed).output["tension"]
             upper, lower = p[:, 0], p[:, 1]
         else:
             upper = lower = np.zeros((0, 3))

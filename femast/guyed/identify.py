@@ -1,4 +1,4 @@
-"""Identification of the mast-model parameters (seed 000, Section IV, Eqs. 27-30).
+"""Identification of the mast-model parameters (the Rocaspect paper, Section IV, Eqs. 27-30).
 
 Every fit calls :func:`scipy.optimize.least_squares` and returns a :class:`FitResult`
 with the estimate ``x``, the standard errors ``stderr`` and the covariance

@@ -1,4 +1,4 @@
-"""Three-elastic-joint (3R) mast model (seed 000, Eqs. 4-7).
+"""Three-elastic-joint (3R) mast model (the Rocaspect paper, Eqs. 4-7).
 
 The mast is a rigid body hinged at its base O_i by three perpendicular elastic joints
 about the base-frame axes i, j, k, of stiffness ``k_theta = [k1, k2, k3]`` in N m/rad

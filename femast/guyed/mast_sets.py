@@ -1,4 +1,4 @@
-"""The four Rocaspect masts under each mast model, as :class:`~.platform_pose.MastSet` (seed 000).
+"""The four Rocaspect masts under each mast model, as :class:`~.platform_pose.MastSet`.
 
 * ``"3R"``: Eqs. 4-6 (corrected J) with the Table III joint stiffnesses of the 50 kg tests at the
   shroud pretension (0 N: test "5 and 9", 400 N: "4", 800 N: "3", 1200 N: "1 and 8"; ``None``,
@@ -30,7 +30,7 @@ _TEST_OF = {None: "7 and 10", 0.0: "5 and 9", 400.0: "4", 800.0: "3", 1200.0: "1
 def _check(pretension):
     if pretension is not None and not (np.isfinite(pretension) and 0.0 <= pretension <= 1200.0):
         raise ModelError(
-            f"shroud pretension {pretension!r} N: the seed's masts are identified for 0 to 1200 N "
+            f"shroud pretension {pretension!r} N: the Rocaspect masts are identified for 0 to 1200 N "
             "(None: shrouds detached)"
         )
 

@@ -1,4 +1,4 @@
-"""Pose of a CDPR platform carried by compliant masts (seed 000, Fig. 7; issue 19 item 3).
+"""Pose of a CDPR platform carried by compliant masts (the Rocaspect paper, Fig. 7).
 
 The controller works in a rigid frame: for the commanded pose ``p_c`` it computes, with the
 exit geometry measured at calibration, the cable lengths (with the swivel-pulley kinematics of

@@ -1,4 +1,4 @@
-"""Swivel-pulley kinematics of a CDPR cable exit (seed 000: "pulley kinematics ... taken into account").
+"""Swivel-pulley kinematics of a CDPR cable exit (the Rocaspect paper: "pulley kinematics ... taken into account").
 
 The cable comes up from its winch along the swivel axis ``w`` (unit) of the pulley, enters the
 pulley groove at the point D on that axis, wraps the pulley of radius r and leaves towards the

@@ -1,6 +1,6 @@
-"""The Rocaspect robot of seed 000: published values and the geometry assumed where the seed is silent.
+"""The Rocaspect robot: published values and the geometry assumed where the paper is silent.
 
-Published (seed 000)
+Published (the Rocaspect paper)
 --------------------
 * Frame 8.3 m x 6.8 m x 4.0 m; 4 masts, 2 cables each; platform 1.0 x 1.0 x 0.5 m, 50 kg.
 * Beam L = 3.651 m, square tube s_out = 0.1 m, s_in = 0.094 m (Section IV-B-2).

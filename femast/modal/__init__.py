@@ -1,11 +1,11 @@
-"""Prestressed modal analysis (issue 18; see docs/architecture.md).
+"""Prestressed modal analysis (see docs/architecture.md).
 
 * :mod:`.modes`: :func:`modal_analysis` about a converged state, :class:`Modes`;
 * :mod:`.mass`: mass matrices of the element families, point masses and rigid bodies;
 * :mod:`.output`: mode shapes as animated VTK series, frequency histories;
 * :mod:`.step`: the ``frequency`` step of model scripts.
 
-``femast.modal`` was one module before the package move (issue 15); its names are re-exported here.
+``femast.modal`` was one module before the package move; its names are re-exported here.
 """
 
 from .modes import (

@@ -1,4 +1,4 @@
-"""Prestressed modal analysis (issue 18) about a converged state of a static analysis.
+"""Prestressed modal analysis about a converged state of a static analysis.
 
 At a converged state the small vibrations u(t) = phi sin(omega t) obey
 
@@ -8,8 +8,9 @@ with K_T the analysis' own tangent at that state (elastic, geometric/stress stif
 prestress, and the cable/latch and joint contributions at their committed state: a slipping
 joint, a latched bead, a slack cable each give the tangent they give Newton) and M the mass
 (:mod:`femast.modal.mass`), both on the free DOFs after the constraints (rigid bodies and ties:
-T^T K T + G and T^T M T).  The lowest ``n`` pairs come from ARPACK's shift-invert Lanczos
-(scipy ``eigsh``, mode 3, which allows DOFs without mass: their modes are at infinity).
+T^T K T + G and T^T M T).  The lowest ``n`` pairs come from :mod:`.eigen`: with few massed DOFs
+an exact condensation of the massless ones and a dense solution, else ARPACK's shift-invert
+Lanczos with a basis no larger than the massed DOFs (DOFs without mass: modes at infinity).
 
 The spin-variable tangent is symmetric at equilibrium for conservative loads; a follower-free
 applied moment or a friction joint leaves a small unsymmetric part.  The symmetric part is used
@@ -27,11 +28,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
-from ..analysis.solvers.convergence import force_moment_abs_max
+from ..analysis.convergence import force_moment_abs_max
 from ..elements.base import IncrementContext
 from ..errors import ModelError, StateError
+from .eigen import default_shift, solve_eigen
 from .mass import assemble_mass
 
 #: Largest residual / reference force ratio accepted as a converged state (100x Newton's default
@@ -134,7 +135,7 @@ class Modes:
 def _state(analysis):
     """(K_ff, residual on the free DOFs, reference force, reference moment) at the analysis'
     current configuration and committed state."""
-    sys_ = getattr(analysis, "system", None)  # the analysis package of issue 15: System holds the assembly
+    sys_ = getattr(analysis, "system", None)  # the analysis package: System holds the assembly
     if sys_ is not None:
         responses = sys_.evaluate(sys_.committed_context())
         res = sys_.residual(responses, analysis.loads)
@@ -165,44 +166,6 @@ def check_equilibrium(analysis, r, fmax, mmax, tol=EQUILIBRIUM_TOL, where=""):
             f"{ratio[worst]:.2g} of the largest force (limit {tol:g}). Run the static analysis to a converged "
             "increment first (an initial pretension out of balance needs a step), or pass check=False."
         )
-
-
-def default_shift(K, M, massed):
-    """A shift omega^2 < 0 below the lowest eigenvalue of a stable state: -1e-2 of the smallest
-    K_ii / M_ii (each is a Rayleigh quotient, an upper bound of the lowest eigenvalue)."""
-    kd, md = K.diagonal()[massed], M.diagonal()[massed]
-    q = kd / md
-    q = q[q > 0]
-    return -1e-2 * float(q.min()) if q.size else -1.0
-
-
-def solve_eigen(K, M, n_modes: int, sigma: float | None = None):
-    """The ``n_modes`` eigenpairs of K phi = lam M phi nearest ``sigma`` ((rad/s)^2; default
-    :func:`default_shift`), sorted ascending; vectors M-normalised.  K, M symmetric sparse."""
-    n = K.shape[0]
-    md = M.diagonal()
-    massed = md > 0
-    if sigma is None:
-        sigma = default_shift(K, M, massed)
-    if n_modes >= n - 1:  # ARPACK needs k < n - 1: tiny problems go dense
-        A = (K - sigma * M).toarray()
-        Ainv_M = np.linalg.solve(A, M.toarray())
-        mu, V = np.linalg.eig(Ainv_M)
-        keep = np.abs(mu) > 1e-12 * np.abs(mu).max()
-        lam = sigma + 1.0 / mu[keep].real
-        V = V[:, keep].real
-        order = np.argsort(np.abs(lam - sigma))[:n_modes]
-        lam, V = lam[order], V[:, order]
-    else:
-        lu = spla.splu((K - sigma * M).tocsc())
-        op = spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
-        rng = np.random.default_rng(0)  # reproducible starting vector
-        v0 = M @ rng.standard_normal(n) + 1e-3 * rng.standard_normal(n) * massed
-        lam, V = spla.eigsh(K, k=n_modes, M=M, sigma=sigma, which="LM", OPinv=op, v0=v0)
-    order = np.argsort(lam)
-    lam, V = lam[order], V[:, order]
-    norms = np.sqrt(np.einsum("ij,ij->j", V, M @ V))
-    return lam, V / np.where(norms > 0, norms, 1.0)
 
 
 def _check_modes(n_modes, nf, n_mass, model_name):
@@ -247,13 +210,9 @@ def modal_analysis(
     Ks = ((K + K.T) * 0.5).tocsr()
     sigma = None if shift_hz is None else float(np.sign(shift_hz) * (2 * math.pi * shift_hz) ** 2)
     try:
-        lam, V = solve_eigen(Ks, M, int(n_modes), sigma)
-    except RuntimeError as exc:  # splu of a singular K - sigma M
-        raise ModelError(
-            f"modal analysis of '{model.name}': K - sigma M is singular at the shift ({exc}); the "
-            "model has a massless mechanism, or an eigenvalue sits exactly at the shift: give "
-            "shift_hz, or mass to the mechanism's DOFs"
-        ) from None
+        lam, V = solve_eigen(Ks, M, int(n_modes), sigma, describe=analysis.dofmap.describe)
+    except ModelError as exc:
+        raise type(exc)(f"modal analysis of '{model.name}': {exc}") from None
     shapes = expand_shapes(analysis, V)
     cells = {f.name: np.asarray(f.nodes) for f in analysis.families}
     return Modes(
@@ -287,4 +246,4 @@ def frequencies_of(analysis, n_modes: int = 10, **kw) -> np.ndarray:
     return modal_analysis(analysis, n_modes, **kw).frequencies
 
 
-__all__ = ["Modes", "modal_analysis", "solve_eigen", "expand_shapes", "frequencies_of"]
+__all__ = ["Modes", "modal_analysis", "solve_eigen", "default_shift", "expand_shapes", "frequencies_of"]

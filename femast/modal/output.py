@@ -1,4 +1,4 @@
-"""Output of modal analyses (issue 18): mode shapes as animated VTK series for ParaView, and the
+"""Output of modal analyses: mode shapes as animated VTK series for ParaView, and the
 modes of every saved increment of a static analysis.
 
 ``export_modes_vtk(modes, folder)`` writes, per mode, ``mode_NN/series.pvd`` with ``n_frames``
@@ -95,7 +95,7 @@ class ModesRecorder:
         self.modes = []
         self.frames = []
         out = getattr(analysis, "output", None)
-        if out is not None and hasattr(out, "recorders"):  # the analysis package (issue 15): an observer's list
+        if out is not None and hasattr(out, "recorders"):  # the analysis package: an observer's list
             self._chain = None
             out.recorders.append(self)
         else:

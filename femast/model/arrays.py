@@ -1,5 +1,5 @@
 """Many nodes, beams or trusses from arrays: ``model.nodes(X)``, ``model.beams(pairs, section)``,
-``model.trusses(pairs, EA)`` (issue 21).
+``model.trusses(pairs, EA)``.
 
 One vectorised check of the whole table replaces a Python call (and its checks) per element: the
 1000-bay mast (4004 nodes, 12000 beams) builds in a few hundredths of a second instead of seconds.
@@ -152,7 +152,7 @@ def add_beams(
     mass_per_length (kg/m; None: section rho A), length_error_m (m), alpha_per_K (1/K): one value or
     one per element.  Returns the element labels (int64 array)."""
     what = f"model '{model.name}': beams()"
-    from .model import BeamSpec
+    from .specs import BeamSpec
 
     labs, rows = node_rows(model, nodes, what)
     n = len(labs)
@@ -239,7 +239,7 @@ def add_trusses(
     tension_only, mass_per_length (kg/m), length_error_m (m), alpha_per_K (1/K): one value or one
     per element; family: a name or one per element (None: "cable" or "truss").  Returns the labels."""
     what = f"model '{model.name}': trusses()"
-    from .model import TrussSpec
+    from .specs import TrussSpec
 
     labs, rows = node_rows(model, nodes, what)
     n = len(labs)

@@ -83,7 +83,7 @@ def _geometric_values(x, rigid, trans_eq, f_net, out):
 
 def transpose_times(T, v):
     """T^T v for a CSR matrix T, without forming T^T (scipy builds and checks a new matrix for
-    ``T.T`` on every call: 8 % of a small constrained model's run, issue 8).  Same order of
+    ``T.T`` on every call: 8 % of a small constrained model's run).  Same order of
     summation as scipy's T.T @ v, so the same bits."""
     out = np.zeros(T.shape[1])
     _csr_transpose_matvec(T.indptr, T.indices, T.data, np.ascontiguousarray(v, dtype=float), out)
@@ -125,7 +125,7 @@ def rigid_body_spec(model, reference, nodes, name: str) -> RigidBodySpec:
 def tie_spec(model, master, slave, dofs) -> TieSpec:
     """The :class:`TieSpec` of :meth:`Model.tie <femast.model.Model.tie>` after checking it
     (default DOFs: the three translations; "all": the six)."""
-    from .model import dof_index
+    from .specs import dof_index
 
     model._check_node(master, "tie")
     model._check_node(slave, "tie")

@@ -17,35 +17,16 @@ stiffnesses in N, N m^2, pressures in Pa, rotations in rad.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from ..elements.base import DOF_NAMES
 from ..errors import ModelError
 from . import validation
-from .amplitudes import Amplitude
 from .arrays import ElementList, add_beams, add_nodes, add_trusses
+from .mass import point_mass_spec
 from .sections import Section
-
-LOAD_NAMES = ("fx", "fy", "fz", "mx", "my", "mz")
-_DOF_INDEX = {n: i for i, n in enumerate(DOF_NAMES)}
-_LOAD_INDEX = {n: i for i, n in enumerate(LOAD_NAMES)}
-
-
-def dof_index(name: str) -> int:
-    """Index 0..5 of a DOF name (ux, uy, uz, rx, ry, rz) or a load name (fx .. mz)."""
-    key = str(name).lower()
-    if key in _DOF_INDEX:
-        return _DOF_INDEX[key]
-    if key in _LOAD_INDEX:
-        return _LOAD_INDEX[key]
-    raise ModelError(f"unknown DOF '{name}'; use one of {', '.join(DOF_NAMES)} (or loads {', '.join(LOAD_NAMES)})")
-
-
-def _finite(value, what, unit=""):
-    """A finite number within validation.MAX_MAGNITUDE of its SI unit, or a ModelError naming ``what``."""
-    return validation.number(value, what, unit)
+from .specs import _DOF_INDEX, LOAD_NAMES, BeamSpec, TrussSpec, dof_index  # noqa: F401  (re-exported)
+from .step import Condition, Step, _finite  # noqa: F401  (re-exported)
 
 
 def _fixed_dofs(node, dofs) -> list[int]:
@@ -64,147 +45,6 @@ def _fixed_dofs(node, dofs) -> list[int]:
                     raise ModelError(f"fix node {node}: unknown DOF '{d}'; use {', '.join(DOF_NAMES)}")
                 idx.append(_DOF_INDEX[str(d).lower()])
     return list(idx)
-
-
-@dataclass
-class BeamSpec:
-    label: int
-    nodes: tuple
-    section: Section
-    up: np.ndarray
-    family: str
-    mass_per_length: float | None = None  # kg/m; None: section.rho * section.A
-
-
-@dataclass
-class TrussSpec:
-    label: int
-    nodes: tuple
-    EA: float
-    L0: float | None
-    pretension: float | None
-    tension_only: bool
-    family: str
-    mass_per_length: float = 0.0  # kg/m (modal analyses, issue 18)
-
-
-@dataclass
-class Condition:
-    """A load or prescribed value on one DOF: ``magnitude`` at the end of the step (or the
-    factor-1 value of its amplitude)."""
-
-    node: int
-    dof: int
-    magnitude: float
-    amplitude: Amplitude | None = None
-
-
-@dataclass
-class Step:
-    """A static step (as an Abaqus *STEP, *STATIC).
-
-    period : step time, s (pseudo-time for static steps).
-    initial_increment, min_increment, max_increment : increments of step time, s.
-    max_increments : most increments allowed in the step.
-    control : None (load / prescribed-displacement control) or a control strategy such as
-        :class:`femast.analysis.solvers.control.DisplacementControl`.
-    stabilize : None, or a :class:`femast.analysis.solvers.stabilize.Stabilize` (issue 3).
-    hit_times : step times (s) at which an increment must end (amplitude table points
-        are added automatically).
-    output_frequency : write a frame (and call the analysis' ``on_frame``) every this many
-        increments and at the step's last increment (Abaqus *OUTPUT, FREQUENCY); 1 (default):
-        every increment.  Frames cost a small model more than its Newton iterations (issue 8);
-        a run that gives up still writes its last converged increment.
-    """
-
-    name: str
-    period: float = 1.0
-    initial_increment: float | None = None
-    min_increment: float | None = None
-    max_increment: float | None = None
-    max_increments: int = 1000
-    control: object = None
-    stabilize: object = None
-    hit_times: tuple = ()
-    output_frequency: int = 1
-    loads: list = field(default_factory=list)
-    prescribed: list = field(default_factory=list)
-    temperatures: list = field(default_factory=list)  # (labels, values K or degC, amplitude): issue 20
-    _model: Model = field(default=None, repr=False)
-
-    def load(self, node, amplitude: Amplitude | None = None, **components):
-        """Nodal force/moment on ``node`` at the end of the step: ``step.load(n, fx=10.0, mz=-2.0)``;
-        ``components`` fx, fy, fz (N) and mx, my, mz (N m), global axes, fixed directions.  The load
-        ramps linearly in step time, or follows ``amplitude`` (an :class:`Amplitude` of step time).
-        A load not redefined in a later step stays applied."""
-        self._model._check_node(node, f"load in step '{self.name}'")
-        if not components:
-            raise ModelError(f"step '{self.name}': load on node {node} has no components; give e.g. fx=1.0")
-        for name, value in components.items():
-            if name.lower() not in _LOAD_INDEX:
-                raise ModelError(
-                    f"step '{self.name}': unknown load component '{name}' on node {node}; use {', '.join(LOAD_NAMES)}"
-                )
-            v = _finite(
-                value, f"step '{self.name}': load {name} on node {node}", "N" if name.lower()[0] == "f" else "N m"
-            )
-            self.loads.append(Condition(node, _LOAD_INDEX[name.lower()], v, amplitude))
-        return self
-
-    def prescribe(self, node, amplitude: Amplitude | None = None, **components):
-        """Prescribed displacement/rotation of ``node`` at the end of the step: ``step.prescribe(n, ux=0.01,
-        rz=0.05)``; ``components`` ux, uy, uz (m) and rx, ry, rz (rad), reached linearly in step time
-        or along ``amplitude``.  A prescribed rotation component is the accumulated spin about that
-        global axis (exact when the other two rotation components are held)."""
-        self._model._check_node(node, f"prescribed motion in step '{self.name}'")
-        if not components:
-            raise ModelError(f"step '{self.name}': prescribe on node {node} has no components; give e.g. ux=0.0")
-        for name, value in components.items():
-            if name.lower() not in _DOF_INDEX:
-                raise ModelError(f"step '{self.name}': unknown DOF '{name}' on node {node}; use {', '.join(DOF_NAMES)}")
-            v = _finite(
-                value, f"step '{self.name}': prescribed {name} on node {node}", "m" if name.lower()[0] == "u" else "rad"
-            )
-            self.prescribed.append(Condition(node, _DOF_INDEX[name.lower()], v, amplitude))
-        return self
-
-
-def _step_temperature(self, T, elements=None, family=None, where=None, amplitude: Amplitude | None = None):
-    """Temperature ``T`` (K or degC; one value or one per element) of beam and truss elements at the
-    end of the step (as Abaqus *TEMPERATURE): picked by ``elements`` (labels), ``family`` (name) and
-    ``where`` (a function of the element midpoint, m: a region); none: all.  With a coefficient of
-    thermal expansion (:meth:`Model.thermal_expansion`) it strains the elements by
-    alpha (T - T_init).  It ramps from the step's start temperature linearly in step time, or as
-    ``T_start + a(t) (T - T_start)`` with an ``amplitude`` a(t); see :mod:`femast.model.thermal`."""
-    from .thermal import add_step_temperature
-
-    return add_step_temperature(self, T, elements, family, where, amplitude)
-
-
-def _step_rotate(self, node, axis, angle: float, amplitude: Amplitude | None = None):
-    """Prescribe a rotation of ``node`` by ``angle`` (rad) about the fixed global ``axis`` (any
-    direction) at the end of the step: the three rotation components are driven together, which
-    is exact for a rotation about a fixed axis.  The angle is reached linearly in step time, or
-    along ``amplitude`` (an :class:`Amplitude` of step time)."""
-    a = np.asarray(axis, dtype=float)
-    if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) == 0:
-        raise ModelError(f"step '{self.name}': rotation axis {axis!r} must be a non-zero 3-vector")
-    a = a / np.linalg.norm(a)
-    return self.prescribe(node, amplitude=amplitude, rx=angle * a[0], ry=angle * a[1], rz=angle * a[2])
-
-
-def _step_follow(self, node, times, **tables):
-    """Drive DOFs of ``node`` along measured time tables: ``step.follow(n, t, rz=theta, ux=x)``
-    with ``times`` (step time, s) and one array of values (m, rad) per DOF; increments end at
-    every table time."""
-    for name, values in tables.items():
-        self.prescribe(node, amplitude=Amplitude(times, values, name=f"{name} of node {node}"), **{name: 1.0})
-    return self
-
-
-Step.rotate = _step_rotate
-Step.temperature = _step_temperature
-Step.follow = _step_follow
 
 
 class Model:
@@ -227,8 +67,8 @@ class Model:
         self.rigid_bodies: list = []
         self.ties: list = []
         self.steps: list[Step] = []
-        self.point_masses: list = []  # femast.modal.mass.PointMassSpec (modal analyses)
-        self.length_errors: dict = {}  # element label -> m (lack of fit, issue 20)
+        self.point_masses: list = []  # femast.model.mass.PointMassSpec (modal analyses, gravity)
+        self.length_errors: dict = {}  # element label -> m (lack of fit)
         self.expansion: dict = {}  # element label -> 1/K
         self.initial_temperatures: dict = {}  # element label -> K or degC
         self._next_element = 1
@@ -479,10 +319,8 @@ class Model:
     def point_mass(self, node, mass: float = 0.0, inertia=None, offset=None, name: str = ""):
         """A mass ``mass`` (kg) with rotary ``inertia`` (kg m^2 about its centre of mass: a scalar,
         3 principal values along the global axes or a 3x3 matrix, initial global axes) at
-        ``node``, its centre of mass ``offset`` (m) from the node (modal analyses); ``name`` labels
-        it in messages.  Returns the :class:`femast.modal.mass.PointMassSpec`."""
-        from ..modal.mass import point_mass_spec
-
+        ``node``, its centre of mass ``offset`` (m) from the node (modal analyses, gravity); ``name``
+        labels it in messages.  Returns the :class:`femast.model.mass.PointMassSpec`."""
         self._check_node(node, "point mass")
         spec = point_mass_spec(node, mass, inertia, offset, name)
         self.point_masses.append(spec)
@@ -545,10 +383,10 @@ class Model:
         self, name: str | None = None, n_modes: int = 10, shift_hz: float | None = None, vtk: bool = False
     ):
         """Append a step called ``name`` that computes the lowest ``n_modes`` vibration modes of the
-        state reached so far (prestress and loads included; see :mod:`femast.modal.step`): the modes
+        state reached so far (prestress and loads included; see :mod:`femast.model.frequency`): the modes
         nearest ``shift_hz`` (Hz) when given, else the lowest; ``vtk=True`` also writes an animated
         VTK series per mode.  Returns it."""
-        from ..modal.step import add_frequency_step
+        from .frequency import add_frequency_step
 
         return add_frequency_step(self, name, n_modes, shift_hz, vtk)
 

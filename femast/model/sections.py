@@ -3,7 +3,7 @@
 A :class:`Section` holds E (Pa), G (Pa), A (m^2), Iy, Iz (m^4, second moments about
 the element's local y and z axes) and J (m^4, St Venant torsion constant).
 
-Note on seed 000, Eq. 10.  The seed gives ``J = s_out L (s_out^2 + L^2) / 12`` for
+Note on Eq. 10 of the Rocaspect paper.  The paper gives ``J = s_out L (s_out^2 + L^2) / 12`` for
 the square-tube mast; that is the polar moment of a solid s_out x L plate, not a
 torsion constant of the tube cross-section (it grows with the beam length L).
 :func:`square_tube` uses Bredt's thin-walled formula for a closed section,
@@ -37,7 +37,7 @@ class Section:
     Iy, Iz : second moments of area about local y and z, m^4.
     J : St Venant torsion constant, m^4.
     name : optional label used in messages and output.
-    rho : density, kg/m^3 (default 0: massless; only modal analyses use it, issue 18).  Give it
+    rho : density, kg/m^3 (default 0: massless; only modal analyses use it).  Give it
         with ``sec.with_(rho=2700.0)``.
     """
 
@@ -172,7 +172,7 @@ def square_tube(
 
 
 def seed000_eq10_torsion_constant(s_out: float, L: float) -> float:
-    """Seed 000 Eq. 10 as printed, J = s_out L (s_out^2 + L^2) / 12 (m^4). Dimensionally
+    """Eq. 10 of the Rocaspect paper as printed, J = s_out L (s_out^2 + L^2) / 12 (m^4). Dimensionally
     an area moment but not a torsion constant of the section; kept only for comparison."""
     return s_out * L * (s_out**2 + L**2) / 12.0
 

@@ -1,4 +1,4 @@
-"""Sources of error in the model: member length errors (lack of fit) and thermal strain (issue 20).
+"""Sources of error in the model: member length errors (lack of fit) and thermal strain.
 
 A beam or truss element whose stress-free length differs from the distance between its nodes is
 modelled by a *length factor* s per element: the element is stress free at the length ``L s``,
@@ -22,7 +22,7 @@ amplitude 0 -> 1 -> 0 is a thermal cycle back to the start temperature).  Temper
 redefined in a later step stay.  Length errors act from the start of the first step.
 
 :class:`FieldLoads` is what the analysis uses: it writes the length factors of the beam and
-truss families at each increment (femast/analysis/controls.py).
+truss families at each increment (femast/analysis/control/).
 """
 
 from __future__ import annotations

@@ -171,7 +171,7 @@ def _balance(x, P, RF, r_free, free_dof):
     """Net force and moment (about the origin) of the loads ``P`` plus reactions ``RF`` at ``x``, the
     summed magnitudes of their forces and of their moments, the largest coordinate magnitude and
     the summed magnitudes of the free residual's forces and moments: one pass, no temporaries
-    (the numpy version cost a small model's increment more than its Newton iteration, issue 21)."""
+    (the numpy version cost a small model's increment more than its Newton iteration)."""
     fx = fy = fz = mx = my = mz = 0.0
     sum_f = sum_m = xmax = 0.0
     for i in range(x.shape[0]):

@@ -1,4 +1,4 @@
-"""Frames of one run encoded from the analysis state without a frame dict (issue 21, item 3).
+"""Frames of one run encoded from the analysis state without a frame dict.
 
 A frame of a small model is a dozen small arrays and eight scalars.  Through the general path
 (a dict of new arrays, then :func:`femast.post.npz.record_bytes`: the signature, a layout lookup,

@@ -1,4 +1,4 @@
-"""Frames as uncompressed ``.npz`` files built in memory (issue 21, item 3).
+"""Frames as uncompressed ``.npz`` files built in memory.
 
 A frame of a small model holds a couple of dozen small arrays; ``np.savez`` (through ``zipfile``)
 spends about 1.5 ms on the bookkeeping of its members, more than a small model's increment costs.

@@ -1,4 +1,4 @@
-"""One plotting style for every femast figure (issue 17): matplotlib settings, axis labels with
+"""One plotting style for every femast figure: matplotlib settings, axis labels with
 units, rounded numbers, titles that fit, and saving.
 
     from femast import plotstyle
@@ -156,6 +156,24 @@ def fit_title(ax_or_fig, text: str, fontsize: float | None = None) -> str:
 def equal_axes(ax) -> None:
     """Equal scales on x and y (a shape drawn in a plane keeps its proportions)."""
     ax.set_aspect("equal", adjustable="datalim")
+
+
+def legend_below(ax, pad_pt: float = 4.0, **kwargs):
+    """A legend centred under ``ax``, below its x tick labels and x label, never over them: the drop
+    is measured in points from the drawn axis (a later layout, which moves axes but keeps the
+    labels' offsets in points, keeps it clear).  Call it once the axis limits and labels are set;
+    ``kwargs`` go to ``ax.legend`` (``ncol``, ``fontsize``...)."""
+    from matplotlib.transforms import offset_copy
+
+    fig = ax.figure
+    drop_pt = 40.0  # tick labels and one line of label at the style's sizes, if the axis cannot be measured
+    if hasattr(fig.canvas, "get_renderer"):
+        fig.canvas.draw()
+        box = ax.xaxis.get_tightbbox(fig.canvas.get_renderer())
+        if box is not None:
+            drop_pt = max(0.0, ax.bbox.y0 - box.y0) * 72.0 / fig.dpi
+    anchor = offset_copy(ax.transAxes, fig=fig, y=-(drop_pt + pad_pt), units="points")
+    return ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=anchor, **kwargs)
 
 
 def save(fig, png, dpi=None) -> Path:

@@ -14,7 +14,7 @@ Layout of a results folder::
 The mesh and the summary are written to a temporary name and renamed into place (``os.replace``);
 frames are appended to the frame log, so a run killed outright leaves at most a partial last
 record, which :class:`Results` ignores with a warning.  Folders of one ``frames/NNNNNN.npz`` per
-frame (femast before issue 21) are read as before, and a restart from one converts them to a log.  A summary still saying "running" after its process has gone (a kill -9, a power cut)
+frame (written by femast 0.1 before the frame log) are read as before, and a restart from one converts them to a log.  A summary still saying "running" after its process has gone (a kill -9, a power cut)
 is reported by :attr:`Results.status` as "interrupted".
 
 Each frame holds: ``step`` (name), ``increment``, ``time`` (step time, s),

@@ -1,4 +1,4 @@
-"""Studies of uncertain inputs (issue 20): run a model over the scatter of its inputs, store
+"""Studies of uncertain inputs: run a model over the scatter of its inputs, store
 every run, and report percentiles, convergence and sensitivity indices.
 
     import femast.studies as st
@@ -17,7 +17,7 @@ from .distributions import Input, LogNormal, Normal, TruncatedNormal, Uniform, e
 from .outputs import ElementOutput, NodeOutput
 from .results import StudyResults, load
 from .runners import RunSummary, run
-from .statistics import bootstrap_ci, convergence, percentile, sobol_convergence, sobol_indices
+from .statistics import bootstrap_ci, convergence, percentile, sobol_convergence, sobol_indices, upper_bound
 from .study import Study
 
 __all__ = [
@@ -35,6 +35,7 @@ __all__ = [
     "load",
     "StudyResults",
     "percentile",
+    "upper_bound",
     "bootstrap_ci",
     "convergence",
     "sobol_indices",

@@ -1,4 +1,4 @@
-"""``femast study SCRIPT --samples N [--workers N | --scheduler ADDRESS]`` (issue 20).
+"""``femast study SCRIPT --samples N [--workers N | --scheduler ADDRESS]``.
 
 SCRIPT is a Python file that defines ``study`` (a :class:`femast.studies.Study`); it is run with
 ``__name__ == "__femast_study__"`` (not ``"__main__"``), so the script's own main block does not

@@ -1,4 +1,4 @@
-"""Uncertain inputs of a study: a name, a distribution and a size (issue 20).
+"""Uncertain inputs of a study: a name, a distribution and a size.
 
 Each input maps a uniform number u in (0, 1) to a value by the inverse of its cumulative
 distribution (``ppf``), so any sampler of the unit cube (Monte Carlo, Latin hypercube, Sobol')
@@ -35,7 +35,7 @@ import math
 import numpy as np
 from scipy import special  # (scipy.stats where needed: 0.45 s to import, and every femast command pays
 
-# the import of this package: issue 21)
+# the import of this package)
 from ..errors import StudyError
 
 #: u is kept inside [EPS, 1 - EPS]: a normal's ppf(0) is -inf (a scrambled Sobol' point can be 0).

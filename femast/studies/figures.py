@@ -1,4 +1,4 @@
-"""Figures of a study (issue 20): the distribution of each output with its percentiles and their
+"""Figures of a study: the distribution of each output with its percentiles and their
 confidence intervals, the convergence of the estimates with the number of samples, and the
 Sobol' indices as a bar chart.  Values in SI units (the axis says which)."""
 

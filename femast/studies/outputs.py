@@ -1,7 +1,7 @@
 """Outputs a study records from each femast run: a node's displacement, rotation or reaction, an
 element quantity, at the end of chosen steps (the load levels of the load history), optionally
 relative to the end of another step (e.g. the pretensioned state; the residual after unloading
-is the value at the end of the unloading step relative to the state before loading) (issue 20).
+is the value at the end of the unloading step relative to the state before loading).
 
     NodeOutput("tip_u", node=tip, quantity="U")                      # (n_steps, 3), m
     NodeOutput("tip_rz", node=tip, quantity="URA", components="z",

@@ -1,4 +1,4 @@
-"""The end-of-study report (issue 20): percentiles with their intervals for every output (each
+"""The end-of-study report: percentiles with their intervals for every output (each
 component of an array output), Sobol' indices when the study has them, and the figures
 (:mod:`femast.studies.figures`)."""
 

@@ -1,4 +1,4 @@
-"""Reading a study's results back (issue 20): ``femast.studies.load(folder)``.
+"""Reading a study's results back: ``femast.studies.load(folder)``.
 
 res = load("studies/tip")
 x = res.output("tip_u")            # (n_ok, ...) values of the successful base samples (block A)

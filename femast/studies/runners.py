@@ -1,5 +1,4 @@
-"""Running a study: in this process, in local worker processes, or on a dask.distributed cluster
-(issue 20).
+"""Running a study: in this process, in local worker processes, or on a dask.distributed cluster.
 
 The runs are cut into chunks; each finished chunk is written to the study folder at once
 (:mod:`femast.studies.store`), so a study that is interrupted (Ctrl-C, a killed job) resumes where

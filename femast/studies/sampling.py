@@ -1,6 +1,6 @@
 """Sample points of a study: Monte Carlo, Latin hypercube or Sobol' points of the unit cube
 (scipy.stats.qmc), a Gaussian copula for correlated inputs, and Saltelli's layout of the runs
-when sensitivity indices are wanted (issue 20).
+when sensitivity indices are wanted.
 
 Every run has an index r.  Without sensitivity, run r is base sample r.  With sensitivity
 (k inputs, a per-member input counting as one group) each base sample i draws a point of twice
@@ -156,7 +156,7 @@ class Design:
                 out.append(pts[lo:hi])
             return np.concatenate(out) if out else np.zeros((0, d))
         if self.sampler == "sobol":
-            from scipy.stats import qmc  # (here: 0.45 s to import, issue 21)
+            from scipy.stats import qmc  # (here: 0.45 s to import)
 
             eng = qmc.Sobol(d, scramble=True, seed=self.seed)
             if start:

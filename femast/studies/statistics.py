@@ -1,4 +1,4 @@
-"""Statistics of a study's outputs (issue 20): percentiles with confidence intervals, convergence
+"""Statistics of a study's outputs: percentiles with confidence intervals, convergence
 of the estimates with the number of samples, first-order and total Sobol' indices.
 
 * Percentile intervals are distribution-free order-statistic intervals: for the q-quantile xi_q
@@ -35,7 +35,7 @@ def order_statistic_ranks(n: int, q: float, confidence: float = 0.95) -> tuple:
     """1-based ranks (l, u) with P(x_(l) <= xi_q <= x_(u)) >= confidence; 0 or n + 1 when n is too
     small for that side (no bound)."""
     alpha = 1.0 - confidence
-    from scipy import stats  # (here: importing scipy.stats costs every femast command 0.45 s, issue 21)
+    from scipy import stats  # (here: importing scipy.stats costs every femast command 0.45 s)
 
     l = int(stats.binom.ppf(alpha / 2, n, q))  # P(B <= l - 1) <= alpha / 2
     if l >= 1 and stats.binom.cdf(l - 1, n, q) > alpha / 2:
@@ -65,6 +65,34 @@ def percentile(x, q: float, confidence: float = 0.95) -> dict:
         "high": float(hi),
         "n": n,
         "coverage": float(cover),
+    }
+
+
+def upper_bound(x, q: float, confidence: float = 0.95) -> dict:
+    """One-sided distribution-free upper confidence bound of the ``q``-quantile of samples ``x``:
+    {'q', 'estimate', 'high', 'rank', 'n', 'coverage', 'needed'}.  x_(u) (sorted, 1-based) lies above
+    xi_q when fewer than u samples fall below it: P = F(u - 1) (F the Binomial(n, q) cdf), and u is
+    the smallest rank with F(u - 1) >= confidence.  'high' is NaN when n is too small; 'needed' is
+    the least n for which the largest sample is a bound (1 - q^n >= confidence: 59 for the 95th
+    percentile at 95 %)."""
+    if not 0.0 < q < 1.0:
+        raise StudyError(f"quantile q = {q!r} must lie in (0, 1) (0.95 for the 95th percentile)")
+    from scipy import stats
+
+    x = np.sort(_values(x))
+    n = len(x)
+    u = int(stats.binom.ppf(confidence, n, q)) + 1
+    if u >= 2 and stats.binom.cdf(u - 2, n, q) >= confidence:
+        u -= 1
+    needed = int(np.ceil(np.log1p(-confidence) / np.log(q)))
+    return {
+        "q": q,
+        "estimate": float(np.quantile(x, q)),
+        "high": float(x[u - 1]) if u <= n else float("nan"),
+        "rank": u,
+        "n": n,
+        "coverage": float(stats.binom.cdf(u - 1, n, q)) if u <= n else float("nan"),
+        "needed": needed,
     }
 
 

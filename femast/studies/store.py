@@ -1,4 +1,4 @@
-"""The results of a study on disk: Parquet chunks written as samples finish (issue 20).
+"""The results of a study on disk: Parquet chunks written as samples finish.
 
 A study folder holds ``study.json`` (the study's description, the number of base samples, the
 shapes of the outputs) and ``chunks/*.parquet``, one file per finished chunk of runs, each

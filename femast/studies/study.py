@@ -1,5 +1,5 @@
-"""A study: a model factory, its uncertain inputs, the outputs to record and the sampling design
-(issue 20).  :func:`femast.studies.run` runs it; ``femast study SCRIPT`` runs the ``study`` of a
+"""A study: a model factory, its uncertain inputs, the outputs to record and the sampling design.
+:func:`femast.studies.run` runs it; ``femast study SCRIPT`` runs the ``study`` of a
 script.
 
 Two ways to say what one sample is:

@@ -5,7 +5,7 @@
 * :mod:`.arclength`: the arc-length cases; :mod:`.modal`: the modal cases;
 * :mod:`.references`: the independent reference solutions (closed forms, published values).
 
-``femast.verification`` was one module before the package move (issue 15); its names are
+``femast.verification`` was one module before the package move; its names are
 re-exported here.
 """
 

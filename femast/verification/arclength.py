@@ -1,4 +1,4 @@
-"""Arc-length verification cases (issue 3, item 4), shared by tests and benchmarks/arc_length.py.
+"""Arc-length verification cases, shared by tests and benchmarks/arc_length.py.
 
 Each returns the femast path (displacement of the loaded point along the load, load) and the
 independent reference from :mod:`femast.verification.references`."""
@@ -8,7 +8,7 @@ from __future__ import annotations
 import tempfile
 
 from ..analysis import Analysis
-from ..analysis.solvers.arclength import ArcLength
+from ..analysis.control.arclength import ArcLength
 from ..model import Model
 from ..model.sections import Section
 from . import references as ref

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis import Analysis
-from ..analysis.solvers.control import DisplacementControl
+from ..analysis.control import DisplacementControl
 from ..model import Model
 from ..model.sections import Section, square_tube
 from . import references as ref
@@ -165,8 +165,8 @@ def bend45(n_elements=16, out_dir=None, progress=False):
 
 
 def linear_compliance(n_elements=4, L=3.651, out_dir=None):
-    """Tip compliance of the seed-000 square-tube cantilever from the FE tangent at the
-    undeformed state against the beam-theory compliance (seed 000 Eq. 8, correct J)."""
+    """Tip compliance of the Rocaspect paper's square-tube cantilever from the FE tangent at the
+    undeformed state against the beam-theory compliance (the Rocaspect paper, Eq. 8, correct J)."""
     sec = square_tube(0.1, 0.094, E=2.1e11, nu=0.3)
     m, root, tip = _cantilever(n_elements, L=L, section=sec, up=(0.0, 1.0, 0.0))
     m.step("none")

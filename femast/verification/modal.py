@@ -1,4 +1,4 @@
-"""Verification of the modal analysis against closed forms (issue 18), shared by the tests and
+"""Verification of the modal analysis against closed forms, shared by the tests and
 ``benchmarks/verification.py``.  Each case returns :class:`~femast.verification.Check` rows
 (relative frequency errors) and the numbers behind them for the plots.
 

@@ -1,4 +1,4 @@
-"""ADAM bay builder (seed 001): Eq. 1 kinematics, bad input, pretension equilibrium, torsion paths.
+"""ADAM bay builder (Stohlman & Pellegrino): Eq. 1 kinematics, bad input, pretension equilibrium, torsion paths.
 
 References are independent of femast's own output: Eq. 1 (closed form), Newton's third law and
 the bay's symmetry, and for the release twist a reduced model (rigid frames on the Eq. 1 path,
@@ -22,7 +22,7 @@ from femast.adam.steps import (
     add_measured_torsion,
     measured_style_path,
 )
-from femast.latch import ZONE_BACKSTOP, ZONE_FREE, LatchParameters
+from femast.elements.latch_law import ZONE_BACKSTOP, ZONE_FREE, LatchParameters
 
 P = BayParameters()
 

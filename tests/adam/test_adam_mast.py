@@ -1,4 +1,4 @@
-"""40-bay ADAM mast (seed 001 Sec. VII, Table 1): tip response, the identified parameters, the table.
+"""40-bay ADAM mast (Stohlman & Pellegrino, Sec. VII, Table 1): tip response, the identified parameters, the table.
 
 The reference values are the seed's Table 1 (x = 1740 um, theta_z = 3030 arcsec under M + F), the
 mast's symmetry (-M-F mirrors M+F) and the latch law's release force (43.9 N, seed's fit)."""
@@ -10,7 +10,7 @@ import femast as fm
 from femast.adam import BayParameters, build_mast
 from femast.adam.post import SEED_TABLE1, TABLE1_ROWS, format_table1, tip_table
 from femast.adam.steps import CONVERGENCE, add_initial_steps, add_table1_steps
-from femast.latch import UNLATCHING, latch_force
+from femast.elements.latch_law import UNLATCHING, latch_force
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""Per-joint, per-latch, per-side and per-member scatter of the ADAM mast builder (issue 20, item 1)."""
+"""Per-joint, per-latch, per-side and per-member scatter of the ADAM mast builder."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""Seed 001's pretension-by-vibration method (Sec. IV, Eq. 16; issue 18)."""
+"""Stohlman & Pellegrino's pretension-by-vibration method (Sec. IV, Eq. 16)."""
 
 import math
 

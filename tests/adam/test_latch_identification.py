@@ -1,12 +1,12 @@
-"""Latch identification from pull tests (seed 001, Section III.B-C, Eq. 15)."""
+"""Latch identification from pull tests (Stohlman & Pellegrino, Section III.B-C, Eq. 15)."""
 
 import copy
 
 import numpy as np
 import pytest
 
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.errors import ModelError
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.latch_identification import (
     fit_latch,
     fit_pull_tests,

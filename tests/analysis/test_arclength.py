@@ -1,4 +1,4 @@
-"""Issue 3, item 4: arc-length control through limit points and snap-backs."""
+"""Arc-length control through limit points and snap-backs."""
 
 import numpy as np
 import pytest

@@ -1,12 +1,12 @@
-"""The compiled helpers of the Newton loop (issue 8) against the numpy/scipy expressions they replace."""
+"""The compiled helpers of the Newton loop against the numpy/scipy expressions they replace."""
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import expm
 
 from femast.analysis.configuration import update_configuration
-from femast.analysis.solvers.convergence import field_abs_max, force_moment_abs_max
-from femast.analysis.solvers.linear import _unpermute
+from femast.analysis.convergence import field_abs_max, force_moment_abs_max
+from femast.analysis.linalg.linear import _unpermute
 from femast.model.constraints import transpose_times
 from femast.rotations import skew
 

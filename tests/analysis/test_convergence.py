@@ -1,5 +1,5 @@
 """The Newton convergence test: the linear-increment rule (Abaqus' R_l) and the round-off load
-step that used to fail without it (noticed in issue 7)."""
+step that used to fail without it (met in the FE experiments' fits)."""
 
 import tempfile
 
@@ -8,7 +8,7 @@ import numpy as np
 from femast.adam import build_mast
 from femast.adam.steps import CONVERGENCE, add_initial_steps
 from femast.analysis import Analysis
-from femast.analysis.solvers.convergence import Convergence
+from femast.analysis.convergence import Convergence
 
 
 def _check(conv, r, du, Du, iteration):
@@ -54,7 +54,7 @@ def test_a_round_off_load_change_converges_with_friction_joints():
         F = [res.frame(i) for i in (len(res) - 3, len(res) - 2, len(res) - 1)]
     # the state does not move: the load changed by 1e-14 relative, and step b's one iteration (the
     # linear-increment rule) is one Newton correction from step a's end, i.e. the error left there.
-    # The correction test (strict or predicted, issue 21) bounds that error in each field by disp_tol
+    # The correction test (strict or predicted) bounds that error in each field by disp_tol
     # times that field's largest change in step a's last increment (the test's own measure: the
     # translations in m, the rotations (accumulated spins URA) in rad; both rules leave ~4e-4 and
     # ~6e-4 of that bound here)

@@ -1,4 +1,4 @@
-"""The dense LAPACK LU for small tangents (issue 21, item 3): solutions against numpy's dense solve,
+"""The dense LAPACK LU for small tangents: solutions against numpy's dense solve,
 unsymmetric, indefinite and singular matrices, the automatic rule (dense up to DENSE_MAX_DOFS) and
 an analysis through it against SuperLU."""
 
@@ -11,8 +11,8 @@ from test_linear_backends import backward_error, chain_matrix
 
 import femast as fm
 from femast.analysis import Analysis
-from femast.analysis.solvers import backends, dense
-from femast.analysis.solvers.linear import SparseLU
+from femast.analysis.linalg import backends, dense
+from femast.analysis.linalg.linear import SparseLU
 from femast.errors import SingularModelError
 
 

@@ -1,4 +1,4 @@
-"""Linear-solver back-ends (issue 21, item 1): the banded LAPACK factorisations, CHOLMOD and
+"""Linear-solver back-ends: the banded LAPACK factorisations, CHOLMOD and
 PARDISO against a dense solve, their behaviour on unsymmetric, indefinite and singular matrices,
 the automatic choice and the fall-back when an optional back-end is missing."""
 
@@ -10,9 +10,9 @@ import scipy.sparse as sp
 
 import femast as fm
 from femast.analysis import Analysis
-from femast.analysis.solvers import backends
-from femast.analysis.solvers.banded import BandedFactor, band_of, band_rule
-from femast.analysis.solvers.linear import SparseLU
+from femast.analysis.linalg import backends
+from femast.analysis.linalg.banded import BandedFactor, band_of, band_rule
+from femast.analysis.linalg.linear import SparseLU
 from femast.errors import ModelError, SingularModelError
 
 
@@ -228,7 +228,7 @@ def test_band_storage_input_factorises_bit_for_bit_as_the_csc_input(asym, shift)
 def test_band_positions_through_the_permutation_compose_the_two_maps():
     """Positions of a matrix K's entries in the band storage of B = P K P^T (given B.data =
     K.data[gather]) are those of B's entries at the permuted positions."""
-    from femast.analysis.solvers.ordering import permuted, permuted_positions
+    from femast.analysis.linalg.ordering import permuted, permuted_positions
 
     K = chain_matrix(n=120, b=5, asym=1e-3)
     perm = np.random.default_rng(8).permutation(K.shape[0])

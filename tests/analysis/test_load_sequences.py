@@ -1,4 +1,4 @@
-"""Issue 3, item 5: several steps (load, unload, reverse, repeat) under load, displacement and
+"""Several steps (load, unload, reverse, repeat) under load, displacement and
 arc-length control in one analysis, keeping path-dependent state across steps."""
 
 import tempfile
@@ -10,7 +10,7 @@ import femast as fm
 from femast.elements.ball_joint import add_ball_joints
 
 MU, B, P, K_STICK = 0.5, 0.004, 1000.0, 2000.0
-Y = MU * B * P  # slip moment of the joint, N m (seed 001 Sec. II.B.1)
+Y = MU * B * P  # slip moment of the joint, N m (Stohlman & Pellegrino, Sec. II.B.1)
 
 
 def _joint_with_spring():

@@ -1,4 +1,4 @@
-"""A reference run's converged increments as the predictor of a nearby run (issue 21, item 6):
+"""A reference run's converged increments as the predictor of a nearby run:
 femast/analysis/reference.py, the whole-increment predictor of newton.py, and its use by the FE
 experiments (femast/experiments/fe_reference.py)."""
 

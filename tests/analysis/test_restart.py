@@ -1,4 +1,4 @@
-"""Issue 16, item 1: restart (Abaqus *RESTART).  A run stopped or killed at any moment and
+"""Restart (Abaqus *RESTART).  A run stopped or killed at any moment and
 continued from its last restart point writes the uninterrupted run's frames, bit for bit."""
 
 import os

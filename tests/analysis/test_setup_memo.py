@@ -1,4 +1,4 @@
-"""femast.jit.setup_call remembers the plain-Python results of the pure set-up kernels (issue 21):
+"""femast.jit.setup_call remembers the plain-Python results of the pure set-up kernels:
 the same results as computing them, never shared with the caller, and a kernel listed as pure
 writes none of its arguments."""
 
@@ -7,7 +7,7 @@ import pytest
 
 from femast import jit
 from femast.analysis.assembly import _block_pattern, _pattern_kernel
-from femast.analysis.solvers.ordering import _permuted_csc, permuted
+from femast.analysis.linalg.ordering import _permuted_csc, permuted
 
 
 def _pattern_args(seed):

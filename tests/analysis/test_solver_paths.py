@@ -1,4 +1,4 @@
-"""Issue 8: the fast paths of the Newton loop give the same answers as the plain ones.
+"""The fast paths of the Newton loop give the same answers as the plain ones.
 
 * converged responses of path-independent families reused at the next increment's start;
 * the symbolic analysis (ordering) done from the assembly pattern at set-up;
@@ -17,7 +17,7 @@ import scipy.sparse.linalg as spla
 
 import femast as fm
 from femast.analysis import Analysis
-from femast.analysis.solvers.linear import SparseLU
+from femast.analysis.linalg.linear import SparseLU
 from femast.elements.base import ElementFamily, ElementResponse
 from femast.errors import ConvergenceError
 from femast.post.results import ResultsWriter

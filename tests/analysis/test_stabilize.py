@@ -1,4 +1,4 @@
-"""Issue 3, item 3: viscous stabilisation (*STABILIZE) of an initially unstable step."""
+"""Viscous stabilisation (*STABILIZE) of an initially unstable step."""
 
 import tempfile
 

@@ -1,4 +1,4 @@
-"""Issue 16, item 5: no raw tracebacks from the CLI.  Every error is one line on stderr naming the
+"""No raw tracebacks from the CLI.  Every error is one line on stderr naming the
 item, exit code 2; a closed output pipe is silent; --debug shows the traceback."""
 
 import os

@@ -1,4 +1,4 @@
-"""Issue 17: the first hour of a new user -- progress that never pollutes output, the compile notice,
+"""What a new user meets first: progress that never pollutes output, the compile notice,
 a CLI that explains itself (lists from the registries), example data reachable from any folder,
 ``render`` choosing the frame of largest displacement."""
 

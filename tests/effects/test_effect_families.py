@@ -1,4 +1,4 @@
-"""Effect families (issue 14): generalised forms whose simpler forms are special cases, checked
+"""Effect families: generalised forms whose simpler forms are special cases, checked
 against closed forms (Jenkins loops, Masing rules of the Iwan model) and the old forms exactly."""
 
 import numpy as np

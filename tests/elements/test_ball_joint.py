@@ -1,4 +1,4 @@
-"""Friction ball joint (seed 001, Sec. II.B.1): slip plateau at mu B |F|, dissipated energy per
+"""Friction ball joint (Stohlman & Pellegrino, Sec. II.B.1): slip plateau at mu B |F|, dissipated energy per
 cycle, no moment without force, consistent tangent (finite differences, stick and slip),
 commit/rollback, a two-beam model solved with fm.solve, bad input."""
 
@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from doc_examples import run_python_blocks
+from doc_examples import printed_in, run_python_blocks
 
 import femast as fm
 from femast.elements.ball_joint import (
@@ -21,7 +21,7 @@ from femast.errors import ModelError
 from femast.rotations import expm_so3
 from femast.testing import fd_tangent
 
-MU, B = 0.5, 0.004  # seed 001, Sec. II.B.1
+MU, B = 0.5, 0.004  # Stohlman & Pellegrino, Sec. II.B.1
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -351,5 +351,13 @@ def test_default_stiffnesses_follow_the_connected_members():
 
 
 # ----------------------------------------------------------------------------- docs
-def test_doc_examples_run():
-    run_python_blocks("ball_joint.md")
+def test_doc_examples_run(capsys):
+    """The page's examples run and print what the page says they print (numbers as numbers)."""
+    import re
+
+    text = run_python_blocks("ball_joint.md")
+    out = capsys.readouterr().out
+    quoted = re.findall(r"prints `([^`]+)`", text) + re.findall(r"`(seated: [^`]+)`", text)
+    assert len(quoted) >= 3
+    for q in quoted:
+        assert printed_in(q, out), f"ball_joint.md says it prints {q!r}"

@@ -1,4 +1,4 @@
-"""Cable over an ordered list of devices (femast.elements.cable_devices; issue 19, seed 001 Sec. II.B.2)."""
+"""Cable over an ordered list of devices (femast.elements.cable_devices; Stohlman & Pellegrino, Sec. II.B.2)."""
 
 import math
 
@@ -10,8 +10,8 @@ from scipy.optimize import brentq
 from femast.elements.base import IncrementContext
 from femast.elements.cable_devices import CableDeviceFamily, Clamp, Latch, Pulley, UserDevice, wrap_geometry
 from femast.elements.cable_latch import CableLatchFamily
+from femast.elements.latch_law import LatchParameters
 from femast.errors import ModelError
-from femast.latch import LatchParameters
 from femast.testing import fd_tangent
 
 EA = 1.0e5  # N
@@ -143,7 +143,7 @@ P2 = LatchParameters(r=1.1e-3, x_backstop=2.0e-3, k=30e3, mu=0.07, h=1.5e-3, R=2
 
 
 def eq14_out(x, p):
-    """Seed 001 Eq. 14, unlatching branch, written out here (independent of femast.latch)."""
+    """Stohlman & Pellegrino, Eq. 14, unlatching branch, written out here (independent of femast.elements.latch_law)."""
     rho = p.r + p.R
     y = np.sqrt(np.clip(rho**2 - x**2, 0.0, None))
     delta = np.clip(y - p.h - p.r, 0.0, None)

@@ -1,4 +1,4 @@
-"""Cable/pulley/latch element of seed 001, Eqs. 2-5 (femast.elements.cable_latch)."""
+"""Cable/pulley/latch element of Stohlman & Pellegrino, Eqs. 2-5 (femast.elements.cable_latch)."""
 
 import numpy as np
 import pytest
@@ -12,8 +12,8 @@ from femast.elements.cable_latch import (
     CableLatchFamily,
     cable_equations,
 )
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force
 from femast.errors import ModelError
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force
 from femast.testing import fd_tangent as _fd
 
 P = LatchParameters.seed_fit()

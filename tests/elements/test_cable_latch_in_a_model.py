@@ -6,7 +6,7 @@ from scipy.optimize import brentq
 
 import femast as fm
 from femast.elements.cable_latch import CableLatchFamily
-from femast.latch import UNLATCHING, LatchParameters, latch_force
+from femast.elements.latch_law import UNLATCHING, LatchParameters, latch_force
 
 P = LatchParameters.seed_fit()
 EA = 2.0e5

@@ -1,5 +1,5 @@
 """Length errors (lack of fit), thermal strain and per-element device parameters of the cable
-families (issue 20, item 1): cable/latch (seed 001 Eqs. 2-5) and cable over devices."""
+families: cable/latch (Stohlman & Pellegrino, Eqs. 2-5) and cable over devices."""
 
 import numpy as np
 import pytest
@@ -9,8 +9,8 @@ from femast.analysis import Analysis
 from femast.elements.base import IncrementContext
 from femast.elements.cable_devices import CableDeviceFamily, Clamp, Latch, Pulley
 from femast.elements.cable_latch import BACKSTOP, CableLatchFamily
+from femast.elements.latch_law import LatchParameters
 from femast.errors import ModelError
-from femast.latch import LatchParameters
 from femast.testing import fd_tangent
 
 P = LatchParameters.seed_fit()

@@ -1,4 +1,4 @@
-"""Latch hysteresis option of the cable/latch element (seed 001 Sec. VIII, the missing physics)
+"""Latch hysteresis option of the cable/latch element (Stohlman & Pellegrino, Sec. VIII, the missing physics)
 and the residual rotation it gives a bay at zero moment.
 
 References: the hysteresis law written out by hand here (w(x) from its definition), Eq. 14 of the
@@ -17,7 +17,7 @@ from femast.adam import build_bay
 from femast.adam.steps import CONVERGENCE, add_idealised_torsion, add_initial_steps
 from femast.elements.base import IncrementContext
 from femast.elements.cable_latch import BACKSTOP, SLIP_IN, SLIP_OUT, STICK, CableLatchFamily, cable_equations
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.testing import fd_tangent
 
 P = LatchParameters.seed_fit()

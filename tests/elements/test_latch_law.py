@@ -1,12 +1,11 @@
-"""Latch law of seed 001, Eqs. 6-14 (femast.latch)."""
+"""Latch law of Stohlman & Pellegrino, Eqs. 6-14 (femast.elements.latch_law)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from femast.errors import ModelError
-from femast.latch import (
+from femast.elements.latch_law import (
     LATCHING,
     UNLATCHING,
     ZONE_BACKSTOP,
@@ -21,6 +20,7 @@ from femast.latch import (
     latch_zone,
     roller_opening,
 )
+from femast.errors import ModelError
 
 P = LatchParameters.seed_fit()
 MM = 1e-3

@@ -1,4 +1,4 @@
-"""Element outputs computed only when read (femast.elements.base.LazyOutput, issue 8)."""
+"""Element outputs computed only when read (femast.elements.base.LazyOutput)."""
 
 import numpy as np
 

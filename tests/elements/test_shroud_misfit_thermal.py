@@ -1,5 +1,5 @@
-"""Length errors (lack of fit) and thermal strain of the Dyneema shroud cables (seed 000, Eq. 25;
-issue 20, item 1), and of the guyed FE mast built from them.
+"""Length errors (lack of fit) and thermal strain of the Dyneema shroud cables (the Rocaspect paper,
+Eq. 25), and of the guyed FE mast built from them.
 
 The closed forms use the rope law only in its printed, forward form ``eps = tau / g(tau)``,
 ``g = k0 + k1 tau + k2 tau^2`` (Eq. 27), solved here with brentq: nothing of the element's inverse
@@ -42,7 +42,7 @@ def tension(eps):
 
 
 #: the closed forms below are checked to 1e-8 .. 1e-10 relative: tolerances of 1e-10 (femast's
-#: default 1e-6 lets a state be up to ~1e-6 off; since issue 21 an increment may be accepted on its
+#: default 1e-6 lets a state be up to ~1e-6 off; an increment may be accepted on its
 #: predicted next correction, without the extra iteration that used to leave it ~1e-12 away)
 TIGHT = fm.Convergence(force_tol=1e-10, disp_tol=1e-10)
 

@@ -1,4 +1,4 @@
-"""Issue 2, items 8e-8f: consistent tangents and rigid-body invariance."""
+"""Consistent tangents and rigid-body invariance."""
 
 import math
 
@@ -149,7 +149,7 @@ def test_prescribed_large_rotation_of_free_frame_is_rigid():
 
 
 def test_small_rotation_logarithm_agrees_with_atan2_form():
-    """The beam kernel's logarithm (series of atan below 0.02 rad, issue 21) against the atan2 form
+    """The beam kernel's logarithm (series of atan below 0.02 rad) against the atan2 form
     of logm_so3: within a few ulps across the switch (two roundings of one quaternion; both are within
     6e-16 of mpmath's logarithm of the same matrices), the same bits above it."""
     from numba import njit

@@ -1,4 +1,4 @@
-"""Issue 4, item 1: a user element written against the documented contract runs in a model."""
+"""A user element written against the documented contract runs in a model."""
 
 import re
 from pathlib import Path

@@ -1,4 +1,4 @@
-"""Issue 16, item 7: a battery of malformed measured-data files.  Each must give a DataFileError
+"""A battery of malformed measured-data files.  Each must give a DataFileError
 whose message names the item (file, line, column or separator); never a raw exception, a NaN
 result or a silent acceptance."""
 

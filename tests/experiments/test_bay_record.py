@@ -1,5 +1,5 @@
 """bay-torsion records the latches' bead positions from the latch family's committed state and
-derives the zones after the run (issue 21: reading an element output builds the family's whole
+derives the zones after the run (reading an element output builds the family's whole
 output dict, 20 % of a run); they must equal the family's own outputs at every frame."""
 
 import numpy as np

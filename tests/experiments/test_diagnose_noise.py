@@ -1,4 +1,4 @@
-"""Noise model of diagnose (issue 14): estimators against noise of known variance and AR(1)
+"""Noise model of diagnose: estimators against noise of known variance and AR(1)
 coefficient, the heteroscedastic law, given uncertainties and the errors on bad input."""
 
 import math
@@ -63,7 +63,7 @@ def test_white_noise_is_called_white_and_the_thresholds_are_the_99th_percentiles
 
 
 def test_heteroscedastic_law_is_recovered():
-    # seed 001 Eq. 15: residual e_T (1 + s C) - s e_d, variance sigma_T^2 (1 + s C)^2 + s^2 sigma_d^2
+    # Stohlman & Pellegrino, Eq. 15: residual e_T (1 + s C) - s e_d, variance sigma_T^2 (1 + s C)^2 + s^2 sigma_d^2
     rng = np.random.default_rng(7)
     n = 600
     s = np.sin(np.linspace(0, 9, n)) * 3e5  # signed slope of the law, N/m

@@ -1,4 +1,4 @@
-"""Verdicts of diagnose (issue 14): significance needs an information-criterion gain AND a share of
+"""Verdicts of diagnose: significance needs an information-criterion gain AND a share of
 the excess error; the conclusions missing_effect / missing_pair / form_imperfect / better_form /
 nothing_missing / not_explained; data with mechanisms written in other forms than the effects."""
 
@@ -42,7 +42,7 @@ def _pair(effects, ratio, dbic, best_single, r0=3.0):
 def test_share_and_significance_need_both_criteria():
     assert share(3.0, 1.0) == 1.0 and share(3.0, 3.0) == 0.0
     np.testing.assert_allclose(share(3.0, np.sqrt(9 - 0.5 * 8)), 0.5, rtol=1e-14)  # half the excess 9 - 1
-    # a large IC gain that removes 2 % of the excess is not significant (issue 14: "sig yes" at 2 %)
+    # a large IC gain that removes 2 % of the excess is not significant (it used to say "sig yes" at 2 %)
     assert flags(-300.0, 0.02) == {"ic_gain": True, "share_ok": False, "significant": False}
     assert flags(-5.0, 0.9)["significant"] is False
     assert flags(-10.5, MIN_SHARE)["significant"] is True

@@ -37,7 +37,7 @@ USER_EXPERIMENT = textwrap.dedent('''
         model=model, hooks={"extension": "u (n,) m"}, error_unit="m")
 
     register_effect(Effect(
-        name="spring_slip", title="slip of the spring mount", physics="the mount slips by +-s with the force sign",
+        name="spring_slip", title="slip of the spring mount", physics="The mount slips by +-s with the force sign.",
         signature="a step at zero force", acts_where=("near-zero load",),
         implementations={"spring-test": Implementation(
             hook="extension", apply=_slip,
@@ -139,7 +139,7 @@ def test_diagnose_json_schema_of_issue_7(tmp_path, capsys):
             assert {"value", "stderr", "unit"} <= set(p)
     assert [e["delta_bic"] for e in r["ranking"]] == sorted(e["delta_bic"] for e in r["ranking"])
     assert set(r["verdict"]) >= {"missing_effect", "explained"}
-    # the example hides two effects: the best single one does not explain it all, the pair does (issue 14)
+    # the example hides two effects: the best single one does not explain it all, the pair does
     assert r["verdict"] == {
         **r["verdict"],
         "missing_effect": None,

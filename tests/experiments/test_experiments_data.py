@@ -1,4 +1,4 @@
-"""Measured-data files: format, example files, and bad input (issue 7 item 8)."""
+"""Measured-data files: format, example files, and bad input."""
 
 from pathlib import Path
 
@@ -31,7 +31,7 @@ def _rows(n=12, cols=9):
     [
         ("mast_top_example.csv", "mast-top"),
         ("latch_pull_example.csv", "latch-pull"),
-        ("tip_cycle_seed001_table1.csv", "tip-cycle"),
+        ("tip_cycle_table1.csv", "tip-cycle"),
         ("bay_torsion_format.csv", "bay-torsion"),
     ],
 )
@@ -43,7 +43,7 @@ def test_example_files_follow_their_format(name, exp):
 
 
 def test_tip_cycle_example_is_seed001_table1_in_si():
-    d = read_data(get_experiment("tip-cycle"), DATA / "tip_cycle_seed001_table1.csv")
+    d = read_data(get_experiment("tip-cycle"), DATA / "tip_cycle_table1.csv")
     assert d.n == 13
     # the file holds 6 significant digits
     np.testing.assert_allclose(d["ux_m"][1], 1740e-6, rtol=1e-5)  # 1740 um under M + F

@@ -15,7 +15,7 @@ DOCS = ROOT / "docs"
 @pytest.mark.parametrize("page", ["experiments.md", "compare_and_diagnose.md"])
 def test_python_examples_run(page, capsys, tmp_path):
     before = {e.name for e in list_effects()}
-    try:  # from a folder outside the repository: the examples find the shipped data (issue 17)
+    try:  # from a folder outside the repository: the examples find the shipped data
         text = run_python_blocks(page, cwd=tmp_path)
     finally:  # an example's user effect must not become a candidate of later diagnoses
         for e in list_effects():

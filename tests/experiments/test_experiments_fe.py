@@ -1,6 +1,6 @@
-"""FE experiments ``bay-torsion`` (single ADAM bay) and ``tip-cycle`` (ADAM mast) of issue 7.
+"""FE experiments ``bay-torsion`` (single ADAM bay) and ``tip-cycle`` (ADAM mast).
 
-Default suite (about a minute): the baselines are the issue-5 FE models (checked against
+Default suite (about a minute): the baselines are the ADAM FE models (checked against
 ``femast.adam`` run directly), the effects change the FE inputs as documented, runs are cached,
 long files are subsampled, and one real hidden-effect diagnosis on a short twist path.  The full
 hidden-effect cases (one per effect, varied paths, noise levels and parameters; a null case and an
@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parents[2]
 BT = get_experiment("bay-torsion")
 N_SIGMA = 4.0  # identified effect parameters within 4 Jacobian standard errors (two-sided p ~ 6e-5)
 REL_TOL = 0.15  # ... and within 15 %: 41-61 samples, the hidden effects are 3-8x the noise (12 % seen at worst)
-REFIT_TOL = 1.2  # issue 7: the refit error is within 1.2x the noise (here the true noise of the sample)
+REFIT_TOL = 1.2  # the refit error is within 1.2x the noise (here the true noise of the sample)
 LOCAL_FACTOR = 1.5  # the worst segment's noise-free misfit is at least 1.5x its path average
 
 
@@ -44,7 +44,7 @@ def _sample_noise(exp, data, truth):
 
 
 # =============================================================================== bay-torsion, fast
-def test_bay_baseline_is_the_issue5_bay_driven_along_the_measured_path():
+def test_bay_baseline_is_the_adam_bay_driven_along_the_measured_path():
     from femast.adam import build_bay
     from femast.adam.post import bay_curve
     from femast.adam.steps import CONVERGENCE, add_initial_steps, add_measured_torsion, measured_style_path
@@ -231,7 +231,7 @@ def test_bay_out_of_library_drift_is_not_explained():
 
 
 # =============================================================================== tip-cycle, fast
-def test_tip_baseline_is_the_issue5_mast_under_the_table1_sequence():
+def test_tip_baseline_is_the_adam_mast_under_the_table1_sequence():
     from femast.adam import build_mast
     from femast.adam.post import ARCSEC, tip_table
     from femast.adam.steps import CONVERGENCE, add_initial_steps, add_table1_steps

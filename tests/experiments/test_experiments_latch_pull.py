@@ -1,15 +1,15 @@
-"""latch-pull experiment (seed 001 latch law, Eqs. 12-14): compare and diagnose on data with hidden effects."""
+"""latch-pull experiment (Stohlman & Pellegrino's latch law, Eqs. 12-14): compare and diagnose on data with hidden effects."""
 
 import numpy as np
 import pytest
 
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.experiments import AT_NOISE, compare, diagnose, from_arrays, get_experiment, predict, run_model
 from femast.experiments.rigs.synthetic import latch_pull_data
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
 
 EXP = get_experiment("latch-pull")
 N_SIGMA = 4.0  # identified parameters within 4 Jacobian standard errors (two-sided p ~ 6e-5 per parameter)
-REFIT_TOL = 1.2  # issue 7: the refit error is within 1.2x the noise
+REFIT_TOL = 1.2  # the refit error is within 1.2x the noise
 SEED_FIT = {"r": 1.1e-3, "x_backstop": 2.0e-3, "k": 1e5, "mu": 0.07}
 OTHER = {"r": 1.3e-3, "x_backstop": 1.8e-3, "k": 8e4, "mu": 0.1}  # a stiffer-friction, shorter latch
 
@@ -90,7 +90,7 @@ def test_null_case_nothing_is_missing(base, seed):
     assert d.verdict["missing_effect"] is None and d.verdict["explained"] is True
     assert not any(e["significant"] for e in d.ranking)
     fit = d.baseline_fit
-    for name, value in base.items():  # the baseline fit recovers the latch (seed 001 Sec. III.C)
+    for name, value in base.items():  # the baseline fit recovers the latch (Stohlman & Pellegrino, Sec. III.C)
         i = fit.names.index(name)
         assert abs(fit.x[i] - value) <= N_SIGMA * fit.stderr[i], (name, fit.x[i], fit.stderr[i], value)
 

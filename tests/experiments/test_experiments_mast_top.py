@@ -1,4 +1,4 @@
-"""mast-top experiment (seed 000, 3R model): compare and diagnose on data with hidden effects.
+"""mast-top experiment (the Rocaspect paper's 3R model): compare and diagnose on data with hidden effects.
 
 Each case hides one effect the baseline lacks in synthetic data (varied load paths, noise levels,
 joint stiffnesses and effect sizes) and checks that compare localises the failure, diagnose ranks
@@ -15,7 +15,7 @@ from femast.guyed.mast_3r import displacement_3r
 EXP = get_experiment("mast-top")
 N_SIGMA = 4.0  # identified parameters within 4 Jacobian standard errors (two-sided p ~ 6e-5 per parameter)
 REL_TOL = 0.10  # ... and within 10 %: every hidden effect below is several times the noise, so it is resolved
-REFIT_TOL = 1.2  # issue 7: the refit error is within 1.2x the noise
+REFIT_TOL = 1.2  # the refit error is within 1.2x the noise
 LOCAL_FACTOR = 1.5  # the worst segment's noise-free misfit is at least 1.5x its path average (1.7-3.7 seen)
 
 
@@ -35,7 +35,7 @@ CASES = [
     ("cable_hysteresis", {"eta": 0.06}, "cycles", 0.0, 4e-5, (2.6e5, 2.5e5), 4),
     ("progressive_stiffness", {"beta": 8e-4}, "ramps", 0.0, 5e-5, (2.0e5, 2.5e5), 5),
     ("pretension_loss", {"lam": 0.15}, "cycles", 0.0, 6e-5, (2.7e5, 2.3e5), 6),
-    ("beam_flexibility", {"E": 7e10}, "rotating", 250.0, 3e-5, (5.1e4, 5.3e4), 7),  # seed 000 test 5 (slack)
+    ("beam_flexibility", {"E": 7e10}, "rotating", 250.0, 3e-5, (5.1e4, 5.3e4), 7),  # Rocaspect test 5 (slack)
 ]
 
 
@@ -119,7 +119,7 @@ def test_two_hidden_effects_are_found_one_after_the_other():
         path=mast_top_path(kind="cycles", seed=41),
         seed=41,
     )
-    d1 = diagnose(EXP, data, workers=1)  # issue 14: the pair is fitted jointly and named at once
+    d1 = diagnose(EXP, data, workers=1)  # the pair is fitted jointly and named at once
     assert d1.verdict["kind"] == "missing_pair" and d1.verdict["best_candidate"] == "joint_clearance"
     assert sorted(d1.verdict["missing_effects"]) == ["friction_hysteresis", "joint_clearance"]
     d2 = diagnose(EXP, data, base_effects=["joint_clearance"], workers=1)

@@ -1,4 +1,4 @@
-"""The platform-pose experiment (issue 19 item 4): baselines, mast-top effects, bad input."""
+"""The platform-pose experiment: baselines, mast-top effects, bad input."""
 
 import numpy as np
 import pytest

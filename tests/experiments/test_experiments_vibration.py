@@ -1,4 +1,4 @@
-"""The ``vibration`` experiment (issue 18): data, baseline against the closed form, effects,
+"""The ``vibration`` experiment: data, baseline against the closed form, effects,
 and diagnose on the shipped example (hidden pretension loss, generator independent of femast)."""
 
 import math
@@ -13,7 +13,7 @@ from femast.effects import get_effect
 from femast.errors import ModelError
 from femast.experiments import diagnose, from_arrays, get_experiment, predict, read_data
 
-EXAMPLE = femast.examples.path("vibration_example.csv")  # package data (issue 17)
+EXAMPLE = femast.examples.path("vibration_example.csv")  # package data
 
 
 def _closed_form(T, m_unit):

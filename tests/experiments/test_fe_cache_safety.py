@@ -1,4 +1,4 @@
-"""Issue 16, item 6: the FE run cache stores data, never code; a corrupt or foreign entry is a miss."""
+"""The FE run cache stores data, never code; a corrupt or foreign entry is a miss."""
 
 import pickle
 import shutil

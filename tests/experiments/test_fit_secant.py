@@ -1,4 +1,4 @@
-"""Fits of finite-difference experiments with fewer model runs (issue 21, item 6): Broyden secant
+"""Fits of finite-difference experiments with fewer model runs: Broyden secant
 Jacobians between finite-difference ones, a finite-difference Jacobian at the solution, and start
 Jacobians seeded from an earlier fit.  An analytic model stands in for an FE run; its data come
 from numpy with Gaussian noise (no femast code generates them)."""
@@ -50,7 +50,7 @@ def _data(seed=3, with_c=False):
 
 
 def _fd_only(monkeypatch):
-    """Every Jacobian by finite differences (the behaviour before issue 21)."""
+    """Every Jacobian by finite differences (the behaviour before secant updates)."""
     orig = fitting._FEJacobian.__init__
 
     def init(self, fun, step, lo, hi, secant=True, J0=None):

@@ -1,4 +1,4 @@
-"""The independent data generator of the diagnose generalisation benchmark (issue 14, item 4).
+"""The independent data generator of the diagnose generalisation benchmark.
 
 Its physics is checked against closed forms (not against femast's effects, which it must not
 share code or functional form with); the two rigs' baselines are cross-checked against femast's
@@ -170,7 +170,7 @@ def test_mast_rig_matches_the_3r_jacobian():
 
 
 def test_latch_rig_matches_the_seed_law():
-    from femast.latch import LATCHING, UNLATCHING, latch_force
+    from femast.elements.latch_law import LATCHING, UNLATCHING, latch_force
 
     p = np.array([LATCH[k] for k in ("r", "xb", "k", "mu", "h", "R")])
     x = np.linspace(-2e-3, 4e-3, 301)
@@ -260,7 +260,7 @@ def test_verdict_adapter_reads_old_and_new_reports():
     assert is_right("null", (), read_verdict(null)) and not is_right("null", (), read_verdict(none))
 
 
-def test_verdict_adapter_reads_the_issue14_kinds():
+def test_verdict_adapter_reads_the_verdict_kinds():
     pair = {
         "verdict": {
             "kind": "missing_pair",

@@ -14,24 +14,6 @@ from process_tree import assert_session_ends, session_processes
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to find the processes")
 
 
-def _experiments_fork() -> bool:
-    """The fits and refits still fork their own children (fe_jacobian's forked columns, the figure
-    process, refits' fork/forkserver pool) instead of running on femast.workers.Pool."""
-    import importlib.util
-
-    from femast.experiments import fe_jacobian
-
-    return (
-        hasattr(fe_jacobian, "FORK_COLUMNS")
-        or importlib.util.find_spec("femast.experiments.figure_process") is not None
-    )
-
-
-# Known to leave processes behind while the experiments fork (a forked child or a pool worker blocked
-# on a pipe that a forked sibling keeps open); a real assertion as soon as they use femast.workers.
-_FORKS = pytest.mark.xfail(_experiments_fork(), reason="experiments still fork their own children", strict=False)
-
-
 def _kill_after(tmp_path, args, seconds, workers_seen=0):
     """Start ``femast ARGS`` in its own session; SIGKILL it ``seconds`` after it started (or, with
     ``workers_seen``, that long after it first had that many processes besides itself); then no
@@ -65,7 +47,6 @@ def _kill_after(tmp_path, args, seconds, workers_seen=0):
     return most
 
 
-@_FORKS
 def test_diagnose_on_two_workers_killed_while_its_refits_run(tmp_path):
     most = _kill_after(tmp_path, ["diagnose", "bay-torsion", "example", "--workers", "2"], 2.0, workers_seen=2)
     assert most <= 1 + 2 + 2  # never more workers than asked (a resource tracker and such aside)
@@ -76,7 +57,6 @@ def test_compare_with_a_fit_killed_early_or_during_its_fit(tmp_path, seconds):
     _kill_after(tmp_path, ["compare", "tip-cycle", "example", "--fit"], seconds)
 
 
-@_FORKS
 @pytest.mark.slow
 @pytest.mark.parametrize("example", ["platform-pose", "mast-top", "tip-cycle"])
 @pytest.mark.parametrize("seconds", [1.0, 5.0, 15.0])

@@ -1,4 +1,4 @@
-"""latch-pull: the loaded side is a property of the test pass (seed 001 Sec. III.B, issue 22).
+"""latch-pull: the loaded side is a property of the test pass (Stohlman & Pellegrino, Sec. III.B).
 
 Data come from ``benchmarks/latch_rig.py``, a quasi-static simulation of the pull-test rig written
 from the seed's equations in angle form (Eqs. 7-11) with its own stick/slip search; it does not
@@ -12,22 +12,22 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.errors import DataFileError
 from femast.experiments import AT_NOISE, compare, diagnose, from_arrays, get_experiment, predict, read_data
 from femast.experiments.rigs.latch_pull import infer_side
 from femast.experiments.rigs.synthetic import latch_pull_data
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, latch_force
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 from latch_rig import SeedLatch, paths, simulate, to_columns  # noqa: E402
 
 EXP = get_experiment("latch-pull")
-TRUE = {"r": 1.1e-3, "x_backstop": 2.0e-3, "k": 1e5, "mu": 0.07}  # seed 001 Sec. III.C
+TRUE = {"r": 1.1e-3, "x_backstop": 2.0e-3, "k": 1e5, "mu": 0.07}  # Stohlman & Pellegrino, Sec. III.C
 LATCH = SeedLatch()
 PATHS = paths(LATCH)
 NOISE_N, NOISE_MM = 0.5, 0.002  # load cell 0.5 N; 2 um position (x noise through slopes <= 0.3 N)
-NULL_TOL = 1.1  # issue 22: a null case sits at the noise floor, RMS <= 1.1x the measurement noise
+NULL_TOL = 1.1  # a null case sits at the noise floor, RMS <= 1.1x the measurement noise
 
 
 def _run(name):
@@ -85,7 +85,7 @@ def test_inferred_side_gives_the_same_model(name):
 
 
 def test_unlatching_reversed_in_zone_b_follows_the_latching_branch():
-    # issue 22's example: the outer cable stays loaded; moving back in, the rollers pull the bead and
+    # the reversal example: the outer cable stays loaded; moving back in, the rollers pull the bead and
     # the taut outer cable holds it: dT = dT_in(x) > 0 (26 N at -0.8 mm), not 0
     run, cols, data = _data("partial unlatching, zone (b)")
     pred = predict(EXP, data, TRUE)["dT_N"]
@@ -125,7 +125,7 @@ def test_slack_cable_is_zero_force_and_the_bead_stays():
 
 def test_full_strokes_unchanged_from_the_direction_rule():
     # full strokes: the loaded side and the direction of motion agree, so the model equals the rule
-    # used before issue 22 (branch of the direction of motion, clipped to the sign of that direction)
+    # of the direction of motion (branch of the direction of motion, clipped to the sign of that direction)
     for data in (latch_pull_data(TRUE, seed=7)[0], _data("full strokes", side=False)[2]):
         pred = predict(EXP, data, TRUE)["dT_N"]
         old = _direction_rule(data, TRUE)
@@ -141,7 +141,7 @@ def test_full_strokes_unchanged_from_the_direction_rule():
 
 
 def _direction_rule(data, params):
-    """The latch-pull model before issue 22 (clipping by the direction of motion), for the test above."""
+    """The latch-pull model of the direction of motion (clipping by the direction of motion), for the test above."""
     from femast.experiments.core import prepared
     from femast.experiments.rigs.latch_pull import _prepare
 
@@ -187,7 +187,7 @@ def test_side_column_words_and_errors(tmp_path):
     bad.write_text("x_mm,dT_N,side\n" + "0.1,1.0,out\n" * 12 + "0.1,1.0,up\n")
     with pytest.raises(DataFileError, match="side.*'up'.*out, in"):
         read_data(EXP, bad)
-    # (dT_N varies: a constant measured channel is refused by read_data, issue 16)
+    # (dT_N varies: a constant measured channel is refused by read_data)
     bad.write_text("x_mm,dT_N,side\n" + "".join(f"0.1,{1.0 + 0.1 * i:.1f},1\n" for i in range(12)) + "0.1,1.0,0.5\n")
     with pytest.raises(DataFileError, match="line 14, column 'side'.*out.*in"):
         predict(EXP, read_data(EXP, bad), TRUE)
@@ -221,7 +221,7 @@ def test_partial_reversal_matches_an_fe_run_of_one_cable_latch_element():
 
 def test_correlated_noise_out_of_contact_does_not_turn_the_side():
     # AR(1) load-cell noise (phi = 0.6): its second differences see a third of its variance, so its
-    # excursions out of roller contact passed "5 noise" and turned the side in mid-pass (issue 14)
+    # excursions out of roller contact passed "5 noise" and turned the side in mid-pass
     run, cols, _ = _data("full strokes")
     rng = np.random.default_rng(3)
     n = cols["dT_N"].size

@@ -1,4 +1,4 @@
-"""CDPR statics of seed 000 (Eqs. 1-3, 7): wrench matrix, tension distribution, mast-top wrenches."""
+"""CDPR statics of the Rocaspect paper (Eqs. 1-3, 7): wrench matrix, tension distribution, mast-top wrenches."""
 
 import numpy as np
 import pytest

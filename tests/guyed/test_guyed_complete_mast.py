@@ -1,4 +1,4 @@
-"""Dyneema law (Eq. 25) and the complete mast: passive / active shroud stiffness (Eqs. 16-26) of seed 000."""
+"""Dyneema law (Eq. 25) and the complete mast: passive / active shroud stiffness (Eqs. 16-26) of the Rocaspect paper."""
 
 import numpy as np
 import pytest

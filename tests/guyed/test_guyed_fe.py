@@ -1,5 +1,5 @@
-"""Seed 000 in the FE core: the Dyneema shroud cable family and the FE mast checked term by term
-against the analytic complete-mast model (issue 6, item 3)."""
+"""The Rocaspect mast in the FE core: the Dyneema shroud cable family and the FE mast checked term by term
+against the analytic complete-mast model."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""Identification (seed 000, Eqs. 27-30): recovery of known parameters from synthetic noisy data."""
+"""Identification (the Rocaspect paper, Eqs. 27-30): recovery of known parameters from synthetic noisy data."""
 
 import numpy as np
 import pytest

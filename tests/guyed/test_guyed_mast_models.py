@@ -1,4 +1,4 @@
-"""3R model (Eqs. 4-7, Eq. 6 sign) and cantilever beam model (Eqs. 8-15, Eq. 10, Eq. 30) of seed 000."""
+"""3R model (Eqs. 4-7, Eq. 6 sign) and cantilever beam model (Eqs. 8-15, Eq. 10, Eq. 30) of the Rocaspect paper."""
 
 import numpy as np
 import pytest

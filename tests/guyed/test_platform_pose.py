@@ -1,4 +1,4 @@
-"""CDPR platform pose on compliant masts (femast.guyed.platform_pose; issue 19 item 3, seed 000 Fig. 7)."""
+"""CDPR platform pose on compliant masts (femast.guyed.platform_pose; the Rocaspect paper, Fig. 7)."""
 
 import math
 

@@ -1,4 +1,4 @@
-"""The ``frequency`` step of model scripts (issue 18)."""
+"""The ``frequency`` step of model scripts."""
 
 import math
 

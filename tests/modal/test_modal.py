@@ -1,4 +1,4 @@
-"""Mass matrices and prestressed modal analysis (issue 18) against closed forms, invariances and
+"""Mass matrices and prestressed modal analysis against closed forms, invariances and
 bad input."""
 
 import math

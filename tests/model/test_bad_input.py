@@ -1,4 +1,4 @@
-"""Issue 2, item 9: bad input gets a clear femast error naming the item."""
+"""Bad input gets a clear femast error naming the item."""
 
 import math
 import tempfile

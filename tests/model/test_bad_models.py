@@ -1,4 +1,4 @@
-"""Issue 16, item 7: a battery of bad models, built and run through the API as a new user or an
+"""A battery of bad models, built and run through the API as a new user or an
 adversary would.  Each must raise the named femast error whose message names the offending item
 (node, DOF, element, step, property), never a raw numpy/Python exception, a NaN or silence."""
 

@@ -1,4 +1,4 @@
-"""Issue 3, item 1: rigid bodies and ties, exact for large rotations."""
+"""Rigid bodies and ties, exact for large rotations."""
 
 import tempfile
 

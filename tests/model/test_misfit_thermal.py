@@ -1,4 +1,4 @@
-"""Length errors (lack of fit) and thermal strain (issue 20, item 1) against closed forms."""
+"""Length errors (lack of fit) and thermal strain against closed forms."""
 
 import numpy as np
 import pytest
@@ -271,7 +271,7 @@ def test_bad_inputs_name_the_item_and_the_unit():
 
 
 def test_thermal_step_under_arc_length_is_refused():
-    from femast.analysis.solvers.arclength import ArcLength
+    from femast.analysis.control.arclength import ArcLength
 
     m = fm.Model("arc")
     n1, n2 = m.node(0, 0, 0), m.node(1, 0, 0)

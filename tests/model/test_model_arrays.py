@@ -1,4 +1,4 @@
-"""Model.beams / Model.trusses / Model.nodes from arrays (issue 21, item 4): the same model and the
+"""Model.beams / Model.trusses / Model.nodes from arrays: the same model and the
 same solution, bit for bit, as the per-element builders; bad input named by element."""
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Issue 16, item 7: property-based random models (hypothesis).  Every random model either
+"""Property-based random models (hypothesis).  Every random model either
 solves with the reactions balancing the applied loads (checked here from the frames, independently
 of the analysis' own check) and finite results, or stops with a femast error: never a raw
 exception, a NaN or a hang.  200 examples in the default suite, 1000 in the slow one."""

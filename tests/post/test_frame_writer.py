@@ -1,4 +1,4 @@
-"""Frames written as a zip built in memory (issue 21, item 3): the same members, dtypes, shapes and
+"""Frames written as a zip built in memory: the same members, dtypes, shapes and
 values as np.savez, a valid zip, and np.savez's own path for what it cannot write."""
 
 import io

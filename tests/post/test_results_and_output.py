@@ -1,4 +1,4 @@
-"""Issue 2, item 7: results on disk, histories, VTK series, PNG rendering and the CLI."""
+"""Results on disk, histories, VTK series, PNG rendering and the CLI."""
 
 import io
 import json

@@ -1,4 +1,4 @@
-"""Issue 16, item 2: results folders that never lie (atomic files, partial files ignored with a
+"""Results folders that never lie (atomic files, partial files ignored with a
 warning, a summary that says "completed" only after the last increment), and a kill-and-read test."""
 
 import json

@@ -1,4 +1,4 @@
-"""femast.studies (issue 20): distributions, sampling, the Sobol' estimators against closed forms,
+"""femast.studies: distributions, sampling, the Sobol' estimators against closed forms,
 percentile intervals' coverage, the store (resume, failures), runners (serial, local processes),
 femast model outputs against the cantilever closed form, and bad input before any sample runs."""
 
@@ -228,7 +228,7 @@ def test_model_outputs_match_the_cantilever_closed_form(tmp_path):
     assert np.allclose(-w[:, 0], F * L_M**3 / (3 * E * I), rtol=2e-3)
     assert np.allclose(rot, F * L_M**2 / (2 * E * I), rtol=2e-3)
     # unloaded: back to zero (elastic), to the correction tolerance (disp_tol 1e-6 of the unload
-    # increment, the loaded deflection: since issue 21 an increment may be accepted on its predicted
+    # increment, the loaded deflection: an increment may be accepted on its predicted
     # next correction, ~1e-7 of it here, without the extra iteration that went to round-off)
     assert np.all(np.abs(w[:, 1]) <= 1e-6 * np.abs(w[:, 0]))
 
@@ -657,8 +657,8 @@ def test_samples_over_the_timeout_are_recorded_failed(tmp_path, workers):
     slow = t["x"] > 0.8
     n_slow = int(np.sum(slow))
     assert n_slow > 0 and s.failed == n_slow and s.ok == 20 - n_slow
+    # the slow samples were cut short by the time-out (a sample that ran its 5 s would have succeeded)
     assert all("SampleTimeout: the sample ran over timeout_s = 0.3 s" in r for _, r in res.failures())
-    assert np.all(t["seconds"][slow] < 5.0)  # the slow samples were stopped before their 5 s sleep ended
     with pytest.raises(StudyError, match="timeout_s"):
         st.Study(run=_sometimes_slow, inputs=[st.Uniform("x", 0.0, 1.0)], outputs=["y"], timeout_s=0)
 
@@ -677,30 +677,28 @@ def _slow_cantilever(F):
     return m
 
 
-def test_deadline_stops_an_analysis_in_a_thread_and_costs_nothing_without_one():
+def test_deadline_stops_an_analysis_in_a_thread():
     import threading
-    import time
 
     from femast.analysis.deadline import check, deadline, remaining
     from femast.errors import SampleTimeout
 
     out = {}
+    an = fm.Analysis(_slow_cantilever(1.5), None, progress=False, on_frame=lambda fr: None)
 
     def job():
-        t0 = time.perf_counter()
         try:
             with deadline(0.3, "stopped: over 0.3 s"):
-                fm.Analysis(_slow_cantilever(1.5), None, progress=False, on_frame=lambda fr: None).run()
+                an.run()
         except SampleTimeout as exc:
             out["err"] = str(exc)
-        out["t"] = time.perf_counter() - t0
         out["after"] = remaining()
 
     th = threading.Thread(target=job)  # not the main thread: no SIGALRM could reach it
     th.start()
-    th.join(60)
+    th.join(600)
     assert out["err"] == "stopped: over 0.3 s"
-    assert out["t"] < 3.0  # stopped at an iteration after 0.3 s; unstopped: 10 000 increments, 6 s
+    assert 0 < an.summary.increments < 10_000  # stopped at an iteration, long before the step's end
     assert out["after"] is None  # the deadline ends with its block
     # nested: the earlier deadline holds
     with deadline(10.0):
@@ -709,18 +707,10 @@ def test_deadline_stops_an_analysis_in_a_thread_and_costs_nothing_without_one():
     with pytest.raises(fm.ModelError, match="must be > 0"):
         with deadline(0.0):
             pass
-    check()  # no deadline: nothing
-    n = 200_000
-    t0 = time.perf_counter()
-    for _ in range(n):
-        check()
-    per_call = (time.perf_counter() - t0) / n
-    assert per_call < 5e-6  # 0.1-0.2 us measured; an iteration of this 2-beam model takes ~300 us
+    check()  # no deadline: nothing (its cost per call: python benchmarks/deadline_check.py)
 
 
 def test_timeout_on_dask_thread_workers_records_the_slow_samples_failed(tmp_path):
-    import time
-
     distributed = pytest.importorskip("distributed")
     study = st.Study(
         model=_slow_cantilever,
@@ -730,7 +720,6 @@ def test_timeout_on_dask_thread_workers_records_the_slow_samples_failed(tmp_path
         seed=3,
         timeout_s=0.5,
     )
-    t0 = time.perf_counter()
     with (
         distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cl,
         distributed.Client(cl) as client,
@@ -739,8 +728,8 @@ def test_timeout_on_dask_thread_workers_records_the_slow_samples_failed(tmp_path
     res = st.load(tmp_path / "d")
     n_slow = int(np.sum(res.table(["F"])["F"] > 1.3))
     assert s.engine == "dask" and n_slow > 0 and s.failed == n_slow and s.ok == 12 - n_slow
+    # cut short by the time-out: unstopped, each slow sample would run its 10 000 increments and succeed
     assert all("SampleTimeout: the sample ran over timeout_s = 0.5 s" in r for _, r in res.failures())
-    assert time.perf_counter() - t0 < 60.0  # unstopped, each slow sample runs 10 000 increments
 
 
 # ------------------------------------------------------------------ correlation between the members of one input

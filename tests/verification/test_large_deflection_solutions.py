@@ -1,4 +1,4 @@
-"""Issue 2, item 8: the FE core against closed-form and published large-deflection solutions."""
+"""The FE core against closed-form and published large-deflection solutions."""
 
 import math
 

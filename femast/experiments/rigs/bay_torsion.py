@@ -170,7 +170,7 @@ def bay_inputs(params: dict, options: dict) -> dict:
 def bay_parameters(inputs: dict):
     """:class:`~femast.adam.BayParameters` from a ``bay_parameters`` hook dict (validated)."""
     from femast.adam.parameters import BayParameters
-    from femast.latch import LatchParameters
+    from femast.elements.latch_law import LatchParameters
 
     latch = LatchParameters(**{f: float(inputs[f"latch_{f}"]) for f in LATCH_FIELDS})
     rest = {k: v for k, v in inputs.items() if not k.startswith("latch_")}
@@ -269,7 +269,7 @@ def _latch_outputs(family, bead) -> dict:
     """``bead`` (m) and ``zone`` (Stohlman & Pellegrino, Fig. 6) of the latches at the driven rows from their committed
     bead positions (rows, elements), as the latch family's outputs ``bead_position`` and
     ``latch_zone`` give them (NaN and -1 for an element without a latch)."""
-    from femast.latch import latch_zone
+    from femast.elements.latch_law import latch_zone
 
     has = np.asarray(family.latch_node) > 0
     return {"bead": np.where(has, bead, np.nan), "zone": np.where(has, latch_zone(bead, family.latch), -1).astype(int)}

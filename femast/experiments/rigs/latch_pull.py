@@ -29,7 +29,7 @@ innermost after an inner-cable one).
 
 Baseline model
 --------------
-The latch law of Stohlman & Pellegrino, Eqs. 12-14 (:mod:`femast.latch`) with ``r``, ``x_backstop``, ``k``,
+The latch law of Stohlman & Pellegrino, Eqs. 12-14 (:mod:`femast.elements.latch_law`) with ``r``, ``x_backstop``, ``k``,
 ``mu`` fitted and ``h``, ``R`` options (measured; defaults 1.5 mm and 2.4 mm as in the paper).
 Each sample is compared with the nearest state the law allows along the path
 (:func:`admissible_band`):
@@ -73,9 +73,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force, latch_zone
 from femast.errors import DataFileError
 from femast.experiments import Column, Experiment, Measured, Parameter, noise_floor, prepared, turning_points
-from femast.latch import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force, latch_zone
 
 SIDE_OUT = 1  # the outer cable (section 2) is loaded: unlatching rig, dT = T2 >= 0
 SIDE_IN = -1  # the inner cable (section 1, through the backstop) is loaded: latching rig, dT = -T1 <= 0

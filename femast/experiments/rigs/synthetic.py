@@ -16,9 +16,9 @@ from __future__ import annotations
 import numpy as np
 
 from femast.effects import resolve
+from femast.elements.latch_law import LATCHING, UNLATCHING, latch_force
 from femast.errors import ModelError
 from femast.experiments import EffectStack, Measured, predict
-from femast.latch import LATCHING, UNLATCHING, latch_force
 
 
 def _stack(exp, effects):

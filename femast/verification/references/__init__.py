@@ -12,8 +12,8 @@ One module per subject, every name re-exported here: :mod:`.cantilever` (elastic
 linear compliance), :mod:`.bend45`, :mod:`.columns` (Euler columns, von Mises truss),
 :mod:`.planar` (Lee's frame, Williams' toggle).
 
-Contents (issue 2 and issue 3 verification cases)
--------------------------------------------------
+Contents (the verification cases of the FE core and its controls)
+-----------------------------------------------------------------
 * :func:`elastica_tip_load` -- cantilever under a transverse dead end load,
   exact elliptic-integral solution; :data:`MATTIASSON_1981` (published table).
 * :func:`pure_bending_tip`, :func:`pure_bending_shape` -- cantilever under an end

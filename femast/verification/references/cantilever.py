@@ -210,7 +210,7 @@ def cantilever_compliance(L: float, E: float, G: float, A: float, Iy: float, Iz:
     the beam about +z, M_z(x) = Fy (L - x), so the slope rz = uy' is positive;
     a tip force Fz gives M_y(x) = -Fz (L - x) (the moment vector of +Fz at a
     lever +x e_x points along -y), and ry = -uz', hence the negative
-    coupling terms in the x-z plane.  Same form as seed 000 Eq. 8 (which
+    coupling terms in the x-z plane.  Same form as the Rocaspect paper, Eq. 8 (which
     uses J there for the torsion constant; give the correct St Venant J).
     Source: e.g. Gere and Timoshenko, "Mechanics of Materials", cantilever
     tables; Przemieniecki (1968), "Theory of Matrix Structural Analysis".

@@ -1,0 +1,85 @@
+"""Module paths that moved, kept for one release as thin modules that warn.
+
+Each old path is a real file (``femast/sections.py``, ``femast/latch.py``,
+``femast/analysis/solvers/linear.py``, ...) of three lines: :func:`moved` warns with a
+:class:`DeprecationWarning` that names the new path and the release that removes the old one,
+then puts the new module in ``sys.modules`` under the old name, so the import returns the *same*
+module object (one class for ``isinstance``, numba's cache keyed on the one source file).  No
+import hook: IDEs, type checkers and ``python -m`` see ordinary files.  femast's own code, tests,
+benchmarks and docs import the new paths (``tests/test_architecture.py`` checks).
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import sys
+import warnings
+
+#: the femast release that removes the old paths
+REMOVED_IN = "0.3"
+
+#: old top-level module names, reachable as ``femast.<name>`` attributes until REMOVED_IN
+OLD_TOP_LEVEL = frozenset(
+    {
+        "amplitudes",
+        "sections",
+        "constraints",
+        "thermal",
+        "validation",
+        "model_arrays",
+        "assembly",
+        "dofs",
+        "reduction",
+        "configuration",
+        "solvers",
+        "mass",
+        "modal_output",
+        "frequency_step",
+        "results",
+        "vtk",
+        "render",
+        "plotstyle",
+        "verification_arclength",
+        "verification_modal",
+        "references",
+        "latch",
+    }
+)
+
+
+def moved(old: str, new: str, warn: bool = True):
+    """Make the module being imported as ``old`` the module ``new`` (warning first, unless not
+    ``warn``: a package whose submodules warn on their own)."""
+    if warn:
+        frame = _importer()
+        g = frame.f_globals if frame is not None else {}
+        warnings.warn_explicit(
+            f"{old} has moved to {new}: import it from there ({old} is removed in femast {REMOVED_IN})",
+            DeprecationWarning,
+            frame.f_code.co_filename if frame is not None else "<unknown>",
+            frame.f_lineno if frame is not None else 0,
+            module=g.get("__name__", "<unknown>"),
+            registry=g.setdefault("__warningregistry__", {}),
+        )
+    module = importlib.import_module(new)
+    sys.modules[old] = module  # what the import of ``old`` returns
+    return module
+
+
+def _importer():
+    """The frame of the code that imported the old path: the first frame outside the import
+    machinery, this module, the old-path module and femast's package ``__getattr__``."""
+    frame = inspect.currentframe()
+    while frame is not None:
+        name = frame.f_globals.get("__name__", "")
+        if not (
+            name == __name__
+            or name == "femast"
+            or name.startswith("importlib")
+            or frame.f_code.co_filename.startswith("<frozen importlib")
+            or frame.f_globals.get("moved") is moved
+        ):
+            return frame
+        frame = frame.f_back
+    return None

@@ -1,0 +1,5 @@
+"""Old path of :mod:`femast.post.results`: warns, and is removed in femast 0.3 (see femast/_moved.py)."""
+
+from femast._moved import moved
+
+moved(__name__, "femast.post.results")
