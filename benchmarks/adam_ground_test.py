@@ -59,7 +59,7 @@ def build(n_bays: int, gravity: bool):
     add_initial_steps(am)
     if gravity:
         am.model.step("weight", initial_increment=0.5).gravity(g=(0.0, 0.0, -G))
-    add_table1_steps(am, cycles=1)
+    add_table1_steps(am, cycles=1, increments=1)  # one increment per step, as the Table 1 reproduction
     return am
 
 

@@ -55,7 +55,7 @@ def bay_cycle(Fh: float, ell: float, theta_max_deg: float = 3.5, keep: Path | No
 def mast_cycles(Fh: float, ell: float, progress: bool, cycles: int = 3):
     am = build_mast(40, hysteresis_force=Fh, hysteresis_length=ell, seat="tied")
     add_initial_steps(am)
-    add_table1_steps(am, cycles=cycles)
+    add_table1_steps(am, cycles=cycles, increments=1)  # one increment per step, as the Table 1 reproduction
     with tempfile.TemporaryDirectory() as out:
         an = fm.Analysis(am.model, out, progress=progress, convergence=CONVERGENCE)
         res = an.run()

@@ -27,7 +27,7 @@ def make_factory(n_bays: int, cycles: int = 1):
         am = build_mast(n_bays, BayParameters().with_(mu=mu, pretension=pretension))
         am.model.length_error(longeron_labels(am.model), dL_longeron)
         add_initial_steps(am)
-        add_table1_steps(am, cycles=cycles)
+        add_table1_steps(am, cycles=cycles, increments=1)  # the throughput figures' runs: one increment per step
         return am.model
 
     return adam_mast

@@ -19,7 +19,16 @@ numba_cache.configure()  # a source checkout: numba's cache in a folder keyed by
 from .analysis import Analysis, solve
 from .analysis.control import ArcLength, DisplacementControl, LoadControl, Stabilize
 from .analysis.convergence import Convergence
-from .errors import ConvergenceError, DataFileError, EquilibriumError, FemastError, ModelError, SingularModelError
+from .errors import (
+    ConvergenceError,
+    DataFileError,
+    EquilibriumError,
+    FemastError,
+    FolderInUseError,
+    ModelError,
+    ResultsWriteError,
+    SingularModelError,
+)
 from .model import Model
 from .model.amplitudes import Amplitude
 from .model.sections import Section, circular_solid, circular_tube, shear_modulus, square_solid, square_tube
@@ -48,6 +57,8 @@ __all__ = [
     "ConvergenceError",
     "DataFileError",
     "EquilibriumError",
+    "FolderInUseError",
+    "ResultsWriteError",
 ]
 __version__ = "0.1.0"
 

@@ -28,12 +28,9 @@ def _run(args):
         del script_args[i : i + 2]
     if restart is not None:
         # the analyses of the script whose results folder is RESTART continue from its restart point
-        from .analysis.restart import ENV, RESTART_DIR
+        from .analysis.restart import ENV, require_point
 
-        if not (Path(restart) / RESTART_DIR / "restart.json").is_file():
-            raise FemastError(
-                f"{restart}: no restart point; run the analysis with restart_every=n to be able to restart it"
-            )
+        require_point(restart)  # (none there, or a link or FIFO in its place: named now, before the script runs)
         old = os.environ.get(ENV)
         os.environ[ENV] = str(restart)
     sys.argv = [str(script)] + script_args
@@ -109,10 +106,15 @@ def _info(args):
             f"cutbacks {s.get('cutbacks', 0)}, wall time {s.get('wall_time', 0.0):.2f} s"
         )
         for st in s.get("steps", []):
-            n, k = st["increments"], st["iterations"]
+            if "frequencies_hz" in st:
+                print(f"  step {st['name']}: modes at {', '.join(f'{f:.4g}' for f in st['frequencies_hz'])} Hz")
+                continue
+            n, k = st.get("increments", 0), st.get("iterations", 0)
             print(f"  step {st['name']}: {n} increment{'' if n == 1 else 's'}, {k} iteration{'' if k == 1 else 's'}")
         if s.get("message"):
             print(f"  {s['message']}")
+    else:
+        print("  status: unknown (no readable summary.json)")
 
 
 class _Intermixed(argparse.ArgumentParser):

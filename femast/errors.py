@@ -31,6 +31,12 @@ class DataFileError(FemastError, ValueError):
     """A measured-data file is malformed."""
 
 
+class NonFiniteError(FemastError, FloatingPointError):
+    """An element family returned NaN or infinite internal forces.  Inside an increment it is a failed
+    attempt (a cutback: a too-large increment can drive a law out of its range); anywhere else (the
+    initial state, the end of a run) it stops the run, naming the family and the element."""
+
+
 class EquilibriumError(FemastError):
     """A converged increment whose reactions do not balance the applied loads (a lost load)."""
 
@@ -48,6 +54,11 @@ class StudyError(FemastError, ValueError):
 class ResultsWriteError(FemastError, OSError):
     """A results folder could not be written (a full disk, a folder that became read-only): the
     run stops at the frame that could not be written and its summary says "failed"."""
+
+
+class FolderInUseError(FemastError):
+    """A results (or history) folder is being written by another femast run: two writers would mix
+    their frames, so the second is refused; the message names the folder and the other process."""
 
 
 class SampleTimeout(FemastError):

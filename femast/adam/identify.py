@@ -45,13 +45,17 @@ def tip_response(
     F: float = TABLE1_F,
     fold: int = 1,
     alternate: bool = True,
+    increments: int = 1,
 ) -> dict:
     """Tip (control node) displacement (m) and rotation (rad) of the pretensioned mast under a tip
-    moment M (N m, about z) and force F (N, along x), relative to the pretensioned state.
-    Returns dict with ``u`` (3,), ``theta`` (3,), ``iterations``, ``wall_time``."""
+    moment M (N m, about z) and force F (N, along x), applied in ``increments`` equal increments,
+    relative to the pretensioned state.  Returns dict with ``u`` (3,), ``theta`` (3,), ``iterations``,
+    ``wall_time``."""
     am = build_mast(n_bays, params, fold=fold, alternate=alternate)
     add_initial_steps(am)
-    am.model.step("M+F", initial_increment=1.0).load(am.control, mz=M, fx=F)
+    am.model.step("M+F", initial_increment=1.0 / increments, max_increment=1.0 / increments).load(
+        am.control, mz=M, fx=F
+    )
     t0 = time.perf_counter()
     row = am.model.index(am.control)
     rec = []  # (step, U, URA) of the control node per converged increment (no files written)
@@ -79,10 +83,12 @@ def fit_tip_response(
     n_bays: int = 40,
     bounds: dict | None = None,
     verbose: bool = False,
+    increments: int = 1,
     **ls_options,
 ) -> OptimizeResult:
     """Fit ``names`` (fields of :class:`BayParameters`) so that the tip response under M + F
-    matches ``targets`` (default Table 1: x = 1740 um, theta_z = 3030 arcsec).
+    matches ``targets`` (default Table 1: x = 1740 um, theta_z = 3030 arcsec), M + F applied in
+    ``increments`` increments (:func:`tip_response`).
 
     Returns a :class:`scipy.optimize.OptimizeResult` with ``x`` (fitted values, SI), ``names``,
     ``units``, ``params`` (the fitted :class:`BayParameters`), ``response`` (model x and theta_z
@@ -114,7 +120,7 @@ def fit_tip_response(
 
     def model(z):
         vals = dict(zip(names, np.exp(z)))
-        r = tip_response(p0.with_(**vals), n_bays=n_bays)
+        r = tip_response(p0.with_(**vals), n_bays=n_bays, increments=increments)
         history.append(
             {
                 "params": vals,

@@ -38,10 +38,9 @@ SCATTER = (
     ("member lengths", "cable_dL", "abs", 0.05e-3, "m"),
 )
 GROUPS = tuple(dict.fromkeys(g for g, *_ in SCATTER))
-#: The bay of the published study (docs/shape_accuracy.md): the paper's tied ball joints.  The
-#: study on seated joints (the physical default of BayParameters) is the next one; pass
-#: ``params=BayParameters()`` to run it.
-STUDY_PARAMS = BayParameters(seat="tied")
+#: The bay of the study (docs/shape_accuracy.md): femast.adam's defaults, seated ball joints (the
+#: physical default).  ``params=BayParameters(seat="tied")`` runs it on the paper's two-way tie.
+STUDY_PARAMS = BayParameters()
 
 
 def n_uniforms(n_bays: int) -> dict:
@@ -125,6 +124,7 @@ def tip_history(
     M: float = TABLE1_M,
     F: float = TABLE1_F,
     settle: bool = True,
+    increments: int = 1,
 ) -> dict:
     """Build the mast with per-element ``values`` (None: nominal), deploy (pretension step) and apply
     ``cycles`` Table 1 cycles (M+F, 0, -M-F, 0; M in N m about z, F in N along x).
@@ -135,6 +135,8 @@ def tip_history(
         penalties) holds the soft bending modes of a scattered mast back: a scattered 40-bay mast
         ends 1.4 mm short of its deployed lateral tip offset of 7.2 mm, and the load steps after it
         (no stabilisation) then carry that relaxation into the "load-cycle residual".
+    increments : increments per Table 1 step (the friction return is first order in the increment:
+        more increments, a closer path).
 
     Returns {"labels": step names, "u": (n_levels, 3) m, "theta": (n_levels, 3) rad, "iterations",
     "cutbacks", "cpu_s"}: level 0 is the deployed state (end of ``equilibrium``, or of ``pretension``
@@ -143,7 +145,7 @@ def tip_history(
     t0 = time.process_time()
     am = build_mast(n_bays, params or STUDY_PARAMS, scatter=None if values is None else as_scatter(values, n_bays))
     add_initial_steps(am, settle=settle)
-    add_table1_steps(am, cycles=cycles, M=M, F=F)
+    add_table1_steps(am, cycles=cycles, M=M, F=F, increments=increments)
     row = am.model.index(am.control)
     last = {}
 

@@ -25,15 +25,28 @@ from ..jit import prepare as prepare_kernels
 from ..model import validation
 from ..model.thermal import FieldLoads, check_controls, has_fields
 from ..post.results import Results, run_outcome
+from ..post.writer import lock_folder
 from .convergence import Convergence, validate
+from .equilibrium import check_end_of_run
 from .families import build_families
 from .newton import Newton
 from .output import ResultsOutput
-from .restart import RestartOutput, load_restart, restart_folder, restore
+from .restart import RestartOutput, load_restart, require_point, restart_folder, restore
 from .state import State
 from .stepping import run_step
 from .summary import AnalysisSummary
 from .system import System
+
+MIN_CUTBACK, MAX_CUTBACK = 1e-3, 0.9  # a factor of 1 (or NaN) never shrinks an increment: no end
+MAX_GROWTH = 10.0
+
+
+def _factor(value, name: str, lo: float, hi: float, why: str) -> float:
+    """``value`` as a finite float between ``lo`` and ``hi``, or a ModelError naming ``name`` and why."""
+    v = validation.number(value, f"Analysis: {name}")
+    if not lo <= v <= hi:
+        raise ModelError(f"Analysis: {name} = {v:g} must be between {lo:g} and {hi:g} ({why})")
+    return v
 
 
 class Analysis:
@@ -46,8 +59,10 @@ class Analysis:
     convergence : :class:`~femast.analysis.convergence.Convergence` (tolerances, max iterations), or a
         convergence test of your own (the contract: :mod:`femast.analysis.convergence`).
     progress : show a tqdm progress bar per step.
-    cutback : factor applied to a failed increment (Abaqus: 0.25).
-    growth : factor applied after two easy increments (Abaqus: 1.5).
+    cutback : factor applied to a failed increment (Abaqus: 0.25), between 0.001 and 0.9.
+    growth : factor applied after two easy increments (Abaqus: 1.5), between 1 (no growth) and 10.
+    max_cutbacks : the most cutbacks of one step (1000): a step cut back that often gives up with a
+        ConvergenceError saying where, whatever its minimum increment.
     line_search : secant line search when a Newton step overshoots (load control): True, False, or
         "auto" (default): only when retrying an increment that failed, where plain Newton
         already went astray (a line search slows the easy increments down).
@@ -97,6 +112,7 @@ class Analysis:
         restart=None,
         restart_every: int | None = None,
         linear_solver: str = "auto",
+        max_cutbacks: int = 1000,
     ):
         _check_model_argument(model, out)
         prepare_kernels()  # the first-run compile notice armed (femast.jit)
@@ -111,9 +127,25 @@ class Analysis:
             )
         self.convergence = Convergence() if convergence is None else validate(convergence)
         self.progress = progress
-        self.cutback = cutback
-        self.growth = growth
-        self.easy_iterations = easy_iterations
+        self.cutback = _factor(
+            cutback,
+            "cutback",
+            MIN_CUTBACK,
+            MAX_CUTBACK,
+            "a failed increment is retried this much smaller: 1 or more "
+            "never shrinks it, and the step would never end; Abaqus uses 0.25",
+        )
+        self.growth = _factor(
+            growth,
+            "growth",
+            1.0,
+            MAX_GROWTH,
+            "easy increments grow by this factor: below 1 every increment shrinks; Abaqus uses 1.5",
+        )
+        self.easy_iterations = validation.whole(easy_iterations, "Analysis: easy_iterations", minimum=1)
+        self.max_cutbacks = validation.whole(max_cutbacks, "Analysis: max_cutbacks", minimum=1)
+        if line_search not in (True, False, "auto"):
+            raise ModelError(f'Analysis: line_search = {line_search!r}; give True, False or "auto"')
         self.line_search = line_search
         self.extrapolate = extrapolate
         self.algorithm = Newton(self.convergence, line_search=line_search, tangent=tangent)
@@ -242,8 +274,14 @@ class Analysis:
         """Run all steps; returns the :class:`Results` of the folder, or None with ``out=None``."""
         t0 = _time.perf_counter()
         ti = None
+        self.folder_lock = None
+        self.output.writer = None  # (a run refused its folder writes no summary there, not even an earlier run's)
         try:
             first = 0
+            if self.out is not None:  # one writer per folder, taken before a restart point is read
+                if self.restart is not None:
+                    require_point(self.restart)  # (no folder is made for a restart that has nothing to read)
+                self.folder_lock = lock_folder(self.out)
             if self.restart is not None:
                 self.resume = load_restart(self.restart, self)  # None: the point is the start
                 if self.resume is not None:
@@ -262,6 +300,7 @@ class Analysis:
                 else:
                     inside = self.resume is not None and k == self.resume["step"] and not self.resume["step_done"]
                     run_step(self, step, resume=self.resume if inside else None)
+            check_end_of_run(self)  # no result without equilibrium (equilibrium.py)
             self.summary.status, self.summary.completed = "completed", True
         except BaseException as exc:  # the summary says how the run ended, then the error goes on
             self.summary.status, self.summary.message = run_outcome(exc)
@@ -272,8 +311,12 @@ class Analysis:
         finally:
             self.summary.increment_time = _time.perf_counter() - ti if ti is not None else 0.0
             self.summary.wall_time = _time.perf_counter() - t0
-            for obs in self.observers:
-                obs.finished(self)
+            try:
+                for obs in self.observers:
+                    obs.finished(self)
+            finally:
+                if self.folder_lock is not None:
+                    self.folder_lock.release()
             if self.progress:
                 tqdm.write(str(self.summary))
         return None if self.out is None else Results(self.out)

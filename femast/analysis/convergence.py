@@ -65,12 +65,14 @@ femast's, and the predicted-correction acceptance (which needs femast's measures
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
 from ..errors import ModelError
+from ..model import validation
 
 
 @njit(cache=True)
@@ -137,6 +139,10 @@ def scaled_size(v, Dv, is_rot, length):
     return s
 
 
+MIN_TOL = 1e-15  # a relative tolerance below round-off can never be met
+MAX_TOL = 1e-2  # above 1 % of the force scale a "converged" increment is not in equilibrium
+
+
 @dataclass
 class Convergence:
     """force_tol, disp_tol : relative tolerances (dimensionless); max_iterations per attempt;
@@ -154,6 +160,22 @@ class Convergence:
     max_contraction: float = 0.5
 
     def __post_init__(self):
+        self.validate()
+
+    def validate(self) -> None:
+        """Every field a number in its range, or a ModelError naming it (also called by the analysis,
+        for fields changed after construction): a tolerance is a finite relative tolerance between
+        :data:`MIN_TOL` (round-off) and :data:`MAX_TOL` (1 %); ``max_iterations`` a whole number >= 1."""
+        for name in ("force_tol", "disp_tol", "linear_tol"):
+            v = getattr(self, name)
+            real = isinstance(v, numbers.Real) and not isinstance(v, bool)
+            if not (real and MIN_TOL <= v <= MAX_TOL):  # (NaN: no)
+                shown = f"{v:g}" if real else repr(v)
+                raise ModelError(
+                    f"Convergence: {name} = {shown} is not a tolerance; give a relative tolerance between "
+                    f"{MIN_TOL:g} and {MAX_TOL:g} (default {getattr(Convergence, name):g})"
+                )
+        self.max_iterations = validation.whole(self.max_iterations, "Convergence: max_iterations", minimum=1)
         try:
             ok = 0.0 < float(self.max_contraction) < 1.0  # (NaN: no)
         except (TypeError, ValueError):  # not a number
@@ -247,4 +269,6 @@ def validate(test):
     n = getattr(test, "max_iterations", None)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise ModelError(f"convergence={name}: max_iterations={n!r} must be a whole number >= 1")
+    if isinstance(test, Convergence):
+        test.validate()  # (its tolerances may have been changed after construction)
     return test

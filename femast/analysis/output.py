@@ -23,8 +23,9 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from ..post import folder as folder_files  # noqa: F401 (the folder's file rules, for the restart observer)
 from ..post.frame_coder import SCALARS, FrameCoder
-from ..post.results import NullWriter, ResultsWriter
+from ..post.writer import NullWriter, ResultsWriter
 from ..rotations import rotation_vectors
 
 
@@ -69,7 +70,11 @@ class ResultsOutput(Observer):
             NullWriter()
             if self.out is None
             else ResultsWriter(
-                self.out, analysis.model, analysis.families, resume=None if resume is None else resume["frames"]
+                self.out,
+                analysis.model,
+                analysis.families,
+                resume=None if resume is None else resume["frames"],
+                lock=getattr(analysis, "folder_lock", None),
             )
         )
         self.pending = None

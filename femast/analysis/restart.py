@@ -27,30 +27,24 @@ ordering may otherwise be analysed from another pattern and move the results at 
 
 from __future__ import annotations
 
+import io
 import json
 import os
+import re
+import stat
 from dataclasses import fields
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import FemastError
-from .output import Observer
+from .output import Observer, folder_files
+from .restart_check import FORMAT, check_arrays, check_point
 from .state import State
 
 RESTART_DIR = "restart"
-FORMAT = "femast-restart-1"
 ENV = "FEMAST_RESTART"
-
-
-def write_json_atomic(path: Path, data: dict) -> None:
-    """JSON to ``path`` through a temporary file renamed into place (flushed to disk first)."""
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w") as fh:
-        json.dump(data, fh, indent=1)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+_OWN = re.compile(r"^(?:(?:state|extra)-[1-9]\d{0,17}\.npz|restart\.json)(?:\.tmp)?$")  # the files it writes
 
 
 def restart_folder(out, restart):
@@ -76,25 +70,24 @@ class RestartOutput(Observer):
     def started(self, analysis):
         if analysis.out is None:
             raise FemastError("restart_every needs a results folder (out=None writes nothing to restart from)")
-        self.folder = Path(analysis.out) / RESTART_DIR
+        self.writer = analysis.output.writer  # every file of the results folder goes through it
+        self.folder = folder_files.own_dir(analysis.out, RESTART_DIR)  # (a link there is refused)
         resume = analysis.resume
-        if resume is None:  # a fresh run: an earlier run's restart point is stale
-            if self.folder.is_dir():
-                for f in self.folder.iterdir():
-                    f.unlink()
+        if resume is None:  # a fresh run: an earlier run's restart point is stale (only its files go)
+            for f in sorted(self.folder.iterdir()):
+                if _OWN.match(f.name):
+                    folder_files.remove_own(f)
             st = analysis.state
             self.step_start = (st.loads.copy(), st.prescribed.copy())
-            self.folder.mkdir(parents=True, exist_ok=True)
             # the start is a restart point too: a run killed before its first save starts over
-            write_json_atomic(self.folder / "restart.json", {"format": FORMAT, "initial": True, **_model_id(analysis)})
+            self._write_json({"format": FORMAT, "initial": True, **_model_id(analysis)})
         else:
             self.saves = resume["saves"]
             self.step_start = resume["step_start"]
             if self.every is None:
-                self.every = int(resume.get("every", 1))
+                self.every = resume["every"]
         if self.every is None:
             self.every = 1
-        self.folder.mkdir(parents=True, exist_ok=True)
 
     def converged(self, analysis, step, increment, attempt, iterations, time, dtime, last, responses, note):
         if last or increment % self.every == 0:
@@ -103,21 +96,23 @@ class RestartOutput(Observer):
             st = analysis.state
             self.step_start = (st.loads.copy(), st.prescribed.copy())
 
+    def _write_json(self, info: dict):
+        self.writer.write_file(self.folder / "restart.json", json.dumps(info, indent=1).encode(), sync=True)
+
     def save(self, analysis, step_done: bool):
         an, st, summary = analysis, analysis.state, analysis.summary
         an.output.flush()  # every frame up to here on disk (fsync'd) before the restart point names them
         self.saves += 1
         k = self.saves
         state_file, extra_file = f"state-{k}.npz", f"extra-{k}.npz"
-        tmp = self.folder / (state_file + ".tmp")
-        st.save(tmp)
-        os.replace(tmp, self.folder / state_file)
-        tmp = self.folder / (extra_file + ".tmp")
+        buf = io.BytesIO()
+        st.save(buf)
+        self.writer.write_file(self.folder / state_file, buf.getvalue(), sync=True)
         reuse = an.algorithm.reuse_configuration()  # the factorisation the next increment reuses
         extra = {} if reuse is None else {"reuse_x": reuse[0], "reuse_R": reuse[1]}
-        with open(tmp, "wb") as fh:
-            np.savez(fh, load_start=self.step_start[0], pres_start=self.step_start[1], **extra)
-        os.replace(tmp, self.folder / extra_file)
+        buf = io.BytesIO()
+        np.savez(buf, load_start=self.step_start[0], pres_start=self.step_start[1], **extra)
+        self.writer.write_file(self.folder / extra_file, buf.getvalue(), sync=True)
         done_iters = sum(s["iterations"] for s in summary.steps)
         zf = an.system.zero_force
         info = {
@@ -142,62 +137,65 @@ class RestartOutput(Observer):
                 "step_iterations": summary.iterations - done_iters,
             },
         }
-        write_json_atomic(self.folder / "restart.json", info)
-        for f in self.folder.glob("*-*.npz"):  # the previous restart point's files
-            if f.name not in (state_file, extra_file):
-                f.unlink(missing_ok=True)
+        self._write_json(info)
+        for f in sorted(self.folder.iterdir()):  # the previous restart point's files
+            if _OWN.match(f.name) and f.name.endswith(".npz") and f.name not in (state_file, extra_file):
+                folder_files.remove_own(f)
 
 
 def _model_id(analysis) -> dict:
     return {"n_nodes": int(len(analysis.system.X0)), "steps": [s.name for s in analysis.model.steps]}
 
 
-def load_restart(folder, analysis) -> dict | None:
-    """Read the restart point of results folder ``folder`` for ``analysis`` (same model): a dict
-    with the State and what the run needs to go on, or None when the point is the run's start (the
-    run starts over); a FemastError naming the folder otherwise."""
-    folder = Path(folder)
-    rdir = folder / RESTART_DIR
-    jfile = rdir / "restart.json"
-    if not jfile.is_file():
+def require_point(folder) -> Path:
+    """The restart.json of results folder ``folder``, or a FemastError saying there is none."""
+    jfile = Path(folder) / RESTART_DIR / "restart.json"
+    st = folder_files.lstat_or_none(jfile)
+    if st is not None and not stat.S_ISREG(st.st_mode):  # a link, FIFO, folder...: named, never followed
+        raise FemastError(f"{folder}: the restart point is refused: {folder_files.refusal(jfile, st.st_mode, 'reads')}")
+    if st is None:
         raise FemastError(
             f"{folder}: no restart point ({jfile} is missing); run the analysis with "
             "restart_every=n (a restart point every n increments) to be able to restart it"
         )
+    return jfile
+
+
+def load_restart(folder, analysis) -> dict | None:
+    """Read the restart point of results folder ``folder`` for ``analysis`` (same model): a dict
+    with the State and what the run needs to go on, or None when the point is the run's start (the
+    run starts over); a FemastError naming the folder otherwise.  Every value is checked
+    (restart_check.py): a restart point edited by hand or damaged is refused, never half-used."""
+    folder = Path(folder)
+    rdir = folder / RESTART_DIR
+    jfile = require_point(folder)
     try:
-        info = json.loads(jfile.read_text())
-        if info.get("format") != FORMAT:
-            raise ValueError(f"format {info.get('format')!r}, not {FORMAT}")
+        folder_files.own_dir(folder, RESTART_DIR)  # (a link is refused)
+        info = check_point(folder_files.read_json(jfile, "restart point"), jfile, analysis)
         if info.get("initial"):
             state = None
         else:
-            state = State.load(rdir / info["state_file"])
-            with np.load(rdir / info["extra_file"], allow_pickle=False) as z:
+            with folder_files.open_regular(rdir / info["state_file"]) as fh:
+                state = State.load(io.BytesIO(fh.read()))
+            with folder_files.open_regular(rdir / info["extra_file"]) as fh:
+                z = np.load(io.BytesIO(fh.read()), allow_pickle=False)
                 step_start = (z["load_start"], z["pres_start"])
                 reuse = (z["reuse_x"], z["reuse_R"]) if "reuse_x" in z.files else None
-    except FemastError:
-        raise
+            check_arrays(state, step_start, reuse, analysis, rdir)
+            if (state.step, state.increment) != (info["step"], info["increment"]):
+                raise FemastError(
+                    f"{rdir / info['state_file']}: the state is at step {state.step} increment {state.increment}, "
+                    f"restart.json says step {info['step']} increment {info['increment']}"
+                )
+    except FemastError as exc:
+        raise FemastError(
+            f"{folder}: the restart point is refused: {exc}; run the analysis again from the start"
+        ) from None
     except Exception as exc:
         raise FemastError(
             f"{folder}: the restart point is unreadable ({type(exc).__name__}: {exc}); "
             "run the analysis again from the start"
         ) from None
-    model = analysis.model
-    names = [s.name for s in model.steps]
-    if (
-        info["n_nodes"] != len(analysis.system.X0)
-        or info["steps"] != names
-        or state is not None
-        and (
-            len(state.families) != len(analysis.families)
-            or any(np.shape(a) != np.shape(f.initial_state()) for a, f in zip(state.families, analysis.families))
-        )
-    ):
-        raise FemastError(
-            f"{folder}: the restart point belongs to another model ({info['n_nodes']} nodes, steps "
-            f"{info['steps']}; this one: {len(analysis.system.X0)} nodes, steps {names}); restart "
-            "with the model that wrote it"
-        )
     if state is None:
         return None
     info.update(state=state, step_start=step_start, folder=folder, reuse=reuse)

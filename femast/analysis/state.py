@@ -135,7 +135,7 @@ class State:
 
     # ------------------------------------------------------------ disk
     def save(self, path):
-        """Write the state to ``path`` (an ``.npz`` file), bit for bit (see :meth:`load`)."""
+        """Write the state to ``path`` (an ``.npz`` file, or a binary file object), bit for bit (see :meth:`load`)."""
         data = {"format": np.array(FORMAT), "n_families": np.array(len(self.families))}
         for k, a in enumerate(self.families):
             data[f"family/{k}"] = np.asarray(a)
@@ -147,6 +147,9 @@ class State:
             v = getattr(self, name)
             if v is not None:
                 data[name] = np.array(v)
+        if hasattr(path, "write"):  # a file object (a restart point writes the bytes itself)
+            np.savez(path, **data)
+            return
         with open(path, "wb") as fh:
             np.savez(fh, **data)
 

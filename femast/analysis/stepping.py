@@ -8,6 +8,7 @@ increments, has the algorithm (newton.py) solve each one, retries failed attempt
 from __future__ import annotations
 
 from .. import progress as _progress
+from ..errors import ConvergenceError
 from .control import LoadControl, plan_for
 
 
@@ -31,6 +32,7 @@ def run_step(analysis, step, resume=None):
         restore(an, resume)
         step_iters = resume["summary"]["step_iterations"]
     bar = plan.bar(disable=not (an.progress and _progress.enabled()))  # no bar when not on a terminal
+    cutbacks = 0  # of this step: at most an.max_cutbacks (a step that never converges ends)
     try:
         while not plan.done():
             plan.next_increment()
@@ -48,6 +50,13 @@ def run_step(analysis, step, resume=None):
                         an, step, st.increment + 1, attempt, out.iterations, time, total_time, dtime, lam, out.note
                     )
                 summary.cutbacks += 1
+                cutbacks += 1
+                if cutbacks >= an.max_cutbacks:
+                    raise ConvergenceError(
+                        f"step '{step.name}': {cutbacks} cutbacks in this step (max_cutbacks = {an.max_cutbacks}) at "
+                        f"step time {st.step_time:.6g}: {out.note}. The {summary.increments} converged increments "
+                        f"are {an.kept()}."
+                    )
                 plan.cutback(out.note)
             st.increment += 1
             summary.increments += 1

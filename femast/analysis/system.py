@@ -18,13 +18,16 @@ import scipy.sparse as sp
 from numba import njit
 
 from ..elements.base import DOF_NAMES, IncrementContext
-from ..errors import ModelError, SingularModelError
+from ..elements.beam_corot import BeamFamily
+from ..elements.truss import TrussFamily
+from ..errors import EquilibriumError, ModelError, NonFiniteError, SingularModelError
 from ..model import validation
 from ..model.constraints import Constraints, transpose_times
 from .assembly import Assembler, assigning_positions
 from .configuration import update_configuration
 from .convergence import all_finite, evaluate, force_moment_abs_max, scaled_size
 from .dofs import number_dofs
+from .equilibrium import family_balance
 from .linalg.linear import SparseLU, mechanism_dofs
 from .reduction import ReducedTangent
 
@@ -47,6 +50,53 @@ def _abs_sum(a):
     for v in a.flat:
         s += abs(v)
     return s
+
+
+def _shape_message(family, r, f_shape, k_shape) -> str:
+    """Why ``family``'s response ``r`` is refused: its f or k does not have the contract's shape."""
+    return (
+        f"element family '{family.name}' returned f of shape {np.shape(r.f)} and k of shape {np.shape(r.k)}; "
+        f"its {f_shape[0]} element(s) of {f_shape[1] // 6} nodes need f {f_shape} and k {k_shape} (6 DOFs per "
+        "node, femast/elements/base.py): fix the family's evaluate()"
+    )
+
+
+def _nonfinite_message(family, f, labels) -> str:
+    """Which element of ``family`` returned the non-finite forces ``f`` (node ``labels`` by row)."""
+    e = int(np.flatnonzero(~np.isfinite(np.asarray(f)).all(axis=1))[0])
+    label = int(family.labels[e]) if hasattr(family, "labels") else e + 1
+    nodes = ", ".join(str(labels[n]) for n in np.asarray(family.nodes)[e])
+    return (
+        f"element family '{family.name}' returned NaN or infinite internal forces for element {label} (nodes "
+        f"{nodes}); check its parameters, or its evaluate() for a user element, at that configuration"
+    )
+
+
+SHORT = 1e-6  # an element shorter than this fraction of the model's size swamps the tangent's conditioning
+
+
+def _response_shapes(family):
+    """The shapes (f, k) of ``family``'s response: (n_el, 6 m) and (n_el, 6 m, 6 m) for m nodes per element."""
+    n_el, m = np.shape(family.nodes)
+    return (n_el, 6 * m), (n_el, 6 * m, 6 * m)
+
+
+def _short_elements(families, X0, size, labels) -> None:
+    """A ModelError naming a beam or truss element shorter than :data:`SHORT` of the model's size
+    ``size`` (m): its stiffness would exceed the others' by 1e6 (axial) to 1e18 (bending), beyond
+    what a factorisation in double precision can tell from a mechanism."""
+    for f in families:
+        if not isinstance(f, (BeamFamily, TrussFamily)):
+            continue
+        nodes = np.asarray(f.nodes)
+        L = np.linalg.norm(X0[nodes[:, 1]] - X0[nodes[:, 0]], axis=1)
+        for e in np.flatnonzero(L < SHORT * size)[:1]:
+            raise ModelError(
+                f"{type(f).__name__[:-6].lower()} element {int(f.labels[e])} (nodes {labels[nodes[e, 0]]}-"
+                f"{labels[nodes[e, 1]]}) of family '{f.name}' is {L[e]:.3g} m long, {L[e] / size:.2g} of the model's "
+                f"size {size:.3g} m: its stiffness would swamp the others' in double precision. Merge its nodes (or "
+                "tie them with Model.tie or a rigid body), or give it a realistic length"
+            )
 
 
 class System:
@@ -115,6 +165,8 @@ class System:
         self._no_update = np.zeros(0)
         self._Pa = None  # (loads array, its values on the active DOFs)
         self.length = float(np.ptp(self.X0, axis=0).max()) or 1.0
+        self._shapes = [_response_shapes(f) for f in families]  # (f, k) of each family's response
+        _short_elements(families, self.X0, self.length, model.node_labels)
         self.symmetric = all(getattr(f, "symmetric", False) for f in self.families)
         self.solver = SparseLU(symmetric=self.symmetric, backend=linear_solver)
         if not self._constrained:
@@ -159,8 +211,10 @@ class System:
                 responses.append(cached[i])
                 continue
             r = f.evaluate(x, R, s, ctx)
+            if np.shape(r.f) != self._shapes[i][0] or np.shape(r.k) != self._shapes[i][1]:
+                raise ModelError(_shape_message(f, r, *self._shapes[i]))
             if not all_finite(r.f):  # (compiled: numpy's isfinite + all cost ~2 us a call)
-                raise FloatingPointError(f"non-finite internal forces in element family '{f.name}'")
+                raise NonFiniteError(_nonfinite_message(f, r.f, self._labels))
             responses.append(r)
         return responses
 
@@ -343,17 +397,22 @@ class System:
             float(sum(np.sum(r.energy) for r in responses if r.energy is not None)),
             equilibrium,
         )
-        if equilibrium and self.check_balance:  # the reactions balance the loads
-            validation.check_equilibrium(
-                st.x,
-                P,
-                RF,
-                res[: self.dofmap.n_free],
-                self.free_dof,
-                f"increment {self.summary.increments + 1}",
-                internal=float(sum(_abs_sum(q.f) for q in responses)),
-                labels=self._labels,
-            )
+        if equilibrium and self.check_balance:  # the reactions balance the loads (every increment)
+            where = f"increment {self.summary.increments + 1}"
+            try:
+                validation.check_equilibrium(
+                    st.x,
+                    P,
+                    RF,
+                    res[: self.dofmap.n_free],
+                    self.free_dof,
+                    where,
+                    internal=float(sum(_abs_sum(q.f) for q in responses)),
+                    labels=self._labels,
+                )
+            except EquilibriumError:
+                family_balance(self, responses, st.x, where)  # names a family that is not in balance
+                raise
 
     # ------------------------------------------------------------ messages
     def worst(self, r):

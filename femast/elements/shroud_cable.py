@@ -321,9 +321,13 @@ def add_shrouds(
     attachment points, non-positive lengths or stiffness, and tensions outside the law's range.
     """
 
-    pairs = np.atleast_2d(np.asarray(pairs, dtype=np.int64))
-    if pairs.ndim != 2 or pairs.shape[1] != 2:
-        raise ModelError(f"{name}: pairs must be (n, 2) node labels; got shape {pairs.shape}")
+    raw = np.atleast_2d(np.asarray(pairs, dtype=object))
+    if raw.ndim != 2 or raw.shape[1] != 2:
+        raise ModelError(f"{name}: pairs must be (n, 2) node labels; got shape {raw.shape}")
+    for k, row in enumerate(raw.tolist()):  # whole labels of the model's nodes (2.7 is not node 2)
+        for label in row:
+            model._check_node(label, f"{name} {k + 1} (nodes {row[0]!r}-{row[1]!r})")
+    pairs = raw.astype(np.int64)
     n = pairs.shape[0]
     laws = _law_array(law, n, name)
     off = np.zeros((n, 2, 3)) if offsets is None else np.broadcast_to(np.asarray(offsets, float), (n, 2, 3))

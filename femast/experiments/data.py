@@ -27,7 +27,11 @@ from __future__ import annotations
 
 import csv
 import difflib
+import errno
 import math
+import os
+import re
+import stat
 import warnings
 from pathlib import Path
 
@@ -62,6 +66,13 @@ def _separator_error(path, line, text, exp):
     return None
 
 
+#: a cell's number as a CSV file writes it: ASCII digits, an optional sign, point and exponent
+#: (and the words nan / inf, refused as not finite below)
+_DECIMAL = re.compile(r"^[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?$|^[+-]?(?:nan|inf|infinity)$", re.ASCII | re.I)
+#: units whose values are positive by nature (a frequency of -3 Hz is a sign or column error)
+POSITIVE_UNITS = ("Hz",)
+
+
 def check_values(exp: Experiment, cols: dict, path: str, lines, measured: bool = True) -> None:
     """Plausibility of the values of a data set (see the module docstring): magnitudes; for
     ``measured`` data (a file) also all-zero or constant measured channels (errors) and consecutive
@@ -75,6 +86,13 @@ def check_values(exp: Experiment, cols: dict, path: str, lines, measured: bool =
             raise DataFileError(
                 f"{path} line {lines[i]}, column '{name}': {a[i]:g} {unit} is beyond {MAX_VALUE:g} "
                 f"{unit}, not a plausible measurement (a corrupt cell?); fix or remove the row"
+            )
+        unit = exp.column(name).unit
+        if measured and unit in POSITIVE_UNITS and np.any(a <= 0.0):
+            i = int(np.flatnonzero(a <= 0.0)[0])
+            raise DataFileError(
+                f"{path} line {lines[i]}, column '{name}': {a[i]:g} {unit}; a value in {unit} is positive "
+                "(a sign error, or the wrong column?); fix or remove the row"
             )
     if not measured:
         return
@@ -194,7 +212,12 @@ def _cell_values(exp: Experiment, header, rows, lines, path, header_line) -> np.
             s = text.strip()
             codes = dict((t.lower(), v) for t, v in col.codes)
             try:
-                v = codes[s.lower()] if s.lower() in codes else float(s)
+                if s.lower() in codes:
+                    v = codes[s.lower()]
+                elif _DECIMAL.match(s):
+                    v = float(s)
+                else:  # (Python's float() also reads "1_0" as 10 and full-width digits "１２" as 12)
+                    raise ValueError(s)
             except ValueError:
                 what = "an empty cell" if not s else f"'{s}' is not a number"
                 words = f" or one of {', '.join(t for t, _ in col.codes)}" if col.codes else ""
@@ -227,6 +250,34 @@ def _group_labels(header, rows, lines, path) -> list:
         labels.append(label)
         cells[g] = "0"
     return labels
+
+
+def _check_data_path(path: Path) -> None:
+    """A DataFileError naming what ``path`` is if it is not a readable regular file (a folder, a FIFO
+    or device, a link to nothing or a loop of links), before anything is opened (a FIFO would block)."""
+    try:
+        st = os.stat(path)  # (follows a link to the data file: that is the user's choice)
+    except FileNotFoundError:
+        if path.is_symlink():
+            raise DataFileError(
+                f"{path}: a symbolic link to {os.readlink(path)}, which does not exist; point it at the data file"
+            ) from None
+        raise DataFileError(f"{path}: no such data file") from None
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise DataFileError(
+                f"{path}: a loop of symbolic links (it leads back to itself); point it at the data file"
+            ) from None
+        raise DataFileError(f"{path}: cannot be read ({exc.strerror}); check the path and its permissions") from None
+    if stat.S_ISDIR(st.st_mode):
+        csvs = sorted(p.name for p in path.glob("*.csv"))[:3]
+        hint = f" (it holds {', '.join(csvs)})" if csvs else ""
+        raise DataFileError(f"{path}: a folder, not a data file{hint}; give the CSV file itself")
+    if not stat.S_ISREG(st.st_mode):
+        kind = "a FIFO (named pipe)" if stat.S_ISFIFO(st.st_mode) else "a device or socket"
+        raise DataFileError(f"{path}: {kind}, not a data file; femast reads measured data from a regular CSV file")
+    if not os.access(path, os.R_OK):
+        raise DataFileError(f"{path}: cannot be read (permission denied); check its permissions")
 
 
 def read_data(exp: Experiment, path, units=None, *, time_continuous: bool = False, offsets: bool = False) -> Measured:
@@ -264,8 +315,7 @@ def _read_one(exp: Experiment, path, units) -> Measured:
 
     override = _units.parse_override(units)
     path = Path(path)
-    if not path.is_file():
-        raise DataFileError(f"{path}: no such data file")
+    _check_data_path(path)
     header, header_line, rows, lines = None, 0, [], []
     with open(path, newline="", encoding="utf-8-sig") as fh, progress.task(f"reading {path.name}", "rows", 2.0) as bar:
         reader = csv.reader(fh)

@@ -16,10 +16,14 @@ and keeps
 
 The disk entries hold data, never code: a run's dict of numeric arrays, numbers and
 strings is stored as the arrays of an ``.npz`` (no object arrays; read with ``allow_pickle=False``)
-plus a JSON header in the same file with the entry's key, the scalars and a SHA-256 of the arrays.
-A file that is truncated, corrupt, of another format, or whose key or checksum does not match (a
-file planted or copied into the folder) is a miss: the run is computed again and the entry
-rewritten.  A value that is not such a dict stays in memory only.
+plus a JSON header in the same file with the entry's key, the scalars and a MAC of them: an
+HMAC-SHA-256 of the key, scalars and arrays whose secret is a second digest of the run's inputs
+(:func:`run_secret`, SHA-256 in its own domain).  The file's name holds only the SHA-1 of the
+inputs, so whoever rewrites an entry (other values, the checksum recomputed) cannot make a MAC that
+matches without the inputs themselves, and the rewritten entry is a miss.  A file that is
+truncated, corrupt, of another format, or whose key or MAC does not match (a file planted, copied
+or edited in the folder) is a miss: the run is computed again and the entry rewritten.  A value
+that is not such a dict stays in memory only.
 
 A cached run is returned as a fresh copy, so callers may modify it.  ``STATS`` counts hits and
 misses (``stats()``; ``clear()`` empties the memory cache and resets the counts).
@@ -29,6 +33,7 @@ from __future__ import annotations
 
 import copy
 import hashlib
+import hmac
 import io
 import json
 import numbers
@@ -87,6 +92,15 @@ def run_key(kind: str, key_parts) -> str:
     return f"{kind}-{key_of(kind, key_parts)}"
 
 
+def run_secret(kind: str, key_parts) -> bytes:
+    """The secret of the MAC of run ``key_parts``' entry: a SHA-256 of the inputs in a domain of its
+    own, which neither the entry nor its name (the SHA-1 of the inputs) reveals."""
+    h = hashlib.sha256(b"femast-fe-cache-mac\0")
+    for p in (kind, key_parts):
+        _feed(h, p)
+    return h.digest()
+
+
 def cached(kind: str, key_parts, compute, options: dict | None = None, refresh: bool = False):
     """``compute()`` once per distinct ``key_parts`` (see the module docstring); returns a copy.
     refresh : compute even if cached (a run whose side products are needed: a reference path) and
@@ -98,8 +112,9 @@ def cached(kind: str, key_parts, compute, options: dict | None = None, refresh: 
         return copy.deepcopy(_MEM[key])
     folder = cache_dir(options)
     path = folder / f"{key}.npz" if folder else None
+    secret = run_secret(kind, key_parts) if folder else None
     if path is not None and path.is_file() and not refresh:
-        value = read_entry(path, key)
+        value = read_entry(path, key, secret)
         if value is not None:
             STATS["disk_hits"] += 1
             _remember(key, value)
@@ -110,7 +125,7 @@ def cached(kind: str, key_parts, compute, options: dict | None = None, refresh: 
     _log_run(kind, key, time.perf_counter() - t0)
     _remember(key, value)
     if path is not None:
-        write_entry(path, key, value)
+        write_entry(path, key, value, secret)
     return copy.deepcopy(value)
 
 
@@ -124,11 +139,11 @@ def _log_run(kind: str, key: str, seconds: float) -> None:
             fh.write(f"{os.getpid()} {kind} {key[-12:]} {seconds:.4f} {time.time():.4f} {time.process_time():.3f}\n")
 
 
-FORMAT = "femast-fe-cache 1"
+FORMAT = "femast-fe-cache 2"  # (1: an unkeyed SHA-256, which whoever rewrote an entry could recompute)
 
 
-def _digest(key: str, arrays: dict, scalars: dict) -> str:
-    h = hashlib.sha256(key.encode())
+def _digest(key: str, arrays: dict, scalars: dict, secret: bytes) -> str:
+    h = hmac.new(secret, key.encode(), hashlib.sha256)
     h.update(json.dumps(scalars, sort_keys=True).encode())
     for name in sorted(arrays):
         a = np.ascontiguousarray(arrays[name])
@@ -165,9 +180,9 @@ def _split(value):
     return arrays, scalars
 
 
-def write_entry(path: Path, key: str, value) -> bool:
-    """Store ``value`` (see :func:`_split`) as entry ``key`` at ``path`` atomically; False if it
-    cannot be stored as data (then nothing is written)."""
+def write_entry(path: Path, key: str, value, secret: bytes) -> bool:
+    """Store ``value`` (see :func:`_split`) as entry ``key`` at ``path`` atomically, its MAC made with
+    ``secret`` (:func:`run_secret`); False if it cannot be stored as data (then nothing is written)."""
     parts = _split(value)
     if parts is None:
         return False
@@ -177,7 +192,7 @@ def write_entry(path: Path, key: str, value) -> bool:
         "key": key,
         "scalars": scalars,
         "arrays": sorted(arrays),
-        "sha256": _digest(key, arrays, scalars),
+        "mac": _digest(key, arrays, scalars, secret),
     }
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -194,9 +209,10 @@ def write_entry(path: Path, key: str, value) -> bool:
     return True
 
 
-def read_entry(path: Path, key: str):
+def read_entry(path: Path, key: str, secret: bytes):
     """The value stored as entry ``key`` at ``path``, or None (a miss) if the file is missing,
-    truncated, corrupt, of another format, holds object arrays, or its key or checksum differ."""
+    truncated, corrupt, of another format, holds object arrays, or its key or MAC (made with
+    ``secret``, :func:`run_secret`) differ."""
     try:
         with np.load(path, allow_pickle=False) as z:
             meta = json.loads(bytes(z["__meta__"]).decode())
@@ -207,7 +223,10 @@ def read_entry(path: Path, key: str):
                 return None
             arrays = {n: z[f"a_{n}"] for n in names}
         scalars = meta["scalars"]
-        if not isinstance(scalars, dict) or _digest(key, arrays, scalars) != meta["sha256"]:
+        mac = meta["mac"]
+        if not isinstance(scalars, dict) or not isinstance(mac, str):
+            return None
+        if not hmac.compare_digest(_digest(key, arrays, scalars, secret), mac):
             return None
     except Exception:  # anything unreadable is a miss, never a crash
         return None

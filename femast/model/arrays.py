@@ -126,6 +126,15 @@ def _lengths(model, rows):
     return a, b, np.sqrt(((b - a) ** 2).sum(axis=1))
 
 
+def _check_lengths(a, b, L, what, labs, kind) -> None:
+    """:func:`validation.element_length` of each element (vectorised: only suspects are checked one by one)."""
+    from .validation import PRECISION, element_length
+
+    far = np.maximum(np.abs(a).max(axis=1), np.abs(b).max(axis=1))
+    for i in np.flatnonzero((L <= 1e-12 * np.maximum(1.0, far)) | (L < PRECISION * far)):
+        element_length(float(L[i]), float(far[i]), _where(what, int(i), labs), kind, labs[i, 0], labs[i, 1])
+
+
 def add_nodes(model, coords) -> list[int]:
     """Nodes at the rows of an (n, 3) array (m), labelled after the largest label so far; returns them."""
     from .validation import coordinates
@@ -193,13 +202,7 @@ def add_beams(
         else per_element(mass_per_length, n, f"{what}: mass_per_length", "kg/m", lo=0.0, strict=False).tolist()
     )
     a, b, L = _lengths(model, rows)
-    short = L <= 1e-12 * np.maximum(1.0, np.abs(a).max(axis=1))
-    if short.any():
-        i = int(np.flatnonzero(short)[0])
-        raise ModelError(
-            f"{_where(what, i, labs)}: nodes {labs[i, 0]} and {labs[i, 1]} coincide (length "
-            f"{L[i]:g} m); a beam needs two distinct nodes"
-        )
+    _check_lengths(a, b, L, what, labs, "beam")
     e = (b - a) / L[:, None]
     U = np.broadcast_to(u, (n, 3))
     perp = U - (U * e).sum(axis=1)[:, None] * e
@@ -244,13 +247,8 @@ def add_trusses(
     labs, rows = node_rows(model, nodes, what)
     n = len(labs)
     EA = per_element(EA, n, f"{what}: EA", "N", lo=0.0)
-    _, _, L = _lengths(model, rows)
-    short = L <= 1e-12
-    if short.any():
-        i = int(np.flatnonzero(short)[0])
-        raise ModelError(
-            f"{_where(what, i, labs)}: nodes {labs[i, 0]} and {labs[i, 1]} coincide; a truss needs two distinct nodes"
-        )
+    a, b, L = _lengths(model, rows)
+    _check_lengths(a, b, L, what, labs, "truss")
     if L0 is not None and pretension is not None:
         raise ModelError(f"{what}: give L0 or pretension, not both")
     l0 = [None] * n if L0 is None else per_element(L0, n, f"{what}: unstretched length L0", "m", lo=0.0).tolist()

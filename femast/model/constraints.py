@@ -106,7 +106,8 @@ class TieSpec:
 
 def rigid_body_spec(model, reference, nodes, name: str) -> RigidBodySpec:
     """The :class:`RigidBodySpec` of :meth:`Model.rigid_body <femast.model.Model.rigid_body>`
-    after checking its nodes (known, the reference and at least one other, none twice)."""
+    after checking its nodes (known, at least one besides the reference, none twice, not the
+    reference itself)."""
     model._check_node(reference, f"rigid body '{name}'")
     nodes = [n for n in np.atleast_1d(nodes).tolist()]
     for n in nodes:
@@ -116,6 +117,11 @@ def rigid_body_spec(model, reference, nodes, name: str) -> RigidBodySpec:
         raise ModelError(
             f"rigid body '{name}': needs the reference node and at least one other node "
             f"(got {len(others) + 1} node in all); a rigid body with fewer than two nodes ties nothing"
+        )
+    if len(others) != len(nodes):
+        raise ModelError(
+            f"rigid body '{name}': node {int(reference)} is its reference node and also listed among the nodes it "
+            "carries; list only the other nodes (the reference moves them)"
         )
     if len(set(int(n) for n in others)) != len(others):
         raise ModelError(f"rigid body '{name}': a node is listed twice")

@@ -124,6 +124,7 @@ class Model:
         except (TypeError, ValueError, OverflowError):
             ok = False
         if not ok:
+            validation.not_fractional(label, where)  # (2.7 is no label, and not node 2 either)
             known = self._node_labels
             hint = f"known labels {known[0]}..{known[-1]}" if known else "the model has no nodes yet"
             raise ModelError(f"{where}: unknown node {label!r} ({hint}); create it with model.node(x, y, z)")
@@ -157,10 +158,7 @@ class Model:
         n = validation.whole(n, f"beam {n1}-{n2}: number of elements n", minimum=1)
         a, b = self.xyz(n1), self.xyz(n2)
         L = float(np.linalg.norm(b - a))
-        if L <= 1e-12 * max(1.0, float(np.abs(a).max())):
-            raise ModelError(
-                f"beam {n1}-{n2}: nodes {n1} and {n2} coincide (length {L:g} m); a beam needs two distinct nodes"
-            )
+        validation.element_length(L, float(max(np.abs(a).max(), np.abs(b).max())), f"beam {n1}-{n2}", "beam", n1, n2)
         up_arr = np.asarray(up, dtype=object)
         if up_arr.shape != (3,):
             raise ModelError(f"beam {n1}-{n2}: up-vector {up!r} must be 3 numbers (a global direction)")
@@ -277,9 +275,9 @@ class Model:
         EA = _finite(EA, f"truss {n1}-{n2}: EA", "N")
         if EA <= 0:
             raise ModelError(f"truss {n1}-{n2}: EA = {EA} N must be positive")
-        L = float(np.linalg.norm(self.xyz(n2) - self.xyz(n1)))
-        if L <= 1e-12:
-            raise ModelError(f"truss {n1}-{n2}: nodes {n1} and {n2} coincide; a truss needs two distinct nodes")
+        a, b = self.xyz(n1), self.xyz(n2)
+        L = float(np.linalg.norm(b - a))
+        validation.element_length(L, float(max(np.abs(a).max(), np.abs(b).max())), f"truss {n1}-{n2}", "truss", n1, n2)
         if L0 is not None and pretension is not None:
             raise ModelError(f"truss {n1}-{n2}: give L0 or pretension, not both")
         if L0 is not None:

@@ -98,7 +98,9 @@ class Step:
             v = _finite(
                 value, f"step '{self.name}': prescribed {name} on node {node}", "m" if name.lower()[0] == "u" else "rad"
             )
-            self.prescribed.append(Condition(node, _DOF_INDEX[name.lower()], v, amplitude))
+            dof = _DOF_INDEX[name.lower()]
+            validation.prescribed_once(self.prescribed, node, dof, v, f"step '{self.name}'")
+            self.prescribed.append(Condition(node, dof, v, amplitude))
         return self
 
 

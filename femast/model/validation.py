@@ -22,10 +22,20 @@ MAX_MAGNITUDE = 1e15
 
 
 def number(
-    value, what: str, unit: str = "", *, positive=False, nonnegative=False, lo=None, hi=None, max_abs=MAX_MAGNITUDE
+    value,
+    what: str,
+    unit: str = "",
+    *,
+    positive=False,
+    nonnegative=False,
+    lo=None,
+    hi=None,
+    ge=None,
+    max_abs=MAX_MAGNITUDE,
 ) -> float:
     """``value`` as a float, or a ModelError naming ``what``: not a number (strings, None, bools,
-    arrays are refused), not finite, beyond ``max_abs``, or outside the asked range."""
+    arrays are refused), not finite, beyond ``max_abs``, or outside the asked range (``lo`` < v,
+    ``ge`` <= v, v <= ``hi``)."""
     u = f" {unit}" if unit else ""
     if isinstance(value, (bool, np.bool_)) or isinstance(value, (str, bytes)) or value is None:
         raise ModelError(f"{what} = {value!r} is not a number; give a number{(' in' + u) if unit else ''}")
@@ -47,6 +57,8 @@ def number(
         raise ModelError(f"{what} = {v:g}{u} must be zero or positive")
     if lo is not None and not v > lo:
         raise ModelError(f"{what} = {v:g}{u} must be greater than {lo:g}{u}")
+    if ge is not None and not v >= ge:
+        raise ModelError(f"{what} = {v:g}{u} must be at least {ge:g}{u}")
     if hi is not None and not v <= hi:
         raise ModelError(f"{what} = {v:g}{u} must be at most {hi:g}{u}")
     return v
@@ -93,6 +105,48 @@ def coordinates(coords, what: str = "nodes") -> np.ndarray:
             f"{what}: row {r} coordinate {'xyz'[c]} = {a[r, c]!r} m is not a finite number within {MAX_MAGNITUDE:g} m"
         )
     return a
+
+
+#: an element shorter than this fraction of its nodes' distance from the origin is below the
+#: resolution of its own coordinates (double precision: 2.2e-16 of the distance; here 2.2e-6 of its length)
+PRECISION = 1e-10
+
+
+def prescribed_once(prescribed, node, dof: int, value: float, where: str) -> None:
+    """A ModelError if DOF ``dof`` of ``node`` is already among the ``prescribed`` conditions of a step
+    (the last value would silently win)."""
+    for c in prescribed:
+        if int(c.node) == int(node) and c.dof == dof:
+            unit = "m" if dof < 3 else "rad"
+            raise ModelError(
+                f"{where}: node {node} {DOF_NAMES[dof]} is prescribed twice in this step "
+                f"({c.magnitude:g} {unit}, then {value:g} {unit}); give it one value (a later step may change it)"
+            )
+
+
+def not_fractional(label, where: str) -> None:
+    """A ModelError if node label ``label`` is a number with a fractional part (never rounded to a node)."""
+    try:
+        fractional = float(label) != int(label) and not isinstance(label, (str, bytes, bool))
+    except (TypeError, ValueError, OverflowError):
+        return
+    if fractional:
+        raise ModelError(f"{where}: node label {label!r} is not a whole number; give the label Model.node returned")
+
+
+def element_length(L: float, far: float, where: str, kind: str, n1, n2) -> None:
+    """Check the length ``L`` (m) of a two-node element (nodes ``n1``, ``n2``) whose nodes lie up to
+    ``far`` (m) from the origin: a ModelError if the nodes coincide, or if the element is too short
+    for its coordinates to resolve it (a 1 m beam 1e12 m from the origin: positions there are known
+    to 1e-4 m, so its strains would be round-off)."""
+    if L <= 1e-12 * max(1.0, far) and not (far > 1e6 and L > 8 * np.finfo(float).eps * far):
+        raise ModelError(f"{where}: nodes {n1} and {n2} coincide (length {L:g} m); a {kind} needs two distinct nodes")
+    if L < PRECISION * far:
+        raise ModelError(
+            f"{where}: nodes {n1} and {n2} are {far:.3g} m from the origin but only {L:.3g} m apart; there double "
+            f"precision resolves {np.spacing(far):.2g} m, too coarse for the {kind}'s strains. Build the model near "
+            "the origin (subtract a reference point from the coordinates)"
+        )
 
 
 def step_increments(step) -> None:
@@ -196,14 +250,16 @@ def _balance(x, P, RF, r_free, free_dof):
 
 
 def check_equilibrium(
-    x, P, RF, r_free, free_dof, where: str, internal: float = 0.0, labels=None, rel: float = 1e-9
+    x, P, RF, r_free, free_dof, where: str, internal: float = 0.0, labels=None, rel: float = 1e-9, ground=None
 ) -> None:
     """Global balance of a converged increment of a model whose elements are self-equilibrated:
     the applied loads ``P`` (n, 6) and reactions ``RF`` (n, 6) at positions ``x`` (n, 3) balance
     (force and moment about the origin) up to what the free DOFs' residual ``r_free`` leaves
     unbalanced (bounded by the triangle inequality) plus round-off: ``rel`` (1e-9, a million times
     double precision, for sums over many nodes) of the summed magnitudes of the loads, reactions
-    and ``internal`` (the summed magnitudes of the element nodal forces, N).
+    and ``internal`` (the summed magnitudes of the element nodal forces, N).  ``ground``: the
+    resultant (6,) (force, moment about the origin) of the element families tied to the ground
+    (not self-equilibrated), which the loads and reactions balance instead of zero.
     Raises :class:`~femast.errors.EquilibriumError` naming the increment otherwise."""
     fx, fy, fz, mx, my, mz, sum_f, sum_m, xmax, rt, rm = _balance(
         np.ascontiguousarray(x, dtype=float),
@@ -212,6 +268,8 @@ def check_equilibrium(
         np.ascontiguousarray(r_free, dtype=float),
         np.ascontiguousarray(free_dof, dtype=np.int64),
     )
+    if ground is not None:
+        fx, fy, fz, mx, my, mz = (a - float(b) for a, b in zip((fx, fy, fz, mx, my, mz), ground))
     arm = xmax * math.sqrt(3.0)
     scale_f = sum_f + internal
     scale_m = sum_m + arm * scale_f

@@ -27,6 +27,8 @@ import zlib
 import numpy as np
 from numpy.lib import format as npformat
 
+from .folder import open_regular, open_write, write_all, write_atomic
+
 TMP_SUFFIX = ".tmp"  # partial files: "<name>.tmp", never matched by the readers' patterns
 _MAX_MEMBER = 2**31 - 2**20  # a member beyond ~2 GB needs ZIP64: left to np.savez
 _LAYOUTS: dict = {}  # signature -> _Layout
@@ -119,27 +121,20 @@ def npz_bytes(arrays: dict) -> bytearray | None:
     return buf
 
 
-_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | getattr(os, "O_BINARY", 0)
+def npz_file_bytes(arrays: dict) -> bytes:
+    """The bytes of an uncompressed .npz of ``arrays``: :func:`npz_bytes`, or np.savez's where it cannot."""
+    data = npz_bytes(arrays)
+    if data is None:
+        buf = io.BytesIO()
+        np.savez(buf, **arrays)
+        data = buf.getvalue()
+    return data
 
 
 def atomic_savez(path, **arrays):
     """An .npz of ``arrays`` to ``path`` through a temporary file renamed into place (atomic on one
-    filesystem: a reader sees the whole file or none)."""
-    path = os.fspath(path)
-    tmp = path + TMP_SUFFIX
-    data = npz_bytes(arrays)
-    if data is None:
-        with open(tmp, "wb") as fh:  # a file object: np.savez would append ".npz" to a name
-            np.savez(fh, **arrays)
-    else:
-        fd = os.open(tmp, _FLAGS, 0o666)
-        try:
-            view = memoryview(data)
-            while view:
-                view = view[os.write(fd, view) :]
-        finally:
-            os.close(fd)
-    os.replace(tmp, path)
+    filesystem: a reader sees the whole file or none; never through a link, femast/post/folder.py)."""
+    write_atomic(path, npz_file_bytes(arrays))
 
 
 # --------------------------------------------------------------------------- the frame log
@@ -151,27 +146,22 @@ _RECORD = struct.Struct("<8sQ")  # magic, length of the .npz that follows (bytes
 def record_bytes(arrays: dict) -> bytes:
     """One record of the frame log: the 16-byte record header (``b"FEMASTFR"``, the length as a
     little-endian uint64) and the frame as an .npz (np.savez's bytes where :func:`npz_bytes` cannot)."""
-    data = npz_bytes(arrays)
-    if data is None:
-        buf = io.BytesIO()
-        np.savez(buf, **arrays)
-        data = buf.getvalue()
+    data = npz_file_bytes(arrays)
     return _RECORD.pack(RECORD_MAGIC, len(data)) + data
 
 
 def append_record(fd: int, record: bytes) -> None:
     """Append ``record`` to the log open as ``fd`` (O_APPEND) in one write (looped if it is short)."""
-    view = memoryview(record)
-    while view:
-        view = view[os.write(fd, view) :]
+    write_all(fd, record)
 
 
 def scan_log(path) -> tuple[list, int]:
     """The records of a frame log: ([(offset of the .npz, its length), ...], bytes left over at the end
     -- a record cut short by a run killed while writing it, or anything that is not a record).
     The headers are read through a memory map (no system call per record), or with a read per record
-    where the file system cannot map the file."""
-    with open(path, "rb") as fh:
+    where the file system cannot map the file.  Only a regular file is read (a FIFO or link: a
+    FemastError, femast/post/folder.py)."""
+    with open_regular(path) as fh:
         size = os.fstat(fh.fileno()).st_size
         if size < _RECORD.size:
             return [], size
@@ -208,7 +198,7 @@ def read_log(path):
     each record's .npz); a partial last record is skipped.  Needs only numpy: the layout is a
     sequence of records, each ``b"FEMASTFR"``, a little-endian uint64 n, then n bytes of .npz."""
     records, _ = scan_log(path)
-    with open(path, "rb") as fh:
+    with open_regular(path) as fh:
         for offset, length in records:
             fh.seek(offset)
             with np.load(io.BytesIO(fh.read(length)), allow_pickle=False) as z:
@@ -218,8 +208,14 @@ def read_log(path):
 def truncate_log(path, keep: int) -> int:
     """Cut the frame log at ``path`` after its first ``keep`` records (a restarted run goes on from
     there); returns the number of whole records it had."""
+    if keep < 0:
+        raise ValueError(f"truncate_log: keep={keep} must be >= 0")
     records, rest = scan_log(path)
     if len(records) >= keep and (len(records) > keep or rest):
         end = records[keep - 1][0] + records[keep - 1][1] if keep else 0
-        os.truncate(path, end)
+        fd = open_write(path)
+        try:
+            os.ftruncate(fd, end)
+        finally:
+            os.close(fd)
     return len(records)

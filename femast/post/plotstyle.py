@@ -190,9 +190,24 @@ def save(fig, png, dpi=None) -> Path:
             fig.tight_layout()
         except Exception:  # a layout that cannot be tightened is saved as it is
             pass
-    fig.savefig(png, dpi=dpi or STYLE["savefig.dpi"], bbox_inches="tight")
-    plt.close(fig)
+    try:
+        fig.savefig(png, dpi=dpi or STYLE["savefig.dpi"], bbox_inches="tight")
+    except ValueError:  # a name with "$" (a user's effect, file or column) read as broken math: shown as typed
+        literal(fig)
+        fig.savefig(png, dpi=dpi or STYLE["savefig.dpi"], bbox_inches="tight")
+    finally:
+        plt.close(fig)
     return png
+
+
+def literal(fig) -> None:
+    """Show every text of ``fig`` that holds a "$" as typed, not as mathtext (a user's name such as
+    ``$\\undefinedcmd{$`` is not maths and would stop the figure)."""
+    from matplotlib.text import Text
+
+    for t in fig.findobj(Text):
+        if "$" in t.get_text():
+            t.set_parse_math(False)
 
 
 _RAW = re.compile(r"\b[A-Za-z]+_(?:m|mm|N|Nm|deg|rad|s)\b")

@@ -153,3 +153,21 @@ def test_tip_history_reports_every_load_level_and_the_nominal_mast_deploys_strai
     # (round-off and the 1e-9 force tolerance: far below 1 nm and 1e-8 rad)
     assert h["u"][0, 2] < 0 and np.abs(h["u"][0, :2]).max() < 1e-9 and np.abs(h["theta"][0]).max() < 1e-8
     assert h["theta"][1, 2] > 0 > h["theta"][3, 2]  # M twists the tip one way, -M the other
+
+
+def test_tip_history_increments_change_only_the_friction_path():
+    """Frictionless joints: the mast is elastic, its tip at every load level independent of the
+    increments per step (to the Newton tolerance); with friction the return over an increment is
+    first order, so the residual moves with the increments."""
+    from femast.adam import BayParameters
+    from femast.adam.shape_study import tip_history
+
+    elastic = BayParameters(mu=0.0)
+    a = tip_history(2, None, cycles=1, params=elastic, increments=1)
+    b = tip_history(2, None, cycles=1, params=elastic, increments=3)
+    np.testing.assert_allclose(b["u"], a["u"], rtol=0, atol=1e-6 * np.abs(a["u"]).max())
+    np.testing.assert_allclose(b["theta"], a["theta"], rtol=0, atol=1e-6 * np.abs(a["theta"]).max())
+    f1 = tip_history(2, None, cycles=1, increments=1)
+    f3 = tip_history(2, None, cycles=1, increments=3)
+    assert f3["iterations"] > f1["iterations"]
+    assert not np.allclose(f3["theta"][-1], f1["theta"][-1], rtol=1e-6, atol=0)

@@ -86,11 +86,13 @@ def test_banded_indefinite_falls_back_to_lu():
 
 @pytest.mark.parametrize("backend", ["superlu", "banded"])
 def test_singular_and_nearly_singular_tangents_are_reported(backend):
-    """A mechanism: one DOF decoupled from the rest with a zero (or 1e-15 relative) stiffness."""
+    """A mechanism: one DOF decoupled from the rest with a zero (or 1e-20 relative) stiffness.  (A
+    pivot 1e-15 of the largest is a stiffness contrast a model can have, judged against its own DOF:
+    tests/analysis/test_singularity_judged_on_the_model.py; 1e-20 is below double precision.)"""
     A = chain_matrix().tolil()
     i = 150
     big = abs(A).max()
-    for eps in (0.0, 1e-15):  # exactly singular, and a pivot far below 1e-13 of the largest
+    for eps in (0.0, 1e-20):  # exactly singular, and a pivot below double precision against the largest
         S = A.copy()
         S[i, :] = 0.0
         S[:, i] = 0.0

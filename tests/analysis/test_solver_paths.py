@@ -199,7 +199,7 @@ def test_a_full_disk_at_the_start_is_a_named_error_and_a_failed_summary(tmp_path
     folder (not a raw OSError), and the summary says "failed" (not "running" forever)."""
     if not os.path.exists("/dev/full"):
         pytest.skip("no /dev/full to stand for a full disk")
-    import femast.post.results as results
+    import femast.post.writer as results
     from femast.errors import FemastError, ResultsWriteError
 
     def full_disk(path, **arrays):  # the OS's own ENOSPC

@@ -109,7 +109,7 @@ def _scattered_mast(n_bays, seed, steps_out):
     vals = sample_scatter({g: rng.random(k) for g, k in n_uniforms(n_bays).items()}, n_bays)
     am = build_mast(n_bays, scatter=as_scatter(vals, n_bays), seat="tied")  # the tied joint's reversal
     add_initial_steps(am)
-    add_table1_steps(am, cycles=1)
+    add_table1_steps(am, cycles=1, increments=1)  # one increment per step: the reversals are widest
 
     def keep(fr):
         steps_out.append({k: np.asarray(fr[f"el/adam_joint/{k}"]).copy() for k in ("moment_norm", "limit", "slip")})
@@ -144,7 +144,7 @@ def test_nominal_100_bay_mast_converges_without_cutbacks():
     frames = []
     am = build_mast(100, seat="tied")
     add_initial_steps(am)
-    add_table1_steps(am, cycles=1)
+    add_table1_steps(am, cycles=1, increments=1)  # one increment per step: the reversals are widest
     an = fm.Analysis(
         am.model,
         None,

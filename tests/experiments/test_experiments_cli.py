@@ -58,7 +58,7 @@ USER_EFFECT = textwrap.dedent('''
         return d
 
     register_effect(Effect(
-        name="thermal_drift", title="thermal drift of the top", physics="the top drifts linearly in time",
+        name="thermal_drift", title="thermal drift of the top", physics="the top drifts linearly in time.",
         implementations={"mast-top": Implementation(hook="top_displacement", apply=_drift, parameters=(
             Parameter("vx", "m", 0.0, -0.01, 0.01, "drift along x over the test", scale=1e-4),
             Parameter("vy", "m", 0.0, -0.01, 0.01, "drift along y over the test", scale=1e-4)))}),

@@ -239,7 +239,7 @@ def test_tip_baseline_is_the_adam_mast_under_the_table1_sequence():
     exp = get_experiment("tip-cycle", n_bays=4)
     am = build_mast(4, mu=0.0)
     add_initial_steps(am)
-    add_table1_steps(am, cycles=1)
+    add_table1_steps(am, cycles=1, increments=1)  # the experiment's path: one increment per ramp
     with tempfile.TemporaryDirectory() as d:
         res = fm.Analysis(am.model, d, progress=False, convergence=CONVERGENCE).run()
         _, ref = tip_table(res, am)  # um and arcsec

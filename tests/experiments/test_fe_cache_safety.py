@@ -39,6 +39,9 @@ def _compute_counter():
     return compute, calls
 
 
+_SECRET = fe_cache.run_secret("unit", ("p", 1.0))  # the MAC secret of _cached's entry
+
+
 def _cached(tmp_path, compute, parts=("p", 1.0)):
     return fe_cache.cached("unit", parts, compute, {"cache_dir": str(tmp_path)})
 
@@ -75,7 +78,7 @@ def test_a_planted_pickle_is_never_loaded(tmp_path):
     _cached(tmp_path, compute)
     assert not marker.exists()  # no code ran
     assert len(calls) == 2  # a miss: computed again
-    assert fe_cache.read_entry(path, path.stem) is not None  # and the entry rewritten as data
+    assert fe_cache.read_entry(path, path.stem, _SECRET) is not None  # and the entry rewritten as data
 
 
 def test_object_arrays_truncated_foreign_and_tampered_entries_are_misses(tmp_path):
@@ -87,24 +90,24 @@ def test_object_arrays_truncated_foreign_and_tampered_entries_are_misses(tmp_pat
     key = path.stem
     # an npz holding an object array (loading it would need pickle)
     np.savez(path, __meta__=np.frombuffer(b"{}", np.uint8), a_Mz=np.array([{"x": 1}], dtype=object))
-    assert fe_cache.read_entry(path, key) is None
+    assert fe_cache.read_entry(path, key, _SECRET) is None
     # truncated (a killed writer of an older version)
     path.write_bytes(good[: len(good) // 2])
-    assert fe_cache.read_entry(path, key) is None
+    assert fe_cache.read_entry(path, key, _SECRET) is None
     # a valid entry of another run copied under this name
     other = tmp_path / "other"
     other.mkdir()
     fe_cache.cached("unit", ("q", 2.0), compute, {"cache_dir": str(other)})
     shutil.copy(_entry(other), path)
-    assert fe_cache.read_entry(path, key) is None
+    assert fe_cache.read_entry(path, key, _SECRET) is None
     # one flipped byte in the arrays: the checksum differs (or the zip is unreadable)
     path.write_bytes(good)
-    assert fe_cache.read_entry(path, key) is not None
+    assert fe_cache.read_entry(path, key, _SECRET) is not None
     raw = bytearray(good)
     i = raw.find(np.array([1.0, -2.5]).tobytes())
     raw[i] ^= 0x01
     path.write_bytes(bytes(raw))
-    assert fe_cache.read_entry(path, key) is None
+    assert fe_cache.read_entry(path, key, _SECRET) is None
     # and through cached(): a miss, computed again
     fe_cache.clear()
     n = len(calls)

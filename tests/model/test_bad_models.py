@@ -196,7 +196,7 @@ CASES = [
         "beam-fraction-node",
         lambda: [m := _m(), m.node(0, 0, 0), m.node(1, 0, 0), m.beam(1, 1.5, _sec())],
         E,
-        r"beam: unknown node 1.5",
+        r"beam: node label 1.5 is not a whole number",
     ),
     (
         "beam-coincident",

@@ -217,7 +217,7 @@ def test_kill_9_and_read(tmp_path):
 _REPORT_SCRIPT = textwrap.dedent(
     """
     import sys, time, femast as fm
-    import femast.post.results as results
+    import femast.post.writer as results
     from femast.analysis.output import Observer
 
     write = results.append_record

@@ -28,7 +28,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ...errors import ConvergenceError, ModelError
-from ...model import dof_index
+from ...model import dof_index, validation
 from ..newton import Increment
 from .plan import Plan, gravity_of, step_values, with_gravity
 
@@ -50,6 +50,20 @@ class ArcLength:
     rotation_scale: float | None = None
     solves_for_load_factor = True
     arc_length = True
+
+    def __post_init__(self):
+        """Every bound a finite number in its range, or a ModelError naming it (a NaN bound would let
+        the arc length shrink, or grow, without end)."""
+        w = "ArcLength:"
+        self.initial_load_factor = validation.number(
+            self.initial_load_factor, f"{w} initial_load_factor", positive=True
+        )
+        self.max_load_factor = validation.number(self.max_load_factor, f"{w} max_load_factor")
+        self.desired_iterations = validation.whole(self.desired_iterations, f"{w} desired_iterations", minimum=1)
+        self.min_arc = validation.number(self.min_arc, f"{w} min_arc", positive=True, hi=1.0)
+        self.max_arc = validation.number(self.max_arc, f"{w} max_arc", ge=1.0)
+        if self.rotation_scale is not None:
+            self.rotation_scale = validation.number(self.rotation_scale, f"{w} rotation_scale", "m", positive=True)
 
     def plan(self, analysis, step):
         return ArcIncrements(analysis, step, self)

@@ -48,6 +48,7 @@ from numba import njit
 from ...errors import ModelError, SingularModelError
 from . import backends
 from .ordering import entry_keys, permuted, permuted_positions, rcm, same_pattern, try_orderings
+from .pivots import PivotChecks
 
 try:  # scipy's SuperLU binding, called directly for the matrix refactorised every iteration
     from scipy.sparse.linalg._dsolve._superlu import gstrf as _gstrf
@@ -88,7 +89,7 @@ def _unpermute(y, perm, x):
     return m
 
 
-class SparseLU:
+class SparseLU(PivotChecks):
     """Factorise once per iteration, solve for one or more right-hand sides.
 
     symmetric : every element family has a symmetric tangent (diagonal pivoting only).
@@ -146,6 +147,8 @@ class SparseLU:
         self.superlu_seconds = 0.0  # wall time inside SuperLU (kept factorisations + solves), s
         self.factorizations = 0  # numeric factorisations kept (trial orderings not counted)
         self.layout = 0  # bumped whenever the permuted matrix (its pattern or ordering) changes
+        self.confirmations = 0  # suspect factorisations SuperLU found regular (and replaced)
+        self._confirmed = None  # SuperLU's factorisation that replaced a suspect one
 
     # ------------------------------------------------------------------ symbolic part
     def _is_master(self, K):
@@ -361,29 +364,6 @@ class SparseLU:
         np.take(data[0], data[1], out=self._B.data)
         self._lu = self._timed(self._factor_permuted, self._B)
         return False
-
-    def _guarded(self, step):
-        """Run ``step()`` (sets self._lu; True if the pattern was newly analysed) with SuperLU's
-        failures raised as SingularModelError, then the zero-pivot test when it is due."""
-        try:  # SuperLU reports a singular matrix as RuntimeError (only spsolve warns instead)
-            analysed = step()
-        except RuntimeError as exc:
-            self._lu = None
-            raise SingularModelError(str(exc)) from None
-        self._checked = False
-        if analysed or self.pivot_check == "always" or self._dmax is None:
-            self._check_pivots()
-
-    def _check_pivots(self):
-        """Zero-pivot test on the diagonal of U (scipy builds L and U as CSC matrices for it:
-        ~10 % of a factorisation)."""
-        pivots = getattr(self._lu, "pivot_magnitudes", None)
-        d = pivots() if pivots is not None else np.abs(self._lu.U.diagonal())
-        if d.size and (not np.all(np.isfinite(d)) or np.min(d) <= 1e-13 * np.max(d)):
-            self._lu = None
-            raise SingularModelError("zero pivot in the LU factorisation")
-        self._dmax = float(np.max(d, initial=0.0))
-        self._checked = True
 
     def solve(self, rhs):
         rhs = np.asarray(rhs, dtype=float)
