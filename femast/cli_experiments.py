@@ -155,9 +155,14 @@ def _examples(args):
     if args.copy:
         dest = Path(args.copy)
         dest.mkdir(parents=True, exist_ok=True)
+        extra = 0
         for n in examples.names():
             shutil.copy(examples.path(n), dest / n)
-        print(f"copied {len(examples.names())} example files to {dest}")
+            for c in examples.companions(n):  # the licence and notice of data made by others
+                shutil.copy(c, dest / c.name)
+                extra += 1
+        licences = f" and {extra} licence files" if extra else ""
+        print(f"copied {len(examples.names())} example files{licences} to {dest}")
         return
     by_file = {v: k for k, v in examples.BY_EXPERIMENT.items()}
     from .text import hanging

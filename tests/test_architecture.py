@@ -135,6 +135,7 @@ CIRCLES = {
             "femast.experiments.registry",
             "femast.experiments.rigs",
             "femast.experiments.rigs.bay_torsion",
+            "femast.experiments.rigs.joint_test",
             "femast.experiments.rigs.latch_pull",
             "femast.experiments.rigs.mast_top",
             "femast.experiments.rigs.platform_pose",

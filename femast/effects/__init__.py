@@ -20,6 +20,8 @@ stretch_error          pull-test stretch-removal error              latch-pull
 latch_hysteresis       friction band near the latched state         latch-pull, bay-torsion, tip-cycle
 ball_joint_friction    |M| = mu B |F| of the ADAM ball joints       bay-torsion, tip-cycle
 off_axis_motion        bay top leaves its axis                      bay-torsion
+pinching               slip through a gap with friction (embedment) joint-test (connection rigs)
+degradation            damage with cumulative slip or energy        joint-test (its damage hook)
 added_mass, joint_stick  natural-frequency effects                  vibration
 =====================  ==========================================  =====================================
 
@@ -27,7 +29,7 @@ added_mass, joint_stick  natural-frequency effects                  vibration
 them beside its own effects.
 """
 
-from . import joints, structure, cables, latch, vibration  # noqa: F401,I001  (register the built-in effects, in this order)
+from . import joints, structure, cables, latch, vibration, connections  # noqa: F401,I001  (register the built-in effects, in this order)
 from .base import (
     Effect,
     Implementation,

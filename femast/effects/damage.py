@@ -89,7 +89,8 @@ def degrade(
     slip_of : ``slip_of(F_eff) -> s`` the slip of the connection's mechanisms (shape of ``F``) under
         the effective load.  D_max, X_d, driver : the law of :func:`damage` and its measure.
     Solves ``D = damage(X(F, s(F / (1 - D))))`` by fixed-point iteration until ``D`` changes by less
-    than ``tol``; raises :class:`~femast.errors.ConvergenceError` after ``max_passes`` passes.  Each
+    than ``tol`` (after a quarter of ``max_passes`` the update is halved, against a slip that flips
+    between two paths); raises :class:`~femast.errors.ConvergenceError` after ``max_passes`` passes.  Each
     column of ``F`` has its own damage.  Returns ``(D, F_eff)``.
     """
     F = np.asarray(F, dtype=float)
@@ -98,11 +99,14 @@ def degrade(
     if D_max == 0.0:
         return D, F_eff
     change = np.inf
-    for _ in range(max_passes):
+    relax = 1.0
+    for k in range(max_passes):
+        if k == max_passes // 4:
+            relax = 0.5  # still moving: the slip jumps between two paths (a threshold crossed or not); damp
         s = np.asarray(slip_of(F_eff), dtype=float)
         D_new = damage(damage_measure(F, s, driver), D_max, X_d)
         change = float(np.max(np.abs(D_new - D))) if D.size else 0.0
-        D = D_new
+        D = D + relax * (D_new - D)
         F_eff = F / (1.0 - D)
         if change < tol:
             return D, F_eff

@@ -19,6 +19,7 @@ bay_torsion_format.csv         bay-torsion     the bay-torsion format, schematic
 tip_cycle_table1.csv           tip-cycle       Table 1 of Stohlman & Pellegrino (their FE prediction)
 vibration_example.csv          vibration       latch resonance at nine tension settings (synthetic)
 platform_pose_example.csv      platform-pose   commanded and measured platform poses (synthetic)
+joint_test_spc1.csv            joint-test      cyclic test of a timber connection (real: SPC1; licence and notice beside it)
 =============================  ==============  ================================================
 """
 
@@ -38,7 +39,17 @@ BY_EXPERIMENT = {
     "tip-cycle": "tip_cycle_table1.csv",
     "vibration": "vibration_example.csv",
     "platform-pose": "platform_pose_example.csv",
+    "joint-test": "joint_test_spc1.csv",
 }
+
+# files that travel with an example (the licence and notice of data made by others)
+COMPANIONS = {"joint_test_spc1.csv": ("NOTICE-SPC1.txt", "LICENSE-SPC1-Apache-2.0.txt")}
+
+
+def companions(name: str) -> list[Path]:
+    """Paths of the files that must stay beside the example ``name`` when it is copied (its licence
+    and notice: data made by others); [] for femast's own."""
+    return [FOLDER / c for c in COMPANIONS.get(name, ())]
 
 
 def names() -> list[str]:

@@ -48,7 +48,7 @@ from .. import progress
 from ..effects.base import get_effect, loaded_scripts
 from .baseline import fit_with_noise
 from .candidates import fit_candidates, rank, remaining_where
-from .compare import analyse
+from .compare import analyse, load_path
 from .core import Experiment, Measured
 from .diagnose_report import diagnosis_result, format_diagnose  # noqa: F401  (format_diagnose: re-exported)
 from .diagnosis import Diagnosis
@@ -69,6 +69,7 @@ from .refits import (  # noqa: F401
 )
 from .residuals import AT_NOISE, at_noise_threshold  # noqa: F401  (AT_NOISE: re-exported)
 from .rows import thin
+from .time_dependence import creep_overrules, reads_time, time_check
 from .units import check_data as check_units
 from .verdict import SIGNIFICANT_DBIC, conclude  # noqa: F401  (SIGNIFICANT_DBIC: re-exported)
 
@@ -213,12 +214,16 @@ def _noise_model(d: Diagnosis) -> None:
 
 def _verdict(d: Diagnosis) -> None:
     """The verdict (:func:`~femast.experiments.verdict.conclude`) from the ranking, the pairs that
-    passed the held-out check and the form check."""
+    passed the held-out check and the form check, overruled where the response moves at constant load
+    (:func:`~femast.experiments.time_dependence.creep_overrules`)."""
     best = next((e for e in d.ranking if e["significant"]), None)
     where = remaining_where(d, best["_z"] if best else d.s0["z"])
     titles = {e["effect"]: get_effect(e["effect"]).title for e in d.ranking}
     pairs = [{k: v for k, v in p.items() if not k.startswith("_")} for p in d.pairs if p.get("heldout_ok", True)]
-    d.verdict = conclude(d.s0["ratio"], d.thr, d.ranking, pairs, d.form_check, titles, where)
+    verdict = conclude(d.s0["ratio"], d.thr, d.ranking, pairs, d.form_check, titles, where)
+    # the holds of the test: a response that moves at constant load rules out rate-independent answers
+    check = time_check(load_path(d.exp, d.data), {c: d.data[c] for c in d.channels}, d.weights)
+    d.verdict = creep_overrules(verdict, check, lambda name: reads_time(d.exp, name))
 
 
 def _import_pyplot():

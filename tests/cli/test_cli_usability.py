@@ -172,12 +172,16 @@ def test_examples_are_package_data_reachable_by_name():
     with pytest.raises(fm.DataFileError, match="shipped"):
         femast.examples.path("nope.csv")
     toml = (ROOT / "pyproject.toml").read_text()
-    assert '"femast.examples" = ["*.csv"]' in toml
+    assert '"femast.examples" = ["*.csv", "*.txt"]' in toml  # the data and the licences of data made by others
+    for name in femast.examples.names():
+        assert all(c.is_file() for c in femast.examples.companions(name))
 
 
 def test_examples_command_copies(tmp_path, capsys):
     assert main(["examples", "--copy", str(tmp_path / "ex")]) == 0
-    assert sorted(p.name for p in (tmp_path / "ex").iterdir()) == femast.examples.names()
+    names = femast.examples.names()
+    expected = names + [c.name for n in names for c in femast.examples.companions(n)]
+    assert sorted(p.name for p in (tmp_path / "ex").iterdir()) == sorted(expected)
 
 
 def test_gitignore_covers_what_the_docs_commands_write():

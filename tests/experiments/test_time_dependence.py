@@ -14,9 +14,10 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 
+from generalisation import connection as conn  # noqa: E402
 from generalisation.cases import _m, generate, get_case  # noqa: E402
 
-from femast.experiments.time_dependence import CREEP_T, hold_drift, holds  # noqa: E402
+from femast.experiments.time_dependence import CREEP_T, creep_overrules, hold_drift, holds, reads_time  # noqa: E402
 
 CH = ("dx_m", "dy_m", "dz_m")
 
@@ -70,3 +71,57 @@ def test_creep_is_told_from_friction_on_independent_data(mechanism, creep):
         out = hold_drift(load, {c: cols[c] for c in CH}, {c: 25e-6 for c in CH})
         assert out["holds"] == 16
         assert out["creep"] is creep, (seed, out["t"])
+
+
+CREEP = {"holds": 16, "t": 7.4, "drift": 2.1, "creep": True}
+STILL = {"holds": 16, "t": 0.6, "drift": 0.1, "creep": False}
+
+
+def _verdict(kind, effects):
+    return {
+        "kind": kind,
+        "missing_effect": effects[0] if len(effects) == 1 else None,
+        "missing_effects": list(effects),
+        "mechanism": effects[0] if kind == "form_imperfect" else None,
+        "conclusion": f"{kind}: {' + '.join(effects)}",
+        "try_next": [],
+    }
+
+
+@pytest.mark.parametrize("kind", ["missing_effect", "form_imperfect", "missing_pair"])
+def test_creep_overrules_a_verdict_that_names_only_rate_independent_effects(kind):
+    effects = ["friction_hysteresis", "joint_clearance"] if kind == "missing_pair" else ["friction_hysteresis"]
+    v = creep_overrules(_verdict(kind, effects), CREEP, lambda name: name == "pretension_loss")
+    assert v["kind"] == "not_explained" and v["missing_effects"] == [] and v["mechanism"] is None
+    assert "keeps moving while the load is held" in v["conclusion"] and "t = 7.4 over 16 holds" in v["conclusion"]
+    assert v["time_dependence"]["creep"] is True
+
+
+def test_a_time_dependent_answer_or_still_holds_leave_the_verdict_alone():
+    v0 = _verdict("missing_effect", ["pretension_loss"])
+    assert creep_overrules(v0, CREEP, lambda name: name == "pretension_loss")["kind"] == "missing_effect"
+    v1 = _verdict("missing_effect", ["friction_hysteresis"])
+    v = creep_overrules(v1, STILL, lambda name: False)
+    assert v["kind"] == "missing_effect" and v["conclusion"] == v1["conclusion"]
+    assert v["time_dependence"] == STILL
+
+
+def test_which_effects_read_the_time():
+    from femast.experiments import get_experiment
+
+    exp = get_experiment("mast-top")
+    assert reads_time(exp, "pretension_loss")
+    assert not reads_time(exp, "friction_hysteresis") and not reads_time(exp, "friction_hysteresis/iwan")
+    assert not reads_time(exp, "no_such_effect")
+
+
+def test_a_yield_plateau_under_displacement_control_is_no_hold():
+    # a connection driven through displacement cycles: past yield its force stays nearly flat while
+    # the displacement moves on at the drive's rate -- rate-independent, no creep
+    u, _ = conn.cyclic_protocol((1e-3, 2e-3, 3e-3, 4e-3), step=0.04e-3)
+    F = conn.bwbn_driven(u, conn.BWBN(), substeps=8)  # smooth Bouc-Wen: 5 % post-yield stiffness
+    for seed in range(3):
+        rng = np.random.default_rng(seed)
+        Fm, um = F + rng.normal(0, 20.0, F.size), u + rng.normal(0, 20e-6, u.size)
+        out = hold_drift(Fm, {"u_m": um}, {"u_m": 20e-6}, noise_load=20.0)
+        assert not out["creep"], (seed, out)

@@ -10,6 +10,7 @@ module                  rig
 ``tip_cycle``           ADAM mast under tip load cycles (FE)
 ``vibration``           natural frequencies of a prestressed bay side (FE modal)
 ``platform_pose``       cable-robot platform on compliant masts (Rocaspect)
+``joint_test``          a connection's cyclic test: force (moment) in, displacement (rotation) out
 ======================  ======================================================================
 
 :mod:`femast.experiments.rigs.synthetic` generates data with hidden effects from their models.
@@ -18,7 +19,7 @@ The registry imports this package on first use; it registers each rig's ``EXPERI
 
 from femast.experiments import register_experiment
 
-from . import bay_torsion, latch_pull, mast_top, platform_pose, tip_cycle, vibration
+from . import bay_torsion, joint_test, latch_pull, mast_top, platform_pose, tip_cycle, vibration
 
-for _rig in (mast_top, latch_pull, bay_torsion, tip_cycle, vibration, platform_pose):
+for _rig in (mast_top, latch_pull, bay_torsion, tip_cycle, vibration, platform_pose, joint_test):
     register_experiment(_rig.EXPERIMENT)
