@@ -79,6 +79,7 @@ def worker_main(conn, initializer, initargs) -> None:
     from . import jit
 
     jit.notice_to(lambda: conn.send_bytes(COMPILING))  # (from the task's thread, between its replies)
+    _thread_lock_for_progress_bars()
     if initializer is not None:
         initializer(*pickle.loads(initargs))
     conn.send_bytes(dumps(None))  # ready: a task's time-out counts from now on
@@ -103,6 +104,16 @@ def worker_main(conn, initializer, initargs) -> None:
         except (EOFError, OSError):
             break
     os._exit(0)  # no exit handlers of the task code (thread pools of numba, tqdm monitors)
+
+
+def _thread_lock_for_progress_bars() -> None:
+    """tqdm guards its bars with a multiprocessing lock (a named semaphore) by default; a worker
+    ends with ``os._exit``, which never releases it, and the resource tracker then warns of "leaked
+    semaphore objects" when the user's command ends.  A worker's bars are its own, so a thread lock
+    is enough (tqdm's public ``set_lock``)."""
+    import tqdm
+
+    tqdm.tqdm.set_lock(threading.RLock())
 
 
 def _portable(exc: BaseException) -> BaseException:

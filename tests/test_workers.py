@@ -171,3 +171,30 @@ def test_workers_that_never_get_set_up_end_the_pool_with_an_error():
     with workers.Pool(2, initializer=_never_returns, start_timeout_s=5.0, name="test") as pool:
         with pytest.raises(WorkerDied, match="as they start"):
             pool.submit(_square, 3).result(timeout=600)
+
+
+BAR_IN_A_WORKER = textwrap.dedent(
+    """
+    from tqdm import tqdm
+
+    from femast import workers
+
+    def with_a_bar(n):
+        return sum(1 for _ in tqdm(range(n), disable=False))
+
+    if __name__ == "__main__":
+        with workers.Pool(2) as pool:
+            print(list(pool.map(with_a_bar, [3, 4])))
+    """
+)
+
+
+def test_progress_bars_in_workers_leave_no_semaphore_behind(tmp_path):
+    """A task that draws a tqdm bar (an FE run inside a refit does) must not leave a named semaphore
+    for the resource tracker to warn about when the user's command ends."""
+    (tmp_path / "bars.py").write_text(BAR_IN_A_WORKER)
+    p = subprocess.run(
+        [sys.executable, "bars.py"], cwd=tmp_path, capture_output=True, text=True, timeout=300, check=True
+    )
+    assert p.stdout.strip().splitlines()[-1] == "[3, 4]"
+    assert "leaked semaphore" not in p.stderr
