@@ -190,7 +190,7 @@ def test_unknown_and_pending_experiments(tmp_path):
     with pytest.raises(
         ModelError,
         match=r"unknown experiment 'mast' \(did you mean 'mast-top'\?\); accepted: mast-top, latch-pull, bay-torsion, "
-        r"tip-cycle, vibration, platform-pose or the path of a Python script",
+        r"tip-cycle, vibration, platform-pose, joint-test or the path of a Python script",
     ):
         get_experiment("mast")
     # an experiment may be registered with its data format before its model exists (model=None)
