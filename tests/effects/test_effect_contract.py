@@ -8,43 +8,12 @@ only (``u = F / k + clip(F / k_c, -g, g)``).
 
 import numpy as np
 import pytest
+from two_axis_rig import RIG  # the user rig of docs/your_own_rig.md's kind, shared with the experiments tests
 
 from femast.effects import Effect, Implementation, Parameter, Quantity, register_effect, resolve, unregister_effect
 from femast.effects.base import forms_of
 from femast.errors import ModelError
 from femast.experiments import Column, Experiment, fit, from_arrays, get_experiment, predict
-
-
-def _model(params, data, effects, options):
-    F = np.column_stack([data["Fx_N"], data["Fy_N"]])
-    F_eff = effects.apply("load", F) if effects else F
-    u = F_eff / np.array([params["k_x"], params["k_y"]])
-    if effects:
-        u = effects.apply("displacement", u)
-    return {"ux_mm": 1e3 * u[:, 0], "uy_mm": 1e3 * u[:, 1]}
-
-
-RIG = Experiment(
-    name="two-axis-joint",
-    title="a connection loaded about two axes",
-    columns=(
-        Column("Fx_N", "N", "force along x"),
-        Column("Fy_N", "N", "force along y"),
-        Column("ux_mm", "mm", "displacement along x"),
-        Column("uy_mm", "mm", "displacement along y"),
-    ),
-    channels=("ux_mm", "uy_mm"),
-    parameters=(
-        Parameter("k_x", "N/m", 1e6, 1e3, 1e9, "stiffness along x"),
-        Parameter("k_y", "N/m", 1e6, 1e3, 1e9, "stiffness along y"),
-    ),
-    model=_model,
-    quantities={
-        "load": Quantity("N", axes=("x", "y"), scale=1e3, doc="force on the connection"),
-        "displacement": Quantity("m", axes=("x", "y"), scale=1e-3, doc="displacement of the connection"),
-    },
-    error_unit="mm",
-)
 
 
 def _data(gap_x=2e-4, noise_mm=5e-3, n=400, seed=3):
