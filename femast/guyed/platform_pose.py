@@ -289,12 +289,16 @@ def solve_pose(
     z0=None,
     method: str = "barycenter",
     J=None,
+    control=None,
 ) -> PoseSolution:
     """Equilibrium of platform, cables and masts at the commanded pose ``pose_c`` ([x, y, z] m, angles rad).
 
     tau : commanded tensions (N) or None (Eq. 2 distribution).  w_cal : (n, 6) mast wrenches at
     calibration (default: zero, i.e. displacements from the unloaded masts).  delta : (n, 6) nonlinear
-    remainder of FE masts (m, rad).  z0 : start (from the previous pose of a trajectory).
+    remainder of FE masts (m, rad).  z0 : start (from the previous pose of a trajectory, or the same
+    pose in the previous pass).  J : a Jacobian of the unknowns to start from.  control : what
+    :func:`controller` returned for this pose (it depends on the commanded pose and tensions only;
+    a trajectory computes it once per pose for all its passes).
     An infeasible pose is returned with ``feasible=False`` and the reason, not raised."""
     g = robot.geom
     p = np.asarray(pose_c, float).ravel()
@@ -315,7 +319,9 @@ def solve_pose(
                 "a cable cannot push"
             )
     try:
-        tau_c, l0 = controller(robot, p, tau, method)
+        tau_c, l0 = controller(robot, p, tau, method) if control is None else control
+        if isinstance(tau_c, ModelError):
+            raise tau_c
     except ModelError as exc:
         return PoseSolution(
             nan,
@@ -377,11 +383,27 @@ class TrajectoryResult:
         return np.linalg.norm(self.error[:, 3:], axis=1)
 
 
-def _pass(robot, masts, poses, tau, w_cal, delta, method, progress):
+def _controls(robot, poses, tau, method) -> list:
+    """:func:`controller` at every pose of a trajectory: ``(tau_c, l0)``, or ``(error, None)`` where it
+    has no tension distribution (the pose is then infeasible in every pass)."""
+    out = []
+    for k, p in enumerate(poses):
+        try:
+            out.append(controller(robot, p, None if tau is None else tau[k], method))
+        except ModelError as exc:
+            out.append((exc, None))
+    return out
+
+
+def _pass(robot, masts, poses, tau, w_cal, delta, method, progress, controls, previous=None):
+    """One pass along the trajectory: each pose starts from the previous pose's solution, or, given
+    the ``previous`` pass, from its own solution there (the passes differ by a small remainder)."""
     sols = []
     z = J = None
     it = poses if progress is None else progress(poses)
     for k, p in enumerate(it):
+        if previous is not None and previous[k].feasible:
+            z, J = previous[k]._z, previous[k]._J
         s = solve_pose(
             robot,
             masts,
@@ -392,6 +414,7 @@ def _pass(robot, masts, poses, tau, w_cal, delta, method, progress):
             z0=z,
             method=method,
             J=J,
+            control=controls[k],
         )
         if s.feasible:
             z, J = s._z, s._J
@@ -454,7 +477,8 @@ def pose_trajectory(
         raise ModelError(f"the calibration pose is infeasible: {c0.reason}")
     w_cal = c0.wrench
     delta = None
-    sols = _pass(robot, masts, poses, tensions, w_cal, delta, method, progress)
+    controls = _controls(robot, poses, tensions, method)
+    sols = _pass(robot, masts, poses, tensions, w_cal, delta, method, progress, controls)
     passes = 0
     if masts.fe is not None and response is None:
         response = _fe_response(masts)
@@ -482,7 +506,7 @@ def pose_trajectory(
             dc_prev = dc
             if change < fe_tol:
                 break  # the tops of the last pass are those of the response: converged
-            sols = _pass(robot, lin, poses, tensions, w_cal, delta, method, progress)
+            sols = _pass(robot, lin, poses, tensions, w_cal, delta, method, progress, controls, sols)
     pick = lambda key: np.array([getattr(s, key) for s in sols])  # noqa: E731
     return TrajectoryResult(
         poses,
