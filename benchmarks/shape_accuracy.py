@@ -90,9 +90,10 @@ def params_for(seat: str) -> BayParameters:
     return BayParameters(seat=seat)
 
 
-def sample_run(n_bays: int, cycles: int, seat: str = "seated", only=None):
+def sample_run(n_bays: int, cycles: int, seat: str = "seated", only=None, increments: int = 1):
     """The run function of the study: one sample -> tip position (m) and rotation (rad) per level.
-    ``only``: the fields that scatter (the others stay nominal); None: all."""
+    ``only``: the fields that scatter (the others stay nominal); None: all.  ``increments``: per
+    Table 1 step."""
     nominal = {field: 0.5 * (lo + hi) for _, field, lo, hi, *_ in stated_inputs(n_bays)}
 
     def run(mu, latch_k, latch_mu, pretension, longeron_dL, batten_dL, arm_dL, cable_dL):
@@ -108,7 +109,7 @@ def sample_run(n_bays: int, cycles: int, seat: str = "seated", only=None):
         )
         if only is not None:
             values = {k: (v if k in only else np.full(np.shape(v), nominal[k])) for k, v in values.items()}
-        h = tip_history(n_bays, values, cycles=cycles, params=params_for(seat))
+        h = tip_history(n_bays, values, cycles=cycles, params=params_for(seat), increments=increments)
         return {
             "tip_u": h["u"],
             "tip_rot": h["theta"],
@@ -120,11 +121,18 @@ def sample_run(n_bays: int, cycles: int, seat: str = "seated", only=None):
 
 
 def make_study(
-    n_bays: int, cycles: int, sensitivity: bool, seed: int = 1, seat: str = "seated", sampler="mc", only=None
+    n_bays: int,
+    cycles: int,
+    sensitivity: bool,
+    seed: int = 1,
+    seat: str = "seated",
+    sampler="mc",
+    only=None,
+    increments: int = 1,
 ):
     inputs = [st.Uniform(field, lo, hi, size=size) for _, field, lo, hi, size, _ in stated_inputs(n_bays)]
     return st.Study(
-        run=sample_run(n_bays, cycles, seat, only),
+        run=sample_run(n_bays, cycles, seat, only, increments),
         inputs=inputs,
         outputs=["tip_u", "tip_rot", "iterations", "cutbacks"],
         sampler="sobol" if sensitivity else sampler,
@@ -165,14 +173,16 @@ def local_dask(workers: int):
 
 
 def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=False, big=False, opts=None):
-    o = dict(seat="seated", sampler="mc", dask=False, only=None) | (opts or {})
+    o = dict(seat="seated", sampler="mc", dask=False, only=None, increments=1) | (opts or {})
     t0 = time.perf_counter()
     folder = out / (f"bays{n_bays}" if sensitivity else f"bays{n_bays}_plain")
-    nominal = tip_history(n_bays, None, cycles=cycles, params=params_for(o["seat"]))
+    nominal = tip_history(n_bays, None, cycles=cycles, params=params_for(o["seat"]), increments=o["increments"])
     if report_only:  # the runs are on disk (an earlier call): statistics and figures only
         summary = "results read from disk (--report-only)"
     else:
-        study = make_study(n_bays, cycles, sensitivity, seat=o["seat"], sampler=o["sampler"], only=o["only"])
+        study = make_study(
+            n_bays, cycles, sensitivity, seat=o["seat"], sampler=o["sampler"], only=o["only"], increments=o["increments"]
+        )
         if o["dask"]:
             client, cluster = local_dask(workers)
             try:
@@ -388,6 +398,7 @@ def main(argv=None):
     ap.add_argument("--big", type=int, default=350, help="bays of the long mast, a few plain samples (0: none)")
     ap.add_argument("--big-samples", type=int, default=4)
     ap.add_argument("--cycles", type=int, default=1, help="Table 1 cycles after deployment")
+    ap.add_argument("--increments", type=int, default=1, help="increments per Table 1 step (the friction path)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default="results/shape_accuracy")
     ap.add_argument("--docs", action="store_true", help="copy the figures to docs/figures/")
@@ -399,7 +410,7 @@ def main(argv=None):
     for g, field, lo, hi, _size, unit in stated_inputs(10):
         print(f"  {g:15s} {field:12s} [{lo:.4g}, {hi:.4g}] {unit}")
     results = []
-    opts = dict(seat=args.seat, sampler=args.sampler, only=args.only)
+    opts = dict(seat=args.seat, sampler=args.sampler, only=args.only, increments=args.increments)
     print(f"ball joints: {args.seat}" + (f"; scattered: {', '.join(args.only)} only" if args.only else ""))
     samples = args.samples if len(args.samples) == len(args.bays) else [args.samples[0]] * len(args.bays)
     for n, ns in zip(args.bays, samples):

@@ -57,7 +57,11 @@ def add_initial_steps(
     """The initial step of Stohlman & Pellegrino, Sec. II.C: the deployed, pretensioned structure comes to
     equilibrium with its cable pretensions under viscous stabilisation (step ``pretension``); the
     steps added after it have no stabilisation (the seed: "no stabilization is used after the
-    initial stable state is achieved").
+    initial stable state is achieved").  The members' length errors (a scattered mast's lack of fit,
+    ``build_mast(scatter=...)``) grow over the same step with the step time
+    (``step.ramp_length_errors()``): applied in full at its start, the misfit of some scattered
+    masts pressed longerons into their seats by tens of micrometres against the penalty in the
+    first increment, which no cutback could make smaller, and the step failed at time 0.
 
     hold_control : DOF names of the control node held at zero from the start (e.g. ``("ux", "uy",
     "rz")`` for the bay test, where the loading rig holds the top frame).
@@ -67,7 +71,7 @@ def add_initial_steps(
     soft mode (a longeron spin held by the joint springs) amplifies it.
     Returns the steps.  The stabilisation energy ratio is in ``analysis.summary.steps[0]``."""
     st = stabilize if stabilize is not None else stabilize_for(am)
-    s1 = am.model.step("pretension", stabilize=st, initial_increment=1.0, max_increments=50)
+    s1 = am.model.step("pretension", stabilize=st, initial_increment=1.0, max_increments=50).ramp_length_errors()
     if hold_control:
         s1.prescribe(am.control, **{d: 0.0 for d in hold_control})
     if not settle:
