@@ -181,7 +181,13 @@ def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=Fal
         summary = "results read from disk (--report-only)"
     else:
         study = make_study(
-            n_bays, cycles, sensitivity, seat=o["seat"], sampler=o["sampler"], only=o["only"], increments=o["increments"]
+            n_bays,
+            cycles,
+            sensitivity,
+            seat=o["seat"],
+            sampler=o["sampler"],
+            only=o["only"],
+            increments=o["increments"],
         )
         if o["dask"]:
             client, cluster = local_dask(workers)
