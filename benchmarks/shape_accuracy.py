@@ -115,6 +115,7 @@ def sample_run(n_bays: int, cycles: int, seat: str = "seated", only=None, increm
             "tip_rot": h["theta"],
             "iterations": float(h["iterations"]),
             "cutbacks": float(h["cutbacks"]),
+            "settle_force": h["settle_force"],
         }
 
     return run
@@ -134,7 +135,7 @@ def make_study(
     return st.Study(
         run=sample_run(n_bays, cycles, seat, only, increments),
         inputs=inputs,
-        outputs=["tip_u", "tip_rot", "iterations", "cutbacks"],
+        outputs=["tip_u", "tip_rot", "iterations", "cutbacks", "settle_force"],
         sampler="sobol" if sensitivity else sampler,
         seed=seed,
         sensitivity=sensitivity,
@@ -206,6 +207,7 @@ def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=Fal
     else:
         m = metrics(u, th, nominal["u"], nominal["theta"])
     cpu = res.table(["seconds"])["seconds"]
+    settle = res.output("settle_force") if "settle_force" in res.output_names else np.array([])
     sob = {}
     if sensitivity:
         fA, fB, fAB, dropped = res.saltelli("tip_u")
@@ -231,6 +233,7 @@ def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=Fal
         "failures": res.failures(),
         "counts": res.counts(),
         "run_seconds": cpu,
+        "settle_force": settle,
         "wall_s": time.perf_counter() - t0,
     }
 
@@ -468,6 +471,11 @@ def main(argv=None):
             f"  per run: median {np.median(sec):.2f} s, max {np.max(sec):.2f} s; failed runs {len(r['failures'])}"
             + (f" (first: {r['failures'][0][1][:120]})" if r["failures"] else "")
         )
+        if len(r["settle_force"]):
+            print(
+                f"  deployed states in equilibrium: largest viscous force left {np.nanmax(r['settle_force']):.2g} N "
+                "(the force tolerance is ~0.01 N)"
+            )
         row = {
             "n_bays": n,
             "length_m": n * BayParameters().l,
