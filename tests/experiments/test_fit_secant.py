@@ -118,9 +118,10 @@ def test_multistart_polishes_only_the_best_start(monkeypatch):
     (a finite-difference Jacobian at the solution, for the covariance): the others are discarded."""
     from femast.experiments import fe_jacobian
     from femast.experiments.fit_problem import FitProblem
+    from femast.experiments.prediction import parameter_specs
 
     exp, data = _experiment(), _data(seed=7)
-    specs = fitting._specs(exp, [])
+    specs = parameter_specs(exp, [])
     pb = FitProblem(exp, data, specs, None, False, None, None)
     starts = [np.array([1.5, 0.8]), np.array([5.0, 0.05]), np.array([0.3, 6.0])]
     polished = []
