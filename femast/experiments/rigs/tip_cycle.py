@@ -49,10 +49,7 @@ Options: ``n_bays`` (40: the paper's 6.84 m mast; 2-8 for fast studies), ``fold`
 (dict of further :class:`~femast.adam.BayParameters` changes), ``max_fe_rows`` (60: longer files are run through
 the turning points of the load and rows spread along the path, and interpolated between them),
 ``cache_dir`` (None; see :mod:`femast.experiments.fe_cache`), ``threads`` (1, numba threads of
-parallel kernels during a run, see :class:`~femast.experiments.fe_cache.kernel_threads`),
-``fe_reference`` (None: ``{cable_EA}`` of a reference run whose converged increments start every run's,
-:mod:`femast.experiments.fe_reference`; a fit sets it to its start: about 40 % fewer Newton
-iterations per run).
+parallel kernels during a run, see :class:`~femast.experiments.fe_cache.kernel_threads`).
 
 The overall error is in m at the tip: rotations are weighted by the 40-bay length, 6.84 m,
 whatever ``n_bays`` (``channel_weights``); fits whiten every channel by its own noise, so the
@@ -78,8 +75,7 @@ import numpy as np
 from femast import progress
 from femast.errors import ConvergenceError, FemastError, ModelError
 from femast.experiments.core import Column, Experiment, Measured, Parameter, prepared
-from femast.experiments.fe_cache import kernel_threads
-from femast.experiments.fe_reference import cached_run
+from femast.experiments.fe_cache import cached, kernel_threads
 from femast.experiments.residuals import turning_points
 
 from .bay_torsion import LATCH_FIELDS, bay_parameters
@@ -151,14 +147,8 @@ def run_mast(
     alternate: bool = True,
     increments: int = 1,
     threads: int | None = 1,
-    reference=None,
-    record_path=None,
 ) -> dict:
     """One FE run of the mast through the load states ``loads`` (m, 6) (uncached).
-
-    reference : a :class:`~femast.analysis.reference.ReferencePath` of another run of the mast whose
-    converged increments start this run's, or None.  record_path : a ReferencePath that records this
-    run's converged increments, or None.
 
     Returns ``motion`` (m, 6) = [ux, uy, uz (m), rx, ry, rz (rad)] of the control node relative to
     the pretensioned state, ``bead`` (m, n_bays, 4) bead positions (m), ``zone`` (m, n_bays, 4),
@@ -211,15 +201,7 @@ def run_mast(
             )
         )
 
-    an = Analysis(
-        am.model,
-        None,
-        progress=False,
-        convergence=CONVERGENCE,
-        on_frame=record,
-        observers=[record_path] if record_path is not None else (),
-    )  # no files
-    an.reference = reference
+    an = Analysis(am.model, None, progress=False, convergence=CONVERGENCE, on_frame=record)  # no files
     with kernel_threads(threads):
         an.run()
     i_ref = max(i for i, s in enumerate(steps) if not s.startswith("row"))
@@ -242,33 +224,25 @@ def run_mast(
     }
 
 
-def solve(inputs: dict, loads: np.ndarray, options: dict, reference=None) -> dict:
-    """:func:`run_mast`, cached; a failed run raises ModelError (a ValueError: a fit rejects the parameters).
-
-    reference : ``(inputs, loads)`` of a reference run whose converged increments start this run's
-        (:mod:`femast.experiments.fe_reference`; part of the cache key), or None."""
-    rest = (
+def solve(inputs: dict, loads: np.ndarray, options: dict) -> dict:
+    """:func:`run_mast`, cached; a failed run raises ModelError (a ValueError: a fit rejects the parameters)."""
+    key = (
+        inputs,
+        np.asarray(loads, float),
         int(options["n_bays"]),
         int(options["fold"]),
         bool(options["alternate"]),
         int(options["increments_per_row"]),
     )
-    key = (inputs, np.asarray(loads, float), *rest)
-    ref_key = None
-    if reference is not None and np.array_equal(np.asarray(reference[1], float), key[1]):
-        # (other loads -- an effect on the tip loads -- run without: the increments differ)
-        ref_key = (dict(reference[0]), np.asarray(reference[1], float), *rest)
 
-    def run(parts, reference=None, record=None):
+    def compute():
         progress.tick("FE runs")
         try:
-            return run_mast(
-                parts[0], parts[1], *rest, threads=options.get("threads", 1), reference=reference, record_path=record
-            )
+            return run_mast(inputs, loads, *key[2:], threads=options.get("threads", 1))
         except (ConvergenceError, FemastError) as e:
             return {"error": f"tip-cycle FE run failed: {e}"}
 
-    out = cached_run("tip-cycle", key, ref_key, run, options)
+    out = cached("tip-cycle", key, compute, options)
     if "error" in out:
         raise ModelError(out["error"])
     return out
@@ -283,11 +257,10 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
     if effects:
         inputs = effects.apply("bay_parameters", inputs, **ctx)
     rows = prep["rows"]
-    loads0 = loads = prep["loads"][rows]
+    loads = prep["loads"][rows]
     if effects:
         loads = effects.apply("tip_loads", loads, bay=inputs, **ctx)
-    ref = options.get("fe_reference")
-    fe = solve(inputs, loads, options, None if ref is None else (mast_inputs(dict(ref), options), loads0))
+    fe = solve(inputs, loads, options)
     mo = fe["motion"]
     if rows.size != data.n:
         mo = np.column_stack([np.interp(prep["s"], prep["s"][rows], mo[:, j]) for j in range(6)])
@@ -358,7 +331,6 @@ EXPERIMENT = Experiment(
         "max_fe_rows": 60,
         "cache_dir": None,
         "threads": 1,
-        "fe_reference": None,
     },
     hooks={
         "bay_parameters": "dict of the FE bays' inputs (BayParameters fields, latch_* for the latch law), SI",
