@@ -532,6 +532,12 @@ def main(argv=None):
             p = p95_abs(r["metrics"][name] * SCALE[unit])
             row["p95_abs"][name] = p
             print(f"  {what:45s} 95th pct of |.|: {_fmt(p, unit)}")
+            v = r["metrics"][name] * SCALE[unit]
+            if len(v):
+                print(
+                    f"  {'':45s} mean {np.mean(v):.4g}, median {np.median(v):.4g}, "
+                    f"range [{np.min(v):.4g}, {np.max(v):.4g}] {unit}"
+                )
             if name in WALK:
                 q, sc = WALK[name]
                 walk = tolerance_walk(n, params=params_for(args.seat)).quantiles(0.95)[q] * sc
