@@ -97,6 +97,17 @@ ZONE_KINDS = (
     "zone (d) no contact",
 )
 LATCH_FIELDS = ("r", "x_backstop", "k", "mu", "h", "R")
+#: fit settings of the FE rigs (bay-torsion, tip-cycle), whose every model run is an FE run:
+#: finite-difference steps above the Newton tolerance's noise, tolerances at the FE runs' accuracy,
+#: few runs per parameter, and ``expensive`` (secant Jacobians, refits in worker processes)
+FE_FIT_OPTIONS = {
+    "diff_step": 1e-3,
+    "xtol": 1e-4,
+    "ftol": 1e-4,
+    "gtol": 1e-8,
+    "max_nfev_per_param": 10,
+    "expensive": True,
+}
 
 
 # --------------------------------------------------------------------------- path
@@ -451,20 +462,13 @@ EXPERIMENT = Experiment(
     # dogbox: the candidates' parameters often end on a bound (no off-axis motion, e = 0), which trf's
     # scaling approaches by about halving the distance per step (11 FE runs for off_axis_motion); dogbox's
     # active set lands on it in one (45 -> 33 runs in the diagnosis' refits)
-    fit_options={
-        "diff_step": 1e-3,
-        "xtol": 1e-4,
-        "ftol": 1e-4,
-        "gtol": 1e-8,
-        "max_nfev_per_param": 10,
-        "expensive": True,
-        "method": "dogbox",
-    },
+    fit_options={**FE_FIT_OPTIONS, "method": "dogbox"},
     source="bay-torsion",
 )
 
 __all__ = [
     "EXPERIMENT",
+    "FE_FIT_OPTIONS",
     "ZONE_KINDS",
     "bay_inputs",
     "bay_parameters",

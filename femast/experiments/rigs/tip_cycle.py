@@ -78,7 +78,7 @@ from femast.experiments.core import Column, Experiment, Measured, Parameter, pre
 from femast.experiments.fe_cache import cached, kernel_threads
 from femast.experiments.residuals import turning_points
 
-from .bay_torsion import LATCH_FIELDS, bay_parameters
+from .bay_torsion import FE_FIT_OPTIONS, LATCH_FIELDS, bay_parameters
 
 L_MAST_40 = 6.84  # m, the 40-bay mast of Stohlman & Pellegrino, Sec. VII
 LOADS = ("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm")
@@ -345,14 +345,7 @@ EXPERIMENT = Experiment(
     channel_weights={"rx_rad": L_MAST_40, "ry_rad": L_MAST_40, "rz_rad": L_MAST_40},
     error_unit="m",
     min_rows=5,
-    fit_options={
-        "diff_step": 1e-3,
-        "xtol": 1e-4,
-        "ftol": 1e-4,
-        "gtol": 1e-8,
-        "max_nfev_per_param": 10,
-        "expensive": True,
-    },
+    fit_options=dict(FE_FIT_OPTIONS),
     source="tip-cycle",
 )
 
