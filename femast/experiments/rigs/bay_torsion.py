@@ -157,22 +157,30 @@ def _prepare(data: Measured, options: dict) -> dict:
 
 
 # --------------------------------------------------------------------------- FE run
-def bay_inputs(params: dict, options: dict) -> dict:
-    """The dict passed through the ``bay_parameters`` hook: baseline inputs of the FE bay (SI)."""
+def adam_inputs(options: dict, **inputs) -> dict:
+    """The inputs of the FE bays of an ADAM rig (bay-torsion, tip-cycle), SI: the pretension, the ball
+    joints and the latch hysteresis from the rig's options, the paper's latch law, the rig's own
+    ``inputs`` (cable EA, longeron wall), and last the option ``bay`` (BayParameters fields the user sets)."""
     from femast.adam.parameters import BayParameters
 
-    base = BayParameters()
     d = {
         "pretension": float(options["pretension_N"]),
-        "cable_EA": float(options["cable_EA_N"]),
         "mu": float(options["ball_mu"]),
         "B": float(options["ball_B_m"]),
         "hysteresis_force": 0.0,
         "hysteresis_length": float(options["latch_hysteresis_length_m"]),
+        **inputs,
     }
+    latch = BayParameters().latch
     for f in LATCH_FIELDS:
-        d[f"latch_{f}"] = float(getattr(base.latch, f))
-    d.update({k: v for k, v in dict(options.get("bay") or {}).items()})
+        d[f"latch_{f}"] = float(getattr(latch, f))
+    d.update(dict(options.get("bay") or {}))
+    return d
+
+
+def bay_inputs(params: dict, options: dict) -> dict:
+    """The dict passed through the ``bay_parameters`` hook: baseline inputs of the FE bay (SI)."""
+    d = adam_inputs(options, cable_EA=float(options["cable_EA_N"]))
     for k in ("latch_k", "latch_mu"):
         if k in params:
             d[k] = float(params[k])
@@ -469,6 +477,7 @@ EXPERIMENT = Experiment(
 __all__ = [
     "EXPERIMENT",
     "FE_FIT_OPTIONS",
+    "adam_inputs",
     "ZONE_KINDS",
     "bay_inputs",
     "bay_parameters",
