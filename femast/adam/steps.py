@@ -79,7 +79,7 @@ def add_initial_steps(
         can miss when a soft mode (a longeron spin held by the joint springs) amplifies it.
     Returns the steps.  The stabilisation energy ratio is in ``analysis.summary.steps[0]``."""
     st = stabilize if stabilize is not None else stabilize_for(am)
-    s1 = am.model.step("pretension", stabilize=st, initial_increment=1.0, max_increments=50).ramp_length_errors()
+    s1 = am.model.step("pretension", stabilize=st, initial_increment=1.0, max_increments=500).ramp_length_errors()
     if hold_control:
         s1.prescribe(am.control, **{d: 0.0 for d in hold_control})
     if not settle:

@@ -165,7 +165,7 @@ def test_active_stiffness_blocks_scale_with_the_right_dimensions():
     s = 3.0
     sh1 = ShroudSet(UPPER, LOWER, TAU0, law=None, stiffness=[1, 1, 1])
     sh3 = ShroudSet(s * UPPER, s * LOWER, TAU0, law=None, stiffness=[1, 1, 1])
-    for form, ok in (("corrected", True), ("seed", False)):
+    for form, ok in (("corrected", True), ("printed", False)):
         K1, K3 = active_stiffness(TOP, sh1, form), active_stiffness(s * TOP, sh3, form)
         expect = np.block([[K1[:3, :3] / s, K1[:3, 3:]], [K1[3:, :3], K1[3:, 3:] * s]])
         assert np.allclose(K3, expect, rtol=1e-10, atol=1e-9) == ok  # exact scaling, round-off only
