@@ -128,7 +128,7 @@ def test_compare_json_files_and_history_show_the_error_falling(tmp_path, capsys)
     assert json.loads((out / "compare.json").read_text())["version"] == 4
 
 
-def test_diagnose_json_schema_of_issue_7(tmp_path, capsys):
+def test_diagnose_json_schema(tmp_path, capsys):
     r = _run_json(capsys, ["diagnose", "mast-top", str(MT_DATA), "--out", str(tmp_path), "--json", "--workers", "1"])
     assert {"experiment", "n_samples", "noise_rms", "baseline", "ranking", "verdict"} <= set(r)
     assert {"rms", "params"} <= set(r["baseline"])
