@@ -207,10 +207,13 @@ def test_text_output(tmp_path, capsys):
 def test_parallel_refits_in_processes_match_serial():
     exp = get_experiment("mast-top")
     data = read_data(exp, MT_DATA)
-    serial = diagnose(exp, data, workers=1)
-    par = diagnose(exp, data, workers=2)
+    # three candidates (their forms: more refits than workers), no pairs or held-out stage: the refits alone
+    refits = dict(candidates=["joint_clearance", "friction_hysteresis", "cable_hysteresis"], pairs=False, heldout=False)
+    serial = diagnose(exp, data, workers=1, **refits)
+    par = diagnose(exp, data, workers=2, **refits)
     assert par.executor == "2 local processes"
     assert {f.pid for f in par.fits.values()} - {os.getpid()}  # the refits ran in worker processes
+    assert len(serial.ranking) == len(par.ranking) >= 3
     for a, b in zip(serial.ranking, par.ranking):
         assert a["effect"] == b["effect"]
         assert a["delta_bic"] == pytest.approx(b["delta_bic"], rel=1e-9, abs=1e-6)  # same deterministic fits
