@@ -265,6 +265,9 @@ def test_user_effect_script_for_a_built_in_experiment(tmp_path, capsys, request)
     assert r2["effects"] == ["thermal_drift"]
 
 
+# slow: a user's script diagnosed on dask processes with the serial result is the default suite's
+# test_diagnose_on_a_dask_cluster.py (a separate scheduler and worker, as users run it)
+@pytest.mark.slow
 def test_dask_local_cluster(spring):
     distributed = pytest.importorskip("distributed")
     script, csv = spring
