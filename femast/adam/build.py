@@ -4,10 +4,10 @@ A mast of ``n_bays`` bays has ``n_bays + 1`` square batten frames (side ``b``) a
 ``0, l, 2 l, ...``.  Each frame has four rigid corner pieces; each bay has
 
 * four longerons (corotational beams) from the bottom to the top corner pieces, joined to them by
-  friction ball joints (seed Sec. II.B.1: |M| <= mu B |F|) at the ball centres: seated by default
+  friction ball joints (Stohlman & Pellegrino, Sec. II.B.1: |M| <= mu B |F|) at the ball centres: seated by default
   (the ball sits in its socket, held there by the cables' preload: the seat carries compression and
   opens in tension; ``BayParameters.seat``), or tied (``seat="tied"``: the paper's two-way tie);
-* on each of its four sides one cable/pulley/latch assembly (seed Sec. II.B.2, Fig. 4): a unit at
+* on each of its four sides one cable/pulley/latch assembly (Stohlman & Pellegrino, Sec. II.B.2, Fig. 4): a unit at
   the centre of the side through which
 
   - one continuous cable runs from one bottom corner, through the latch, over the unit's pulley
@@ -26,15 +26,15 @@ A mast of ``n_bays`` bays has ``n_bays + 1`` square batten frames (side ``b``) a
 * Rigid corner pieces: the corner node (ball centre, where the ball joints and the cable anchors
   are) is the reference node of a rigid body that also carries the two batten ends, ``corner``
   from the ball centre along the frame edges.  The bottom frame is fixed; the top frame (corner
-  pieces and battens) is one rigid body with the *control node* at its centre as reference (seed
-  Sec. II.C: "a control node ... rigidly connected to the four corners of the top batten frame").
+  pieces and battens) is one rigid body with the *control node* at its centre as reference
+  (Stohlman & Pellegrino, Sec. II.C: "a control node ... rigidly connected to the four corners of the top batten frame").
 
 Corners are numbered k = 0..3 counter-clockwise seen from +z, corner k at polar angle
 45 + 90 k degrees (corner 0 at (+b/2, +b/2)); side k joins corners k and k+1 (side 0 is the
 side y = +b/2, side 1 x = -b/2, side 2 y = -b/2, side 3 x = +b/2).  A bay with ``fold = +1`` folds
 (stows) under a positive twist of its top frame about +z, one with ``fold = -1`` under a negative
 twist (its cable assemblies are mirror images).  ``build_mast(..., alternate=True)`` alternates the
-folding sense from bay to bay, as in the seed's mast (Sec. VIII).
+folding sense from bay to bay, as in the paper's mast (Sec. VIII).
 
 All inputs are SI (m, N, Pa, rad).
 """
@@ -98,8 +98,38 @@ class AdamModel:
 
     @property
     def latch(self) -> CableLatchFamily:
-        """The latch-cable element family of the model."""
+        """The latch-cable element family of the model (a CableDeviceFamily when the units have a bearing sheave)."""
         return next(f for f in self.model.families if f.name == self.latch_family)
+
+
+def _sheave_latch_family(latch_nodes, LA, LB, stretch, sc, p: BayParameters):
+    """The latch cables of a mast whose units' pulleys are bearing sheaves (``p.pulley``): one
+    :class:`~femast.elements.cable_devices.CableDeviceFamily` of two-section cables over a
+    :class:`~femast.elements.cable_devices.Latch` with that sheave, the same cables, pretensions,
+    beads, latches and lack of fit as the paper's element (:class:`CableLatchFamily`)."""
+    from ..elements.cable_devices import CableDeviceFamily, Latch
+
+    lat = latch_array(sc, p)  # (n, 6): r, x_backstop, k, mu, h, R per latch
+    values = {name: lat[:, i] for i, name in enumerate(("r", "x_backstop", "k", "mu", "h", "R"))}
+    if p.latch_mu_k is not None:
+        values["mu_k"] = np.minimum(p.latch_mu_k, lat[:, 3])
+    latch = Latch(
+        params=p.latch,
+        x0=-p.latch.x_backstop,
+        hysteresis_force=p.hysteresis_force,
+        hysteresis_length=p.hysteresis_length,
+        sheave=p.pulley,
+    )
+    return CableDeviceFamily(
+        np.array(latch_nodes, dtype=np.int64),
+        EA=p.cable_EA,
+        L0=(LA + LB) / stretch,
+        devices=[latch],
+        s0=(LA / stretch)[:, None],
+        device_values={0: values},
+        length_error=sc["cable_dL"].reshape(-1, 2),
+        name=LATCH_FAMILY,
+    )
 
 
 def corner_xy(b: float) -> np.ndarray:
@@ -148,7 +178,7 @@ def build_mast(
 
     params : :class:`BayParameters`; keyword ``changes`` override single parameters.
     fold : folding sense of the first (bottom) bay, +1 or -1.
-    alternate : alternate the folding sense from bay to bay (seed Sec. VIII: "the bays are
+    alternate : alternate the folding sense from bay to bay (Stohlman & Pellegrino, Sec. VIII: "the bays are
         arranged to fold in alternate directions").
     The base frame is fixed (all DOFs of its nodes); the top frame is a rigid body whose reference
     is the control node at its centre.  ``cables=False`` leaves out the cable assemblies.
@@ -284,6 +314,8 @@ def build_mast(
     fam = (
         None
         if not cables
+        else _sheave_latch_family(latch_nodes, LA, LB, stretch, sc, p)
+        if p.pulley is not None
         else CableLatchFamily(
             np.array(latch_nodes, dtype=np.int64),
             EA=p.cable_EA,

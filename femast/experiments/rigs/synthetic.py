@@ -15,10 +15,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from femast._moved import renamed
 from femast.effects import resolve
 from femast.elements.latch_law import LATCHING, UNLATCHING, latch_force
 from femast.errors import ModelError
-from femast.experiments import EffectStack, Measured, predict
+from femast.experiments.core import EffectStack, Measured
+from femast.experiments.prediction import predict
+from femast.experiments.registry import get_experiment
 
 
 def _stack(exp, effects):
@@ -46,11 +49,15 @@ def mast_top_path(
     kind : ``"cycles"`` (zero-mean force cycles along ``angle_deg`` with an amplitude that varies
         from cycle to cycle), ``"ramps"`` (piecewise-linear ramps with random turning loads, partial
         unloading and reversals away from zero), ``"rotating"`` (a force of varying magnitude whose
-        direction turns), ``"seed000"`` (the mast-1 wrench along the the Rocaspect paper, Fig. 5a trajectory,
-        repeated ``cycles`` times).
+        direction turns), ``"rocaspect_fig5a"`` (the mast-1 wrench along the trajectory of Fig. 5a of the
+        Rocaspect paper, repeated ``cycles`` times; ``"seed000"``, its old name, warns and is removed
+        in femast 0.3).
     moment_Nm : amplitude of top moments out of phase with the force (an offset attachment);
         needed to separate beam bending from joint rotation.
     """
+    if kind == "seed000":
+        renamed("mast_top_path(kind='seed000')", "mast_top_path(kind='rocaspect_fig5a')")
+        kind = "rocaspect_fig5a"
     rng = np.random.default_rng(seed)
     t = np.linspace(0.0, 1.0, n)
     a = np.radians(angle_deg)
@@ -70,7 +77,7 @@ def mast_top_path(
         ang = a + 2 * np.pi * 0.5 * cycles * t
         F = mag * np.sin(2 * np.pi * cycles * t)
         fx, fy = F * np.cos(ang), F * np.sin(ang)
-    elif kind == "seed000":
+    elif kind == "rocaspect_fig5a":
         from femast.guyed.cdpr import trajectory_loads
         from femast.guyed.rocaspect import fig5a_trajectory, rocaspect_geometry
 
@@ -81,7 +88,7 @@ def mast_top_path(
         w = np.column_stack([np.interp(tt, one, dw[:, j]) for j in range(6)])
         return dict(zip(("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"), w.T))
     else:
-        raise ModelError(f"unknown path kind {kind!r}; use cycles, ramps, rotating or seed000")
+        raise ModelError(f"unknown path kind {kind!r}; use cycles, ramps, rotating or rocaspect_fig5a")
     fz = -0.3 * np.abs(F)
     ph = 2 * np.pi * cycles * t + np.pi / 2
     mx = moment_Nm * np.sin(ph) * np.cos(a + 1.0)
@@ -101,8 +108,6 @@ def mast_top_data(
     drift_m : amplitude of a slow thermal drift of the top (m) that no effect models.
     Returns ``(data, truth)`` with ``truth`` the noise-free displacements ``{dx_m, dy_m, dz_m}``.
     """
-    from femast.experiments import get_experiment
-
     exp = experiment or get_experiment("mast-top")
     rng = np.random.default_rng(seed + 1000)
     path = path or mast_top_path(seed=seed)
@@ -146,8 +151,6 @@ def latch_pull_data(
     drift_N : a slow drift of the load cell (N) that no effect models.
     Returns ``(data, truth)`` with the true bead positions (m) and force jumps (N).
     """
-    from femast.experiments import get_experiment
-
     exp = experiment or get_experiment("latch-pull")
     o = exp.options
     p = {**exp.defaults(), **(params or {})}
@@ -257,8 +260,6 @@ def bay_torsion_data(
     params : baseline ``{latch_k, latch_mu}`` (default the paper's pull-test fit).
     drift_Nm : amplitude of a slow drift of the load cell (N m) that no effect models.
     Returns ``(data, truth)`` with ``truth`` the noise-free ``{Mz_Nm}``."""
-    from femast.experiments import get_experiment
-
     exp = experiment or get_experiment("bay-torsion")
     path = dict(path or bay_torsion_path(seed=seed))
     n = len(path["theta_deg"])
@@ -334,8 +335,6 @@ def tip_cycle_data(
 
     params : baseline ``{cable_EA}``.  drift_m : a slow drift of the tip along x and y
     (m) that no effect models.  Returns ``(data, truth)`` with the noise-free channels."""
-    from femast.experiments import get_experiment
-
     exp = experiment or get_experiment("tip-cycle")
     path = dict(path or tip_cycle_path(seed=seed))
     n = len(path["fx_N"])
