@@ -1,7 +1,8 @@
 """compare and diagnose on a long record (2 million rows by default): how long a user waits, how
 often the progress moves, how many rows are used, and what the statistics lose by using them.
 
-    python -m femast.benchmarks.long_records [--rows 2000000] [--max-rows 10000] [--workers N] [--no-reference]
+    python -m femast.benchmarks.long_records [--rows 2000000] [--max-rows 10000] [--workers N]
+                                              [--reference-rows 100000] [--no-reference]
 
 The record: a mast top (the ``mast-top`` experiment) cycled ``--rows / 12500`` times, as a logger at
 a few hundred hertz writes it over hours of quasi-static cycling, with a hidden joint clearance of
@@ -14,12 +15,11 @@ every 5 s while something long runs).  Printed per command: wall and CPU time (t
 children), the rows used of the rows read, the longest time without a line on stderr (the user's
 longest wait without news), and the result.
 
-What the statistics lose: by default (``--no-reference`` to skip it, it takes minutes) ``femast
-compare --fit`` also runs on every row; printed beside the thinned fit are the noise floor, the
-baseline parameters and their standard errors, and the clearance fitted by ``compare --effects
-joint_clearance --fit``, against the truth.  For white noise the standard errors of the thinned fit
-are sqrt(rows read / rows used) times those of the whole record, the factor printed beside the
-measured ratio.
+What the statistics lose: ``femast compare --effects joint_clearance --fit`` on the thinned record
+and on ``--reference-rows`` rows (default 100 000, ten times more; ``--no-reference`` to skip it);
+printed: the noise floor, the parameters and their standard errors against the truth, and the ratio
+of the standard errors beside sqrt(ratio of the rows) (white noise); the rows of the whole record
+would shrink them by sqrt(rows read / rows used) in all.
 """
 
 from __future__ import annotations
@@ -91,36 +91,36 @@ def run_command(args: list, folder: Path) -> dict:
     }
 
 
-def _fmt_params(params: dict) -> str:
-    return ", ".join(f"{k} = {v['value']:.5g} +- {v['stderr']:.2g}" for k, v in params.items())
-
-
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rows", type=int, default=2_000_000, help="rows of the generated record (default 2000000)")
     ap.add_argument("--max-rows", type=int, default=None, help="passed to compare and diagnose (default: theirs)")
     ap.add_argument("--workers", default=None, help="passed to diagnose --workers (default: its own choice)")
-    ap.add_argument("--no-reference", action="store_true", help="skip the fits on every row")
+    ap.add_argument("--reference-rows", type=int, default=100_000, help="rows of the reference fit (default 100000)")
+    ap.add_argument("--no-reference", action="store_true", help="skip the reference fit")
     ap.add_argument("--keep", type=Path, default=None, help="folder to keep the record and the outputs in")
     args = ap.parse_args(argv)
     folder = args.keep or Path(tempfile.mkdtemp(prefix="femast-long-records-"))
     folder.mkdir(parents=True, exist_ok=True)
-    csv = folder / "mast_top_long.csv"
+    csv = folder / f"mast_top_{args.rows}_rows.csv"
     print(f"load average {' '.join(f'{v:.2f}' for v in os.getloadavg())} on {os.cpu_count()} CPUs")
     if not csv.is_file() or args.keep is None:
         s = write_record(csv, args.rows)
         print(f"record: {args.rows} rows of mast-top, {csv.stat().st_size / 1e6:.0f} MB, written in {s:.0f} s")
     limit = [] if args.max_rows is None else ["--max-rows", str(args.max_rows)]
-    every = ["--max-rows", str(args.rows)]
+    more = ["--max-rows", str(args.reference_rows)]
     clearance = ["--effects", "joint_clearance"]
     runs = {  # name: (command, its own output folder, options)
         "compare --fit": ("compare", "compare", ["--fit", *limit]),
         "diagnose": ("diagnose", "diagnose", [*limit, *([] if args.workers is None else ["--workers", args.workers])]),
     }
     if not args.no_reference:
-        runs["compare --fit, every row"] = ("compare", "every", ["--fit", *every])
         runs["compare clearance --fit"] = ("compare", "clearance", ["--fit", *clearance, *limit])
-        runs["compare clearance --fit, every row"] = ("compare", "clearance_every", ["--fit", *clearance, *every])
+        runs[f"compare clearance --fit, {args.reference_rows} rows"] = (
+            "compare",
+            "clearance_more",
+            ["--fit", *clearance, *more],
+        )
     results = {}
     print(f"{'command':<36s} {'wall s':>7s} {'CPU s':>7s} {'rows used':>17s} {'longest silence s':>18s}")
     for name, (command, out, options) in runs.items():
@@ -134,18 +134,20 @@ def main(argv=None) -> None:
     print(f"diagnose says: {thinning[0].split(': ', 1)[-1] if thinning else '(nothing about thinning)'}")
     if args.no_reference:
         return
-    a, b = results["compare --fit"]["report"], results["compare --fit, every row"]["report"]
-    print("what the statistics lose (thinned record against every row; truth in brackets):")
+    a = results["compare clearance --fit"]["report"]
+    b = results[f"compare clearance --fit, {args.reference_rows} rows"]["report"]
+    print(f"what the statistics lose: {a['n_samples']} rows against {b['n_samples']} (truth in brackets):")
     print(f"  noise floor: {a['noise_rms'] * 1e6:.2f} um against {b['noise_rms'] * 1e6:.2f} um [{NOISE_M * 1e6:g} um]")
-    print(f"  baseline thinned:   {_fmt_params(a['params'])}")
-    print(f"  baseline every row: {_fmt_params(b['params'])}")
-    ca, cb = results["compare clearance --fit"]["report"], results["compare clearance --fit, every row"]["report"]
-    print(f"  clearance thinned:   {_fmt_params(ca['params'])}")
-    print(f"  clearance every row: {_fmt_params(cb['params'])}  [c = {CLEARANCE_RAD:g} rad]")
+    truth = {**TRUTH, "joint_clearance.c": CLEARANCE_RAD}
     expected = np.sqrt(b["n_samples"] / a["n_samples"])
-    for key in cb["params"]:
-        ratio = ca["params"][key]["stderr"] / cb["params"][key]["stderr"]
-        print(f"  standard error of {key}: x{ratio:.1f} thinned (white noise: x{expected:.1f})")
+    for key, pa in a["params"].items():
+        pb = b["params"][key]
+        print(
+            f"  {key}: {pa['value']:.5g} +- {pa['stderr']:.2g} against {pb['value']:.5g} +- {pb['stderr']:.2g} "
+            f"[{truth[key]:.5g}]; standard error x{pa['stderr'] / pb['stderr']:.2f} (white noise: x{expected:.2f})"
+        )
+    whole = np.sqrt(args.rows / a["n_samples"])
+    print(f"  every row of the record would shrink the standard errors of the thinned fit by ~{whole:.0f}x")
     print(f"load average {' '.join(f'{v:.2f}' for v in os.getloadavg())} on {os.cpu_count()} CPUs")
 
 
