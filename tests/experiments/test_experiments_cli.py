@@ -151,22 +151,8 @@ def test_diagnose_json_schema(tmp_path, capsys):
     assert {"noise_model", "n_eff", "pairs", "form_check"} <= set(r)
     assert {"form", "forms", "ic_gain", "share_ok"} <= set(r["ranking"][0])
     assert (tmp_path / "diagnose.png").stat().st_size > 0 and (tmp_path / "diagnose.json").is_file()
-    r = _run_json(
-        capsys,
-        [
-            "diagnose",
-            "mast-top",
-            str(MT_DATA),
-            "--out",
-            str(tmp_path),
-            "--json",
-            "--effects",
-            "joint_clearance",
-            "--workers",
-            "1",
-        ],
-    )
-    assert r["verdict"]["missing_effect"] == "friction_hysteresis" and r["verdict"]["explained"] is True
+    # with joint_clearance in the model, friction_hysteresis is what is missing: the tutorial quotes that
+    # diagnosis (docs/compare_and_diagnose.md, test_experiments_docs.py), not run a second time here
 
 
 def test_text_output(tmp_path, capsys):
