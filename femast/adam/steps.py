@@ -32,8 +32,8 @@ TABLE1_F = 14.0  # N along x
 # docs/adam_mast.md, benchmarks/friction_convergence.py).
 TABLE1_INCREMENTS = 32
 #: Damping of the ``equilibrium`` step of :func:`add_initial_steps` relative to the pretension step's: a
-#: regularisation whose largest viscous force in the step is ~1e-8 N on the scattered 40-bay masts (the
-#: convergence test's force tolerance is ~0.01 N), so the step ends in equilibrium; without it the Newton
+#: regularisation whose viscous force left at the end of the step is below 1e-4 N on 64 scattered 40-bay
+#: masts (the convergence test's force tolerance is ~0.01 N), so the step ends in equilibrium; without it the Newton
 #: iterates of some scattered masts cycle (a seat or a joint's stick/slip switching and back) and every
 #: cutback repeats the same iterations, since nothing in the step depends on the increment.
 SETTLE_DAMPING = 1e-3
@@ -62,7 +62,7 @@ def add_initial_steps(
 ):
     """The initial step of Stohlman & Pellegrino, Sec. II.C: the deployed, pretensioned structure comes to
     equilibrium with its cable pretensions under viscous stabilisation (step ``pretension``); the
-    load steps added after it have no stabilisation (the seed: "no stabilization is used after the
+    load steps added after it have no stabilisation (the paper: "no stabilization is used after the
     initial stable state is achieved"; ``settle`` below is an equilibrium step).  The members' length errors (a scattered mast's lack of fit,
     ``build_mast(scatter=...)``) grow over the same step with the step time
     (``step.ramp_length_errors()``): applied in full at its start, the misfit of some scattered
@@ -73,8 +73,8 @@ def add_initial_steps(
     "rz")`` for the bay test, where the loading rig holds the top frame).
     settle : also add a step ``equilibrium`` without load change whose damping is
         :data:`SETTLE_DAMPING` of the pretension step's (its largest viscous force is in
-        ``analysis.summary.steps[1]["stabilization_force"]``, N: ~1e-8 N, the step ends in
-        equilibrium).  Off by default: femast's convergence test needs a displacement correction
+        ``analysis.summary.steps[1]["stabilization_force"]``, N: below 1e-4 N on the scattered 40-bay
+        masts, the step ends in equilibrium).  Off by default: femast's convergence test needs a displacement correction
         below 1e-15 (rad or 1e-15 x model size) in a step whose increment is zero, which round-off
         can miss when a soft mode (a longeron spin held by the joint springs) amplifies it.
     Returns the steps.  The stabilisation energy ratio is in ``analysis.summary.steps[0]``."""
@@ -101,7 +101,7 @@ def add_idealised_torsion(
     max_increment: float = 0.01,
     unload: bool = True,
 ):
-    """Seed Fig. 16, idealised path: the control node turns about z from 0 to ``theta_max`` (rad)
+    """Stohlman & Pellegrino, Fig. 16, idealised path: the control node turns about z from 0 to ``theta_max`` (rad)
     in the bay's folding sense and back to 0, with x and y held (z and the tilts free).
 
     The twist is driven by displacement control of the control node's rz with a moment about z
@@ -110,7 +110,7 @@ def add_idealised_torsion(
     ``<name>-back`` (theta_max -> 0; its reference moment is a large fixed value, so that the
     pattern never vanishes whatever moment the bay holds at theta_max).  With ``unload`` a last,
     load-controlled step ``<name>-unload`` brings the moment to zero: the bay settles at its
-    residual rotation at zero moment (seed Sec. VIII).  ``max_increment``: fraction of each step.
+    residual rotation at zero moment (Stohlman & Pellegrino, Sec. VIII).  ``max_increment``: fraction of each step.
     Returns the steps."""
     from ..analysis.control import DisplacementControl
 
@@ -138,7 +138,7 @@ def add_idealised_torsion(
 
 @dataclass
 class MeasuredPath:
-    """A measured-style path of the control node (seed Sec. VI.B): step time ``t`` (s), twist
+    """A measured-style path of the control node (Stohlman & Pellegrino, Sec. VI.B): step time ``t`` (s), twist
     ``theta`` (rad), translations ``x``, ``y`` (m).  ``synthetic`` says it was generated, not
     measured; ``note`` says how."""
 
@@ -187,10 +187,10 @@ def measured_style_path(
     rng_seed: int = 1,
     sense: int = 1,
 ) -> MeasuredPath:
-    """A synthetic, measured-style path of the control node with off-axis drift (seed Sec. VI.A-B:
+    """A synthetic, measured-style path of the control node with off-axis drift (Stohlman & Pellegrino, Sec. VI.A-B:
     "displacements of up to 1 cm in the x and y directions were recorded").
 
-    The seed's measured table is not available; this path has its character: the top frame turns
+    The paper's measured table is not available; this path has its character: the top frame turns
     from 0 to ``theta_max`` and back, and as the bay loosens the centre of rotation moves from the
     bay axis to the centre of side ``hold_side`` (the bay turns about the side that stays latched),
     plus a slow translation ``drift`` (m, at theta_max).  With ``pivot`` the fraction of the way the
@@ -222,7 +222,7 @@ def measured_style_path(
 
 
 def add_measured_torsion(am: AdamModel, path: MeasuredPath, name: str = "twist", max_increment: float = 0.0125):
-    """Seed Fig. 17: drive the control node along ``path`` (theta_z, x, y); z and tilts free."""
+    """Stohlman & Pellegrino, Fig. 17: drive the control node along ``path`` (theta_z, x, y); z and tilts free."""
     period = float(path.t[-1])
     s = am.model.step(
         name,
@@ -247,9 +247,9 @@ def add_table1_steps(
     F: float = TABLE1_F,
     increments: int = TABLE1_INCREMENTS,
 ) -> list:
-    """Seed Table 1 load sequence at the control node: M+F, 0, -M-F, 0, ``cycles`` times, with
+    """Stohlman & Pellegrino, Table 1 load sequence at the control node: M+F, 0, -M-F, 0, ``cycles`` times, with
     M (N m) about z and F (N) along x.  ``increments``: increments per step, of equal size (default
-    :data:`TABLE1_INCREMENTS`, converged within 1 %; 1 is the seed's one increment per load step)."""
+    :data:`TABLE1_INCREMENTS`, converged within 1 %; 1 is the paper's one increment per load step)."""
     steps = []
     for c in range(cycles):
         for k, lab in enumerate(TABLE1_SEQUENCE):

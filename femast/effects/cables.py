@@ -70,7 +70,7 @@ PROGRESSIVE_STIFFNESS = register_effect(
         signature="the structure is stiffer than the linear model at high load and softer near zero: the error is "
         "odd in the load, largest at the load peaks",
         acts_where=("peak",),
-        seed="the Rocaspect paper, Eq. 25",
+        source="the Rocaspect paper, Eq. 25",
         mechanism=Implementation(
             hook="displacement",
             needs=("load",),
@@ -105,18 +105,25 @@ def _cable_hysteresis_iwan(L, p, ctx):
 
 
 _ETA = Parameter("eta", "-", 0.05, 0.0, 0.6, "loop half-width relative to the load", scale=0.05, starts=(0.01, 0.2))
-_ETA_IWAN = (
-    Parameter(
+
+
+def _iwan_eta(default, of, starts):
+    """eta of the Iwan form: the largest friction threshold of a rope's fibre groups, relative to ``of``."""
+    return Parameter(
         "eta",
         "-",
-        0.3,
+        default,
         0.0,
         0.99,
-        "largest friction threshold of the fibre groups relative to the load",
+        f"largest friction threshold of the fibre groups relative to the {of}",
         scale=0.1,
-        starts=(0.6, 0.95, 0.3),
-    ),
-    Parameter(
+        starts=starts,
+    )
+
+
+def _iwan_beta(starts):
+    """beta of the Iwan form: the shape of the distribution of the fibre groups' thresholds."""
+    return Parameter(
         "beta",
         "-",
         1.0,
@@ -124,8 +131,13 @@ _ETA_IWAN = (
         50.0,
         "shape of the threshold distribution P(e <= s) = (s / eta)^beta",
         scale=1.0,
-        starts=(1.0, 3.0, 0.5),
-    ),
+        starts=starts,
+    )
+
+
+_ETA_IWAN = (
+    _iwan_eta(0.3, "load", (0.6, 0.95, 0.3)),
+    _iwan_beta((1.0, 3.0, 0.5)),
     Parameter("alpha", "-", 0.1, 0.0, 0.95, "share of the load without friction", scale=0.1, starts=(0.2, 0.0, 0.1)),
 )
 
@@ -158,7 +170,7 @@ CABLE_HYSTERESIS = register_effect(
         signature="loading and unloading branches with different slopes, a loop whose width grows with the load "
         "and closes at zero; the error is largest at high load and just after reversals",
         acts_where=("peak", "reversal", "loading", "unloading"),
-        seed="Rocaspect guyed mast, Sec. IV-A, Fig. 4a",
+        source="Rocaspect guyed mast, Sec. IV-A, Fig. 4a",
         mechanism=Implementation(
             hook="load",
             order=45,
@@ -205,26 +217,8 @@ CABLE_HYSTERESIS = register_effect(
                         hook="bead_position",
                         order=45,
                         parameters=(
-                            Parameter(
-                                "eta",
-                                "-",
-                                0.5,
-                                0.0,
-                                0.99,
-                                "largest friction threshold of the fibre groups relative to the tension",
-                                scale=0.1,
-                                starts=(0.9, 0.3, 0.6),
-                            ),
-                            Parameter(
-                                "beta",
-                                "-",
-                                1.0,
-                                0.05,
-                                50.0,
-                                "shape of the threshold distribution P(e <= s) = (s / eta)^beta",
-                                scale=1.0,
-                                starts=(1.0, 4.0, 0.5),
-                            ),
+                            _iwan_eta(0.5, "tension", (0.9, 0.3, 0.6)),
+                            _iwan_beta((1.0, 4.0, 0.5)),
                             Parameter(
                                 "gain",
                                 "-",
@@ -292,7 +286,7 @@ PRETENSION = register_effect(
         "(pretension lost during the test); once the latches have released, the bay's moment is offset (a "
         "pretension set differently from the model's)",
         acts_where=("peak", "loading", "unloading", "zone (d) no contact"),
-        seed="Rocaspect guyed mast, Table III; Stohlman & Pellegrino, Eq. 16",
+        source="Rocaspect guyed mast, Table III; Stohlman & Pellegrino, Eq. 16",
         mechanism=Implementation(
             hook="displacement",
             needs=("time",),
@@ -370,7 +364,7 @@ STRETCH_ERROR = register_effect(
         signature="the measured curve is sheared along x in proportion to the force: the error is largest at the "
         "force peaks and changes sign with the force",
         acts_where=("peak",),
-        seed="Stohlman & Pellegrino, Eq. 15",
+        source="Stohlman & Pellegrino, Eq. 15",
         implementations={
             "latch-pull": Implementation(
                 hook="bead_position",

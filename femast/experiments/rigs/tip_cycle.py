@@ -78,7 +78,7 @@ from femast.experiments.core import Column, Experiment, Measured, Parameter, pre
 from femast.experiments.fe_cache import cached, kernel_threads
 from femast.experiments.residuals import turning_points
 
-from .bay_torsion import LATCH_FIELDS, bay_parameters
+from .bay_torsion import FE_FIT_OPTIONS, adam_inputs, bay_parameters
 
 L_MAST_40 = 6.84  # m, the 40-bay mast of Stohlman & Pellegrino, Sec. VII
 LOADS = ("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm")
@@ -121,19 +121,7 @@ def mast_inputs(params: dict, options: dict) -> dict:
     """The dict passed through the ``bay_parameters`` hook (baseline inputs of every bay, SI)."""
     from femast.adam.parameters import BayParameters
 
-    base = BayParameters()
-    d = {
-        "pretension": float(options["pretension_N"]),
-        "cable_EA": float(base.cable_EA),
-        "longeron_t": float(options["longeron_t_m"]),
-        "mu": float(options["ball_mu"]),
-        "B": float(options["ball_B_m"]),
-        "hysteresis_force": 0.0,
-        "hysteresis_length": float(options["latch_hysteresis_length_m"]),
-    }
-    for f in LATCH_FIELDS:
-        d[f"latch_{f}"] = float(getattr(base.latch, f))
-    d.update(dict(options.get("bay") or {}))
+    d = adam_inputs(options, cable_EA=float(BayParameters().cable_EA), longeron_t=float(options["longeron_t_m"]))
     if "cable_EA" in params:
         d["cable_EA"] = float(params["cable_EA"])
     return d
@@ -271,10 +259,10 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
 
 def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: dict) -> None:
     """Tip displacement x and tip twist (as L rz, L the mast height) against the signed tip load, mm."""
-    from femast.adam.parameters import SEED_BAY_HEIGHT
+    from femast.adam.parameters import ADAM_BAY_HEIGHT
 
     s = prepared(data, _prepare, options)["load"]
-    L = int(options["n_bays"]) * float(dict(options.get("bay") or {}).get("l", SEED_BAY_HEIGHT))
+    L = int(options["n_bays"]) * float(dict(options.get("bay") or {}).get("l", ADAM_BAY_HEIGHT))
     ax.plot(s, 1e3 * data["ux_m"], "o", ms=3.5, color="0.35", label="ux measured")
     ax.plot(s, 1e3 * predicted["ux_m"], "-", lw=1.2, color="C3", label="ux model")
     ax.plot(s, 1e3 * L * data["rz_rad"], "s", ms=3.0, color="0.6", label=f"{L:.3g} m x rz measured")
@@ -345,14 +333,7 @@ EXPERIMENT = Experiment(
     channel_weights={"rx_rad": L_MAST_40, "ry_rad": L_MAST_40, "rz_rad": L_MAST_40},
     error_unit="m",
     min_rows=5,
-    fit_options={
-        "diff_step": 1e-3,
-        "xtol": 1e-4,
-        "ftol": 1e-4,
-        "gtol": 1e-8,
-        "max_nfev_per_param": 10,
-        "expensive": True,
-    },
+    fit_options=dict(FE_FIT_OPTIONS),
     source="tip-cycle",
 )
 
