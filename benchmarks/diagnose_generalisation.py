@@ -36,7 +36,8 @@ Usage::
     python benchmarks/diagnose_generalisation.py --quick     # a smoke subset (14 runs)
     python benchmarks/diagnose_generalisation.py --cases 'lp_*,mt_friction*' --redraws 5
 
-Options: ``--workers N`` parallel processes (default 2), ``--out DIR``, ``--redraws N`` (null
+Options: ``--workers N`` worker processes (:mod:`femast.workers`; default one per CPU, 1 runs in
+this process), ``--out DIR``, ``--redraws N`` (null
 redraws, default 20), ``--quick`` (one case per mechanism family and 3 null redraws per null
 case), ``--cases`` comma-separated names or shell patterns.
 """
@@ -48,11 +49,12 @@ import fnmatch
 import json
 import os
 import resource
+import site
 import subprocess
 import sys
 import time
 import zlib
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from pathlib import Path
 
 import numpy as np
@@ -154,23 +156,32 @@ def select(patterns: str | None, quick: bool) -> list:
     return cases
 
 
-def run_all(cases, redraws: int, workers: int, progress: bool = True) -> list:
-    """Run every (case, redraw) in ``workers`` processes with a tqdm bar; rows in case order."""
+def run_all(cases, redraws: int, workers: int | None, progress: bool = True) -> list:
+    """Run every (case, redraw) with a tqdm bar: in this process for ``workers=1``, else on femast's
+    worker pool (:mod:`femast.workers`; None: one worker per CPU, at most one per run); rows in
+    case order."""
+    from femast import workers as femast_workers
+
     jobs = [(c, r) for c in cases for r in range(redraws if c.expect == "null" else c.redraws)]
+    n = 1 if workers == 1 else femast_workers.worker_count(workers, tasks=len(jobs))
     rows = []
     bar = None
     if progress:
         from tqdm import tqdm
 
         bar = tqdm(total=len(jobs), desc="diagnose runs", unit="run")
-    if workers <= 1:
+    if workers == 1:
         for c, r in jobs:
             rows.append(run_one(c, r))
             if bar:
                 bar.update()
     else:
-        with ProcessPoolExecutor(max_workers=workers) as ex:
-            futs = [ex.submit(run_one, c, r) for c, r in jobs]
+        # the workers import this file as the module ``diagnose_generalisation`` (its folder on their
+        # path), whether it runs as a script or as ``python -m femast.benchmarks...``
+        import diagnose_generalisation as this
+
+        with femast_workers.Pool(n, initializer=site.addsitedir, initargs=(str(HERE),), name="benchmark") as pool:
+            futs = [pool.submit(this.run_one, c, r) for c, r in jobs]
             for f in as_completed(futs):
                 rows.append(f.result())
                 if bar:
@@ -347,7 +358,9 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="a smoke subset with 3 null redraws")
     ap.add_argument("--cases", help="comma-separated case names or shell patterns (e.g. 'lp_*')")
     ap.add_argument("--redraws", type=int, help="noise redraws of each null case (default 20; 3 with --quick)")
-    ap.add_argument("--workers", type=int, default=2, help="parallel processes (default 2)")
+    ap.add_argument(
+        "--workers", type=int, help="worker processes (femast.workers; default: one per CPU; 1: in this process)"
+    )
     ap.add_argument("--out", default=str(HERE / "out" / "diagnose_generalisation"), help="output folder")
     ap.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     ap.add_argument(
