@@ -32,13 +32,17 @@ ON_GRID = 1e-3
 #: a grid finer than this share of the column's span is no resolution worth a floor
 FINEST = 1e-9
 MIN_VALUES = 8  # fewer readings than this: no grid is claimed
+#: fewest steps of the grid over the column's range: a coarser grid is a designed path (a protocol of
+#: prescribed levels, 0.12 deg steps of a twist), not the resolution of a recorder
+MIN_COUNTS = 100
 
 
 def resolution(values) -> float:
     """The step ``q`` (unit of the values) of the grid ``a + k q`` every finite value of ``values``
     lies on, ``a`` the smallest value: the smallest nonzero gap between distinct values, accepted
     only if every value lies on that grid (to ``ON_GRID`` of a step).  0.0 when the values lie on
-    no grid (continuous readings), take fewer than three distinct values, or are fewer than
+    no grid (continuous readings), on one of fewer than ``MIN_COUNTS`` steps over their range (a
+    designed path of prescribed levels), take fewer than three distinct values, or are fewer than
     ``MIN_VALUES``.  A column recorded to two decimals of a millimetre in metres gives 1e-5."""
     x = np.asarray(values, float).ravel()
     x = x[np.isfinite(x)]
@@ -54,6 +58,8 @@ def resolution(values) -> float:
         return 0.0
     q = float(gaps.min())
     q = span / round(span / q)  # the step that fits the whole span (the smallest gap carries round-off)
+    if span / q < MIN_COUNTS:
+        return 0.0
     k = (v - v[0]) / q
     if np.max(np.abs(k - np.round(k))) > ON_GRID:
         return 0.0

@@ -48,6 +48,7 @@ def test_resolution_is_the_step_of_the_grid():
     assert resolution(rec) == pytest.approx(Q_U, rel=1e-9)
     assert resolution(0.37 + 0.05 * np.round(x / 0.05e-3)) == pytest.approx(0.05, rel=1e-9)  # offset grid
     assert resolution(np.r_[0.0, 1.0, 2.0]) == 0.0  # too few readings to claim a grid
+    assert resolution(0.6 * (1.0 - np.abs(np.linspace(-1.0, 1.0, 11)))) == 0.0  # a designed path of 5 steps
     assert rounding_sigma(Q_U) == pytest.approx(Q_U / np.sqrt(12.0))
 
 
