@@ -126,12 +126,6 @@ def _ho(ratio, prefix: str = "") -> str:
     return f"{prefix}{ratio:.2f}" + ("x" if prefix else "")
 
 
-def _one_scale(exp: Experiment) -> bool:
-    """True if every compared channel is in the experiment's error unit, unweighted (one RMS and one
-    noise floor in that unit then compare)."""
-    return all(exp.unit_of(c) == exp.error_unit and exp.weight(c) == 1.0 for c in exp.channels)
-
-
 def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
     """Plain-text summary of a diagnosis (what ``femast diagnose`` prints)."""
     f, ul = display_scale(exp.error_unit)
@@ -141,7 +135,7 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
         f"{result.executor})",
     ]
     named = f"baseline{' + ' + '+'.join(b['effects']) if b['effects'] else ''}"
-    if _one_scale(exp):  # every channel in the error unit: one RMS and one noise floor say it
+    if exp.one_scale:  # every channel in the error unit: one RMS and one noise floor say it
         lines.append(
             f"  noise floor {f * result.noise_rms:.4g} {ul}; {named} RMS {f * b['rms']:.4g} {ul} "
             f"({b['ratio']:.2f}x noise{_ho(b.get('heldout_ratio'), '; held out ')})"

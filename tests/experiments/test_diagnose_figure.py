@@ -155,3 +155,8 @@ def test_text_gives_each_channel_in_its_own_unit():
     assert "noise floor" not in text  # no RMS of metres and radians together
     assert "ux_m: RMS error 12 mm, noise 0.9 mm (13.33x)" in text
     assert "rz_rad: RMS error 4 mrad, noise 8.8 mrad (0.45x)" in text
+
+
+def test_one_scale_only_where_every_channel_is_in_the_error_unit():
+    assert not get_experiment("tip-cycle").one_scale  # m and rad (rotations weighted by the mast length)
+    assert all(get_experiment(n).one_scale for n in ("mast-top", "latch-pull", "joint-test", "bay-torsion"))
