@@ -90,9 +90,10 @@ def params_for(seat: str) -> BayParameters:
     return BayParameters(seat=seat)
 
 
-def sample_run(n_bays: int, cycles: int, seat: str = "seated", only=None):
+def sample_run(n_bays: int, cycles: int, seat: str = "seated", only=None, increments: int = 1):
     """The run function of the study: one sample -> tip position (m) and rotation (rad) per level.
-    ``only``: the fields that scatter (the others stay nominal); None: all."""
+    ``only``: the fields that scatter (the others stay nominal); None: all.  ``increments``: per
+    Table 1 step."""
     nominal = {field: 0.5 * (lo + hi) for _, field, lo, hi, *_ in stated_inputs(n_bays)}
 
     def run(mu, latch_k, latch_mu, pretension, longeron_dL, batten_dL, arm_dL, cable_dL):
@@ -108,25 +109,33 @@ def sample_run(n_bays: int, cycles: int, seat: str = "seated", only=None):
         )
         if only is not None:
             values = {k: (v if k in only else np.full(np.shape(v), nominal[k])) for k, v in values.items()}
-        h = tip_history(n_bays, values, cycles=cycles, params=params_for(seat))
+        h = tip_history(n_bays, values, cycles=cycles, params=params_for(seat), increments=increments)
         return {
             "tip_u": h["u"],
             "tip_rot": h["theta"],
             "iterations": float(h["iterations"]),
             "cutbacks": float(h["cutbacks"]),
+            "settle_force": h["settle_force"],
         }
 
     return run
 
 
 def make_study(
-    n_bays: int, cycles: int, sensitivity: bool, seed: int = 1, seat: str = "seated", sampler="mc", only=None
+    n_bays: int,
+    cycles: int,
+    sensitivity: bool,
+    seed: int = 1,
+    seat: str = "seated",
+    sampler="mc",
+    only=None,
+    increments: int = 1,
 ):
     inputs = [st.Uniform(field, lo, hi, size=size) for _, field, lo, hi, size, _ in stated_inputs(n_bays)]
     return st.Study(
-        run=sample_run(n_bays, cycles, seat, only),
+        run=sample_run(n_bays, cycles, seat, only, increments),
         inputs=inputs,
-        outputs=["tip_u", "tip_rot", "iterations", "cutbacks"],
+        outputs=["tip_u", "tip_rot", "iterations", "cutbacks", "settle_force"],
         sampler="sobol" if sensitivity else sampler,
         seed=seed,
         sensitivity=sensitivity,
@@ -165,14 +174,22 @@ def local_dask(workers: int):
 
 
 def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=False, big=False, opts=None):
-    o = dict(seat="seated", sampler="mc", dask=False, only=None) | (opts or {})
+    o = dict(seat="seated", sampler="mc", dask=False, only=None, increments=1) | (opts or {})
     t0 = time.perf_counter()
     folder = out / (f"bays{n_bays}" if sensitivity else f"bays{n_bays}_plain")
-    nominal = tip_history(n_bays, None, cycles=cycles, params=params_for(o["seat"]))
+    nominal = tip_history(n_bays, None, cycles=cycles, params=params_for(o["seat"]), increments=o["increments"])
     if report_only:  # the runs are on disk (an earlier call): statistics and figures only
         summary = "results read from disk (--report-only)"
     else:
-        study = make_study(n_bays, cycles, sensitivity, seat=o["seat"], sampler=o["sampler"], only=o["only"])
+        study = make_study(
+            n_bays,
+            cycles,
+            sensitivity,
+            seat=o["seat"],
+            sampler=o["sampler"],
+            only=o["only"],
+            increments=o["increments"],
+        )
         if o["dask"]:
             client, cluster = local_dask(workers)
             try:
@@ -190,6 +207,7 @@ def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=Fal
     else:
         m = metrics(u, th, nominal["u"], nominal["theta"])
     cpu = res.table(["seconds"])["seconds"]
+    settle = res.output("settle_force") if "settle_force" in res.output_names else np.array([])
     sob = {}
     if sensitivity:
         fA, fB, fAB, dropped = res.saltelli("tip_u")
@@ -215,6 +233,7 @@ def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=Fal
         "failures": res.failures(),
         "counts": res.counts(),
         "run_seconds": cpu,
+        "settle_force": settle,
         "wall_s": time.perf_counter() - t0,
     }
 
@@ -388,6 +407,7 @@ def main(argv=None):
     ap.add_argument("--big", type=int, default=350, help="bays of the long mast, a few plain samples (0: none)")
     ap.add_argument("--big-samples", type=int, default=4)
     ap.add_argument("--cycles", type=int, default=1, help="Table 1 cycles after deployment")
+    ap.add_argument("--increments", type=int, default=1, help="increments per Table 1 step (the friction path)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default="results/shape_accuracy")
     ap.add_argument("--docs", action="store_true", help="copy the figures to docs/figures/")
@@ -399,7 +419,7 @@ def main(argv=None):
     for g, field, lo, hi, _size, unit in stated_inputs(10):
         print(f"  {g:15s} {field:12s} [{lo:.4g}, {hi:.4g}] {unit}")
     results = []
-    opts = dict(seat=args.seat, sampler=args.sampler, only=args.only)
+    opts = dict(seat=args.seat, sampler=args.sampler, only=args.only, increments=args.increments)
     print(f"ball joints: {args.seat}" + (f"; scattered: {', '.join(args.only)} only" if args.only else ""))
     samples = args.samples if len(args.samples) == len(args.bays) else [args.samples[0]] * len(args.bays)
     for n, ns in zip(args.bays, samples):
@@ -451,6 +471,11 @@ def main(argv=None):
             f"  per run: median {np.median(sec):.2f} s, max {np.max(sec):.2f} s; failed runs {len(r['failures'])}"
             + (f" (first: {r['failures'][0][1][:120]})" if r["failures"] else "")
         )
+        if len(r["settle_force"]):
+            print(
+                f"  deployed states in equilibrium: largest viscous force left {np.nanmax(r['settle_force']):.2g} N "
+                "(the force tolerance is ~0.01 N)"
+            )
         row = {
             "n_bays": n,
             "length_m": n * BayParameters().l,

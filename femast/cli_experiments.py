@@ -26,7 +26,7 @@ from pathlib import Path
 
 
 def _effect_names(arg):
-    from .effects.base import effects_of_script, load_script
+    from .effects.scripts import effects_of_script, load_script
 
     names = []
     for item in (arg or "").split(","):

@@ -6,7 +6,7 @@ output never get bar text; a bar is closed (and erased) before an error propagat
 never mixed into the error message.
 
 * :func:`task` -- a bar for one piece of work of unknown length (a fit): it counts the model
-  evaluations (:func:`tick` from :func:`femast.experiments.fitting.predict`) and shows the FE runs
+  evaluations (:func:`tick` from :func:`femast.experiments.prediction.predict`) and shows the FE runs
   as they happen (:func:`tick` ``("FE runs")`` from the FE experiments).
 * :func:`items` -- a bar over a known list (the cases of a benchmark, the refits of diagnose),
   naming the item being worked on.

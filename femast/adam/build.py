@@ -98,8 +98,38 @@ class AdamModel:
 
     @property
     def latch(self) -> CableLatchFamily:
-        """The latch-cable element family of the model."""
+        """The latch-cable element family of the model (a CableDeviceFamily when the units have a bearing sheave)."""
         return next(f for f in self.model.families if f.name == self.latch_family)
+
+
+def _sheave_latch_family(latch_nodes, LA, LB, stretch, sc, p: BayParameters):
+    """The latch cables of a mast whose units' pulleys are bearing sheaves (``p.pulley``): one
+    :class:`~femast.elements.cable_devices.CableDeviceFamily` of two-section cables over a
+    :class:`~femast.elements.cable_devices.Latch` with that sheave, the same cables, pretensions,
+    beads, latches and lack of fit as the paper's element (:class:`CableLatchFamily`)."""
+    from ..elements.cable_devices import CableDeviceFamily, Latch
+
+    lat = latch_array(sc, p)  # (n, 6): r, x_backstop, k, mu, h, R per latch
+    values = {name: lat[:, i] for i, name in enumerate(("r", "x_backstop", "k", "mu", "h", "R"))}
+    if p.latch_mu_k is not None:
+        values["mu_k"] = np.minimum(p.latch_mu_k, lat[:, 3])
+    latch = Latch(
+        params=p.latch,
+        x0=-p.latch.x_backstop,
+        hysteresis_force=p.hysteresis_force,
+        hysteresis_length=p.hysteresis_length,
+        sheave=p.pulley,
+    )
+    return CableDeviceFamily(
+        np.array(latch_nodes, dtype=np.int64),
+        EA=p.cable_EA,
+        L0=(LA + LB) / stretch,
+        devices=[latch],
+        s0=(LA / stretch)[:, None],
+        device_values={0: values},
+        length_error=sc["cable_dL"].reshape(-1, 2),
+        name=LATCH_FAMILY,
+    )
 
 
 def corner_xy(b: float) -> np.ndarray:
@@ -284,6 +314,8 @@ def build_mast(
     fam = (
         None
         if not cables
+        else _sheave_latch_family(latch_nodes, LA, LB, stretch, sc, p)
+        if p.pulley is not None
         else CableLatchFamily(
             np.array(latch_nodes, dtype=np.int64),
             EA=p.cable_EA,

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, fields, replace
 
+from ..elements.cable_device_specs import Pulley, Sheave
 from ..elements.latch_law import LatchParameters, contact_half_width, validate_latch_array
 from ..errors import ModelError
 from ..model.sections import Section, circular_tube
@@ -53,6 +54,14 @@ class BayParameters:
         paper's one coefficient (Sec. III.A: "the kinetic and static coefficients ... are assumed to
         be equal").  Below it, ``latch.mu`` is the static coefficient: a bead starts to slide at
         ``latch.mu`` and slides on at ``latch_mu_k``.
+    pulley : the pulley of each side's pulley-and-latch unit (the paper's Sec. II.B.2): None
+        (default) a frictionless pulley, the paper's element; or a
+        :class:`~femast.elements.cable_devices.Sheave` (radius, pin_radius, mu): the wheel turns on
+        its pin, and its bearing friction ``mu pin_radius / radius x |resultant|`` adds to the
+        latch's jump.  ADAM's pulley is such a sheave, not a capstan drum (the cable does not slide
+        on it); its bearing friction is 0 by default because the latch's friction (``latch.mu``) was
+        fitted to pulls of the cable through the whole unit, pulley included (Sec. III.B), and
+        holds it already.  See ``docs/adam_bay.md``.
 
     Joints
     ------
@@ -94,6 +103,7 @@ class BayParameters:
     hysteresis_force: float = 0.0
     hysteresis_length: float = 3e-4
     latch_mu_k: float | None = None
+    pulley: Sheave | None = None
     mu: float = 0.5
     B: float = 0.004
     mu_k: float | None = None
@@ -124,6 +134,7 @@ class BayParameters:
         "hysteresis_force": "N",
         "hysteresis_length": "m",
         "latch_mu_k": "-",
+        "pulley": "-",
         "mu": "-",
         "B": "m",
         "mu_k": "-",
@@ -212,6 +223,17 @@ class BayParameters:
                 f"BayParameters: latch must be a femast.elements.latch_law.LatchParameters, got {type(self.latch).__name__}"
             )
         validate_latch_array(self.latch.as_array(), "BayParameters.latch")
+        if isinstance(self.pulley, Pulley):
+            raise ModelError(
+                f"BayParameters: pulley = {self.pulley!r}: ADAM's pulley turns on a pin (the cable does not "
+                "slide on it), so a capstan drum or fixed pulley at the latch is not modelled; give "
+                "pulley=Sheave(radius, pin_radius, mu) for its bearing friction, or None (frictionless)"
+            )
+        if self.pulley is not None and not isinstance(self.pulley, Sheave):
+            raise ModelError(
+                f"BayParameters: pulley must be None or a femast.elements.cable_devices.Sheave, got "
+                f"{type(self.pulley).__name__}"
+            )
         v = self.latch_mu_k
         if v is not None and (not _is_number(v) or not (0.0 <= v <= self.latch.mu)):
             raise ModelError(
@@ -273,7 +295,9 @@ class BayParameters:
         rows = []
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name == "latch":
+            if f.name == "pulley" and v is not None:
+                rows += [(f"pulley.{k}", val, "m" if "radius" in k else "-") for k, val in asdict(v).items()]
+            elif f.name == "latch":
                 for k, val in asdict(v).items():
                     rows.append((f"latch.{k}", val, "N/m" if k == "k" else ("-" if k == "mu" else "m")))
             else:

@@ -10,7 +10,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..elements.latch_law import ZONE_BACKSTOP, ZONE_BEHIND_AXIS, ZONE_FREE, ZONE_IN_FRONT, ZONE_LABELS
+from ..elements.latch_law import (
+    ZONE_BACKSTOP,
+    ZONE_BEHIND_AXIS,
+    ZONE_FREE,
+    ZONE_IN_FRONT,
+    ZONE_LABELS,
+    latch_zone,
+)
 from ..post.results import Results
 from .build import AdamModel
 
@@ -28,7 +35,8 @@ def bay_curve(res: Results, am: AdamModel, bay: int = -1) -> dict:
     N m, in the sign of Stohlman & Pellegrino: the moment of the bay on the loading rig, i.e. minus
     the moment applied to the bay; the rig holds the bay against stowing with a negative moment), ``M_applied`` (N m),
     ``bead`` (n, 4) bead positions (m), ``zone`` (n, 4) zones of Fig. 6, ``dT`` (n, 4) N,
-    ``tension`` (n, 4, 2) N (sections 1 and 2 of each latch cable)."""
+    ``tension`` (n, 4, 2) N (sections 1 and 2 of each latch cable).  With a bearing sheave in the units
+    (``BayParameters.pulley``) ``dT`` is the jump across the whole unit, latch and bearing."""
     j = range(am.n_bays)[bay]
     labels = am.latch_labels[j]
     fam = am.latch_family
@@ -48,10 +56,14 @@ def bay_curve(res: Results, am: AdamModel, bay: int = -1) -> dict:
         out["ux"][i], out["uy"][i], out["uz"][i] = fr["U"][row]
         out["M_applied"][i] = fr["P"][row, 5]
         out["M_reaction"][i] = fr["RF"][row, 5]
-        out["bead"][i] = fr[f"el/{fam}/bead_position"][rows]
-        out["zone"][i] = fr[f"el/{fam}/latch_zone"][rows]
-        out["dT"][i] = fr[f"el/{fam}/latch_dT"][rows]
+        out["bead"][i] = np.ravel(fr[f"el/{fam}/bead_position"][rows])
         out["tension"][i] = fr[f"el/{fam}/tension"][rows]
+        if f"el/{fam}/latch_zone" in fr:  # the paper's cable/latch element
+            out["zone"][i] = fr[f"el/{fam}/latch_zone"][rows]
+            out["dT"][i] = fr[f"el/{fam}/latch_dT"][rows]
+        else:  # a latch over a bearing sheave (BayParameters.pulley): the jump across the whole unit
+            out["zone"][i] = latch_zone(out["bead"][i], am.params.latch)
+            out["dT"][i] = out["tension"][i][:, 1] - out["tension"][i][:, 0]
     out["step"] = np.array(res.steps)
     # the moment the rig applies is a load (displacement control) or a reaction (prescribed rz)
     out["M"] = -(out["M_applied"] + out["M_reaction"])

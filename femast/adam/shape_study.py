@@ -139,7 +139,9 @@ def tip_history(
         more increments, a closer path).
 
     Returns {"labels": step names, "u": (n_levels, 3) m, "theta": (n_levels, 3) rad, "iterations",
-    "cutbacks", "cpu_s"}: level 0 is the deployed state (end of ``equilibrium``, or of ``pretension``
+    "cutbacks", "cpu_s", "settle_force"}: ``settle_force`` is the largest viscous force (N) left at the
+    end of the ``equilibrium`` step (NaN without ``settle``), the deployed state's distance from
+    equilibrium (the convergence test's force tolerance is ~0.01 N); level 0 is the deployed state (end of ``equilibrium``, or of ``pretension``
     without ``settle``), then one level per load step, all relative to the initial (design)
     geometry: the control node's displacement and rotation vector at the end of each step."""
     t0 = time.process_time()
@@ -167,6 +169,7 @@ def tip_history(
         "iterations": an.summary.iterations,
         "cutbacks": an.summary.cutbacks,
         "cpu_s": time.process_time() - t0,
+        "settle_force": float(an.summary.steps[1]["stabilization_force"]) if settle else float("nan"),
     }
 
 

@@ -31,6 +31,12 @@ TABLE1_F = 14.0  # N along x
 # 40-bay mast, one or three cycles, is within 1 % of its converged value (16: 1.3 % after two cycles;
 # docs/adam_mast.md, benchmarks/friction_convergence.py).
 TABLE1_INCREMENTS = 32
+#: Damping of the ``equilibrium`` step of :func:`add_initial_steps` relative to the pretension step's: a
+#: regularisation whose largest viscous force in the step is ~1e-8 N on the scattered 40-bay masts (the
+#: convergence test's force tolerance is ~0.01 N), so the step ends in equilibrium; without it the Newton
+#: iterates of some scattered masts cycle (a seat or a joint's stick/slip switching and back) and every
+#: cutback repeats the same iterations, since nothing in the step depends on the increment.
+SETTLE_DAMPING = 1e-3
 
 
 def stabilize_for(am: AdamModel, fraction: float = 1e-4, dt0: float = 1.0) -> Stabilize:
@@ -56,23 +62,35 @@ def add_initial_steps(
 ):
     """The initial step of Stohlman & Pellegrino, Sec. II.C: the deployed, pretensioned structure comes to
     equilibrium with its cable pretensions under viscous stabilisation (step ``pretension``); the
-    steps added after it have no stabilisation (the seed: "no stabilization is used after the
-    initial stable state is achieved").
+    load steps added after it have no stabilisation (the seed: "no stabilization is used after the
+    initial stable state is achieved"; ``settle`` below is an equilibrium step).  The members' length errors (a scattered mast's lack of fit,
+    ``build_mast(scatter=...)``) grow over the same step with the step time
+    (``step.ramp_length_errors()``): applied in full at its start, the misfit of some scattered
+    masts pressed longerons into their seats by tens of micrometres against the penalty in the
+    first increment, which no cutback could make smaller, and the step failed at time 0.
 
     hold_control : DOF names of the control node held at zero from the start (e.g. ``("ux", "uy",
     "rz")`` for the bay test, where the loading rig holds the top frame).
-    settle : also add a step ``equilibrium`` without stabilisation and without load change.  Off
-    by default: femast's convergence test needs a displacement correction below 1e-15 (rad or
-    1e-15 x model size) in a step whose increment is zero, which round-off can miss when a
-    soft mode (a longeron spin held by the joint springs) amplifies it.
+    settle : also add a step ``equilibrium`` without load change whose damping is
+        :data:`SETTLE_DAMPING` of the pretension step's (its largest viscous force is in
+        ``analysis.summary.steps[1]["stabilization_force"]``, N: ~1e-8 N, the step ends in
+        equilibrium).  Off by default: femast's convergence test needs a displacement correction
+        below 1e-15 (rad or 1e-15 x model size) in a step whose increment is zero, which round-off
+        can miss when a soft mode (a longeron spin held by the joint springs) amplifies it.
     Returns the steps.  The stabilisation energy ratio is in ``analysis.summary.steps[0]``."""
     st = stabilize if stabilize is not None else stabilize_for(am)
-    s1 = am.model.step("pretension", stabilize=st, initial_increment=1.0, max_increments=50)
+    s1 = am.model.step("pretension", stabilize=st, initial_increment=1.0, max_increments=50).ramp_length_errors()
     if hold_control:
         s1.prescribe(am.control, **{d: 0.0 for d in hold_control})
     if not settle:
         return (s1,)
-    return s1, am.model.step("equilibrium", initial_increment=1.0)
+    weaker = (
+        dict(factor=SETTLE_DAMPING * st.factor)
+        if st.factor is not None
+        else dict(energy_fraction=SETTLE_DAMPING * st.energy_fraction)
+    )
+    settle_damping = Stabilize(**weaker, warn_ratio=st.warn_ratio, adaptive=False)
+    return s1, am.model.step("equilibrium", stabilize=settle_damping, initial_increment=1.0)
 
 
 # ---------------------------------------------------------------------------- single-bay torsion

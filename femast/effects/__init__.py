@@ -37,8 +37,6 @@ from .base import (
     applicable_effects,
     get_effect,
     list_effects,
-    load_script,
-    loaded_scripts,
     register_effect,
     resolve,
     unregister_effect,
@@ -46,6 +44,7 @@ from .base import (
 from .operators import play, proportional_play
 from .parameters import Parameter
 from .quantities import Quantity
+from .scripts import load_script, loaded_scripts
 
 __all__ = [
     "Effect",

@@ -58,7 +58,6 @@ from dataclasses import dataclass, field, replace
 from ..errors import ModelError, did_you_mean
 from .parameters import Parameter  # noqa: F401  (re-exported: effects declare Parameters)
 from .quantities import ALWAYS, HOOKS
-from .scripts import effects_of_script, load_script, loaded_scripts  # noqa: F401  (re-exported)
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from ..errors import ModelError
+from .base import list_effects
 
 _SCRIPTS: list[str] = []  # scripts loaded in this process (re-loaded by worker processes)
 _SCRIPT_EFFECTS: dict[str, list] = {}  # script path -> names of the effects it registered
@@ -18,8 +19,6 @@ _SCRIPT_EFFECTS: dict[str, list] = {}  # script path -> names of the effects it 
 
 def registry() -> tuple:
     """Names of the registered effects."""
-    from .base import list_effects  # (base re-exports this module's functions)
-
     return tuple(e.name for e in list_effects())
 
 

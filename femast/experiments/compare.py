@@ -22,9 +22,11 @@ from .fitting import fit as _fit
 from .fitting import params_table
 from .history import append_history, plot_history
 from .noise import noise_model
-from .residuals import (
+from .residuals import (  # noqa: F401  (principal_load: compare's name for it, kept)
     TURN_FRACTION,
+    load_path,
     noise_floor,
+    principal_load,
     segment_path,
     segment_report,
     signatures,
@@ -32,30 +34,6 @@ from .residuals import (
 )
 from .rows import thin
 from .units import check_data as check_units
-
-
-def load_path(exp: Experiment, data: Measured) -> np.ndarray:
-    """The signed load that drives the segmentation: ``exp.load_measure`` (else the first input
-    column); a load with several axes ((n, k): a moment about two axes) is taken along its principal
-    direction (:func:`principal_load`)."""
-    if exp.load_measure is not None:
-        s = np.asarray(exp.load_measure(data, exp.options), dtype=float)
-        return principal_load(s) if s.ndim == 2 else s
-    inputs = [c.name for c in exp.columns if c.required and c.name not in exp.channels]
-    return data[inputs[0]] if inputs else np.arange(data.n, dtype=float)
-
-
-def principal_load(L) -> np.ndarray:
-    """(n,) a load of several axes (n, k) projected on its principal direction (the largest singular
-    vector), signed so that its largest value is positive."""
-    L = np.asarray(L, float)
-    if L.ndim == 1 or L.shape[1] == 1:
-        return L.reshape(len(L))
-    if not np.any(L):
-        return np.zeros(len(L))
-    _, _, Vt = np.linalg.svd(L, full_matrices=False)
-    s = L @ Vt[0]
-    return s if s[np.argmax(np.abs(s))] > 0 else -s
 
 
 def analyse(exp: Experiment, data: Measured, run: OptimizeResult) -> dict:

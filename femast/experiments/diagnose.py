@@ -45,10 +45,11 @@ from contextlib import nullcontext
 from scipy.optimize import OptimizeResult
 
 from .. import progress
-from ..effects.base import get_effect, loaded_scripts
+from ..effects.base import get_effect
+from ..effects.scripts import loaded_scripts
 from .baseline import fit_with_noise
 from .candidates import fit_candidates, rank, remaining_where
-from .compare import analyse, load_path
+from .compare import analyse
 from .core import Experiment, Measured
 from .diagnose_report import diagnosis_result, format_diagnose  # noqa: F401  (format_diagnose: re-exported)
 from .diagnosis import Diagnosis
@@ -67,7 +68,7 @@ from .refits import (  # noqa: F401
     _serial_refits,
     refit_pool,
 )
-from .residuals import AT_NOISE, at_noise_threshold  # noqa: F401  (AT_NOISE: re-exported)
+from .residuals import AT_NOISE, at_noise_threshold, load_path  # noqa: F401  (AT_NOISE: re-exported)
 from .rows import thin
 from .time_dependence import creep_overrules, reads_time, time_check
 from .units import check_data as check_units

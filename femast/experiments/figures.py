@@ -9,6 +9,7 @@ import numpy as np
 
 from ..post import plotstyle
 from ..post.plotstyle import column_label, display_scale, fit_title, num  # noqa: F401  (display_scale: re-exported)
+from .residuals import AT_NOISE
 
 
 def verdict_words(v: dict) -> str:
@@ -93,8 +94,6 @@ def compare_figure(exp, data, result, png) -> Path:
         else:
             ax3.axhline(f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
             ax3.axhline(-f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
-    from .diagnose import AT_NOISE
-
     for k, seg in enumerate([w for w in result.worst[:3] if w["ratio"] > AT_NOISE]):
         ax3.axvspan(seg["start_row"] - 0.5, seg["end_row"] + 0.5, color="C3", alpha=0.18 - 0.04 * k, lw=0)
         mid = 0.5 * (seg["start_row"] + seg["end_row"])

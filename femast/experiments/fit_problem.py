@@ -6,7 +6,7 @@ scaling, the whitened residual, the solver settings and the solve itself.
 * **starts** -- the given values, else the experiment's ``initial_guess`` and the effects'
   defaults; with multistart, also each effect parameter's ``starts`` (zipped), the best fit kept;
 * **residual** -- ``(measured - predicted) / sigma`` per channel, stacked; a parameter set the model
-  cannot be evaluated at (:data:`~femast.experiments.fitting.MODEL_FAILURES`) is skipped (a large
+  cannot be evaluated at (:data:`~femast.experiments.prediction.MODEL_FAILURES`) is skipped (a large
   residual) and counted, and the fit goes on;
 * **solve** -- :func:`scipy.optimize.least_squares` (trust-region reflective) with the experiment's
   ``fit_options``; an expensive model fitted by finite differences gets secant Jacobians, a seeded
@@ -21,6 +21,7 @@ from scipy.optimize import least_squares
 
 from ..errors import ModelError
 from .fe_jacobian import LOG_RANGE, POLISH_MIN_DECREASE, _Coords, _FEJacobian, _polish
+from .prediction import MODEL_FAILURES, channel_residuals, estimate_noise, predict, split_parameters
 
 _BAD = 1e6  # whitened residual given to a parameter set the model rejects
 
@@ -29,8 +30,6 @@ class FitProblem:
     """One fit's problem (module docstring); ``skipped`` lists ``(x, error)`` of the sets skipped."""
 
     def __init__(self, exp, data, specs, start, given_start_clip, max_nfev, nfev_per_param):
-        from .fitting import _split
-
         self.data, self.specs = data, specs
         self.x0 = self._start(exp, data, specs, dict(start or {}), given_start_clip)
         self.scale = np.array([p.typical for _, p, _ in specs])
@@ -44,7 +43,7 @@ class FitProblem:
         if self.secant and "fe_reference" in exp.options and exp.options["fe_reference"] is None:
             # every FE run of the fit starts its increments from those of the baseline model at the start
             # (femast.experiments.fe_reference): about half the Newton iterations
-            exp = exp.with_options(fe_reference=_split(specs, self.x0)[0])
+            exp = exp.with_options(fe_reference=split_parameters(specs, self.x0)[0])
         self.exp = exp
         self.lo = self.co.to_u(np.array([p.lower for _, p, _ in specs]))
         self.hi = self.co.to_u(np.array([p.upper for _, p, _ in specs]))
@@ -100,13 +99,11 @@ class FitProblem:
 
     def fun(self, sigma):
         """The whitened residual as a function of the scaled parameters u."""
-        from .fitting import MODEL_FAILURES, _split, predict
-
         exp, data, specs = self.exp, self.data, self.specs
 
         def fun(u):
             x = self.co.to_x(u)
-            base, eff = _split(specs, x)
+            base, eff = split_parameters(specs, x)
             try:
                 pred = predict(exp, data, base, eff)
             except MODEL_FAILURES as e:
@@ -173,13 +170,11 @@ class FitProblem:
     def solve_estimating_noise(self, starts, start_sensitivity):
         """A first fit with the noise of the start's residual, then the fit with the noise of the
         first fit's residual: ``(solution, sigma)``."""
-        from .fitting import _split, channel_residuals, estimate_noise, predict
-
         exp, data, specs, co = self.exp, self.data, self.specs, self.co
-        base, eff = _split(specs, self.x0)
+        base, eff = split_parameters(specs, self.x0)
         sigma0 = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
         sol = self.solve(sigma0, starts, self.seed(start_sensitivity, sigma0, self.x0))
-        base, eff = _split(specs, co.to_x(sol.x))
+        base, eff = split_parameters(specs, co.to_x(sol.x))
         sigma = estimate_noise(exp, channel_residuals(exp, data, predict(exp, data, base, eff)))
         if self.secant and len(exp.channels) == 1:
             # one channel, one noise level: the whitened residual only changes by a constant factor, so

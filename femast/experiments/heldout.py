@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import OptimizeResult
 
-from .residuals import robust_rms, turning_points
+from .residuals import load_path, noise_floor, robust_rms, turning_points
 
 FOLDS = 4  # folds of a data set without groups
 MAX_FOLDS = 8  # at most this many folds (neighbouring groups merged)
@@ -82,9 +82,6 @@ def folds(exp, data, k: int | None = None) -> list:
 
 def _cycle_starts(exp, data) -> list:
     """Rows where the load path's cycles start (0 and every second confirmed turning point)."""
-    from .compare import load_path
-    from .residuals import noise_floor
-
     s = np.asarray(load_path(exp, data), float)
     rng = float(np.ptp(s)) if s.size else 0.0
     if rng <= 0:

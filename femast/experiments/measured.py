@@ -2,7 +2,7 @@
 
 A data set may hold several **groups** -- stations, specimens, test runs, files -- each a path of
 its own: the model runs group by group (a path-dependent state starts relaxed in every group,
-:func:`~femast.experiments.fitting.predict`), held-out validation leaves one group out at a time
+:func:`~femast.experiments.prediction.predict`), held-out validation leaves one group out at a time
 (:mod:`femast.experiments.heldout`), and with ``offsets`` every group gets its own zero in every
 channel (a station whose sensors were zeroed again), counted in the information criterion.
 

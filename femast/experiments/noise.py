@@ -95,6 +95,7 @@ from .noise_estimators import (  # noqa: F401  (re-exported: the estimators of t
     repeated_points,
     robust_rms,
 )
+from .residuals import load_path, noise_floor
 from .resolution import rounding_floors
 
 HETERO_MIN_RANGE = 1.3
@@ -194,8 +195,6 @@ def channel_noise(
             f"channel {channel}: {n} rows are too few for the noise model (at least {MIN_ROWS} rows, "
             f"or a sigma_{channel} column giving each row's standard uncertainty)"
         )
-    from .residuals import noise_floor
-
     if n < MIN_ROWS_STRUCTURE:
         return ChannelNoise(
             channel,
@@ -403,8 +402,6 @@ def plain_unless_noise(model: ChannelNoise, r, pinned=None) -> ChannelNoise:
     blind to the model's error -- is the honest one; otherwise ``model`` stands (on latch-pull data
     without a hidden effect the lag-1 autocorrelation is -0.07 to -0.03 and the difference estimate
     -0.09 to 0.15; with a hidden latch hysteresis or friction 0.64-0.69 against 0.05)."""
-    from .residuals import noise_floor
-
     if model.kind in ("white", "given"):
         return model
     r = np.asarray(r, float)
@@ -476,8 +473,6 @@ def path_coordinate(exp, data) -> np.ndarray | None:
     try:
         if getattr(exp, "path_coordinate", None) is not None:
             return np.asarray(exp.path_coordinate(data, exp.options), float)
-        from .compare import load_path
-
         return np.asarray(load_path(exp, data), float)
     except Exception:  # a coordinate is optional: no repeated-pass check rather than a failed diagnosis
         return None

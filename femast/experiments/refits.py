@@ -21,11 +21,12 @@ from contextlib import nullcontext
 from scipy.optimize import OptimizeResult
 
 from .. import progress
-from ..effects.base import load_script, loaded_scripts
+from ..effects.scripts import load_script, loaded_scripts
 from ..errors import ModelError, TaskTimeout, WorkerDied
 from ..workers import Pool, worker_count
 from .core import Experiment
-from .fitting import MODEL_FAILURES, fit
+from .fitting import fit
+from .prediction import MODEL_FAILURES
 
 REFIT_NFEV = 25  # evaluations per parameter and start of a refit (a converging refit needs 5-20; a direction the
 # data do not determine -- beam flexibility against the joint stiffness under top forces -- would use 100)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
-from ..effects.base import load_script
+from ..effects.scripts import load_script
 from ..errors import ModelError, did_you_mean
 from .core import Experiment
 
@@ -20,12 +20,16 @@ _BUILTIN_LOADED = False
 
 
 def _load_builtin() -> None:
-    """Register the built-in rigs (:mod:`femast.experiments.rigs`) on first use: they are written
-    against this package's public API, so they are imported after it, not by it."""
+    """Register the built-in rigs (:data:`femast.experiments.rigs.BUILT_IN`) on first use of the
+    registry: importing them imports their models (the ADAM and guyed-mast builders), which
+    ``import femast.experiments`` alone does not need."""
     global _BUILTIN_LOADED
     if not _BUILTIN_LOADED:
         _BUILTIN_LOADED = True
-        from . import rigs  # noqa: F401  (registers them)
+        from .rigs import BUILT_IN
+
+        for rig in BUILT_IN:
+            register_experiment(rig.EXPERIMENT)
 
 
 def register_experiment(experiment: Experiment, replace_existing: bool = False) -> Experiment:

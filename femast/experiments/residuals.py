@@ -197,6 +197,32 @@ def _runs(mask, kind):
     return [Segment(kind, int(a), int(b)) for a, b in zip(edges[::2], edges[1::2])]
 
 
+def load_path(exp, data) -> np.ndarray:
+    """The signed load that drives the segmentation (:func:`segment_path`) of an experiment's data
+    (an :class:`~femast.experiments.Experiment` and its :class:`~femast.experiments.Measured`):
+    ``exp.load_measure`` (else the first input
+    column); a load with several axes ((n, k): a moment about two axes) is taken along its principal
+    direction (:func:`principal_load`)."""
+    if exp.load_measure is not None:
+        s = np.asarray(exp.load_measure(data, exp.options), dtype=float)
+        return principal_load(s) if s.ndim == 2 else s
+    inputs = [c.name for c in exp.columns if c.required and c.name not in exp.channels]
+    return data[inputs[0]] if inputs else np.arange(data.n, dtype=float)
+
+
+def principal_load(L) -> np.ndarray:
+    """(n,) a load of several axes (n, k) projected on its principal direction (the largest singular
+    vector), signed so that its largest value is positive."""
+    L = np.asarray(L, float)
+    if L.ndim == 1 or L.shape[1] == 1:
+        return L.reshape(len(L))
+    if not np.any(L):
+        return np.zeros(len(L))
+    _, _, Vt = np.linalg.svd(L, full_matrices=False)
+    s = L @ Vt[0]
+    return s if s[np.argmax(np.abs(s))] > 0 else -s
+
+
 def segment_path(s, noise_s: float = 0.0, extra=()):
     """Split the path of the signed load s (n,) into segments (see the module docstring).
 

@@ -30,6 +30,7 @@ import math
 import numpy as np
 
 from ..errors import DataFileError
+from .prediction import predict
 
 # the unit a header suffix names, in pint's words ("dx_mm" -> "mm")
 SUFFIXES = {
@@ -269,8 +270,6 @@ def check_data(exp, data) -> None:
     """:func:`check_scale` of ``data`` against the model of ``exp`` with its default parameters
     (one model run; the FE experiments keep it in their run cache, where the fits that follow
     find it).  The channels the user confirmed (``--units dx_m=m``) are not checked."""
-    from .fitting import predict
-
     check_scale(exp, data, predict(exp, data), confirmed=data.cache.get(CONFIRMED, ()))
 
 

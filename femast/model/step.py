@@ -63,6 +63,7 @@ class Step:
     loads: list = field(default_factory=list)
     prescribed: list = field(default_factory=list)
     temperatures: list = field(default_factory=list)  # (labels, values K or degC, amplitude)
+    ramps_length_errors: bool = False  # the model's length errors grow over this step (ramp_length_errors)
     _model: object = field(default=None, repr=False)  # the Model the step belongs to
 
     def load(self, node, amplitude: Amplitude | None = None, **components):
@@ -116,6 +117,22 @@ def _step_temperature(self, T, elements=None, family=None, where=None, amplitude
     return add_step_temperature(self, T, elements, family, where, amplitude)
 
 
+def _step_ramp_length_errors(self):
+    """Apply the model's length errors (lack of fit, :meth:`Model.length_error`) gradually over this
+    step, linearly in step time: none act before the step, all after it.  Without it they act in
+    full from the start of the first step.  Use it where a misfit is closed at assembly (as Abaqus
+    resolves an interference fit over a step, *CONTACT INTERFERENCE, SHRINK): a cut-back increment
+    then closes less of the misfit.  One step per model; see :mod:`femast.model.thermal`."""
+    for other in self._model.steps:
+        if other.ramps_length_errors and other is not self:
+            raise ModelError(
+                f"step '{self.name}': the length errors already ramp over step '{other.name}'; "
+                "they can ramp over one step only"
+            )
+    self.ramps_length_errors = True
+    return self
+
+
 def _step_rotate(self, node, axis, angle: float, amplitude: Amplitude | None = None):
     """Prescribe a rotation of ``node`` by ``angle`` (rad) about the fixed global ``axis`` (any
     direction) at the end of the step: the three rotation components are driven together, which
@@ -139,5 +156,6 @@ def _step_follow(self, node, times, **tables):
 
 Step.rotate = _step_rotate
 Step.temperature = _step_temperature
+Step.ramp_length_errors = _step_ramp_length_errors
 Step.follow = _step_follow
 Step.gravity = _step_gravity

@@ -19,7 +19,10 @@ temperature is uniform over an element (no gradient through the section: no ther
 A step's temperatures ramp from those at the start of the step to the given values linearly in
 step time, or as ``T_start + a(t) (T - T_start)`` with an amplitude a(t) (a ramp factor: an
 amplitude 0 -> 1 -> 0 is a thermal cycle back to the start temperature).  Temperatures not
-redefined in a later step stay.  Length errors act from the start of the first step.
+redefined in a later step stay.  Length errors act from the start of the first step, or, with
+``step.ramp_length_errors()``, grow over that step linearly in step time (s = 1 + (t / period) dL / L
+in it, 1 before it): a misfit closed at assembly, which a cut-back increment then closes less of
+(as Abaqus resolves an interference fit over a step).
 
 :class:`FieldLoads` is what the analysis uses: it writes the length factors of the beam and
 truss families at each increment (femast/analysis/control/).
@@ -240,8 +243,18 @@ class FieldLoads:
             self.starts.append([t.copy() for t in T])
             T = self.temperatures(len(self.starts) - 1, 1.0)
         self.current = None
+        # the step over which the length errors grow (step.ramp_length_errors), None: from the start
+        self.ramp = next((i for i, st in enumerate(model.steps) if getattr(st, "ramps_length_errors", False)), None)
         for k, fam in enumerate(self.families):
-            np.copyto(fam.length_factor, self.base[k])
+            np.copyto(fam.length_factor, self.length_error_factors(0, 0.0)[k])
+
+    def length_error_factors(self, step_index, frac) -> list:
+        """1 + r dL / L per element (per family) at fraction ``frac`` of step ``step_index``: r = 1, or
+        with a ramp step r = 0 before it, ``frac`` in it and 1 after it."""
+        if self.ramp is None or step_index > self.ramp:
+            return self.base
+        r = 0.0 if step_index < self.ramp else float(frac)
+        return [1.0 + r * (b - 1.0) for b in self.base]
 
     def temperatures(self, step_index, frac) -> list:
         """Element temperatures (per family) at fraction ``frac`` of step ``step_index``'s time."""
@@ -259,8 +272,9 @@ class FieldLoads:
         """Write the length factors at fraction ``frac`` of the step; True if any changed."""
         changed = False
         T = self.temperatures(step_index, frac)
+        base = self.length_error_factors(step_index, frac)
         for k, fam in enumerate(self.families):
-            s = self.base[k] * (1.0 + self.alpha[k] * (T[k] - self.T_init[k]))
+            s = base[k] * (1.0 + self.alpha[k] * (T[k] - self.T_init[k]))
             if not np.array_equal(s, fam.length_factor):
                 np.copyto(fam.length_factor, s)
                 changed = True
@@ -278,12 +292,11 @@ def check_controls(model):
     """A step that changes temperatures must follow step time (load or displacement control)."""
     for step in model.steps:
         if (
-            getattr(step, "temperatures", None)
+            (getattr(step, "temperatures", None) or getattr(step, "ramps_length_errors", False))
             and step.control is not None
             and (getattr(step.control, "arc_length", False) or hasattr(step.control, "plan"))
         ):
             raise ModelError(
-                f"step '{step.name}': temperatures follow step time; they cannot be used with "
-                f"{type(step.control).__name__} (use load or displacement control for the "
-                "thermal step)"
+                f"step '{step.name}': temperatures follow step time (and so do ramped length errors); they "
+                f"cannot be used with {type(step.control).__name__} (use load or displacement control for that step)"
             )

@@ -8,8 +8,8 @@ import two_axis_rig as rig
 
 from femast.errors import DataFileError
 from femast.experiments import compare, fit, predict, read_data, write_data
-from femast.experiments.compare import principal_load
 from femast.experiments.data import combine
+from femast.experiments.residuals import principal_load
 
 
 def test_a_group_column_holds_any_labels_and_survives_a_round_trip(tmp_path):

@@ -1,16 +1,13 @@
 """``femast study S --scheduler tcp://...`` against a real ``dask scheduler`` and ``dask worker``
 started as separate processes (not an in-process client): the same results as a serial run."""
 
-import json
-import os
-import signal
 import subprocess
 import sys
 import textwrap
-import time
 
 import numpy as np
 import pytest
+from dask_processes import dask_cluster
 
 import femast.studies as st
 
@@ -30,44 +27,10 @@ STUDY = textwrap.dedent(
 )
 
 
-def _start(args, cwd, log):
-    return subprocess.Popen(
-        [sys.executable, "-m", "dask", *args],
-        cwd=cwd,
-        stdout=log,
-        stderr=subprocess.STDOUT,
-        start_new_session=True,  # (ended with its whole session below)
-    )
-
-
-def _end(p):
-    try:
-        os.killpg(p.pid, signal.SIGKILL)
-    except ProcessLookupError:
-        pass
-    p.wait(timeout=30)
-
-
 def test_cli_study_on_a_separate_dask_scheduler_and_worker(tmp_path):
     script = tmp_path / "ishigami_study.py"
     script.write_text(STUDY)
-    info = tmp_path / "scheduler.json"
-    log = open(tmp_path / "dask.log", "wb")
-    scheduler = _start(
-        ["scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard", "--scheduler-file", str(info)],
-        tmp_path,
-        log,
-    )
-    worker = None
-    try:
-        deadline = time.monotonic() + 120.0
-        while not (info.is_file() and info.stat().st_size > 0):
-            assert scheduler.poll() is None and time.monotonic() < deadline, (tmp_path / "dask.log").read_text()
-            time.sleep(0.2)
-        address = json.loads(info.read_text())["address"]
-        worker = _start(
-            ["worker", address, "--nthreads", "1", "--nworkers", "1", "--no-nanny", "--no-dashboard"], tmp_path, log
-        )
+    with dask_cluster(tmp_path) as address:
         p = subprocess.run(
             [
                 sys.executable,
@@ -90,11 +53,6 @@ def test_cli_study_on_a_separate_dask_scheduler_and_worker(tmp_path):
         )
         assert p.returncode == 0, p.stderr + (tmp_path / "dask.log").read_text()
         assert "dask worker(s)" in p.stdout and "complete" in p.stdout
-    finally:
-        for proc in (worker, scheduler):
-            if proc is not None:
-                _end(proc)
-        log.close()
     ns = {}
     exec(STUDY, ns)
     st.run(ns["study"], tmp_path / "serial", samples=16)

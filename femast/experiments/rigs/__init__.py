@@ -1,5 +1,7 @@
 """The built-in rigs: one module per test rig, each written as a user's rig is (docs/your_own_rig.md),
-through the public API of :mod:`femast.experiments` and :mod:`femast.effects`.
+through the framework's names (the public names of :mod:`femast.experiments`, imported from the
+framework's modules that define them, so that no rig imports the package whose registry lists it)
+and :mod:`femast.effects`.
 
 ======================  ======================================================================
 module                  rig
@@ -14,12 +16,11 @@ module                  rig
 ======================  ======================================================================
 
 :mod:`femast.experiments.rigs.synthetic` generates data with hidden effects from their models.
-The registry imports this package on first use; it registers each rig's ``EXPERIMENT``.
+The registry (:mod:`femast.experiments.registry`) imports this package on first use of an
+experiment name and registers the ``EXPERIMENT`` of each rig of :data:`BUILT_IN`, in its order.
 """
-
-from femast.experiments import register_experiment
 
 from . import bay_torsion, joint_test, latch_pull, mast_top, platform_pose, tip_cycle, vibration
 
-for _rig in (mast_top, latch_pull, bay_torsion, tip_cycle, vibration, platform_pose, joint_test):
-    register_experiment(_rig.EXPERIMENT)
+#: the built-in rigs, in the order ``femast experiments`` lists them
+BUILT_IN = (mast_top, latch_pull, bay_torsion, tip_cycle, vibration, platform_pose, joint_test)

@@ -85,9 +85,10 @@ import numpy as np
 
 from femast import progress
 from femast.errors import ConvergenceError, FemastError, ModelError
-from femast.experiments import Column, Experiment, Measured, Parameter, prepared, turning_points
+from femast.experiments.core import Column, Experiment, Measured, Parameter, prepared
 from femast.experiments.fe_cache import kernel_threads
 from femast.experiments.fe_reference import cached_run
+from femast.experiments.residuals import turning_points
 
 ZONE_KINDS = (
     "zone (a) at backstop",
@@ -332,7 +333,7 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
 def latch_zones(params: dict, data: Measured, options: dict, effects=None) -> np.ndarray:
     """(n, 4) zones of Stohlman & Pellegrino, Fig. 6, of the four latches at every row (nearest driven row), from the
     (cached) FE run of the model with ``params``."""
-    from femast.experiments import EffectStack
+    from femast.experiments.core import EffectStack
 
     prep, _, _, _, fe = _run(params, data, effects or EffectStack(), options)
     rows = prep["rows"]

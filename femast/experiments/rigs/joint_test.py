@@ -42,7 +42,7 @@ import numpy as np
 
 from femast.effects import Quantity
 from femast.effects.connections import add_connection_effects
-from femast.experiments import Column, Experiment, Measured, Parameter, prepared
+from femast.experiments.core import Column, Experiment, Measured, Parameter, prepared
 
 NAME = "joint-test"
 

@@ -75,7 +75,8 @@ from numba import njit
 
 from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, contact_half_width, latch_force, latch_zone
 from femast.errors import DataFileError
-from femast.experiments import Column, Experiment, Measured, Parameter, noise_floor, prepared, turning_points
+from femast.experiments.core import Column, Experiment, Measured, Parameter, prepared
+from femast.experiments.residuals import noise_floor, turning_points
 
 SIDE_OUT = 1  # the outer cable (section 2) is loaded: unlatching rig, dT = T2 >= 0
 SIDE_IN = -1  # the inner cable (section 1, through the backstop) is loaded: latching rig, dT = -T1 <= 0

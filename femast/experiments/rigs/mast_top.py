@@ -53,7 +53,7 @@ from __future__ import annotations
 import numpy as np
 
 from femast.effects import Quantity
-from femast.experiments import Column, Experiment, Measured, Parameter, prepared
+from femast.experiments.core import Column, Experiment, Measured, Parameter, prepared
 from femast.guyed.mast_3r import jacobian_3r
 
 WRENCH = ("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm")

@@ -45,7 +45,8 @@ from __future__ import annotations
 import numpy as np
 
 from femast.errors import ModelError
-from femast.experiments import Column, Experiment, Measured, Parameter, from_arrays
+from femast.experiments.core import Column, Experiment, Measured, Parameter
+from femast.experiments.data import from_arrays
 
 from . import mast_top
 

@@ -18,7 +18,9 @@ import numpy as np
 from femast.effects import resolve
 from femast.elements.latch_law import LATCHING, UNLATCHING, latch_force
 from femast.errors import ModelError
-from femast.experiments import EffectStack, Measured, predict
+from femast.experiments.core import EffectStack, Measured
+from femast.experiments.prediction import predict
+from femast.experiments.registry import get_experiment
 
 
 def _stack(exp, effects):
@@ -101,8 +103,6 @@ def mast_top_data(
     drift_m : amplitude of a slow thermal drift of the top (m) that no effect models.
     Returns ``(data, truth)`` with ``truth`` the noise-free displacements ``{dx_m, dy_m, dz_m}``.
     """
-    from femast.experiments import get_experiment
-
     exp = experiment or get_experiment("mast-top")
     rng = np.random.default_rng(seed + 1000)
     path = path or mast_top_path(seed=seed)
@@ -146,8 +146,6 @@ def latch_pull_data(
     drift_N : a slow drift of the load cell (N) that no effect models.
     Returns ``(data, truth)`` with the true bead positions (m) and force jumps (N).
     """
-    from femast.experiments import get_experiment
-
     exp = experiment or get_experiment("latch-pull")
     o = exp.options
     p = {**exp.defaults(), **(params or {})}
@@ -257,8 +255,6 @@ def bay_torsion_data(
     params : baseline ``{latch_k, latch_mu}`` (default the paper's pull-test fit).
     drift_Nm : amplitude of a slow drift of the load cell (N m) that no effect models.
     Returns ``(data, truth)`` with ``truth`` the noise-free ``{Mz_Nm}``."""
-    from femast.experiments import get_experiment
-
     exp = experiment or get_experiment("bay-torsion")
     path = dict(path or bay_torsion_path(seed=seed))
     n = len(path["theta_deg"])
@@ -334,8 +330,6 @@ def tip_cycle_data(
 
     params : baseline ``{cable_EA}``.  drift_m : a slow drift of the tip along x and y
     (m) that no effect models.  Returns ``(data, truth)`` with the noise-free channels."""
-    from femast.experiments import get_experiment
-
     exp = experiment or get_experiment("tip-cycle")
     path = dict(path or tip_cycle_path(seed=seed))
     n = len(path["fx_N"])

@@ -74,8 +74,9 @@ import numpy as np
 
 from femast import progress
 from femast.errors import ConvergenceError, FemastError, ModelError
-from femast.experiments import Column, Experiment, Measured, Parameter, prepared, turning_points
+from femast.experiments.core import Column, Experiment, Measured, Parameter, prepared
 from femast.experiments.fe_cache import cached, kernel_threads
+from femast.experiments.residuals import turning_points
 
 from .bay_torsion import LATCH_FIELDS, bay_parameters
 

@@ -60,7 +60,7 @@ import numpy as np
 from femast.analysis import Analysis
 from femast.effects import load_script
 from femast.errors import ModelError
-from femast.experiments import Column, Experiment, Measured, Parameter, prepared
+from femast.experiments.core import Column, Experiment, Measured, Parameter, prepared
 from femast.modal import modal_analysis
 
 FITS = {"pretension": ("pretension",), "mass": ("unit_mass",), "both": ("pretension", "unit_mass")}
