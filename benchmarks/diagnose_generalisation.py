@@ -369,13 +369,15 @@ def figures(rows, summary, out: Path) -> list:
     a1.set_yticks(y, [f"{r['case']} -> {verdict_label(r)}" for r in single], fontsize=7)
     a1.invert_yaxis()
     a1.set_xscale("log")
-    from matplotlib.ticker import FixedLocator, NullLocator, ScalarFormatter
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
 
-    a1.xaxis.set_major_locator(FixedLocator([0.8, 1, 1.2, 1.5, 2, 3, 4, 6, 8, 10]))
-    a1.xaxis.set_major_formatter(ScalarFormatter())
+    a1.xaxis.set_major_locator(FixedLocator([0.8, 1, 1.2, 1.5, 2, 3, 4, 6, 8, 10, 20, 40, 100]))
+    a1.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     a1.xaxis.set_minor_locator(NullLocator())
     a1.set_xlabel("RMS error / noise floor (as diagnose estimates it)")
-    a1.legend(fontsize=7, loc="lower right")
+    from femast.post import plotstyle
+
+    plotstyle.legend_below(a1, ncol=2, fontsize=7)  # never over the bars
     names = list(nulls)
     fa = [sum(not r["right"] for r in nulls[n]) / len(nulls[n]) for n in names]
     a2.barh(np.arange(len(names)), fa, color="C3")
