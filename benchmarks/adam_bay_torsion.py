@@ -8,13 +8,13 @@
   of rz, the moment is the load factor); then the moment is brought back to zero to read the
   residual rotation.  The bay is symmetric, so the four latches release together.
 * actual: the control node follows a measured-style table of theta_z, x and y (synthetic, with
-  off-axis drift up to about 1 cm: seed Sec. VI); the bay turns about the side that stays
+  off-axis drift up to about 1 cm: Stohlman & Pellegrino, Sec. VI); the bay turns about the side that stays
   latched, and the other three release one after the other.
 
 Each path writes to DIR/<path>/: the results folder (frames, status.sta, summary.json), the VTK
 series (vtk/series.pvd), the curve (curve.csv: moment, rotation, drift, bead positions, zones,
 force jumps) and the figure (torsion.png: moment-rotation curve with the four latch-status bars,
-zones of seed Fig. 6).  --docs copies the figures to docs/figures/adam_bay_<path>.png.
+zones of Stohlman & Pellegrino, Fig. 6).  --docs copies the figures to docs/figures/adam_bay_<path>.png.
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ from femast.post.vtk import export_vtk
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs" / "figures"
 
-SEED_NOTE = {
+PAPER_NOTE = {
     "ideal": "Stohlman & Pellegrino Fig. 16: model of the ideal path, all four latches\n"
     "release together; experiment: -35 N m to start, about\n"
     "3 deg to unlatch three of four latches",
@@ -89,7 +89,7 @@ def run_path(
     )
     if hysteresis is not None:
         title += f"\nlatch hysteresis F_h = {hysteresis[0]:g} N, ell = {hysteresis[1] * 1e3:g} mm"
-    png = plot_bay_torsion(curve, folder / "torsion.png", title=title, seed_note=SEED_NOTE[kind])
+    png = plot_bay_torsion(curve, folder / "torsion.png", title=title, note=PAPER_NOTE[kind])
     rel = np.degrees(release_angles(curve))
     back = np.degrees(relatch_angles(curve))
     twist = np.array(["twist" in s for s in curve["step"]])

@@ -3,17 +3,17 @@
     femast run benchmarks/adam_hysteresis.py [--target 0.10] [--length 1e-3] [--force F_h]
                                              [--skip-mast] [--docs] [--no-progress]
 
-The seed's latch law has one curve near the latched state, so its bay returns to zero rotation at
+The paper's latch law has one curve near the latched state, so its bay returns to zero rotation at
 zero moment, while the bay test kept about 0.10 degrees.  The latch element's hysteresis option
 (``hysteresis_force`` F_h, ``hysteresis_length`` ell: the static band widens to
 [dT_in - H, dT_out + H], H = F_h w(x), w = 1 on the backstop fading to 0 at the roller axis)
-is calibrated here so that the single bay's idealised path (seed Fig. 16) ends at 0.10 degrees
+is calibrated here so that the single bay's idealised path (Stohlman & Pellegrino, Fig. 16) ends at 0.10 degrees
 at zero moment, then:
 
 1. single bay: residual rotation at zero moment with and without the option, and against the
    largest twist of the cycle (the option acts only on beads that have left the backstop);
 2. 40-bay mast, Table 1 load sequence (3 cycles): residual tip rotation with and without the
-   option, against the seed's scaling estimate of 2.0 degrees (20 bays x 0.10 degrees).
+   option, against the paper's scaling estimate of 2.0 degrees (20 bays x 0.10 degrees).
 
 Writes DIR/hysteresis.png (and docs/figures/adam_hysteresis.png with --docs), DIR/summary.json.
 """
@@ -68,7 +68,9 @@ def mast_cycles(Fh: float, ell: float, progress: bool, cycles: int = 3):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", default="results/adam_hysteresis")
-    ap.add_argument("--target", type=float, default=0.10, help="single-bay residual rotation, degrees (seed: 0.10)")
+    ap.add_argument(
+        "--target", type=float, default=0.10, help="single-bay residual rotation, degrees (Stohlman & Pellegrino: 0.10)"
+    )
     ap.add_argument("--length", type=float, default=1e-3, help="hysteresis_length ell, m")
     ap.add_argument("--force", type=float, default=None, help="hysteresis_force F_h, N (skip the calibration)")
     ap.add_argument("--skip-mast", action="store_true")

@@ -17,7 +17,7 @@ DIR/summary.json.
 --compare-mu MU   also run the first M+F, 0 with ball-joint friction coefficient MU (e.g. 0.01)
                   to show how much of the residual is joint friction.
 --render          PNG of the distorted shape under M+F (scale factor --scale, default 100 as
-                  the seed's Fig. 18) and a VTK series.
+                  Stohlman & Pellegrino, Fig. 18) and a VTK series.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ import numpy as np
 
 import femast as fm
 from femast.adam import BayParameters, build_mast
-from femast.adam.post import SEED_TABLE1, TABLE1_COLUMNS, format_table1, tip_table
+from femast.adam.post import ADAM_TABLE1, TABLE1_COLUMNS, format_table1, tip_table
 from femast.adam.steps import CONVERGENCE, TABLE1_F, TABLE1_M, add_initial_steps, add_table1_steps
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -43,7 +43,7 @@ DOCS = ROOT / "docs" / "figures"
 EXPLAIN = """\
 Differences from the paper's Table 1 (see docs/adam_mast.md for the numbers behind each point):
 * x and theta_z under M+F match by construction: cable EA and the longeron wall were identified
-  from these two numbers (the seed gives neither).
+  from these two numbers (the paper gives neither).
 * theta_y: the paper's 210 arcsec cannot come with x = 1740 um from any cantilever: under a tip
   shear the bending part of x alone is (2/3) L theta_y = 4.56 m x 1.02e-3 rad = 4650 um. The model
   carries x mostly by shear of the cable net, so its theta_y (tip rotation of bending only) is
@@ -148,8 +148,8 @@ def main(argv=None):
         w = csv.writer(fh)
         w.writerow(["load"] + [f"femast {c}" for c in TABLE1_COLUMNS] + [f"paper {c}" for c in TABLE1_COLUMNS])
         for i, lab in enumerate(labels):
-            seed = SEED_TABLE1[i] if i < len(SEED_TABLE1) else [np.nan] * 6
-            w.writerow([lab] + [f"{v:.6g}" for v in vals[i]] + [f"{v:.6g}" for v in seed])
+            paper = ADAM_TABLE1[i] if i < len(ADAM_TABLE1) else [np.nan] * 6
+            w.writerow([lab] + [f"{v:.6g}" for v in vals[i]] + [f"{v:.6g}" for v in paper])
     first = labels.index("M+F")
     rel_x = vals[first, 0] / 1740.0 - 1
     rel_t = vals[first, 5] / 3030.0 - 1

@@ -92,7 +92,7 @@ def main(show=False):
     runs = {P: single_joint(P, tmp / f"P{int(P)}") for P in FORCES}
     beams = two_beams(tmp / "beams")
     lines = [
-        "Friction ball joint, seed 001 Sec. II.B.1 (mu = 0.5, B = 4 mm)",
+        "Friction ball joint, ADAM (Stohlman & Pellegrino), Sec. II.B.1 (mu = 0.5, B = 4 mm)",
         f"single joint, A = {A} rad, k_stick = {K_STICK} N m/rad, two cycles",
         f"{'F (N)':>8} {'plateau (N m)':>14} {'mu B F':>8} {'cycle':>6} {'D numeric (J)':>14} "
         f"{'D analytic (J)':>15} {'rel. err':>9}",

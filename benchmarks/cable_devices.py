@@ -68,7 +68,7 @@ def capstan(ax):
 
 
 def two_latches(ax):
-    P1 = LatchParameters.seed_fit()
+    P1 = LatchParameters.adam_fit()
     P2 = LatchParameters(r=1.1e-3, x_backstop=2.0e-3, k=30e3, mu=0.07, h=1.5e-3, R=2.4e-3)
     X = np.array([[0.0, 0, 0], [0.5, 0, 0], [5.5, 0, 0], [6.0, 0, 0]])
     fam = CableDeviceFamily.pretensioned([[0, 1, 2, 3]], X, 2.0e4, 5.0, [Latch(P1), Latch(P2)])

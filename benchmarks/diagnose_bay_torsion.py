@@ -12,7 +12,7 @@ latch k = 108 N/mm and mu = 0.065, frictionless ball joints, the nominal 170 N p
 hidden latch hysteresis of F_h = 8 N (fading over 0.3 mm, the element's option), driven along a
 measured-style path (0 -> 3.2 degrees -> 0 in 49 rows, denser near zero and through the release,
 with an off-axis drift of the top-frame centre up to 4 mm recorded in ux_m, uy_m), plus 0.2 N m of
-Gaussian noise on Mz (seed 7).  ``femast diagnose`` should find latch_hysteresis with F_h near 8 N.
+Gaussian noise on Mz (random seed 7).  ``femast diagnose`` should find latch_hysteresis with F_h near 8 N.
 
 The timed commands run in fresh processes (``femast ...`` through ``femast.cli.main``: imports, numba cache loads
 and worker start-up included) with an empty FE cache; the machine's load is printed beside the

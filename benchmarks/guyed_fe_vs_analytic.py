@@ -2,7 +2,7 @@
 
 1. Term by term at the pretensioned equilibrium (400 N and 1200 N): K_beam, K_p, K_a of the FE
    (condensed tangent, shroud tangent switched part by part) against Eqs. 8-18, 24, 26.
-2. The beam's own geometric stiffness from its axial compression (omitted by the seed), against the
+2. The beam's own geometric stiffness from its axial compression (omitted by the paper), against the
    exact beam-column and its leading term -6P/(5L).
 3. Conventions that change the active term (nominal vs deformed geometry, tension in the initial
    geometry vs at equilibrium, printed vs corrected Eq. 26, the skew part).
@@ -101,14 +101,14 @@ def term_by_term():
         )
         c["conventions"] = dict(
             nominal=relative_difference(Ka_nom, c["K_a_FE"]),
-            seed=relative_difference(c["K_a_seed"], c["K_a_FE"]),
+            printed=relative_difference(c["K_a_printed"], c["K_a_FE"]),
             relaxed=t_relaxed,
             skew=np.abs(skew).max(),
             m_net=m_net,
         )
         lines.append(
             f"  {P:.0f} N: nominal geometry {c['conventions']['nominal']:.1e}; printed Eq. 26 "
-            f"{c['conventions']['seed']:.2f}; tension set in the initial geometry relaxes to "
+            f"{c['conventions']['printed']:.2f}; tension set in the initial geometry relaxes to "
             f"{np.round(t_relaxed, 1).tolist()} N ({100 * (t_relaxed.min() / P - 1):.1f} %); "
             f"max |K_a - K_a^T| = {c['conventions']['skew']:.2f} N m/rad, net shroud moment "
             f"{np.round(m_net, 2).tolist()} N m"
@@ -141,7 +141,7 @@ def sweep(s=None):
         K_mg = K_m + (beam_column_geometric_stiffness(L_BEAM, EI, Pb) if Pb > 0 else 0.0)
         lin = {
             "FE tangent": np.linalg.solve(K_t, w0),
-            "complete (seed K_m)": np.linalg.solve(K_m, w0),
+            "complete (paper's K_m)": np.linalg.solve(K_m, w0),
             "complete + beam K_geo": np.linalg.solve(K_mg, w0),
         }
         out["cases"][P] = {"du": du, "tension": tau, "lin": lin}
@@ -173,7 +173,7 @@ def plot(sw, path):
     fig, axes = plt.subplots(2, 3, figsize=(14, 8), sharex=True)
     styles = {
         "FE tangent": dict(color="k", ls="--"),
-        "complete (seed K_m)": dict(color="C2"),
+        "complete (paper's K_m)": dict(color="C2"),
         "complete + beam K_geo": dict(color="C1", ls="-."),
     }
     for k, (P, c) in enumerate(sw["cases"].items()):
@@ -201,7 +201,7 @@ def plot(sw, path):
         if k == 0:
             b.legend(fontsize=8, loc="upper left")
     fig.suptitle(
-        "Seed 000, mast 1: nonlinear FE under growing cable loads vs linear models "
+        "Rocaspect guyed mast 1: nonlinear FE under growing cable loads vs linear models "
         "(s = 1: the real load at the initial pose)"
     )
     fig.tight_layout()

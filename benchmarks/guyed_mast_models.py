@@ -1,16 +1,16 @@
 """Mast-1 top displacement of the Rocaspect robot predicted by the Rocaspect paper's mast models (Figs. 5-6).
 
-The platform follows a trajectory like the seed's Fig. 5a (:func:`femast.guyed.rocaspect.fig5a_trajectory`).
+The platform follows a trajectory like the Rocaspect paper, Fig. 5a (:func:`femast.guyed.rocaspect.fig5a_trajectory`).
 At each pose the cable tensions come from the barycentric tension distribution, the cable
 wrench on the top of mast 1 from Eq. 7, and each model maps the change of that wrench from
-the initial pose, ``dw = w(pose) - w(POSE_0)``, to a top displacement, as in the seed's
+the initial pose, ``dw = w(pose) - w(POSE_0)``, to a top displacement, as in the paper's
 Section IV-C.  Three shroud cases as in Fig. 6: 1200 N, 400 N, no shrouds.
 
-Parameters (all from the seed unless stated):
+Parameters (all from the paper unless stated):
 
 * 3R: Table III, tests "1 and 8" (1200 N), "4" (400 N), "7 and 10" (no shrouds); the torsion
-  joint is rigid (the seed found it unidentifiable).
-* beam: E_1200N = 1.55e11 Pa and E_no_shroud = 6.55e10 Pa.  The seed gives no E for 400 N;
+  joint is rigid (the paper found it unidentifiable).
+* beam: E_1200N = 1.55e11 Pa and E_no_shroud = 6.55e10 Pa.  The paper gives no E for 400 N;
   here it is identified (``fit_beam_E``) from the 3R model's predicted displacements, so the
   400 N beam curve is the closest beam model to the 3R one, not an independent estimate.
 * complete: the bare beam (E_no_shroud) plus three shrouds at the case's pretension, Dyneema
@@ -82,7 +82,7 @@ MAST = 0  # mast 1
 
 @dataclass
 class Case:
-    """One shroud configuration of the seed's Fig. 6."""
+    """One shroud configuration of the Rocaspect paper, Fig. 6."""
 
     name: str
     pretension: float | None  # N per shroud; None = shrouds detached

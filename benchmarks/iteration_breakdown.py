@@ -1,4 +1,4 @@
-"""Where a Newton iteration's time goes, against the linear solve in the same run (issues 8, 21).
+"""Where a Newton iteration's time goes, against the linear solve in the same run.
 
     python benchmarks/iteration_breakdown.py [--bays 40 400 1000] [--runs 8]
 

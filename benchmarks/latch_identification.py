@@ -1,7 +1,7 @@
 """Latch identification from pull tests (Stohlman & Pellegrino, Figs. 9-10, Eq. 15), on synthetic data.
 
 The "measured" tests are simulated with the cable/latch element for a known latch
-(the seed's fit), with noise on the cable end distance (5 um) and the tension
+(the paper's fit), with noise on the cable end distance (5 um) and the tension
 (0.3 N).  The script removes the cable stretch (Eq. 15), fits r, x_backstop, k, mu
 with h and R given, prints the estimates with their standard errors, checks them
 against a Monte-Carlo spread, and draws the analogue of Figs. 9 and 10.
@@ -43,7 +43,7 @@ def noisy(tests, rng):
 
 
 def main(n_monte_carlo: int = 50) -> dict:
-    true = LatchParameters.seed_fit()
+    true = LatchParameters.adam_fit()
     theta = np.array([true.r, true.x_backstop, true.k, true.mu])
     clean = [simulate_pull_test(true, d, EA=EA, n_steps=300) for d in (UNLATCHING, LATCHING)]
     tests = noisy(clean, np.random.default_rng(2024))

@@ -1,6 +1,6 @@
 """Reproduce Stohlman & Pellegrino, Fig. 10 (with the zones of Fig. 6): latch force jump vs bead position.
 
-Plots, for the seed's fitted latch (r = 1.1 mm, x_backstop = 2.0 mm, k = 100 N/mm,
+Plots, for the paper's fitted latch (r = 1.1 mm, x_backstop = 2.0 mm, k = 100 N/mm,
 mu = 0.07, h = 1.5 mm, R = 2.4 mm):
 
 * the two branches of Eq. 14 (latching dx < 0, unlatching dx > 0) and the static
@@ -43,7 +43,7 @@ DOCS = Path(__file__).resolve().parents[1] / "docs" / "figures"
 
 
 def main(show_paths: bool = True) -> dict:
-    p = LatchParameters.seed_fit()
+    p = LatchParameters.adam_fit()
     mm = 1e3
     xct = contact_half_width(p)
     x = np.linspace(-p.x_backstop, 4e-3, 2001)
@@ -100,7 +100,8 @@ def main(show_paths: bool = True) -> dict:
     ax.set_xlabel("bead position x, distance to latch (mm)   [x > 0: outside, backstop at x = -x_backstop]")
     ax.set_ylabel(r"$\Delta T = T_2 - T_1$ (N)")
     ax.set_title(
-        "Latch law, seed 001 Fig. 10: r=1.1 mm, x_bs=2.0 mm, k=100 N/mm, mu=0.07, h=1.5 mm, R=2.4 mm", fontsize=9
+        "Latch law of ADAM (Stohlman & Pellegrino), Fig. 10: r=1.1 mm, x_bs=2.0 mm, k=100 N/mm, mu=0.07, h=1.5 mm, R=2.4 mm",
+        fontsize=9,
     )
     ax.plot([], [], ":", color="0.3", label="snap (bead jumps; dotted arrows)")
     ax.legend(loc="upper right", bbox_to_anchor=(1.0, 0.86), fontsize=7.5, framealpha=0.9)

@@ -3,7 +3,7 @@ and against an FE run of one cable/latch element; writes docs/figures/latch_pull
 
     python benchmarks/latch_pull_partial.py
 
-Data: ``benchmarks/latch_rig.py`` (quasi-static rig from the seed's Eqs. 7-11, no femast code),
+Data: ``benchmarks/latch_rig.py`` (quasi-static rig from Stohlman & Pellegrino, Eqs. 7-11, no femast code),
 0.5 N and 2 um noise.  FE: a femast Model with one cable/latch element (Stohlman & Pellegrino, Eqs. 2-5, two
 sections, latch at the middle node on a 1e9 N/m mount), the outer grip driven by a prescribed
 displacement, the inner section slack.  Prints the RMS error / noise of each null case for the
@@ -22,7 +22,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 from latch_rig import SeedLatch, paths, simulate, to_columns  # noqa: E402
 
-SEED = {"r": 1.1e-3, "x_backstop": 2.0e-3, "k": 1e5, "mu": 0.07}
+ADAM_FIT = {"r": 1.1e-3, "x_backstop": 2.0e-3, "k": 1e5, "mu": 0.07}
 
 
 def fe_partial_unlatching(
@@ -38,7 +38,7 @@ def fe_partial_unlatching(
     from femast.elements.cable_latch import CableLatchFamily
     from femast.elements.latch_law import LatchParameters, latch_force
 
-    P = LatchParameters.seed_fit()
+    P = LatchParameters.adam_fit()
     m = fm.Model("latch pull test")
     Lb = L_in - P.x_backstop  # material coordinate of the bead: seated on the backstop
     a, latch, grip = m.node(-(L_in - 0.01), 0, 0), m.node(0, 0, 0), m.node(L_out * (1 + 1e-6), 0, 0)
@@ -64,7 +64,7 @@ def fe_partial_unlatching(
         status = res.element_history("cable", 1, "latch_status")
         d = L_out * (1 + 1e-6) + res.node_history(grip, "ux") - res.node_history(latch, "ux")
     L_loaded = L_in + L_out - Lb  # unstretched cable from the bead (at x = 0) to the grip
-    x15 = d / (1.0 + T[:, 1] / EA) - L_loaded  # Eq. 15 with the loaded length (seed: constant length)
+    x15 = d / (1.0 + T[:, 1] / EA) - L_loaded  # Eq. 15 with the loaded length (the paper: constant length)
     return {"x": x, "x15": x15, "T": T, "dT": T[:, 1] - T[:, 0], "status": status}
 
 
@@ -97,14 +97,14 @@ def main():
         run = simulate(latch, knots, side, x_start=x0)
         cols = to_columns(run, noise_N=0.5, noise_mm=0.002, seed=5)
         data = from_arrays(exp, **cols)
-        c = compare(exp, data, params=SEED)
+        c = compare(exp, data, params=ADAM_FIT)
         drawn = np.sqrt(np.mean((cols["dT_N"] - run["dT"]) ** 2))
         print(f"  {name:32s} {data.n:5d} {c.rms / drawn:16.3f} {c.ratio:15.3f}")
-        runs[name] = (run, cols, predict(exp, data, SEED)["dT_N"])
+        runs[name] = (run, cols, predict(exp, data, ADAM_FIT)["dT_N"])
 
     fe = fe_partial_unlatching()
     data = from_arrays(exp, x_mm=1e3 * fe["x15"], dT_N=fe["dT"], side=np.ones(fe["dT"].size))
-    pred = predict(exp, data, SEED)["dT_N"]
+    pred = predict(exp, data, ADAM_FIT)["dT_N"]
     print(
         f"FE partial unlatching (zone b, {fe['dT'].size} increments): max |model - FE| = "
         f"{np.abs(pred - fe['dT']).max():.2e} N"
@@ -119,7 +119,7 @@ def main():
         ax.plot(cols["x_mm"], p, "-", lw=1.0, color="C3", label="latch-pull model, loaded side")
         ax.plot(
             1e3 * run["x_meas"],
-            direction_rule(run["x_meas"], run["dT"], SEED),
+            direction_rule(run["x_meas"], run["dT"], ADAM_FIT),
             "--",
             lw=0.8,
             color="C0",

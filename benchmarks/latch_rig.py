@@ -1,9 +1,9 @@
 """Independent simulator of the latch pull-test rig of Stohlman & Pellegrino (Sec. III.B, Fig. 8), for test data.
 
-Written from the seed's equations without :mod:`femast.elements.latch_law` or the ``latch-pull`` experiment,
+Written from the paper's equations without :mod:`femast.elements.latch_law` or the ``latch-pull`` experiment,
 so that data with partial reversals can test that model.  Differences in form on purpose:
 
-* the latch law is evaluated in the seed's angle form, Eqs. 7-11 (``cos(theta) = x / (r + R)``,
+* the latch law is evaluated in the paper's angle form, Eqs. 7-11 (``cos(theta) = x / (r + R)``,
   roller normal force ``F_n`` from Eq. 11, ``dT`` from Eq. 9 with the factor 2 on both terms),
   not the closed form of Eq. 14;
 * the rig is a quasi-static simulation of the bead on a cable of stiffness ``k_cable`` (N/m)

@@ -3,7 +3,7 @@
     PYTHONPATH=$PWD python benchmarks/platform_pose.py [--out docs/figures] [--n 25] [--no-speed]
 
 For each mast model (3R, beam, beam+shroud, FE guyed mast) and shroud pretension (0, 400, 800,
-1200 N): the 8.3 x 6.8 x 4.0 m robot, 50 kg platform, trajectory like Fig. 5a from the seed's
+1200 N): the 8.3 x 6.8 x 4.0 m robot, 50 kg platform, trajectory like Fig. 5a from the paper's
 initial pose (:func:`femast.guyed.rocaspect.fig5a_trajectory`), tensions from Eq. 2 (barycentric,
 20-1500 N), swivel pulleys of 0.03 m, exit geometry calibrated at the initial pose.  Prints the
 largest and RMS position error and the largest orientation error of the platform against the

@@ -5,11 +5,11 @@ its shroud lengths, shroud pretensions and the temperature.
     python benchmarks/study_guyed.py [--samples 128] [--workers 2]      # the same, plus the error figure
 
 Model: :class:`femast.guyed.fe_mast.MastFE` (mast 1: the 3.651 m aluminium tube as 16 corotational
-beams, three Dyneema shrouds with the seed's Eq. 25 law on rigid offsets of the top).  Load
+beams, three Dyneema shrouds with the Rocaspect paper, Eq. 25 law on rigid offsets of the top).  Load
 history: pretension, a uniform temperature change of tube and shrouds (step ``thermal``), then the
 working pull of the robot's cable on the top (step ``load``, ``WORK_LOAD``).
 
-Scatter (stated here; the seed gives none):
+Scatter (stated here; the paper gives none):
 * shroud length errors ``dL_shroud``: each rope's lack of fit, normal 0.5 mm standard deviation
   truncated at +-1 mm (cut to length by hand on ~3.8 m of rope);
 * pretensions ``pretension``: each rope tensioned to 1200 N within a normal 5 % (60 N) standard
@@ -34,7 +34,7 @@ from femast.elements.shroud_cable import unstretched_length
 from femast.elements.shroud_law import DyneemaLaw
 from femast.guyed.fe_mast import MastFE
 
-T_NOMINAL = 1200.0  # N, the seed's pretension
+T_NOMINAL = 1200.0  # N, the paper's pretension
 ALPHA_SHROUD, ALPHA_TUBE = -12e-6, 23e-6  # 1/K (Dyneema along the fibre, aluminium)
 WORK_LOAD = {"fx": 200.0, "fy": 160.0, "fz": -160.0}  # N, the cable's pull toward the platform
 STEPS = ["thermal", "load"]

@@ -1,4 +1,4 @@
-"""Writes femast/examples/vibration_example.csv (package data): the seed's calibration on the mock bay side,
+"""Writes femast/examples/vibration_example.csv (package data): the paper's calibration on the mock bay side,
 nine pretension settings 120-200 N, the latch's out-of-plane resonance, with a
 hidden pretension loss of 15 N (the cables carry 15 N less than the settings say) and 0.12 Hz of
 measurement noise.
@@ -33,8 +33,14 @@ def main(path=EXAMPLE):
     T = settings - LOSS
     f = np.sqrt(4 * T / (HALF_DIAGONAL * MASS)) / (2 * math.pi) + NOISE * rng.standard_normal(settings.size)
     with open(path, "w") as fh:
-        fh.write("# mock bay side of seed 001 Fig. 11: out-of-plane resonance of the latch (mode 1) at nine\n")
-        fh.write("# pretension settings (inline sensors); synthetic, see benchmarks/vibration_example_data.py\n")
+        fh.write(
+            "# vibration example: out-of-plane resonance of the latch (mode 1) at nine pretension settings, "
+            "synthetic. A mock\n"
+        )
+        fh.write(
+            "# bay side of Stohlman & Pellegrino, Fig. 11 (inline sensors); from python -m "
+            "femast.benchmarks.vibration_example_data\n"
+        )
         fh.write("mode,f_Hz,pretension_N\n")
         for s, fr in zip(settings, f):
             fh.write(f"1,{fr:.3f},{s:.1f}\n")

@@ -83,3 +83,41 @@ def _importer():
             return frame
         frame = frame.f_back
     return None
+
+
+def renamed(old: str, new: str, stacklevel: int = 3) -> None:
+    """Warn that the name or option value ``old`` is now ``new`` (a :class:`DeprecationWarning` naming
+    both and the release that removes ``old``), at the caller of the function that calls this."""
+    warnings.warn(
+        f"{old} is now {new}: use the new name ({old} is removed in femast {REMOVED_IN})",
+        DeprecationWarning,
+        stacklevel=stacklevel,
+    )
+
+
+def renamed_attributes(module_name: str, names: dict):
+    """A module ``__getattr__`` that gives each old name of ``names`` (old -> new) the object of its
+    new name, with the warning of :func:`renamed`."""
+    module = sys.modules[module_name]
+
+    def __getattr__(name):
+        if name in names:
+            renamed(f"{module_name}.{name}", f"{module_name}.{names[name]}")
+            return getattr(module, names[name])
+        raise AttributeError(f"module {module_name!r} has no attribute {name!r}")
+
+    return __getattr__
+
+
+class RenamedKeys(dict):
+    """A dict whose old keys (``renames``: old -> new) still read, with the warning of :func:`renamed`."""
+
+    def __init__(self, data=(), renames=None, what="the result"):
+        super().__init__(data)
+        self.renames, self.what = dict(renames or {}), what
+
+    def __missing__(self, key):
+        if key in self.renames:
+            renamed(f"{self.what}[{key!r}]", f"{self.what}[{self.renames[key]!r}]")
+            return self[self.renames[key]]
+        raise KeyError(key)

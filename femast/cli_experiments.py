@@ -103,7 +103,7 @@ def effect_rows(experiment=None) -> list[dict]:
                 "quantities": [k for k in ("load", "displacement", "time", "temperature") if k in (m.hook, *m.needs)]
                 if m is not None
                 else [],
-                "source": e.seed,  # the paper and equation it comes from
+                "source": e.source,  # the paper and equation it comes from
             }
         )
     return rows

@@ -1,6 +1,6 @@
 """Identification of the latch law from pull tests (Stohlman & Pellegrino, Section III.B-C, Eq. 15).
 
-A pull test (seed Fig. 8) pulls the bead into (latching) or out of (unlatching) the
+A pull test (Stohlman & Pellegrino, Fig. 8) pulls the bead into (latching) or out of (unlatching) the
 latch with one cable while the cable on the other side of the latch is slack, and
 records the cable end-to-end distance ``d_i`` (m) and the tension ``T_i`` (N).
 
@@ -8,11 +8,11 @@ records the cable end-to-end distance ``d_i`` (m) and the tension ``T_i`` (N).
 
        x_i = sign * (d_i - T_i L_cable / EA - d0)
 
-   The seed prints ``x_i = d_i - T_i / k_cable (L10 + L30) - d0``: ``k_cable`` is the
+   The paper prints ``x_i = d_i - T_i / k_cable (L10 + L30) - d0``: ``k_cable`` is the
    cable's stiffness per unit strain, i.e. its axial rigidity EA (N), and
    ``L10 + L30`` the unstretched length of the cables in the load path (``L_cable``).
    ``sign`` is +1 when ``d`` grows as the bead moves out (unlatching rig, Fig. 8b,
-   the seed's form) and -1 when it grows as the bead moves in (latching rig, Fig.
+   the paper's form) and -1 when it grows as the bead moves in (latching rig, Fig.
    8a); ``d0`` is the zero-tension distance with the bead on the roller axis.  The
    measured force jump is ``dT_i = direction * T_i`` (direction +1 unlatching, -1
    latching; see :mod:`femast.elements.latch_law` for the signs).
@@ -43,11 +43,11 @@ _REF = np.array([1e-3, 1e-3, 1e5, 0.1])  # scales of the fitted parameters (m, m
 
 @dataclass
 class PullTest:
-    """One pull test (seed Fig. 8): arrays d (m) and T (N) and the constants of Eq. 15.
+    """One pull test (Stohlman & Pellegrino, Fig. 8): arrays d (m) and T (N) and the constants of Eq. 15.
 
     direction : +1 unlatching (bead pulled out, dT = +T) or -1 latching (dT = -T).
-    EA : axial rigidity of the loaded cable, N (the seed's k_cable).
-    L_cable : unstretched length of the loaded cable(s), m (the seed's L10 + L30).
+    EA : axial rigidity of the loaded cable, N (the paper's k_cable).
+    L_cable : unstretched length of the loaded cable(s), m (the paper's L10 + L30).
     d0 : distance d at zero tension with the bead on the roller axis, m.
     sign : +1 if d grows when the bead moves out, -1 if it grows when it moves in.
     x_true : bead positions, m, when known (simulated tests).
@@ -112,7 +112,7 @@ def simulate_pull_test(
     p = (
         params
         if isinstance(params, LatchParameters)
-        else LatchParameters.seed_fit()
+        else LatchParameters.adam_fit()
         if params is None
         else LatchParameters(*np.asarray(params, float))
     )
@@ -188,7 +188,7 @@ def initial_guess(x, dT, h, R, noise_T=1.0):
 
     x_backstop from the smallest bead position; r from the largest |x| with a force above
     the noise (the contact half-width, Eq. 6 with delta = 0); k from the peak force by
-    the ratio to the seed's fit; mu = 0.05."""
+    the ratio to the paper's fit; mu = 0.05."""
     x = np.asarray(x, float)
     dT = np.asarray(dT, float)
     xb = max(-np.min(x), 1e-5)

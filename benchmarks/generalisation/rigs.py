@@ -1,4 +1,4 @@
-"""The two rigs of the benchmark, written from the seeds (numpy only).
+"""The two rigs of the benchmark, written from the papers (numpy only).
 
 Mast top (the Rocaspect paper, Sec. III-A, Eqs. 4-7)
 -----------------------------------------
@@ -19,9 +19,9 @@ Roller latch law (Eqs. 6-14), ``x`` the bead position (m, positive outside, back
     dT_in(x)  = -2 k delta (x + mu y) / (y - mu x)     latching   (dx < 0)
     dT_out(x) = -2 k delta (x - mu y) / (y + mu x)     unlatching (dx > 0)
 
-with the seed's fit r = 1.1 mm, x_b = 2.0 mm, k = 100 N/mm, mu = 0.07, h = 1.5 mm, R = 2.4 mm.
+with the paper's fit r = 1.1 mm, x_b = 2.0 mm, k = 100 N/mm, mu = 0.07, h = 1.5 mm, R = 2.4 mm.
 The rig pulls with one cable at a time (Sec. III.B), so a latching pass cannot hold dT > 0 and an
-unlatching pass cannot hold dT < 0 (the seed's text has the two the other way round; with the
+unlatching pass cannot hold dT < 0 (the paper's text has the two the other way round; with the
 signs of Eqs. 5 and 14 this is the physical reading).  A cycle: a hold on the backstop (pushed
 in to -F_push, released, pulled to the breakaway force), unlatching out to x_max, latching back
 to the backstop.

@@ -4,10 +4,10 @@ A mast of ``n_bays`` bays has ``n_bays + 1`` square batten frames (side ``b``) a
 ``0, l, 2 l, ...``.  Each frame has four rigid corner pieces; each bay has
 
 * four longerons (corotational beams) from the bottom to the top corner pieces, joined to them by
-  friction ball joints (seed Sec. II.B.1: |M| <= mu B |F|) at the ball centres: seated by default
+  friction ball joints (Stohlman & Pellegrino, Sec. II.B.1: |M| <= mu B |F|) at the ball centres: seated by default
   (the ball sits in its socket, held there by the cables' preload: the seat carries compression and
   opens in tension; ``BayParameters.seat``), or tied (``seat="tied"``: the paper's two-way tie);
-* on each of its four sides one cable/pulley/latch assembly (seed Sec. II.B.2, Fig. 4): a unit at
+* on each of its four sides one cable/pulley/latch assembly (Stohlman & Pellegrino, Sec. II.B.2, Fig. 4): a unit at
   the centre of the side through which
 
   - one continuous cable runs from one bottom corner, through the latch, over the unit's pulley
@@ -26,15 +26,15 @@ A mast of ``n_bays`` bays has ``n_bays + 1`` square batten frames (side ``b``) a
 * Rigid corner pieces: the corner node (ball centre, where the ball joints and the cable anchors
   are) is the reference node of a rigid body that also carries the two batten ends, ``corner``
   from the ball centre along the frame edges.  The bottom frame is fixed; the top frame (corner
-  pieces and battens) is one rigid body with the *control node* at its centre as reference (seed
-  Sec. II.C: "a control node ... rigidly connected to the four corners of the top batten frame").
+  pieces and battens) is one rigid body with the *control node* at its centre as reference
+  (Stohlman & Pellegrino, Sec. II.C: "a control node ... rigidly connected to the four corners of the top batten frame").
 
 Corners are numbered k = 0..3 counter-clockwise seen from +z, corner k at polar angle
 45 + 90 k degrees (corner 0 at (+b/2, +b/2)); side k joins corners k and k+1 (side 0 is the
 side y = +b/2, side 1 x = -b/2, side 2 y = -b/2, side 3 x = +b/2).  A bay with ``fold = +1`` folds
 (stows) under a positive twist of its top frame about +z, one with ``fold = -1`` under a negative
 twist (its cable assemblies are mirror images).  ``build_mast(..., alternate=True)`` alternates the
-folding sense from bay to bay, as in the seed's mast (Sec. VIII).
+folding sense from bay to bay, as in the paper's mast (Sec. VIII).
 
 All inputs are SI (m, N, Pa, rad).
 """
@@ -178,7 +178,7 @@ def build_mast(
 
     params : :class:`BayParameters`; keyword ``changes`` override single parameters.
     fold : folding sense of the first (bottom) bay, +1 or -1.
-    alternate : alternate the folding sense from bay to bay (seed Sec. VIII: "the bays are
+    alternate : alternate the folding sense from bay to bay (Stohlman & Pellegrino, Sec. VIII: "the bays are
         arranged to fold in alternate directions").
     The base frame is fixed (all DOFs of its nodes); the top frame is a rigid body whose reference
     is the control node at its centre.  ``cables=False`` leaves out the cable assemblies.

@@ -1,6 +1,6 @@
 """Identification of the unknown bay parameters from the 40-bay tip response of Stohlman & Pellegrino, Table 1.
 
-The seed gives the elastic tip response of its 40-bay model under M + F (M = 6.8 N m about z,
+The paper gives the elastic tip response of its 40-bay model under M + F (M = 6.8 N m about z,
 F = 14 N along x): x = 1740 um and theta_z = 3030 arcsec.  It does not give the cable EA nor the
 longeron section.  :func:`fit_tip_response` finds them by least squares (scipy's trust-region
 reflective ``least_squares``, as the project's other fits): each residual evaluation builds the

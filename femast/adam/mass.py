@@ -7,7 +7,7 @@ Stohlman & Pellegrino give no mass.  The defaults are stated choices (SI):
 * cables: stranded steel, mass per length = 7850 kg/m^3 x EA / 200 GPa (the cable EA of the
   bay parameters over steel's modulus: 1.33e-3 kg/m for the default EA = 3.4e4 N);
 * pulley-and-latch unit (latch, bead, pulley, housing): the effective mass identified from the
-  seed's vibration fit (Eq. 16 read in lbf, see :mod:`femast.adam.vibration`), ``UNIT_MASS``;
+  the paper's vibration fit (Eq. 16 read in lbf, see :mod:`femast.adam.vibration`), ``UNIT_MASS``;
 * corner pieces (ball ends, fittings): 0.02 kg each, lumped at the corner node (a guess: only
   the mast's modes use it, not the bay-side method).
 """

@@ -1,7 +1,7 @@
 """Parameters of an ADAM-type bay (Stohlman & Pellegrino): every dimension, section, material, pretension and
 latch parameter, in SI units, with the source of each default value.
 
-The seed gives the bay height (6.84 m / 40 bays = 0.171 m), the ball joints (mu = 0.5, B = 4 mm),
+The paper gives the bay height (6.84 m / 40 bays = 0.171 m), the ball joints (mu = 0.5, B = 4 mm),
 the latch (Sec. III.C fit), the range of cable pretensions (125-210 N, Figs. 13-14), the bay's
 torsion test (about 3 degrees to unlatch three of four latches under about 35 N m, Figs. 16-17)
 and the 40-bay tip response (Table 1).  It does not give the batten side, the member sections or
@@ -14,13 +14,14 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, fields, replace
 
+from .._moved import renamed_attributes
 from ..elements.cable_device_specs import Pulley, Sheave
 from ..elements.latch_law import LatchParameters, contact_half_width, validate_latch_array
 from ..errors import ModelError
 from ..model.sections import Section, circular_tube
 
 #: Bay height of Stohlman & Pellegrino, Sec. VII: 40 bays make a 6.84 m mast.
-SEED_BAY_HEIGHT = 6.84 / 40
+ADAM_BAY_HEIGHT = 6.84 / 40
 
 
 @dataclass(frozen=True)
@@ -29,27 +30,27 @@ class BayParameters:
 
     Geometry
     --------
-    b : batten frame side, ball centre to ball centre, m.  Not in the seed: chosen so that the
+    b : batten frame side, ball centre to ball centre, m.  Not in the paper: chosen so that the
         single-bay torsion test unlatches after about 3 degrees (Sec. V).
     l : longeron length, ball centre to ball centre, m; equal to the deployed bay height
-        (Eq. 1 with theta_t = 0).  Seed: 6.84 m / 40 = 0.171 m.
+        (Eq. 1 with theta_t = 0).  Stohlman & Pellegrino: 6.84 m / 40 = 0.171 m.
     corner : size of the rigid corner piece: the batten ends sit this far from the ball centre
         along the frame edges, m.
 
     Members (circular tubes: outer diameter, wall thickness, material)
     -----------------------------------------------------------------
-    longeron_d, longeron_t : m.  longeron_E (Pa), longeron_nu.  Not in the seed: the wall is
+    longeron_d, longeron_t : m.  longeron_E (Pa), longeron_nu.  Not in the paper: the wall is
         identified from Table 1 (``femast.adam.identify``).
     batten_d, batten_t, batten_E, batten_nu : same for the battens (frame members).
 
     Cables (one cable/pulley/latch assembly per side)
     -------------------------------------------------
-    cable_EA : axial rigidity of the cables, N.  Not in the seed: identified from Table 1.
+    cable_EA : axial rigidity of the cables, N.  Not in the paper: identified from Table 1.
     pretension : cable tension of the deployed, latched bay before it comes to equilibrium, N
         (Figs. 13-14: 125-210 N).
-    latch : :class:`~femast.elements.latch_law.LatchParameters` (seed Sec. III.C fit by default).
+    latch : :class:`~femast.elements.latch_law.LatchParameters` (Stohlman & Pellegrino, Sec. III.C fit by default).
     hysteresis_force, hysteresis_length : latch hysteresis near the latched state (N, m); 0
-        switches it off (the seed's model).  See ``docs/cable_latch_element.md``.
+        switches it off (the paper's model).  See ``docs/cable_latch_element.md``.
     latch_mu_k : kinetic friction of the latch rollers (-); None (default): the latch's ``mu``, the
         paper's one coefficient (Sec. III.A: "the kinetic and static coefficients ... are assumed to
         be equal").  Below it, ``latch.mu`` is the static coefficient: a bead starts to slide at
@@ -71,7 +72,7 @@ class BayParameters:
     seat_clearance_radial : seated joints: radial play of the ball in its socket, m (default 0).
     seat_clearance_axial : seated joints: axial play from the seat to a retainer, m; None (default):
         no retainer, the seat opens freely in tension.
-    mu, B : ball joint friction coefficient and ball end radius, m (seed Sec. II.B.1: 0.5, 4 mm).
+    mu, B : ball joint friction coefficient and ball end radius, m (Stohlman & Pellegrino, Sec. II.B.1: 0.5, 4 mm).
     mu_k : kinetic friction coefficient of the ball joints; None: the same as ``mu`` (the paper).
     joint_penalty_factor, joint_stick_factor : numerical stiffness factors of the ball joints
         (:func:`femast.elements.ball_joint.add_ball_joints`): k_pen = factor x EA/l and
@@ -87,7 +88,7 @@ class BayParameters:
     """
 
     b: float = 0.25
-    l: float = SEED_BAY_HEIGHT
+    l: float = ADAM_BAY_HEIGHT
     corner: float = 0.015
     longeron_d: float = 0.025
     longeron_t: float = 6.527e-3
@@ -99,7 +100,7 @@ class BayParameters:
     batten_nu: float = 0.3
     cable_EA: float = 3.4006e4
     pretension: float = 170.0
-    latch: LatchParameters = field(default_factory=LatchParameters.seed_fit)
+    latch: LatchParameters = field(default_factory=LatchParameters.adam_fit)
     hysteresis_force: float = 0.0
     hysteresis_length: float = 3e-4
     latch_mu_k: float | None = None
@@ -311,3 +312,7 @@ def _is_number(v) -> bool:
     except (TypeError, ValueError):
         return False
     return not isinstance(v, bool)
+
+
+#: old names, kept for one release (they warn): femast 0.3 removes them
+__getattr__ = renamed_attributes(__name__, {"SEED_BAY_HEIGHT": "ADAM_BAY_HEIGHT"})

@@ -1,6 +1,6 @@
 """Post-processing of ADAM analyses: the bay's moment-rotation curve with the four latch-status
-bars (seed Figs. 16-17, zones of Fig. 6), CSV files, release angles, residual rotations, and the
-tip table of the 40-bay mast in the layout of seed Table 1.  Reads :class:`~femast.post.results.Results`
+bars (Stohlman & Pellegrino, Figs. 16-17, zones of Fig. 6), CSV files, release angles, residual rotations, and the
+tip table of the 40-bay mast in the layout of Stohlman & Pellegrino, Table 1.  Reads :class:`~femast.post.results.Results`
 only (never the live solver)."""
 
 from __future__ import annotations
@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._moved import renamed, renamed_attributes
 from ..elements.latch_law import (
     ZONE_BACKSTOP,
     ZONE_BEHIND_AXIS,
@@ -23,7 +24,7 @@ from .build import AdamModel
 
 ARCSEC = 180.0 / np.pi * 3600.0  # arcsec per rad
 
-#: Colours of the zones of seed Fig. 6: red latched, yellow intermediate, green unlatched.
+#: Colours of the zones of Stohlman & Pellegrino, Fig. 6: red latched, yellow intermediate, green unlatched.
 ZONE_COLORS = {ZONE_BACKSTOP: "#d7191c", ZONE_BEHIND_AXIS: "#fdae61", ZONE_IN_FRONT: "#ffe55c", ZONE_FREE: "#1a9641"}
 
 
@@ -129,11 +130,17 @@ def relatch_angles(curve: dict) -> np.ndarray:
     return out
 
 
-def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", reference=None):
-    """Figure in the style of seed Figs. 16-17: moment about z against the twist (top) and the four
-    latch-status bars (zones of Fig. 6) along the path (bottom; the twist is drawn over them).
+def plot_bay_torsion(curve: dict, png, title: str = "", note: str = "", reference=None, *, seed_note=None):
+    """Figure in the style of Figs. 16-17 of Stohlman & Pellegrino: moment about z against the twist
+    (top) and the four latch-status bars (zones of Fig. 6) along the path (bottom; the twist is drawn
+    over them).
 
+    note : a line above the axes (what the paper shows for this path; ``seed_note=``, its old name,
+        warns and is removed in femast 0.3).
     reference : optional (theta_deg, M) curve drawn in black (e.g. measured data)."""
+    if seed_note is not None:
+        renamed("plot_bay_torsion(seed_note=...)", "plot_bay_torsion(note=...)")
+        note = seed_note
     import matplotlib
 
     matplotlib.use("Agg")
@@ -177,8 +184,8 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
     ax.legend(loc="lower right", fontsize=9)
     if title:
         fig.suptitle(title, fontsize=11)
-    if seed_note:  # above the axes, never over the curve
-        ax.set_title(seed_note, loc="left", fontsize=8.5, color="0.25")
+    if note:  # above the axes, never over the curve
+        ax.set_title(note, loc="left", fontsize=8.5, color="0.25")
     bx = fig.add_subplot(gs[1])
     for k in range(4):
         z = zones[:, k]
@@ -203,7 +210,7 @@ def plot_bay_torsion(curve: dict, png, title: str = "", seed_note: str = "", ref
 #: Stohlman & Pellegrino, Table 1, rows 0, M+F, 0, -M-F, 0, ... (x, y, z in um; theta_x, theta_y, theta_z in
 #: arcsec).  The extracted table prints the x displacement under -M-F as "-1.740" and under M+F
 #: after the first cycle as "1.740": read here as -1740 and 1740 um (a thousands separator).
-SEED_TABLE1 = np.array(
+ADAM_TABLE1 = np.array(
     [
         # x      y      z       thx    thy     thz
         [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
@@ -247,15 +254,25 @@ def tip_table(res: Results, am: AdamModel, reference_step: str = "pretension") -
     return labels, vals
 
 
-def format_table1(labels, model_vals, seed=SEED_TABLE1, note_width: int = 0) -> str:
-    """The tip table in the paper's layout, model value beside the seed's value (um, arcsec)."""
-    n = min(len(labels), len(seed))
+def format_table1(labels, model_vals, paper=ADAM_TABLE1, note_width: int = 0, *, seed=None) -> str:
+    """The tip table in the paper's layout, model value beside the paper's value (um, arcsec).
+
+    paper : (n, 6) the values printed beside the model's (default Table 1 of the paper; ``seed=``,
+        its old name, warns and is removed in femast 0.3)."""
+    if seed is not None:
+        renamed("format_table1(seed=...)", "format_table1(paper=...)")
+        paper = seed
+    n = min(len(labels), len(paper))
     head = f"{'load':>6} | " + " | ".join(f"{c:^21}" for c in TABLE1_COLUMNS)
     sub = f"{'':>6} | " + " | ".join(f"{'femast':>10} {'paper':>10}" for _ in TABLE1_COLUMNS)
     lines = [head, sub, "-" * len(head)]
     for i in range(n):
         cells = []
         for j in range(6):
-            cells.append(f"{model_vals[i, j]:>10.4g} {seed[i, j]:>10.4g}")
+            cells.append(f"{model_vals[i, j]:>10.4g} {paper[i, j]:>10.4g}")
         lines.append(f"{labels[i]:>6} | " + " | ".join(cells))
     return "\n".join(lines)
+
+
+#: old names, kept for one release (they warn): femast 0.3 removes them
+__getattr__ = renamed_attributes(__name__, {"SEED_TABLE1": "ADAM_TABLE1"})

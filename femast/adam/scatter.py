@@ -17,9 +17,9 @@ value everywhere); the shapes, for a mast of n bays (corner k, side k as in
 field           shape          unit    what
 =============== ============== ======= =========================================================
 mu              (n, 4, 2)      -       friction coefficient of the ball joint at bay j, corner k,
-                                       bottom (0) / top (1) end of the longeron (seed Sec. II.B.1)
-latch_k         (n, 4)         N/m     latch roller stiffness k of bay j, side k (seed Eq. 10)
-latch_mu        (n, 4)         -       latch roller friction coefficient (seed Eq. 14)
+                                       bottom (0) / top (1) end of the longeron (Stohlman & Pellegrino, Sec. II.B.1)
+latch_k         (n, 4)         N/m     latch roller stiffness k of bay j, side k (Stohlman & Pellegrino, Eq. 10)
+latch_mu        (n, 4)         -       latch roller friction coefficient (Stohlman & Pellegrino, Eq. 14)
 pretension      (n, 4)         N       cable pretension of bay j, side k (latch cable and arms)
 longeron_dL     (n, 4)         m       length error of the longeron of bay j at corner k
 batten_dL       (n + 1, 4)     m       length error of the batten of frame i on side k

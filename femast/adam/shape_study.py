@@ -28,7 +28,7 @@ from .steps import CONVERGENCE, TABLE1_F, TABLE1_M, add_initial_steps, add_table
 #: independent from element to element.  (group, MastScatter field, kind, half width, unit)
 #: kind "rel": half width relative to the nominal value; "abs": absolute (lengths, m).
 SCATTER = (
-    ("joint friction", "mu", "rel", 0.20, "-"),  # ball-joint mu 0.5 +- 20 % (seed: assumed 0.5)
+    ("joint friction", "mu", "rel", 0.20, "-"),  # ball-joint mu 0.5 +- 20 % (Stohlman & Pellegrino assume 0.5)
     ("latch", "latch_k", "rel", 0.20, "N/m"),  # roller stiffness 100 N/mm +- 20 %
     ("latch", "latch_mu", "rel", 0.20, "-"),  # roller friction 0.07 +- 20 %
     ("pretension", "pretension", "rel", 0.10, "N"),  # 170 N +- 10 % per bay side

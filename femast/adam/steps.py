@@ -62,7 +62,7 @@ def add_initial_steps(
 ):
     """The initial step of Stohlman & Pellegrino, Sec. II.C: the deployed, pretensioned structure comes to
     equilibrium with its cable pretensions under viscous stabilisation (step ``pretension``); the
-    load steps added after it have no stabilisation (the seed: "no stabilization is used after the
+    load steps added after it have no stabilisation (the paper: "no stabilization is used after the
     initial stable state is achieved"; ``settle`` below is an equilibrium step).  The members' length errors (a scattered mast's lack of fit,
     ``build_mast(scatter=...)``) grow over the same step with the step time
     (``step.ramp_length_errors()``): applied in full at its start, the misfit of some scattered
@@ -79,7 +79,7 @@ def add_initial_steps(
         can miss when a soft mode (a longeron spin held by the joint springs) amplifies it.
     Returns the steps.  The stabilisation energy ratio is in ``analysis.summary.steps[0]``."""
     st = stabilize if stabilize is not None else stabilize_for(am)
-    s1 = am.model.step("pretension", stabilize=st, initial_increment=1.0, max_increments=50).ramp_length_errors()
+    s1 = am.model.step("pretension", stabilize=st, initial_increment=1.0, max_increments=500).ramp_length_errors()
     if hold_control:
         s1.prescribe(am.control, **{d: 0.0 for d in hold_control})
     if not settle:
@@ -101,7 +101,7 @@ def add_idealised_torsion(
     max_increment: float = 0.01,
     unload: bool = True,
 ):
-    """Seed Fig. 16, idealised path: the control node turns about z from 0 to ``theta_max`` (rad)
+    """Stohlman & Pellegrino, Fig. 16, idealised path: the control node turns about z from 0 to ``theta_max`` (rad)
     in the bay's folding sense and back to 0, with x and y held (z and the tilts free).
 
     The twist is driven by displacement control of the control node's rz with a moment about z
@@ -110,7 +110,7 @@ def add_idealised_torsion(
     ``<name>-back`` (theta_max -> 0; its reference moment is a large fixed value, so that the
     pattern never vanishes whatever moment the bay holds at theta_max).  With ``unload`` a last,
     load-controlled step ``<name>-unload`` brings the moment to zero: the bay settles at its
-    residual rotation at zero moment (seed Sec. VIII).  ``max_increment``: fraction of each step.
+    residual rotation at zero moment (Stohlman & Pellegrino, Sec. VIII).  ``max_increment``: fraction of each step.
     Returns the steps."""
     from ..analysis.control import DisplacementControl
 
@@ -138,7 +138,7 @@ def add_idealised_torsion(
 
 @dataclass
 class MeasuredPath:
-    """A measured-style path of the control node (seed Sec. VI.B): step time ``t`` (s), twist
+    """A measured-style path of the control node (Stohlman & Pellegrino, Sec. VI.B): step time ``t`` (s), twist
     ``theta`` (rad), translations ``x``, ``y`` (m).  ``synthetic`` says it was generated, not
     measured; ``note`` says how."""
 
@@ -187,10 +187,10 @@ def measured_style_path(
     rng_seed: int = 1,
     sense: int = 1,
 ) -> MeasuredPath:
-    """A synthetic, measured-style path of the control node with off-axis drift (seed Sec. VI.A-B:
+    """A synthetic, measured-style path of the control node with off-axis drift (Stohlman & Pellegrino, Sec. VI.A-B:
     "displacements of up to 1 cm in the x and y directions were recorded").
 
-    The seed's measured table is not available; this path has its character: the top frame turns
+    The paper's measured table is not available; this path has its character: the top frame turns
     from 0 to ``theta_max`` and back, and as the bay loosens the centre of rotation moves from the
     bay axis to the centre of side ``hold_side`` (the bay turns about the side that stays latched),
     plus a slow translation ``drift`` (m, at theta_max).  With ``pivot`` the fraction of the way the
@@ -222,7 +222,7 @@ def measured_style_path(
 
 
 def add_measured_torsion(am: AdamModel, path: MeasuredPath, name: str = "twist", max_increment: float = 0.0125):
-    """Seed Fig. 17: drive the control node along ``path`` (theta_z, x, y); z and tilts free."""
+    """Stohlman & Pellegrino, Fig. 17: drive the control node along ``path`` (theta_z, x, y); z and tilts free."""
     period = float(path.t[-1])
     s = am.model.step(
         name,
@@ -247,9 +247,9 @@ def add_table1_steps(
     F: float = TABLE1_F,
     increments: int = TABLE1_INCREMENTS,
 ) -> list:
-    """Seed Table 1 load sequence at the control node: M+F, 0, -M-F, 0, ``cycles`` times, with
+    """Stohlman & Pellegrino, Table 1 load sequence at the control node: M+F, 0, -M-F, 0, ``cycles`` times, with
     M (N m) about z and F (N) along x.  ``increments``: increments per step, of equal size (default
-    :data:`TABLE1_INCREMENTS`, converged within 1 %; 1 is the seed's one increment per load step)."""
+    :data:`TABLE1_INCREMENTS`, converged within 1 %; 1 is the paper's one increment per load step)."""
     steps = []
     for c in range(cycles):
         for k, lab in enumerate(TABLE1_SEQUENCE):

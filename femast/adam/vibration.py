@@ -1,6 +1,6 @@
 """Stohlman & Pellegrino's pretension-by-vibration method (Sec. IV, Eq. 16) reproduced with the modal analysis.
 
-The mock bay side (seed Fig. 11) holds one cable/pulley/latch assembly in the geometry of a bay
+The mock bay side (Stohlman & Pellegrino, Fig. 11) holds one cable/pulley/latch assembly in the geometry of a bay
 side: the latch cable from one bottom corner through the unit (pulley and latch) to the other,
 and the two arms from the unit to the top corners, all four anchored.  A shaker drives the unit
 out of the plane of the side; the resonance gives the average cable tension through Eq. 16.
@@ -45,7 +45,7 @@ from .parameters import BayParameters
 LBF = 4.4482216152605  # N per pound-force
 EQ16 = (0.012, -0.58, 17.0)  # coefficients as printed (f in Hz; the result in lbf, see module)
 EQ16_SD_N = 2.0 * LBF  # the fit's standard deviation, 2 (lbf), in N
-EQ16_RANGE_N = (120.0, 200.0)  # average tensions of the comparison (seed Figs. 13-14: 125-210 N)
+EQ16_RANGE_N = (120.0, 200.0)  # average tensions of the comparison (Stohlman & Pellegrino, Figs. 13-14: 125-210 N)
 ARM_FAMILY = "mock_arm"
 LATCH_FAMILY = "mock_latch"
 
@@ -91,7 +91,7 @@ def mock_bay_side(
     unit_mass: float = UNIT_MASS,
     cable_mass: float | None = None,
 ) -> MockSide:
-    """Seed Fig. 11: side 0 of an ADAM bay (``params``: b, l, cable EA, latch) with the latch cable
+    """Stohlman & Pellegrino, Fig. 11: side 0 of an ADAM bay (``params``: b, l, cable EA, latch) with the latch cable
     and both arms pretensioned to ``tension`` (N), the four ends anchored, a point mass
     ``unit_mass`` (kg) at the unit and the cables' mass ``cable_mass`` (kg/m; default steel,
     :func:`femast.adam.mass.cable_mass_per_length`) lumped at the section ends."""
@@ -178,7 +178,7 @@ def identify_unit_mass(
 ) -> UnitMassFit:
     """Fit the unit's mass so that the FE mock side's (tension, frequency) curve matches Eq. 16
     (lbf reading) in the least-squares sense over ``tensions`` (N; default 9 settings across
-    120-200 N, like the seed's 9 points).  The FE model is solved once per tension with
+    120-200 N, like the paper's 9 points).  The FE model is solved once per tension with
     ``reference_mass``; the fit scales its frequencies (at fixed tension f^2 M_total is fixed; the
     cable share of M_total is found from two masses)."""
     T_set = np.linspace(*EQ16_RANGE_N, n_points) if tensions is None else np.asarray(tensions, float)

@@ -52,9 +52,11 @@ implementation to an existing effect with :func:`add_implementation`); see docs/
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
+from .._moved import renamed
 from ..errors import ModelError, did_you_mean
 from .parameters import Parameter  # noqa: F401  (re-exported: effects declare Parameters)
 from .quantities import ALWAYS, HOOKS
@@ -142,7 +144,8 @@ class Effect:
     mechanism : the implementation on physical quantities (applies to every experiment that
         declares them), or None.
     implementations : ``{experiment name: Implementation}`` on experiments' own hooks.
-    seed : the paper and equation it comes from.
+    source : the paper and equation it comes from (``seed=``, its old name, warns and is removed in
+        femast 0.3; ``effect.seed`` reads ``source`` with the same warning).
     """
 
     name: str
@@ -151,7 +154,7 @@ class Effect:
     signature: str = ""
     acts_where: tuple = ()
     implementations: dict = field(default_factory=dict)
-    seed: str = ""
+    source: str = ""
     mechanism: Implementation | None = None
 
     def implementation(self, experiment) -> Implementation | None:
@@ -175,6 +178,27 @@ class Effect:
         impl = self.implementation(experiment)
         return impl.parameters if impl else ()
 
+
+def _with_old_seed_keyword(init):
+    """``Effect(..., seed=...)``, the old name of ``source``, for one release (it warns)."""
+
+    @functools.wraps(init)
+    def __init__(self, *args, seed=None, **kwargs):
+        if seed is not None:
+            renamed("Effect(seed=...)", "Effect(source=...)")
+            kwargs.setdefault("source", seed)
+        init(self, *args, **kwargs)
+
+    return __init__
+
+
+def _old_seed(effect: Effect) -> str:
+    renamed("Effect.seed", "Effect.source")
+    return effect.source
+
+
+Effect.__init__ = _with_old_seed_keyword(Effect.__init__)
+Effect.seed = property(_old_seed, doc="Old name of :attr:`Effect.source`: warns, and is removed in femast 0.3.")
 
 _REGISTRY: dict[str, Effect] = {}
 

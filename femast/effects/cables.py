@@ -70,7 +70,7 @@ PROGRESSIVE_STIFFNESS = register_effect(
         signature="the structure is stiffer than the linear model at high load and softer near zero: the error is "
         "odd in the load, largest at the load peaks",
         acts_where=("peak",),
-        seed="the Rocaspect paper, Eq. 25",
+        source="the Rocaspect paper, Eq. 25",
         mechanism=Implementation(
             hook="displacement",
             needs=("load",),
@@ -158,7 +158,7 @@ CABLE_HYSTERESIS = register_effect(
         signature="loading and unloading branches with different slopes, a loop whose width grows with the load "
         "and closes at zero; the error is largest at high load and just after reversals",
         acts_where=("peak", "reversal", "loading", "unloading"),
-        seed="Rocaspect guyed mast, Sec. IV-A, Fig. 4a",
+        source="Rocaspect guyed mast, Sec. IV-A, Fig. 4a",
         mechanism=Implementation(
             hook="load",
             order=45,
@@ -292,7 +292,7 @@ PRETENSION = register_effect(
         "(pretension lost during the test); once the latches have released, the bay's moment is offset (a "
         "pretension set differently from the model's)",
         acts_where=("peak", "loading", "unloading", "zone (d) no contact"),
-        seed="Rocaspect guyed mast, Table III; Stohlman & Pellegrino, Eq. 16",
+        source="Rocaspect guyed mast, Table III; Stohlman & Pellegrino, Eq. 16",
         mechanism=Implementation(
             hook="displacement",
             needs=("time",),
@@ -370,7 +370,7 @@ STRETCH_ERROR = register_effect(
         signature="the measured curve is sheared along x in proportion to the force: the error is largest at the "
         "force peaks and changes sign with the force",
         acts_where=("peak",),
-        seed="Stohlman & Pellegrino, Eq. 15",
+        source="Stohlman & Pellegrino, Eq. 15",
         implementations={
             "latch-pull": Implementation(
                 hook="bead_position",

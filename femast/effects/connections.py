@@ -114,7 +114,7 @@ PINCHING = register_effect(
         signature="after large excursions the measured displacement runs ahead of the model at small loads of either "
         "sign (a soft, nearly flat stretch of the loop through zero load) and the envelope bends over past a load",
         acts_where=("near-zero load", "reversal", "peak"),
-        seed="dowel-type connections of timber engineering (embedment and slack)",
+        source="dowel-type connections of timber engineering (embedment and slack)",
         implementations={},
     )
 )
@@ -235,7 +235,7 @@ DEGRADATION = register_effect(
         signature="the model is too stiff and too strong late in the test and after large cycles: the error grows "
         "with the history (repeated cycles at one amplitude drift apart), largest at the peaks",
         acts_where=("peak", "loading", "unloading"),
-        seed="continuum damage mechanics (Kachanov); energy damage index (Park & Ang)",
+        source="continuum damage mechanics (Kachanov); energy damage index (Park & Ang)",
         implementations={},
     )
 )

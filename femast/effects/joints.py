@@ -106,7 +106,7 @@ JOINT_CLEARANCE = register_effect(
         ),
         signature="a step in the displacement where the load changes sign; the error is largest near zero load",
         acts_where=("near-zero load",),
-        seed="Rocaspect guyed mast, Sec. IV-C",
+        source="Rocaspect guyed mast, Sec. IV-C",
         mechanism=Implementation(
             hook="displacement",
             needs=("load",),
@@ -300,7 +300,7 @@ FRICTION_HYSTERESIS = register_effect(
         signature="the error changes sign with the direction of loading (loading and unloading offset in opposite "
         "directions) and the response sticks just after each reversal",
         acts_where=("loading", "unloading", "reversal"),
-        seed="Stohlman & Pellegrino, Sec. II.B.1",
+        source="Stohlman & Pellegrino, Sec. II.B.1",
         mechanism=Implementation(
             hook="load",
             order=40,
@@ -384,7 +384,7 @@ BALL_JOINT_FRICTION = register_effect(
         "direction of twisting all along the path (bay torsion), the tip keeps a residual displacement at "
         "zero load (mast)",
         acts_where=("reversal", "loading", "unloading", "near-zero load"),
-        seed="Stohlman & Pellegrino, Sec. II.B.1",
+        source="Stohlman & Pellegrino, Sec. II.B.1",
         implementations={
             e: Implementation(
                 hook="bay_parameters",

@@ -54,7 +54,7 @@ LATCH_HYSTERESIS = register_effect(
         signature="latching and unlatching curves differ near the backstop, where the baseline has a single curve; "
         "the error is concentrated in the latched zones (a)-(b) of Stohlman & Pellegrino, Fig. 6",
         acts_where=("zone (a) at backstop", "zone (b) behind roller axis", "near-zero load"),
-        seed="Stohlman & Pellegrino, Sec. III.C, Sec. VIII",
+        source="Stohlman & Pellegrino, Sec. III.C, Sec. VIII",
         implementations={
             "latch-pull": Implementation(
                 hook="branch_force",

@@ -41,7 +41,7 @@ BEAM_FLEXIBILITY = register_effect(
         signature="the ratio of the top displacement under a top moment to that under a top force differs from a "
         "rigid mast's; the error follows the top moments",
         acts_where=("peak",),
-        seed="the Rocaspect paper, Eqs. 8-15",
+        source="the Rocaspect paper, Eqs. 8-15",
         implementations={
             "mast-top": Implementation(
                 hook="top_displacement",
@@ -100,7 +100,7 @@ OFF_AXIS = register_effect(
         signature="the latches do not release together: the moment differs where they leave the rollers (zone (c)) "
         "and around release and relatching, where the idealised model has one sharp step",
         acts_where=("latch release/relatch", "zone (c) in front of roller axis", "zone (d) no contact"),
-        seed="Stohlman & Pellegrino, Sec. VI.B, Fig. 17",
+        source="Stohlman & Pellegrino, Sec. VI.B, Fig. 17",
         implementations={
             "bay-torsion": Implementation(
                 hook="control_path",

@@ -77,7 +77,7 @@ ADDED_MASS = _register(
         physics="Mass moving with the unit that the model leaves out: m -> m + added; every frequency falls by "
         "the same factor sqrt(m / (m + added)) at the out-of-plane mode.",
         signature="measured frequencies below the model by a constant fraction at every tension",
-        seed="Stohlman & Pellegrino, Sec. IV (the shaker drives the latch through a force sensor)",
+        source="Stohlman & Pellegrino, Sec. IV (the shaker drives the latch through a force sensor)",
         implementations={
             "vibration": Implementation(
                 hook="unit_mass",
@@ -98,7 +98,7 @@ JOINT_STICK = _register(
         "against the out-of-plane motion: f^2 = (sum T_i/L_i + k_stick) / (4 pi^2 m).",
         signature="measured frequencies above the model, most at low tension (a positive intercept of f^2 "
         "against tension)",
-        seed="Stohlman & Pellegrino, Sec. II.B.1 (ball joints stick below mu B |F|)",
+        source="Stohlman & Pellegrino, Sec. II.B.1 (ball joints stick below mu B |F|)",
         implementations={
             "vibration": Implementation(
                 hook="model",

@@ -71,7 +71,7 @@ def friction_return(st, th, k_s, Ys, Yk, prev, has_prev, m, C, nv):
     A slip returns to Yk (radial return: m = Yk n, dgamma = (|m_tr| - Yk) / k_s).  At a slip onset
     from Ys the dissipation adds (Ys - Yk)^2 / (2 k_s): the elastic energy released by the drop
     from Ys to Yk (so that work = stored energy + dissipation holds exactly in one-axis motion).
-    With Ys = Yk this is the seed's one-coefficient law, to the bit.  ``prev``: see
+    With Ys = Yk this is the paper's one-coefficient law, to the bit.  ``prev``: see
     :func:`ball_joint_element` (slip reversal between Newton iterations)."""
     mtr = np.empty(3)
     for i in range(3):
@@ -111,7 +111,7 @@ def friction_return(st, th, k_s, Ys, Yk, prev, has_prev, m, C, nv):
 @njit(cache=True)
 def ball_joint_element(xa, xb, Ra, Rb, d0, k_pen, k_s, mu_s, mu_k, B, st, f, K, new, out, prev, has_prev):
     """Forces ``f`` (12), tangent ``K`` (12x12), trial state ``new`` (15) and output ``out``
-    (11: M (3, global), F (3, global), |F|, limit, slip, gamma, D) of one tied joint (the seed's
+    (11: M (3, global), F (3, global), |F|, limit, slip, gamma, D) of one tied joint (the paper's
     two-way tie); static and kinetic coefficients ``mu_s``, ``mu_k`` (:func:`friction_return`).
 
     ``prev`` (15): the joint's trial state at the previous Newton iteration (``has_prev``).  A

@@ -10,11 +10,11 @@ unstretched lengths are l0_i = S_{i+1} - S_i and the tensions (Eqs. 2-3)
 
     e_i = L_i / l0_i - 1,        T_i = EA max(0, e_i).
 
-One equation per device (the seed's jumps Delta T_i = T_{i+1} - T_i as functions of the cable
+One equation per device (the paper's jumps Delta T_i = T_{i+1} - T_i as functions of the cable
 distribution): ``EA (e_out - e_in) = 0`` for a frictionless pulley, ``S - S_committed = 0`` for a
 device that sticks (or a clamp), ``S - S_max = 0`` at a stop, and ``r_sigma(T_in, T_out, S, phi) = 0``
 (:mod:`._device_laws`) for a device sliding in direction sigma.  With the 2n unknowns (T_i, l0_i)
-eliminated by Eqs. 2-4 this is the seed's 2n system.
+eliminated by Eqs. 2-4 this is the paper's 2n system.
 
 Stick/slip: an active-set return mapping from the committed state.  All friction devices start
 sticking; the device whose static band is most violated starts sliding in the direction of its

@@ -60,14 +60,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._moved import renamed_attributes
 from ..errors import ModelError
 from .ball_joint_family import (
+    ADAM_B,
+    ADAM_MU,
     MAX_CLEARANCE_FRACTION,
     OPEN_FACTOR,
     PENALTY_FACTOR,
     SEATS,
-    SEED_B,
-    SEED_MU,
     STICK_FACTOR,
     TOL_FACTOR,
     BallJointFamily,
@@ -84,8 +85,8 @@ __all__ = [
     "STICK_FACTOR",
     "OPEN_FACTOR",
     "SEATS",
-    "SEED_MU",
-    "SEED_B",
+    "ADAM_MU",
+    "ADAM_B",
 ]
 
 
@@ -188,7 +189,7 @@ def add_ball_joints(
     model,
     pairs,
     mu=None,
-    B=SEED_B,
+    B=ADAM_B,
     *,
     mu_s=None,
     mu_k=None,
@@ -263,3 +264,7 @@ def add_ball_joints(
         pairs, k_pen, k_stick, mu, B, mu_s=mu_s, mu_k=mu_k, seat=seat, X=X, tol=tol, labels=labels, name=name, **extra
     )
     return model.add_family(fam)
+
+
+#: old names, kept for one release (they warn): femast 0.3 removes them
+__getattr__ = renamed_attributes(__name__, {"SEED_MU": "ADAM_MU", "SEED_B": "ADAM_B"})

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._moved import renamed_attributes
 from ..errors import ModelError
 from ._ball_joint_kernels import (
     ERR_BIG_INCREMENT,
@@ -32,10 +33,10 @@ from ._ball_seat_kernels import (
 )
 from .base import ElementFamily, ElementResponse, IncrementContext, LazyOutput
 
-__all__ = ["BallJointFamily", "PENALTY_FACTOR", "STICK_FACTOR", "OPEN_FACTOR", "SEATS", "SEED_MU", "SEED_B"]
+__all__ = ["BallJointFamily", "PENALTY_FACTOR", "STICK_FACTOR", "OPEN_FACTOR", "SEATS", "ADAM_MU", "ADAM_B"]
 
-SEED_MU = 0.5  # Stohlman & Pellegrino, Sec. II.B.1: static = kinetic friction coefficient
-SEED_B = 0.004  # Stohlman & Pellegrino, Sec. II.B.1: longeron ball end radius, m
+ADAM_MU = 0.5  # Stohlman & Pellegrino, Sec. II.B.1: static = kinetic friction coefficient
+ADAM_B = 0.004  # Stohlman & Pellegrino, Sec. II.B.1: longeron ball end radius, m
 #: The seats a joint can have (module docstring).
 SEATS = ("tied", "seated")
 # Default penalty k_pen = PENALTY_FACTOR * (largest EA/L of the members at the joint): the tie
@@ -74,7 +75,7 @@ def friction_coefficients(mu, mu_s, mu_k, name):
         raise ModelError(
             f"ball joints '{name}': give mu (static = kinetic) or mu_s (and mu_k), not both (mu = {mu!r}, mu_s = {mu_s!r})"
         )
-    mu_s = SEED_MU if mu is None and mu_s is None else (mu if mu_s is None else mu_s)
+    mu_s = ADAM_MU if mu is None and mu_s is None else (mu if mu_s is None else mu_s)
     return mu_s, (mu_s if mu_k is None else mu_k)
 
 
@@ -115,7 +116,7 @@ class BallJointFamily(ElementFamily):
         k_pen,
         k_stick,
         mu=None,
-        B=SEED_B,
+        B=ADAM_B,
         *,
         mu_s=None,
         mu_k=None,
@@ -373,3 +374,7 @@ def _outputs(out, seated):
             normal_force=out[:, 11].copy(), gap=out[:, 12].copy(), contact=out[:, 13].copy(), wall=out[:, 14].copy()
         )
     return d
+
+
+#: old names, kept for one release (they warn): femast 0.3 removes them
+__getattr__ = renamed_attributes(__name__, {"SEED_MU": "ADAM_MU", "SEED_B": "ADAM_B"})

@@ -124,7 +124,7 @@ def _sheave_params(dev, k, name, p):
 class Latch:
     """A roller latch of Stohlman & Pellegrino (Eqs. 5, 14) at a node; the bead is on the cable.
 
-    params : :class:`~femast.elements.latch_law.LatchParameters` (default the seed's fit).
+    params : :class:`~femast.elements.latch_law.LatchParameters` (default the paper's fit).
     bead : material coordinate Lb of the bead, m (unstretched length from node 0); ``None`` with
         :meth:`CableDeviceFamily.pretensioned` puts it at ``x0`` in the initial geometry.
     x0 : initial bead position, m (default ``-x_backstop``: latched, on the backstop).

@@ -1,7 +1,7 @@
 """A cable over an ordered list of devices: pulleys (frictionless), sheaves with bearing friction,
 capstan drums, latches, clamps and user devices (Stohlman & Pellegrino, Sec. II.B.2, Eqs. 2-5).
 
-Seed 001 writes the cable element for a cable over any number of pulleys, latches or other
+Stohlman & Pellegrino write the cable element for a cable over any number of pulleys, latches or other
 devices, each with its own law for the jump ``Delta T_i = T_{i+1} - T_i``.  One element here is
 one cable of n sections between n + 1 nodes; ``devices[k]`` sits at interior node k + 1.  The
 equations and the stick/slip return mapping are in :mod:`._device_kernels`, the laws (and the

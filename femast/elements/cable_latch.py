@@ -19,7 +19,7 @@ Equations (SI: N, m)
 the bead).  ``x > 0`` means the bead is on the section-(j+1) side of the latch
 (outside), ``x < 0`` on the section-j side, where the backstop is (at
 ``x = -x_backstop``).  So section j must be the cable that runs through the
-backstop.  In the seed's two-section element, j = 1 (one-based), i.e. the latch
+backstop.  In the paper's two-section element, j = 1 (one-based), i.e. the latch
 is local node 1 of nodes (0, 1, 2).
 
 State per element (``n_state = n + 2``): ``[x_bead (m), status, L0_1 ... L0_n (m)]``,
@@ -126,12 +126,12 @@ class CableLatchFamily(ElementFamily):
         (every interior node is then a frictionless pulley and the element is a cable
         over pulleys).  Scalar or per element (0 = no latch).
     bead : material coordinate Lb of the bead, m (unstretched length from node 0), Eq. 5.
-    latch : :class:`~femast.elements.latch_law.LatchParameters` (or (n_el, 6) array, SI); default the seed's fit.
+    latch : :class:`~femast.elements.latch_law.LatchParameters` (or (n_el, 6) array, SI); default the paper's fit.
     x0 : initial bead position, m (default ``-x_backstop``: latched, against the backstop).
     max_strain : largest cable strain accepted in a committed configuration; beyond it the
         total unstretched length is reported as too short (default 0.1).
     hysteresis_force, hysteresis_length : the *latch hysteresis* option (N, m; scalar or per
-        element; default 0: off, the seed's law).  Near the latched state the static band
+        element; default 0: off, the paper's law).  Near the latched state the static band
         widens to ``[dT_in - H, dT_out + H]`` and a sliding bead follows the widened branches,
         ``H = hysteresis_force * w(x)``, ``w = 1`` on the backstop fading to 0 at the roller axis
         over ``hysteresis_length`` (see :func:`femast.elements.latch_law.hysteresis_force`).

@@ -2,16 +2,16 @@
 
 The latch is two friction rollers (radius ``r``) on cantilever springs gripping a
 spherical bead (radius ``R``) fixed on the cable, with a backstop behind the
-rollers.  All quantities are SI (m, N, N/m); the seed's fit is given in mm and
-N/mm and converted by :meth:`LatchParameters.seed_fit`.
+rollers.  All quantities are SI (m, N, N/m); the paper's fit is given in mm and
+N/mm and converted by :meth:`LatchParameters.adam_fit`.
 
-Coordinates and signs (checked against Figs. 6, 7 and 10 of the seed)
+Coordinates and signs (checked against Figs. 6, 7 and 10 of the paper)
 -----------------------------------------------------------------------
 * ``x`` (m) is the axial distance from the roller axis (the line through the two
   roller centres) to the bead centre, positive on the *outside* of the latch
   ("distance to latch" in Figs. 6 and 10).  ``dx > 0`` moves the bead out of the
   latch (unlatching), ``dx < 0`` moves it in (latching).
-* The backstop is *behind* the rollers, at ``x = -x_backstop``.  The seed writes
+* The backstop is *behind* the rollers, at ``x = -x_backstop``.  The paper writes
   "x_backstop = 2.0 mm ... prevents further motion in the -x direction"; with
   rollers touching the bead only for ``|x| < 2.34 mm`` a backstop at ``+2.0 mm``
   would stop the bead before the roller axis and the latch could never latch,
@@ -44,7 +44,7 @@ holds any ``dT`` in ``[dT_in(x), dT_out(x)]``; against the backstop the lower
 bound is ``-inf`` (the backstop takes any inward pull).  No contact
 (``|x| >= x_contact``) gives ``dT = 0``.
 
-Corrections to the seed text
+Corrections to the paper's text
 ----------------------------
 * Eq. 9 is printed ``-2 F_n cos(theta) - mu F_n sin(theta)``; the factor 2 (two
   rollers) multiplies both terms, as Eqs. 12-13 confirm.
@@ -74,6 +74,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 from numba import njit
 
+from .._moved import renamed
 from ..errors import ModelError
 
 # Direction of motion of the bead.
@@ -107,14 +108,20 @@ class LatchParameters:
     R: float = 2.4e-3
 
     @classmethod
-    def seed_fit(cls) -> LatchParameters:
-        """The fit of Stohlman & Pellegrino, Section III.C: r = 1.1 mm, x_backstop = 2.0 mm,
-        k = 100 N/mm, mu = 0.07, h = 1.5 mm, R = 2.4 mm (returned in SI)."""
+    def adam_fit(cls) -> LatchParameters:
+        """The fit of the ADAM latch by Stohlman & Pellegrino, Section III.C: r = 1.1 mm,
+        x_backstop = 2.0 mm, k = 100 N/mm, mu = 0.07, h = 1.5 mm, R = 2.4 mm (returned in SI)."""
         return cls(r=1.1e-3, x_backstop=2.0e-3, k=100e3, mu=0.07, h=1.5e-3, R=2.4e-3)
 
     @classmethod
+    def seed_fit(cls) -> LatchParameters:
+        """Old name of :meth:`adam_fit`: warns, and is removed in femast 0.3."""
+        renamed("LatchParameters.seed_fit()", "LatchParameters.adam_fit()")
+        return cls.adam_fit()
+
+    @classmethod
     def from_mm(cls, r, x_backstop, k, mu, h, R) -> LatchParameters:
-        """Build from lengths in mm and k in N/mm (the seed's units)."""
+        """Build from lengths in mm and k in N/mm (the paper's units)."""
         return cls(r=r * 1e-3, x_backstop=x_backstop * 1e-3, k=k * 1e3, mu=mu, h=h * 1e-3, R=R * 1e-3)
 
     def as_array(self) -> np.ndarray:
@@ -137,7 +144,7 @@ PARAM_NAMES = tuple(f.name for f in fields(LatchParameters))
 
 def _as_param_array(params) -> np.ndarray:
     if params is None:
-        params = LatchParameters.seed_fit()
+        params = LatchParameters.adam_fit()
     if isinstance(params, LatchParameters):
         return params.as_array()
     if isinstance(params, dict):
@@ -249,7 +256,7 @@ def latch_force(x, direction, params=None, derivative: bool = False):
     x : bead position, m (positive outside the latch, see module docstring); any shape.
     direction : +1 (``UNLATCHING``, dx > 0) or -1 (``LATCHING``, dx < 0), broadcast with x.
     params : :class:`LatchParameters`, dict, or [..., 6] array [r, x_backstop, k, mu, h, R] (SI);
-        default the seed's fit.
+        default the paper's fit.
     derivative : also return d(dT)/dx, N/m.
 
     The backstop is not applied here (see :func:`friction_band`); outside the contact

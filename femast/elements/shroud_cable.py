@@ -1,7 +1,7 @@
 """Tension-only Dyneema shroud cable: two nodes, the tension-dependent rope law of the Rocaspect paper (Eq. 25).
 
 One element is a straight rope between two end points.  Each end point may sit on a
-*rigid offset* from its node (a lever rigidly attached to the node, as the seed's
+*rigid offset* from its node (a lever rigidly attached to the node, as the paper's
 shroud attachment points C_ir are rigidly attached to the mast top C_i3):
 
     p_a = x_a + R_a o_a                      (o_a: offset in the initial configuration, m)
@@ -19,7 +19,7 @@ measured from the unstretched length L0, ``eps = l / L0 - 1``, and the tension i
 and the material tangent ``d tau / d l = EA_t(tau) / L0`` with ``EA_t = g^2 / (k0 - k2 tau^2)``
 (:func:`femast.elements.shroud_law.axial_rigidity_tangent`).  At exactly ``eps = 0`` the rope counts as
 taut (tangent ``k0 / L0``, the one-sided derivative from the taut side): a shroud installed
-exactly taut with zero pretension then has the seed's passive stiffness at tau = 0.
+exactly taut with zero pretension then has the paper's passive stiffness at tau = 0.
 
 Forces and consistent tangent (q = [x_a, w_a, x_b, w_b], w spatial spins; e the unit vector from
 p_a to p_b; r = R o the current arms; ``G = [I, -[r]x]`` maps a node increment to its end
@@ -30,7 +30,7 @@ point's increment; ``D = [-G_a, G_b]`` (3 x 12) maps q to ``d(p_b - p_a)``):
       + tau / l D^T (I - e e^T) D                   geometric part of the rope turning
       + tau ([e]x [r_b]x on (w_b, w_b)  -  [e]x [r_a]x on (w_a, w_a))   arms turning with the nodes
 
-The first term is the FE counterpart of the seed's passive stiffness K_p (Eq. 24), the last two
+The first term is the FE counterpart of the paper's passive stiffness K_p (Eq. 24), the last two
 of the active stiffness K_a (Eq. 26): for a shroud from the mast top (node a, arm e_r) to a
 ground anchor (node b, fixed) the (a, a) block of K is exactly ``K_p + K_a`` of
 :mod:`femast.guyed.complete_mast`.  ``tangent_parts`` selects the parts assembled
@@ -92,7 +92,7 @@ def _law_array(law, n_el, name):
         raise ModelError(
             f"{name} element {bad[0]}: rope law [k0, k1, k2] = {arr[bad[0]].tolist()} needs a finite, "
             "positive k0 (axial rigidity at zero tension, N) and finite k1 (-), k2 (1/N); "
-            "give the physical stiffness (the seed's is k0 = 935353.664 N)"
+            "give the physical stiffness (the paper's is k0 = 935353.664 N)"
         )
     return arr
 
@@ -111,7 +111,7 @@ class ShroudCableFamily(ElementFamily):
     ----------
     nodes : (n_el, 2) int, end nodes (labels when added with ``Model.add_family``).
     L0 : unstretched lengths, m (> 0), scalar or per element.
-    law : :class:`~femast.elements.shroud_law.DyneemaLaw` (default: the seed's coefficients), a list of
+    law : :class:`~femast.elements.shroud_law.DyneemaLaw` (default: the paper's coefficients), a list of
         them, or an (n_el, 3) array ``[k0 (N), k1 (-), k2 (1/N)]``; k0 must be > 0.
     offsets : optional (n_el, 2, 3) rigid offsets of the end points from nodes a and b in the
         initial configuration, m (global axes).  With any nonzero offset the family also acts on

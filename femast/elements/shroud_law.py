@@ -4,7 +4,7 @@ The constitutive law of the shroud element (:mod:`femast.elements.shroud_cable`)
 analytic guyed-mast models of :mod:`femast.guyed` (it was ``femast/guyed/shroud.py``; the old path
 still imports).
 
-The seed writes the shroud spring coefficient as (Eq. 25)
+The paper writes the shroud spring coefficient as (Eq. 25)
 
     k(tau) = (k0 + k1 tau + k2 tau^2) / l
 
@@ -13,8 +13,8 @@ and identifies ``x_s = [k0, k1, k2] = [935353.664, 144.320, -0.000465]`` from a
 
 Dimensions.  k is a spring stiffness (N/m) and l a length (m), so the numerator
 is an axial rigidity ``EA(tau)`` in N: **k0 is in N, k1 is dimensionless and k2 is
-in 1/N** (the seed calls all three "stiffness coefficients" without units).  With
-the seed's values, EA = 0.935 MN at zero load and 1.108 MN at 1200 N.
+in 1/N** (the paper calls all three "stiffness coefficients" without units).  With
+the paper's values, EA = 0.935 MN at zero load and 1.108 MN at 1200 N.
 
 Secant versus tangent.  Eq. 27 uses ``tau = k(tau) dl``, i.e. k is the *secant*
 stiffness ``tau/dl``.  The passive stiffness of Eq. 24 needs ``d tau / d l``, the
@@ -36,11 +36,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._moved import renamed_attributes
 from ..errors import ModelError
 from .base import check_positive
 
 #: The Rocaspect paper's shroud coefficients [k0 (N), k1 (-), k2 (1/N)], Section IV-A.
-SEED_X_S = (935353.664, 144.320, -0.000465)
+ROCASPECT_X_S = (935353.664, 144.320, -0.000465)
 
 
 @dataclass(frozen=True)
@@ -52,9 +53,9 @@ class DyneemaLaw:
     k2 : 1/N.
     """
 
-    k0: float = SEED_X_S[0]
-    k1: float = SEED_X_S[1]
-    k2: float = SEED_X_S[2]
+    k0: float = ROCASPECT_X_S[0]
+    k1: float = ROCASPECT_X_S[1]
+    k2: float = ROCASPECT_X_S[2]
 
     def __post_init__(self):
         check_positive("Dyneema law k0 (axial rigidity at zero tension)", self.k0, "N")
@@ -136,3 +137,7 @@ def tension_from_strain(law: DyneemaLaw, eps):
             "finite tension there: check the strain or the coefficients"
         )
     return 2.0 * law.k0 * e / den
+
+
+#: old names, kept for one release (they warn): femast 0.3 removes them
+__getattr__ = renamed_attributes(__name__, {"SEED_X_S": "ROCASPECT_X_S"})

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .._moved import renamed
 from ..effects.parameters import Parameter  # noqa: F401  (re-exported: experiments declare Parameters)
 from ..effects.quantities import HOOKS, check_quantities
 from ..errors import ModelError
@@ -117,6 +118,8 @@ class Experiment:
         through ``effects.apply("load", ...)`` and ``effects.apply("displacement", ...)``),
         ``"temperature"`` (a data column).  Every effect whose mechanism acts on quantities the
         experiment declares applies to it, the library's and the user's alike.
+    renamed_options : ``{old name: new name}`` of options renamed: :meth:`with_options` takes the old
+        name for one release, with a DeprecationWarning naming the new one.
 
     Every channel ``c`` also accepts an optional column ``sigma_c`` (same unit) with the standard
     uncertainty of each row; ``diagnose`` then uses it as the noise of that channel.
@@ -146,6 +149,7 @@ class Experiment:
     noise_covariates: Callable | None = None
     path_coordinate: Callable | None = None
     quantities: dict = field(default_factory=dict)
+    renamed_options: dict = field(default_factory=dict)
 
     def __post_init__(self):
         names = [c.name for c in self.columns]
@@ -226,6 +230,10 @@ class Experiment:
 
     def with_options(self, **options) -> Experiment:
         """A copy with some options changed; unknown option names raise ModelError."""
+        for old in set(options) & set(self.renamed_options):
+            new = self.renamed_options[old]
+            renamed(f"option {old} of {self.name}", f"option {new}")
+            options[new] = options.pop(old)
         unknown = sorted(set(options) - set(self.options))
         if unknown:
             raise ModelError(

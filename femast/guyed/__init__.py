@@ -9,11 +9,12 @@ Modules, one concept each (SI units throughout):
 * :mod:`.shroud` -- Dyneema rope law (Eq. 25; units, secant and tangent stiffness).
 * :mod:`.complete_mast` -- beam plus shrouds, active and passive stiffness (Eqs. 16-26).
 * :mod:`.identify` -- least-squares identification with uncertainties (Eqs. 27-30).
-* :mod:`.rocaspect` -- the seed's robot: published values and documented assumptions.
+* :mod:`.rocaspect` -- the paper's robot: published values and documented assumptions.
 """
 
+from .._moved import renamed_attributes
 from ..elements.shroud_law import (
-    SEED_X_S,
+    ROCASPECT_X_S,
     DyneemaLaw,
     axial_rigidity_secant,
     axial_rigidity_tangent,
@@ -50,3 +51,6 @@ from .complete_mast import (
 )
 from .identify import FitResult, fit_3r, fit_beam_E, fit_shroud_law
 from .mast_3r import compliance_3r, displacement_3r, jacobian_3r
+
+#: old names, kept for one release (they warn): femast 0.3 removes them
+__getattr__ = renamed_attributes(__name__, {"SEED_X_S": "ROCASPECT_X_S"})

@@ -12,10 +12,10 @@ Eq. 10 as printed, ``J = s_out L (s_out^2 + L^2)/12``, is the polar moment of a
 solid s_out x L rectangle: it grows with the beam length and is about 1.5e5 times
 Bredt's torsion constant of the 0.1 m x 3 mm tube.  The default here is
 :func:`femast.model.sections.square_tube` (Bredt, ``J = t (s_out - t)^3``);
-``torsion="seed_eq10"`` uses the printed value for comparison.
+``torsion="printed_eq10"`` uses the printed value for comparison.
 
 Eq. 14 is printed ``C_bi = R_aug C_be bR_b^aug``; the last factor must be the
-transpose ``R_aug^T`` (the extraction of the seed lost it): a compliance transforms
+transpose ``R_aug^T`` (the extraction of the paper lost it): a compliance transforms
 as ``R C R^T``.
 """
 
@@ -23,8 +23,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._moved import renamed
 from ..errors import ModelError
-from ..model.sections import Section, seed000_eq10_torsion_constant, square_tube
+from ..model.sections import Section, rocaspect_eq10_torsion_constant, square_tube
 from ._common import check_positive, check_vectors
 
 #: Eq. 13: beam frame -> base frame for a vertical mast (x_be = z_b, y_be = y_b, z_be = -x_b).
@@ -37,19 +38,23 @@ def mast_section(
     """Square-tube section of the mast beam (Eqs. 9-11); E in Pa, sides in m.
 
     ``torsion="bredt"`` (default) uses the correct closed-section torsion constant;
-    ``torsion="seed_eq10"`` replaces it with the printed Eq. 10, which needs the beam length L (m).
-    G = E / (2 (1 + nu)) as in Section IV-B-2 of the seed.
+    ``torsion="printed_eq10"`` replaces it with Eq. 10 as printed, which needs the beam length L (m)
+    (``"seed_eq10"``, its old name, warns and is removed in femast 0.3).
+    G = E / (2 (1 + nu)) as in Section IV-B-2 of the Rocaspect paper.
     """
+    if torsion == "seed_eq10":
+        renamed("mast_section(torsion='seed_eq10')", "mast_section(torsion='printed_eq10')")
+        torsion = "printed_eq10"
     check_positive("Young's modulus E", E, "Pa")
     sec = square_tube(s_out, s_in, E, nu, name="mast beam")
     if torsion == "bredt":
         return sec
-    if torsion == "seed_eq10":
+    if torsion == "printed_eq10":
         if L is None:
-            raise ModelError("torsion='seed_eq10' needs the beam length L (m): Eq. 10 depends on it")
+            raise ModelError("torsion='printed_eq10' needs the beam length L (m): Eq. 10 depends on it")
         check_positive("beam length L", L, "m")
-        return sec.with_(J=seed000_eq10_torsion_constant(s_out, L))
-    raise ModelError(f"unknown torsion option {torsion!r}; use 'bredt' or 'seed_eq10'")
+        return sec.with_(J=rocaspect_eq10_torsion_constant(s_out, L))
+    raise ModelError(f"unknown torsion option {torsion!r}; use 'bredt' or 'printed_eq10'")
 
 
 def cantilever_compliance_local(L: float, section: Section) -> np.ndarray:
@@ -109,8 +114,8 @@ def cantilever_compliance_parts(L: float, section: Section, axis=(0.0, 0.0, 1.0)
     """Split the base-frame compliance as ``C_bi = C_E / E + C_G / G`` (the matrix of Eq. 30).
 
     Returns ``(C_E, C_G)`` (6, 6): C_E in Pa m/N etc. (bending and axial terms times E),
-    C_G in Pa rad/(N m) (the torsion term times G).  ``[C_E dw, C_G dw]`` is the seed's
-    identification matrix A_be of Eq. 30 for the unknowns ``[1/E, 1/G]`` (the seed writes
+    C_G in Pa rad/(N m) (the torsion term times G).  ``[C_E dw, C_G dw]`` is the paper's
+    identification matrix A_be of Eq. 30 for the unknowns ``[1/E, 1/G]`` (the paper writes
     ``[E, G]``, but the displacements are linear in the compliances 1/E and 1/G, not in E, G).
     """
     unit = section.with_(E=1.0, G=1.0)

@@ -13,15 +13,15 @@ Conventions (SI units: m, N, kg, rad)
 Sign correction to Eqs. 2-3
 ---------------------------
 With Eq. 1's ``u_j`` (from A_j towards the platform) a cable *pulls the platform along
--u_j*, so the cables' wrench on the platform is ``-W_seed tau`` with ``W_seed`` the matrix
+-u_j*, so the cables' wrench on the platform is ``-W_printed tau`` with ``W_printed`` the matrix
 printed as Eq. 3.  Eq. 2 (``W tau + w_g = 0``) therefore only holds with ``w_g`` the
 *gravity* wrench if the columns of W are built from ``-u_j``.  This module does that:
 :func:`wrench_matrix` returns ``W = [-u_j ; (R b_j) x (-u_j)]`` (moments about the platform
 origin) and :func:`gravity_wrench` returns the physical gravity wrench, so Eq. 2 holds as
-printed.  ``W_seed = -W`` is also ``d|l|/dx`` (the cable-length Jacobian with respect to the
+printed.  ``W_printed = -W`` is also ``d|l|/dx`` (the cable-length Jacobian with respect to the
 platform twist), which the tests check by finite differences.
 
-Pulleys are treated as points (the seed takes their kinematics into account in the
+Pulleys are treated as points (the paper takes their kinematics into account in the
 controller but does not give them).  The cable leaves the pulley at A_j towards the
 platform and returns to its winch at F_j; the force on the mast at A_j is therefore
 ``tau_j (u_j + v_j)`` with ``v_j`` the unit vector from A_j to F_j (Eq. 7).
@@ -147,7 +147,7 @@ def wrench_matrix(geom: CdprGeometry, pose) -> np.ndarray:
     """Wrench matrix W (6, m) of Eq. 3, sign-corrected so that Eq. 2 ``W tau + w_g = 0`` holds.
 
     Column j is the wrench (N, N m about the platform origin, per N of tension) cable j applies
-    to the platform: ``[-u_j ; (R b_j) x (-u_j)]``.  The seed's printed Eq. 3 is ``-W``
+    to the platform: ``[-u_j ; (R b_j) x (-u_j)]``.  The paper's printed Eq. 3 is ``-W``
     (see the module note).
     """
     _, u, _, Rb = cable_vectors(geom, pose)

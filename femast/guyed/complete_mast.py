@@ -20,8 +20,8 @@ with ``E_r = I - d_r d_r^T``.
 Correction to Eq. 26.  The printed lower-right block contains ``[l_r d_r]x``: times
 ``tau_r / l_r`` it has units of N, whereas a moment/rotation stiffness is in N m.
 Deriving ``-d(W_s tau_s)/dc`` gives ``[l_r d_r]x [e_r]x`` instead (the moment arm e_r
-rotating with the top): the seed's factor ``[e_r]x`` is missing.  The other blocks
-of Eq. 26 agree with the derivation.  ``form="seed"`` in :func:`active_stiffness`
+rotating with the top): the paper's factor ``[e_r]x`` is missing.  The other blocks
+of Eq. 26 agree with the derivation.  ``form="printed"`` in :func:`active_stiffness`
 keeps the printed matrix for comparison.  K_a is not symmetric in general: with
 spin increments of the top, the ``[d]x[e]x`` term (a force turning with its moment arm)
 is only symmetric when the net shroud moment about C_i3 vanishes.
@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._moved import renamed
 from ..elements.shroud_law import DyneemaLaw, shroud_stiffness
 from ..errors import ModelError
 from ._common import check_positive, check_vectors, skew, unit_vectors
@@ -42,10 +43,10 @@ from ._common import check_positive, check_vectors, skew, unit_vectors
 class ShroudSet:
     """The q shrouds of one mast.
 
-    upper : (q, 3) upper attachment points C_ir in F_b, m (C_i3, the mast top, is one of them in the seed).
+    upper : (q, 3) upper attachment points C_ir in F_b, m (C_i3, the mast top, is one of them in the paper).
     lower : (q, 3) lower (ground) attachment points D_ir in F_b, m.
-    tension : (q,) shroud tensions at the reference state, N (the seed measures them).
-    law : Dyneema law of Eq. 25 (default: seed coefficients), or ``None`` when ``stiffness`` is given.
+    tension : (q,) shroud tensions at the reference state, N (the paper measures them).
+    law : Dyneema law of Eq. 25 (default: the paper's coefficients), or ``None`` when ``stiffness`` is given.
     stiffness : optional (q,) spring coefficients k_r, N/m, overriding the law.
     labels : shroud names for messages.
     """
@@ -129,8 +130,12 @@ def active_stiffness(top, shrouds: ShroudSet, form: str = "corrected") -> np.nda
     """Active stiffness K_a (6, 6) of Eq. 26 at the shroud tensions, in SI (N/m, N, N m/rad).
 
     ``form="corrected"`` (default) is ``-d(W_s tau)/dc`` at constant tension (module note);
-    ``form="seed"`` is Eq. 26 as printed, kept only to show the difference.
+    ``form="printed"`` is Eq. 26 as printed, kept only to show the difference (``"seed"``, its old
+    name, warns and is removed in femast 0.3).
     """
+    if form == "seed":
+        renamed("active_stiffness(form='seed')", "active_stiffness(form='printed')")
+        form = "printed"
     d, length, e = shroud_geometry(top, shrouds)
     tau = shrouds.tension
     E = np.eye(3) - d[:, :, None] * d[:, None, :]
@@ -138,11 +143,11 @@ def active_stiffness(top, shrouds: ShroudSet, form: str = "corrected") -> np.nda
     if form == "corrected":
         br = -S @ E @ S - length[:, None, None] * skew(d) @ S
         blocks = np.block([[E, -E @ S], [S @ E, br]])
-    elif form == "seed":
+    elif form == "printed":
         br = skew(length[:, None] * d) + S @ E @ S
         blocks = -np.block([[-E, E @ S], [-S @ E, br]])
     else:
-        raise ModelError(f"unknown active-stiffness form {form!r}; use 'corrected' or 'seed'")
+        raise ModelError(f"unknown active-stiffness form {form!r}; use 'corrected' or 'printed'")
     return np.einsum("r,rij->ij", tau / length, blocks)
 
 
@@ -164,7 +169,7 @@ class MastStiffness:
 
     @property
     def compliance(self) -> np.ndarray:
-        """K_m^+ (Eq. 16), the pseudo-inverse used by the seed."""
+        """K_m^+ (Eq. 16), the pseudo-inverse used by the paper."""
         return np.linalg.pinv(self.K_m)
 
 

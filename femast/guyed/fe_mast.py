@@ -9,15 +9,15 @@ Model (SI units)
   from their upper attachment points C_ir to the ground anchors D_ir of
   :func:`femast.guyed.rocaspect.rocaspect_shrouds` (anchors fixed).
   - ``attach="top"`` (default, the analytic convention of Fig. 3): the points C_ir are rigid offsets
-    ``e_r = C_ir - C_i3`` of the top node, so the top is the rigid body the seed's model assumes.
+    ``e_r = C_ir - C_i3`` of the top node, so the top is the rigid body the paper's model assumes.
   - ``attach="wall"``: shrouds 1 and 2 are tied to a beam node 0.25 m below the top through a 0.05 m
     rigid offset to the tube wall (the physical mast); the top segment of the tube is then flexible.
 * Sources of error: ``length_error`` (m, per shroud) cuts the shrouds that much longer
   than the pretension asks (lack of fit; negative: shorter, tighter); ``temperature_change_K`` heats
   the shrouds and the tube by dT in a step ``"thermal"`` after the pretension, with the expansion
-  coefficients ``shroud_alpha_per_K`` and ``beam_alpha_per_K`` (1/K; the seed gives none: Dyneema
+  coefficients ``shroud_alpha_per_K`` and ``beam_alpha_per_K`` (1/K; the paper gives none: Dyneema
   is about -12e-6 /K along the fibre, aluminium +23e-6 /K).
-* Pretension: the shroud tensions *at the pretensioned equilibrium* equal ``pretension`` (the seed
+* Pretension: the shroud tensions *at the pretensioned equilibrium* equal ``pretension`` (the paper
   measures them there).  :meth:`MastFE.equilibrate` adjusts the unstretched lengths until they do
   (the beam shortens and bends under the shroud loads, which relaxes the shrouds by a few percent).
 
@@ -32,7 +32,7 @@ part by part (``tangent_parts``) at the same configuration:
 * ``K_p,FE``: material part only (``(d tau / d l) B B^T``), the FE counterpart of Eq. 24;
 * ``K_a,FE``: geometric part only (the ropes and their arms turning at constant tension), Eq. 26;
 * ``K_geo = K_beam,stressed - K_beam,unstressed``: the beam's own geometric stiffness from its
-  axial compression (and the small bending from the unbalanced shroud wrench) that the seed omits.
+  axial compression (and the small bending from the unbalanced shroud wrench) that the paper omits.
 
 The analytic terms are evaluated with the same conventions: top and attachment points at the FE
 equilibrium (deformed) positions, tensions from the FE, spins about C_i3, tangent rope stiffness.
@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._moved import RenamedKeys
 from ..analysis import Analysis
 from ..analysis.convergence import Convergence
 from ..elements.shroud_cable import ShroudCableFamily, unstretched_length
@@ -95,9 +96,9 @@ class MastFE:
 
     pretension : shroud tension at the pretensioned equilibrium, N (``None``: shrouds detached;
         ``0.0``: shrouds installed exactly taut at zero tension).
-    E : Young's modulus of the beam, Pa (default the seed's no-shroud value, as the complete model).
+    E : Young's modulus of the beam, Pa (default the paper's no-shroud value, as the complete model).
     n_beam : number of beam elements (the beam's geometric stiffness converges as 1/n_beam^2).
-    law : Dyneema law (default the seed's x_s).
+    law : Dyneema law (default the paper's x_s).
     attach : "top" (shroud points rigidly on the top, the analytic convention) or "wall".
     length_error : lack of fit per shroud, m (scalar or 3 values; module note).
     temperature_change_K : uniform temperature change of shrouds and tube in a step ``"thermal"``
@@ -443,7 +444,8 @@ def compare_stiffness(
     * at the pretensioned equilibrium: ``K_p`` / ``K_p_FE`` (``rel_passive``), ``K_a`` / ``K_a_FE``
       (``rel_active``), the shroud sum (``rel_shroud``), ``K_geo`` (the beam's own geometric
       stiffness), ``K_m`` (analytic at the FE state), ``K_FE``, ``K_m_nominal`` (analytic at the
-      nominal geometry and tension, corrected Eq. 26) and ``K_a_seed`` (printed Eq. 26 at the FE state);
+      nominal geometry and tension, corrected Eq. 26) and ``K_a_printed`` (printed Eq. 26 at the FE state; ``K_a_seed``, its old
+      name, warns and is removed in femast 0.3);
     * ``state``: the FE state, ``beam_N``: the mean axial force in the beam, N.
     """
     law = law or DyneemaLaw()
@@ -469,7 +471,7 @@ def compare_stiffness(
     res["beam_N"] = float(np.mean(st.beam_N))
     res["K_p"] = passive_stiffness(st.top, sh)
     res["K_a"] = active_stiffness(st.top, sh)
-    res["K_a_seed"] = active_stiffness(st.top, sh, form="seed")
+    res["K_a_printed"] = active_stiffness(st.top, sh, form="printed")
     res["K_geo"] = parts["K_beam_stressed"] - K_beam_FE
     res["K_m"] = K_beam + res["K_a"] + res["K_p"]
     nominal = rocaspect_shrouds(fe.mast, pretension, law)
@@ -478,4 +480,4 @@ def compare_stiffness(
     res["rel_active"] = relative_difference(res["K_a_FE"], res["K_a"])
     res["rel_shroud"] = relative_difference(parts["K_FE"] - parts["K_beam_stressed"], res["K_a"] + res["K_p"])
     res["fe"] = fe
-    return res
+    return RenamedKeys(res, {"K_a_seed": "K_a_printed"}, "compare_stiffness(...)")

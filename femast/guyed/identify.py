@@ -7,11 +7,11 @@ with the estimate ``x``, the standard errors ``stderr`` and the covariance
 determine (a singular direction of J) get ``stderr = inf`` and ``success`` stays True
 with a message saying which ones.
 
-Notes on the seed's identification equations
+Notes on the paper's identification equations
 --------------------------------------------
 * Eq. 27 is linear in ``[k0, k1, k2]``; the residual is in N.
 * Eqs. 28-29 and 30 are linear in the *compliances* ``1/k_theta`` and ``1/E, 1/G``, not in
-  the stiffnesses the seed lists as unknowns.  Here the stiffness (or E) itself is fitted
+  the stiffnesses the paper lists as unknowns.  Here the stiffness (or E) itself is fitted
   (so its standard error comes out directly), started from the linear solution.
 * Eq. 29 is built from J of Eq. 6; with the corrected sign (:mod:`.mast_3r`) only the
   force/moment coupling changes.
@@ -28,10 +28,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from .._moved import renamed_attributes
 from ..errors import ModelError
 from ._common import check_positive, check_vectors
 from .cantilever import cantilever_compliance_parts, mast_section
-from .mast_3r import compliance_3r, jacobian_3r
+from .mast_3r import compliance_3r, jacobian_3r, printed_sign_of
 
 
 @dataclass(frozen=True)
@@ -114,7 +115,7 @@ def shroud_design_matrix(dl, tau, l0: float = 0.5):
 def fit_shroud_law(dl, tau, l0: float = 0.5) -> FitResult:
     """Fit ``x_s = [k0 (N), k1 (-), k2 (1/N)]`` of Eq. 25 to a tensile test (Eq. 27).
 
-    dl : elongations, m.  tau : forces, N.  l0 : free length of the sample, m (0.5 m in the seed).
+    dl : elongations, m.  tau : forces, N.  l0 : free length of the sample, m (0.5 m in the paper).
     Residuals ``A_s x_s - b_s`` in N.
     """
     A, b = shroud_design_matrix(dl, tau, l0)
@@ -137,18 +138,27 @@ def _pairs(dw, dc):
     return dw, dc
 
 
-def seed_eq29_matrix(dw, r_oc, seed_sign: bool = False) -> np.ndarray:
+def rocaspect_eq29_matrix(dw, r_oc, printed_sign: bool = False, *, seed_sign: bool | None = None) -> np.ndarray:
     """A_theta of Eq. 29 stacked over the samples (6 k, 3): column c is ``J[:, c] (J[:, c] . dw)``.
 
     Multiplying by the joint compliances ``1 / k_theta`` (rad/(N m)) gives the displacements (m, rad).
     """
-    J = jacobian_3r(r_oc, seed_sign)
+    printed_sign = printed_sign_of(printed_sign, seed_sign, "rocaspect_eq29_matrix")
+    J = jacobian_3r(r_oc, printed_sign)
     dw = check_vectors("wrench changes dw", dw, (6,)).reshape(-1, 6)
     return (J[None, :, :] * (dw @ J)[:, None, :]).reshape(-1, 3)
 
 
 def fit_3r(
-    dw, dc, r_oc, rows=None, free=(True, True, True), k_fixed=(np.inf, np.inf, np.inf), seed_sign: bool = False
+    dw,
+    dc,
+    r_oc,
+    rows=None,
+    free=(True, True, True),
+    k_fixed=(np.inf, np.inf, np.inf),
+    printed_sign: bool = False,
+    *,
+    seed_sign: bool | None = None,
 ) -> FitResult:
     """Fit the 3R joint stiffnesses k_theta (N m/rad) to wrench changes dw (k, 6; N, N m) and measured
     top displacements dc (k, 6; m, rad) (Eqs. 28-29).
@@ -159,13 +169,14 @@ def fit_3r(
         translations measured, the torsion joint (about the vertical mast axis) has no effect and
         is reported as not identifiable if left free.
     """
+    printed_sign = printed_sign_of(printed_sign, seed_sign, "fit_3r")
     dw, dc = _pairs(dw, dc)
     rows = _rows(rows)
     free = np.asarray(free, dtype=bool)
     if not free.any():
         raise ModelError("fit_3r: at least one joint stiffness must be free")
     k_fixed = check_positive("fixed 3R joint stiffness", k_fixed, "N m/rad", allow_inf=True).reshape(3)
-    A = seed_eq29_matrix(dw, r_oc, seed_sign).reshape(-1, 6, 3)[:, rows, :].reshape(-1, 3)
+    A = rocaspect_eq29_matrix(dw, r_oc, printed_sign).reshape(-1, 6, 3)[:, rows, :].reshape(-1, 3)
     comp_fixed = np.where(free, 0.0, 1.0 / k_fixed)
     b = dc[:, rows].ravel() - A @ comp_fixed
     comp0 = np.linalg.lstsq(A[:, free], b, rcond=None)[0]
@@ -177,7 +188,7 @@ def fit_3r(
     def residual(kf):
         k = k_fixed.copy()
         k[free] = kf
-        return (dw @ compliance_3r(k, r_oc, seed_sign).T)[:, rows].ravel() - dc[:, rows].ravel()
+        return (dw @ compliance_3r(k, r_oc, printed_sign).T)[:, rows].ravel() - dc[:, rows].ravel()
 
     names = tuple(f"k_theta{i + 1}" for i in range(3) if free[i])
     return _fit(residual, k0, names, ("N m/rad",) * len(names), bounds=(0.0, np.inf))
@@ -224,3 +235,7 @@ def fit_beam_E(
     comp = (a @ b) / (a @ a) if a @ a > 0 else 0.0
     x0 = [1.0 / comp if comp > 0 else 7e10]
     return _fit(lambda x: a / x[0] - b, x0, ("E",), ("Pa",), bounds=(0.0, np.inf))
+
+
+#: old names, kept for one release (they warn): femast 0.3 removes them
+__getattr__ = renamed_attributes(__name__, {"seed_eq29_matrix": "rocaspect_eq29_matrix"})

@@ -2,10 +2,10 @@
 
 * ``"3R"``: Eqs. 4-6 (corrected J) with the Table III joint stiffnesses of the 50 kg tests at the
   shroud pretension (0 N: test "5 and 9", 400 N: "4", 800 N: "3", 1200 N: "1 and 8"; ``None``,
-  detached shrouds: "7 and 10"); torsion joint rigid (unidentified in the seed).
-* ``"beam"``: the cantilever of Eqs. 8-15 with the shrouds lumped into E, as the seed does: E =
-  6.55e10 Pa without shrouds and 1.55e11 Pa at 1200 N (seed); between them E is interpolated
-  linearly in the pretension (an assumption: the seed identifies only these two).
+  detached shrouds: "7 and 10"); torsion joint rigid (unidentified in the paper).
+* ``"beam"``: the cantilever of Eqs. 8-15 with the shrouds lumped into E, as the paper does: E =
+  6.55e10 Pa without shrouds and 1.55e11 Pa at 1200 N (the paper); between them E is interpolated
+  linearly in the pretension (an assumption: the paper identifies only these two).
 * ``"beam+shroud"``: the complete model of Eqs. 16-26 (bare beam E = 6.55e10 Pa plus three
   shrouds at the pretension, tangent Dyneema stiffness, :func:`.rocaspect.rocaspect_shrouds`).
 * ``"FE"``: :class:`~.fe_mast.MastFE` per mast, pretension equilibrated, condensed tangent as the
@@ -50,7 +50,7 @@ def masts_3r(pretension) -> MastSet:
 
 
 def beam_E(pretension) -> float:
-    """Beam-model E (Pa) at the pretension (N): seed values at 0 (no shrouds) and 1200 N, linear between."""
+    """Beam-model E (Pa) at the pretension (N): the paper's values at 0 (no shrouds) and 1200 N, linear between."""
     _check(pretension)
     p = 0.0 if pretension is None else float(pretension)
     return E_NO_SHROUD + (E_1200N - E_NO_SHROUD) * p / 1200.0

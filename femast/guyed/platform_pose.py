@@ -23,7 +23,7 @@ smooth), continued along a trajectory.  Output: the pose error ``p - p_c`` (what
 controller does not see), the tensions, and the exit points at equilibrium (what a controller
 should use instead of the calibrated ones).
 
-Assumptions (not in the seed): steel cables of EA = 1.0e6 N (about 4 mm), swivel pulleys of
+Assumptions (not in the paper): steel cables of EA = 1.0e6 N (about 4 mm), swivel pulleys of
 radius 0.03 m with vertical axes through the calibrated exit points, cables returning vertically to
 winches at the mast feet (as :mod:`.rocaspect`).
 """
@@ -53,7 +53,7 @@ class CableRobot:
 
     geom : :class:`~.cdpr.CdprGeometry`; its ``exit_points`` are the swivel entry points D_j as
         calibrated (m) and ``winch_points`` the winches F_j (m).
-    EA : cable axial rigidity, N.  pulley_radius : m (0: point exits, the seed's Eq. 1).
+    EA : cable axial rigidity, N.  pulley_radius : m (0: point exits, the Rocaspect paper, Eq. 1).
     """
 
     geom: CdprGeometry

@@ -5,10 +5,10 @@ Published (the Rocaspect paper)
 * Frame 8.3 m x 6.8 m x 4.0 m; 4 masts, 2 cables each; platform 1.0 x 1.0 x 0.5 m, 50 kg.
 * Beam L = 3.651 m, square tube s_out = 0.1 m, s_in = 0.094 m (Section IV-B-2).
 * Initial platform pose [2.65 m, 2.5 m, 1.6 m, 0, 0, 0]; platform height <= 2 m.
-* Shroud law x_s = [935353.664, 144.320, -0.000465] (:data:`.shroud.SEED_X_S`).
+* Shroud law x_s = [935353.664, 144.320, -0.000465] (:data:`femast.elements.shroud_law.ROCASPECT_X_S`).
 * Table III 3R joint stiffnesses and the identified E of the beam model.
 
-Assumed here (documented choices, not in the seed)
+Assumed here (documented choices, not in the paper)
 --------------------------------------------------
 * Base frame at the foot of mast 1; masts at the corners (0, 0), (8.3, 0), (8.3, 6.8),
   (0, 6.8) m.  Each beam stands on a 0.349 m foot, so its base O_i is at z = 0.349 m and its
@@ -27,7 +27,7 @@ Assumed here (documented choices, not in the seed)
   tied to the top C_i3 (e_i3 = 0); shrouds 1 and 2 tied 0.25 m lower on the tube wall.  The
   masts are free-standing, so the shrouds are tied to the mast's own foot: lower points D_ir
   on the ground at 0.6 m from the mast axis.  With this radius the complete model's lateral
-  compliance at 1200 N is within about 25 % of the 3R model identified by the seed.
+  compliance at 1200 N is within about 25 % of the 3R model identified by the paper.
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ PLATFORM_MASS = 50.0
 POSE_0 = np.array([2.65, 2.5, 1.6, 0.0, 0.0, 0.0])
 """Initial pose of the identification trajectory (m, rad)."""
 NU = 0.3
-"""Poisson's ratio used by the seed to get G from E."""
+"""Poisson's ratio used by the paper to get G from E."""
 E_NO_SHROUD = 6.55e10
 """Beam-model E identified without shrouds, Pa."""
 E_1200N = 1.55e11
@@ -66,7 +66,7 @@ TABLE_III = {
     "6": (24.0, 0.0, 42110.0, 56700.0),
     "7 and 10": (50.0, None, 75562.0, 63079.0),
 }
-"""Seed Table III, joint stiffnesses (N m/rad; printed as N/m)."""
+"""The Rocaspect paper, Table III, joint stiffnesses (N m/rad; printed as N/m)."""
 
 FOOT_HEIGHT = FRAME[2] - L_BEAM
 PULLEY_OFFSET = 0.1
@@ -132,11 +132,11 @@ def rocaspect_shrouds(mast: int, pretension: float, law: DyneemaLaw | None = Non
 
 
 def fig5a_trajectory(n_per_segment: int = 25) -> np.ndarray:
-    """Platform trajectory in the spirit of the seed's Fig. 5a, poses (k, 6) in m and rad.
+    """Platform trajectory in the spirit of the Rocaspect paper, Fig. 5a, poses (k, 6) in m and rad.
 
     From POSE_0: a 3.0 m x 1.8 m rectangle at z = 1.6 m (segments along x and y give the
     'wing-like' mast-top paths), then a diagonal climb to the far corner at z = 2.0 m (the
-    seed's height limit) and back (the 'straight diagonal' segment), orientation fixed.
+    the paper's height limit) and back (the 'straight diagonal' segment), orientation fixed.
     """
     x0, y0, z0 = POSE_0[:3]
     way = np.array(

@@ -10,7 +10,7 @@ torsion constant of the tube cross-section (it grows with the beam length L).
 ``J = 4 A_m^2 t / p_m = t (s - t)^3`` with s the outer side and t the wall
 thickness (A_m, p_m area and perimeter enclosed by the wall mid-line), which is
 also the thick-walled approximation of Roark's formulas for a square tube.
-:func:`seed000_eq10_torsion_constant` keeps the printed formula for comparison.
+:func:`rocaspect_eq10_torsion_constant` keeps the printed formula for comparison.
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ import math
 import numbers
 from dataclasses import dataclass, replace
 
+from .._moved import renamed_attributes
 from ..errors import ModelError
 from .validation import MAX_MAGNITUDE, number
 
@@ -171,7 +172,7 @@ def square_tube(
     return Section(E=E, G=shear_modulus(E, nu, name), A=A, Iy=I, Iz=I, J=J, name=name)
 
 
-def seed000_eq10_torsion_constant(s_out: float, L: float) -> float:
+def rocaspect_eq10_torsion_constant(s_out: float, L: float) -> float:
     """Eq. 10 of the Rocaspect paper as printed, J = s_out L (s_out^2 + L^2) / 12 (m^4). Dimensionally
     an area moment but not a torsion constant of the section; kept only for comparison."""
     return s_out * L * (s_out**2 + L**2) / 12.0
@@ -223,3 +224,7 @@ def _check_dims(name, outer, inner):
             )
     if outer <= 0 or inner >= outer:
         raise ModelError(f"section '{name}': need 0 <= inner ({inner}) < outer ({outer}) size, in m")
+
+
+#: old names, kept for one release (they warn): femast 0.3 removes them
+__getattr__ = renamed_attributes(__name__, {"seed000_eq10_torsion_constant": "rocaspect_eq10_torsion_constant"})

@@ -184,7 +184,7 @@ def linear_compliance(n_elements=4, L=3.651, out_dir=None):
             err,
             "rel",
             1e-8,
-            "seed 000 Eq. 8 / beam theory",
+            "Rocaspect paper, Eq. 8 / beam theory",
         ),
         Check(
             f"square-tube cantilever compliance, {n_elements} el.",
@@ -194,7 +194,7 @@ def linear_compliance(n_elements=4, L=3.651, out_dir=None):
             diag_err,
             "rel",
             1e-8,
-            "seed 000 Eq. 8 / beam theory",
+            "Rocaspect paper, Eq. 8 / beam theory",
         ),
     ], C_fe
 

@@ -155,7 +155,7 @@ def test_pretension_equilibrium(pretensioned):
 
 # ---------------------------------------------------------------------------- torsion
 def _reference_release_twist(p: BayParameters):
-    """Release twist of the seed's latch from a reduced model independent of femast: rigid frames
+    """Release twist of the paper's latch from a reduced model independent of femast: rigid frames
     on the Eq. 1 path, the unit held by its two arms and the latch cable (sliding freely, as it
     does at the edge of the contact zone where dT = 0), cables elastic, energy minimised by scipy."""
     lp = p.latch
@@ -222,7 +222,7 @@ def test_measured_style_path_gives_asymmetric_release(tmp_path):
     am = build_bay()
     path = measured_style_path(am.params.b, theta_max=math.radians(3.2), hold_side=0, n=41)
     drift = np.hypot(path.x, path.y).max()
-    assert 5e-3 < drift < 1.2e-2  # "displacements of up to 1 cm" (seed Sec. VI.A)
+    assert 5e-3 < drift < 1.2e-2  # "displacements of up to 1 cm" (Stohlman & Pellegrino, Sec. VI.A)
     path.to_csv(tmp_path / "path.csv")
     back = MeasuredPath.from_csv(tmp_path / "path.csv")
     assert np.allclose(back.theta, path.theta) and np.allclose(back.x, path.x)

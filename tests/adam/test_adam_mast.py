@@ -1,14 +1,14 @@
 """40-bay ADAM mast (Stohlman & Pellegrino, Sec. VII, Table 1): tip response, the identified parameters, the table.
 
-The reference values are the seed's Table 1 (x = 1740 um, theta_z = 3030 arcsec under M + F), the
-mast's symmetry (-M-F mirrors M+F) and the latch law's release force (43.9 N, seed's fit)."""
+The reference values are Stohlman & Pellegrino, Table 1 (x = 1740 um, theta_z = 3030 arcsec under M + F), the
+mast's symmetry (-M-F mirrors M+F) and the latch law's release force (43.9 N, the paper's fit)."""
 
 import numpy as np
 import pytest
 
 import femast as fm
 from femast.adam import BayParameters, build_mast
-from femast.adam.post import SEED_TABLE1, TABLE1_ROWS, format_table1, tip_table
+from femast.adam.post import ADAM_TABLE1, TABLE1_ROWS, format_table1, tip_table
 from femast.adam.steps import CONVERGENCE, add_initial_steps, add_table1_steps
 from femast.elements.latch_law import UNLATCHING, latch_force
 
@@ -26,7 +26,7 @@ def one_cycle(tmp_path_factory):
 def test_mast_geometry():
     am = build_mast(40)
     assert am.height == pytest.approx(6.84, rel=1e-12)  # seed: 40 bays, 6.84 m
-    assert am.folds[:4].tolist() == [1, -1, 1, -1]  # alternate folding (seed Sec. VIII)
+    assert am.folds[:4].tolist() == [1, -1, 1, -1]  # alternate folding (Stohlman & Pellegrino, Sec. VIII)
 
 
 def test_table1_tip_response_matches_the_seed_under_M_plus_F(one_cycle):
@@ -56,7 +56,7 @@ def test_table1_loads_do_not_move_any_bead(one_cycle):
 
 def test_table_layout():
     labels = list(TABLE1_ROWS)
-    txt = format_table1(labels, SEED_TABLE1)
+    txt = format_table1(labels, ADAM_TABLE1)
     lines = txt.splitlines()
     assert len(lines) == 3 + 13 and "thz (asec)" in lines[0] and "femast" in lines[1]
     assert lines[4].split("|")[1].split() == ["1740", "1740"]

@@ -71,7 +71,7 @@ def shrouds():  # a mast held by a Dyneema shroud, pushed towards its anchor
 
 
 def latches():  # the pull test of docs/cable_latch_element.md
-    lp = LatchParameters.seed_fit()
+    lp = LatchParameters.adam_fit()
     m = fm.Model("latches")
     a, l, g = m.node(-0.29, 0, 0), m.node(0, 0, 0), m.node(0.5000005, 0, 0)
     m.fix(a)

@@ -157,7 +157,7 @@ def test_effects_do_not_change_the_model_at_their_neutral_values():
         np.testing.assert_allclose(got["dx_m"], base["dx_m"], rtol=1e-12, atol=1e-15, err_msg=name)
 
 
-def test_beam_flexibility_is_the_seed000_cantilever_in_series():
+def test_beam_flexibility_is_the_rocaspect_cantilever_in_series():
     from femast.guyed.cantilever import cantilever_compliance, mast_section
 
     exp = get_experiment("mast-top")

@@ -138,7 +138,7 @@ def test_belt_over_two_capstans_by_hand():
 
 
 # ---------------------------------------------------------------- latches
-P1 = LatchParameters.seed_fit()
+P1 = LatchParameters.adam_fit()
 P2 = LatchParameters(r=1.1e-3, x_backstop=2.0e-3, k=30e3, mu=0.07, h=1.5e-3, R=2.4e-3)
 
 

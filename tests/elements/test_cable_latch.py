@@ -16,7 +16,7 @@ from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, con
 from femast.errors import ModelError
 from femast.testing import fd_tangent as _fd
 
-P = LatchParameters.seed_fit()
+P = LatchParameters.adam_fit()
 MM = 1e-3
 # A bay-side cable: anchor, latch (node 1), anchor; section 0 runs through the backstop.
 X3 = np.array([[-0.40, 0.0, 0.0], [0.0, 0.12, 0.02], [0.45, 0.01, 0.0]])

@@ -8,7 +8,7 @@ import femast as fm
 from femast.elements.cable_latch import CableLatchFamily
 from femast.elements.latch_law import UNLATCHING, LatchParameters, latch_force
 
-P = LatchParameters.seed_fit()
+P = LatchParameters.adam_fit()
 EA = 2.0e5
 
 

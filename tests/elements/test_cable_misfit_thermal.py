@@ -13,7 +13,7 @@ from femast.elements.latch_law import LatchParameters
 from femast.errors import ModelError
 from femast.testing import fd_tangent
 
-P = LatchParameters.seed_fit()
+P = LatchParameters.adam_fit()
 X3 = np.array([[-0.40, 0.0, 0.0], [0.0, 0.12, 0.02], [0.45, 0.01, 0.0]])
 EA = 2.0e4  # N
 T0 = 50.0  # N

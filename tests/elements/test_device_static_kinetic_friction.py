@@ -90,7 +90,7 @@ def test_one_coefficient_is_mu_s_equal_mu_k_bit_for_bit():
     for one, two in (
         (Drum(mu=0.3), Drum(mu_s=0.3, mu_k=0.3)),
         (Sheave(0.05, 0.01, 0.3, point=True), Sheave(0.05, 0.01, point=True, mu_s=0.3)),
-        (Latch(LatchParameters.seed_fit()), Latch(LatchParameters.seed_fit(), mu_s=0.07, mu_k=0.07)),
+        (Latch(LatchParameters.adam_fit()), Latch(LatchParameters.adam_fit(), mu_s=0.07, mu_k=0.07)),
     ):
         a = CableDeviceFamily.pretensioned([[0, 1, 2]], X90, EA, T0, [one])
         b = CableDeviceFamily.pretensioned([[0, 1, 2]], X90, EA, T0, [two])
@@ -112,7 +112,7 @@ def eq14(x, sigma, p, mu):
 
 
 def test_latch_leaves_its_backstop_at_mu_s_and_slides_at_mu_k():
-    p = LatchParameters.seed_fit()
+    p = LatchParameters.adam_fit()
     mu_s, mu_k = 0.12, 0.05
     X = np.array([[0.0, 0, 0], [0.5, 0, 0], [1.0, 0, 0]])
     fam = CableDeviceFamily.pretensioned([[0, 1, 2]], X, 2e4, 5.0, [Latch(p, mu_s=mu_s, mu_k=mu_k)])
@@ -151,7 +151,7 @@ def test_latch_leaves_its_backstop_at_mu_s_and_slides_at_mu_k():
         (Drum(mu_s=0.1, mu_k=0.2), "kinetic mu_k = 0.2 above static mu_s = 0.1"),
         (Drum(mu=0.2, mu_s=0.3), "give mu \\(static = kinetic\\) or mu_s"),
         (Drum(mu_s=-0.1), "mu_s = -0.1 must be a finite friction coefficient"),
-        (Latch(LatchParameters.seed_fit(), mu_k=0.1), "kinetic mu_k = 0.1 above static mu_s = 0.07"),
+        (Latch(LatchParameters.adam_fit(), mu_k=0.1), "kinetic mu_k = 0.1 above static mu_s = 0.07"),
     ],
 )
 def test_bad_friction_pairs_are_named(dev, words):
@@ -166,7 +166,7 @@ def test_single_latch_element_with_kinetic_friction_matches_the_device_family():
     from femast.elements.cable_devices import Pulley
     from femast.elements.cable_latch import CableLatchFamily
 
-    p = LatchParameters.seed_fit()
+    p = LatchParameters.adam_fit()
     X = np.array([[-0.40, 0.0, 0.0], [0.0, 0.12, 0.02], [0.45, 0.01, 0.0], [0.9, 0.3, 0.0]])
     old = CableLatchFamily.pretensioned([[0, 1, 2, 3]], X, EA=2e4, T0=20.0, latch_node=2, latch=p, mu_k=0.03)
     new = CableDeviceFamily.pretensioned([[0, 1, 2, 3]], X, 2e4, 20.0, [Pulley(), Latch(p, mu_k=0.03)])

@@ -20,7 +20,7 @@ from femast.elements.cable_latch import BACKSTOP, SLIP_IN, SLIP_OUT, STICK, Cabl
 from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.testing import fd_tangent
 
-P = LatchParameters.seed_fit()
+P = LatchParameters.adam_fit()
 MM = 1e-3
 X3 = np.array([[-0.40, 0.0, 0.0], [0.0, 0.12, 0.02], [0.45, 0.01, 0.0]])
 EA = 2.0e4
@@ -81,7 +81,7 @@ def _committed_at(fam, x):
 
 
 def test_band_is_widened_near_the_backstop():
-    """A bead resting at x = -1.8 mm with T2 - T1 = dT_in - 0.4 H: the seed's law pulls it in (the
+    """A bead resting at x = -1.8 mm with T2 - T1 = dT_in - 0.4 H: the paper's law pulls it in (the
     rollers push harder than the cable holds), the hysteresis option keeps it where it is."""
     x = -1.8 * MM
     lo_seed = float(latch_force(x, LATCHING, P))
@@ -150,7 +150,7 @@ def test_sliding_bead_follows_widened_branch(x0, node, dx, status, sigma):
 def test_release_from_backstop_needs_the_extra_force():
     """Seated on the backstop the bead leaves at dT_out(-x_b) + F_h (43.9 N + 40 N), not at 43.9 N."""
     thr = float(latch_force(-P.x_backstop, UNLATCHING, P))
-    assert thr == pytest.approx(43.9, abs=0.05)  # the seed's fit (docs/cable_latch_element.md)
+    assert thr == pytest.approx(43.9, abs=0.05)  # the paper's fit (docs/cable_latch_element.md)
     for hyst, target, expect in (
         (False, thr + 0.5 * FH, SLIP_OUT),
         (True, thr + 0.5 * FH, BACKSTOP),
@@ -193,6 +193,6 @@ def test_residual_rotation_zero_without_and_positive_with_hysteresis(tmp_path):
     # without: an elastic structure (cables, members, joint springs) returns to zero; what is left
     # is Newton's displacement tolerance, 1e-6 of the 1-degree cycle
     assert abs(off) < 1e-5
-    # with the option calibrated on the seed's 0.10 degrees (docs/adam_bay.md), a bead that left
+    # with the option calibrated on the paper's 0.10 degrees (docs/adam_bay.md), a bead that left
     # its backstop stays away from it at zero moment: a residual of the order of 0.1 degree
     assert 0.05 < on < 0.2

@@ -22,11 +22,11 @@ from femast.elements.latch_law import (
 )
 from femast.errors import ModelError
 
-P = LatchParameters.seed_fit()
+P = LatchParameters.adam_fit()
 MM = 1e-3
 
 
-def test_seed_fit_in_si():
+def test_adam_fit_in_si():
     p = LatchParameters.from_mm(r=1.1, x_backstop=2.0, k=100.0, mu=0.07, h=1.5, R=2.4)
     np.testing.assert_allclose(p.as_array(), P.as_array(), rtol=1e-15)  # same numbers, two unit paths
     np.testing.assert_allclose(P.as_array(), [1.1e-3, 2.0e-3, 1e5, 0.07, 1.5e-3, 2.4e-3], rtol=1e-15)  # exact SI

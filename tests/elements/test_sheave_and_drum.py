@@ -206,7 +206,7 @@ def test_latch_with_the_bearing_of_its_unit_sheave():
     from femast.elements.cable_devices import Latch
     from femast.elements.latch_law import LatchParameters
 
-    p = LatchParameters.seed_fit()
+    p = LatchParameters.adam_fit()
     sheave = Sheave(0.01, 0.002, 0.3, point=True)
     rho = 0.3 * 0.002 / 0.01
     Xc = np.array([[0.0, 0.0, 0.0], [0.3, 0.0, 0.0], [0.3, 0.4, 0.0]])  # a quarter turn at the unit

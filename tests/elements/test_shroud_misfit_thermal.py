@@ -22,7 +22,7 @@ from femast.testing import fd_tangent
 
 LAW = DyneemaLaw()
 K0, K1, K2 = LAW.k0, LAW.k1, LAW.k2
-T0 = 1200.0  # N, the seed's pretension
+T0 = 1200.0  # N, the paper's pretension
 
 
 def g(tau):

@@ -119,7 +119,7 @@ def _scattered_mast(n_bays, seed, steps_out):
 
 def _check_coulomb(frames):
     for fr in frames:
-        # |M| <= mu B |F| (seed Sec. II.B.1); 1e-9: the kernel's stick test allows 1e-12, the
+        # |M| <= mu B |F| (Stohlman & Pellegrino, Sec. II.B.1); 1e-9: the kernel's stick test allows 1e-12, the
         # moment is rebuilt in the global frame (a rotation: round-off only)
         assert np.all(fr["moment_norm"] <= fr["limit"] * (1 + 1e-9) + 1e-15)
         assert set(np.unique(fr["slip"])) <= {0.0, 1.0}

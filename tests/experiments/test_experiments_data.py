@@ -42,7 +42,7 @@ def test_example_files_follow_their_format(name, exp):
     assert all(c.name in d.columns for c in e.columns if c.required)
 
 
-def test_tip_cycle_example_is_seed001_table1_in_si():
+def test_tip_cycle_example_is_adam_table1_in_si():
     d = read_data(get_experiment("tip-cycle"), DATA / "tip_cycle_table1.csv")
     assert d.n == 13
     # the file holds 6 significant digits

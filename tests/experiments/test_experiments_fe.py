@@ -49,7 +49,7 @@ def test_bay_baseline_is_the_adam_bay_driven_along_the_measured_path():
     from femast.adam.post import bay_curve
     from femast.adam.steps import CONVERGENCE, add_initial_steps, add_measured_torsion, measured_style_path
 
-    path = measured_style_path(0.25, theta_max=np.radians(3.0), n=13)  # the seed's "actual path", off-axis
+    path = measured_style_path(0.25, theta_max=np.radians(3.0), n=13)  # the paper's "actual path", off-axis
     am = build_bay(mu=0.0)
     add_initial_steps(am, hold_control=("ux", "uy", "rz"))
     add_measured_torsion(am, path, name="twist-path", max_increment=path.t[1] - path.t[0])
@@ -64,7 +64,7 @@ def test_bay_baseline_is_the_adam_bay_driven_along_the_measured_path():
     assert got[0] == pytest.approx(0.0, abs=1e-6)  # the pretensioned bay holds no moment at theta = 0
     # same model, same increments, only the step time differs: Newton round-off (~1e-6 N m seen)
     np.testing.assert_allclose(got[1:], ref, atol=1e-4)
-    assert np.ptp(got) > 20.0  # the latches hold ~25 N m and release (seed Figs. 16-17: ~35 N m)
+    assert np.ptp(got) > 20.0  # the latches hold ~25 N m and release (Stohlman & Pellegrino, Figs. 16-17: ~35 N m)
 
 
 def test_bay_effects_change_the_fe_inputs_as_documented():
@@ -146,7 +146,7 @@ def test_bay_short_path_hidden_latch_hysteresis_is_found():
     )
     c = compare(BT, data, fit=True)
     assert c.ratio > 2.0  # 10 N of hysteresis against 0.15 N m of noise
-    # the latch zones of seed Fig. 6 are segments (the bay never releases on this path: zones (a)-(b) only);
+    # the latch zones of Stohlman & Pellegrino, Fig. 6 are segments (the bay never releases on this path: zones (a)-(b) only);
     # localisation against the noise-free misfit is checked by the slow cases, on paths long enough for it
     assert {k["kind"] for k in c.by_kind} >= {"zone (b) behind roller axis", "loading", "unloading"}
     assert not any(k["kind"].startswith("zone (d)") for k in c.by_kind)

@@ -104,7 +104,7 @@ def test_out_of_library_load_cell_drift_is_not_explained():
 
 def test_model_follows_the_latch_law_on_its_branches():
     # unlatching out from the backstop then latching back in, noise-free: the prediction is Eq. 14
-    p = LatchParameters.seed_fit()
+    p = LatchParameters.adam_fit()
     x = np.concatenate([np.linspace(-1.9e-3, 3e-3, 60), np.linspace(3e-3, -1.9e-3, 60)])
     sig = np.where(np.arange(x.size) < 60, UNLATCHING, LATCHING)
     dT = latch_force(x, sig, p)

@@ -88,7 +88,7 @@ def test_clearance_fails_near_zero_load_and_friction_with_the_direction_of_loadi
     assert c.signatures[0]["name"] == "time x load"
 
 
-@pytest.mark.parametrize("kind,noise,seed", [("cycles", 5e-5, 21), ("seed000", 2e-5, 22)])
+@pytest.mark.parametrize("kind,noise,seed", [("cycles", 5e-5, 21), ("rocaspect_fig5a", 2e-5, 22)])
 def test_null_case_nothing_is_missing(kind, noise, seed):
     data, _ = mast_top_data(
         {"k_theta1": 2.2e5, "k_theta2": 2.2e5},
@@ -128,7 +128,7 @@ def test_two_hidden_effects_are_found_one_after_the_other():
     assert d3.verdict["missing_effect"] is None and d3.verdict["explained"] is True
 
 
-def test_baseline_is_the_seed000_3r_model_with_its_sign_correction():
+def test_baseline_is_the_rocaspect_3r_model_with_its_sign_correction():
     rng = np.random.default_rng(0)
     r_oc = np.array([0.2, -0.1, 3.5])
     exp = get_experiment("mast-top", r_oc_m=tuple(r_oc))

@@ -2,7 +2,7 @@
 
 Its physics is checked against closed forms (not against femast's effects, which it must not
 share code or functional form with); the two rigs' baselines are cross-checked against femast's
-baseline models of the seeds (3R Jacobian, latch law), which the generator re-implements.
+baseline models of the papers (3R Jacobian, latch law), which the generator re-implements.
 """
 
 import ast
@@ -157,7 +157,7 @@ def test_eq15_noise_variance_follows_the_slope():
         assert np.var(r) == pytest.approx(float(nz.eq15_residual_variance(s, C, sT, sd)), rel=0.02)  # SE 0.3 %
 
 
-# --------------------------------------------------------------------------- rigs against the seeds' baselines
+# --------------------------------------------------------------------------- rigs against the papers' baselines
 def test_mast_rig_matches_the_3r_jacobian():
     from femast.guyed.mast_3r import jacobian_3r
 
@@ -180,7 +180,7 @@ def test_latch_rig_matches_the_seed_law():
 
 @pytest.mark.parametrize("name", ["mt_null_white", "mt_null_hetero", "lp_null_white", "lp_null_ar1"])
 def test_noise_free_null_data_is_the_seed_baseline(name):
-    # the null cases must be exactly what the experiment's baseline model predicts at the seed's
+    # the null cases must be exactly what the experiment's baseline model predicts at the paper's
     # parameters, or every null redraw carries a systematic error (a hold pulled past the
     # breakaway force once did: 4 samples 1-4 N above the static band on the backstop)
     from dataclasses import replace

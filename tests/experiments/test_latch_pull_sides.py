@@ -1,7 +1,7 @@
 """latch-pull: the loaded side is a property of the test pass (Stohlman & Pellegrino, Sec. III.B).
 
 Data come from ``benchmarks/latch_rig.py``, a quasi-static simulation of the pull-test rig written
-from the seed's equations in angle form (Eqs. 7-11) with its own stick/slip search; it does not
+from the paper's equations in angle form (Eqs. 7-11) with its own stick/slip search; it does not
 import femast.  The model under test is ``femast.experiments.rigs.latch_pull`` (Eq. 14 closed form,
 nearest admissible state, parked bead behind a slack cable).
 """
@@ -49,7 +49,7 @@ def test_generator_does_not_use_femast():
 def test_two_forms_of_the_seed_law_agree():
     # the rig's angle form (Eqs. 7-11) and femast's closed form (Eq. 14) are the same law
     x = np.linspace(-2.0e-3, 2.6e-3, 233)
-    p = LatchParameters.seed_fit()
+    p = LatchParameters.adam_fit()
     for d in (LATCHING, UNLATCHING):
         mine = np.array([LATCH.dT(v, d) for v in x])
         np.testing.assert_allclose(mine, latch_force(x, d, p), rtol=1e-12, atol=1e-9)  # round-off of two forms
@@ -94,7 +94,7 @@ def test_unlatching_reversed_in_zone_b_follows_the_latching_branch():
     assert back.sum() > 50 and run["dT"][back].min() > 10.0
     x = 1e-3 * cols["x_mm"][back]
     np.testing.assert_allclose(
-        run["dT"][back], latch_force(x, LATCHING, LatchParameters.seed_fit()), atol=0.5
+        run["dT"][back], latch_force(x, LATCHING, LatchParameters.adam_fit()), atol=0.5
     )  # 2 um position noise on a slope up to 130 N/mm: 0.26 N, 2x margin
     assert np.sqrt(np.mean((pred[back] - run["dT"][back]) ** 2)) < 0.6  # same noise budget, RMS
 

@@ -151,7 +151,7 @@ def test_mast_force_is_tension_times_u_plus_v():
 def test_trajectory_is_feasible_and_continuous():
     traj = fig5a_trajectory(10)
     taus = np.array([tension_distribution(GEOM, p).tau for p in traj])
-    assert np.all(traj[:, 2] <= 2.0 + 1e-12)  # the seed's height limit, m
+    assert np.all(traj[:, 2] <= 2.0 + 1e-12)  # the paper's height limit, m
     # steps of ~0.3 m: a continuous distribution changes by far less than the tension range
     assert np.abs(np.diff(taus, axis=0)).max() < 0.1 * (GEOM.tau_max - GEOM.tau_min)
 

@@ -5,7 +5,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from femast.elements.shroud_law import (
-    SEED_X_S,
+    ROCASPECT_X_S,
     DyneemaLaw,
     axial_rigidity_secant,
     axial_rigidity_tangent,
@@ -38,8 +38,8 @@ TAU0 = np.array([900.0, 1200.0, 400.0])
 # ----------------------------------------------------------------------------- Eq. 25 law
 def test_dyneema_law_units_and_seed_values():
     # k0 is an axial rigidity (N): EA at zero load; at 1200 N: k0 + k1 1200 + k2 1200^2 by hand.
-    assert axial_rigidity_secant(LAW, 0.0) == SEED_X_S[0]
-    assert axial_rigidity_tangent(LAW, 0.0) == pytest.approx(SEED_X_S[0], rel=1e-15)  # same formula at 0
+    assert axial_rigidity_secant(LAW, 0.0) == ROCASPECT_X_S[0]
+    assert axial_rigidity_tangent(LAW, 0.0) == pytest.approx(ROCASPECT_X_S[0], rel=1e-15)  # same formula at 0
     assert axial_rigidity_secant(LAW, 1200.0) == pytest.approx(
         935353.664 + 144.32 * 1200 - 0.000465 * 1200**2, rel=1e-15
     )  # round-off
@@ -114,7 +114,7 @@ def test_active_plus_passive_equals_finite_difference_of_shroud_wrench():
     # central differences with h = 1e-6 m: relative error ~1e-9 on entries up to 1e5
     np.testing.assert_allclose(K, K_fd, atol=1e-6 * np.abs(K_fd).max())
     # the printed Eq. 26 misses the moment-arm term: it is off by much more than the FD error
-    K_seed = active_stiffness(TOP, shrouds, form="seed") + passive_stiffness(TOP, shrouds)
+    K_seed = active_stiffness(TOP, shrouds, form="printed") + passive_stiffness(TOP, shrouds)
     assert np.abs(K_seed - K_fd)[3:, 3:].max() > 100.0  # N m/rad; ~tau |e|
 
 
@@ -165,7 +165,7 @@ def test_active_stiffness_blocks_scale_with_the_right_dimensions():
     s = 3.0
     sh1 = ShroudSet(UPPER, LOWER, TAU0, law=None, stiffness=[1, 1, 1])
     sh3 = ShroudSet(s * UPPER, s * LOWER, TAU0, law=None, stiffness=[1, 1, 1])
-    for form, ok in (("corrected", True), ("seed", False)):
+    for form, ok in (("corrected", True), ("printed", False)):
         K1, K3 = active_stiffness(TOP, sh1, form), active_stiffness(s * TOP, sh3, form)
         expect = np.block([[K1[:3, :3] / s, K1[:3, 3:]], [K1[3:, :3], K1[3:, 3:] * s]])
         assert np.allclose(K3, expect, rtol=1e-10, atol=1e-9) == ok  # exact scaling, round-off only

@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from femast.elements.shroud_law import SEED_X_S, DyneemaLaw, strain_from_tension
+from femast.elements.shroud_law import ROCASPECT_X_S, DyneemaLaw, strain_from_tension
 from femast.errors import ModelError
 from femast.guyed.cantilever import cantilever_compliance, mast_section
 from femast.guyed.cdpr import trajectory_loads
-from femast.guyed.identify import fit_3r, fit_beam_E, fit_shroud_law, seed_eq29_matrix, shroud_design_matrix
+from femast.guyed.identify import fit_3r, fit_beam_E, fit_shroud_law, rocaspect_eq29_matrix, shroud_design_matrix
 from femast.guyed.mast_3r import displacement_3r
 from femast.guyed.rocaspect import (
     E_1200N,
@@ -27,7 +27,7 @@ N_SIGMA = 3.5  # a fixed-seed estimate lies within 3.5 standard errors (two-side
 
 
 def _tensile_test(rng, sigma, n=60):
-    """Loading 50-400 kg and 0-300 kg as in the seed's Fig. 4a; elongations of a 0.5 m sample (m)."""
+    """Loading 50-400 kg and 0-300 kg as in the Rocaspect paper, Fig. 4a; elongations of a 0.5 m sample (m)."""
     tau = np.concatenate([np.linspace(50, 400, n) * 9.81, np.linspace(0, 300, n) * 9.81])
     dl = 0.5 * strain_from_tension(DyneemaLaw(), tau)
     return dl + rng.normal(0.0, sigma, dl.size), tau
@@ -37,15 +37,15 @@ def test_shroud_law_exact_data_recovers_seed_coefficients():
     dl, tau = _tensile_test(np.random.default_rng(0), 0.0)
     r = fit_shroud_law(dl, tau)
     # noise-free data: only the conditioning of the 3-column fit (~1e8) limits the accuracy
-    np.testing.assert_allclose(r.x, SEED_X_S, rtol=1e-6)
+    np.testing.assert_allclose(r.x, ROCASPECT_X_S, rtol=1e-6)
     assert r.success and r.names == ("k0", "k1", "k2") and r.units == ("N", "-", "1/N")
 
 
 def test_shroud_law_noisy_data_recovers_seed_coefficients_within_stderr():
     r = fit_shroud_law(*_tensile_test(np.random.default_rng(1), 0.5e-6))  # dial indicator noise 0.5 um
-    assert np.all(np.abs(r.x - SEED_X_S) < N_SIGMA * r.stderr)
-    assert r.stderr[0] / SEED_X_S[0] < 0.01  # k0 (EA at zero load) is well determined
-    assert r.stderr[2] / abs(SEED_X_S[2]) < 0.5  # the small curvature term is resolved, but only just
+    assert np.all(np.abs(r.x - ROCASPECT_X_S) < N_SIGMA * r.stderr)
+    assert r.stderr[0] / ROCASPECT_X_S[0] < 0.01  # k0 (EA at zero load) is well determined
+    assert r.stderr[2] / abs(ROCASPECT_X_S[2]) < 0.5  # the small curvature term is resolved, but only just
 
 
 def test_shroud_law_stderr_is_calibrated():
@@ -75,9 +75,9 @@ def test_3r_stiffnesses_recovered_from_trajectory_data():
 
 
 def test_eq29_linear_system_gives_the_compliances():
-    # Eq. 28: A_theta [1/k1, 1/k2, 1/k3] = dc; the seed's unknowns are compliances.
+    # Eq. 28: A_theta [1/k1, 1/k2, 1/k3] = dc; the paper's unknowns are compliances.
     k = np.array([2.7e5, 2.3e5, 5.0e4])
-    A = seed_eq29_matrix(DW, R_OC)
+    A = rocaspect_eq29_matrix(DW, R_OC)
     comp = np.linalg.lstsq(A, displacement_3r(k, R_OC, DW).ravel(), rcond=None)[0]
     np.testing.assert_allclose(comp, 1 / k, rtol=1e-9)  # exact linear data, conditioning ~1e4
 

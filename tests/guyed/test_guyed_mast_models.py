@@ -34,7 +34,7 @@ def test_eq6_translational_columns_follow_the_physical_motion():
     )
     J = jacobian_3r(R_OC)
     np.testing.assert_allclose(J[:3], fd, atol=1e-8)  # central-difference round-off ~ 1e-16 * 4 m / 1e-7
-    np.testing.assert_allclose(jacobian_3r(R_OC, seed_sign=True)[:3], -fd, atol=1e-8)  # same
+    np.testing.assert_allclose(jacobian_3r(R_OC, printed_sign=True)[:3], -fd, atol=1e-8)  # same
     np.testing.assert_array_equal(J[3:], np.eye(3))  # exact: joint axes are the base axes
 
 
@@ -48,9 +48,9 @@ def test_3r_compliance_equals_direct_statics():
         np.testing.assert_allclose(displacement_3r(K_THETA, R_OC, dw), expected, rtol=1e-12, atol=1e-18)  # round-off
 
 
-def test_seed_sign_changes_only_the_coupling_blocks():
+def test_printed_sign_changes_only_the_coupling_blocks():
     C = compliance_3r(K_THETA, R_OC)
-    Cs = compliance_3r(K_THETA, R_OC, seed_sign=True)
+    Cs = compliance_3r(K_THETA, R_OC, printed_sign=True)
     np.testing.assert_allclose(Cs[:3, :3], C[:3, :3], rtol=1e-14)  # sign cancels: exact up to round-off
     np.testing.assert_allclose(Cs[3:, 3:], C[3:, 3:], rtol=1e-14)
     np.testing.assert_allclose(Cs[:3, 3:], -C[:3, 3:], rtol=1e-14)
@@ -98,7 +98,7 @@ def test_vertical_beam_rotation_is_eq13():
 
 
 def test_eq30_rows_with_corrected_row_2():
-    # The seed's identification matrix (Eq. 30) written out by hand with I_y = I_z = I,
+    # The paper's identification matrix (Eq. 30) written out by hand with I_y = I_z = I,
     # except row 2 whose moment term has the corrected (negative) sign.
     L = L_BEAM
     sec = mast_section(1.0)
@@ -124,16 +124,16 @@ def test_eq30_rows_with_corrected_row_2():
 
 def test_eq10_printed_torsion_constant_is_not_the_tube_one():
     bredt = mast_section(7e10).J
-    printed = mast_section(7e10, torsion="seed_eq10", L=L_BEAM).J
+    printed = mast_section(7e10, torsion="printed_eq10", L=L_BEAM).J
     assert bredt == pytest.approx(0.003 * 0.097**3, rel=1e-12)  # t (s - t)^3 by hand
     assert printed == pytest.approx(0.1 * 3.651 * (0.01 + 3.651**2) / 12, rel=1e-12)  # Eq. 10 by hand
     assert printed / bredt > 1e5  # five orders of magnitude too stiff in torsion
     with pytest.raises(ModelError, match="needs the beam length"):
-        mast_section(7e10, torsion="seed_eq10")
+        mast_section(7e10, torsion="printed_eq10")
 
 
 def test_seed_3r_and_beam_values_agree_as_the_seed_reports():
-    # The seed reports that the 3R and beam models give nearly identical results with 1200 N
+    # The paper reports that the 3R and beam models give nearly identical results with 1200 N
     # shrouds.  With its E_1200N and Table III (tests 1 and 8), the lateral top compliances agree
     # to within 20 % (the two models are identified independently from noisy data).
     C_beam = cantilever_compliance(L_BEAM, mast_section(E_1200N))

@@ -39,7 +39,7 @@ Fitted: the latch law as it acts in the bay, ``latch_k`` (N/m, one roller's cant
 (0.1 of k moves the curve by up to 2.7 N m, 0.01 of mu by up to 1 N m, on a 3.2-degree cycle),
 whereas a 10 % change of cable EA moves it by 0.4 N m and 20 N of pretension by 0.6 N m, mostly
 after release: EA (``cable_EA_N``, identified from Table 1 (docs/adam_mast.md)) and the pretension
-(``pretension_N``, measured by vibration, seed Eq. 16) are options, and a pretension error is a
+(``pretension_N``, measured by vibration, Stohlman & Pellegrino, Eq. 16) are options, and a pretension error is a
 candidate effect.
 
 Speed: one run is about 0.1 s for 49 driven rows on one core (warm; 0.07 s started from a reference
@@ -414,7 +414,7 @@ EXPERIMENT = Experiment(
             1.0e5,
             1.0e4,
             1.0e6,
-            "stiffness of one latch roller's cantilever (seed Eq. 10)",
+            "stiffness of one latch roller's cantilever (Stohlman & Pellegrino, Eq. 10)",
             scale=1.0e5,
         ),
         Parameter(

@@ -58,12 +58,12 @@ from femast.guyed.mast_3r import jacobian_3r
 
 WRENCH = ("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm")
 DISPLACEMENT = ("dx_m", "dy_m", "dz_m")
-L_SEED = 3.651  # m, the Rocaspect paper, Sec. IV-B-2
+L_MAST = 3.651  # m, the Rocaspect paper, Sec. IV-B-2
 
 
 def _prepare(data: Measured, options: dict) -> dict:
     dw = np.column_stack([data[c] for c in WRENCH])
-    J = jacobian_3r(np.asarray(options["r_oc_m"], dtype=float), seed_sign=bool(options.get("seed_sign", False)))
+    J = jacobian_3r(np.asarray(options["r_oc_m"], dtype=float), printed_sign=bool(options.get("printed_sign", False)))
     m = dw @ J
     return {"dw": dw, "J": J, "m": m, "tau": data.tau}
 
@@ -153,13 +153,14 @@ _EXPERIMENT = Experiment(
     ),
     model=model,
     options={
-        "r_oc_m": (0.0, 0.0, L_SEED),
+        "r_oc_m": (0.0, 0.0, L_MAST),
         "k_theta3_Nm_per_rad": np.inf,
         "s_out_m": 0.1,
         "s_in_m": 0.094,
         "nu": 0.3,
-        "seed_sign": False,
+        "printed_sign": False,
     },
+    renamed_options={"seed_sign": "printed_sign"},
     hooks={"top_displacement": "dc_T (n, 3) m: translation of the top point"},
     quantities={
         "load": Quantity("N m", axes=("x", "y"), symbol="M", scale=1e3, doc="moment on the base joint"),

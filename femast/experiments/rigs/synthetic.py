@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from femast._moved import renamed
 from femast.effects import resolve
 from femast.elements.latch_law import LATCHING, UNLATCHING, latch_force
 from femast.errors import ModelError
@@ -48,11 +49,15 @@ def mast_top_path(
     kind : ``"cycles"`` (zero-mean force cycles along ``angle_deg`` with an amplitude that varies
         from cycle to cycle), ``"ramps"`` (piecewise-linear ramps with random turning loads, partial
         unloading and reversals away from zero), ``"rotating"`` (a force of varying magnitude whose
-        direction turns), ``"seed000"`` (the mast-1 wrench along the the Rocaspect paper, Fig. 5a trajectory,
-        repeated ``cycles`` times).
+        direction turns), ``"rocaspect_fig5a"`` (the mast-1 wrench along the trajectory of Fig. 5a of the
+        Rocaspect paper, repeated ``cycles`` times; ``"seed000"``, its old name, warns and is removed
+        in femast 0.3).
     moment_Nm : amplitude of top moments out of phase with the force (an offset attachment);
         needed to separate beam bending from joint rotation.
     """
+    if kind == "seed000":
+        renamed("mast_top_path(kind='seed000')", "mast_top_path(kind='rocaspect_fig5a')")
+        kind = "rocaspect_fig5a"
     rng = np.random.default_rng(seed)
     t = np.linspace(0.0, 1.0, n)
     a = np.radians(angle_deg)
@@ -72,7 +77,7 @@ def mast_top_path(
         ang = a + 2 * np.pi * 0.5 * cycles * t
         F = mag * np.sin(2 * np.pi * cycles * t)
         fx, fy = F * np.cos(ang), F * np.sin(ang)
-    elif kind == "seed000":
+    elif kind == "rocaspect_fig5a":
         from femast.guyed.cdpr import trajectory_loads
         from femast.guyed.rocaspect import fig5a_trajectory, rocaspect_geometry
 
@@ -83,7 +88,7 @@ def mast_top_path(
         w = np.column_stack([np.interp(tt, one, dw[:, j]) for j in range(6)])
         return dict(zip(("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"), w.T))
     else:
-        raise ModelError(f"unknown path kind {kind!r}; use cycles, ramps, rotating or seed000")
+        raise ModelError(f"unknown path kind {kind!r}; use cycles, ramps, rotating or rocaspect_fig5a")
     fz = -0.3 * np.abs(F)
     ph = 2 * np.pi * cycles * t + np.pi / 2
     mx = moment_Nm * np.sin(ph) * np.cos(a + 1.0)

@@ -271,10 +271,10 @@ def model(params: dict, data: Measured, effects, options: dict) -> dict:
 
 def plot_measured(ax, data: Measured, predicted: dict, params: dict, options: dict) -> None:
     """Tip displacement x and tip twist (as L rz, L the mast height) against the signed tip load, mm."""
-    from femast.adam.parameters import SEED_BAY_HEIGHT
+    from femast.adam.parameters import ADAM_BAY_HEIGHT
 
     s = prepared(data, _prepare, options)["load"]
-    L = int(options["n_bays"]) * float(dict(options.get("bay") or {}).get("l", SEED_BAY_HEIGHT))
+    L = int(options["n_bays"]) * float(dict(options.get("bay") or {}).get("l", ADAM_BAY_HEIGHT))
     ax.plot(s, 1e3 * data["ux_m"], "o", ms=3.5, color="0.35", label="ux measured")
     ax.plot(s, 1e3 * predicted["ux_m"], "-", lw=1.2, color="C3", label="ux model")
     ax.plot(s, 1e3 * L * data["rz_rad"], "s", ms=3.0, color="0.6", label=f"{L:.3g} m x rz measured")
