@@ -7,6 +7,10 @@ then puts the new module in ``sys.modules`` under the old name, so the import re
 module object (one class for ``isinstance``, numba's cache keyed on the one source file).  No
 import hook: IDEs, type checkers and ``python -m`` see ordinary files.  femast's own code, tests,
 benchmarks and docs import the new paths (``tests/test_architecture.py`` checks).
+
+Renamed names and option values warn the same way for one release: :func:`renamed` (an old keyword
+or value), :func:`renamed_attributes` (a module's old names), :class:`RenamedKeys` (a result dict's
+old keys); ``tests/test_renamed_names.py`` tests each.
 """
 
 from __future__ import annotations

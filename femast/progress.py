@@ -85,21 +85,43 @@ def _clock(seconds: float) -> str:
     return f"{m // 60}:{m % 60:02d}:{s:02d}" if m >= 60 else f"{m}:{s:02d}"
 
 
+# the plain lines of this process's bars on the default clock, as one stream: (the time of the last
+# line, or of the start of the stretch of work; bars open; when the last one closed)
+_PLAIN = {"last": None, "open": 0, "closed_at": None}
+
+
+def _plain_clock() -> float:
+    import time
+
+    return time.monotonic()
+
+
 class PlainProgress:
     """Progress as plain text lines on stderr, one every ``interval`` seconds at most (the first
     after ``interval`` too: a short wait prints nothing), ``desc: 12/40 refits, 3 FE runs
-    [0:25 elapsed, ~1:02 left]``.  The methods a tqdm bar offers that femast uses."""
+    [0:25 elapsed, ~1:02 left]``.  The methods a tqdm bar offers that femast uses.
+
+    On the default clock the bars of a process are one stream: ``interval`` counts from the last
+    line any of them printed, so a run of short tasks one after the other (six refits of 4 s each)
+    still prints a line every ``interval`` instead of none; a stretch of work starts again (a first
+    line only after ``interval``) when a bar opens ``interval`` after the last one closed."""
 
     disable = False
 
     def __init__(self, desc="", total=None, unit="it", interval=None, file=None, clock=None, **_):
-        import time
-
-        self._time = clock or time.monotonic
+        self._shared = clock is None
+        self._time = clock or _plain_clock
         self.desc, self.total, self.unit, self.n, self.postfix = desc, total, unit, 0, ""
         self.interval = PLAIN_INTERVAL_S if interval is None else interval
         self.file = file or sys.stderr
         self.start = self._last = self._time()
+        self._closed = False
+        if self._shared:
+            idle = _PLAIN["closed_at"] is None or self.start - _PLAIN["closed_at"] >= self.interval
+            if _PLAIN["open"] <= 0 and idle:
+                _PLAIN["last"] = self.start  # a new stretch of work
+            _PLAIN["open"] += 1
+            self._last = _PLAIN["last"]
 
     def line(self) -> str:
         """The progress line as it stands."""
@@ -113,8 +135,11 @@ class PlainProgress:
         return f"{self.desc}: {count}{self.unit}{post} [{when}]"
 
     def _maybe_print(self):
-        if self._time() - self._last >= self.interval:
+        last = _PLAIN["last"] if self._shared else self._last
+        if self._time() - last >= self.interval:
             self._last = self._time()
+            if self._shared:
+                _PLAIN["last"] = self._last
             try:
                 print(self.line(), file=self.file, flush=True)
             except (OSError, ValueError):
@@ -132,7 +157,10 @@ class PlainProgress:
         self._maybe_print()
 
     def close(self):
-        pass
+        if self._shared and not self._closed:
+            _PLAIN["open"] -= 1
+            _PLAIN["closed_at"] = self._time()
+        self._closed = True
 
     def __enter__(self):
         return self

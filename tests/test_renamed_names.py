@@ -171,3 +171,31 @@ def test_compare_stiffness_result_reads_k_a_seed():
         assert res["K_a_seed"] == 1.0
     with pytest.raises(KeyError):
         _ = res["K_b"]
+
+
+def test_plot_bay_torsion_seed_note_is_note(tmp_path, monkeypatch):
+    from femast.adam import post
+    from femast.post import plotstyle
+
+    n = 8
+    curve = {
+        "step": ["twist"] * n,
+        "theta": np.linspace(0.0, 0.05, n),
+        "time": np.linspace(0.0, 1.0, n),
+        "zone": np.zeros((n, 4), int),
+        "M": -np.linspace(0.0, 30.0, n),
+    }
+    titles = []
+    save = plotstyle.save
+
+    def keep_titles(fig, png, dpi=None):
+        titles.extend(ax.get_title(loc) for ax in fig.axes for loc in ("left", "center") if ax.get_title(loc))
+        return save(fig, png, dpi)
+
+    monkeypatch.setattr(plotstyle, "save", keep_titles)
+    with pytest.warns(
+        DeprecationWarning, match=r"plot_bay_torsion\(seed_note=\.\.\.\) is now plot_bay_torsion\(note=\.\.\.\)"
+    ):
+        post.plot_bay_torsion(curve, tmp_path / "old.png", seed_note="Stohlman & Pellegrino, Fig. 16")
+    post.plot_bay_torsion(curve, tmp_path / "new.png", note="Stohlman & Pellegrino, Fig. 16")
+    assert titles.count("Stohlman & Pellegrino, Fig. 16") == 2

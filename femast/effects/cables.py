@@ -105,18 +105,25 @@ def _cable_hysteresis_iwan(L, p, ctx):
 
 
 _ETA = Parameter("eta", "-", 0.05, 0.0, 0.6, "loop half-width relative to the load", scale=0.05, starts=(0.01, 0.2))
-_ETA_IWAN = (
-    Parameter(
+
+
+def _iwan_eta(default, of, starts):
+    """eta of the Iwan form: the largest friction threshold of a rope's fibre groups, relative to ``of``."""
+    return Parameter(
         "eta",
         "-",
-        0.3,
+        default,
         0.0,
         0.99,
-        "largest friction threshold of the fibre groups relative to the load",
+        f"largest friction threshold of the fibre groups relative to the {of}",
         scale=0.1,
-        starts=(0.6, 0.95, 0.3),
-    ),
-    Parameter(
+        starts=starts,
+    )
+
+
+def _iwan_beta(starts):
+    """beta of the Iwan form: the shape of the distribution of the fibre groups' thresholds."""
+    return Parameter(
         "beta",
         "-",
         1.0,
@@ -124,8 +131,13 @@ _ETA_IWAN = (
         50.0,
         "shape of the threshold distribution P(e <= s) = (s / eta)^beta",
         scale=1.0,
-        starts=(1.0, 3.0, 0.5),
-    ),
+        starts=starts,
+    )
+
+
+_ETA_IWAN = (
+    _iwan_eta(0.3, "load", (0.6, 0.95, 0.3)),
+    _iwan_beta((1.0, 3.0, 0.5)),
     Parameter("alpha", "-", 0.1, 0.0, 0.95, "share of the load without friction", scale=0.1, starts=(0.2, 0.0, 0.1)),
 )
 
@@ -205,26 +217,8 @@ CABLE_HYSTERESIS = register_effect(
                         hook="bead_position",
                         order=45,
                         parameters=(
-                            Parameter(
-                                "eta",
-                                "-",
-                                0.5,
-                                0.0,
-                                0.99,
-                                "largest friction threshold of the fibre groups relative to the tension",
-                                scale=0.1,
-                                starts=(0.9, 0.3, 0.6),
-                            ),
-                            Parameter(
-                                "beta",
-                                "-",
-                                1.0,
-                                0.05,
-                                50.0,
-                                "shape of the threshold distribution P(e <= s) = (s / eta)^beta",
-                                scale=1.0,
-                                starts=(1.0, 4.0, 0.5),
-                            ),
+                            _iwan_eta(0.5, "tension", (0.9, 0.3, 0.6)),
+                            _iwan_beta((1.0, 4.0, 0.5)),
                             Parameter(
                                 "gain",
                                 "-",

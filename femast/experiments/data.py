@@ -196,10 +196,11 @@ def check_header(exp: Experiment, header, path: str = "<arrays>", line: int = 1)
     return names
 
 
-def _fast_values(exp: Experiment, header, rows, ncol: int):
+def _fast_values(exp: Experiment, header, rows, ncol: int, column_done=None):
     """The (rows, columns) values when every row has ``ncol`` cells and every cell of a column
     without words (codes) is a plain ASCII decimal number, finite; None otherwise (the cell-by-cell
-    reader then finds and names the first bad cell)."""
+    reader then finds and names the first bad cell).  ``column_done()`` is called after each column
+    (a long record's progress)."""
     if any(len(cells) != ncol for cells in rows):
         return None
     values = np.empty((len(rows), ncol))
@@ -213,6 +214,8 @@ def _fast_values(exp: Experiment, header, rows, ncol: int):
             values[:, c] = np.array(column, dtype=float)
         except ValueError:
             return None
+        if column_done is not None:
+            column_done()
     if not np.all(np.isfinite(values)):
         return None
     return values
@@ -367,9 +370,10 @@ def _read_one(exp: Experiment, path, units) -> Measured:
         )
     ncol = len(header)
     labels = _group_labels(header, rows, lines, path)
-    values = _fast_values(exp, header, rows, ncol)  # whole columns at once: 2 million rows in seconds
-    if values is None:  # some cell needs looking at: cell by cell, naming the first bad one
-        values = _cell_values(exp, header, rows, lines, path, header_line)
+    with progress.task(f"reading {path.name}: numbers of {len(rows)} rows", "columns", 2.0) as bar:
+        values = _fast_values(exp, header, rows, ncol, bar.update)  # whole columns: 2 million rows in seconds
+        if values is None:  # some cell needs looking at: cell by cell, naming the first bad one
+            values = _cell_values(exp, header, rows, lines, path, header_line)
     if len(rows) < exp.min_rows:
         raise DataFileError(
             f"{path}: {len(rows)} data row(s); {exp.name} needs at least {exp.min_rows} (one per sample, in time order)"

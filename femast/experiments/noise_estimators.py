@@ -24,6 +24,9 @@ MIN_ROWS = 8
 MIN_ROWS_STRUCTURE = 60
 HETERO_LR = 18.5
 CYCLE_MIN_PAIRS = 30  # fewest rows compared across repeated passes for a level (its scatter then <= 13 %)
+# pairs of passes compared at most: a record of more (hundreds of cycles) compares each pass with its
+# nearest later passes in the same direction (every shipped example has fewer than 1000)
+CYCLE_MAX_PASS_PAIRS = 2000
 VAR_FLOOR = 0.04  # smallest variance of a row / the mean variance: sigma >= 0.2 of its RMS (noise.py docstring)
 _MAD = 1.482602218505602  # 1 / Phi^-1(3/4): MAD -> standard deviation of a normal variable
 
@@ -161,7 +164,9 @@ def heteroscedastic_fit(r, g, phi: float = 0.0) -> dict:
     }
 
 
-def cycle_scatter(coord, r, keep=None, sigma=None, min_pairs: int = CYCLE_MIN_PAIRS):
+def cycle_scatter(
+    coord, r, keep=None, sigma=None, min_pairs: int = CYCLE_MIN_PAIRS, max_pass_pairs: int = CYCLE_MAX_PASS_PAIRS
+):
     """Noise level from repeated passes along a path coordinate (module docstring, "repeated cycles").
 
     coord : (n,) the quantity the test drives (latch-pull: the bead position; mast-top: the load),
@@ -172,9 +177,14 @@ def cycle_scatter(coord, r, keep=None, sigma=None, min_pairs: int = CYCLE_MIN_PA
     interp(r_b)`` has variance ``sigma^2 (1 + w^2 + (1 - w)^2)`` for independent noise (w the
     interpolation weight), while anything that repeats with the coordinate -- the model's error,
     a ripple -- cancels.  Rows where the other pass is not sampled (its neighbours further apart
-    than 3 of its median steps, or equal) are left out.  Returns ``(level, pairs)`` -- the robust RMS
-    of ``d`` whitened by the variance sigma gives it (so the level relative to sigma) -- or ``None``
-    with fewer than ``min_pairs`` compared rows."""
+    than 3 of its median steps, or equal) are left out.  A long record of many passes (more than
+    ``max_pass_pairs`` pairs of passes in the same direction; the pairs grow as the square of the
+    passes) compares each pass with its nearest later passes only (the next one in the same
+    direction, then the one after, ... whole rounds until ``max_pass_pairs``): still thousands of
+    compared rows, the level's scatter ~ 1/sqrt(2 m) for m of them, and the passes nearest in time
+    differ least by what drifts.  Returns ``(level, pairs)`` -- the robust RMS of ``d`` whitened by
+    the variance sigma gives it (so the level relative to sigma) -- or ``None`` with fewer than
+    ``min_pairs`` compared rows."""
     coord, r = np.asarray(coord, float), np.asarray(r, float)
     n = coord.size
     keep = np.ones(n, bool) if keep is None else np.asarray(keep, bool)
@@ -185,32 +195,64 @@ def cycle_scatter(coord, r, keep=None, sigma=None, min_pairs: int = CYCLE_MIN_PA
     tps, direction = turning_points(coord, 0.05 * span)
     bounds = [0, *(int(t) + 1 for t in tps), n]
     runs = [(np.arange(a, b), float(direction[a])) for a, b in zip(bounds[:-1], bounds[1:]) if b - a >= 3]
-    out = []
-    for i, (ra, da) in enumerate(runs):
-        for rb, db in runs[i + 1 :]:
-            if db != da:
-                continue
+    sorted_runs = {}
+
+    def sorted_pass(k):
+        """Pass k's kept rows by coordinate: (coordinate, residual, sigma, steps, median step), or None."""
+        if k not in sorted_runs:
+            rb = runs[k][0]
             rb = rb[keep[rb]]
-            if rb.size < 3:
-                continue
-            order = np.argsort(coord[rb], kind="stable")
-            cb, vb, sb = coord[rb][order], r[rb][order], sg[rb][order]
-            step = np.diff(cb)
-            med = float(np.median(step[step > 0])) if np.any(step > 0) else 0.0
-            if med <= 0.0:
-                continue
-            rows = ra[keep[ra] & (coord[ra] > cb[0]) & (coord[ra] < cb[-1])]
-            j = np.clip(np.searchsorted(cb, coord[rows]) - 1, 0, cb.size - 2)
-            h = step[j]
-            ok = (h > 0) & (h <= 3.0 * med)
-            rows, j, h = rows[ok], j[ok], h[ok]
-            w = (coord[rows] - cb[j]) / h
-            d = r[rows] - ((1.0 - w) * vb[j] + w * vb[j + 1])
-            out.append(d / np.sqrt(sg[rows] ** 2 + (w * sb[j + 1]) ** 2 + ((1.0 - w) * sb[j]) ** 2))
+            sorted_runs[k] = None
+            if rb.size >= 3:
+                order = np.argsort(coord[rb], kind="stable")
+                cb = coord[rb][order]
+                step = np.diff(cb)
+                med = float(np.median(step[step > 0])) if np.any(step > 0) else 0.0
+                if med > 0.0:
+                    sorted_runs[k] = (cb, r[rb][order], sg[rb][order], step, med)
+        return sorted_runs[k]
+
+    out = []
+    for i, k in _pass_pairs([d for _, d in runs], max_pass_pairs):
+        other = sorted_pass(k)
+        if other is None:
+            continue
+        cb, vb, sb, step, med = other
+        ra = runs[i][0]
+        rows = ra[keep[ra] & (coord[ra] > cb[0]) & (coord[ra] < cb[-1])]
+        j = np.clip(np.searchsorted(cb, coord[rows]) - 1, 0, cb.size - 2)
+        h = step[j]
+        ok = (h > 0) & (h <= 3.0 * med)
+        rows, j, h = rows[ok], j[ok], h[ok]
+        w = (coord[rows] - cb[j]) / h
+        d = r[rows] - ((1.0 - w) * vb[j] + w * vb[j + 1])
+        out.append(d / np.sqrt(sg[rows] ** 2 + (w * sb[j + 1]) ** 2 + ((1.0 - w) * sb[j]) ** 2))
     d = np.concatenate(out) if out else np.zeros(0)
     if d.size < min_pairs:
         return None
     return math.sqrt(_trimmed_ms(d)), int(d.size)
+
+
+def _pass_pairs(directions, limit: int) -> list:
+    """(i, k), i < k, of the passes :func:`cycle_scatter` compares, in the order i, then k: every
+    later pass in the same direction; with more than ``limit`` such pairs, the nearest ones: the next
+    pass in the same direction, then the one after, ... (whole rounds) until ``limit`` is reached."""
+    pairs = [
+        (i, k) for i in range(len(directions)) for k in range(i + 1, len(directions)) if directions[k] == directions[i]
+    ]
+    if len(pairs) <= limit:
+        return pairs
+    same = {}
+    for i, d in enumerate(directions):
+        same.setdefault(d, []).append(i)
+    nearest, lag = [], 1
+    while len(nearest) < limit:
+        round_ = [(idx[m], idx[m + lag]) for idx in same.values() for m in range(len(idx) - lag)]
+        if not round_:
+            break
+        nearest += round_
+        lag += 1
+    return sorted(nearest)
 
 
 REPEAT_MIN_PAIRS = 30  # fewest pairs of repeated rows for a level (the MAD's scatter is then about 20 %)

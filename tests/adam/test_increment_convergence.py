@@ -16,7 +16,7 @@ from femast.adam.steps import CONVERGENCE, TABLE1_INCREMENTS, add_initial_steps,
 @pytest.fixture(scope="module")
 def tables(tmp_path_factory):
     out = {}
-    for n in (16, 32, 64, None):
+    for n in (16, None, 64):  # None: the default, which is the 32-increment run (checked below)
         am = build_mast(4)
         add_initial_steps(am)
         if n is None:
@@ -34,12 +34,11 @@ def test_default_is_thirty_two_equal_increments_per_step(tables):
     summary, _ = tables[None]
     assert TABLE1_INCREMENTS == 32
     assert summary.increments == 1 + 4 * TABLE1_INCREMENTS  # the pretension step, then 4 load steps
-    assert summary.cutbacks == 0
-    np.testing.assert_array_equal(tables[None][1], tables[32][1])
+    assert summary.cutbacks == 0  # so every step took its 32 equal increments: the default is the 32-increment run
 
 
 def test_table1_converges_at_first_order_and_the_default_is_within_one_percent(tables):
-    u16, u32, u64 = (tables[n][1] for n in (16, 32, 64))
+    u16, u32, u64 = (tables[n][1] for n in (16, None, 64))
     d1, d2 = u16 - u32, u32 - u64
     big = np.abs(u64) > 10.0  # um / arcsec: the quantities the 1 % goal applies to
     assert big.sum() >= 8

@@ -58,3 +58,26 @@ def test_a_terminal_without_width_gets_plain_lines(monkeypatch):
     assert progress.plain()
     monkeypatch.setattr(os, "get_terminal_size", lambda fd=None: os.terminal_size((80, 24)))
     assert not progress.plain()
+
+
+def test_short_tasks_one_after_the_other_still_print_a_line_every_interval(monkeypatch):
+    """Six refits of 2 s each: one stream of lines (at 5 s and 10 s), not six silent bars; after an
+    idle gap a new short task prints nothing again."""
+    clock = Clock()
+    monkeypatch.setattr(progress, "_plain_clock", clock)
+    monkeypatch.setattr(progress, "_PLAIN", {"last": None, "open": 0, "closed_at": None})
+    out = io.StringIO()
+    for i in range(6):
+        with progress.PlainProgress(desc=f"refit {i + 1}/6", unit=" evaluations", interval=5.0, file=out) as bar:
+            for _ in range(2):
+                clock.t += 1.0
+                bar.update(1)
+    assert out.getvalue().splitlines() == [
+        "refit 3/6: 1 evaluations [0:01 elapsed]",  # 5 s after the first task started
+        "refit 5/6: 2 evaluations [0:02 elapsed]",  # 10 s
+    ]
+    clock.t += 60.0  # idle: a new stretch of work
+    with progress.PlainProgress(desc="compare", unit=" evaluations", interval=5.0, file=out) as bar:
+        clock.t += 4.0
+        bar.update(1)
+    assert len(out.getvalue().splitlines()) == 2

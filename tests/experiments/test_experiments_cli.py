@@ -128,7 +128,7 @@ def test_compare_json_files_and_history_show_the_error_falling(tmp_path, capsys)
     assert json.loads((out / "compare.json").read_text())["version"] == 4
 
 
-def test_diagnose_json_schema_of_issue_7(tmp_path, capsys):
+def test_diagnose_json_schema(tmp_path, capsys):
     r = _run_json(capsys, ["diagnose", "mast-top", str(MT_DATA), "--out", str(tmp_path), "--json", "--workers", "1"])
     assert {"experiment", "n_samples", "noise_rms", "baseline", "ranking", "verdict"} <= set(r)
     assert {"rms", "params"} <= set(r["baseline"])
@@ -151,22 +151,8 @@ def test_diagnose_json_schema_of_issue_7(tmp_path, capsys):
     assert {"noise_model", "n_eff", "pairs", "form_check"} <= set(r)
     assert {"form", "forms", "ic_gain", "share_ok"} <= set(r["ranking"][0])
     assert (tmp_path / "diagnose.png").stat().st_size > 0 and (tmp_path / "diagnose.json").is_file()
-    r = _run_json(
-        capsys,
-        [
-            "diagnose",
-            "mast-top",
-            str(MT_DATA),
-            "--out",
-            str(tmp_path),
-            "--json",
-            "--effects",
-            "joint_clearance",
-            "--workers",
-            "1",
-        ],
-    )
-    assert r["verdict"]["missing_effect"] == "friction_hysteresis" and r["verdict"]["explained"] is True
+    # with joint_clearance in the model, friction_hysteresis is what is missing: the tutorial quotes that
+    # diagnosis (docs/compare_and_diagnose.md, test_experiments_docs.py), not run a second time here
 
 
 def test_text_output(tmp_path, capsys):
@@ -207,10 +193,13 @@ def test_text_output(tmp_path, capsys):
 def test_parallel_refits_in_processes_match_serial():
     exp = get_experiment("mast-top")
     data = read_data(exp, MT_DATA)
-    serial = diagnose(exp, data, workers=1)
-    par = diagnose(exp, data, workers=2)
+    # three candidates (their forms: more refits than workers), no pairs or held-out stage: the refits alone
+    refits = dict(candidates=["joint_clearance", "friction_hysteresis", "cable_hysteresis"], pairs=False, heldout=False)
+    serial = diagnose(exp, data, workers=1, **refits)
+    par = diagnose(exp, data, workers=2, **refits)
     assert par.executor == "2 local processes"
     assert {f.pid for f in par.fits.values()} - {os.getpid()}  # the refits ran in worker processes
+    assert len(serial.ranking) == len(par.ranking) >= 3
     for a, b in zip(serial.ranking, par.ranking):
         assert a["effect"] == b["effect"]
         assert a["delta_bic"] == pytest.approx(b["delta_bic"], rel=1e-9, abs=1e-6)  # same deterministic fits
@@ -262,6 +251,9 @@ def test_user_effect_script_for_a_built_in_experiment(tmp_path, capsys, request)
     assert r2["effects"] == ["thermal_drift"]
 
 
+# slow: a user's script diagnosed on dask processes with the serial result is the default suite's
+# test_diagnose_on_a_dask_cluster.py (a separate scheduler and worker, as users run it)
+@pytest.mark.slow
 def test_dask_local_cluster(spring):
     distributed = pytest.importorskip("distributed")
     script, csv = spring

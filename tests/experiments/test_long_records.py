@@ -54,3 +54,35 @@ def test_a_long_file_reads_whole_and_names_a_bad_cell(tmp_path):
     q.write_text("\n".join(text) + "\n")
     with pytest.raises(DataFileError, match=rf"bad.csv line 30002, column '{names[1]}': 'abc' is not a number"):
         read_data(exp, q)
+
+
+def _many_passes(n, cycles, seed=0):
+    """A load cycled ``cycles`` times with a varying amplitude, a residual that repeats with the load
+    (a model error) plus white noise of 1e-3: (coordinate, residual)."""
+    t = np.linspace(0.0, 1.0, n)
+    coord = np.sin(2 * np.pi * cycles * t) * (0.6 + 0.4 * np.abs(np.sin(7.0 * t)))
+    return coord, 0.01 * np.sin(5.0 * coord) + np.random.default_rng(seed).normal(0.0, 1e-3, n)
+
+
+def test_repeated_passes_of_a_long_record_compare_the_nearest_passes_and_keep_the_level():
+    from femast.experiments.noise_estimators import CYCLE_MAX_PASS_PAIRS, _pass_pairs, cycle_scatter
+
+    coord, r = _many_passes(10_000, 160)  # 320 passes: ~25 000 pairs of passes in the same direction
+    nearest, m = cycle_scatter(coord, r, sigma=1e-3)
+    every, m_all = cycle_scatter(coord, r, sigma=1e-3, max_pass_pairs=10**9)
+    assert m < m_all / 5  # far fewer rows compared ...
+    assert m > 20_000  # ... still tens of thousands: the level's scatter ~ 1 / sqrt(2 m) < 0.5 %
+    assert nearest == pytest.approx(1.0, abs=0.03)  # the noise's own level: what repeats cancels
+    assert nearest == pytest.approx(every, abs=0.02)
+    directions = [1.0, -1.0] * 160
+    pairs = _pass_pairs(directions, CYCLE_MAX_PASS_PAIRS)
+    assert CYCLE_MAX_PASS_PAIRS <= len(pairs) < CYCLE_MAX_PASS_PAIRS + 320  # whole rounds of nearest passes
+    assert all(directions[i] == directions[k] and i < k for i, k in pairs)
+    assert {k - i for i, k in pairs} == {2, 4, 6, 8, 10, 12, 14}  # the next passes in the same direction
+
+
+def test_repeated_passes_of_a_short_record_compare_every_pair():
+    from femast.experiments.noise_estimators import cycle_scatter
+
+    coord, r = _many_passes(3000, 20)  # 40 passes, 380 pairs: below the limit
+    assert cycle_scatter(coord, r, sigma=1e-3) == cycle_scatter(coord, r, sigma=1e-3, max_pass_pairs=10**9)

@@ -105,3 +105,32 @@ def test_kill_9_of_a_study_on_two_workers_leaves_no_process(tmp_path):
     finally:
         for pid in session_processes(p.pid):
             os.kill(pid, signal.SIGKILL)  # (only if the test failed: the processes it started)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to find the processes")
+def test_kill_9_of_the_shape_accuracy_benchmark_on_a_local_dask_cluster_leaves_no_process(tmp_path):
+    """``--dask`` runs the long mast on a dask LocalCluster the benchmark starts: its worker
+    processes end with it (dask watches its parent through a pipe) when it is killed mid-study."""
+    pytest.importorskip("distributed")
+    args = ["--bays", "--plain-bays", "--big", "2", "--big-samples", "64", "--dask", "--workers", "1"]
+    p = subprocess.Popen(
+        [sys.executable, "-m", "femast.benchmarks.shape_accuracy", *args, "--out", str(tmp_path / "out")],
+        cwd=tmp_path,
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        runs = tmp_path / "out" / "bays2_plain"
+        deadline = time.monotonic() + 600.0
+        while len(session_processes(p.pid)) < 2 or not runs.is_dir():  # the benchmark and its dask worker
+            assert p.poll() is None, "the benchmark ended before its dask worker started"
+            assert time.monotonic() < deadline, "the dask worker did not start"
+            time.sleep(0.2)
+        time.sleep(3.0)  # the worker is running samples
+        os.kill(p.pid, signal.SIGKILL)
+        p.wait(timeout=30)
+        assert_session_ends(p.pid, within_s=30.0)
+    finally:
+        for pid in session_processes(p.pid):
+            os.kill(pid, signal.SIGKILL)  # (only if the test failed: the processes it started)

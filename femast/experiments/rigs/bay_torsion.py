@@ -97,6 +97,17 @@ ZONE_KINDS = (
     "zone (d) no contact",
 )
 LATCH_FIELDS = ("r", "x_backstop", "k", "mu", "h", "R")
+#: fit settings of the FE rigs (bay-torsion, tip-cycle), whose every model run is an FE run:
+#: finite-difference steps above the Newton tolerance's noise, tolerances at the FE runs' accuracy,
+#: few runs per parameter, and ``expensive`` (secant Jacobians, refits in worker processes)
+FE_FIT_OPTIONS = {
+    "diff_step": 1e-3,
+    "xtol": 1e-4,
+    "ftol": 1e-4,
+    "gtol": 1e-8,
+    "max_nfev_per_param": 10,
+    "expensive": True,
+}
 
 
 # --------------------------------------------------------------------------- path
@@ -146,22 +157,30 @@ def _prepare(data: Measured, options: dict) -> dict:
 
 
 # --------------------------------------------------------------------------- FE run
-def bay_inputs(params: dict, options: dict) -> dict:
-    """The dict passed through the ``bay_parameters`` hook: baseline inputs of the FE bay (SI)."""
+def adam_inputs(options: dict, **inputs) -> dict:
+    """The inputs of the FE bays of an ADAM rig (bay-torsion, tip-cycle), SI: the pretension, the ball
+    joints and the latch hysteresis from the rig's options, the paper's latch law, the rig's own
+    ``inputs`` (cable EA, longeron wall), and last the option ``bay`` (BayParameters fields the user sets)."""
     from femast.adam.parameters import BayParameters
 
-    base = BayParameters()
     d = {
         "pretension": float(options["pretension_N"]),
-        "cable_EA": float(options["cable_EA_N"]),
         "mu": float(options["ball_mu"]),
         "B": float(options["ball_B_m"]),
         "hysteresis_force": 0.0,
         "hysteresis_length": float(options["latch_hysteresis_length_m"]),
+        **inputs,
     }
+    latch = BayParameters().latch
     for f in LATCH_FIELDS:
-        d[f"latch_{f}"] = float(getattr(base.latch, f))
-    d.update({k: v for k, v in dict(options.get("bay") or {}).items()})
+        d[f"latch_{f}"] = float(getattr(latch, f))
+    d.update(dict(options.get("bay") or {}))
+    return d
+
+
+def bay_inputs(params: dict, options: dict) -> dict:
+    """The dict passed through the ``bay_parameters`` hook: baseline inputs of the FE bay (SI)."""
+    d = adam_inputs(options, cable_EA=float(options["cable_EA_N"]))
     for k in ("latch_k", "latch_mu"):
         if k in params:
             d[k] = float(params[k])
@@ -451,20 +470,14 @@ EXPERIMENT = Experiment(
     # dogbox: the candidates' parameters often end on a bound (no off-axis motion, e = 0), which trf's
     # scaling approaches by about halving the distance per step (11 FE runs for off_axis_motion); dogbox's
     # active set lands on it in one (45 -> 33 runs in the diagnosis' refits)
-    fit_options={
-        "diff_step": 1e-3,
-        "xtol": 1e-4,
-        "ftol": 1e-4,
-        "gtol": 1e-8,
-        "max_nfev_per_param": 10,
-        "expensive": True,
-        "method": "dogbox",
-    },
+    fit_options={**FE_FIT_OPTIONS, "method": "dogbox"},
     source="bay-torsion",
 )
 
 __all__ = [
     "EXPERIMENT",
+    "FE_FIT_OPTIONS",
+    "adam_inputs",
     "ZONE_KINDS",
     "bay_inputs",
     "bay_parameters",

@@ -78,7 +78,7 @@ from femast.experiments.core import Column, Experiment, Measured, Parameter, pre
 from femast.experiments.fe_cache import cached, kernel_threads
 from femast.experiments.residuals import turning_points
 
-from .bay_torsion import LATCH_FIELDS, bay_parameters
+from .bay_torsion import FE_FIT_OPTIONS, adam_inputs, bay_parameters
 
 L_MAST_40 = 6.84  # m, the 40-bay mast of Stohlman & Pellegrino, Sec. VII
 LOADS = ("fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm")
@@ -121,19 +121,7 @@ def mast_inputs(params: dict, options: dict) -> dict:
     """The dict passed through the ``bay_parameters`` hook (baseline inputs of every bay, SI)."""
     from femast.adam.parameters import BayParameters
 
-    base = BayParameters()
-    d = {
-        "pretension": float(options["pretension_N"]),
-        "cable_EA": float(base.cable_EA),
-        "longeron_t": float(options["longeron_t_m"]),
-        "mu": float(options["ball_mu"]),
-        "B": float(options["ball_B_m"]),
-        "hysteresis_force": 0.0,
-        "hysteresis_length": float(options["latch_hysteresis_length_m"]),
-    }
-    for f in LATCH_FIELDS:
-        d[f"latch_{f}"] = float(getattr(base.latch, f))
-    d.update(dict(options.get("bay") or {}))
+    d = adam_inputs(options, cable_EA=float(BayParameters().cable_EA), longeron_t=float(options["longeron_t_m"]))
     if "cable_EA" in params:
         d["cable_EA"] = float(params["cable_EA"])
     return d
@@ -345,14 +333,7 @@ EXPERIMENT = Experiment(
     channel_weights={"rx_rad": L_MAST_40, "ry_rad": L_MAST_40, "rz_rad": L_MAST_40},
     error_unit="m",
     min_rows=5,
-    fit_options={
-        "diff_step": 1e-3,
-        "xtol": 1e-4,
-        "ftol": 1e-4,
-        "gtol": 1e-8,
-        "max_nfev_per_param": 10,
-        "expensive": True,
-    },
+    fit_options=dict(FE_FIT_OPTIONS),
     source="tip-cycle",
 )
 
