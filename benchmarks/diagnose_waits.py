@@ -3,16 +3,21 @@ compile cache, against the targets: platform-pose < 30 s, tip-cycle < 20 s, bay-
 and the first run on an empty compile cache at most 2x the warm time.
 
     python -m femast.benchmarks.diagnose_waits [--cases bay-torsion tip-cycle platform-pose]
-                                               [--repeat 2] [--no-cold] [--workers N]
+                                               [--repeat 2] [--no-cold] [--workers N] [--other CHECKOUT]
 
 Each run is the command a user types, ``femast diagnose EXPERIMENT example``, in a fresh process
 (imports, numba cache loads and worker start-up included) from an empty folder.  Warm: numba's
 compile cache filled by a first run; cold: ``NUMBA_CACHE_DIR`` an empty folder (every kernel
 compiled on the way).  No disk cache of FE runs (``FEMAST_FE_CACHE`` unset).  Printed per case:
-wall time (the best of ``--repeat`` runs), the CPU time of the process and its workers, the
-processes started (the most alive at once) and the verdict, so that a faster run can be checked to
-conclude the same; the load average is printed beside (the machine is shared: wall time grows with
-load, CPU time much less).
+wall time (the best of ``--repeat`` runs), the CPU time of the process and its workers, the model
+runs computed by all of them (``$FEMAST_FE_RUN_LOG``: the FE runs of bay-torsion and tip-cycle; 0
+for a model that is not an FE run), the processes started (the most alive at once) and the verdict,
+so that a faster run can be checked to conclude the same; the load average is printed beside (the
+machine is shared: wall time grows with load, CPU time much less).
+
+``--other CHECKOUT`` times the femast of another source tree (e.g. ``git worktree add /tmp/main
+main``) in the same minutes: every run of this tree is followed by the same run of that one
+(``PYTHONPATH``), and both are printed, A/B.
 """
 
 from __future__ import annotations
@@ -57,12 +62,16 @@ def _descendants(pid: int) -> int:
     return n
 
 
-def run(case: str, env: dict, workers=None) -> dict:
-    """One ``femast diagnose CASE example --json`` in a fresh process and an empty folder."""
+def run(case: str, env: dict, workers=None, tree=None) -> dict:
+    """One ``femast diagnose CASE example --json`` in a fresh process and an empty folder (``tree``: the
+    femast of that source tree, on ``PYTHONPATH``)."""
     cmd = [sys.executable, "-m", "femast.cli", "diagnose", case, "example", "--json", "--out", "out"]
     if workers is not None:
         cmd += ["--workers", str(workers)]
     with tempfile.TemporaryDirectory() as folder:
+        env = dict(env, FEMAST_FE_RUN_LOG=os.path.join(folder, "runs.log"))
+        if tree is not None:
+            env["PYTHONPATH"] = os.path.abspath(tree)
         c0, t0 = _cpu(), time.perf_counter()
         p = subprocess.Popen(cmd, cwd=folder, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         most = [0]
@@ -77,10 +86,22 @@ def run(case: str, env: dict, workers=None) -> dict:
         out, err = p.communicate()
         wall, cpu = time.perf_counter() - t0, _cpu() - c0
         t.join()
+        try:
+            with open(env["FEMAST_FE_RUN_LOG"]) as fh:
+                runs = sum(1 for _ in fh)
+        except OSError:
+            runs = 0
     if p.returncode != 0:
         raise SystemExit(f"femast diagnose {case} example failed:\n{err[-2000:]}")
     report = json.loads(out)
-    return {"wall": wall, "cpu": cpu, "processes": most[0], "verdict": report["verdict"]["conclusion"]}
+    return {"wall": wall, "cpu": cpu, "runs": runs, "processes": most[0], "verdict": report["verdict"]["conclusion"]}
+
+
+def _row(case: str, label: str, r: dict, target: str, judged: str) -> str:
+    return (
+        f"{case:<14s} {label:<11s} {r['wall']:>7.1f} {r['cpu']:>7.1f} {r['runs']:>5d} {r['processes']:>5d} "
+        f"{target:>8s}  {r['verdict']}  [{judged}]"
+    )
 
 
 def main(argv=None) -> None:
@@ -89,28 +110,32 @@ def main(argv=None) -> None:
     ap.add_argument("--repeat", type=int, default=2, help="warm runs per case (the best is shown)")
     ap.add_argument("--no-cold", action="store_true", help="skip the runs on an empty compile cache")
     ap.add_argument("--workers", type=int, default=None, help="passed to femast diagnose --workers")
+    ap.add_argument("--other", default=None, metavar="CHECKOUT", help="also time this source tree, interleaved (A/B)")
     args = ap.parse_args(argv)
-    env = {k: v for k, v in os.environ.items() if k not in ("FEMAST_FE_CACHE", "NUMBA_CACHE_DIR")}
+    env = {k: v for k, v in os.environ.items() if k not in ("FEMAST_FE_CACHE", "NUMBA_CACHE_DIR", "PYTHONPATH")}
     env["FEMAST_QUIET"] = "1"
+    trees = [("this", None)] + ([("other", args.other)] if args.other else [])
     print(f"load average {' '.join(f'{v:.2f}' for v in os.getloadavg())} on {os.cpu_count()} CPUs")
-    print(f"{'case':<14s} {'run':<5s} {'wall s':>7s} {'CPU s':>7s} {'procs':>5s} {'target':>8s}  verdict")
+    print(f"{'case':<14s} {'run':<11s} {'wall s':>7s} {'CPU s':>7s} {'runs':>5s} {'procs':>5s} {'target':>8s}  verdict")
     for case in args.cases:
-        run(case, env, args.workers)  # fills numba's cache (and the OS file cache)
-        warm = [run(case, env, args.workers) for _ in range(args.repeat)]
-        best = min(warm, key=lambda r: r["wall"])
-        ok = "met" if best["wall"] < TARGETS[case] else "MISSED"
-        print(
-            f"{case:<14s} {'warm':<5s} {best['wall']:>7.1f} {best['cpu']:>7.1f} {best['processes']:>5d} "
-            f"{'< ' + format(TARGETS[case], 'g') + ' s':>8s}  {best['verdict']}  [{ok}]"
-        )
+        for _, tree in trees:
+            run(case, env, args.workers, tree)  # fills numba's cache (and the OS file cache)
+        warm = {name: [] for name, _ in trees}
+        for _ in range(args.repeat):
+            for name, tree in trees:  # interleaved: A, B, A, B
+                warm[name].append(run(case, env, args.workers, tree))
+        best = {name: min(w, key=lambda r: r["wall"]) for name, w in warm.items()}
+        for name, _ in trees:
+            b = best[name]
+            ok = "met" if b["wall"] < TARGETS[case] else "MISSED"
+            print(_row(case, f"warm {name}" if args.other else "warm", b, f"< {TARGETS[case]:g} s", ok))
         if not args.no_cold:
-            with tempfile.TemporaryDirectory() as cache:
-                cold = run(case, dict(env, NUMBA_CACHE_DIR=cache), args.workers)
-            ratio = cold["wall"] / best["wall"]
-            print(
-                f"{case:<14s} {'cold':<5s} {cold['wall']:>7.1f} {cold['cpu']:>7.1f} {cold['processes']:>5d} "
-                f"{'<= 2x':>8s}  {cold['verdict']}  [{ratio:.1f}x warm: {'met' if ratio <= 2.0 else 'MISSED'}]"
-            )
+            for name, tree in trees:
+                with tempfile.TemporaryDirectory() as cache:
+                    cold = run(case, dict(env, NUMBA_CACHE_DIR=cache), args.workers, tree)
+                ratio = cold["wall"] / best[name]["wall"]
+                judged = f"{ratio:.1f}x warm: {'met' if ratio <= 2.0 else 'MISSED'}"
+                print(_row(case, f"cold {name}" if args.other else "cold", cold, "<= 2x", judged))
     print(f"load average {' '.join(f'{v:.2f}' for v in os.getloadavg())} on {os.cpu_count()} CPUs")
 
 

@@ -133,20 +133,28 @@ class FitProblem:
         return J0 if np.isfinite(J0).any() else None
 
     def solve(self, sigma, candidates, J0=None, noise_given: bool = False):
-        """The best least-squares solution from the ``candidates`` start vectors, weighted by ``sigma``."""
+        """The best least-squares solution from the ``candidates`` start vectors, weighted by ``sigma``.
+
+        An expensive model (secant Jacobians) polishes only the best of the starts' solutions
+        (:func:`_polish`: a finite-difference Jacobian there, for the covariance, and a restart where
+        it promises more): the others are discarded anyway.  ``J0``, the columns known at the first
+        start, seeds every start's first Jacobian (the starts differ in the effect parameters,
+        whose columns are not known and are computed)."""
         co, lo, hi, kw, secant, fd_step = self.co, self.lo, self.hi, self.kw, self.secant, self.fd_step
-        best = None
+        best = best_fj = None
         fun0 = self.fun(sigma)
-        nfev = runs = 0
-        for k, x in enumerate(candidates):
+        nfev = 0
+        jacobians = []
+        min_dec = POLISH_MIN_DECREASE if secant and noise_given else 0.0
+        for x in candidates:
             u0 = co.start(x, lo, hi) if secant else np.clip(x / self.scale, lo, hi)
             fj = None
             fun = fun0
             if fd_step:
-                fj = _FEJacobian(fun0, float(fd_step), lo, hi, secant=secant, J0=J0 if k == 0 and secant else None)
+                fj = _FEJacobian(fun0, float(fd_step), lo, hi, secant=secant, J0=J0 if secant else None)
                 fun, kw["jac"] = fj.value, fj.jac
+                jacobians.append(fj)
             kw_k = kw
-            min_dec = POLISH_MIN_DECREASE if secant and noise_given else 0.0
             if min_dec:
                 # a noise model given: the cost is half the chi-square, and a decrease below min_dec is no
                 # reason for more FE runs (see _polish); scipy's ftol is relative to the current cost,
@@ -156,13 +164,13 @@ class FitProblem:
             with np.errstate(all="ignore"):
                 sol = least_squares(fun, u0, bounds=(lo, hi), **kw_k)
             nfev += sol.nfev
-            if fj is not None:
-                if secant:
-                    sol = _polish(sol, fj, fun, lo, hi, kw, min_dec)
-                nfev += getattr(sol, "nfev_polish", 0)
-                runs += fj.runs
             if best is None or sol.cost < best.cost:
-                best = sol
+                best, best_fj = sol, fj
+        if secant:
+            kw["jac"] = best_fj.jac
+            best = _polish(best, best_fj, best_fj.value, lo, hi, kw, min_dec)
+            nfev += getattr(best, "nfev_polish", 0)
+        runs = sum(fj.runs for fj in jacobians)
         best.nfev_total = nfev
         best.fe_runs = runs if fd_step else nfev
         return best

@@ -118,17 +118,21 @@ HO_MARGIN = 0.02  # a mechanism must lower the held-out ratio by at least 2 % (i
 def heldout_check(d) -> None:
     """The held-out stage of ``diagnose`` (module docstring), on a
     :class:`~femast.experiments.diagnosis.Diagnosis`: the baseline, every significant candidate and
-    the two best significant pairs are refitted once per fold (in parallel, on the refits' executor)
-    and scored on the rows each fold left out.  Sets ``d.heldout_ratio`` (the baseline's) and, on the
+    the two best significant pairs are refitted once per fold (in parallel, on the refits' executor),
+    each from its fit on all the data and with that fit's derivatives as its first Jacobian, and
+    scored on the rows each fold left out.  Without a significant candidate or pair nothing is
+    refitted (the check could only refuse one; ``d.heldout_ratio`` stays None).  Sets ``d.heldout_ratio`` (the baseline's) and, on the
     ranking's entries and the pairs, ``heldout_ratio`` and ``heldout_ok`` -- a candidate lowers the
     baseline's held-out ratio by ``HO_MARGIN``, a pair its best member's -- and makes the candidates
     that fail not significant (the reading says why)."""
     exp, data = d.exp, d.data
+    cands = [e for e in d.ranking if e.get("significant")]
+    best_pairs = [p for p in d.pairs if p.get("significant")][:2]
+    if not cands and not best_pairs:
+        return  # nothing the check could refuse: the verdict does not depend on it
     fold_list = folds(exp, data, 3 if exp.fit_options.get("expensive") else None)
     if not fold_list:
         return
-    cands = [e for e in d.ranking if e.get("significant")]
-    best_pairs = [p for p in d.pairs if p.get("significant")][:2]
     models = [("baseline", list(d.base_effects), d.baseline)]
     models += [(e["effect"], list(d.base_effects) + [e["spec"]], d.fits[e["effect"]]) for e in cands]
     models += [(" + ".join(p["effects"]), list(p["_fit"].effects), p["_fit"]) for p in best_pairs]
@@ -137,6 +141,9 @@ def heldout_check(d) -> None:
         {
             "effects": effects,
             "start": dict(zip(res.names, res.x)),
+            # the fold's fit starts where the model's fit ended: its derivatives there are the
+            # fold's first Jacobian (an expensive model saves a finite-difference run per parameter)
+            "sensitivity": getattr(res, "sensitivity", None),
             "noise": sigma,
             "rows": ~left_out,
             "label": f"{name}, {fold} held out",

@@ -73,9 +73,10 @@ def _safe_fit(exp, data, effects, start, noise, sensitivity=None, rows=None) -> 
             noise=noise,
             given_start_clip=True,
             nfev_per_param=REFIT_NFEV,
-            start_sensitivity=sensitivity if rows is None else None,
+            start_sensitivity=sensitivity,
             rows=rows,
-        )  # the baseline's derivatives seed the refit's
+        )  # derivatives known at (or near) the start seed the refit's: the baseline's for a candidate, a
+        # model's own at its solution for a held-out fold
     except (*MODEL_FAILURES, ArithmeticError) as e:
         return OptimizeResult(failed=True, success=False, message=f"{type(e).__name__}: {e}", effects=tuple(effects))
 

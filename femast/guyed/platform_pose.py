@@ -38,7 +38,8 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import ModelError
 from ._common import fmt_pose
-from .cdpr import GRAVITY, CdprGeometry, tension_distribution
+from .cdpr import CdprGeometry, tension_distribution
+from .pose_equilibrium import _jacobian_batch, _newton, _newton_batch, _rot, _System
 from .pulley_kinematics import swivel_exit
 
 CABLE_EA = 1.0e6
@@ -109,149 +110,6 @@ class PoseSolution:
     iterations: int = 0
 
 
-def _rot(angles):
-    return Rotation.from_euler("xyz", angles).as_matrix()
-
-
-def _cross(a, b):
-    """Row-wise cross product (faster than numpy.cross for these small stacks)."""
-    return np.stack(
-        [
-            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
-        ],
-        axis=-1,
-    )
-
-
-def _rotvec_batch(V):
-    """Rotation matrices (k, 3, 3) of rotation vectors V (k, 3), rad (Rodrigues)."""
-    th = np.sqrt(np.einsum("ki,ki->k", V, V))
-    K = np.zeros((len(V), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -V[:, 2], V[:, 1], -V[:, 0]
-    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = V[:, 2], -V[:, 1], V[:, 0]
-    small = th < 1e-8
-    ths = np.where(small, 1.0, th)
-    a = np.where(small, 1.0, np.sin(ths) / ths)
-    b = np.where(small, 0.5, (1.0 - np.cos(ths)) / ths**2)
-    return np.eye(3) + a[:, None, None] * K + b[:, None, None] * (K @ K)
-
-
-def _rotvec(v):
-    """Rotation matrix of the rotation vector v (rad), Rodrigues."""
-    th = float(np.sqrt(v @ v))
-    K = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-    if th < 1e-8:
-        return np.eye(3) + K + 0.5 * K @ K
-    return np.eye(3) + np.sin(th) / th * K + (1.0 - np.cos(th)) / th**2 * K @ K
-
-
-class _System:
-    """Residuals of platform + cables + masts at one commanded pose (module note)."""
-
-    def __init__(self, robot: CableRobot, masts: MastSet, pose_c, l0, w_cal, delta):
-        g = robot.geom
-        self.robot, self.g = robot, g
-        self.Rc = _rot(pose_c[3:])
-        self.tc = np.asarray(pose_c[:3], float)
-        self.l0 = l0
-        self.C = masts.compliance
-        self.w_cal = w_cal
-        self.delta = delta
-        self.mast = g.mast_of_cable
-        self.n = g.n_masts
-        self.D0 = g.exit_points
-        self.F = g.winch_points
-        self.top0 = g.mast_tops
-        self.fg = np.array([0.0, 0.0, -g.mass * GRAVITY])
-        self.gather = (np.arange(self.n)[:, None] == self.mast[None, :]).astype(float)  # (n, m) cable -> mast
-        self.w0 = robot.axes
-        self.mg = np.cross(self.Rc @ g.cog, self.fg)
-
-    def state(self, z):
-        """Geometry, tensions and mast wrenches for unknowns z (N,) or a batch (k, N)."""
-        z = np.asarray(z, float)
-        single = z.ndim == 1
-        Z = z[None] if single else z
-        k = Z.shape[0]
-        t = self.tc + Z[:, :3]
-        R = _rotvec_batch(Z[:, 3:6]) @ self.Rc  # (k, 3, 3)
-        dc = Z[:, 6:].reshape(k, self.n, 6)
-        dT, dR = dc[:, self.mast, :3], dc[:, self.mast, 3:]
-        D = self.D0 + dT + _cross(dR, self.D0 - self.top0[self.mast])
-        w = self.w0 + _cross(dR, self.w0)
-        w /= np.linalg.norm(w, axis=-1)[..., None]
-        Rb = np.einsum("kij,mj->kmi", R, self.g.anchor_points)
-        B = Rb + t[:, None, :]
-        m = self.mast.size
-        ex = swivel_exit(D.reshape(-1, 3), w.reshape(-1, 3), B.reshape(-1, 3), self.robot.pulley_radius)
-        u, E, C = (ex[key].reshape(k, m, 3) for key in ("u", "E", "C"))
-        DF = self.F - D
-        lDF = np.linalg.norm(DF, axis=-1)
-        length = lDF + ex["length"].reshape(k, m)
-        tau = self.robot.EA * (length - self.l0) / self.l0
-        v = DF / lDF[..., None]
-        fp = tau[..., None] * (u + v)  # force of each cable on its pulley (Eq. 7)
-        top = self.top0 + dc[:, :, :3]
-        mom = _cross(C - top[:, self.mast], fp)
-        wr = np.einsum("nm,kmj->knj", self.gather, np.concatenate([fp, mom], axis=-1))
-        out = dict(t=t, R=R, dc=dc, tau=tau, u=u, Rb=Rb, E=E, wrench=wr)
-        return {key: val[0] for key, val in out.items()} if single else out
-
-    def residual(self, z):
-        """Residuals (N,) (or (k, N) for a batch of z) and the state."""
-        z = np.asarray(z, float)
-        single = z.ndim == 1
-        s = self.state(z[None] if single else z)
-        f = -(s["tau"][..., None] * s["u"])
-        cog = np.einsum("kij,j->ki", s["R"], self.g.cog)
-        rp = np.concatenate([f.sum(axis=1) + self.fg, _cross(s["Rb"], f).sum(axis=1) + _cross(cog, self.fg)], axis=1)
-        rm = s["dc"] - np.einsum("nij,knj->kni", self.C, s["wrench"] - self.w_cal) - self.delta
-        r = np.concatenate([rp, rm.reshape(len(rp), -1)], axis=1)
-        if single:
-            return r[0], {key: val[0] for key, val in s.items()}
-        return r, s
-
-
-def _jacobian(sys: _System, z):
-    """Central finite differences (h = 1e-7: truncation ~h^2, round-off ~1e-16/h relative), all columns
-    in one batched evaluation."""
-    h = 1e-7
-    N = z.size
-    Z = np.vstack([z + h * np.eye(N), z - h * np.eye(N)])
-    r = sys.residual(Z)[0]
-    return (r[:N] - r[N:]).T / (2 * h)
-
-
-def _newton(sys: _System, z0, J=None, tol=1e-11, max_iter=60, full=False):
-    """Newton with a finite-difference Jacobian, reused (from the previous pose of a trajectory, too)
-    while it contracts fast and refreshed when it does not.  Returns z, state, iterations, J."""
-    z = z0.copy()
-    age = 0
-    if J is None:
-        J = _jacobian(sys, z)
-    last = np.inf
-    for it in range(max_iter):
-        r, s = sys.residual(z)
-        dz = np.linalg.solve(J, -r)
-        step = np.abs(dz).max()
-        if age > 0 and (full or step > 0.8 * last):
-            J = _jacobian(sys, z)  # slow contraction: refresh the Jacobian
-            age = 0
-            dz = np.linalg.solve(J, -r)
-            step = np.abs(dz).max()
-        z += dz
-        age += 1
-        last = step
-        if step < tol:
-            r, s = sys.residual(z)
-            return z, s, it + 1, J
-    raise ModelError(
-        f"platform/cable/mast equilibrium did not converge in {max_iter} iterations (last correction {step:.3g})"
-    )
-
-
 def controller(robot: CableRobot, pose_c, tau=None, method: str = "barycenter"):
     """What the rigid-frame controller sets at the commanded pose: the rigid exit geometry, the tension
     distribution (Eq. 2 with the swivel-pulley exit points and the tension limits, or ``tau`` given, N)
@@ -289,12 +147,16 @@ def solve_pose(
     z0=None,
     method: str = "barycenter",
     J=None,
+    control=None,
 ) -> PoseSolution:
     """Equilibrium of platform, cables and masts at the commanded pose ``pose_c`` ([x, y, z] m, angles rad).
 
     tau : commanded tensions (N) or None (Eq. 2 distribution).  w_cal : (n, 6) mast wrenches at
     calibration (default: zero, i.e. displacements from the unloaded masts).  delta : (n, 6) nonlinear
-    remainder of FE masts (m, rad).  z0 : start (from the previous pose of a trajectory).
+    remainder of FE masts (m, rad).  z0 : start (from the previous pose of a trajectory, or the same
+    pose in the previous pass).  J : a Jacobian of the unknowns to start from.  control : what
+    :func:`controller` returned for this pose (it depends on the commanded pose and tensions only;
+    a trajectory computes it once per pose for all its passes).
     An infeasible pose is returned with ``feasible=False`` and the reason, not raised."""
     g = robot.geom
     p = np.asarray(pose_c, float).ravel()
@@ -315,7 +177,9 @@ def solve_pose(
                 "a cable cannot push"
             )
     try:
-        tau_c, l0 = controller(robot, p, tau, method)
+        tau_c, l0 = controller(robot, p, tau, method) if control is None else control
+        if isinstance(tau_c, ModelError):
+            raise tau_c
     except ModelError as exc:
         return PoseSolution(
             nan,
@@ -327,14 +191,24 @@ def solve_pose(
             False,
             str(exc),
         )
-    sys = _System(
-        robot, masts, p, l0, np.zeros((n, 6)) if w_cal is None else w_cal, np.zeros((n, 6)) if delta is None else delta
-    )
+    sys = _system(robot, masts, p, l0, w_cal, delta)
     start = np.zeros(6 + 6 * n) if z0 is None else z0
     try:
         z, s, it, J = _newton(sys, start, J)
     except (ModelError, np.linalg.LinAlgError):
         z, s, it, J = _newton(sys, np.zeros(6 + 6 * n), None, full=True)  # plain Newton from the commanded pose
+    return _solution(g, p, z, s, it, J)
+
+
+def _system(robot, masts, p, l0, w_cal, delta) -> _System:
+    n = robot.geom.n_masts
+    return _System(
+        robot, masts, p, l0, np.zeros((n, 6)) if w_cal is None else w_cal, np.zeros((n, 6)) if delta is None else delta
+    )
+
+
+def _solution(g, p, z, s, it, J) -> PoseSolution:
+    """The pose solution of the converged unknowns ``z`` and state ``s`` at commanded pose ``p``."""
     rotvec = z[3:6]
     pose = np.concatenate([s["t"], Rotation.from_matrix(s["R"]).as_euler("xyz")])
     sol = PoseSolution(pose, np.concatenate([z[:3], rotvec]), s["tau"], s["E"], s["dc"], s["wrench"], True, "", it)
@@ -377,11 +251,35 @@ class TrajectoryResult:
         return np.linalg.norm(self.error[:, 3:], axis=1)
 
 
-def _pass(robot, masts, poses, tau, w_cal, delta, method, progress):
+def _controls(robot, poses, tau, method) -> list:
+    """:func:`controller` at every pose of a trajectory: ``(tau_c, l0)``, or ``(error, None)`` where it
+    has no tension distribution (the pose is then infeasible in every pass)."""
+    out = []
+    for k, p in enumerate(poses):
+        try:
+            out.append(controller(robot, p, None if tau is None else tau[k], method))
+        except ModelError as exc:
+            out.append((exc, None))
+    return out
+
+
+def _pass(robot, masts, poses, tau, w_cal, delta, method, progress, controls, previous=None):
+    """One pass along the trajectory.  All poses at once (:func:`~femast.guyed.pose_equilibrium._newton_batch`:
+    one batched residual evaluation per iteration) when the controller holds every pose: each pose
+    from its commanded pose or, given the ``previous`` pass, from its own solution there (the passes
+    differ by a small remainder).  Else, or if that does not converge, and with a ``progress`` bar,
+    pose by pose, each from the previous pose's solution."""
+    if progress is None and all(c[1] is not None for c in controls):
+        if previous is None or all(s.feasible for s in previous):
+            batch = _batch_pass(robot, masts, poses, w_cal, delta, controls, previous)
+            if batch is not None:
+                return batch
     sols = []
     z = J = None
     it = poses if progress is None else progress(poses)
     for k, p in enumerate(it):
+        if previous is not None and previous[k].feasible:
+            z, J = previous[k]._z, previous[k]._J
         s = solve_pose(
             robot,
             masts,
@@ -392,11 +290,37 @@ def _pass(robot, masts, poses, tau, w_cal, delta, method, progress):
             z0=z,
             method=method,
             J=J,
+            control=controls[k],
         )
         if s.feasible:
             z, J = s._z, s._J
         sols.append(s)
     return sols
+
+
+def _batch_pass(robot, masts, poses, w_cal, delta, controls, previous):
+    """The poses of a pass solved together, from their solutions in the ``previous`` pass or (None)
+    from their commanded poses; None when that does not converge (the caller then solves them one
+    by one)."""
+    systems = [
+        _system(robot, masts, np.asarray(p, float), l0, w_cal, None if delta is None else delta[k])
+        for k, (p, (_, l0)) in enumerate(zip(poses, controls))
+    ]
+    stk = _System.stack(systems)
+    try:
+        if previous is None:
+            Z0 = np.zeros((len(systems), 6 + 6 * robot.geom.n_masts))
+            J0 = _jacobian_batch(stk, Z0)
+        else:
+            Z0, J0 = np.array([s._z for s in previous]), np.array([s._J for s in previous])
+        Z, st, its, J = _newton_batch(stk, Z0, J0)
+    except (ModelError, np.linalg.LinAlgError):
+        return None
+    out = []
+    for k, p in enumerate(poses):
+        sol = _solution(robot.geom, np.asarray(p, float), Z[k], {key: v[k] for key, v in st.items()}, int(its[k]), J[k])
+        out.append(sol)
+    return out
 
 
 def _fe_response(masts: MastSet):
@@ -454,7 +378,8 @@ def pose_trajectory(
         raise ModelError(f"the calibration pose is infeasible: {c0.reason}")
     w_cal = c0.wrench
     delta = None
-    sols = _pass(robot, masts, poses, tensions, w_cal, delta, method, progress)
+    controls = _controls(robot, poses, tensions, method)
+    sols = _pass(robot, masts, poses, tensions, w_cal, delta, method, progress, controls)
     passes = 0
     if masts.fe is not None and response is None:
         response = _fe_response(masts)
@@ -482,7 +407,7 @@ def pose_trajectory(
             dc_prev = dc
             if change < fe_tol:
                 break  # the tops of the last pass are those of the response: converged
-            sols = _pass(robot, lin, poses, tensions, w_cal, delta, method, progress)
+            sols = _pass(robot, lin, poses, tensions, w_cal, delta, method, progress, controls, sols)
     pick = lambda key: np.array([getattr(s, key) for s in sols])  # noqa: E731
     return TrajectoryResult(
         poses,

@@ -111,3 +111,48 @@ def test_single_channel_noise_reestimate_needs_no_second_fit(seed):
     z = (data["y"] - res.predicted["y"]) / res.noise["y"]
     np.testing.assert_allclose(res.fun, z, rtol=1e-12)  # residual whitened by the final noise
     np.testing.assert_allclose(res.cost, 0.5 * z @ z, rtol=1e-12)
+
+
+def test_multistart_polishes_only_the_best_start(monkeypatch):
+    """Several starts of an expensive fit: each runs to its own minimum, and only the best is polished
+    (a finite-difference Jacobian at the solution, for the covariance): the others are discarded."""
+    from femast.experiments import fe_jacobian
+    from femast.experiments.fit_problem import FitProblem
+    from femast.experiments.prediction import parameter_specs
+
+    exp, data = _experiment(), _data(seed=7)
+    specs = parameter_specs(exp, [])
+    pb = FitProblem(exp, data, specs, None, False, None, None)
+    starts = [np.array([1.5, 0.8]), np.array([5.0, 0.05]), np.array([0.3, 6.0])]
+    polished = []
+    orig = fe_jacobian._polish
+
+    def counting(sol, *args, **kw):
+        polished.append(sol.cost)
+        return orig(sol, *args, **kw)
+
+    monkeypatch.setattr("femast.experiments.fit_problem._polish", counting)
+    sigma = {"y": NOISE}
+    best = pb.solve(sigma, starts)
+    assert len(polished) == 1
+    singles = []
+    for x in starts:
+        singles.append(pb.solve(sigma, [x]))
+    # the one polished is the start whose unpolished minimum was lowest, and nothing better was left out
+    assert polished[0] == pytest.approx(min(polished[1:]), rel=1e-12)
+    assert best.cost <= min(s.cost for s in singles) * (1 + 1e-4) + 1e-9
+
+
+def test_a_held_out_fold_started_from_the_full_fit_takes_its_jacobian_from_it():
+    """A fold of the held-out check starts where the fit on all the data ended: that fit's derivatives
+    there replace the fold's first finite-difference Jacobian, and the fold fit ends where it would
+    without them."""
+    exp, data = _experiment(), _data(seed=11)
+    full = fitting.fit(exp, data)
+    rows = np.arange(data.n) % 3 != 0
+    start = dict(zip(full.names, full.x))
+    noise = {"y": float(full.noise["y"])}
+    seeded = fitting.fit(exp, data, start=start, noise=noise, rows=rows, start_sensitivity=full.sensitivity)
+    plain = fitting.fit(exp, data, start=start, noise=noise, rows=rows)
+    assert seeded.fe_runs <= plain.fe_runs - 2  # the two first-Jacobian columns were not run
+    assert np.all(np.abs(seeded.x - plain.x) <= 0.15 * plain.stderr)  # ftol, as above

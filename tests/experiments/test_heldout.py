@@ -94,3 +94,17 @@ def test_fit_on_one_file_score_another(tmp_path, capsys):
     assert rep["ratio"] < 1.3
     assert main(["compare", str(script), str(tmp_path / "b.csv"), "--params-from", str(tmp_path / "nothing")]) == 2
     assert "no compare.json there" in capsys.readouterr().err
+
+
+def test_nothing_significant_nothing_held_out(monkeypatch):
+    """The held-out check can only refuse a candidate or a pair: without a significant one it refits
+    nothing (the verdict cannot depend on it), and the report has no held-out ratio of the baseline."""
+    from femast.experiments import heldout
+
+    calls = []
+    monkeypatch.setattr(heldout, "folds", lambda *a, **k: calls.append(a) or [])
+    data = rig.data(gap_x=0.0, n=300, seed=4)  # springs only: nothing is missing
+    d = diagnose(rig.RIG, data, ["joint_clearance", "friction_hysteresis"], workers=1)
+    assert d.verdict["kind"] == "nothing_missing"
+    assert not any(e["significant"] for e in d.ranking)
+    assert calls == [] and d.report["baseline"]["heldout_ratio"] is None
