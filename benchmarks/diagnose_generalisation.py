@@ -34,11 +34,16 @@ Usage::
 
     python benchmarks/diagnose_generalisation.py             # every case (154 runs)
     python benchmarks/diagnose_generalisation.py --quick     # a smoke subset (14 runs)
+    python benchmarks/diagnose_generalisation.py --stratified  # every family on every rig, every null (73 runs)
     python benchmarks/diagnose_generalisation.py --cases 'lp_*,mt_friction*' --redraws 5
 
-Options: ``--workers N`` parallel processes (default 2), ``--out DIR``, ``--redraws N`` (null
+Options: ``--workers N`` worker processes (:mod:`femast.workers`; default one per CPU, 1 runs in
+this process), ``--out DIR``, ``--redraws N`` (null
 redraws, default 20), ``--quick`` (one case per mechanism family and 3 null redraws per null
-case), ``--cases`` comma-separated names or shell patterns.
+case), ``--stratified`` (each mechanism family once on each rig, the misses of real use, every
+null case -- every noise type -- with 5 redraws), ``--cases`` comma-separated names or shell
+patterns, ``--resume`` (keep the runs already in ``OUT/runs.jsonl``, where every run is appended as
+it ends: a run stopped half-way keeps what it did).
 """
 
 from __future__ import annotations
@@ -48,11 +53,12 @@ import fnmatch
 import json
 import os
 import resource
+import site
 import subprocess
 import sys
 import time
 import zlib
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from pathlib import Path
 
 import numpy as np
@@ -77,6 +83,32 @@ QUICK = (
     "lp_null_eq15",
 )
 QUICK_REDRAWS = 3
+STRATIFIED = (  # each family once per rig (mast top, latch pull, joint test), the misses of real use, every null
+    "mt_friction_jenkins",
+    "mt_clearance_hertz",
+    "mt_progressive_asinh",
+    "mt_cable_loop_power",
+    "mt_pretension_step",
+    "mt_beam_stepped",
+    "mt_pair_clearance_friction",
+    "mt_ool_viscous",
+    "mt_guys_slack",
+    "mt_friction_preisach",
+    "mt_creep_log",
+    "mt_clearance_x_only",
+    "lp_friction_boucwen",
+    "lp_latch_band_lorentz",
+    "lp_clearance_piecewise",
+    "lp_stretch_twoslope",
+    "lp_cable_loop_quadratic",
+    "lp_pair_friction_clearance",
+    "lp_ool_zero_drift",
+    "jt_bwbn_plain",
+    "jt_bwbn_pinched",
+    "jt_bwbn_degrading",
+    "jt_clearance_hertz",
+)
+STRATIFIED_REDRAWS = 5
 
 
 def seed_of(case: str, redraw: int) -> int:
@@ -141,8 +173,8 @@ def run_one(case: Case, redraw: int) -> dict:
     return row
 
 
-def select(patterns: str | None, quick: bool) -> list:
-    """The cases to run: ``--cases`` patterns, else the quick subset or all."""
+def select(patterns: str | None, quick: bool, stratified: bool = False) -> list:
+    """The cases to run: ``--cases`` patterns, else the quick or stratified subset, or all."""
     cases = list(CASES)
     if patterns:
         pats = [p.strip() for p in patterns.split(",") if p.strip()]
@@ -151,28 +183,58 @@ def select(patterns: str | None, quick: bool) -> list:
             raise SystemExit(f"--cases {patterns!r} matches no case; cases: {', '.join(c.name for c in CASES)}")
     elif quick:
         cases = [c for c in cases if c.name in QUICK]
+    elif stratified:
+        cases = [c for c in cases if c.name in STRATIFIED or c.expect == "null"]
     return cases
 
 
-def run_all(cases, redraws: int, workers: int, progress: bool = True) -> list:
-    """Run every (case, redraw) in ``workers`` processes with a tqdm bar; rows in case order."""
+def run_all(cases, redraws: int, workers: int | None, progress: bool = True, log: Path | None = None) -> list:
+    """Run every (case, redraw) with a tqdm bar: in this process for ``workers=1``, else on femast's
+    worker pool (:mod:`femast.workers`; None: one worker per CPU, at most one per run); rows in
+    case order.  log : a JSON-lines file each row is appended to as its run ends; the runs already
+    in it are not run again (their rows are returned with the others)."""
+    from femast import workers as femast_workers
+
     jobs = [(c, r) for c in cases for r in range(redraws if c.expect == "null" else c.redraws)]
     rows = []
+    if log is not None and log.exists():
+        wanted = {(c.name, r) for c, r in jobs}
+        for line in log.read_text().splitlines():
+            try:
+                row = json.loads(line)
+            except ValueError:  # a line cut short by a stop: that run runs again
+                continue
+            if (row["case"], row["redraw"]) in wanted:
+                rows.append(row)
+                wanted.discard((row["case"], row["redraw"]))
+        jobs = [(c, r) for c, r in jobs if (c.name, r) in wanted]
+
+    def keep(row):
+        rows.append(row)
+        if log is not None:
+            with open(log, "a") as f:
+                f.write(json.dumps(row, default=float) + "\n")
+
+    n = 1 if workers == 1 else femast_workers.worker_count(workers, tasks=len(jobs))
     bar = None
     if progress:
         from tqdm import tqdm
 
         bar = tqdm(total=len(jobs), desc="diagnose runs", unit="run")
-    if workers <= 1:
+    if workers == 1:
         for c, r in jobs:
-            rows.append(run_one(c, r))
+            keep(run_one(c, r))
             if bar:
                 bar.update()
     else:
-        with ProcessPoolExecutor(max_workers=workers) as ex:
-            futs = [ex.submit(run_one, c, r) for c, r in jobs]
+        # the workers import this file as the module ``diagnose_generalisation`` (its folder on their
+        # path), whether it runs as a script or as ``python -m femast.benchmarks...``
+        import diagnose_generalisation as this
+
+        with femast_workers.Pool(n, initializer=site.addsitedir, initargs=(str(HERE),), name="benchmark") as pool:
+            futs = [pool.submit(this.run_one, c, r) for c, r in jobs]
             for f in as_completed(futs):
-                rows.append(f.result())
+                keep(f.result())
                 if bar:
                     bar.update()
     if bar:
@@ -307,13 +369,15 @@ def figures(rows, summary, out: Path) -> list:
     a1.set_yticks(y, [f"{r['case']} -> {verdict_label(r)}" for r in single], fontsize=7)
     a1.invert_yaxis()
     a1.set_xscale("log")
-    from matplotlib.ticker import FixedLocator, NullLocator, ScalarFormatter
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
 
-    a1.xaxis.set_major_locator(FixedLocator([0.8, 1, 1.2, 1.5, 2, 3, 4, 6, 8, 10]))
-    a1.xaxis.set_major_formatter(ScalarFormatter())
+    a1.xaxis.set_major_locator(FixedLocator([0.8, 1, 1.2, 1.5, 2, 3, 4, 6, 8, 10, 20, 40, 100]))
+    a1.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     a1.xaxis.set_minor_locator(NullLocator())
     a1.set_xlabel("RMS error / noise floor (as diagnose estimates it)")
-    a1.legend(fontsize=7, loc="lower right")
+    from femast.post import plotstyle
+
+    plotstyle.legend_below(a1, ncol=2, fontsize=7)  # never over the bars
     names = list(nulls)
     fa = [sum(not r["right"] for r in nulls[n]) / len(nulls[n]) for n in names]
     a2.barh(np.arange(len(names)), fa, color="C3")
@@ -345,22 +409,34 @@ def _commit() -> str:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="a smoke subset with 3 null redraws")
+    ap.add_argument(
+        "--stratified",
+        action="store_true",
+        help=f"each family once per rig, the misses of real use, every null case ({STRATIFIED_REDRAWS} redraws)",
+    )
+    ap.add_argument("--resume", action="store_true", help="keep the runs already in OUT/runs.jsonl")
     ap.add_argument("--cases", help="comma-separated case names or shell patterns (e.g. 'lp_*')")
     ap.add_argument("--redraws", type=int, help="noise redraws of each null case (default 20; 3 with --quick)")
-    ap.add_argument("--workers", type=int, default=2, help="parallel processes (default 2)")
+    ap.add_argument(
+        "--workers", type=int, help="worker processes (femast.workers; default: one per CPU; 1: in this process)"
+    )
     ap.add_argument("--out", default=str(HERE / "out" / "diagnose_generalisation"), help="output folder")
     ap.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     ap.add_argument(
         "--docs", action="store_true", help="also copy the figures to docs/figures/diagnose_generalisation_*.png"
     )
     a = ap.parse_args(argv)
-    cases = select(a.cases, a.quick)
-    redraws = a.redraws if a.redraws is not None else (QUICK_REDRAWS if a.quick else 20)
+    cases = select(a.cases, a.quick, a.stratified)
+    default = QUICK_REDRAWS if a.quick else STRATIFIED_REDRAWS if a.stratified and not a.cases else 20
+    redraws = a.redraws if a.redraws is not None else default
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    log = out / "runs.jsonl"
+    if not a.resume and log.exists():
+        log.unlink()
     commit = _commit()  # the code the runs use (HEAD when they start)
     t0 = time.perf_counter()
-    rows = run_all(cases, redraws, a.workers, progress=True)
+    rows = run_all(cases, redraws, a.workers, progress=True, log=log)
     wall = time.perf_counter() - t0
     summary = score(rows)
     summary.update(
@@ -372,6 +448,7 @@ def main(argv=None) -> int:
         cpu_s_parent=resource.getrusage(resource.RUSAGE_SELF).ru_utime,
         load=os.getloadavg(),
         quick=a.quick,
+        stratified=a.stratified,
         cases_filter=a.cases,
         redraws=redraws,
     )

@@ -254,10 +254,13 @@ def format_compare(exp: Experiment, result: OptimizeResult) -> str:
     for name, p in r["params"].items():
         se = f" +- {p['stderr']:.3g}" if p["stderr"] is not None and result.fitted else ""
         lines.append(f"    {name:>22s} = {p['value']:.6g}{se} {p['unit']}")
-    lines.append(
-        f"  overall RMS error {_fmt(result.rms, exp.error_unit)}; noise floor {_fmt(result.noise_rms, exp.error_unit)}"
-        f" -> {result.ratio:.2f}x noise"
-    )
+    if exp.one_scale:
+        lines.append(
+            f"  overall RMS error {_fmt(result.rms, exp.error_unit)}; noise floor "
+            f"{_fmt(result.noise_rms, exp.error_unit)} -> {result.ratio:.2f}x noise"
+        )
+    else:  # channels of different units: each against its own noise (below)
+        lines.append(f"  overall: {result.ratio:.2f}x the noise (each channel's error over its own noise)")
     for c in exp.channels:
         u = exp.unit_of(c)
         m = result.noise_model[c]

@@ -217,6 +217,13 @@ class Experiment:
         """Factor converting ``channel`` to :attr:`error_unit` (1 by default)."""
         return float(self.channel_weights.get(channel, 1.0))
 
+    @property
+    def one_scale(self) -> bool:
+        """True if every compared channel is in :attr:`error_unit`, unweighted: one RMS error and one
+        noise floor in that unit then say what the ratio to the noise says (not so for metres and
+        radians together, where each channel is read against its own noise)."""
+        return all(self.unit_of(c) == self.error_unit and self.weight(c) == 1.0 for c in self.channels)
+
     def defaults(self) -> dict:
         """Default baseline parameters ``{name: value}``."""
         return {p.name: float(p.default) for p in self.parameters}

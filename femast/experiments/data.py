@@ -20,7 +20,9 @@ disconnected sensor or a wrong column); a file separated by ';', tabs or '|' is 
 error saying femast reads comma-separated files.  Consecutive identical rows are accepted with a
 :class:`DataWarning`: a repeated sample weighs twice in a fit, and its zero difference from the
 previous row makes the noise floor estimated from second differences too small (every row doubled
-roughly halves it), so the "at the noise floor" verdicts become too strict.
+roughly halves it), so the "at the noise floor" verdicts become too strict.  Not warned: a row that
+repeats a reading at rest at the recorder's resolution (every column on a grid of counts, the row
+before moved by at most one count: the same counts read again, a genuine sample).
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ import numpy as np
 from .. import progress
 from ..errors import DataFileError
 from .core import Experiment, Measured
+from .resolution import resolution
 
 #: largest accepted magnitude of a data value in the unit of its column
 MAX_VALUE = 1e15
@@ -116,6 +119,7 @@ def check_values(exp: Experiment, cols: dict, path: str, lines, measured: bool =
         table = np.column_stack(list(cols.values()))
         if len(table) > 1:
             dup = np.flatnonzero(np.all(table[1:] == table[:-1], axis=1)) + 1
+            dup = dup[~_repeats_at_rest(table, dup)]
             if dup.size:
                 shown = ", ".join(str(lines[i]) for i in dup[:5]) + (", ..." if dup.size > 5 else "")
                 warnings.warn(
@@ -126,6 +130,23 @@ def check_values(exp: Experiment, cols: dict, path: str, lines, measured: bool =
                     DataWarning,
                     stacklevel=3,
                 )
+
+
+def _repeats_at_rest(table, dup) -> np.ndarray:
+    """(len(dup),) bool: which repeated rows ``dup`` (indices into ``table`` (n, k), each equal to the
+    row before it) are a reading at rest at the recorder's resolution rather than a sample written
+    twice: every column lies on a grid (:func:`~femast.experiments.resolution.resolution`) and the
+    row before the pair moved by at most one step in every column -- the signal was at rest within a
+    count, where the same counts are read again (a load cell flickering between 10 and 20 N at rest
+    reads 20, 10, 20, 20)."""
+    q = np.array([resolution(table[:, j]) for j in range(table.shape[1])])
+    at_rest = np.zeros(dup.size, bool)
+    if dup.size == 0 or np.any(q <= 0.0):
+        return at_rest
+    for i, r in enumerate(dup):
+        if r >= 2:
+            at_rest[i] = bool(np.all(np.abs(table[r - 1] - table[r - 2]) <= 1.001 * q))
+    return at_rest
 
 
 def _accepted(exp: Experiment) -> str:

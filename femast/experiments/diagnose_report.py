@@ -12,6 +12,8 @@ from scipy.optimize import OptimizeResult
 from .core import Experiment
 from .figures import diagnose_figure, display_scale
 from .fitting import params_table
+from .residuals import robust_rms
+from .verdict import pair_beats_members
 
 #: the fields of a ranking entry in the JSON report
 PUBLIC = (
@@ -131,10 +133,25 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
     lines = [
         f"femast diagnose: {exp.name} on {result.report['data']} ({result.n_samples} samples; refits: "
         f"{result.executor})",
-        f"  noise floor {f * result.noise_rms:.4g} {ul}; baseline"
-        f"{' + ' + '+'.join(b['effects']) if b['effects'] else ''} RMS {f * b['rms']:.4g} {ul} "
-        f"({b['ratio']:.2f}x noise{_ho(b.get('heldout_ratio'), '; held out ')})",
     ]
+    named = f"baseline{' + ' + '+'.join(b['effects']) if b['effects'] else ''}"
+    if exp.one_scale:  # every channel in the error unit: one RMS and one noise floor say it
+        lines.append(
+            f"  noise floor {f * result.noise_rms:.4g} {ul}; {named} RMS {f * b['rms']:.4g} {ul} "
+            f"({b['ratio']:.2f}x noise{_ho(b.get('heldout_ratio'), '; held out ')})"
+        )
+    else:  # channels of different units (m and rad) or weights: each against its own noise
+        lines.append(
+            f"  {named}: {b['ratio']:.2f}x the noise (each channel's error over its own noise"
+            f"{_ho(b.get('heldout_ratio'), '; held out ')})"
+        )
+        for c in exp.channels:
+            r, s = np.asarray(result.baseline_fit.residuals[c], float), np.asarray(result.noise[c], float)
+            fc, uc = display_scale(exp.unit_of(c), np.abs(r))
+            lines.append(
+                f"    {c}: RMS error {fc * np.sqrt(np.mean(r**2)):.4g} {uc}, noise {fc * np.sqrt(np.mean(s**2)):.4g} "
+                f"{uc} ({robust_rms(r / s):.2f}x)"
+            )
     if result.by_kind:
         lines.append(
             "  the model fails most in: " + ", ".join(f"{k['kind']} ({k['ratio']:.1f}x)" for k in result.by_kind[:3])
@@ -169,7 +186,7 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
         lines.append(
             f"  pair  {' + '.join(p['effects']):<33s} {f * p['rms']:>10.4g} {p['ratio']:>8.2f} "
             f"{_ho(p.get('heldout_ratio')):>8s} {p['delta_bic']:>9.1f} {100 * p['explained_fraction']:>5.0f}%  "
-            f"{'yes' if p['significant'] and p.get('heldout_ok', True) else ' no'}"
+            f"{'yes' if pair_beats_members(p) else ' no'}"
         )
     for fc in getattr(result, "form_check", None) or []:
         lines.append(

@@ -12,6 +12,12 @@ from ..post.plotstyle import column_label, display_scale, fit_title, num  # noqa
 from .residuals import AT_NOISE
 
 
+def verdict_words(v: dict) -> str:
+    """The verdict as the command line says it: its conclusion up to the first ';' (the figures' title)."""
+    text = (v.get("conclusion") or "").split(";")[0].strip()
+    return text or "none of the candidates explains this"
+
+
 def _plt():
     return plotstyle.pyplot()
 
@@ -127,16 +133,20 @@ def compare_figure(exp, data, result, png) -> Path:
 
 
 def diagnose_figure(exp, data, result, png) -> Path:
-    """Error of the baseline and of each candidate effect (bars, noise floor), and the residual of the
-    baseline and of the best candidate along the path."""
+    """Error of the baseline and of each candidate effect and pair over the noise (bars; the verdict's
+    ratio: each channel's error over its own noise, so channels of different units -- m and rad --
+    are never added), and the residual of the baseline and of the best candidate along the path."""
+    from .verdict import pair_beats_members
+
     plt = _plt()
     png = Path(png)
+    # (label, ratio to the noise, dBIC, green, failed, held-out ratio)
     entries = (
-        [("baseline", result.baseline["rms"], None, False, False, result.baseline.get("heldout_ratio"))]
+        [("baseline", result.baseline["ratio"], None, False, False, result.baseline.get("heldout_ratio"))]
         + [
             (
                 r["effect"] + (f" ({r['form']})" if r.get("form") else ""),
-                r["rms"],
+                r.get("ratio"),
                 r["delta_bic"],
                 r["significant"],
                 bool(r.get("failed")),
@@ -145,67 +155,40 @@ def diagnose_figure(exp, data, result, png) -> Path:
             for r in result.ranking
         ]
         + [
-            (
-                " + ".join(p["effects"]),
-                p["rms"],
-                p["delta_bic"],
-                p["significant"] and p.get("heldout_ok", True),
-                False,
-                p.get("heldout_ratio"),
-            )
+            (" + ".join(p["effects"]), p["ratio"], p["delta_bic"], pair_beats_members(p), False, p.get("heldout_ratio"))
             for p in (getattr(result, "pairs", None) or [])[:3]
         ]
     )
-    errors = [e[1] for e in entries if not e[4]] + [result.noise_rms * result.at_noise]
-    f, ul = display_scale(exp.error_unit, errors)  # the unit that suits the errors shown (um, mm, arcsec)
     fig, (ax0, ax1) = plt.subplots(
         1, 2, figsize=(13, max(4.0, 0.45 * len(entries) + 2)), gridspec_kw={"width_ratios": [1, 1.3]}
     )
     y = np.arange(len(entries))[::-1]
     colors = ["C0"] + [("C2" if e[3] else "0.65") for e in entries[1:]]
     ok = [not e[4] for e in entries]  # a refit that failed has no error to draw: it is named, not a bar
-    ax0.barh(y[ok], [f * e[1] for e, k in zip(entries, ok) if k], color=[c for c, k in zip(colors, ok) if k])
+    ax0.barh(y[ok], [e[1] for e, k in zip(entries, ok) if k], color=[c for c, k in zip(colors, ok) if k])
     ax0.set_yticks(y)
     ax0.set_yticklabels([e[0] for e in entries], fontsize=9)
     ho = [(yy, e[5]) for yy, e in zip(y, entries) if e[5] is not None and np.isfinite(e[5])]
-    if ho:  # held-out error: the RMS on data the fit has not seen, about ratio x noise floor
-        ax0.plot(
-            [f * r * result.noise_rms for _, r in ho],
-            [yy for yy, _ in ho],
-            "kx",
-            ms=7,
-            label="held out (data the fit has not seen)",
-        )
-    ax0.axvline(f * result.noise_rms, color="k", ls="--", lw=1, label="noise floor")
+    if ho:  # held-out error: on data the fit has not seen, over the same noise
+        ax0.plot([r for _, r in ho], [yy for yy, _ in ho], "kx", ms=7, label="held out (data the fit has not seen)")
+    ax0.axvline(1.0, color="k", ls="--", lw=1, label="noise floor (1x)")
     ax0.axvline(
-        f * result.noise_rms * result.at_noise,
-        color="k",
-        ls=":",
-        lw=1,
-        label=f"at-noise threshold, {num(result.at_noise, 2)} x noise",
+        result.at_noise, color="k", ls=":", lw=1, label=f"at-noise threshold, {num(result.at_noise, 2)} x noise"
     )
+    right = max([e[1] for e, k in zip(entries, ok) if k] + [r for _, r in ho] + [1.0, result.at_noise])
     for yy, e in zip(y, entries):
         if e[4]:
             ax0.text(0.0, yy, "  refit failed", va="center", fontsize=8, color="C3")
-        elif e[2] is not None:  # right of the bar and of its held-out marker
-            x = max(f * e[1], f * e[5] * result.noise_rms if e[5] is not None and np.isfinite(e[5]) else 0.0)
-            ax0.text(x, yy, f"  dBIC {e[2]:+.0f}", va="center", fontsize=8)
-    ax0.set_xlabel(f"RMS error after refit ({ul})")
-    bars = [f * e[1] for e, k in zip(entries, ok) if k] + [f * r * result.noise_rms for _, r in ho]
-    ax0.set_xlim(0, 1.35 * max(bars + [f * result.noise_rms * result.at_noise]))  # the noise lines inside too
+        elif e[2] is not None:  # right of every bar, marker and line: never over the noise lines
+            ax0.text(right, yy, f"  dBIC {e[2]:+.0f}", va="center", fontsize=8)
+    ax0.set_xlabel("RMS error / noise after refit (each channel over its own noise, -)")
+    ax0.set_xlim(0, 1.45 * right)
     v = result.verdict
-    verdict = {
-        "missing_effect": f"missing: {v['missing_effect']}",
-        "missing_pair": f"missing: {' + '.join(v.get('missing_effects', []))}",
-        "form_imperfect": f"mechanism found ({v.get('mechanism')}), form imperfect",
-        "better_form": f"better form of {v.get('mechanism')}: {v.get('form')}",
-        "nothing_missing": "nothing is missing",
-    }.get(v.get("kind"), "none of the candidates explains this")
     ax0.set_title(
         fit_title(
             ax0,
-            f"{exp.name}: refit with each candidate and pair (green: significant and better held out); "
-            f"verdict: {verdict}",
+            f"{exp.name}: refit with each candidate and pair (green: significant, better held out; a pair: "
+            f"better than its best member); verdict: {verdict_words(v)}",
         )
     )
     plotstyle.legend_below(ax0, ncol=2, fontsize=8)

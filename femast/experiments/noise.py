@@ -60,6 +60,11 @@ estimate, channel by channel:
   residual is zero or repeats its neighbour's exactly (:func:`informative_rows`) are left out of
   the estimates, which use the remaining rows in path order; the level then applies to every row.
 
+* **resolution** -- readings recorded to a fixed step carry a rounding error that estimates built on
+  differences do not see where readings repeat (:mod:`femast.experiments.resolution`): printed as
+  the source ``resolution``, a floor under every level estimated from the data (a given level is
+  used as it is).
+
 Fewer than ``MIN_ROWS`` = 8 rows (without ``sigma_`` columns) leave too few differences for any
 estimate: a :class:`~femast.errors.ModelError`.  Correlation and heteroscedasticity are only tested
 from ``MIN_ROWS_STRUCTURE`` = 60 rows (below that the white estimate is used and the report says so).
@@ -91,6 +96,7 @@ from .noise_estimators import (  # noqa: F401  (re-exported: the estimators of t
     robust_rms,
 )
 from .residuals import load_path, noise_floor
+from .resolution import rounding_floors
 
 HETERO_MIN_RANGE = 1.3
 DISAGREE = 1.5  # sources of the level that differ by more than this are printed side by side
@@ -118,8 +124,12 @@ class ChannelNoise:
 
     @property
     def disagree(self) -> bool:
-        """True if the sources of the level differ by more than ``DISAGREE``."""
-        v = [x for x in self.levels.values() if x > 0]
+        """True if the sources of the level differ by more than ``DISAGREE`` (the resolution is a
+        floor: it disagrees only with an estimate below it)."""
+        v = [x for k, x in self.levels.items() if x > 0 and k != "resolution"]
+        floor = self.levels.get("resolution", 0.0)
+        if floor > 0 and (not v or floor > min(v)):
+            v.append(floor)
         return len(v) > 1 and max(v) > DISAGREE * min(v)
 
     def to_json(self) -> dict:
@@ -314,6 +324,7 @@ def noise_model(
     coord = path_coordinate(exp, data) if correlate else None
     inputs = input_matrix(exp, data)
     user = check_sigma(exp, sigma)
+    floors = rounding_floors(exp, data, pred, input_names(exp, data))
     out = {}
     for c in exp.channels:
         r = fit_result.residuals[c]
@@ -355,9 +366,26 @@ def noise_model(
             )
         elif model.kind.endswith("+cycles"):
             model.source = "repeated passes"
+        if c in floors:
+            levels["resolution"] = floors[c][0]
+            model = with_floor(model, *floors[c])
         model.levels = levels
         out[c] = model
     return out
+
+
+def with_floor(model: ChannelNoise, level: float, reason: str) -> ChannelNoise:
+    """``model`` with no row's level below the rounding floor ``level`` (a given level as it is)."""
+    if model.kind == "given" or np.all(model.sigma >= level):
+        return model
+    sigma, source = np.maximum(model.sigma, level), model.source if model.sigma_rms >= level else "resolution"
+    if source != "resolution":  # a few rows raised: the estimate stands
+        why = f"{model.reason}; no row below {reason}"
+    else:  # the estimate is below the rounding: the floor is the level
+        why = f"at least {reason} (the estimate from the {model.source}, {model.sigma_rms:.3g}, is below it)"
+    return ChannelNoise(
+        model.channel, model.kind, sigma, model.phi, model.n_eff, model.covariate, why, dict(model.extra), source
+    )
 
 
 def plain_unless_noise(model: ChannelNoise, r, pinned=None) -> ChannelNoise:
@@ -426,11 +454,16 @@ def check_sigma(exp, sigma) -> dict:
     return out
 
 
-def input_matrix(exp, data):
-    """(n, k) the experiment's input columns in the data (not channels, time, ``sigma_`` or group), or None."""
+def input_names(exp, data) -> list:
+    """The experiment's input columns in the data (not channels, time, ``sigma_`` or group)."""
     skip = set(exp.channels) | {"t_s", "group"}
     cols = [c.name for c in exp.columns if c.name not in skip and c.name in data.columns]
-    cols = [c for c in cols if not c.startswith("sigma_")]
+    return [c for c in cols if not c.startswith("sigma_")]
+
+
+def input_matrix(exp, data):
+    """(n, k) the experiment's input columns in the data (:func:`input_names`), or None."""
+    cols = input_names(exp, data)
     return np.column_stack([data[c] for c in cols]) if cols else None
 
 

@@ -147,8 +147,12 @@ def compare_report(exp, data, result, folder) -> Path:
                 ],
                 numeric=(1, 2, 4),
             )
-            + f"<p>overall RMS error {num(f * result.rms, 4)} {esc(ul)}; noise floor "
-            f"{num(f * result.noise_rms, 4)} {esc(ul)}.</p>",
+            + (
+                f"<p>overall RMS error {num(f * result.rms, 4)} {esc(ul)}; noise floor "
+                f"{num(f * result.noise_rms, 4)} {esc(ul)}.</p>"
+                if exp.one_scale
+                else f"<p>overall: {num(result.ratio, 3)}x the noise (each channel's error over its own noise).</p>"
+            ),
         ),
         (
             "Where it fails",
@@ -221,9 +225,13 @@ def diagnose_report(exp, data, result, folder) -> Path:
     sections = [
         (
             "Baseline",
-            f"<p>baseline{' + ' + ' + '.join(b['effects']) if b['effects'] else ''}: RMS "
-            f"{num(f * b['rms'], 4)} {esc(ul)} ({num(b['ratio'], 3)}x noise; noise floor "
-            f"{num(f * result.noise_rms, 4)} {esc(ul)})</p>"
+            f"<p>baseline{' + ' + ' + '.join(b['effects']) if b['effects'] else ''}: "
+            + (
+                f"RMS {num(f * b['rms'], 4)} {esc(ul)} ({num(b['ratio'], 3)}x noise; noise floor "
+                f"{num(f * result.noise_rms, 4)} {esc(ul)})</p>"
+                if exp.one_scale
+                else f"{num(b['ratio'], 3)}x the noise (each channel's error over its own noise)</p>"
+            )
             + table(["parameter", "value", "std. error", "unit"], _params_rows(b["params"]), numeric=(1, 2)),
         ),
         (

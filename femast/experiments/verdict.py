@@ -109,6 +109,18 @@ def pair_candidates(ranking: list, top: int = PAIR_TOP) -> list:
     return [e["effect"] for e in ok[:top]]
 
 
+def pair_beats_members(p: dict) -> bool:
+    """True if the pair ``p`` passes the pair test: significant against the baseline, significantly
+    better than its best member alone (information criterion and another ``MIN_SHARE`` of the
+    excess) and, where it was checked, better held out than its best member."""
+    return bool(
+        p["significant"]
+        and p["gain_over_best_single"] < SIGNIFICANT_DBIC
+        and p["share_over_best_single"] >= MIN_SHARE
+        and p.get("heldout_ok", True)
+    )
+
+
 def conclude(
     r0: float, thr: float, ranking: list, pairs: list, form_check: list, titles: dict, remaining_where=()
 ) -> dict:
@@ -130,14 +142,7 @@ def conclude(
         "remaining_where": list(remaining_where),
         "conclusion": "",
     }
-    pair_ok = (
-        bp is not None
-        and bp["ratio"] <= thr
-        and bp["significant"]
-        and best is not None
-        and bp["gain_over_best_single"] < SIGNIFICANT_DBIC
-        and bp["share_over_best_single"] >= MIN_SHARE
-    )
+    pair_ok = bp is not None and bp["ratio"] <= thr and best is not None and pair_beats_members(bp)
     if fc is not None and fc["ratio"] <= thr:
         v.update(kind="better_form", mechanism=fc["effect"], form=fc["form"], explained=True)
         v["conclusion"] = (

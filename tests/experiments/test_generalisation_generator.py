@@ -318,6 +318,31 @@ def test_benchmark_harness_smoke(tmp_path):
     assert all(p.stat().st_size > 10_000 for p in paths)  # a real PNG, not an empty canvas
 
 
+def test_benchmark_runs_on_femast_workers(monkeypatch):
+    """--workers other than 1 runs on femast's one pool (here one worker: one run); the row is the
+    same as in this process (the draw's seed depends on the case and redraw only)."""
+    import diagnose_generalisation as bench
+
+    from femast import workers
+
+    started = []
+    monkeypatch.setattr(workers.Pool, "__init__", _recording(workers.Pool.__init__, started))
+    cases = bench.select("mt_null_white", quick=False)
+    pooled = bench.run_all(cases, redraws=1, workers=None, progress=False)
+    here = bench.run_all(cases, redraws=1, workers=1, progress=False)
+    assert started == [1]  # one pool of one worker (one run), none for workers=1
+    for key in ("kind", "effects", "right", "baseline_ratio"):
+        assert pooled[0][key] == here[0][key]
+
+
+def _recording(init, started):
+    def wrapped(self, n, *args, **kwargs):
+        started.append(n)
+        init(self, n, *args, **kwargs)
+
+    return wrapped
+
+
 def test_docs_page_example_runs():
     from doc_examples import run_python_blocks
 

@@ -116,7 +116,7 @@ def test_the_figure_checks_see_what_a_reader_sees(tmp_path):
 
 def test_diagnose_figure_keeps_its_noise_lines_and_legend_clear(tmp_path, drawn):
     """Every error below the at-noise threshold (a model already at the noise): the threshold and
-    noise-floor lines stay inside the axes, the legend clear of the x label, errors in um."""
+    noise-floor lines stay inside the axes, the legend clear of the x label, the verdict in words."""
     from types import SimpleNamespace
 
     import numpy as np
@@ -127,16 +127,21 @@ def test_diagnose_figure_keeps_its_noise_lines_and_legend_clear(tmp_path, drawn)
     exp = get_experiment("mast-top")
     n = 40
     ranking = [
-        {"effect": name, "form": None, "rms": rms, "delta_bic": dbic, "significant": False, "heldout_ratio": None}
-        for name, rms, dbic in (("joint_clearance", 2.1e-6, -3.0), ("friction_hysteresis", 2.2e-6, 1.0))
+        {"effect": name, "form": None, "ratio": ratio, "delta_bic": dbic, "significant": False, "heldout_ratio": None}
+        for name, ratio, dbic in (("joint_clearance", 1.05, -3.0), ("friction_hysteresis", 1.1, 1.0))
     ]
     result = SimpleNamespace(
-        baseline={"rms": 2.3e-6, "heldout_ratio": 1.1},
+        baseline={"ratio": 1.15, "heldout_ratio": 1.1},
         ranking=ranking,
         pairs=[],
         noise_rms=2.0e-6,
-        at_noise=2.0,  # the threshold at 4 um, beyond every bar (and 1.35x the largest)
-        verdict={"kind": "nothing_missing", "missing_effect": None, "missing_effects": [], "mechanism": None},
+        at_noise=2.0,  # the threshold beyond every bar
+        verdict={
+            "kind": "nothing_missing",
+            "missing_effects": [],
+            "conclusion": "nothing is missing: the model is at the noise floor (1.15x noise) and no candidate is "
+            "significant",
+        },
         baseline_z=np.ones(len(exp.channels) * n),
         baseline_fit=SimpleNamespace(fun=np.ones(len(exp.channels) * n)),
         best_fit=None,
@@ -145,4 +150,5 @@ def test_diagnose_figure_keeps_its_noise_lines_and_legend_clear(tmp_path, drawn)
     diagnose_figure(exp, SimpleNamespace(n=n), result, tmp_path / "diagnose.png")
     ((png, problems, texts),) = drawn
     assert problems == []
-    assert "RMS error after refit (um)" in texts and "nothing is missing" in texts
+    words = " ".join(texts.split())  # the title wraps to its axes
+    assert "RMS error / noise after refit" in words and "nothing is missing" in words
