@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from spring_rig import spring_script
 
 from femast.cli import main
 from femast.effects import unregister_effect
@@ -16,34 +17,7 @@ from femast.experiments.rigs.synthetic import mast_top_data, mast_top_path
 ROOT = Path(__file__).resolve().parents[2]
 MT_DATA = ROOT / "femast" / "examples" / "mast_top_example.csv"
 
-USER_EXPERIMENT = textwrap.dedent('''
-    """A user experiment: a spring pulled back and forth, and a user effect (slip at zero force)."""
-    import numpy as np
-    from femast.effects import Effect, Implementation, register_effect
-    from femast.experiments import Column, Experiment, Parameter
-
-    def model(params, data, effects, options):
-        u = data["F_N"] / params["k"]
-        u = effects.apply("extension", u, data=data, params=params, options=options)
-        return {"u_m": u}
-
-    def _slip(u, p, ctx):
-        return u + p["s"] * np.tanh(ctx["data"]["F_N"] / 1.0)
-
-    experiment = Experiment(
-        name="spring-test", title="a spring pulled back and forth",
-        columns=(Column("F_N", "N", "applied force"), Column("u_m", "m", "measured extension")),
-        channels=("u_m",), parameters=(Parameter("k", "N/m", 1e4, 1.0, 1e8, "spring stiffness"),),
-        model=model, hooks={"extension": "u (n,) m"}, error_unit="m")
-
-    register_effect(Effect(
-        name="spring_slip", title="slip of the spring mount", physics="The mount slips by +-s with the force sign.",
-        signature="a step at zero force", acts_where=("near-zero load",),
-        implementations={"spring-test": Implementation(
-            hook="extension", apply=_slip,
-            parameters=(Parameter("s", "m", 1e-4, 0.0, 1e-2, "half slip", scale=1e-4),))}),
-        replace_existing=True)
-''')
+USER_EXPERIMENT = spring_script("spring-test", "spring_slip")
 
 USER_EFFECT = textwrap.dedent('''
     """A user effect for the built-in mast-top experiment: a linear thermal drift of the top."""

@@ -69,6 +69,25 @@ SLOW_STUDY = textwrap.dedent(
 )
 
 
+def _kill_9_once_running(p, running, what, within_s, settle_s):
+    """SIGKILL process ``p`` (the leader of its own session) ``settle_s`` seconds after ``running()``
+    first holds (at most ``within_s`` seconds); then no process of its session may be alive 30 s
+    later.  Whatever happens, the session's processes are killed at the end."""
+    try:
+        deadline = time.monotonic() + within_s
+        while not running():
+            assert p.poll() is None, f"it ended before {what} started"
+            assert time.monotonic() < deadline, f"{what} did not start"
+            time.sleep(0.2)
+        time.sleep(settle_s)
+        os.kill(p.pid, signal.SIGKILL)
+        p.wait(timeout=30)
+        assert_session_ends(p.pid, within_s=30.0)
+    finally:
+        for pid in session_processes(p.pid):
+            os.kill(pid, signal.SIGKILL)  # (only if the test failed: the processes it started)
+
+
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to find the processes")
 def test_kill_9_of_a_study_on_two_workers_leaves_no_process(tmp_path):
     script = tmp_path / "slow_study.py"
@@ -92,19 +111,8 @@ def test_kill_9_of_a_study_on_two_workers_leaves_no_process(tmp_path):
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
-    try:
-        deadline = time.monotonic() + 300.0
-        while len(session_processes(p.pid)) < 3:  # the study and its two workers
-            assert p.poll() is None, "the study ended before its workers started"
-            assert time.monotonic() < deadline, "the workers did not start"
-            time.sleep(0.2)
-        time.sleep(2.0)  # the workers are running samples
-        os.kill(p.pid, signal.SIGKILL)
-        p.wait(timeout=30)
-        assert_session_ends(p.pid, within_s=30.0)
-    finally:
-        for pid in session_processes(p.pid):
-            os.kill(pid, signal.SIGKILL)  # (only if the test failed: the processes it started)
+    # the study and its two workers; then 2 s while the workers run samples
+    _kill_9_once_running(p, lambda: len(session_processes(p.pid)) >= 3, "the workers", 300.0, 2.0)
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to find the processes")
@@ -120,17 +128,6 @@ def test_kill_9_of_the_shape_accuracy_benchmark_on_a_local_dask_cluster_leaves_n
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
-    try:
-        runs = tmp_path / "out" / "bays2_plain"
-        deadline = time.monotonic() + 600.0
-        while len(session_processes(p.pid)) < 2 or not runs.is_dir():  # the benchmark and its dask worker
-            assert p.poll() is None, "the benchmark ended before its dask worker started"
-            assert time.monotonic() < deadline, "the dask worker did not start"
-            time.sleep(0.2)
-        time.sleep(3.0)  # the worker is running samples
-        os.kill(p.pid, signal.SIGKILL)
-        p.wait(timeout=30)
-        assert_session_ends(p.pid, within_s=30.0)
-    finally:
-        for pid in session_processes(p.pid):
-            os.kill(pid, signal.SIGKILL)  # (only if the test failed: the processes it started)
+    runs = tmp_path / "out" / "bays2_plain"
+    # the benchmark and its dask worker, writing runs; then 3 s while the worker runs samples
+    _kill_9_once_running(p, lambda: len(session_processes(p.pid)) >= 2 and runs.is_dir(), "the dask worker", 600.0, 3.0)
