@@ -7,6 +7,7 @@ dominated it: a baseline at 3.86x the noise was drawn as a 13 mm bar under a 25 
 The figure draws the ratios, the text gives each channel its own unit.
 """
 
+import re
 from types import SimpleNamespace
 
 import numpy as np
@@ -151,10 +152,18 @@ def test_labels_stand_clear_of_bars_and_noise_lines_and_the_title_says_the_verdi
 def test_text_gives_each_channel_in_its_own_unit():
     exp, result = _tip_cycle_result()
     text = format_diagnose(exp, result)
-    assert "baseline: 3.86x the noise (each channel's error over its own noise; held out 3.97x)" in text
+    baseline = re.search(
+        r"baseline: ([\d.]+)x the noise \(each channel's error over its own noise; held out ([\d.]+)x\)", text
+    )
+    assert baseline and [float(v) for v in baseline.groups()] == pytest.approx([3.86, 3.97], rel=1e-3)
     assert "noise floor" not in text  # no RMS of metres and radians together
-    assert "ux_m: RMS error 12 mm, noise 0.9 mm (13.33x)" in text
-    assert "rz_rad: RMS error 4 mrad, noise 8.8 mrad (0.45x)" in text
+    # each channel in its own unit: 12 mm against 0.9 mm (12 / 0.9 = 13.33x), 4 mrad against 8.8 mrad
+    for channel, unit, rms, noise in (("ux_m", "mm", 12.0, 0.9), ("rz_rad", "mrad", 4.0, 8.8)):
+        line = re.search(rf"{channel}: RMS error ([\d.]+) {unit}, noise ([\d.]+) {unit} \(([\d.]+)x\)", text)
+        assert line, channel
+        got_rms, got_noise, got_ratio = (float(v) for v in line.groups())
+        assert [got_rms, got_noise] == pytest.approx([rms, noise], rel=2e-3), channel
+        assert got_ratio == pytest.approx(rms / noise, abs=0.005), channel  # printed to two decimals
 
 
 def test_one_scale_only_where_every_channel_is_in_the_error_unit():
