@@ -79,6 +79,10 @@ class Implementation:
     forms : ``{name: Implementation}`` of generalised forms (module docstring), selected as
         ``effect/name``; each has its own parameters and ``doc``.
     min_axes : fewest axes its quantities must have (2 for a per-axis form).
+    from_baseline : for a generalised form that can gain where the default form does not (one-sided:
+        the default, even in the sign of the load, averages a mechanism acting on one side away),
+        ``diagnose`` fits it from the baseline beside the default form instead of only after the
+        default has gained (:mod:`femast.experiments.candidates`).
     """
 
     hook: str
@@ -90,6 +94,7 @@ class Implementation:
     forms: dict = field(default_factory=dict)
     needs: tuple = ()
     min_axes: int = 1
+    from_baseline: bool = False
 
     def variant(self, form: str | None) -> Implementation:
         """This implementation (``form`` None, "" or its own form name) or its generalised ``form``."""

@@ -22,14 +22,19 @@ def _progressive(u, p, ctx):
     return u / (1.0 + p["beta"] * a + p.get("beta2", 0.0) * a * a)
 
 
-def _beta(L, lower=0.0):
+def _progressive_per_side(u, p, ctx):
+    L = ctx["load"]
+    return u / (1.0 + p["beta_p"] * np.maximum(L, 0.0) - p["beta_n"] * np.minimum(L, 0.0))
+
+
+def _beta(L, lower=0.0, name="beta", what="relative stiffening per unit load"):
     return Parameter(
-        "beta",
+        name,
         unit_inverse(L.unit),
         0.1 / L.scale,
         lower * 100 / L.scale,
         100 / L.scale,
-        "relative stiffening per unit load",
+        what,
         scale=0.1 / L.scale,
         starts=(0.01 / L.scale, 1 / L.scale),
     )
@@ -37,6 +42,14 @@ def _beta(L, lower=0.0):
 
 def _progressive_params(q):
     return (_beta(q["load"]),)
+
+
+def _progressive_per_side_params(q):
+    L = q["load"]
+    return (
+        _beta(L, name="beta_p", what="relative stiffening per unit load, positive load (the shroud on that side)"),
+        _beta(L, name="beta_n", what="relative stiffening per unit load, negative load (the shroud on that side)"),
+    )
 
 
 def _progressive_quadratic_params(q):
@@ -88,7 +101,18 @@ PROGRESSIVE_STIFFNESS = register_effect(
                     apply=_progressive,
                     doc="u = u_linear / (1 + beta |L| + beta2 L^2): both terms of the Rocaspect paper's Eq. 25 (beta2 = "
                     "0: the linear form).",
-                )
+                ),
+                "per_side": Implementation(
+                    hook="displacement",
+                    needs=("load",),
+                    order=20,
+                    parameters=_progressive_per_side_params,
+                    apply=_progressive_per_side,
+                    from_baseline=True,
+                    doc="u = u_linear / (1 + beta_p <L>+ + beta_n <-L>+): each sign of the load is taken up by "
+                    "its own shroud or guy, stiffening by its own amount (a slack or differently tensioned guy "
+                    "on one side: one-sided stiffening; beta_p = beta_n: the linear form).",
+                ),
             },
         ),
     )

@@ -1,10 +1,13 @@
 """The candidates stage of ``diagnose``: refit the model with each candidate effect, in each form.
 
 1. the effects already in the model are refitted in their other forms (a shape mismatch: the form
-   check), and every candidate in its default form, all from the baseline's fit;
-2. the generalised forms of the candidates whose default form gains in the information criterion
-   (under the null nothing does, and a generalised form cannot gain where its default did not),
-   from the default form's fit;
+   check), and every candidate in its default form, all from the baseline's fit; with them, except
+   on the expensive (FE) experiments, the forms that can gain where the default cannot
+   (``from_baseline``: a one-sided form, whose mechanism the default, even in the sign of the
+   load, averages away);
+2. the other generalised forms of the candidates whose default form gains in the information
+   criterion (under the null nothing does, and a refinement of the default cannot gain where the
+   default did not), from the default form's fit;
 3. :func:`rank` scores every refit under the current noise model
    (:func:`~femast.experiments.verdict.score`): ``delta_bic``, the share of the excess error it
    explains, significance (:func:`~femast.experiments.verdict.flags`); each candidate keeps its best
@@ -29,23 +32,35 @@ def fit_candidates(d, while_waiting=None) -> None:
         for alt in forms_of(name, d.exp):
             if alt != b and alt != name + "/" + (form or ""):
                 jobs.append(("form_check", name, alt, [alt if e == b else e for e in d.base_effects], start))
+    cheap = not d.exp.fit_options.get("expensive")
     for c in d.candidates:
         jobs.append(("candidate", c, c, d.base_effects + [c], start))
+        if cheap:  # the forms that can gain where the default cannot (one-sided), from the baseline too
+            jobs += [("candidate", c, alt, d.base_effects + [alt], start) for alt in _from_baseline_forms(c, d.exp)]
     fits = d.refit([(effs, st) for *_, effs, st in jobs], while_waiting)
     ic0 = d.score(d.baseline)["ic"]
+    done = {spec for _, _, spec, *_ in jobs}
     more = []
-    for (stage, c, _spec, _, _), res in zip(jobs, fits):
-        if stage != "candidate" or getattr(res, "failed", False) or d.score(res)["ic"] - ic0 >= SIGNIFICANT_DBIC:
+    for (stage, c, spec, _, _), res in zip(jobs, fits):
+        if stage != "candidate" or spec != c or getattr(res, "failed", False):
+            continue
+        if d.score(res)["ic"] - ic0 >= SIGNIFICANT_DBIC:
             continue
         fitted = {k.split(".", 1)[1]: v for k, v in zip(res.names, res.x) if k.startswith(c + ".")}
         base_fit = {k: v for k, v in zip(res.names, res.x) if "." not in k}
-        for alt in forms_of(c, d.exp)[1:]:
+        for alt in (f for f in forms_of(c, d.exp)[1:] if f not in done):
             _, impl = resolve(d.exp, [alt])[0]
             st = {**base_fit, **{f"{alt}.{p.name}": fitted[p.name] for p in impl.parameters if p.name in fitted}}
             more.append(("candidate", c, alt, d.base_effects + [alt], st))
     if more:
         fits += d.refit([(effs, st) for *_, effs, st in more])
     d.jobs, d.fits_list = jobs + more, fits
+
+
+def _from_baseline_forms(effect: str, exp) -> list:
+    """The generalised forms of ``effect`` on ``exp`` fitted from the baseline (``from_baseline``)."""
+    impl = get_effect(effect).implementation(exp)
+    return [f"{effect}/{n}" for n, f in (impl.forms.items() if impl else ()) if f.from_baseline]
 
 
 def rank(d) -> None:

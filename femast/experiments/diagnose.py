@@ -220,8 +220,11 @@ def _verdict(d: Diagnosis) -> None:
     best = next((e for e in d.ranking if e["significant"]), None)
     where = remaining_where(d, best["_z"] if best else d.s0["z"])
     titles = {e["effect"]: get_effect(e["effect"]).title for e in d.ranking}
-    pairs = [{k: v for k, v in p.items() if not k.startswith("_")} for p in d.pairs if p.get("heldout_ok", True)]
-    verdict = conclude(d.s0["ratio"], d.thr, d.ranking, pairs, d.form_check, titles, where)
+    kept = [p for p in d.pairs if p.get("heldout_ok", True)]
+    pairs = [{k: v for k, v in p.items() if not k.startswith("_")} for p in kept]
+    bp = min(kept, key=lambda p: p["delta_bic"], default=None)
+    pair_where = remaining_where(d, d.score(bp["_fit"])["z"]) if bp is not None else ()
+    verdict = conclude(d.s0["ratio"], d.thr, d.ranking, pairs, d.form_check, titles, where, pair_where)
     # the holds of the test: a response that moves at constant load rules out rate-independent answers
     check = time_check(load_path(d.exp, d.data), {c: d.data[c] for c in d.channels}, d.weights)
     d.verdict = creep_overrules(verdict, check, lambda name: reads_time(d.exp, name))

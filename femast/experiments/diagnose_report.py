@@ -71,10 +71,11 @@ def diagnosis_result(d, out=None) -> OptimizeResult:
         "baseline_signatures": d.analysis["signatures"][:3],
         "executor": d.how,
         "at_noise": d.thr,
+        "untimed": list(d.untimed),
     }
     v = d.verdict
     best_fit = None
-    if v["kind"] == "missing_pair":
+    if len(v.get("missing_effects") or []) == 2:  # a pair found (at the noise or with its forms imperfect)
         best_fit = next((p["_fit"] for p in d.pairs if p["effects"] == v["missing_effects"]), None)
     elif d.ranking and not d.ranking[0].get("failed"):
         best_fit = d.fits[d.ranking[0]["effect"]]
@@ -98,6 +99,7 @@ def diagnosis_result(d, out=None) -> OptimizeResult:
         files={},
         at_noise=d.thr,
         n_eff=d.n_eff,
+        untimed=list(d.untimed),
         success=bool(d.baseline.success) and all(e["success"] for e in d.ranking),
         message=v["conclusion"],
         by_kind=d.analysis["by_kind"],
@@ -192,6 +194,11 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
         lines.append(
             f"  form check of the added {fc['effect']}: form {fc['form']} {fc['ratio']:.2f}x noise, dBIC "
             f"{fc['delta_bic']:+.1f}{' (significant)' if fc['significant'] else ''}"
+        )
+    if getattr(result, "untimed", None):
+        lines.append(
+            f"  not tried: {', '.join(result.untimed)} (a law in time; the data have no t_s column, and their row "
+            "number follows the load path, not the clock: add t_s, or name it with --candidates)"
         )
     if result.ranking:
         lines.append(f"  reading of #1: {result.ranking[0]['reading']}")

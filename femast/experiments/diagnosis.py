@@ -15,10 +15,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import OptimizeResult
 
-from ..effects.base import applicable_effects, resolve, split_form
+from ..effects.base import applicable_effects, get_effect, resolve, split_form
 from ..errors import ModelError
 from .refits import _dispatch
 from .verdict import score
+
+
+def _reads_time(exp, name: str) -> bool:
+    """True if the effect ``name`` acts on ``exp`` as a law in time (its implementation there needs it)."""
+    impl = get_effect(name).implementation(exp)
+    return impl is not None and "time" in impl.needs
 
 
 def effect_names(names) -> list:
@@ -40,6 +46,7 @@ class Diagnosis:
     workers: int | None = None
     scheduler: object = None
     pool: object = None  # refit workers started with the diagnosis (femast.experiments.refits.refit_pool)
+    untimed: list = field(default_factory=list)  # effects in time not tried: the data record no time
     # the baseline stage
     baseline: OptimizeResult | None = None
     models: dict = field(default_factory=dict)  # {channel: ChannelNoise}, the noise model of the moment
@@ -66,18 +73,26 @@ class Diagnosis:
     @classmethod
     def of(cls, exp, data, candidates, exclude, base_effects, **kw) -> Diagnosis:
         """A diagnosis of ``exp`` on ``data``: the effects already in the model checked, the candidates
-        (every applicable effect not in it, or those given, less ``exclude``)."""
+        (every applicable effect not in it, or those given, less ``exclude``).  By default an effect
+        that acts as a law in time (a stiffness lost over the test) is a candidate only on data that
+        record the time (a ``t_s`` column): the row number of a test recorded step by step follows
+        its load path, not the clock (``untimed`` lists those left out); named in ``candidates`` it
+        runs on the row index."""
         base = [n for n, _ in resolve(exp, effect_names(base_effects))]
         in_model = {split_form(n)[0] for n in base}
+        untimed = []
         if candidates is None:
             cands = [e.name for e in applicable_effects(exp) if e.name not in in_model]
+            if not data.has_time:  # a law in time fitted against the row number is not a law in time
+                untimed = [c for c in cands if _reads_time(exp, c)]
+                cands = [c for c in cands if c not in untimed]
         else:
             cands = [split_form(n)[0] for n, _ in resolve(exp, effect_names(candidates))]
             dup = set(cands) & in_model
             if dup:
                 raise ModelError(f"candidate effect(s) {', '.join(sorted(dup))} are already in the model")
         excluded = {split_form(n)[0] for n, _ in resolve(exp, effect_names(exclude))}
-        return cls(exp, data, base, [c for c in cands if c not in excluded], **kw)
+        return cls(exp, data, base, [c for c in cands if c not in excluded], untimed=untimed, **kw)
 
     @property
     def channels(self) -> tuple:

@@ -201,7 +201,7 @@ def diagnose_figure(exp, data, result, png) -> Path:
         ).reshape(len(exp.channels), -1)
         label = (
             " + ".join(v.get("missing_effects") or [])
-            if v.get("kind") == "missing_pair"
+            if len(v.get("missing_effects") or []) == 2
             else result.ranking[0]["effect"]
         )
         ax1.plot(rows, np.sqrt((zc**2).mean(0)), "-", lw=0.8, color="C2", label=f"with {label}")

@@ -73,6 +73,12 @@ class Measured:
         return np.asarray(t, float) if t is not None else np.arange(self.n, dtype=float)
 
     @property
+    def has_time(self) -> bool:
+        """True if the data record the time of each row (a ``t_s`` column): without it the row index
+        stands in for the time (the order of the rows, not their spacing)."""
+        return "t_s" in self.columns
+
+    @property
     def tau(self) -> np.ndarray:
         """Normalised time in [0, 1] (from ``t_s`` if present, else the row index), dimensionless: over
         each group, or over the whole data set when ``time_continuous`` (module docstring)."""

@@ -38,7 +38,9 @@ Conclusions (``verdict["kind"]``)
   to the noise floor and is significantly better than its best member alone (information
   criterion -10 and another 10 % of the excess), also when that member alone reaches the floor
   (a small second effect);
-* ``form_imperfect`` -- the best candidate explains at least ``FORM_SHARE`` = 60 % of the excess
+* ``form_imperfect`` -- the best pair passes the pair test and explains at least ``FORM_SHARE`` =
+  60 % of the excess but leaves structure (``missing_effects`` names both: two mechanisms are
+  there, their forms are not right); else the best candidate explains at least 60 % of the excess
   but leaves structure: the mechanism is there, its form is not right (the verdict names where the
   rest sits and what to try);
 * ``nothing_missing`` -- no candidate is significant and the baseline is at the noise floor;
@@ -122,9 +124,18 @@ def pair_beats_members(p: dict) -> bool:
 
 
 def conclude(
-    r0: float, thr: float, ranking: list, pairs: list, form_check: list, titles: dict, remaining_where=()
+    r0: float,
+    thr: float,
+    ranking: list,
+    pairs: list,
+    form_check: list,
+    titles: dict,
+    remaining_where=(),
+    pair_where=(),
 ) -> dict:
-    """The verdict (module docstring) from the scored ranking (best first), pairs and form check."""
+    """The verdict (module docstring) from the scored ranking (best first), pairs and form check;
+    ``remaining_where`` and ``pair_where`` name the segments where the error of the best candidate
+    and of the best pair stays above the noise (worst first)."""
     best = next((e for e in ranking if e["significant"]), None)
     bp = min(pairs, key=lambda p: p["delta_bic"]) if pairs else None
     fc = min((f for f in form_check if f["significant"]), key=lambda f: f["delta_bic"], default=None)
@@ -182,6 +193,23 @@ def conclude(
         )
         if alts:
             v["conclusion"] += f"; also consistent with the data: {', '.join(alts)}"
+        return v
+    pair_found = bp is not None and best is not None and pair_beats_members(bp)
+    if pair_found and bp["explained_fraction"] >= FORM_SHARE:
+        where = ", ".join(pair_where[:3]) or "spread along the path"
+        v.update(
+            kind="form_imperfect",
+            missing_effects=list(bp["effects"]),
+            mechanism=" + ".join(bp["effects"]),
+            remaining_where=list(pair_where),
+        )
+        v["try_next"].append("generalised forms of these effects (an own effect or form: docs/experiments.md)")
+        v["conclusion"] = (
+            f"mechanisms found, forms imperfect: {' + '.join(bp['effects'])} (fitted together) explain "
+            f"{100 * bp['explained_fraction']:.0f} % of the excess error ({r0:.2f}x -> {bp['ratio']:.2f}x the "
+            f"noise), significantly more than either alone, but structure remains, mostly in: {where}; try "
+            f"{'; '.join(v['try_next'])}"
+        )
         return v
     if bp is not None and bp["significant"] and bp["ratio"] < (best["ratio"] if best else r0):
         v["try_next"].append(f"the pair {' + '.join(bp['effects'])} ({bp['ratio']:.2f}x the noise)")

@@ -105,3 +105,19 @@ def test_copying_the_examples_keeps_the_licence_beside_the_real_data(tmp_path):
     assert main(["examples", "--copy", str(tmp_path)]) in (0, None)
     assert (tmp_path / "joint_test_spc1.csv").is_file()
     assert (tmp_path / "NOTICE-SPC1.txt").is_file() and (tmp_path / "LICENSE-SPC1-Apache-2.0.txt").is_file()
+
+
+def test_a_law_in_time_is_a_candidate_only_on_data_that_record_the_time(rig):
+    """Recorded step by step, a test's row number follows its load path: a stiffness lost "with time"
+    fitted against it is a law of the cumulative stroke (the degradation's), not of the clock."""
+    from femast.experiments.diagnosis import Diagnosis
+
+    exp, data, F = rig
+    d = Diagnosis.of(exp, data, None, (), ())
+    assert "pretension_loss" not in d.candidates and d.untimed == ["pretension_loss"]
+    assert {"friction_hysteresis", "degradation"} <= set(d.candidates)
+    timed = from_arrays(exp, F_N=F, u_m=F / 2e6, t_s=np.arange(F.size, dtype=float))
+    d = Diagnosis.of(exp, timed, None, (), ())
+    assert "pretension_loss" in d.candidates and d.untimed == []
+    d = Diagnosis.of(exp, data, ["pretension_loss"], (), ())  # named: runs on the row index
+    assert d.candidates == ["pretension_loss"] and d.untimed == []
