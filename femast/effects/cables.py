@@ -265,10 +265,14 @@ CABLE_HYSTERESIS = register_effect(
                             ),
                         ),
                         apply=_cable_hysteresis_latch_pull_iwan,
+                        from_baseline=True,  # the play form is centred on Eq. 15's line: see its doc
                         doc="x_bead = x + sign(dT) c_cable (kappa |dT| - gain P(|dT|)), P(T) = mean_j play(T; eta_j T), "
                         "eta_j = eta q_j^(1/beta): the test cable's stretch c_cable gain P(T) follows the tension "
                         "through fibre groups with a distribution of friction coefficients (smooth loops closing at "
-                        "zero), Eq. 15 removed c_cable kappa T.  kappa = gain = 1, beta -> inf: the play form.",
+                        "zero), Eq. 15 removed c_cable kappa T.  kappa = gain = 1, beta -> inf: the play form.  Fitted from the "
+                        "baseline too: the play form's loop is centred on the line Eq. 15 removed, so a loop that "
+                        "follows that line on loading and bows only on the return (a rope that creeps back) "
+                        "gains nothing in it, and in this form it does.",
                     )
                 },
             ),
@@ -376,6 +380,15 @@ def _stretch_latch_pull(x, p, ctx):
     return x - p["c_s"] * ctx["prep"]["dT"]
 
 
+def _stretch_latch_pull_per_cable(x, p, ctx):
+    dT = ctx["prep"]["dT"]
+    return x - np.where(dT > 0.0, p["c_out"], p["c_in"]) * dT
+
+
+def _compliance_error(name, what):
+    return Parameter(name, "m/N", 1e-6, -1e-4, 1e-4, f"compliance error of the stretch removal{what}", scale=1e-6)
+
+
 STRETCH_ERROR = register_effect(
     Effect(
         name="stretch_error",
@@ -393,11 +406,23 @@ STRETCH_ERROR = register_effect(
             "latch-pull": Implementation(
                 hook="bead_position",
                 order=20,
-                parameters=(
-                    Parameter("c_s", "m/N", 1e-6, -1e-4, 1e-4, "compliance error of the stretch removal", scale=1e-6),
-                ),
+                parameters=(_compliance_error("c_s", ""),),
                 apply=_stretch_latch_pull,
                 doc="x_bead = x - c_s dT.",
+                forms={
+                    "per_cable": Implementation(
+                        hook="bead_position",
+                        order=20,
+                        parameters=(
+                            _compliance_error("c_out", " of the outer cable (dT > 0)"),
+                            _compliance_error("c_in", " of the inner cable (dT < 0)"),
+                        ),
+                        apply=_stretch_latch_pull_per_cable,
+                        doc="x_bead = x - c dT with c = c_out while the outer cable pulls (dT > 0), c_in while the "
+                        "inner one does: a pass loads one cable of each diagonal pair at a time (Stohlman & "
+                        "Pellegrino, Sec. III.B), each with its own length and EA (c_out = c_in: the default form).",
+                    )
+                },
             ),
         },
     )

@@ -11,6 +11,8 @@ baseline and against their best member alone (``gain_over_best_single``,
 
 from __future__ import annotations
 
+from ..effects.base import split_form
+from .candidates import form_of
 from .verdict import flags, pair_candidates, robust_delta, share
 
 
@@ -45,10 +47,11 @@ def score_pairs(d) -> None:
         delta, frac = sc["ic"] - ic0, share(r0, sc["ratio"])
         dr = robust_delta(d.s0["z"], sc["z"], d.data.n, d.models, int(d.baseline.n_params), int(res.n_params))
         x, y = sorted((x, y), key=order.index)  # the better-ranked member first
+        spec = {split_form(s)[0]: s for s in res.effects}  # the forms fitted (the ranking may since differ)
         out.append(
             {
                 "effects": [x, y],
-                "forms": [by[x]["form"], by[y]["form"]],
+                "forms": [form_of(spec[x], x, d.exp), form_of(spec[y], y, d.exp)],
                 "ratio": sc["ratio"],
                 "rms": float(res.rms),
                 "delta_bic": float(delta),
