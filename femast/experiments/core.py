@@ -120,6 +120,10 @@ class Experiment:
         experiment declares applies to it, the library's and the user's alike.
     renamed_options : ``{old name: new name}`` of options renamed: :meth:`with_options` takes the old
         name for one release, with a DeprecationWarning naming the new one.
+    row_clock : True (default) if, without a ``t_s`` column, the row index may stand in for the time
+        (rows logged at a steady rate); False for a test recorded step by step along its load
+        protocol (a cyclic connection test), whose row number follows the load path, not the clock:
+        ``diagnose`` then tries the effects that are laws in time only on data with ``t_s``.
 
     Every channel ``c`` also accepts an optional column ``sigma_c`` (same unit) with the standard
     uncertainty of each row; ``diagnose`` then uses it as the noise of that channel.
@@ -150,6 +154,7 @@ class Experiment:
     path_coordinate: Callable | None = None
     quantities: dict = field(default_factory=dict)
     renamed_options: dict = field(default_factory=dict)
+    row_clock: bool = True
 
     def __post_init__(self):
         names = [c.name for c in self.columns]

@@ -166,9 +166,11 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
             lines.append(
                 "    the sources disagree: " + ", ".join(f"{k} {fc * v:.4g} {uc}" for k, v in m.levels.items())
             )
+    # channels of different units (m and rad) have no pooled RMS: each is over its own noise (x noise)
+    rms_of = (lambda r: f"{f * r:>10.4g}") if exp.one_scale else (lambda r: f"{'-':>10s}")
     lines.append(
-        f"  {'rank':>4s}  {'effect':<22s} {'form':<10s} {'RMS':>10s} {'x noise':>8s} {'held out':>8s} {'dBIC':>9s} "
-        f"{'share':>6s}  sig  parameters"
+        f"  {'rank':>4s}  {'effect':<22s} {'form':<10s} {'RMS':>10s} {'x noise':>8s} "
+        f"{'held out':>8s} {'dBIC':>9s} {'share':>6s}  sig  parameters"
     )
     for i, e in enumerate(result.ranking):
         if e.get("failed"):
@@ -179,14 +181,14 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
             for k, v in e["params"].items()
         )
         lines.append(
-            f"  {i + 1:>4d}  {e['effect']:<22s} {e.get('form') or '-':<10s} {f * e['rms']:>10.4g} "
+            f"  {i + 1:>4d}  {e['effect']:<22s} {e.get('form') or '-':<10s} {rms_of(e['rms'])} "
             f"{e['ratio']:>8.2f} {_ho(e.get('heldout_ratio')):>8s} {e['delta_bic']:>9.1f} "
             f"{100 * e['explained_fraction']:>5.0f}%  "
             f"{'yes' if e['significant'] else ' no'}  {ps}"
         )
     for p in (getattr(result, "pairs", None) or [])[:3]:
         lines.append(
-            f"  pair  {' + '.join(p['effects']):<33s} {f * p['rms']:>10.4g} {p['ratio']:>8.2f} "
+            f"  pair  {' + '.join(p['effects']):<33s} {rms_of(p['rms'])} {p['ratio']:>8.2f} "
             f"{_ho(p.get('heldout_ratio')):>8s} {p['delta_bic']:>9.1f} {100 * p['explained_fraction']:>5.0f}%  "
             f"{'yes' if pair_beats_members(p) else ' no'}"
         )
@@ -197,8 +199,8 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
         )
     if getattr(result, "untimed", None):
         lines.append(
-            f"  not tried: {', '.join(result.untimed)} (a law in time; the data have no t_s column, and their row "
-            "number follows the load path, not the clock: add t_s, or name it with --candidates)"
+            f"  not tried: {', '.join(result.untimed)} (a law in time; the data have no t_s column, and on this "
+            "rig the row number follows the load path, not the clock: add t_s, or name it with --candidates)"
         )
     if result.ranking:
         lines.append(f"  reading of #1: {result.ranking[0]['reading']}")

@@ -73,17 +73,18 @@ class Diagnosis:
     @classmethod
     def of(cls, exp, data, candidates, exclude, base_effects, **kw) -> Diagnosis:
         """A diagnosis of ``exp`` on ``data``: the effects already in the model checked, the candidates
-        (every applicable effect not in it, or those given, less ``exclude``).  By default an effect
-        that acts as a law in time (a stiffness lost over the test) is a candidate only on data that
-        record the time (a ``t_s`` column): the row number of a test recorded step by step follows
-        its load path, not the clock (``untimed`` lists those left out); named in ``candidates`` it
-        runs on the row index."""
+        (every applicable effect not in it, or those given, less ``exclude``).  On an experiment
+        recorded step by step along its protocol (``Experiment.row_clock`` False: a connection test)
+        an effect that acts as a law in time (a stiffness lost over the test) is by default a
+        candidate only on data that record the time (a ``t_s`` column): there the row number follows
+        the load path, not the clock, and a law in it is a law of the stroke (``untimed`` lists those
+        left out); named in ``candidates`` it runs on the row index."""
         base = [n for n, _ in resolve(exp, effect_names(base_effects))]
         in_model = {split_form(n)[0] for n in base}
         untimed = []
         if candidates is None:
             cands = [e.name for e in applicable_effects(exp) if e.name not in in_model]
-            if not data.has_time:  # a law in time fitted against the row number is not a law in time
+            if not data.has_time and not exp.row_clock:  # the row number follows the load path, not the clock
                 untimed = [c for c in cands if _reads_time(exp, c)]
                 cands = [c for c in cands if c not in untimed]
         else:

@@ -18,6 +18,25 @@ def verdict_words(v: dict) -> str:
     return text or "none of the candidates explains this"
 
 
+def _load_label(label: str, load):
+    """(label, factor) of the load panel: a label ending in an SI unit ("force (N)") shown in the unit
+    that suits the load's size ("force (kN)")."""
+    head, sep, unit = label.rpartition(" (")
+    if sep and unit.endswith(")"):
+        f, ul = display_scale(unit[:-1], load)
+        return f"{head} ({ul})", f
+    return label, 1.0
+
+
+def _shade(color, amount: float):
+    """``color`` mixed with white (``amount`` > 0) or black (< 0) by ``|amount|`` (0: unchanged)."""
+    from matplotlib.colors import to_rgb
+
+    rgb = np.asarray(to_rgb(color))
+    target = 1.0 if amount > 0 else 0.0
+    return tuple(rgb + abs(amount) * (target - rgb))
+
+
 def _plt():
     return plotstyle.pyplot()
 
@@ -65,26 +84,26 @@ def compare_figure(exp, data, result, png) -> Path:
         ax0.plot(lim, lim, "k--", lw=0.8)
         ax0.set_xlabel("measured " + column_label(c, ul))
         ax0.set_ylabel("model " + column_label(c, ul))
-    for i, c in enumerate(exp.channels):
+    for i, c in enumerate(exp.channels):  # measured light, model dark: one hue per channel
         f, ul = shown[c]
-        ax1.plot(rows, f * data[c], ".", ms=2, color=f"C{i}", alpha=0.6)
-        ax1.plot(rows, f * pred[c], "-", lw=1.0, color=f"C{i}", label=column_label(c, ul))
-    ax1.set_title("measured (dots) and model (lines) along the path")
+        ax1.plot(rows, f * data[c], ".", ms=2, color=_shade(f"C{i}", 0.55), zorder=1)
+        ax1.plot(rows, f * pred[c], "-", lw=1.1, color=_shade(f"C{i}", -0.45), label=column_label(c, ul), zorder=2)
+    ax1.set_title("measured (light dots) and model (dark lines) along the path")
     ax1.set_xlabel("data row (time order)")
     uc = _common_unit(shown)
     ax1.set_ylabel(f"measured and model ({uc})" if uc else "measured and model (unit: legend)")
     ax1.legend(ncol=min(3, len(exp.channels)))
-    s = result.load
+    lab, fl = _load_label(exp.load_label, result.load)
+    s = fl * np.asarray(result.load, dtype=float)
     ax2.plot(rows, s, "-", color="0.3", lw=1.0)
     for kind, color in (("near-zero load", "C1"), ("reversal", "C4"), ("peak", "C2")):
         m = result.masks.get(kind)
         if m is not None and m.any():
             ax2.plot(rows[m], s[m], ".", ms=3, color=color, label=kind)
-    lab = exp.load_label
     ax2.set_ylabel(lab.replace(" (", "\n(", 1) if len(lab) > 24 else lab)  # a long label on two lines
-    ax2.set_title("load along the path: near-zero load, reversals and peaks marked")
-    if ax2.get_legend_handles_labels()[0]:  # a path with no marked rows has no legend
-        ax2.legend(ncol=3, loc="upper right")
+    ax2.set_title("load along the path, segments marked", loc="left")
+    if ax2.get_legend_handles_labels()[0]:  # a path with no marked rows has no legend; above the axes, off the data
+        ax2.legend(ncol=3, loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
     for i, c in enumerate(exp.channels):
         f, ul = errors[c]
         ax3.plot(rows, f * result.residuals[c], "-", lw=0.8, color=f"C{i}", label=column_label(c, ul))
@@ -94,20 +113,29 @@ def compare_figure(exp, data, result, png) -> Path:
         else:
             ax3.axhline(f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
             ax3.axhline(-f * result.noise[c], color=f"C{i}", ls=":", lw=0.7)
+    worst = []  # shaded and numbered on the axes, named in the legend below them (labels never pile up)
     for k, seg in enumerate([w for w in result.worst[:3] if w["ratio"] > AT_NOISE]):
-        ax3.axvspan(seg["start_row"] - 0.5, seg["end_row"] + 0.5, color="C3", alpha=0.18 - 0.04 * k, lw=0)
-        mid = 0.5 * (seg["start_row"] + seg["end_row"])
-        ha = "right" if mid > 0.85 * data.n else ("left" if mid < 0.15 * data.n else "center")  # inside the axes
+        worst.append(
+            ax3.axvspan(
+                seg["start_row"] - 0.5,
+                seg["end_row"] + 0.5,
+                color="C3",
+                alpha=0.18 - 0.04 * k,
+                lw=0,
+                label=f"#{k + 1} {seg['kind']}, {seg['ratio']:.1f}x noise",
+            )
+        )
         ax3.text(
-            mid,
-            0.97 - 0.13 * k,
-            f"#{k + 1} {seg['kind']} {seg['ratio']:.1f}x noise",
+            0.5 * (seg["start_row"] + seg["end_row"]),
+            0.98 - 0.08 * k,
+            f"#{k + 1}",
             transform=ax3.get_xaxis_transform(),
-            ha=ha,
+            ha="center",
             va="top",
-            fontsize=7.5,
+            fontsize=8,
             color="C3",
-            bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.7),
+            clip_on=True,
+            bbox=dict(boxstyle="round,pad=0.1", fc="white", ec="none", alpha=0.8),
         )
     ax3.set_xlabel("data row (time order)")
     ue = _common_unit(errors)
@@ -119,7 +147,8 @@ def compare_figure(exp, data, result, png) -> Path:
             f"shaded; RMS {num(result.ratio)}x noise",
         )
     )
-    ax3.legend(ncol=min(3, len(exp.channels)), loc="lower right")
+    handles, _ = ax3.get_legend_handles_labels()
+    plotstyle.legend_below(ax3, ncol=min(3, len(handles)), fontsize=8)
     eff = "+".join(result.effects) or "baseline"
     fig.suptitle(
         fit_title(

@@ -215,7 +215,7 @@ def diagnose_report(exp, data, result, folder) -> Path:
             [
                 i + 1,
                 e["effect"],
-                "failed" if e.get("failed") else num(f * e["rms"], 4),
+                *(["failed" if e.get("failed") else num(f * e["rms"], 4)] if exp.one_scale else []),
                 num(e["ratio"], 3),
                 f"{e['delta_bic']:+.1f}",
                 "yes" if e["significant"] else "no",
@@ -237,9 +237,11 @@ def diagnose_report(exp, data, result, folder) -> Path:
         (
             "Candidates, best first",
             table(
-                ["rank", "effect", f"RMS ({ul})", "x noise", "delta BIC", "significant", "parameters"],
+                # channels of different units (m and rad): no pooled RMS, each channel over its own noise
+                ["rank", "effect", *([f"RMS ({ul})"] if exp.one_scale else []), "x noise", "delta BIC", "significant"]
+                + ["parameters"],
                 rows,
-                numeric=(0, 2, 3, 4),
+                numeric=(0, 2, 3, 4) if exp.one_scale else (0, 2, 3),
             )
             + "".join(f"<p><b>{esc(e['effect'])}</b>: {esc(e['reading'])}</p>" for e in result.ranking[:3]),
         ),

@@ -166,6 +166,17 @@ def test_text_gives_each_channel_in_its_own_unit():
         assert got_ratio == pytest.approx(rms / noise, abs=0.005), channel  # printed to two decimals
 
 
+def test_ranking_has_no_rms_of_metres_and_radians_together():
+    exp, result = _tip_cycle_result()
+    for e in result.ranking:  # an RMS a pooled table would print as a length
+        e["rms"] = 0.0123
+    text = format_diagnose(exp, result)
+    rows = [line.split() for line in text.splitlines() if line.strip()[:1].isdigit() or line.strip().startswith("pair")]
+    assert rows and all("12.3" not in r and "0.0123" not in r for r in rows)
+    first = next(r for r in rows if r[1] == result.ranking[0]["effect"])
+    assert first[3] == "-" and float(first[4]) == pytest.approx(result.ranking[0]["ratio"], abs=0.005)
+
+
 def test_one_scale_only_where_every_channel_is_in_the_error_unit():
     assert not get_experiment("tip-cycle").one_scale  # m and rad (rotations weighted by the mast length)
     assert all(get_experiment(n).one_scale for n in ("mast-top", "latch-pull", "joint-test", "bay-torsion"))
