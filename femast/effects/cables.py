@@ -380,15 +380,6 @@ def _stretch_latch_pull(x, p, ctx):
     return x - p["c_s"] * ctx["prep"]["dT"]
 
 
-def _stretch_latch_pull_per_cable(x, p, ctx):
-    dT = ctx["prep"]["dT"]
-    return x - np.where(dT > 0.0, p["c_out"], p["c_in"]) * dT
-
-
-def _compliance_error(name, what):
-    return Parameter(name, "m/N", 1e-6, -1e-4, 1e-4, f"compliance error of the stretch removal{what}", scale=1e-6)
-
-
 STRETCH_ERROR = register_effect(
     Effect(
         name="stretch_error",
@@ -406,23 +397,11 @@ STRETCH_ERROR = register_effect(
             "latch-pull": Implementation(
                 hook="bead_position",
                 order=20,
-                parameters=(_compliance_error("c_s", ""),),
+                parameters=(
+                    Parameter("c_s", "m/N", 1e-6, -1e-4, 1e-4, "compliance error of the stretch removal", scale=1e-6),
+                ),
                 apply=_stretch_latch_pull,
                 doc="x_bead = x - c_s dT.",
-                forms={
-                    "per_cable": Implementation(
-                        hook="bead_position",
-                        order=20,
-                        parameters=(
-                            _compliance_error("c_out", " of the outer cable (dT > 0)"),
-                            _compliance_error("c_in", " of the inner cable (dT < 0)"),
-                        ),
-                        apply=_stretch_latch_pull_per_cable,
-                        doc="x_bead = x - c dT with c = c_out while the outer cable pulls (dT > 0), c_in while the "
-                        "inner one does: a pass loads one cable of each diagonal pair at a time (Stohlman & "
-                        "Pellegrino, Sec. III.B), each with its own length and EA (c_out = c_in: the default form).",
-                    )
-                },
             ),
         },
     )

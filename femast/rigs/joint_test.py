@@ -16,6 +16,10 @@ u_m    m     the displacement it drives (compared channel)
 t_s    s     optional time; rows in time order
 =====  ====  ==================================================================
 
+A connection test is recorded step by step along its protocol, so without ``t_s`` the row number
+follows the load path, not the clock: ``diagnose`` tries the effects that are laws in time
+(``pretension_loss``) only on data with ``t_s`` (or when named with ``candidates``).
+
 Baseline model
 --------------
 A linear elastic connection: ``u = F / k``, ``k`` fitted (N/m).  Every mechanism of a real
@@ -157,6 +161,7 @@ def joint_test(
         ),
         error_unit=du,
         min_rows=10,
+        row_clock=False,  # recorded step by step along the protocol: the row number is not a clock
         source=NAME if name == NAME else "",
     )
     add_connection_effects(name, exp.quantities)
