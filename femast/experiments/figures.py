@@ -86,7 +86,7 @@ def compare_figure(exp, data, result, png) -> Path:
         ax0.set_ylabel("model " + column_label(c, ul))
     for i, c in enumerate(exp.channels):  # measured light, model dark: one hue per channel
         f, ul = shown[c]
-        ax1.plot(rows, f * data[c], ".", ms=2, color=_shade(f"C{i}", 0.55), zorder=1)
+        ax1.plot(rows, f * data[c], ".", ms=2 if data.n > 500 else 5, color=_shade(f"C{i}", 0.55), zorder=1)
         ax1.plot(rows, f * pred[c], "-", lw=1.1, color=_shade(f"C{i}", -0.45), label=column_label(c, ul), zorder=2)
     ax1.set_title("measured (light dots) and model (dark lines) along the path")
     ax1.set_xlabel("data row (time order)")
