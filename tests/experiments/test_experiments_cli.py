@@ -102,8 +102,11 @@ def test_compare_json_files_and_history_show_the_error_falling(tmp_path, capsys)
     assert json.loads((out / "compare.json").read_text())["version"] == 4
 
 
-def test_diagnose_json_schema(tmp_path, capsys):
-    r = _run_json(capsys, ["diagnose", "mast-top", str(MT_DATA), "--out", str(tmp_path), "--json", "--workers", "1"])
+def test_diagnose_json_schema(example_diagnosis):
+    # `femast diagnose mast-top example --workers 1` (run once per session): its diagnose.json, the
+    # report --json prints
+    run = example_diagnosis("mast-top")
+    r = run.report
     assert {"experiment", "n_samples", "noise_rms", "baseline", "ranking", "verdict"} <= set(r)
     assert {"rms", "params"} <= set(r["baseline"])
     for e in r["ranking"]:
@@ -124,7 +127,7 @@ def test_diagnose_json_schema(tmp_path, capsys):
     assert sorted(r["verdict"]["missing_effects"]) == ["friction_hysteresis", "joint_clearance"]
     assert {"noise_model", "n_eff", "pairs", "form_check"} <= set(r)
     assert {"form", "forms", "ic_gain", "share_ok"} <= set(r["ranking"][0])
-    assert (tmp_path / "diagnose.png").stat().st_size > 0 and (tmp_path / "diagnose.json").is_file()
+    assert (run.out / "diagnose.png").stat().st_size > 0 and r["files"]["json"] == str(run.out / "diagnose.json")
     # with joint_clearance in the model, friction_hysteresis is what is missing: the tutorial quotes that
     # diagnosis (docs/compare_and_diagnose.md, test_experiments_docs.py), not run a second time here
 

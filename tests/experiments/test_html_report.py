@@ -28,12 +28,15 @@ KINDS = ["compare", "diagnose"] + [f"compare:{name}" for name in EXPERIMENTS if 
 
 
 @pytest.fixture(scope="module")
-def reports(tmp_path_factory):
+def reports(tmp_path_factory, example_diagnosis):
     folder = tmp_path_factory.mktemp("reports")
     out = folder / "mast"
     assert main(["compare", "mast-top", "example", "--out", str(out), "--json"]) == 0
-    assert main(["diagnose", "latch-pull", "example", "--out", str(folder / "latch"), "--workers", "1", "--json"]) == 0
-    return {"compare": out / "compare_report.html", "diagnose": folder / "latch" / "diagnose_report.html"}
+    # `femast diagnose latch-pull example --workers 1`, run once per session for the tests that read it
+    return {
+        "compare": out / "compare_report.html",
+        "diagnose": example_diagnosis("latch-pull").out / "diagnose_report.html",
+    }
 
 
 def _report(reports, kind, folder):
