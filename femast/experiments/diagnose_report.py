@@ -178,7 +178,7 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
             for k, v in e["params"].items()
         )
         if e.get("screened"):
-            ps = "screened out: linearised, not refitted (its reading says why)"
+            ps = "screened out: not refitted in full (its reading says why)"
         lines.append(
             f"  {i + 1:>4d}  {e['effect']:<22s} {e.get('form') or '-':<10s} {f * e['rms']:>10.4g} "
             f"{e['ratio']:>8.2f} {_ho(e.get('heldout_ratio')):>8s} {e['delta_bic']:>9.1f} "
