@@ -162,7 +162,7 @@ class FitProblem:
                 fun, kw["jac"] = fj.value, fj.jac
                 jacobians.append(fj)
                 if screen and secant:
-                    fj.futile = futility_check(screen, p_new, sr, lo, hi)
+                    fj.futile = futility_check(screen, p_new, sr, lo, hi, _BAD)
             kw_k = kw
             if min_dec:
                 # a noise model given: the cost is half the chi-square, and a decrease below min_dec is no

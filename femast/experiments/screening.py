@@ -102,12 +102,13 @@ def judge(lin, s: dict, p_new: int, sigma_rows, fitted_with=None) -> tuple:
     return could_be_significant(rss, rss_lin, s, p_new), rss_lin, du
 
 
-def futility_check(s: dict, p_new: int, sigma_rows, lo, hi):
+def futility_check(s: dict, p_new: int, sigma_rows, lo, hi, bad: float):
     """The check an expensive refit's Jacobian runs at every iterate (:class:`~.fe_jacobian._FEJacobian`):
-    raises :class:`Futile` where the refit cannot make its candidate significant."""
+    raises :class:`Futile` where the refit cannot make its candidate significant.  An iterate where the
+    model failed (a whitened residual of ``bad``: a skipped parameter set) is not judged."""
 
     def check(u, f0, J):
-        if not (np.all(np.isfinite(f0)) and np.all(np.isfinite(J)) and np.all(np.isfinite(sigma_rows))):
+        if not (np.all(np.abs(f0) < bad) and np.all(np.isfinite(J)) and np.all(np.isfinite(sigma_rows))):
             return
         lin = (f0 * sigma_rows, J * sigma_rows[:, None], lo - u, hi - u)
         if not judge(lin, s, p_new, sigma_rows)[0]:
