@@ -1,11 +1,11 @@
-"""The shipped examples' diagnoses, run once per test session for every test that reads them.
+"""The shipped examples' compare and diagnose, run once per test session for every test that reads them.
 
-``femast diagnose NAME example --workers 1`` of a shipped example takes seconds to tens of seconds;
-the tutorial's transcript, the user's-words checks, the JSON schema and the HTML report each read
-the same diagnosis.  :func:`diagnose_example` runs it through the command line, as a user does,
-recording what it prints and the checks of every figure it draws (:mod:`figure_geometry`), and the
-session fixture ``example_diagnosis`` of tests/conftest.py keeps one run per experiment.  The
-tests read its folder and text; none writes there."""
+``femast compare NAME example`` and ``femast diagnose NAME example --workers 1`` of a shipped
+example take seconds to tens of seconds; the tutorial's transcript, the user's-words checks, the
+JSON schema and the HTML reports each read the same runs.  :func:`run_example` runs one through the
+command line, as a user does, recording what it prints and the checks of every figure it draws
+(:mod:`figure_geometry`); the session fixture ``example_run`` of tests/conftest.py keeps one run per
+command and experiment.  The tests read its folder and text; none writes there."""
 
 import contextlib
 import io
@@ -14,9 +14,10 @@ from pathlib import Path
 from types import SimpleNamespace
 
 
-def diagnose_example(name: str, folder: Path) -> SimpleNamespace:
-    """Run ``femast diagnose NAME example --out FOLDER --workers 1``; returns SimpleNamespace(out,
-    stdout, stderr, report (diagnose.json), drawn: [(png name, figure problems, the figure's texts)])."""
+def run_example(command: str, name: str, folder: Path) -> SimpleNamespace:
+    """Run ``femast compare NAME example --out FOLDER`` or ``femast diagnose NAME example --out FOLDER
+    --workers 1``; returns SimpleNamespace(out, stdout, stderr, report (compare.json or diagnose.json),
+    drawn: [(png name, figure problems, the figure's texts)])."""
     import pytest
     from figure_geometry import figure_problems
 
@@ -34,7 +35,8 @@ def diagnose_example(name: str, folder: Path) -> SimpleNamespace:
     out, err = io.StringIO(), io.StringIO()
     with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         mp.setattr(plotstyle, "save", checked_save)
-        code = main(["diagnose", name, "example", "--out", str(folder), "--workers", "1"])
-    assert code == 0, f"femast diagnose {name} example: exit {code}\n{out.getvalue()}\n{err.getvalue()}"
-    report = json.loads((folder / "diagnose.json").read_text())
+        extra = ["--workers", "1"] if command == "diagnose" else []
+        code = main([command, name, "example", "--out", str(folder), *extra])
+    assert code == 0, f"femast {command} {name} example: exit {code}\n{out.getvalue()}\n{err.getvalue()}"
+    report = json.loads((folder / f"{command}.json").read_text())
     return SimpleNamespace(out=folder, stdout=out.getvalue(), stderr=err.getvalue(), report=report, drawn=drawn)

@@ -35,12 +35,12 @@ SHARED = {
 }
 
 
-def test_tutorial_commands_print_what_the_page_quotes(tmp_path, capsys, monkeypatch, example_diagnosis):
+def test_tutorial_commands_print_what_the_page_quotes(tmp_path, capsys, monkeypatch, example_run):
     text = (DOCS / "compare_and_diagnose.md").read_text()
     blocks = re.findall(r"```console\n(.*?)```", text, re.S)
     assert len(blocks) >= 5
     assert all(f"$ {cmd}\n" in text for cmd in SHARED), "a shared diagnosis is no longer on the page"
-    printed = {cmd: example_diagnosis(name).stdout for cmd, name in SHARED.items()}
+    printed = {cmd: example_run("diagnose", name).stdout for cmd, name in SHARED.items()}
     capsys.readouterr()
     monkeypatch.chdir(tmp_path)  # outputs (tutorial/...) go to a temporary folder; the data are femast's examples
     checked = sum(

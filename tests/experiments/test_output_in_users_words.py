@@ -83,14 +83,16 @@ def _assert_in_users_words(printed, out, drawn):
 
 
 @pytest.mark.parametrize("name", EXPERIMENTS)
-def test_compare_on_every_example(name, tmp_path, capsys, drawn):
-    _check("compare", name, tmp_path, capsys, drawn)
+def test_compare_on_every_example(name, example_run):
+    # `femast compare NAME example`, run once per session for the tests that read it
+    run = example_run("compare", name)
+    _assert_in_users_words(run.stdout + run.stderr, run.out, run.drawn)
 
 
 @pytest.mark.parametrize("name", CHEAP)
-def test_diagnose_on_the_quick_examples(name, example_diagnosis):
+def test_diagnose_on_the_quick_examples(name, example_run):
     # `femast diagnose NAME example --workers 1`, run once per session for the tests that read it
-    run = example_diagnosis(name)
+    run = example_run("diagnose", name)
     _assert_in_users_words(run.stdout + run.stderr, run.out, run.drawn)
 
 
