@@ -166,10 +166,18 @@ def p95_abs(x):
 
 def local_dask(workers: int):
     """A dask.distributed client on a local cluster of ``workers`` single-threaded processes (closed
-    by the caller)."""
+    by the caller), without a dashboard.  The scheduler serves its HTTP routes (health, metrics) even
+    without one, on port 8787 unless told otherwise, and warns when that port is taken (another
+    cluster on the machine): here on a free port of this machine's loopback interface."""
     from dask.distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+    cluster = LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+    )
     return Client(cluster), cluster
 
 
