@@ -114,14 +114,30 @@ def renamed_attributes(module_name: str, names: dict):
 
 
 class RenamedKeys(dict):
-    """A dict whose old keys (``renames``: old -> new) still read, with the warning of :func:`renamed`."""
+    """A dict whose old keys (``renames``: old -> new) still read, with the warning of :func:`renamed`:
+    ``d[old]``, ``d.get(old)`` and ``old in d`` all see the new key's entry (the old key is not
+    stored: iterating, ``keys()`` and ``len`` show only the new names)."""
 
     def __init__(self, data=(), renames=None, what="the result"):
         super().__init__(data)
         self.renames, self.what = dict(renames or {}), what
 
+    def _new_key(self, key, stacklevel=4):
+        """The new name of an old ``key`` (with the warning), or ``key`` itself."""
+        if key in self.renames and not dict.__contains__(self, key):
+            new = self.renames[key]
+            renamed(f"{self.what}[{key!r}]", f"{self.what}[{new!r}]", stacklevel=stacklevel)
+            return new
+        return key
+
     def __missing__(self, key):
-        if key in self.renames:
-            renamed(f"{self.what}[{key!r}]", f"{self.what}[{self.renames[key]!r}]")
-            return self[self.renames[key]]
-        raise KeyError(key)
+        new = self._new_key(key)
+        if new is key:
+            raise KeyError(key)
+        return self[new]
+
+    def get(self, key, default=None):
+        return dict.get(self, self._new_key(key), default)
+
+    def __contains__(self, key):
+        return dict.__contains__(self, self._new_key(key))

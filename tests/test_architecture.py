@@ -174,6 +174,46 @@ def test_no_import_circle():
     assert not circles, "import circles: " + "; ".join(" <-> ".join(sorted(c)) for c in circles)
 
 
+def _folder(module):
+    """The folder a module lives in (``femast/analysis/control``), or the module itself for femast's root
+    modules and package ``__init__`` (each is a unit of :data:`LEVELS` of its own)."""
+    folder = MODULES[module].parent.relative_to(ROOT).as_posix()
+    return module if folder == "femast" else folder
+
+
+def _folder_graph():
+    """Folder -> the folders its modules import (old paths left out: they import their new path by name)."""
+    graph = {}
+    for m, imported in GRAPH.items():
+        if m not in OLD_PATH_MODULES:
+            graph.setdefault(_folder(m), set()).update(
+                _folder(i) for i in imported if i not in OLD_PATH_MODULES and _folder(i) != _folder(m)
+            )
+    return graph
+
+
+#: circles between folders that remain, each with the change that removes it
+FOLDER_CIRCLES = {
+    frozenset({"femast/experiments", "femast/experiments/rigs"}): "the built-in rigs move above the framework",
+}
+
+
+def test_no_import_circle_between_folders():
+    # each folder read as one node: a subpackage sits wholly above or below its parent's modules
+    # (analysis/control below the Newton loop and the step loop, which import its strategies)
+    circles = [c for c in _circles(_folder_graph()) if c not in FOLDER_CIRCLES]
+    assert not circles, "import circles between folders: " + "; ".join(" <-> ".join(sorted(c)) for c in circles)
+    assert not set(FOLDER_CIRCLES) - set(_circles(_folder_graph())), "a listed folder circle is gone: strike it off"
+
+
+def test_the_control_strategies_import_nothing_else_of_the_analysis():
+    control = {m: imp for m, imp in GRAPH.items() if m.startswith("femast.analysis.control")}
+    assert control
+    for m, imported in control.items():
+        above = {i for i in imported if _unit(i) == "analysis" and not i.startswith("femast.analysis.control")}
+        assert not above, f"{m} imports {sorted(above)}"
+
+
 def test_the_built_in_rigs_never_import_the_package_that_lists_them():
     # the registry of femast.experiments imports the rigs on first use: a rig that imported the package
     # (its __init__ runs the registry) would close a circle; rigs import the framework's modules

@@ -171,6 +171,14 @@ def test_compare_stiffness_result_reads_k_a_seed():
         assert res["K_a_seed"] == 1.0
     with pytest.raises(KeyError):
         _ = res["K_b"]
+    # get() and `in` see the old key too (a dict's get() would not call __missing__: None, silently)
+    with pytest.warns(DeprecationWarning, match=r"\['K_a_seed'\] is now .*\['K_a_printed'\]") as got:
+        assert res.get("K_a_seed") == 1.0
+    assert got[0].filename == __file__  # the warning points at the line that used the old key
+    with pytest.warns(DeprecationWarning, match=r"\['K_a_seed'\] is now"):
+        assert "K_a_seed" in res
+    assert res.get("K_b") is None and res.get("K_b", 2.0) == 2.0 and "K_b" not in res
+    assert list(res) == ["K_a_printed"] and len(res) == 1
 
 
 def test_plot_bay_torsion_seed_note_is_note(tmp_path, monkeypatch):

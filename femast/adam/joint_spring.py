@@ -18,31 +18,52 @@ for finite relative rotations).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import carray, njit
 
+from ..elements._mat3 import mm, mm_at, mm_bt, mtv, skew_into
+from ..elements._stack import stack_buffer
 from ..elements.base import ElementFamily, ElementResponse
-from ..rotations import logm_so3, skew, ts_inv, ts_inv_T_times_derivative
+from ..rotations import logm_so3_into, ts_inv_into, ts_inv_T_times_derivative_into
 
 
 @njit(cache=True)
 def _spring_kernel(nodes, R, k, f, K, theta):
+    # scratch on the stack, 3x3 products without BLAS (femast/elements/_mat3.py)
+    vec = carray(stack_buffer(9), (3, 3))
+    th, m, g = vec[0], vec[1], vec[2]
+    mats = carray(stack_buffer(54), (6, 3, 3))
+    Q, Ti, G, GT, H, S = mats[0], mats[1], mats[2], mats[3], mats[4], mats[5]
     for e in range(nodes.shape[0]):
         a, b = nodes[e, 0], nodes[e, 1]
-        Q = R[b] @ R[a].T
-        th = logm_so3(Q)
-        m = k[e] * th
-        Ti = ts_inv(th)
-        g = Ti.T @ m
-        G = Ti.T * k[e] + ts_inv_T_times_derivative(th, m)
-        GT = G @ Ti
-        H = Q.T @ (skew(g) + GT)
-        f[e, 3:6] = -Q.T @ g
-        f[e, 9:12] = g
-        K[e, 9:12, 9:12] = GT
-        K[e, 9:12, 3:6] = -GT @ Q
-        K[e, 3:6, 9:12] = -H
-        K[e, 3:6, 3:6] = H @ Q
-        theta[e] = th
+        mm_bt(R[b], R[a], Q)
+        logm_so3_into(Q, th)
+        for i in range(3):
+            m[i] = k[e] * th[i]
+        ts_inv_into(th, Ti)
+        mtv(Ti, m, g)
+        ts_inv_T_times_derivative_into(th, m, G)
+        for i in range(3):
+            for j in range(3):
+                G[i, j] = Ti[j, i] * k[e] + G[i, j]
+        mm(G, Ti, GT)
+        skew_into(g, S)
+        for i in range(3):
+            for j in range(3):
+                S[i, j] = S[i, j] + GT[i, j]
+        mm_at(Q, S, H)
+        mtv(Q, g, f[e, 3:6])
+        for i in range(3):
+            f[e, 3 + i] = -f[e, 3 + i]
+            f[e, 9 + i] = g[i]
+        mm(GT, Q, K[e, 9:12, 3:6])
+        mm(H, Q, K[e, 3:6, 3:6])
+        for i in range(3):
+            for j in range(3):
+                K[e, 9 + i, 9 + j] = GT[i, j]
+                K[e, 9 + i, 3 + j] = -K[e, 9 + i, 3 + j]
+                K[e, 3 + i, 9 + j] = -H[i, j]
+        for i in range(3):
+            theta[e, i] = th[i]
 
 
 class JointSprings(ElementFamily):

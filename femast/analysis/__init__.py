@@ -14,11 +14,12 @@
 """
 
 from .analysis import Analysis, solve
+from .control.stabilize import StabilizationWarning
 from .families import build_families
 from .newton import Increment, Newton, Outcome
 from .output import Observer, ResultsOutput
 from .state import State
-from .summary import AnalysisSummary, StabilizationWarning
+from .summary import AnalysisSummary
 from .system import System
 
 __all__ = [

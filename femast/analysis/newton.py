@@ -1,7 +1,7 @@
 """The one incremental-iterative solution algorithm: Newton-Raphson, with its options.
 
 :meth:`Newton.solve` solves one increment for every control strategy.  The control (through the
-:class:`Increment` it proposes) supplies what differs between strategies:
+:class:`~femast.analysis.control.plan.Increment` its plan proposes) supplies what differs between strategies:
 
 * the loads: fixed for the increment (load control), or ``P_start + lambda P_ref`` with the load
   factor lambda an unknown (displacement control, arc length);
@@ -42,50 +42,10 @@ import numpy as np
 
 from ..elements.base import IncrementContext
 from ..errors import ModelError, SingularModelError
+from .control.plan import Increment
 from .convergence import Convergence, all_finite, predicts
 from .deadline import check as check_deadline
 from .tangent_update import UPDATES
-
-
-@dataclass
-class Increment:
-    """One increment as a control strategy proposes it to :meth:`Newton.solve`.
-
-    time, dtime, total_time : step time at its end, its size and the analysis time at its end (s),
-    passed to the elements.  step_name : for messages.  lam : load factor at its start (load
-    control: its fixed value).  P : the loads (n, 6), N and N m, if fixed for the increment; else
-    ``P_start + lam * P_ref`` with P_ref the reference pattern (n, 6).  dpres : increment of the
-    constrained DOFs' values (prescribed displacements, rad for rotations), or None.
-    predictor : (du, dlam) added before the first iteration (linear extrapolation), or None.
-    whole : the predictor is the whole increment of the free DOFs (a reference run's, see
-    :mod:`femast.analysis.reference`; fixed loads or prescribed motion only): the prescribed motion
-    is applied with it, and the first iteration is not taken as a linear solve.
-    predict : ``predict(du_p) -> dlam``, the tangent predictor of the load factor from
-    K du_p = P_ref (arc length), or None.  dlambda : ``dlambda(du_r, du_p, Du) -> dlam or None``,
-    the load-factor correction of an iteration (None: the constraint has no solution).
-    viscous : a :class:`~femast.analysis.control.stabilize.ViscousTerm` (stabilised step), or None.
-    direct : assemble straight into the solver's matrix where possible (off for arc length, whose
-    verified results were computed through the CSR tangent; the two differ at round-off).
-    """
-
-    time: float
-    dtime: float
-    total_time: float
-    step_name: str
-    lam: float
-    P: np.ndarray | None = None
-    P_start: np.ndarray | None = None
-    P_ref: np.ndarray | None = None
-    dpres: np.ndarray | None = None
-    predictor: tuple | None = None
-    predict: object = None
-    dlambda: object = None
-    viscous: object = None
-    direct: bool = True
-    whole: bool = False
-
-    def loads(self, lam):
-        return self.P if self.P_ref is None else self.P_start + lam * self.P_ref
 
 
 @dataclass

@@ -9,7 +9,7 @@ motion: Newton then starts an increment from the reference's solution and needs 
   converged increments of a run, keyed by (step, total time at the start, at the end);
 * ``Analysis.reference = ref`` (another run of a model with the same DOF numbering) makes the
   increment control propose the recorded ``Du`` of the increment with the same step and times as
-  the predictor (:attr:`femast.analysis.newton.Increment.predictor`); the prescribed motion of the
+  the predictor (:attr:`femast.analysis.control.plan.Increment.predictor`); the prescribed motion of the
   increment is applied together with it (newton.py), and increments without a recorded match (a
   cutback, a step the reference did not make) start as without a reference.
 

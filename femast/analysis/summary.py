@@ -1,12 +1,8 @@
-"""What a run did (:class:`AnalysisSummary`) and the warning of a stabilised step."""
+"""What a run did (:class:`AnalysisSummary`)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-
-
-class StabilizationWarning(UserWarning):
-    """The stabilisation energy of a step exceeds its warning ratio of the strain energy."""
 
 
 @dataclass

@@ -19,9 +19,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import carray, njit
 
-from ..rotations import logm_so3, skew, ts_inv
+from ..rotations import logm_so3_into, skew, ts_inv
+from ._mat3 import mm_at
+from ._stack import stack_buffer
 
 N_STATE = 15
 I_M = 0
@@ -41,17 +43,29 @@ MAX_INCREMENT = 3.0  # rad
 
 
 @njit(cache=True)
-def relative_increment(Ra, Rb, st):
-    """Finite relative-rotation increment ``theta = log(Q_c^T Q)``, Q = R_a^T R_b (right, body-b
-    form: Q = Q_c exp(theta)), Q_c the committed Q of state row ``st``; returns (theta, error code)."""
-    Q = Ra.T @ Rb
-    Qc = np.empty((3, 3))
+def relative_increment_into(Ra, Rb, st, Q, th):
+    """Finite relative-rotation increment ``th = log(Q_c^T Q)`` (3), Q = R_a^T R_b (3x3, written too)
+    (right, body-b form: Q = Q_c exp(theta)), Q_c the committed Q of state row ``st``; returns the
+    error code.  No allocation (:mod:`._mat3`)."""
+    Qc = carray(stack_buffer(9), (3, 3))
+    D = carray(stack_buffer(9), (3, 3))
+    mm_at(Ra, Rb, Q)
     for i in range(3):
         for j in range(3):
             Qc[i, j] = st[I_Q + 3 * i + j]
-    th = logm_so3(Qc.T @ Q)
+    mm_at(Qc, Q, D)
+    logm_so3_into(D, th)
     tn = math.sqrt(th[0] ** 2 + th[1] ** 2 + th[2] ** 2)
-    return th, (ERR_BIG_INCREMENT if tn > MAX_INCREMENT else OK)
+    return ERR_BIG_INCREMENT if tn > MAX_INCREMENT else OK
+
+
+@njit(cache=True)
+def relative_increment(Ra, Rb, st):
+    """:func:`relative_increment_into` returning (theta, error code)."""
+    Q = np.empty((3, 3))
+    th = np.empty(3)
+    err = relative_increment_into(Ra, Rb, st, Q, th)
+    return th, err
 
 
 @njit(cache=True)
@@ -73,35 +87,38 @@ def friction_return(st, th, k_s, Ys, Yk, prev, has_prev, m, C, nv):
     from Ys to Yk (so that work = stored energy + dissipation holds exactly in one-axis motion).
     With Ys = Yk this is the paper's one-coefficient law, to the bit.  ``prev``: see
     :func:`ball_joint_element` (slip reversal between Newton iterations)."""
-    mtr = np.empty(3)
-    for i in range(3):
-        mtr[i] = st[I_M + i] + k_s * th[i]
-    nm = math.sqrt(mtr[0] ** 2 + mtr[1] ** 2 + mtr[2] ** 2)
+    mtr0 = st[I_M] + k_s * th[0]
+    mtr1 = st[I_M + 1] + k_s * th[1]
+    mtr2 = st[I_M + 2] + k_s * th[2]
+    nm = math.sqrt(mtr0**2 + mtr1**2 + mtr2**2)
     Y = Ys
     if Yk != Ys and st[I_SLIP] == 1.0 and st[I_M] * th[0] + st[I_M + 1] * th[1] + st[I_M + 2] * th[2] >= 0.0:
         Y = Yk  # slipping on: the kinetic limit
     # slip reversed since the previous iteration: stuck for this iteration (see ball_joint_element)
     reversed_ = False
     if has_prev and prev[I_SLIP] == 1.0 and nm > Y * (1.0 + 1e-12):
-        reversed_ = mtr[0] * prev[I_M] + mtr[1] * prev[I_M + 1] + mtr[2] * prev[I_M + 2] < 0.0
+        reversed_ = mtr0 * prev[I_M] + mtr1 * prev[I_M + 1] + mtr2 * prev[I_M + 2] < 0.0
     for i in range(3):
         for j in range(3):
             C[i, j] = 0.0
     # relative tolerance: a point on the slip surface (|m_tr| = Y to round-off) sticks
     if nm <= Y * (1.0 + 1e-12) or reversed_:
+        m[0] = mtr0
+        m[1] = mtr1
+        m[2] = mtr2
         for i in range(3):
-            m[i] = mtr[i]
             C[i, i] = k_s
         return (REVERSED if reversed_ else 0.0), 0.0, 0.0, Ys
     # return mapping (radial return = backward Euler on the circular slip surface)
-    n = mtr / nm
+    nv[0] = mtr0 / nm
+    nv[1] = mtr1 / nm
+    nv[2] = mtr2 / nm
     dgam = (nm - Yk) / k_s
     r = Yk * k_s / nm
     for i in range(3):
-        nv[i] = n[i]
-        m[i] = Yk * n[i]
+        m[i] = Yk * nv[i]
         for j in range(3):
-            C[i, j] = r * ((1.0 if i == j else 0.0) - n[i] * n[j])
+            C[i, j] = r * ((1.0 if i == j else 0.0) - nv[i] * nv[j])
     dD = Yk * dgam
     if Y != Yk:
         dD += (Y - Yk) ** 2 / (2.0 * k_s)  # onset: the drop from the static to the kinetic limit

@@ -24,10 +24,9 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-from numba import njit
+from numba import carray, njit
 
-from ..rotations import skew, ts_inv
+from ..rotations import ts_inv_into
 from ._ball_joint_kernels import (
     ERR_NOT_FINITE,
     I_DISS,
@@ -37,8 +36,10 @@ from ._ball_joint_kernels import (
     I_SLIP,
     N_STATE,
     friction_return,
-    relative_increment,
+    relative_increment_into,
 )
+from ._mat3 import mm, mm_atbt, mm_bt, mtv, mv, skew_into
+from ._stack import stack_buffer
 
 #: State row of a seated joint: the tied joint's 15 values, then the contact status of the seat the
 #: trial was answered with and the status the law gives at the trial (axial branch 0 open / 1 seated
@@ -104,7 +105,7 @@ def seat_law(r, e, k, k_o, c_r, c_a, status, g, Kl):
     compression or the retainer's pull, negative when a held branch is stretched the other way),
     dN/dg_n (N/m))."""
     gn = r[0] * e[0] + r[1] * e[1] + r[2] * e[2]
-    rt = np.empty(3)
+    rt = carray(stack_buffer(3), (3,))
     for i in range(3):
         rt[i] = r[i] - gn * e[i]
     for i in range(3):
@@ -174,13 +175,24 @@ def seated_joint_element(
         dM   = R_b C Ts^-T(theta) R_b^T (dw_b - dw_a) - [M]x dw_b
                + R_b n mu_k B h^T (dp + [p]x dw_b)                      (slip only)
     """
-    c = Ra @ d0
-    p = xa + c - xb
+    # scratch on the stack (no allocation per joint); 3x3 products by ._mat3 (no BLAS call)
+    buf = carray(stack_buffer(21), (7, 3))
+    c, p, r, gl, m, n, th = buf[0], buf[1], buf[2], buf[3], buf[4], buf[5], buf[6]
+    vec = carray(stack_buffer(9), (3, 3))
+    G, M, Re = vec[0], vec[1], vec[2]
+    mats = carray(stack_buffer(24 * 9), (24, 3, 3))
+    Kl, C, Q, A, Afr, Ti, T1, T2, W = mats[0], mats[1], mats[2], mats[3], mats[4], mats[5], mats[6], mats[7], mats[8]
+    Sc, Sp, SG, SM = mats[9], mats[10], mats[11], mats[12]
+    dG_wa, dG_wb, ma_wa, ma_x, ma_wb, mb_x, mb_wa, mb_wb, M_wa, M_wb = (
+        mats[13], mats[14], mats[15], mats[16], mats[17], mats[18], mats[19], mats[20], mats[21], mats[22]
+    )  # fmt: skip
+    T3 = mats[23]
+    mv(Ra, d0, c)
+    for i in range(3):
+        p[i] = xa[i] + c[i] - xb[i]
     if not (math.isfinite(p.sum()) and math.isfinite(Ra.sum()) and math.isfinite(Rb.sum())):
         return 0.0, ERR_NOT_FINITE, False
-    r = Rb.T @ p
-    gl = np.empty(3)
-    Kl = np.empty((3, 3))
+    mtv(Rb, p, r)
     status = seat_status(r, e, c_r, c_a)
     ref = prev if has_prev else st
     answered = int(ref[I_STATUS])
@@ -201,36 +213,57 @@ def seated_joint_element(
     Nabs = abs(N)
     if N < 0.0:
         dN = -dN
-    th, err = relative_increment(Ra, Rb, st)
-    C = np.empty((3, 3))
-    m = np.empty(3)
-    n = np.empty(3)
+    err = relative_increment_into(Ra, Rb, st, Q, th)
     slip, dgam, dD, Y = friction_return(st, th, k_s, mu_s * B * Nabs, mu_k * B * Nabs, prev, has_prev, m, C, n)
-    G = Rb @ gl
-    M = Rb @ m
-    A = Rb @ (Kl @ Rb.T)
-    Afr = Rb @ (C @ (ts_inv(th).T @ Rb.T))
+    mv(Rb, gl, G)
+    mv(Rb, m, M)
+    mm_bt(Kl, Rb, T1)
+    mm(Rb, T1, A)  # A = Rb Kl Rb^T
+    ts_inv_into(th, Ti)
+    mm_atbt(Ti, Rb, T1)
+    mm(C, T1, T2)
+    mm(Rb, T2, Afr)  # Afr = Rb C Ts^-T Rb^T
     # d|N| through the contact: h (global, N/m per m of dp + [p]x dw_b); slip only
-    W = np.zeros((3, 3))
+    for i in range(3):
+        for j in range(3):
+            W[i, j] = 0.0
     if slip == 1.0 and dN != 0.0:
-        Re = Rb @ e
-        Rn = Rb @ n
+        mv(Rb, e, Re)
+        mv(Rb, n, T3[0])
         for i in range(3):
             for j in range(3):
-                W[i, j] = Rn[i] * mu_k * B * dN * Re[j]
-    Sc, Sp, SG, SM = skew(c), skew(p), skew(G), skew(M)
+                W[i, j] = T3[0, i] * mu_k * B * dN * Re[j]
+    skew_into(c, Sc)
+    skew_into(p, Sp)
+    skew_into(G, SG)
+    skew_into(M, SM)
     # blocks: derivative of G, of c x G, of G x p (w.r.t. xa, wa, xb, wb)
-    dG_wa = -(A @ Sc)
-    dG_wb = A @ Sp - SG
-    ma_wa = SG @ Sc + Sc @ dG_wa
-    ma_x = Sc @ A
-    ma_wb = Sc @ dG_wb
-    mb_x = SG - Sp @ A
-    mb_wa = Sp @ A @ Sc - SG @ Sc
-    mb_wb = -(Sp @ dG_wb)
+    mm(A, Sc, dG_wa)  # -(A Sc), negated below
+    mm(A, Sp, dG_wb)
+    for i in range(3):
+        for j in range(3):
+            dG_wa[i, j] = -dG_wa[i, j]
+            dG_wb[i, j] = dG_wb[i, j] - SG[i, j]
+    mm(SG, Sc, T1)
+    mm(Sc, dG_wa, T2)
+    mm(Sc, A, ma_x)
+    mm(Sc, dG_wb, ma_wb)
+    mm(Sp, A, T3)
+    mm(T3, Sc, mb_wa)  # Sp A Sc
+    mm(Sp, dG_wb, mb_wb)
+    for i in range(3):
+        for j in range(3):
+            ma_wa[i, j] = T1[i, j] + T2[i, j]
+            mb_x[i, j] = SG[i, j] - T3[i, j]
+            mb_wa[i, j] = mb_wa[i, j] - T1[i, j]  # - SG Sc
+            mb_wb[i, j] = -mb_wb[i, j]
     # friction moment: through theta, and (slip) through N
-    M_wa = -Afr - W @ Sc
-    M_wb = Afr - SM + W @ Sp
+    mm(W, Sc, T1)
+    mm(W, Sp, T2)
+    for i in range(3):
+        for j in range(3):
+            M_wa[i, j] = -Afr[i, j] - T1[i, j]
+            M_wb[i, j] = Afr[i, j] - SM[i, j] + T2[i, j]
     for i in range(12):
         f[i] = 0.0
         for j in range(12):
@@ -260,7 +293,6 @@ def seated_joint_element(
             K[9 + i, 3 + j] = mb_wa[i, j] + M_wa[i, j]
             K[9 + i, 6 + j] = -mb_x[i, j] - W[i, j]
             K[9 + i, 9 + j] = mb_wb[i, j] + M_wb[i, j]
-    Q = Ra.T @ Rb
     for i in range(3):
         new[I_M + i] = m[i]
     new[I_STATUS] = branch
@@ -285,8 +317,8 @@ def seated_joint_element(
     out[12] = gn
     out[13] = status % 3
     out[14] = status // 3
-    mm = m[0] ** 2 + m[1] ** 2 + m[2] ** 2
-    return Ec + 0.5 * mm / k_s, err, held
+    msq = m[0] ** 2 + m[1] ** 2 + m[2] ** 2
+    return Ec + 0.5 * msq / k_s, err, held
 
 
 @njit(cache=True)
@@ -297,12 +329,16 @@ def seats_settled(nodes, x, R, d0, e, c_r, state, prev, has_prev):
     may open.  (A single seat's test is not enough: a seat released while the rest of the structure
     is still far from equilibrium frees its member, whose axial mode holds only k_open, and the next
     iterate sends it millimetres through the seat.)"""
+    buf = carray(stack_buffer(9), (3, 3))
+    c, p, r = buf[0], buf[1], buf[2]
     for el in range(nodes.shape[0]):
         a = nodes[el, 0]
         b = nodes[el, 1]
         ref = prev[el] if has_prev else state[el]
-        p = x[a] + R[a] @ d0[el] - x[b]
-        r = R[b].T @ p
+        mv(R[a], d0[el], c)
+        for i in range(3):
+            p[i] = x[a, i] + c[i] - x[b, i]
+        mtv(R[b], p, r)
         gn = r[0] * e[el, 0] + r[1] * e[el, 1] + r[2] * e[el, 2]
         floor = 1e-12 * max(math.sqrt(x[b, 0] ** 2 + x[b, 1] ** 2 + x[b, 2] ** 2), 1.0)
         if abs(gn - ref[I_GAP]) > 0.5 * abs(gn) + floor:

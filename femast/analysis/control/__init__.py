@@ -10,14 +10,15 @@ Each strategy's module holds the user's parameters and the step's plan together:
   :class:`ArcIncrements`;
 * :mod:`.stabilize`: :class:`Stabilize` (viscous stabilisation of a step, Abaqus *STABILIZE) and
   the :class:`ViscousTerm` the Newton loop adds;
-* :mod:`.plan`: the :class:`Plan` base every plan extends, :func:`step_values`;
+* :mod:`.plan`: the :class:`Plan` base every plan extends, the :class:`Increment` a plan proposes to the
+  Newton loop (the strategies import nothing else of the analysis), :func:`step_values`;
 * :func:`plan_for`: the plan of a step under a control.
 """
 
 from .arclength import ArcIncrements, ArcLength
 from .displacement import DisplacementControl
 from .load import LoadControl, TimeIncrements
-from .plan import Plan, step_values
+from .plan import Increment, Plan, step_values
 from .stabilize import Stabilize, ViscousTerm
 
 
@@ -35,6 +36,7 @@ def plan_for(analysis, step, control):
 __all__ = [
     "ArcIncrements",
     "ArcLength",
+    "Increment",
     "DisplacementControl",
     "LoadControl",
     "TimeIncrements",

@@ -29,8 +29,7 @@ from tqdm.auto import tqdm
 
 from ...errors import ConvergenceError, ModelError
 from ...model import dof_index, validation
-from ..newton import Increment
-from .plan import Plan, gravity_of, step_values, with_gravity
+from .plan import Increment, Plan, gravity_of, step_values, with_gravity
 
 
 @dataclass

@@ -16,10 +16,8 @@ import warnings
 from tqdm.auto import tqdm
 
 from ...errors import ConvergenceError, ModelError
-from ..newton import Increment
-from ..summary import StabilizationWarning
-from .plan import Plan, _rows, _values, gravity_of, with_gravity
-from .stabilize import ViscousTerm
+from .plan import Increment, Plan, _rows, _values, gravity_of, with_gravity
+from .stabilize import StabilizationWarning, ViscousTerm
 
 
 class LoadControl:

@@ -4,9 +4,9 @@ A control strategy (:mod:`.load`, :mod:`.displacement`, :mod:`.arclength`, or on
 holds the user's parameters and makes a *plan* for each step with its ``plan(analysis, step)``
 method (:func:`femast.analysis.control.plan_for`; docs/architecture.md shows a control of your own).  The plan is all that
 differs between strategies in the step loop (stepping.py): it proposes each increment (times,
-loads, predictor, load-factor constraint: a :class:`~femast.analysis.newton.Increment`), shrinks it
-after a failure (cutback) and sizes the next one after a success.  The Newton loop and the output
-are shared.
+loads, predictor, load-factor constraint: an :class:`Increment`, all that the Newton loop reads
+from a control), shrinks it after a failure (cutback) and sizes the next one after a success.  The
+Newton loop and the output are shared; the control strategies sit below them and import neither.
 
 A plan keeps what it carries from increment to increment in the analysis :class:`State`
 (``step_time``, ``size``, ``first_size``, ``easy``, ``last_increment``...), so a saved state holds it.
@@ -14,10 +14,53 @@ A plan keeps what it carries from increment to increment in the analysis :class:
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from tqdm.auto import tqdm
 
 from ...model.gravity import step_gravity, unit_gravity_loads
+
+
+@dataclass
+class Increment:
+    """One increment as a control strategy proposes it to :meth:`femast.analysis.newton.Newton.solve`.
+
+    time, dtime, total_time : step time at its end, its size and the analysis time at its end (s),
+    passed to the elements.  step_name : for messages.  lam : load factor at its start (load
+    control: its fixed value).  P : the loads (n, 6), N and N m, if fixed for the increment; else
+    ``P_start + lam * P_ref`` with P_ref the reference pattern (n, 6).  dpres : increment of the
+    constrained DOFs' values (prescribed displacements, rad for rotations), or None.
+    predictor : (du, dlam) added before the first iteration (linear extrapolation), or None.
+    whole : the predictor is the whole increment of the free DOFs (a reference run's, see
+    :mod:`femast.analysis.reference`; fixed loads or prescribed motion only): the prescribed motion
+    is applied with it, and the first iteration is not taken as a linear solve.
+    predict : ``predict(du_p) -> dlam``, the tangent predictor of the load factor from
+    K du_p = P_ref (arc length), or None.  dlambda : ``dlambda(du_r, du_p, Du) -> dlam or None``,
+    the load-factor correction of an iteration (None: the constraint has no solution).
+    viscous : a :class:`~femast.analysis.control.stabilize.ViscousTerm` (stabilised step), or None.
+    direct : assemble straight into the solver's matrix where possible (off for arc length, whose
+    verified results were computed through the CSR tangent; the two differ at round-off).
+    """
+
+    time: float
+    dtime: float
+    total_time: float
+    step_name: str
+    lam: float
+    P: np.ndarray | None = None
+    P_start: np.ndarray | None = None
+    P_ref: np.ndarray | None = None
+    dpres: np.ndarray | None = None
+    predictor: tuple | None = None
+    predict: object = None
+    dlambda: object = None
+    viscous: object = None
+    direct: bool = True
+    whole: bool = False
+
+    def loads(self, lam):
+        return self.P if self.P_ref is None else self.P_start + lam * self.P_ref
 
 
 def step_values(model, conds, start, frac_time, period):

@@ -35,6 +35,10 @@ import numpy as np
 from ...errors import ModelError
 
 
+class StabilizationWarning(UserWarning):
+    """The stabilisation energy of a step exceeds its warning ratio of the strain energy."""
+
+
 @dataclass
 class Stabilize:
     """energy_fraction : dissipated-energy fraction (dimensionless, default 2e-4), or
