@@ -12,7 +12,7 @@ from spring_rig import spring_script
 from femast.cli import main
 from femast.effects import unregister_effect
 from femast.experiments import diagnose, get_experiment, read_data, read_history, write_data
-from femast.experiments.rigs.synthetic import mast_top_data, mast_top_path
+from femast.rigs.synthetic import mast_top_data, mast_top_path
 
 ROOT = Path(__file__).resolve().parents[2]
 MT_DATA = ROOT / "femast" / "examples" / "mast_top_example.csv"
