@@ -21,7 +21,7 @@ import numpy as np
 
 from femast.cli import main as femast_main
 from femast.experiments import Measured, get_experiment, write_data
-from femast.experiments.rigs.synthetic import latch_pull_data, mast_top_data, mast_top_path
+from femast.rigs.synthetic import latch_pull_data, mast_top_data, mast_top_path
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "femast" / "examples"

@@ -7,7 +7,7 @@ example data set it runs on.
     python benchmarks/diagnose_bay_torsion.py --docs          # also copy the figures to docs/figures
     python benchmarks/diagnose_bay_torsion.py --tip-cycle     # also a tip-cycle example (2-bay mast, in-process)
 
-The example is synthetic: the FE single ADAM bay (``femast.experiments.rigs.bay_torsion``) with
+The example is synthetic: the FE single ADAM bay (``femast.rigs.bay_torsion``) with
 latch k = 108 N/mm and mu = 0.065, frictionless ball joints, the nominal 170 N pretension, and a
 hidden latch hysteresis of F_h = 8 N (fading over 0.3 mm, the element's option), driven along a
 measured-style path (0 -> 3.2 degrees -> 0 in 49 rows, denser near zero and through the release,
@@ -47,7 +47,7 @@ TRUTH = {
 def make_data() -> None:
     """Write femast/examples/bay_torsion_example.csv (see the module docstring)."""
     from femast.experiments import get_experiment, write_data
-    from femast.experiments.rigs.synthetic import bay_torsion_data, bay_torsion_path
+    from femast.rigs.synthetic import bay_torsion_data, bay_torsion_path
 
     exp = get_experiment("bay-torsion")
     path = bay_torsion_path(seed=TRUTH["seed"], **TRUTH["path"])
@@ -73,7 +73,7 @@ def tip_cycle_example(docs: bool) -> dict:
     2 um and 5 urad: compare --fit, diagnose (timed, in this process, empty cache), compare with the
     effect; figures experiments_tip_compare_baseline.png and experiments_tip_compare_friction.png."""
     from femast.experiments import compare, diagnose, fe_cache, format_diagnose, get_experiment
-    from femast.experiments.rigs.synthetic import tip_cycle_data, tip_cycle_path
+    from femast.rigs.synthetic import tip_cycle_data, tip_cycle_path
 
     exp = get_experiment("tip-cycle", n_bays=2)
     path = tip_cycle_path(points_per_ramp=3, cycles=2, kind="table1", hold=2, seed=1)

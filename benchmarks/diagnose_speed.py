@@ -56,7 +56,7 @@ def timed(args) -> tuple:
 
 def mast_top_file(folder: Path) -> Path:
     from femast.experiments import get_experiment, write_data
-    from femast.experiments.rigs.synthetic import mast_top_data, mast_top_path
+    from femast.rigs.synthetic import mast_top_data, mast_top_path
 
     exp = get_experiment("mast-top")
     data, _ = mast_top_data(

@@ -4,7 +4,7 @@
 
 Times, in this process with a warm numba cache:
 
-* one bay-torsion FE run (``femast.experiments.rigs.bay_torsion.run_bay``: the ADAM bay driven along the
+* one bay-torsion FE run (``femast.rigs.bay_torsion.run_bay``: the ADAM bay driven along the
   49 rows of ``femast/examples/bay_torsion_example.csv``), as the experiment runs it (no files,
   ``Analysis(out=None)``) and with its frames written to a temporary results folder (what it did
   before), alternating;
@@ -44,7 +44,7 @@ def _fmt(ts, unit=1.0, name="s"):
 
 def bay_runs(repeat):
     import femast.analysis as fa
-    import femast.experiments.rigs.bay_torsion as bt
+    import femast.rigs.bay_torsion as bt
     from femast.analysis import Analysis
     from femast.experiments import get_experiment, read_data
 

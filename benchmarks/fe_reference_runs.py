@@ -38,7 +38,7 @@ def main(argv=None) -> int:
     from femast import examples
     from femast.analysis.reference import ReferencePath
     from femast.experiments import get_experiment, read_data
-    from femast.experiments.rigs import bay_torsion as bt
+    from femast.rigs import bay_torsion as bt
 
     exp = get_experiment("bay-torsion")
     data = read_data(exp, examples.for_experiment("bay-torsion"))

@@ -30,7 +30,7 @@ def _tip_cycle():
     from femast.experiments.core import prepared
     from femast.experiments.data import read_data
     from femast.experiments.registry import get_experiment
-    from femast.experiments.rigs import tip_cycle
+    from femast.rigs import tip_cycle
 
     exp = get_experiment("tip-cycle")
     options = dict(exp.options)
@@ -43,8 +43,8 @@ def run_cost(runs: int) -> None:
     from femast.adam import build_mast
     from femast.adam.steps import CONVERGENCE, add_initial_steps
     from femast.analysis import Analysis
-    from femast.experiments.rigs.bay_torsion import bay_parameters
-    from femast.experiments.rigs.tip_cycle import run_mast
+    from femast.rigs.bay_torsion import bay_parameters
+    from femast.rigs.tip_cycle import run_mast
 
     inputs, loads, options = _tip_cycle()
     run_mast(inputs, loads, options["n_bays"])  # kernels loaded or compiled

@@ -7,7 +7,7 @@ often the progress moves, how many rows are used, and what the statistics lose b
 The record: a mast top (the ``mast-top`` experiment) cycled ``--rows / 12500`` times, as a logger at
 a few hundred hertz writes it over hours of quasi-static cycling, with a hidden joint clearance of
 0.15 mrad and 50 um of white noise on every displacement (the synthetic generator of
-:mod:`femast.experiments.rigs.synthetic`), written as a CSV file.
+:mod:`femast.rigs.synthetic`), written as a CSV file.
 
 Each run is the command a user types (``femast compare mast-top FILE --fit``, ``femast diagnose
 mast-top FILE``) in a fresh process with plain-text progress (``FEMAST_PROGRESS=plain``: a line
@@ -45,7 +45,7 @@ TRUTH = {"k_theta1": 2.7e5, "k_theta2": 2.3e5}  # N m/rad
 def write_record(path: Path, rows: int, seed: int = 3) -> float:
     """The long mast-top record as CSV at ``path``; returns the seconds it took."""
     from femast.experiments import get_experiment, write_data
-    from femast.experiments.rigs.synthetic import mast_top_data, mast_top_path
+    from femast.rigs.synthetic import mast_top_data, mast_top_path
 
     t0 = time.perf_counter()
     route = mast_top_path(n=rows, kind="cycles", cycles=rows / 12_500, amplitude_N=150.0, moment_Nm=20.0, seed=seed)

@@ -83,7 +83,7 @@ def run_mast(n_bays, tangent):
 
 
 def run_adam_bay(tangent):
-    import femast.experiments.rigs.bay_torsion as bt
+    import femast.rigs.bay_torsion as bt
     from femast.experiments import get_experiment, read_data
 
     exp = get_experiment("bay-torsion")

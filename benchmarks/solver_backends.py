@@ -81,7 +81,7 @@ def mast_tangents(n_bays):
 
 
 def adam_bay_tangents():
-    import femast.experiments.rigs.bay_torsion as bt
+    import femast.rigs.bay_torsion as bt
     from femast.experiments import get_experiment, read_data
 
     exp = get_experiment("bay-torsion")

@@ -1,7 +1,7 @@
 """Module paths that moved, kept for one release as thin modules that warn.
 
 Each old path is a real file (``femast/sections.py``, ``femast/latch.py``,
-``femast/analysis/solvers/linear.py``, ...) of three lines: :func:`moved` warns with a
+``femast/analysis/solvers/linear.py``, ``femast/experiments/rigs/mast_top.py``, ...) of three lines: :func:`moved` warns with a
 :class:`DeprecationWarning` that names the new path and the release that removes the old one,
 then puts the new module in ``sys.modules`` under the old name, so the import returns the *same*
 module object (one class for ``isinstance``, numba's cache keyed on the one source file).  No
@@ -56,19 +56,37 @@ def moved(old: str, new: str, warn: bool = True):
     """Make the module being imported as ``old`` the module ``new`` (warning first, unless not
     ``warn``: a package whose submodules warn on their own)."""
     if warn:
-        frame = _importer()
-        g = frame.f_globals if frame is not None else {}
-        warnings.warn_explicit(
-            f"{old} has moved to {new}: import it from there ({old} is removed in femast {REMOVED_IN})",
-            DeprecationWarning,
-            frame.f_code.co_filename if frame is not None else "<unknown>",
-            frame.f_lineno if frame is not None else 0,
-            module=g.get("__name__", "<unknown>"),
-            registry=g.setdefault("__warningregistry__", {}),
-        )
+        _warn_moved(old, new)
     module = importlib.import_module(new)
     sys.modules[old] = module  # what the import of ``old`` returns
     return module
+
+
+def moved_package(old: str, new: str):
+    """For an old package whose modules are old paths too (each a module of :func:`moved` in the old
+    package's folder): warn like :func:`moved` and return the module ``__getattr__`` that gives the new
+    package's names.  The old package stays a module of its own, so that ``old.module`` is found in
+    the old folder and is the new module, never a second copy of it loaded under the old name."""
+    _warn_moved(old, new)
+
+    def __getattr__(name):
+        return getattr(importlib.import_module(new), name)
+
+    return __getattr__
+
+
+def _warn_moved(old: str, new: str) -> None:
+    """The :class:`DeprecationWarning` of an old module path, at the line of the code that imported it."""
+    frame = _importer()
+    g = frame.f_globals if frame is not None else {}
+    warnings.warn_explicit(
+        f"{old} has moved to {new}: import it from there ({old} is removed in femast {REMOVED_IN})",
+        DeprecationWarning,
+        frame.f_code.co_filename if frame is not None else "<unknown>",
+        frame.f_lineno if frame is not None else 0,
+        module=g.get("__name__", "<unknown>"),
+        registry=g.setdefault("__warningregistry__", {}),
+    )
 
 
 def _importer():
@@ -83,6 +101,7 @@ def _importer():
             or name.startswith("importlib")
             or frame.f_code.co_filename.startswith("<frozen importlib")
             or frame.f_globals.get("moved") is moved
+            or frame.f_globals.get("moved_package") is moved_package
         ):
             return frame
         frame = frame.f_back

@@ -68,15 +68,15 @@ def _module_imports(path):
     return {m for m in out | (parents - own) if m and m != me and m in MODULES}
 
 
-#: the old paths of moved modules (femast/_moved.py): three-line modules at the top of the layout
-OLD_PATH_MODULES = {m for m, p in MODULES.items() if "moved(__name__" in p.read_text()}
+#: the old paths of moved modules and packages (femast/_moved.py): three-line modules at the top of the layout
+OLD_PATH_MODULES = {m for m, p in MODULES.items() if re.search(r"\bmoved(?:_package)?\(__name__", p.read_text())}
 
 
 def _unit(module):
     """The layout unit of a module: its top package, a root module, ``femast`` (the package's own
     ``__init__``: the public API), or ``old paths`` (a root module left where a module moved from)."""
     parts = module.split(".")
-    if len(parts) == 2 and module in OLD_PATH_MODULES or module == "femast.solvers":
+    if module in OLD_PATH_MODULES:
         return "old paths"
     return parts[1] if len(parts) > 1 else "femast"
 
@@ -101,6 +101,7 @@ LEVELS = [
     {"adam", "guyed"},
     {"effects"},
     {"experiments"},
+    {"rigs"},  # the built-in rigs: above the framework, registered through its entry point
     {"studies"},
     {"cli_experiments", "warmup"},
     {"cli"},
@@ -193,9 +194,7 @@ def _folder_graph():
 
 
 #: circles between folders that remain, each with the change that removes it
-FOLDER_CIRCLES = {
-    frozenset({"femast/experiments", "femast/experiments/rigs"}): "the built-in rigs move above the framework",
-}
+FOLDER_CIRCLES = {}
 
 
 def test_no_import_circle_between_folders():
@@ -214,12 +213,22 @@ def test_the_control_strategies_import_nothing_else_of_the_analysis():
         assert not above, f"{m} imports {sorted(above)}"
 
 
-def test_the_built_in_rigs_never_import_the_package_that_lists_them():
-    # the registry of femast.experiments imports the rigs on first use: a rig that imported the package
-    # (its __init__ runs the registry) would close a circle; rigs import the framework's modules
-    rigs = {m: imp for m, imp in GRAPH.items() if m.startswith("femast.experiments.rigs")}
-    assert rigs and not [m for m, imp in rigs.items() if "femast.experiments" in imp]
-    assert "femast.experiments.rigs" in GRAPH["femast.experiments.registry"]
+def test_the_framework_imports_no_rig_and_finds_them_by_their_entry_point():
+    # the built-in rigs sit above the experiments framework; the registry finds them as it finds an
+    # installed package of rigs: the entry point group femast.experiments (pyproject.toml)
+    from importlib.metadata import entry_points
+
+    framework = {m: imp for m, imp in GRAPH.items() if _unit(m) == "experiments"}
+    assert framework and not [m for m, imp in framework.items() if {_unit(i) for i in imp} & {"rigs"}]
+    assert '[project.entry-points."femast.experiments"]\nfemast = "femast.rigs:EXPERIMENTS"' in (
+        (ROOT / "pyproject.toml").read_text()
+    )
+    installed = [ep for ep in entry_points(group="femast.experiments") if ep.dist and ep.dist.name == "femast"]
+    assert [ep.value for ep in installed] == ["femast.rigs:EXPERIMENTS"], "reinstall: pip install -e ."
+    from femast.experiments import list_experiments
+    from femast.rigs import BUILT_IN
+
+    assert [e.name for e in list_experiments()][: len(BUILT_IN)] == [r.EXPERIMENT.name for r in BUILT_IN]
 
 
 def test_the_circle_finder_finds_a_lazy_circle():
@@ -334,6 +343,18 @@ OLD_TO_NEW = [
     ("femast.guyed.shroud", "femast.elements.shroud_law"),
     ("femast.verification_arclength", "femast.verification.arclength"),
     ("femast.verification_modal", "femast.verification.modal"),
+] + [
+    (f"femast.experiments.rigs.{m}", f"femast.rigs.{m}")
+    for m in (
+        "bay_torsion",
+        "joint_test",
+        "latch_pull",
+        "mast_top",
+        "platform_pose",
+        "synthetic",
+        "tip_cycle",
+        "vibration",
+    )
 ]
 
 
@@ -359,6 +380,25 @@ def test_an_old_import_path_warns_and_gives_the_moved_module(old, new):
     assert mod.__name__ == new
     parent, _, leaf = old.rpartition(".")
     assert getattr(importlib.import_module(parent), leaf) is mod  # from femast import results
+
+
+def test_an_old_package_path_warns_and_gives_the_new_package_names():
+    import importlib
+
+    import femast.rigs
+
+    _forget("femast.experiments.rigs")
+    with pytest.warns(DeprecationWarning, match=r"femast\.experiments\.rigs has moved to femast\.rigs.*femast 0\.3"):
+        from femast.experiments.rigs import BUILT_IN, mast_top
+    assert BUILT_IN is femast.rigs.BUILT_IN and mast_top is femast.rigs.mast_top
+    # a module of the old package is the new module, never a second copy loaded under the old name
+    _forget("femast.experiments.rigs.synthetic")
+    with pytest.warns(
+        DeprecationWarning, match=r"femast\.experiments\.rigs\.synthetic has moved to femast\.rigs\.synthetic"
+    ):
+        old = importlib.import_module("femast.experiments.rigs.synthetic")
+    assert old is importlib.import_module("femast.rigs.synthetic")
+    assert not [m for m in sys.modules.values() if getattr(m, "__file__", "") == old.__file__ and m is not old]
 
 
 def test_the_old_paths_are_plain_modules_not_an_import_hook():
@@ -406,7 +446,7 @@ OLD_PATH_FILES = {MODULES[m] for m in OLD_PATH_MODULES}
 
 
 def test_the_project_imports_no_old_path():
-    old = tuple(o for o, _ in OLD_TO_NEW) + ("femast.solvers", "femast.analysis.solvers")
+    old = tuple(o for o, _ in OLD_TO_NEW) + ("femast.solvers", "femast.analysis.solvers", "femast.experiments.rigs")
     root = PKG.parent
     pattern = re.compile(r"^\s*(?:from|import)\s+(femast(?:\.\w+)+)", re.M)
     offenders = []

@@ -120,7 +120,7 @@ def test_identification_seed_sign_is_printed_sign(function):
 
 
 def test_mast_top_path_kind_seed000_is_rocaspect_fig5a():
-    from femast.experiments.rigs.synthetic import mast_top_path
+    from femast.rigs.synthetic import mast_top_path
 
     with pytest.warns(DeprecationWarning, match=r"kind='seed000'\) is now mast_top_path\(kind='rocaspect_fig5a'\)"):
         old = mast_top_path(n=60, kind="seed000")

@@ -12,7 +12,7 @@
   its elastic stiffness (docs/joint_test.md, "Your own connection test").
 
 Both are connection mechanisms: they apply to the rigs that say they test a connection --
-``joint-test``, the rigs made by :func:`~femast.experiments.rigs.joint_test.joint_test`, and any
+``joint-test``, the rigs made by :func:`~femast.rigs.joint_test.joint_test`, and any
 rig that calls :func:`add_connection_effects` with its name and quantities -- not to every rig
 with a load and a displacement (a mast top's base joints are not dowelled timber).
 """

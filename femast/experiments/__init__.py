@@ -5,7 +5,7 @@ function, its fittable parameters and the hooks where physical effects (:mod:`fe
 act; :func:`compare` runs or fits a model variant along the measured path and shows where it
 fails; :func:`diagnose` refits it with each candidate effect and says which one is missing.
 
-The rigs: the built-in experiments live in :mod:`femast.experiments.rigs`, one module per rig,
+The rigs: the built-in experiments live in :mod:`femast.rigs`, one module per rig,
 each written as a user's own rig is (``mast-top``, ``latch-pull``, ``bay-torsion``,
 ``tip-cycle``, ``vibration``, ``platform-pose``); ``femast experiments`` lists them.
 

@@ -17,7 +17,7 @@ It returns a dict ``{channel: (n,) array}`` with one predicted value per row for
 noise floor, segmentation, ranking of effects, figures, history) is generic.
 
 The built-in experiments are rigs written against this contract, one module each in
-:mod:`femast.experiments.rigs`; a user adds one from a Python script that defines a module-level
+:mod:`femast.rigs`; a user adds one from a Python script that defines a module-level
 ``experiment`` (see ``docs/experiments.md``).
 """
 

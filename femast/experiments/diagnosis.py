@@ -40,6 +40,7 @@ class Diagnosis:
     workers: int | None = None
     scheduler: object = None
     pool: object = None  # refit workers started with the diagnosis (femast.experiments.refits.refit_pool)
+    screen: bool = True  # screen the candidates of an expensive model (femast.experiments.screening)
     # the baseline stage
     baseline: OptimizeResult | None = None
     models: dict = field(default_factory=dict)  # {channel: ChannelNoise}, the noise model of the moment

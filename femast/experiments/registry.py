@@ -1,35 +1,58 @@
 """Registry of experiments: built-in names and user scripts.
 
-``get_experiment(name_or_path, **options)`` returns a built-in experiment by name or loads a
+``get_experiment(name_or_path, **options)`` returns a registered experiment by name or loads a
 user script (a ``.py`` file defining a module-level ``experiment``; it may also register
 effects).  ``register_experiment`` adds one under its name (a script may also do that and then
 be referred to by name in the same process).
+
+The built-in rigs (:mod:`femast.rigs`) sit above this framework and are registered the way an
+installed package of rigs is: through the ``femast.experiments`` entry point group
+(``pyproject.toml``: ``[project.entry-points."femast.experiments"]``), whose entries name a sequence
+of experiments (or one); the registry loads every entry on first use, femast's own first.  The
+framework itself imports no rig.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
+from importlib.metadata import entry_points
 from pathlib import Path
 
 from ..effects.scripts import load_script
-from ..errors import ModelError, did_you_mean
+from ..errors import FemastError, ModelError, did_you_mean
 from .core import Experiment
+
+#: the entry point group that installed packages (femast's built-in rigs first) register experiments in
+ENTRY_POINTS = "femast.experiments"
 
 _EXPERIMENTS: dict[str, Experiment] = {}
 _BUILTIN_LOADED = False
 
 
 def _load_builtin() -> None:
-    """Register the built-in rigs (:data:`femast.experiments.rigs.BUILT_IN`) on first use of the
-    registry: importing them imports their models (the ADAM and guyed-mast builders), which
-    ``import femast.experiments`` alone does not need."""
+    """Register the experiments of every installed package's ``femast.experiments`` entry points
+    (femast's built-in rigs first) on first use of the registry: importing them imports their
+    models (the ADAM and guyed-mast builders), which ``import femast.experiments`` alone does not need."""
     global _BUILTIN_LOADED
-    if not _BUILTIN_LOADED:
-        _BUILTIN_LOADED = True
-        from .rigs import BUILT_IN
-
-        for rig in BUILT_IN:
-            register_experiment(rig.EXPERIMENT)
+    if _BUILTIN_LOADED:
+        return
+    _BUILTIN_LOADED = True
+    found = sorted(entry_points(group=ENTRY_POINTS), key=lambda ep: ep.dist is None or ep.dist.name != "femast")
+    if not any(ep.dist is not None and ep.dist.name == "femast" for ep in found):
+        raise FemastError(
+            f"femast's built-in experiments are not registered (no '{ENTRY_POINTS}' entry point of femast): "
+            "the installed package metadata is out of date; reinstall femast (pip install -e . in a source checkout)"
+        )
+    for ep in found:
+        try:
+            loaded = ep.load()
+        except Exception as e:
+            raise FemastError(
+                f"the experiments of entry point '{ep.name} = {ep.value}' (package {ep.dist.name if ep.dist else '?'}) "
+                f"do not load: {type(e).__name__}: {e}"
+            ) from e
+        for experiment in (loaded,) if isinstance(loaded, Experiment) else loaded:
+            register_experiment(experiment)
 
 
 def register_experiment(experiment: Experiment, replace_existing: bool = False) -> Experiment:

@@ -101,7 +101,7 @@ def test_bay_runs_with_a_reference_are_cached_under_their_own_key_and_agree():
     without the reference."""
     from femast import examples
     from femast.experiments import fe_cache, fe_reference, get_experiment, read_data
-    from femast.experiments.rigs import bay_torsion as bt
+    from femast.rigs import bay_torsion as bt
 
     exp = get_experiment("bay-torsion")
     data = read_data(exp, examples.for_experiment("bay-torsion"))

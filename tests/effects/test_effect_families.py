@@ -10,7 +10,7 @@ from femast.effects.latch import fade
 from femast.effects.operators import IWAN_ELEMENTS, iwan, iwan_strengths, jenkins, proportional_iwan, proportional_play
 from femast.errors import ModelError
 from femast.experiments import Parameter, fit, get_experiment, predict
-from femast.experiments.rigs.synthetic import latch_pull_data, mast_top_data, mast_top_path
+from femast.rigs.synthetic import latch_pull_data, mast_top_data, mast_top_path
 
 CYCLE = np.concatenate([np.linspace(0, 10, 101), np.linspace(10, -10, 201), np.linspace(-10, 4, 141)])
 

@@ -20,7 +20,7 @@ from femast.effects import (
 )
 from femast.errors import ModelError
 from femast.experiments import Parameter, get_experiment, list_experiments, predict
-from femast.experiments.rigs.synthetic import mast_top_data, mast_top_path
+from femast.rigs.synthetic import mast_top_data, mast_top_path
 
 ROOT = Path(__file__).resolve().parents[2]
 REQUIRED = (

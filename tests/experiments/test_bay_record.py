@@ -5,7 +5,7 @@ output dict, 20 % of a run); they must equal the family's own outputs at every f
 import numpy as np
 
 from femast.analysis import Analysis
-from femast.experiments.rigs import bay_torsion as bt
+from femast.rigs import bay_torsion as bt
 
 
 def test_committed_beads_and_zones_equal_the_latch_outputs():

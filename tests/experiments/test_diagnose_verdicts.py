@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from femast.experiments import Measured, diagnose, get_experiment
-from femast.experiments.rigs.synthetic import mast_top_path
 from femast.experiments.verdict import MIN_SHARE, conclude, flags, share
 from femast.guyed.mast_3r import jacobian_3r
+from femast.rigs.synthetic import mast_top_path
 
 THR = 1.2
 
@@ -132,7 +132,7 @@ def test_piecewise_linear_clearance_is_found_with_its_closing_scale():
 
 @pytest.mark.slow
 def test_latch_pull_null_redraws_with_eq15_noise_and_a_small_friction():
-    from femast.experiments.rigs.synthetic import latch_pull_data
+    from femast.rigs.synthetic import latch_pull_data
 
     exp = get_experiment("latch-pull")
     for seed in range(5):  # docs/experiments.md "Limits": 5 of 5 nothing missing

@@ -8,7 +8,7 @@ import pytest
 from femast.cli import main
 from femast.errors import DataFileError, ModelError
 from femast.experiments import compare, diagnose, from_arrays, get_experiment, read_data, write_data
-from femast.experiments.rigs.synthetic import mast_top_data
+from femast.rigs.synthetic import mast_top_data
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "femast" / "examples"

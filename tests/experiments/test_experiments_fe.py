@@ -19,9 +19,9 @@ import pytest
 import femast as fm
 from femast.effects import applicable_effects, get_effect, resolve
 from femast.experiments import EffectStack, Measured, compare, diagnose, fe_cache, get_experiment, predict
-from femast.experiments.rigs.bay_torsion import bay_inputs, fe_rows
-from femast.experiments.rigs.synthetic import bay_torsion_data, bay_torsion_path, tip_cycle_data, tip_cycle_path
-from femast.experiments.rigs.tip_cycle import MOTION
+from femast.rigs.bay_torsion import bay_inputs, fe_rows
+from femast.rigs.synthetic import bay_torsion_data, bay_torsion_path, tip_cycle_data, tip_cycle_path
+from femast.rigs.tip_cycle import MOTION
 
 ROOT = Path(__file__).resolve().parents[2]
 BT = get_experiment("bay-torsion")

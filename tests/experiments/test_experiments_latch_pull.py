@@ -5,7 +5,7 @@ import pytest
 
 from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.experiments import AT_NOISE, compare, diagnose, from_arrays, get_experiment, predict, run_model
-from femast.experiments.rigs.synthetic import latch_pull_data
+from femast.rigs.synthetic import latch_pull_data
 
 EXP = get_experiment("latch-pull")
 N_SIGMA = 4.0  # identified parameters within 4 Jacobian standard errors (two-sided p ~ 6e-5 per parameter)

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from femast.experiments import AT_NOISE, compare, diagnose, get_experiment, predict, run_model
-from femast.experiments.rigs.synthetic import mast_top_data, mast_top_path
 from femast.guyed.mast_3r import displacement_3r
+from femast.rigs.synthetic import mast_top_data, mast_top_path
 
 EXP = get_experiment("mast-top")
 N_SIGMA = 4.0  # identified parameters within 4 Jacobian standard errors (two-sided p ~ 6e-5 per parameter)

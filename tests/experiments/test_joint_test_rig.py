@@ -10,7 +10,7 @@ from femast.effects.damage import damage, degrade
 from femast.effects.gap_slip import gap_slip
 from femast.effects.operators import play
 from femast.experiments import from_arrays, get_experiment, predict, read_data
-from femast.experiments.rigs.joint_test import joint_test
+from femast.rigs.joint_test import joint_test
 
 
 def _cycles(amps, n=200):

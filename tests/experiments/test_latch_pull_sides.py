@@ -2,7 +2,7 @@
 
 Data come from ``benchmarks/latch_rig.py``, a quasi-static simulation of the pull-test rig written
 from the paper's equations in angle form (Eqs. 7-11) with its own stick/slip search; it does not
-import femast.  The model under test is ``femast.experiments.rigs.latch_pull`` (Eq. 14 closed form,
+import femast.  The model under test is ``femast.rigs.latch_pull`` (Eq. 14 closed form,
 nearest admissible state, parked bead behind a slack cable).
 """
 
@@ -15,8 +15,8 @@ import pytest
 from femast.elements.latch_law import LATCHING, UNLATCHING, LatchParameters, latch_force
 from femast.errors import DataFileError
 from femast.experiments import AT_NOISE, compare, diagnose, from_arrays, get_experiment, predict, read_data
-from femast.experiments.rigs.latch_pull import infer_side
-from femast.experiments.rigs.synthetic import latch_pull_data
+from femast.rigs.latch_pull import infer_side
+from femast.rigs.synthetic import latch_pull_data
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "benchmarks"))
@@ -143,7 +143,7 @@ def test_full_strokes_unchanged_from_the_direction_rule():
 def _direction_rule(data, params):
     """The latch-pull model of the direction of motion (clipping by the direction of motion), for the test above."""
     from femast.experiments.core import prepared
-    from femast.experiments.rigs.latch_pull import _prepare
+    from femast.rigs.latch_pull import _prepare
 
     prep = prepared(data, _prepare, EXP.options)
     p = np.array([params["r"], params["x_backstop"], params["k"], params["mu"], 1.5e-3, 2.4e-3])

@@ -15,7 +15,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 from generalisation import noise as nz  # noqa: E402
 from generalisation.cases import get_case, latch_truth  # noqa: E402
 
-from femast.experiments.rigs.latch_pull import infer_side, running_median  # noqa: E402
+from femast.rigs.latch_pull import infer_side, running_median  # noqa: E402
 
 
 def test_running_median_ignores_two_row_spikes_and_keeps_steps():

@@ -9,7 +9,7 @@ import two_axis_rig as rig
 from femast.errors import ModelError
 from femast.experiments import compare, diagnose, from_arrays, get_experiment
 from femast.experiments.residuals import noise_floor, robust_rms
-from femast.experiments.rigs.synthetic import mast_top_data, mast_top_path
+from femast.rigs.synthetic import mast_top_data, mast_top_path
 
 START = {"k_x": 2e6, "k_y": 3e6}
 
