@@ -273,6 +273,7 @@ def _diagnose(args):
         scheduler=args.scheduler,
         out=out,
         max_rows=args.max_rows,
+        screen=not args.no_screen,
     )
     print(json.dumps(res.report, indent=2) if args.json else format_diagnose(exp, res))
 
@@ -399,6 +400,12 @@ def register(subparsers, fmt=None) -> None:
         "applies to the experiment)",
     )
     p.add_argument("--exclude", default=None, help="comma-separated effects not to try (default: none)")
+    p.add_argument(
+        "--no-screen",
+        action="store_true",
+        help="refit every candidate in full (default: on an FE experiment, a candidate whose linearised gain "
+        "cannot be significant is screened out after one model run per start and new parameter)",
+    )
     p.set_defaults(func=_diagnose)
     p = subparsers.add_parser(
         "experiments",

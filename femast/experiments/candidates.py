@@ -4,14 +4,17 @@
    check), and every candidate in its default form, all from the baseline's fit; with them, except
    on the expensive (FE) experiments, the forms that can gain where the default cannot
    (``from_baseline``: a one-sided form, whose mechanism the default, even in the sign of the
-   load, averages away);
+   load, averages away); on an expensive (FE) model a candidate whose linearisation at the start
+   of its refit shows that it cannot be significant stops there, screened out
+   (:mod:`femast.experiments.screening`);
 2. the other generalised forms of the candidates whose default form gains in the information
    criterion (under the null nothing does, and a refinement of the default cannot gain where the
    default did not), from the default form's fit;
 3. :func:`rank` scores every refit under the current noise model
    (:func:`~femast.experiments.verdict.score`): ``delta_bic``, the share of the excess error it
    explains, significance (:func:`~femast.experiments.verdict.flags`); each candidate keeps its best
-   form; a refit that failed is listed last, as failed.
+   form; the candidates refitted in full come first, then those screened out (by their linearised
+   ``delta_bic``), and a refit that failed is listed last, as failed.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..effects.base import forms_of, get_effect, resolve, split_form
+from . import screening
 from .fitting import params_table
 from .verdict import MIN_SHARE, SIGNIFICANT_DBIC, flags, robust_delta, share
 
@@ -37,14 +41,25 @@ def fit_candidates(d, while_waiting=None) -> None:
         jobs.append(("candidate", c, c, d.base_effects + [c], start))
         if cheap:  # the forms that can gain where the default cannot (one-sided), from the baseline too
             jobs += [("candidate", c, alt, d.base_effects + [alt], start) for alt in _from_baseline_forms(c, d.exp)]
-    fits = d.refit([(effs, st) for *_, effs, st in jobs], while_waiting)
+    scr = screening.spec(d) if d.screen and d.exp.fit_options.get("expensive") else None
+    fits = d.refit(
+        [
+            {"effects": effs, "start": st, "screen": scr if stage == "candidate" else None}
+            for stage, *_, effs, st in jobs
+        ],
+        while_waiting,
+    )
     ic0 = d.score(d.baseline)["ic"]
     done = {spec for _, _, spec, *_ in jobs}
     more = []
     for (stage, c, spec, _, _), res in zip(jobs, fits):
-        if stage != "candidate" or spec != c or getattr(res, "failed", False):
-            continue
-        if d.score(res)["ic"] - ic0 >= SIGNIFICANT_DBIC:
+        if (
+            stage != "candidate"
+            or spec != c
+            or getattr(res, "failed", False)
+            or getattr(res, "screened", False)
+            or d.score(res)["ic"] - ic0 >= SIGNIFICANT_DBIC
+        ):
             continue
         fitted = {k.split(".", 1)[1]: v for k, v in zip(res.names, res.x) if k.startswith(c + ".")}
         base_fit = {k: v for k, v in zip(res.names, res.x) if "." not in k}
@@ -92,7 +107,7 @@ def rank(d) -> None:
             e["reading"] = reading(d, effect, e)
         d.fits[effect] = res
         out.append(e)
-    out.sort(key=lambda e: (e.get("failed", False), e["delta_bic"]))
+    out.sort(key=lambda e: (e.get("failed", False), e.get("screened", False), e["delta_bic"]))
     d.ranking = out
 
 
@@ -141,6 +156,7 @@ def entry(d, effect: str, spec: str, res) -> dict:
         "n_params": int(res.n_params),
         "skipped": int(getattr(res, "skipped", 0)),
         "_z": sc["z"],
+        **({"screened": True, "significant": False, "ic_gain": False} if getattr(res, "screened", False) else {}),
     }
 
 
@@ -166,6 +182,13 @@ def reading(d, effect: str, e: dict) -> str:
     nch, masks = len(d.channels), d.analysis["masks"]
     text = f"{eff.signature[0].upper()}{eff.signature[1:]}. " if eff.signature else ""
     form = f" (form {e['form']})" if e.get("form") else ""
+    if e.get("screened"):
+        return text + (
+            f"Screened out: linearised at the start of its refit (one model run per start and new parameter), "
+            f"{eff.title}{form} takes the error from {e['baseline_ratio']:.2f}x to {e['ratio']:.2f}x the noise "
+            f"(delta BIC {e['delta_bic']:+.1f}); even {screening.SCREEN_MARGIN:g} times that gain would not be "
+            "significant, so it was not refitted in full."
+        )
     text += (
         f"Refitted with {eff.title}{form}, the error goes from {e['baseline_ratio']:.2f}x to "
         f"{e['ratio']:.2f}x the noise (explains {100 * e['explained_fraction']:.0f} % of the excess; "

@@ -70,6 +70,7 @@ from .refits import (  # noqa: F401
 )
 from .residuals import AT_NOISE, at_noise_threshold, load_path  # noqa: F401  (AT_NOISE: re-exported)
 from .rows import thin
+from .screening import refit_unscreened
 from .time_dependence import creep_overrules, reads_time, time_check
 from .units import check_data as check_units
 from .verdict import SIGNIFICANT_DBIC, conclude  # noqa: F401  (SIGNIFICANT_DBIC: re-exported)
@@ -89,6 +90,7 @@ def diagnose(
     pairs: bool = True,
     heldout: bool = True,
     max_rows: int | None = None,
+    screen: bool = True,
 ) -> OptimizeResult:
     """Refit the model with each candidate effect (every form), pairs of the best, and conclude.
 
@@ -115,6 +117,9 @@ def diagnose(
         member held out too.
     max_rows : above this many rows (default 10 000), every k-th row is used and a DataWarning
         says so (:mod:`femast.experiments.rows`).
+    screen : on an expensive (FE) experiment, a candidate whose linearisation at the start of its refit
+        shows that it cannot be significant is not refitted in full (:mod:`femast.experiments.screening`);
+        False refits every candidate in full.
 
     The stages, in order (each a function of its module, reading and writing a
     :class:`~femast.experiments.diagnosis.Diagnosis`): the baseline fit and the noise model its refits
@@ -153,14 +158,24 @@ def diagnose(
             pairs=pairs,
             heldout=heldout,
             pool=pool,
+            screen=screen,
         )
 
 
 def _diagnose(
-    exp, data, candidates, *, exclude, base_effects, sigma, workers, scheduler, out, pairs, heldout, pool
+    exp, data, candidates, *, exclude, base_effects, sigma, workers, scheduler, out, pairs, heldout, pool, screen
 ) -> OptimizeResult:
     d = Diagnosis.of(
-        exp, data, candidates, exclude, base_effects, sigma=sigma, workers=workers, scheduler=scheduler, pool=pool
+        exp,
+        data,
+        candidates,
+        exclude,
+        base_effects,
+        sigma=sigma,
+        workers=workers,
+        scheduler=scheduler,
+        pool=pool,
+        screen=screen,
     )
     _baseline(d)
     # the report's matplotlib is imported while the worker processes refit
@@ -169,6 +184,9 @@ def _diagnose(
     if pairs:
         fit_pairs(d)
     _noise_model(d)
+    if refit_unscreened(d):  # a candidate screened out under the first noise model that could pass under this one
+        rank(d)
+        score_pairs(d)
     if heldout:
         heldout_check(d)
     _verdict(d)
@@ -204,7 +222,11 @@ def _score_baseline(d: Diagnosis, thr: float) -> None:
 def _noise_model(d: Diagnosis) -> None:
     """The noise model from the residual of the best model (baseline, candidate or pair: its residual
     is the closest to the noise), by which everything is scored again."""
-    fits = [d.baseline, *(f for f in d.fits_list if not getattr(f, "failed", False)), *(r for *_, r in d.pair_fits)]
+    fits = [
+        d.baseline,
+        *(f for f in d.fits_list if not getattr(f, "failed", False) and not getattr(f, "screened", False)),
+        *(r for *_, r in d.pair_fits),
+    ]
     best = min(fits, key=lambda f: d.score(f)["rss"])
     d.models = noise_model(d.exp, d.data, best, pinned=pinned_rows(d.baseline, d.channels), sigma=d.sigma)
     d.n_eff = min(m.n_eff for m in d.models.values())

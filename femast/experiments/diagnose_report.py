@@ -33,6 +33,7 @@ PUBLIC = (
     "heldout_ratio",
     "heldout_ok",
     "skipped",
+    "screened",
 )
 
 
@@ -77,7 +78,7 @@ def diagnosis_result(d, out=None) -> OptimizeResult:
     best_fit = None
     if len(v.get("missing_effects") or []) == 2:  # a pair found (at the noise or with its forms imperfect)
         best_fit = next((p["_fit"] for p in d.pairs if p["effects"] == v["missing_effects"]), None)
-    elif d.ranking and not d.ranking[0].get("failed"):
+    elif d.ranking and not d.ranking[0].get("failed") and not d.ranking[0].get("screened"):
         best_fit = d.fits[d.ranking[0]["effect"]]
     result = OptimizeResult(
         experiment=exp.name,
@@ -180,6 +181,8 @@ def format_diagnose(exp: Experiment, result: OptimizeResult) -> str:
             f"{k} = {v['value']:.4g}" + (f" +- {v['stderr']:.2g}" if v["stderr"] is not None else "") + f" {v['unit']}"
             for k, v in e["params"].items()
         )
+        if e.get("screened"):
+            ps = "screened out: not refitted in full (its reading says why)"
         lines.append(
             f"  {i + 1:>4d}  {e['effect']:<22s} {e.get('form') or '-':<10s} {rms_of(e['rms'])} "
             f"{e['ratio']:>8.2f} {_ho(e.get('heldout_ratio')):>8s} {e['delta_bic']:>9.1f} "

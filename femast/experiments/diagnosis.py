@@ -47,6 +47,7 @@ class Diagnosis:
     scheduler: object = None
     pool: object = None  # refit workers started with the diagnosis (femast.experiments.refits.refit_pool)
     untimed: list = field(default_factory=list)  # effects in time not tried: the data record no time
+    screen: bool = True  # screen the candidates of an expensive model (femast.experiments.screening)
     # the baseline stage
     baseline: OptimizeResult | None = None
     models: dict = field(default_factory=dict)  # {channel: ChannelNoise}, the noise model of the moment

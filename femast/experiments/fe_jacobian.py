@@ -42,6 +42,7 @@ class _FEJacobian:
         self.since = 0  # evaluations since the last Jacobian (> 1: a rejected step)
         self.runs = 0
         self.fd_at = self.fd_J = None
+        self.futile = None  # check(u, f, J) run at every iterate; raises to stop the fit (screening)
 
     def value(self, u):
         key = np.asarray(u, float).tobytes()
@@ -88,6 +89,8 @@ class _FEJacobian:
             ss = float(s @ s)
             J = self.J if ss == 0.0 else self.J + np.outer((f0 - self.f) - self.J @ s, s) / ss
         self.J, self.u, self.f, self.since = J, u.copy(), f0, 0
+        if self.futile is not None:
+            self.futile(u, f0, J)
         return J
 
     def at_solution(self, u):

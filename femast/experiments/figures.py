@@ -174,7 +174,9 @@ def diagnose_figure(exp, data, result, png) -> Path:
         [("baseline", result.baseline["ratio"], None, False, False, result.baseline.get("heldout_ratio"))]
         + [
             (
-                r["effect"] + (f" ({r['form']})" if r.get("form") else ""),
+                r["effect"]
+                + (f" ({r['form']})" if r.get("form") else "")
+                + (", screened out" if r.get("screened") else ""),
                 r.get("ratio"),
                 r["delta_bic"],
                 r["significant"],

@@ -22,6 +22,7 @@ from scipy.optimize import least_squares
 from ..errors import ModelError
 from .fe_jacobian import LOG_RANGE, POLISH_MIN_DECREASE, _Coords, _FEJacobian, _polish
 from .prediction import MODEL_FAILURES, channel_residuals, estimate_noise, predict, split_parameters
+from .screening import Futile, futility_check, screened_out
 
 _BAD = 1e6  # whitened residual given to a parameter set the model rejects
 
@@ -132,20 +133,26 @@ class FitProblem:
                 J0[:, i] = -np.asarray(col, float) * dxdu[i] / rows
         return J0 if np.isfinite(J0).any() else None
 
-    def solve(self, sigma, candidates, J0=None, noise_given: bool = False):
+    def solve(self, sigma, candidates, J0=None, noise_given: bool = False, screen=None, polish: bool = True):
         """The best least-squares solution from the ``candidates`` start vectors, weighted by ``sigma``.
 
         An expensive model (secant Jacobians) polishes only the best of the starts' solutions
         (:func:`_polish`: a finite-difference Jacobian there, for the covariance, and a restart where
-        it promises more): the others are discarded anyway.  ``J0``, the columns known at the first
+        it promises more): the others are discarded anyway; ``polish=False`` skips it (a held-out
+        fold, whose covariance nobody reads).  ``J0``, the columns known at the first
         start, seeds every start's first Jacobian (the starts differ in the effect parameters,
-        whose columns are not known and are computed)."""
+        whose columns are not known and are computed).  ``screen`` (an expensive model's candidate
+        refit in ``diagnose``, :mod:`femast.experiments.screening`): a start stops at the first iterate
+        from which it cannot make the candidate significant; when every start stopped, the result is
+        the screening (``screened`` True)."""
         co, lo, hi, kw, secant, fd_step = self.co, self.lo, self.hi, self.kw, self.secant, self.fd_step
         best = best_fj = None
         fun0 = self.fun(sigma)
         nfev = 0
-        jacobians = []
+        jacobians, stops = [], []
         min_dec = POLISH_MIN_DECREASE if secant and noise_given else 0.0
+        sr = self.sigma_rows(sigma)
+        p_new = len(self.specs) - int(screen["p0"]) if screen else 0
         for x in candidates:
             u0 = co.start(x, lo, hi) if secant else np.clip(x / self.scale, lo, hi)
             fj = None
@@ -154,6 +161,8 @@ class FitProblem:
                 fj = _FEJacobian(fun0, float(fd_step), lo, hi, secant=secant, J0=J0 if secant else None)
                 fun, kw["jac"] = fj.value, fj.jac
                 jacobians.append(fj)
+                if screen and secant:
+                    fj.futile = futility_check(screen, p_new, sr, lo, hi, _BAD)
             kw_k = kw
             if min_dec:
                 # a noise model given: the cost is half the chi-square, and a decrease below min_dec is no
@@ -161,12 +170,24 @@ class FitProblem:
                 # bounded here by the start's (the start's run is the fit's first evaluation anyway)
                 f0 = fun(u0)
                 kw_k = {**kw, "ftol": max(float(kw.get("ftol", 1e-8)), min_dec / max(0.5 * float(f0 @ f0), 1e-300))}
-            with np.errstate(all="ignore"):
-                sol = least_squares(fun, u0, bounds=(lo, hi), **kw_k)
+            try:
+                with np.errstate(all="ignore"):
+                    sol = least_squares(fun, u0, bounds=(lo, hi), **kw_k)
+            except Futile as stop:  # this start cannot make the candidate significant
+                stops.append((fj.u, stop.lin))
+                continue
+            finally:
+                if fj is not None:
+                    fj.futile = None
             nfev += sol.nfev
             if best is None or sol.cost < best.cost:
                 best, best_fj = sol, fj
-        if secant:
+        runs = sum(fj.runs for fj in jacobians)
+        if best is None:  # every start stopped: screened out
+            out = screened_out(stops, screen, p_new, sr)
+            out.screened, out.fe_runs = True, runs
+            return out
+        if secant and polish:
             kw["jac"] = best_fj.jac
             best = _polish(best, best_fj, best_fj.value, lo, hi, kw, min_dec)
             nfev += getattr(best, "nfev_polish", 0)

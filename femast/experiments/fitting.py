@@ -178,6 +178,7 @@ def fit(
     nfev_per_param: int | None = None,
     start_sensitivity: dict | None = None,
     rows=None,
+    screen: dict | None = None,
 ) -> OptimizeResult:
     """Fit the baseline parameters and those of the switched-on ``effects`` to the data.
 
@@ -197,7 +198,12 @@ def fit(
         columns instead of FE runs.  The Jacobian at the solution (covariance) is always computed.
     rows : (n,) bool, the rows the fit sees (default all): the model still runs along the whole path
         -- its state at a row depends on the rows before -- and the other rows are predicted, not
-        fitted (held-out validation, :mod:`femast.experiments.heldout`); needs ``noise``.
+        fitted (held-out validation, :mod:`femast.experiments.heldout`); needs ``noise``.  Such a fit
+        is not polished (no finite-difference Jacobian at its solution: its covariance is not needed).
+    screen : a candidate's screening in ``diagnose`` (:mod:`femast.experiments.screening`; expensive
+        models with a given ``noise``): when its linearisation at every start shows it cannot be
+        significant, the fit stops there and the result has ``screened`` True, the linearised
+        residual and parameters, and ``screen`` (the linearisations).
 
     Returns an ``OptimizeResult`` with ``x``, ``names``, ``units``, ``stderr``, ``cov``,
     ``params`` (baseline ``{name: value}``), ``effect_params`` (``{effect: {name: value}}``),
@@ -230,8 +236,36 @@ def fit(
         if rows is not None:  # rows not fitted weigh nothing: an infinite noise
             rows = np.asarray(rows, bool)
             sigma = {c: np.where(rows, np.broadcast_to(v, (data.n,)), np.inf) for c, v in sigma.items()}
-        sol = pb.solve(sigma, starts, pb.seed(start_sensitivity, sigma, pb.x0), noise_given=True)
+        sol = pb.solve(
+            sigma,
+            starts,
+            pb.seed(start_sensitivity, sigma, pb.x0),
+            noise_given=True,
+            screen=screen,
+            polish=rows is None,
+        )
+        if getattr(sol, "screened", False):
+            return _screened(pb, sol, sigma, [i[0] for i in impls])
     return _fitted(pb, sol, sigma, [i[0] for i in impls])
+
+
+def _screened(pb, sol, sigma, effect_names) -> OptimizeResult:
+    """The result of a refit stopped by its screening: the linearised solution (the Gauss-Newton step
+    from its best start, not run) with its linearised residual; ``screened`` True, ``screen``."""
+    exp, data, specs = pb.exp, pb.data, pb.specs
+    x = pb.co.to_x(sol.u)
+    n, p = data.n, len(x)
+    r = np.asarray(sol.r_lin, float).reshape(len(exp.channels), n)
+    predicted = {c: data[c] - r[i] for i, c in enumerate(exp.channels)}
+    msg = "screened out: its linearised gain cannot make it significant (not refitted in full)"
+    nan = np.full(p, np.nan)
+    out = _result(
+        exp, data, specs, x, nan, np.full((p, p), np.nan), sigma, predicted, True, True, msg, sol.fe_runs, effect_names
+    )
+    out.screened, out.screen = True, sol
+    out.sensitivity, out.fe_runs, out.skipped = None, int(sol.fe_runs), len(pb.skipped)
+    out.fe_reference = exp.options.get("fe_reference")
+    return out
 
 
 def _fitted(pb, sol, sigma, effect_names) -> OptimizeResult:

@@ -53,6 +53,7 @@ def _refit_task(payload: dict) -> OptimizeResult:
             noise=payload["noise"],
             sensitivity=payload.get("sensitivity"),
             rows=payload.get("rows"),
+            screen=payload.get("screen"),
         )
     finally:
         progress.relay_to(None)
@@ -60,7 +61,7 @@ def _refit_task(payload: dict) -> OptimizeResult:
     return res
 
 
-def _safe_fit(exp, data, effects, start, noise, sensitivity=None, rows=None) -> OptimizeResult:
+def _safe_fit(exp, data, effects, start, noise, sensitivity=None, rows=None, screen=None) -> OptimizeResult:
     """:func:`fit`, or a result with ``failed = True`` and the error as ``message`` when the model
     cannot be evaluated even at the start of the refit (an FE run that does not converge with the
     effect's default parameters): one failed candidate must not end the whole diagnosis."""
@@ -75,6 +76,7 @@ def _safe_fit(exp, data, effects, start, noise, sensitivity=None, rows=None) -> 
             nfev_per_param=REFIT_NFEV,
             start_sensitivity=sensitivity,
             rows=rows,
+            screen=screen,  # a candidate screened by its linearisation (femast.experiments.screening)
         )  # derivatives known at (or near) the start seed the refit's: the baseline's for a candidate, a
         # model's own at its solution for a held-out fold
     except (*MODEL_FAILURES, ArithmeticError) as e:
@@ -232,6 +234,7 @@ def _dispatch(exp, data, payloads, start, sigma, workers, scheduler, t_base, whi
                     noise=p.get("noise", sigma),
                     sensitivity=p.get("sensitivity"),
                     rows=p.get("rows"),
+                    screen=p.get("screen"),
                 )
                 for p in payloads
             ],
