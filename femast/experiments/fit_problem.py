@@ -182,6 +182,12 @@ class FitProblem:
             nfev += sol.nfev
             if best is None or sol.cost < best.cost:
                 best, best_fj = sol, fj
+        if best is not None and screen and secant:  # a start that converged: is it worth its polish?
+            try:
+                futility_check(screen, p_new, sr, lo, hi, _BAD)(best.x, best.fun, best_fj.J)
+            except Futile as stop:
+                stops.append((best.x, stop.lin))
+                best = None
         runs = sum(fj.runs for fj in jacobians)
         if best is None:  # every start stopped: screened out
             out = screened_out(stops, screen, p_new, sr)
