@@ -182,6 +182,8 @@ class FitProblem:
             nfev += sol.nfev
             if best is None or sol.cost < best.cost:
                 best, best_fj = sol, fj
+        if best is not None and stops and min(0.5 * float(np.sum((lin[0] / sr) ** 2)) for _, lin in stops) < best.cost:
+            best = None  # the starts that converged ended above where a stopped one stopped: no better than it
         if best is not None and screen and secant:  # a start that converged: is it worth its polish?
             try:
                 futility_check(screen, p_new, sr, lo, hi, _BAD)(best.x, best.fun, best_fj.J)
