@@ -19,14 +19,17 @@ the candidate significant against the baseline's ``rss0``:
 
     dIC = N ln((rss - 3 (rss - rss_lin)) / rss0) + p_new ln N  <  SIGNIFICANT_DBIC (-10)
 
-Otherwise that start of the refit stops (a futility stop); a start that converged is judged so at
+Otherwise that start of the refit stops (a futility stop).  A start the model cannot be run at (an
+FE run that does not converge there) is left out when another start can be run: its fit would
+only grope its way out of the failures.  A start that converged is judged so at
 its solution before it is polished (the finite-difference Jacobian there, for the covariance, is
 not needed for a candidate that cannot be significant).  Every start of a multistart refit is run
 so; a candidate is *screened out* when every start stopped -- at its first iterate when nothing is
 to be gained (``1 + p_new`` runs per start instead of a full fit) -- and reported with the figures of
 the model run where its best start stopped (its ``significant`` always False, its parameters
 without standard errors).  A start that stops cannot have been the best of a significant refit (it
-could not reach significance), so a candidate that is significant is fitted as without the screen.
+could not reach significance), so a candidate that is significant is fitted as without the screen,
+but for the starts the model cannot be run at.
 
 The screen is judged again under the final noise model of the diagnosis (from the residual of its
 best model, :mod:`femast.experiments.diagnose`), by which every refit is scored: the linearisations
