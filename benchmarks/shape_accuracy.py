@@ -38,9 +38,12 @@ scaling (20 of 40 bays x 0.10 deg = 2.0 deg); writes DIR/summary.json and four P
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import shutil
+import signal
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -166,11 +169,40 @@ def p95_abs(x):
 
 def local_dask(workers: int):
     """A dask.distributed client on a local cluster of ``workers`` single-threaded processes (closed
-    by the caller)."""
+    by the caller), without a dashboard.  The scheduler serves its HTTP routes (health, metrics) even
+    without one, on port 8787 unless told otherwise, and warns when that port is taken (another
+    cluster on the machine): here on a free port of this machine's loopback interface."""
     from dask.distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+    cluster = LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+    )
     return Client(cluster), cluster
+
+
+@contextlib.contextmanager
+def interrupt_on_sigterm():
+    """In the block, SIGTERM (``kill PID``) raises KeyboardInterrupt as Ctrl-C does: the study stops
+    with its finished runs on disk and the ``finally`` that closes the dask cluster runs, so that its
+    worker processes end with their semaphores released (killed by SIGTERM's default action, the
+    process died with its workers still sending heartbeats, and the resource tracker warned of
+    leaked semaphores).  Outside the main thread, nothing (only it receives signals)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise KeyboardInterrupt(f"stopped by signal {signum}")
+
+    old = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
 
 
 def rerun_failed(res, folder, n_bays, cycles, o) -> dict:
@@ -217,12 +249,13 @@ def run_mast(n_bays, samples, cycles, workers, out, sensitivity, report_only=Fal
             increments=o["increments"],
         )
         if o["dask"]:
-            client, cluster = local_dask(workers)
-            try:
-                summary = st.run(study, folder, samples=samples, scheduler=client)
-            finally:
-                client.close()
-                cluster.close()
+            with interrupt_on_sigterm():
+                client, cluster = local_dask(workers)
+                try:
+                    summary = st.run(study, folder, samples=samples, scheduler=client)
+                finally:
+                    client.close()
+                    cluster.close()
         else:
             summary = st.run(study, folder, samples=samples, workers=workers)
     res = st.load(folder)

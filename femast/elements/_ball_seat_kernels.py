@@ -67,6 +67,21 @@ def radial_gap(r, e, gn, c_r):
     return math.sqrt(rho2) - c_r
 
 
+#: A seated ball lifts off its seat only when its axial gap exceeds this many units of round-off of the
+#: nodes' positions (:func:`seat_hold_gap`).
+HOLD_ULPS = 8.0
+
+
+@njit(cache=True)
+def seat_hold_gap(xa, xb):
+    """The axial gap (m) a seated ball must exceed to open its seat: HOLD_ULPS units of round-off of the
+    larger of the two nodes' distances from the origin (at least 1 m)."""
+    s = 1.0
+    for x in (xa, xb):
+        s = max(s, math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]))
+    return HOLD_ULPS * 2.220446049250313e-16 * s
+
+
 @njit(cache=True)
 def seat_status(r, e, c_r, c_a):
     """Contact status of the seat at ``r`` (socket frame): axial branch + 3 x wall contact."""
@@ -179,14 +194,16 @@ def seated_joint_element(
         return 0.0, ERR_NOT_FINITE, False
     mtv(Rb, p, r)
     status = seat_status(r, e, c_r, c_a)
+    ref = prev if has_prev else st
+    answered = int(ref[I_STATUS])
+    gn_now = r[0] * e[0] + r[1] * e[1] + r[2] * e[2]
+    if answered % 3 == SEATED and status % 3 == OPEN and gn_now <= seat_hold_gap(xa, xb):
+        status = SEATED + 3 * (status // 3)  # lifted off by round-off only: still seated
     # a contact that the last iterate was answered with (the committed state's in the first
     # iteration) is released only when ``may_release`` (every seat of the family has settled,
     # :func:`seats_settled`); until then the joint is answered on the old branches, provisionally.
     # A new contact is taken at once: a seat held open while the ball passes through it would let
     # the member float through its seat.
-    ref = prev if has_prev else st
-    answered = int(ref[I_STATUS])
-    gn_now = r[0] * e[0] + r[1] * e[1] + r[2] * e[2]
     rg_now = radial_gap(r, e, gn_now, c_r)
     held = False
     if status != answered and not may_release:

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import femast as fm
-from femast.elements._ball_seat_kernels import I_STATUS, I_TRUE_STATUS, seat_status
+from femast.elements._ball_seat_kernels import I_STATUS, I_TRUE_STATUS, seat_hold_gap, seat_status
 from femast.elements.ball_joint import OPEN_FACTOR, PENALTY_FACTOR, BallJointFamily, add_ball_joints
 from femast.elements.base import IncrementContext
 from femast.errors import ModelError
@@ -232,6 +232,44 @@ def test_a_status_change_is_taken_when_two_iterates_agree():
     ctx = IncrementContext(previous={id(fam): first.state})
     second = fam.evaluate(x, R, st, ctx)
     assert not second.provisional and second.output["normal_force"][0] == 0.0  # open, as the law says
+
+
+def _lifted(gap_ulps, committed):
+    """One seated joint, ball node a above socket node b = (0, 0, 1) m along the seat axis z by
+    ``gap_ulps`` units of round-off of 1 m (2.2e-16 m), its seat ``committed`` seated (1) or open (0)."""
+    fam = BallJointFamily([[0, 1]], k_pen=2.66e11, k_stick=50.0, mu_s=0.5, mu_k=0.5, seat="seated", axis=(0, 0, 1))
+    x = np.array([[0.0, 0.0, 1.0 + gap_ulps * np.finfo(float).eps], [0.0, 0.0, 1.0]])
+    st = fam.initial_state()
+    st[0, I_STATUS] = st[0, I_TRUE_STATUS] = committed
+    return fam, x, np.stack([np.eye(3), np.eye(3)]), st
+
+
+@pytest.mark.parametrize("gap_ulps", [1.0, 2.0, 8.0])
+def test_a_seat_lifted_by_round_off_stays_seated(gap_ulps):
+    """A gap of a few units of round-off says nothing about the side the ball is on: a seated ball
+    stays seated up to seat_hold_gap = 8 ulps of its position (1.8e-15 m at 1 m) and carries the
+    tension k_pen g of that gap, and its seat keeps the penalty stiffness; an open seat at the same
+    gap stays open (hysteresis, no chattering between the branches)."""
+    fam, x, R, st = _lifted(gap_ulps, committed=1)
+    g = gap_ulps * np.finfo(float).eps
+    assert seat_hold_gap(x[0], x[1]) == pytest.approx(8 * np.finfo(float).eps, rel=1e-15)
+    r = fam.evaluate(x, R, st)
+    assert not r.provisional and r.output["contact"][0] == 1 and r.output["gap"][0] == g  # exact: 1 + k eps
+    assert r.output["normal_force"][0] == pytest.approx(2.66e11 * g, rel=1e-12)  # k_pen g, <= 4.7e-4 N
+    assert r.k[0][8, 8] == pytest.approx(2.66e11, rel=1e-12)  # the seat's axial stiffness, node b's uz
+    fam, x, R, st = _lifted(gap_ulps, committed=0)
+    r = fam.evaluate(x, R, st)
+    assert r.output["contact"][0] == 0 and r.output["normal_force"][0] == 0.0
+    assert r.k[0][8, 8] == pytest.approx(fam.k_open[0], rel=1e-12)
+
+
+def test_a_seat_lifted_beyond_round_off_opens():
+    """Past seat_hold_gap (16 ulps here) a seated ball opens its seat as before (its gap moved by less
+    than the contact search's floor since the committed state, so at once): no normal force, k_open."""
+    fam, x, R, st = _lifted(16.0, committed=1)
+    r = fam.evaluate(x, R, st)
+    assert not r.provisional and r.output["contact"][0] == 0 and r.output["normal_force"][0] == 0.0
+    assert r.k[0][8, 8] == pytest.approx(fam.k_open[0], rel=1e-12)
 
 
 # ------------------------------------------------------------- a path through every state

@@ -1,6 +1,7 @@
 """A study's worker processes: a sample stuck inside a compiled loop (which no signal interrupts)
-is ended at the study's time-out and recorded as failed, serial or on two workers; and a kill -9
-of ``femast study --workers 2`` leaves no process behind."""
+is ended at the study's time-out and recorded as failed, serial or on two workers; a kill -9
+of ``femast study --workers 2`` leaves no process behind; a kill (SIGTERM) of the shape-accuracy
+benchmark on dask closes its cluster."""
 
 import os
 import signal
@@ -69,10 +70,11 @@ SLOW_STUDY = textwrap.dedent(
 )
 
 
-def _kill_9_once_running(p, running, what, within_s, settle_s):
-    """SIGKILL process ``p`` (the leader of its own session) ``settle_s`` seconds after ``running()``
-    first holds (at most ``within_s`` seconds); then no process of its session may be alive 30 s
-    later.  Whatever happens, the session's processes are killed at the end."""
+def _kill_once_running(p, running, what, within_s, settle_s, sig=signal.SIGKILL):
+    """Signal ``sig`` (SIGKILL unless told) to process ``p`` (the leader of its own session)
+    ``settle_s`` seconds after ``running()`` first holds (at most ``within_s`` seconds); then no process
+    of its session may be alive 30 s later.  Whatever happens, the session's processes are killed at
+    the end."""
     try:
         deadline = time.monotonic() + within_s
         while not running():
@@ -80,8 +82,8 @@ def _kill_9_once_running(p, running, what, within_s, settle_s):
             assert time.monotonic() < deadline, f"{what} did not start"
             time.sleep(0.2)
         time.sleep(settle_s)
-        os.kill(p.pid, signal.SIGKILL)
-        p.wait(timeout=30)
+        os.kill(p.pid, sig)
+        p.wait(timeout=60)
         assert_session_ends(p.pid, within_s=30.0)
     finally:
         for pid in session_processes(p.pid):
@@ -112,7 +114,7 @@ def test_kill_9_of_a_study_on_two_workers_leaves_no_process(tmp_path):
         stderr=subprocess.DEVNULL,
     )
     # the study and its two workers; then 2 s while the workers run samples
-    _kill_9_once_running(p, lambda: len(session_processes(p.pid)) >= 3, "the workers", 300.0, 2.0)
+    _kill_once_running(p, lambda: len(session_processes(p.pid)) >= 3, "the workers", 300.0, 2.0)
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to find the processes")
@@ -130,4 +132,29 @@ def test_kill_9_of_the_shape_accuracy_benchmark_on_a_local_dask_cluster_leaves_n
     )
     runs = tmp_path / "out" / "bays2_plain"
     # the benchmark and its dask worker, writing runs; then 3 s while the worker runs samples
-    _kill_9_once_running(p, lambda: len(session_processes(p.pid)) >= 2 and runs.is_dir(), "the dask worker", 600.0, 3.0)
+    _kill_once_running(p, lambda: len(session_processes(p.pid)) >= 2 and runs.is_dir(), "the dask worker", 600.0, 3.0)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to find the processes")
+def test_kill_of_the_shape_accuracy_benchmark_closes_its_dask_cluster(tmp_path):
+    """``kill PID`` (SIGTERM) of the benchmark mid-study stops it as Ctrl-C does: it closes its dask
+    cluster, so the worker ends with it and no semaphore is left for the resource tracker to report
+    (SIGTERM's default action killed the process with the worker still sending heartbeats, and the
+    tracker warned of leaked semaphores); the study's folder reads back."""
+    pytest.importorskip("distributed")
+    args = ["--bays", "--plain-bays", "--big", "2", "--big-samples", "64", "--dask", "--workers", "1"]
+    runs = tmp_path / "out" / "bays2_plain"
+    with open(tmp_path / "stderr.txt", "w") as err:
+        p = subprocess.Popen(
+            [sys.executable, "-m", "femast.benchmarks.shape_accuracy", *args, "--out", str(tmp_path / "out")],
+            cwd=tmp_path,
+            start_new_session=True,
+            stdout=subprocess.DEVNULL,
+            stderr=err,
+        )
+        running = lambda: len(session_processes(p.pid)) >= 2 and runs.is_dir()  # noqa: E731
+        _kill_once_running(p, running, "the dask worker", 600.0, 3.0, sig=signal.SIGTERM)
+    text = (tmp_path / "stderr.txt").read_text()
+    assert "KeyboardInterrupt: stopped by signal 15" in text
+    assert "leaked semaphore" not in text
+    assert st.load(runs).counts()["expected"] == 64  # the folder reads back: the study of 64 samples
