@@ -188,9 +188,10 @@ def local_dask(workers: int):
 def interrupt_on_sigterm():
     """In the block, SIGTERM (``kill PID``) raises KeyboardInterrupt as Ctrl-C does: the study stops
     with its finished runs on disk and the ``finally`` that closes the dask cluster runs, so that its
-    worker processes end with their semaphores released (killed by SIGTERM's default action, the
-    process died with its workers still sending heartbeats, and the resource tracker warned of
-    leaked semaphores).  Outside the main thread, nothing (only it receives signals)."""
+    worker processes end (killed by SIGTERM's default action, the process died with its worker still
+    sending heartbeats, and the resource tracker reported 7 leaked semaphores; a worker stopped in
+    the middle of a long run still leaves one).  Outside the main thread, nothing (only it receives
+    signals)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
