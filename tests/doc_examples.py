@@ -144,19 +144,26 @@ def _printed(line: str, out: str) -> bool:
     return any(core in o or _same_line(core, o.strip()) for o in out.splitlines())
 
 
-def replay_transcript(block: str, folder, capsys, ignore=lambda line: False, what: str = "the page") -> int:
+def replay_transcript(
+    block: str, folder, capsys, ignore=lambda line: False, what: str = "the page", printed=None
+) -> int:
     """Run the commands of a quoted console transcript in ``folder`` (the current directory) --
     ``$ femast ...`` through femast.cli.main, ``$ head -N FILE`` -- and check that every other
     non-blank line (unless ``ignore(line)``) is in what the command before it printed, numbers to 3
     units in their last quoted digit (:func:`_same_line`).  A run time quoted after a command,
-    ``(12.3 s)``, is not part of it.  Returns the number of lines checked."""
+    ``(12.3 s)``, is not part of it.  ``printed``: {command line as quoted: what that command printed
+    in a run the test has made already} (the same command, perhaps with another ``--out``), not run
+    again.  Returns the number of lines checked."""
     from femast.cli import main
 
     out, checked = "", 0
     for line in block.splitlines():
         if line.startswith("$ "):
-            cmd = shlex.split(re.sub(r"\s+\(\d+(\.\d+)? s\)$", "", line[2:]))
-            if cmd[0] == "femast":
+            quoted = re.sub(r"\s+\(\d+(\.\d+)? s\)$", "", line[2:])
+            cmd = shlex.split(quoted)
+            if printed and quoted in printed:
+                out = printed[quoted]
+            elif cmd[0] == "femast":
                 assert main(cmd[1:]) == 0, line
                 out = capsys.readouterr().out
             elif cmd[0] == "head":

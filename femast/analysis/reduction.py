@@ -16,6 +16,9 @@ prescribed-displacement increments, K_fc.
 
 from __future__ import annotations
 
+import hashlib
+import threading
+
 import numpy as np
 import scipy.sparse as sp
 from numba import njit
@@ -62,6 +65,72 @@ def _fill(a_data, t_data, pa, pt1, pt2, pos, g_vals, g_pos, out):
             out[g_pos[g]] += g_vals[g]
 
 
+# The layout of the reduced blocks depends on the patterns of K, T and G alone: a process that sets
+# up the same model again and again (the FE fits of femast.experiments: 50-100 runs of one ADAM mast
+# with other parameters in a diagnosis) computes it once (the 40-bay mast's: 70 ms, a twentieth of a
+# run).  The last LAYOUTS_KEPT layouts are remembered by a SHA-1 of the patterns; their arrays are
+# read-only and shared.
+LAYOUTS_KEPT = 4
+_LAYOUTS: dict = {}
+_LAYOUTS_LOCK = threading.Lock()  # (models set up in threads: a Study on dask threads)
+
+
+def _layout_key(arrays, nf, n_ind) -> bytes:
+    h = hashlib.sha1(f"{nf} {n_ind}".encode())
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        h.update(f"|{a.dtype.str}{a.shape}|".encode())
+        h.update(a.data)
+    return h.digest()
+
+
+def _layout(a_ptr, a_idx, t_ptr, t_idx, g_rows, g_cols, nf, n_ind):
+    """The contributions (pa, pt1, pt2) and their positions ``pos`` in the data array of the two
+    blocks, the positions ``g_pos`` of G's entries, and the blocks' CSR structure."""
+    n = _count(a_ptr, a_idx, t_ptr, t_idx, nf)
+    pa, pt1, pt2, key = (np.empty(n, np.int64) for _ in range(4))
+    _list(a_ptr, a_idx, t_ptr, t_idx, nf, n_ind, pa, pt1, pt2, key)
+    g_key = np.where(g_rows < nf, g_rows * n_ind + g_cols, -1)
+    all_keys = np.concatenate([key, g_key[g_key >= 0]])
+    uniq = np.unique(all_keys)
+    rows, cols = uniq // n_ind, uniq % n_ind
+    in_ff = cols < nf
+    # one data array holding both blocks: ff entries first (row-major), then fc entries
+    order = np.concatenate([np.flatnonzero(in_ff), np.flatnonzero(~in_ff)])
+    slot = np.empty(uniq.size, np.int64)
+    slot[order] = np.arange(uniq.size)
+    pos = slot[np.searchsorted(uniq, key)]
+    g_pos = np.full(g_key.size, -1, np.int64)
+    ok = g_key >= 0
+    g_pos[ok] = slot[np.searchsorted(uniq, g_key[ok])]
+    ff_r, ff_c = rows[in_ff], cols[in_ff]
+    fc_r, fc_c = rows[~in_ff], cols[~in_ff] - nf
+    out = dict(
+        pa=pa, pt1=pt1, pt2=pt2, pos=pos, g_pos=g_pos, size=int(uniq.size), n_ff=int(in_ff.sum()),
+        ff=(ff_c, _indptr(ff_r, nf)), fc=(fc_c, _indptr(fc_r, nf)),
+    )  # fmt: skip
+    for v in (pa, pt1, pt2, pos, g_pos, ff_c, fc_c, out["ff"][1], out["fc"][1]):
+        v.flags.writeable = False
+    return out
+
+
+def _remembered_layout(K, T, g_rows, g_cols, nf):
+    n_ind = T.shape[1]
+    a_ptr, a_idx = K.indptr.astype(np.int64), K.indices.astype(np.int64)
+    t_ptr, t_idx = T.indptr.astype(np.int64), T.indices.astype(np.int64)
+    g_rows = np.asarray(g_rows, np.int64)
+    g_cols = np.asarray(g_cols, np.int64)
+    key = _layout_key((a_ptr, a_idx, t_ptr, t_idx, g_rows, g_cols), nf, n_ind)
+    hit = _LAYOUTS.get(key)
+    if hit is None:
+        hit = _layout(a_ptr, a_idx, t_ptr, t_idx, g_rows, g_cols, nf, n_ind)
+        with _LAYOUTS_LOCK:
+            while _LAYOUTS and len(_LAYOUTS) >= LAYOUTS_KEPT:
+                _LAYOUTS.pop(next(iter(_LAYOUTS)))  # the oldest
+            _LAYOUTS[key] = hit
+    return hit
+
+
 class ReducedTangent:
     """T^T K T + G restricted to the free rows, filled in place into fixed CSR blocks.
 
@@ -70,34 +139,15 @@ class ReducedTangent:
 
     def __init__(self, K, T, g_rows, g_cols, nf):
         n_ind = T.shape[1]
-        a_ptr, a_idx = K.indptr.astype(np.int64), K.indices.astype(np.int64)
-        t_ptr, t_idx = T.indptr.astype(np.int64), T.indices.astype(np.int64)
-        n = _count(a_ptr, a_idx, t_ptr, t_idx, nf)
-        pa, pt1, pt2, key = (np.empty(n, np.int64) for _ in range(4))
-        _list(a_ptr, a_idx, t_ptr, t_idx, nf, n_ind, pa, pt1, pt2, key)
-        g_rows = np.asarray(g_rows, np.int64)
-        g_cols = np.asarray(g_cols, np.int64)
-        g_key = np.where(g_rows < nf, g_rows * n_ind + g_cols, -1)
-        all_keys = np.concatenate([key, g_key[g_key >= 0]])
-        uniq = np.unique(all_keys)
-        rows, cols = uniq // n_ind, uniq % n_ind
-        in_ff = cols < nf
-        # one data array holding both blocks: ff entries first (row-major), then fc entries
-        order = np.concatenate([np.flatnonzero(in_ff), np.flatnonzero(~in_ff)])
-        slot = np.empty(uniq.size, np.int64)
-        slot[order] = np.arange(uniq.size)
-        self.data = np.zeros(uniq.size)
-        n_ff = int(in_ff.sum())
-        self.pos = slot[np.searchsorted(uniq, key)]
-        self.g_pos = np.full(g_key.size, -1, np.int64)
-        ok = g_key >= 0
-        self.g_pos[ok] = slot[np.searchsorted(uniq, g_key[ok])]
-        self.pa, self.pt1, self.pt2 = pa, pt1, pt2
-        # CSR blocks viewing self.data (unique keys are row-major sorted, so each block's rows are too)
-        ff_r, ff_c = rows[in_ff], cols[in_ff]
-        fc_r, fc_c = rows[~in_ff], cols[~in_ff] - nf
-        self.K_ff = sp.csr_matrix((self.data[:n_ff], ff_c, _indptr(ff_r, nf)), shape=(nf, nf))
-        self.K_fc = sp.csr_matrix((self.data[n_ff:], fc_c, _indptr(fc_r, nf)), shape=(nf, n_ind - nf))
+        lay = _remembered_layout(K, T, g_rows, g_cols, nf)
+        self.pa, self.pt1, self.pt2, self.pos, self.g_pos = lay["pa"], lay["pt1"], lay["pt2"], lay["pos"], lay["g_pos"]
+        self.data = np.zeros(lay["size"])
+        n_ff = lay["n_ff"]
+        # CSR blocks viewing self.data (their index arrays copied: the solver may keep them)
+        ff_c, ff_ptr = (a.copy() for a in lay["ff"])
+        fc_c, fc_ptr = (a.copy() for a in lay["fc"])
+        self.K_ff = sp.csr_matrix((self.data[:n_ff], ff_c, ff_ptr), shape=(nf, nf))
+        self.K_fc = sp.csr_matrix((self.data[n_ff:], fc_c, fc_ptr), shape=(nf, n_ind - nf))
         self.K_ff.data = self.data[:n_ff]  # views: filling self.data fills both blocks
         self.K_fc.data = self.data[n_ff:]
         self.K_ff.has_canonical_format = True

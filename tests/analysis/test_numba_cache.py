@@ -63,7 +63,9 @@ def _run(tmp_path, pkg, guard, numba_cache_dir=None):
 
 
 @pytest.mark.parametrize("options", ["", "inline='always'"])
-@pytest.mark.parametrize("guard", [False, True])
+# without the guard: numba's own behaviour (the stale helper, numba issue #1833), the control that shows
+# the test can see the bug; slow, since femast's guard is what the default cases test
+@pytest.mark.parametrize("guard", [pytest.param(False, marks=pytest.mark.slow), True])
 def test_edited_helper_in_another_file(tmp_path, options, guard):
     pkg = _package(tmp_path, options)
     assert _run(tmp_path, pkg, guard) == 3.0  # 1 * 2 + 1, compiled and cached

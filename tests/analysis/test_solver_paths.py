@@ -274,6 +274,41 @@ def test_reduced_tangent_matches_the_sparse_product():
         np.testing.assert_allclose(K_fc.toarray(), full[:nf, nf:], atol=1e-12)
 
 
+def test_reduced_tangent_of_a_model_set_up_again_reuses_its_layout():
+    """A second model with the same patterns (the FE fits' runs) reuses the layout of the reduced
+    blocks; each keeps its own values, both T^T K T + G."""
+    from femast.analysis.reduction import ReducedTangent
+
+    rng = np.random.default_rng(7)
+    n_act, n_ind, nf = 30, 24, 18
+
+    def patterns(seed):
+        K = sp.random(n_act, n_act, density=0.2, random_state=seed, format="csr") + sp.identity(n_act, format="csr")
+        T = (sp.random(n_act, n_ind, density=0.08, random_state=seed + 1, format="csr") + sp.eye(n_act, n_ind)).tocsr()
+        K.sort_indices()
+        T.sort_indices()
+        return K, T
+
+    K1, T1 = patterns(11)
+    K2, T2 = patterns(11)  # the same patterns, other arrays
+    g_rows, g_cols = rng.integers(0, n_ind, 10), rng.integers(0, n_ind, 10)
+    first = ReducedTangent(K1, T1, g_rows, g_cols, nf)
+    again = ReducedTangent(K2, T2, g_rows.copy(), g_cols.copy(), nf)
+    assert again.pa is first.pa and again.pos is first.pos
+    assert again.data is not first.data and again.K_ff.indices is not first.K_ff.indices
+    for K, T, red in ((K1, T1, first), (K2, T2, again)):
+        K.data[:] = rng.normal(size=K.nnz)
+        T.data[:] = rng.normal(size=T.nnz)
+        g = rng.normal(size=10)
+        K_ff, K_fc = red.fill(K.data, T.data, g)
+        full = (T.T @ K @ T + sp.csr_matrix((g, (g_rows, g_cols)), shape=(n_ind, n_ind))).toarray()
+        np.testing.assert_allclose(K_ff.toarray(), full[:nf, :nf], atol=1e-12)
+        np.testing.assert_allclose(K_fc.toarray(), full[:nf, nf:], atol=1e-12)
+    assert not np.array_equal(first.data, again.data)  # filled independently
+    K3, T3 = patterns(21)  # another pattern: its own layout
+    assert ReducedTangent(K3, T3, g_rows, g_cols, nf).pa is not first.pa
+
+
 def _cantilever(freq, **step_options):
     m = fm.Model("frequency")
     a, b = m.node(0, 0, 0), m.node(1, 0, 0)

@@ -102,8 +102,11 @@ def test_compare_json_files_and_history_show_the_error_falling(tmp_path, capsys)
     assert json.loads((out / "compare.json").read_text())["version"] == 4
 
 
-def test_diagnose_json_schema(tmp_path, capsys):
-    r = _run_json(capsys, ["diagnose", "mast-top", str(MT_DATA), "--out", str(tmp_path), "--json", "--workers", "1"])
+def test_diagnose_json_schema(example_run):
+    # `femast diagnose mast-top example --workers 1` (run once per session): its diagnose.json, the
+    # report --json prints
+    run = example_run("diagnose", "mast-top")
+    r = run.report
     assert {"experiment", "n_samples", "noise_rms", "baseline", "ranking", "verdict"} <= set(r)
     assert {"rms", "params"} <= set(r["baseline"])
     for e in r["ranking"]:
@@ -124,12 +127,12 @@ def test_diagnose_json_schema(tmp_path, capsys):
     assert sorted(r["verdict"]["missing_effects"]) == ["friction_hysteresis", "joint_clearance"]
     assert {"noise_model", "n_eff", "pairs", "form_check"} <= set(r)
     assert {"form", "forms", "ic_gain", "share_ok"} <= set(r["ranking"][0])
-    assert (tmp_path / "diagnose.png").stat().st_size > 0 and (tmp_path / "diagnose.json").is_file()
+    assert (run.out / "diagnose.png").stat().st_size > 0 and r["files"]["json"] == str(run.out / "diagnose.json")
     # with joint_clearance in the model, friction_hysteresis is what is missing: the tutorial quotes that
     # diagnosis (docs/compare_and_diagnose.md, test_experiments_docs.py), not run a second time here
 
 
-def test_text_output(tmp_path, capsys):
+def test_text_output(tmp_path, capsys, example_run):
     assert (
         main(
             [
@@ -146,21 +149,8 @@ def test_text_output(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "overall RMS error" in text and "noise floor" in text and "worst segments:" in text
     assert "x_backstop =" in text and "file lines" in text
-    assert (
-        main(
-            [
-                "diagnose",
-                "latch-pull",
-                str(ROOT / "femast/examples/latch_pull_example.csv"),
-                "--out",
-                str(tmp_path),
-                "--workers",
-                "1",
-            ]
-        )
-        == 0
-    )
-    text = capsys.readouterr().out
+    # `femast diagnose latch-pull example --workers 1`, run once per session for the tests that read it
+    text = example_run("diagnose", "latch-pull").stdout
     assert "verdict: missing effect: latch_hysteresis" in text and "reading of #1" in text
 
 

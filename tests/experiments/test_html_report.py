@@ -1,10 +1,11 @@
 """compare and diagnose write a self-contained HTML report that opens offline.
 
-The static checks run everywhere; the browser check renders every experiment's compare report and
-a diagnosis report in headless Chromium (Debian's package ``chromium``, which ``.ci/run`` installs
-when it is missing), asks the browser itself whether the verdict is shown and every figure
-decoded, and saves a screenshot of each page (in ``$FEMAST_SCREENSHOTS`` when set, else the test's
-temporary folder).  Without Chromium it skips, saying why; under CI (``CI=true``) it fails."""
+The static checks run on every experiment's compare report and a diagnosis report; the browser
+check renders a compare and a diagnosis report (every experiment's compare report: slow) in
+headless Chromium (Debian's package ``chromium``, which ``.ci/run`` installs when it is missing),
+asks the browser itself whether the verdict is shown and every figure decoded, and saves a
+screenshot of each page (in ``$FEMAST_SCREENSHOTS`` when set, else the test's temporary folder).
+Without Chromium it skips, saying why; under CI (``CI=true``) it fails."""
 
 import base64
 import json
@@ -17,7 +18,6 @@ from pathlib import Path
 import pytest
 
 from femast import examples
-from femast.cli import main
 from femast.experiments import list_experiments
 
 CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
@@ -28,32 +28,31 @@ KINDS = ["compare", "diagnose"] + [f"compare:{name}" for name in EXPERIMENTS if 
 
 
 @pytest.fixture(scope="module")
-def reports(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("reports")
-    out = folder / "mast"
-    assert main(["compare", "mast-top", "example", "--out", str(out), "--json"]) == 0
-    assert main(["diagnose", "latch-pull", "example", "--out", str(folder / "latch"), "--workers", "1", "--json"]) == 0
-    return {"compare": out / "compare_report.html", "diagnose": folder / "latch" / "diagnose_report.html"}
+def reports(example_run):
+    # `femast compare mast-top example` and `femast diagnose latch-pull example --workers 1`, run once per
+    # session for the tests that read them
+    return {
+        "compare": example_run("compare", "mast-top").out / "compare_report.html",
+        "diagnose": example_run("diagnose", "latch-pull").out / "diagnose_report.html",
+    }
 
 
-def _report(reports, kind, folder):
-    """The report of ``kind``: the two built by the fixture, or ``compare:EXPERIMENT`` made now."""
+def _report(reports, kind, example_run):
+    """The report of ``kind``: ``compare``, ``diagnose`` or ``compare:EXPERIMENT`` (its example's)."""
     if kind in reports:
         return reports[kind]
-    name = kind.split(":", 1)[1]
-    assert main(["compare", name, "example", "--out", str(folder / name), "--json"]) == 0
-    return folder / name / "compare_report.html"
+    return example_run("compare", kind.split(":", 1)[1]).out / "compare_report.html"
 
 
 def _images(text):
     return re.findall(r'<img alt="[^"]*" src="data:image/png;base64,([A-Za-z0-9+/=]+)"', text)
 
 
-@pytest.mark.parametrize("kind", ["compare", "diagnose"])
-def test_report_is_self_contained(reports, kind):
-    path = reports[kind]
+@pytest.mark.parametrize("kind", KINDS)
+def test_report_is_self_contained(reports, kind, example_run):
+    path = _report(reports, kind, example_run)
     text = path.read_text(encoding="utf-8")
-    report = json.loads((path.parent / f"{kind}.json").read_text())
+    report = json.loads((path.parent / f"{kind.split(':')[0]}.json").read_text())
     assert report["files"]["html"] == str(path)
     # nothing fetched from anywhere: no script, no link, no URL, every image a data URI
     assert "<script" not in text and "<link" not in text
@@ -113,13 +112,15 @@ def _chromium(*args, profile):
     return subprocess.run(cmd, capture_output=True, text=True, timeout=180)
 
 
-@pytest.mark.parametrize("kind", KINDS)
-def test_report_renders_in_headless_chromium(reports, kind, tmp_path):
+# every report is checked above without a browser (self-contained, every image a PNG); the browser renders
+# a compare and a diagnose report by default, and every experiment's compare report as a slow test
+@pytest.mark.parametrize("kind", [k if ":" not in k else pytest.param(k, marks=pytest.mark.slow) for k in KINDS])
+def test_report_renders_in_headless_chromium(reports, kind, tmp_path, example_run):
     if CHROMIUM is None:
         if os.environ.get("CI") == "true":
             pytest.fail("Chromium is missing under CI: .ci/run installs Debian's chromium with apt-get")
         pytest.skip("Chromium is not installed (Debian: apt-get install chromium); the static checks above ran")
-    report = _report(reports, kind, tmp_path)
+    report = _report(reports, kind, example_run)
     page = tmp_path / "probe.html"  # the report plus a probe script that reports what the browser shows
     page.write_text(report.read_text(encoding="utf-8").replace("</body>", _PROBE), encoding="utf-8")
     p = _chromium("--virtual-time-budget=10000", "--dump-dom", page.as_uri(), profile=tmp_path / "profile")

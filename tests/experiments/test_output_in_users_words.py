@@ -67,7 +67,12 @@ def _check(command, name, tmp_path, capsys, drawn):
     extra = ["--workers", "1"] if command == "diagnose" else []
     assert main([command, name, "example", "--out", str(out), *extra]) == 0
     printed = capsys.readouterr()
-    problems = [f"printed: {w}" for w in internal_words(printed.out + printed.err)]
+    _assert_in_users_words(printed.out + printed.err, out, drawn)
+
+
+def _assert_in_users_words(printed, out, drawn):
+    """What a command printed, the HTML pages it wrote in ``out`` and the figures it drew (``drawn``)."""
+    problems = [f"printed: {w}" for w in internal_words(printed)]
     for page in out.glob("*.html"):
         problems += [f"{page.name}: {w}" for w in internal_words(_page_text(page))]
     assert drawn, "no figure drawn"
@@ -78,13 +83,17 @@ def _check(command, name, tmp_path, capsys, drawn):
 
 
 @pytest.mark.parametrize("name", EXPERIMENTS)
-def test_compare_on_every_example(name, tmp_path, capsys, drawn):
-    _check("compare", name, tmp_path, capsys, drawn)
+def test_compare_on_every_example(name, example_run):
+    # `femast compare NAME example`, run once per session for the tests that read it
+    run = example_run("compare", name)
+    _assert_in_users_words(run.stdout + run.stderr, run.out, run.drawn)
 
 
 @pytest.mark.parametrize("name", CHEAP)
-def test_diagnose_on_the_quick_examples(name, tmp_path, capsys, drawn):
-    _check("diagnose", name, tmp_path, capsys, drawn)
+def test_diagnose_on_the_quick_examples(name, example_run):
+    # `femast diagnose NAME example --workers 1`, run once per session for the tests that read it
+    run = example_run("diagnose", name)
+    _assert_in_users_words(run.stdout + run.stderr, run.out, run.drawn)
 
 
 @pytest.mark.slow
