@@ -3,17 +3,21 @@ compile cache, against the targets: platform-pose < 30 s, tip-cycle < 20 s, bay-
 and the first run on an empty compile cache at most 2x the warm time.
 
     python -m femast.benchmarks.diagnose_waits [--cases bay-torsion tip-cycle platform-pose]
-                                               [--repeat 2] [--no-cold] [--workers N] [--other CHECKOUT]
+                                               [--repeat 2] [--no-cold] [--warm] [--workers N [N ...]]
+                                               [--other CHECKOUT]
 
 Each run is the command a user types, ``femast diagnose EXPERIMENT example``, in a fresh process
 (imports, numba cache loads and worker start-up included) from an empty folder.  Warm: numba's
 compile cache filled by a first run; cold: ``NUMBA_CACHE_DIR`` an empty folder (every kernel
-compiled on the way).  No disk cache of FE runs (``FEMAST_FE_CACHE`` unset).  Printed per case:
+compiled on the way; ``--warm``: the cache is known to be filled, no filling run).  No disk cache of
+FE runs (``FEMAST_FE_CACHE`` unset).  ``--workers``: one or more settings of ``femast diagnose
+--workers`` (``default``: none given, the command's own choice -- one worker process per CPU for
+the FE experiments), each timed.  Printed per case and setting:
 wall time (the best of ``--repeat`` runs), the CPU time of the process and its workers, the model
 runs computed by all of them (``$FEMAST_FE_RUN_LOG``: the FE runs of bay-torsion and tip-cycle; 0
-for a model that is not an FE run), the processes started (the most alive at once) and the verdict,
-so that a faster run can be checked to conclude the same; the load average is printed beside (the
-machine is shared: wall time grows with load, CPU time much less).
+for a model that is not an FE run), the processes started (the most alive at once), the load average
+when it ended (the machine may be shared: wall time grows with load, CPU time much less), the target
+and the verdict, so that a faster run can be checked to conclude the same.
 
 ``--other CHECKOUT`` times the femast of another source tree (e.g. ``git worktree add /tmp/main
 main``) in the same minutes: every run of this tree is followed by the same run of that one
@@ -94,13 +98,20 @@ def run(case: str, env: dict, workers=None, tree=None) -> dict:
     if p.returncode != 0:
         raise SystemExit(f"femast diagnose {case} example failed:\n{err[-2000:]}")
     report = json.loads(out)
-    return {"wall": wall, "cpu": cpu, "runs": runs, "processes": most[0], "verdict": report["verdict"]["conclusion"]}
+    return {
+        "wall": wall,
+        "cpu": cpu,
+        "runs": runs,
+        "processes": most[0],
+        "load": os.getloadavg()[0],
+        "verdict": report["verdict"]["conclusion"],
+    }
 
 
 def _row(case: str, label: str, r: dict, target: str, judged: str) -> str:
     return (
-        f"{case:<14s} {label:<11s} {r['wall']:>7.1f} {r['cpu']:>7.1f} {r['runs']:>5d} {r['processes']:>5d} "
-        f"{target:>8s}  {r['verdict']}  [{judged}]"
+        f"{case:<14s} {label:<15s} {r['wall']:>7.1f} {r['cpu']:>7.1f} {r['runs']:>5d} {r['processes']:>5d} "
+        f"{r['load']:>5.1f} {target:>8s}  [{judged}]  {r['verdict']}"
     )
 
 
@@ -109,33 +120,46 @@ def main(argv=None) -> None:
     ap.add_argument("--cases", nargs="+", default=list(TARGETS), choices=list(TARGETS))
     ap.add_argument("--repeat", type=int, default=2, help="warm runs per case (the best is shown)")
     ap.add_argument("--no-cold", action="store_true", help="skip the runs on an empty compile cache")
-    ap.add_argument("--workers", type=int, default=None, help="passed to femast diagnose --workers")
+    ap.add_argument(
+        "--workers",
+        nargs="+",
+        default=["default"],
+        help="settings of femast diagnose --workers to time: numbers, or 'default' (none given)",
+    )
+    ap.add_argument("--warm", action="store_true", help="numba's cache is filled already: no filling run")
     ap.add_argument("--other", default=None, metavar="CHECKOUT", help="also time this source tree, interleaved (A/B)")
     args = ap.parse_args(argv)
     env = {k: v for k, v in os.environ.items() if k not in ("FEMAST_FE_CACHE", "NUMBA_CACHE_DIR", "PYTHONPATH")}
     env["FEMAST_QUIET"] = "1"
     trees = [("this", None)] + ([("other", args.other)] if args.other else [])
     print(f"load average {' '.join(f'{v:.2f}' for v in os.getloadavg())} on {os.cpu_count()} CPUs")
-    print(f"{'case':<14s} {'run':<11s} {'wall s':>7s} {'CPU s':>7s} {'runs':>5s} {'procs':>5s} {'target':>8s}  verdict")
+    print(
+        f"{'case':<14s} {'run':<15s} {'wall s':>7s} {'CPU s':>7s} {'runs':>5s} {'procs':>5s} {'load':>5s} {'target':>8s}  [judged]  verdict"
+    )
+    settings = [None if w == "default" else int(w) for w in args.workers]
     for case in args.cases:
-        for _, tree in trees:
-            run(case, env, args.workers, tree)  # fills numba's cache (and the OS file cache)
-        warm = {name: [] for name, _ in trees}
-        for _ in range(args.repeat):
-            for name, tree in trees:  # interleaved: A, B, A, B
-                warm[name].append(run(case, env, args.workers, tree))
-        best = {name: min(w, key=lambda r: r["wall"]) for name, w in warm.items()}
-        for name, _ in trees:
-            b = best[name]
-            ok = "met" if b["wall"] < TARGETS[case] else "MISSED"
-            print(_row(case, f"warm {name}" if args.other else "warm", b, f"< {TARGETS[case]:g} s", ok))
-        if not args.no_cold:
-            for name, tree in trees:
-                with tempfile.TemporaryDirectory() as cache:
-                    cold = run(case, dict(env, NUMBA_CACHE_DIR=cache), args.workers, tree)
-                ratio = cold["wall"] / best[name]["wall"]
-                judged = f"{ratio:.1f}x warm: {'met' if ratio <= 2.0 else 'MISSED'}"
-                print(_row(case, f"cold {name}" if args.other else "cold", cold, "<= 2x", judged))
+        if not args.warm:
+            for _, tree in trees:
+                run(case, env, settings[0], tree)  # fills numba's cache (and the OS file cache)
+        for workers in settings:
+            label = "w=" + ("default" if workers is None else str(workers))
+            warm = {name: [] for name, _ in trees}
+            for _ in range(args.repeat):
+                for name, tree in trees:  # interleaved: A, B, A, B
+                    warm[name].append(run(case, env, workers, tree))
+            best = {name: min(w, key=lambda r: r["wall"]) for name, w in warm.items()}
+            for name, _ in trees:
+                b = best[name]
+                ok = "met" if b["wall"] < TARGETS[case] else "MISSED"
+                print(_row(case, f"warm {label}" + (f" {name}" if args.other else ""), b, f"< {TARGETS[case]:g} s", ok))
+            if not args.no_cold:
+                for name, tree in trees:
+                    with tempfile.TemporaryDirectory() as cache:
+                        cold = run(case, dict(env, NUMBA_CACHE_DIR=cache), workers, tree)
+                    ratio = cold["wall"] / best[name]["wall"]
+                    judged = f"{ratio:.1f}x warm: {'met' if ratio <= 2.0 else 'MISSED'}"
+                    print(_row(case, f"cold {label}" + (f" {name}" if args.other else ""), cold, "<= 2x", judged))
+            sys.stdout.flush()
     print(f"load average {' '.join(f'{v:.2f}' for v in os.getloadavg())} on {os.cpu_count()} CPUs")
 
 

@@ -10,8 +10,8 @@
 3. :func:`rank` scores every refit under the current noise model
    (:func:`~femast.experiments.verdict.score`): ``delta_bic``, the share of the excess error it
    explains, significance (:func:`~femast.experiments.verdict.flags`); each candidate keeps its best
-   form; the candidates refitted in full come first, then those screened out (by their linearised
-   ``delta_bic``), and a refit that failed is listed last, as failed.
+   form; the candidates refitted in full come first, then those screened out (by the ``delta_bic``
+   where their refits stopped), and a refit that failed is listed last, as failed.
 """
 
 from __future__ import annotations
@@ -170,10 +170,10 @@ def reading(d, effect: str, e: dict) -> str:
     form = f" (form {e['form']})" if e.get("form") else ""
     if e.get("screened"):
         return text + (
-            f"Screened out: linearised at the start of its refit (one model run per start and new parameter), "
-            f"{eff.title}{form} takes the error from {e['baseline_ratio']:.2f}x to {e['ratio']:.2f}x the noise "
-            f"(delta BIC {e['delta_bic']:+.1f}); even {screening.SCREEN_MARGIN:g} times that gain would not be "
-            "significant, so it was not refitted in full."
+            f"Screened out: with {eff.title}{form} the error goes from {e['baseline_ratio']:.2f}x to "
+            f"{e['ratio']:.2f}x the noise where its refit stopped (delta BIC {e['delta_bic']:+.1f}): from there "
+            f"even {screening.SCREEN_MARGIN:g} times the gain its Gauss-Newton step predicts would not be "
+            "significant, so it was not refitted to the end."
         )
     text += (
         f"Refitted with {eff.title}{form}, the error goes from {e['baseline_ratio']:.2f}x to "

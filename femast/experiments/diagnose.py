@@ -224,7 +224,7 @@ def _noise_model(d: Diagnosis) -> None:
     is the closest to the noise), by which everything is scored again."""
     fits = [
         d.baseline,
-        *(f for f in d.fits_list if not getattr(f, "failed", False) and not getattr(f, "screened", False)),
+        *(f for f in d.fits_list if not getattr(f, "failed", False)),  # a screened one: where its refit stopped
         *(r for *_, r in d.pair_fits),
     ]
     best = min(fits, key=lambda f: d.score(f)["rss"])

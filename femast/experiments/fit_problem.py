@@ -142,9 +142,10 @@ class FitProblem:
         fold, whose covariance nobody reads).  ``J0``, the columns known at the first
         start, seeds every start's first Jacobian (the starts differ in the effect parameters,
         whose columns are not known and are computed).  ``screen`` (an expensive model's candidate
-        refit in ``diagnose``, :mod:`femast.experiments.screening`): a start stops at the first iterate
-        from which it cannot make the candidate significant; when every start stopped, the result is
-        the screening (``screened`` True)."""
+        refit in ``diagnose``, :mod:`femast.experiments.screening`): a start the model fails at is left
+        out when another start can be run, and a start stops at the first iterate from which it
+        cannot make the candidate significant; when every start stopped, the result is the screening
+        (``screened`` True)."""
         co, lo, hi, kw, secant, fd_step = self.co, self.lo, self.hi, self.kw, self.secant, self.fd_step
         best = best_fj = None
         fun0 = self.fun(sigma)
@@ -153,14 +154,23 @@ class FitProblem:
         min_dec = POLISH_MIN_DECREASE if secant and noise_given else 0.0
         sr = self.sigma_rows(sigma)
         p_new = len(self.specs) - int(screen["p0"]) if screen else 0
+        starts = []
         for x in candidates:
             u0 = co.start(x, lo, hi) if secant else np.clip(x / self.scale, lo, hi)
             fj = None
-            fun = fun0
             if fd_step:
                 fj = _FEJacobian(fun0, float(fd_step), lo, hi, secant=secant, J0=J0 if secant else None)
-                fun, kw["jac"] = fj.value, fj.jac
                 jacobians.append(fj)
+            starts.append((u0, fj))
+        if screen and secant and len(starts) > 1:
+            # a start the model fails at is left out when another can be run (its first evaluation is the
+            # one its fit would make first, kept by its _FEJacobian)
+            runnable = [(u0, fj) for u0, fj in starts if np.all(np.abs(fj.value(u0)) < _BAD)]
+            starts = runnable or starts
+        for u0, fj in starts:
+            fun = fun0
+            if fj is not None:
+                fun, kw["jac"] = fj.value, fj.jac
                 if screen and secant:
                     fj.futile = futility_check(screen, p_new, sr, lo, hi, _BAD)
             kw_k = kw
@@ -182,6 +192,14 @@ class FitProblem:
             nfev += sol.nfev
             if best is None or sol.cost < best.cost:
                 best, best_fj = sol, fj
+        if best is not None and stops and min(0.5 * float(np.sum((lin[0] / sr) ** 2)) for _, lin in stops) < best.cost:
+            best = None  # the starts that converged ended above where a stopped one stopped: no better than it
+        if best is not None and screen and secant:  # a start that converged: is it worth its polish?
+            try:
+                futility_check(screen, p_new, sr, lo, hi, _BAD)(best.x, best.fun, best_fj.J)
+            except Futile as stop:
+                stops.append((best.x, stop.lin))
+                best = None
         runs = sum(fj.runs for fj in jacobians)
         if best is None:  # every start stopped: screened out
             out = screened_out(stops, screen, p_new, sr)

@@ -202,8 +202,8 @@ def fit(
         is not polished (no finite-difference Jacobian at its solution: its covariance is not needed).
     screen : a candidate's screening in ``diagnose`` (:mod:`femast.experiments.screening`; expensive
         models with a given ``noise``): when its linearisation at every start shows it cannot be
-        significant, the fit stops there and the result has ``screened`` True, the linearised
-        residual and parameters, and ``screen`` (the linearisations).
+        significant, the fit stops there and the result has ``screened`` True, the parameters and
+        residual of the model run where it stopped, and ``screen`` (the linearisations).
 
     Returns an ``OptimizeResult`` with ``x``, ``names``, ``units``, ``stderr``, ``cov``,
     ``params`` (baseline ``{name: value}``), ``effect_params`` (``{effect: {name: value}}``),
@@ -250,14 +250,14 @@ def fit(
 
 
 def _screened(pb, sol, sigma, effect_names) -> OptimizeResult:
-    """The result of a refit stopped by its screening: the linearised solution (the Gauss-Newton step
-    from its best start, not run) with its linearised residual; ``screened`` True, ``screen``."""
+    """The result of a refit stopped by its screening: the model run where its best start stopped
+    (parameters, prediction, residual), without standard errors; ``screened`` True, ``screen``."""
     exp, data, specs = pb.exp, pb.data, pb.specs
     x = pb.co.to_x(sol.u)
     n, p = data.n, len(x)
-    r = np.asarray(sol.r_lin, float).reshape(len(exp.channels), n)
+    r = np.asarray(sol.r, float).reshape(len(exp.channels), n)
     predicted = {c: data[c] - r[i] for i, c in enumerate(exp.channels)}
-    msg = "screened out: its linearised gain cannot make it significant (not refitted in full)"
+    msg = "screened out: it cannot be significant (stopped before a full refit)"
     nan = np.full(p, np.nan)
     out = _result(
         exp, data, specs, x, nan, np.full((p, p), np.nan), sigma, predicted, True, True, msg, sol.fe_runs, effect_names

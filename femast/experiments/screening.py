@@ -19,12 +19,17 @@ the candidate significant against the baseline's ``rss0``:
 
     dIC = N ln((rss - 3 (rss - rss_lin)) / rss0) + p_new ln N  <  SIGNIFICANT_DBIC (-10)
 
-Otherwise that start of the refit stops (a futility stop).  Every start of a multistart refit is
-run so; a candidate is *screened out* when every start stopped, usually at its first iterate
-(``1 + p_new`` runs per start instead of a full fit), and reported with the numbers of its best
-linearisation (its ``delta_bic`` is the linearised one, its ``significant`` always False).  A start
-that stops cannot have been the best of a significant refit (it could not reach significance), so
-a candidate that is significant is fitted as without the screen.
+Otherwise that start of the refit stops (a futility stop).  A start the model cannot be run at (an
+FE run that does not converge there) is left out when another start can be run: its fit would
+only grope its way out of the failures.  A start that converged is judged so at
+its solution before it is polished (the finite-difference Jacobian there, for the covariance, is
+not needed for a candidate that cannot be significant).  Every start of a multistart refit is run
+so; a candidate is *screened out* when every start stopped -- at its first iterate when nothing is
+to be gained (``1 + p_new`` runs per start instead of a full fit) -- and reported with the figures of
+the model run where its best start stopped (its ``significant`` always False, its parameters
+without standard errors).  A start that stops cannot have been the best of a significant refit (it
+could not reach significance), so a candidate that is significant is fitted as without the screen,
+but for the starts the model cannot be run at.
 
 The screen is judged again under the final noise model of the diagnosis (from the residual of its
 best model, :mod:`femast.experiments.diagnose`), by which every refit is scored: the linearisations
@@ -118,18 +123,16 @@ def futility_check(s: dict, p_new: int, sigma_rows, lo, hi, bad: float):
 
 
 def screened_out(stops, s: dict, p_new: int, sigma_rows) -> OptimizeResult:
-    """What a refit whose every start stopped reports: ``k`` (the stop with the lowest linearised
-    chi-square), ``du`` (its Gauss-Newton step), ``r_lin`` (the linearised raw residual there),
-    ``rss_lin``, ``lins`` (every stop's linearisation).  ``stops``: ``[(u, lin)]``."""
-    best = None
-    for k, (_, lin) in enumerate(stops):
-        _, rss, du = judge(lin, s, p_new, sigma_rows)
-        if best is None or rss < best[1]:
-            best = (k, rss, du)
-    k, rss, du = best
-    r, Jr = stops[k][1][0], stops[k][1][1]
+    """What a refit whose every start stopped reports: the stop with the lowest chi-square, ``k``, its
+    point ``u`` and raw residual ``r`` (a model run there: the figures of the screened candidate are
+    those of a real run), its Gauss-Newton prediction ``rss_lin``, and ``lins`` (every stop's
+    linearisation, for the judgement under the final noise model).  ``stops``: ``[(u, lin)]``."""
+    w = s["w"]
+    chi2 = [float(np.sum(w * (lin[0] / sigma_rows) ** 2)) for _, lin in stops]
+    k = int(np.argmin(chi2))
+    u, lin = stops[k]
     return OptimizeResult(
-        k=k, u=stops[k][0] + du, du=du, r_lin=r + Jr @ du, rss_lin=rss, lins=[lin for _, lin in stops]
+        k=k, u=u, r=lin[0], rss=chi2[k], rss_lin=judge(lin, s, p_new, sigma_rows)[1], lins=[x for _, x in stops]
     )
 
 
