@@ -138,7 +138,7 @@ def test_kill_9_of_the_shape_accuracy_benchmark_on_a_local_dask_cluster_leaves_n
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to find the processes")
 def test_kill_of_the_shape_accuracy_benchmark_closes_its_dask_cluster(tmp_path):
     """``kill PID`` (SIGTERM) of the benchmark mid-study stops it as Ctrl-C does: it closes its dask
-    cluster, so the worker ends with it and no semaphore is left for the resource tracker to report
+    cluster, so the worker ends with it and (a run of two bays) no semaphore is left for the resource tracker to report
     (SIGTERM's default action killed the process with the worker still sending heartbeats, and the
     tracker warned of leaked semaphores); the study's folder reads back."""
     pytest.importorskip("distributed")
