@@ -13,9 +13,14 @@ PAGE = DOCS / "your_own_rig.md"
 
 
 def run_page(tmp_path, capsys):
-    """Save the script blocks (first line ``# NAME.py``), run the others in order; returns the printed text."""
+    """Save the script blocks (first line ``# NAME.py``), run the others in order; returns the printed text.
+    The effects the page registers (its ``load_creep``) are unregistered at the end: they must not
+    become candidates of the diagnoses of tests that run later in the same process."""
     import os
 
+    from femast.effects import list_effects, unregister_effect
+
+    before = {e.name for e in list_effects()}
     text = PAGE.read_text()
     old = os.getcwd()
     os.chdir(tmp_path)
@@ -35,6 +40,9 @@ def run_page(tmp_path, capsys):
             printed.append(out)
     finally:
         os.chdir(old)
+        for e in list_effects():
+            if e.name not in before:
+                unregister_effect(e.name)
     return text, "".join(printed)
 
 
